@@ -1,0 +1,3 @@
+from accelcal_rig.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,115 @@
+"""`rig`: the command line. Every failure a user can cause is one line on stderr and a non-zero exit."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import signal
+import sys
+from pathlib import Path
+
+from accelcal_rig import __version__
+from accelcal_rig.engine.campaign import TerminationRequested
+from accelcal_rig.engine.events import LOGGER, format_duration
+from accelcal_rig.errors import CampaignAborted, RigError
+
+EXIT_INTERRUPTED = 130
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="rig", description="Run MEMS accelerometer calibration campaigns.")
+    parser.add_argument("--version", action="version", version=f"accelcal-rig {__version__}")
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    run = commands.add_parser(
+        "run", help="run a campaign from a procedure file",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Run a campaign: ramp and soak at each setpoint, measure every pose, store pose by pose.",
+        epilog="example:\n  rig run procedures/paper-24pos-thermal.yaml --dry-run -o campaign.h5",
+    )
+    run.add_argument("procedure", type=Path, help="procedure YAML file")
+    run.add_argument("-o", "--output", type=Path, required=True, help="campaign file to create (HDF5)")
+    run.add_argument("--config", type=Path, help="rig config YAML (overrides the procedure's `rig`)")
+    run.add_argument("--dry-run", action="store_true", help="simulated rig in virtual time")
+    run.add_argument("--seed", type=int, default=0, help="seed of the simulated noise (default 0)")
+    run.add_argument("--overwrite", action="store_true", help="replace an existing campaign file")
+    run.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
+    run.add_argument("-q", "--quiet", action="store_true", help="print only warnings and the summary")
+
+    status = commands.add_parser(
+        "status", help="show a campaign file's state and progress",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Show a campaign's state and progress (works on finished, aborted and running files).",
+        epilog="example:\n  rig status campaign.h5 --json",
+    )
+    status.add_argument("campaign", type=Path, help="campaign file (HDF5)")
+    status.add_argument("--json", action="store_true", help="print one JSON object")
+    return parser
+
+
+def _configure_logging(output: Path, verbose: bool, quiet: bool) -> None:
+    """Console on stderr at the chosen level; the full debug log in a file beside the campaign file."""
+    LOGGER.setLevel(logging.DEBUG)
+    LOGGER.propagate = False
+    LOGGER.handlers.clear()
+    console = logging.StreamHandler(sys.stderr)
+    console.setLevel(logging.DEBUG if verbose else logging.WARNING if quiet else logging.INFO)
+    console.setFormatter(logging.Formatter("%(message)s"))
+    LOGGER.addHandler(console)
+    log_file = logging.FileHandler(output.with_suffix(output.suffix + ".log"), mode="w", encoding="utf-8")
+    log_file.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s"))
+    LOGGER.addHandler(log_file)
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise TerminationRequested()
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from accelcal_rig.engine.session import prepare, run_campaign
+
+    prepared = prepare(args.procedure, args.config)
+    if args.output.exists() and not args.overwrite:
+        raise RigError(f"{args.output}: campaign file exists; choose another -o or pass --overwrite")
+    _configure_logging(args.output, args.verbose, args.quiet)
+    signal.signal(signal.SIGTERM, _terminate)
+    result = run_campaign(prepared, args.output, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite)
+    summary = result.summary
+    setpoints = summary.setpoints_c
+    size_mb = result.output.stat().st_size / 1e6
+    print(f"campaign {summary.state}: {prepared.procedure.model.name}")
+    print(f"  setpoints  {len(setpoints)} ({min(setpoints):g} … {max(setpoints):g} °C)")
+    print(f"  poses      {summary.poses_done} of {summary.poses_total} × {summary.n_duts} DUTs × "
+          f"{prepared.procedure.model.acquisition.samples_per_pose} samples")
+    print(f"  duration   {format_duration(summary.virtual_duration_s)} virtual, {result.wall_s:.1f} s wall")
+    print(f"  output     {result.output} ({size_mb:.1f} MB)")
+    return 0
+
+
+def _cmd_status(args: argparse.Namespace) -> int:
+    from accelcal_rig.store.read import campaign_status, status_json
+
+    if args.json:
+        print(status_json(args.campaign))
+        return 0
+    status = campaign_status(args.campaign)
+    for key, value in status.items():
+        print(f"{key:17s}{value}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _build_parser().parse_args(argv)
+    handler = {"run": _cmd_run, "status": _cmd_status}[args.command]
+    try:
+        return handler(args)
+    except CampaignAborted as exc:
+        print(f"rig: campaign aborted, rig in safe state: {exc}", file=sys.stderr)
+        interrupted = isinstance(exc.__cause__, (KeyboardInterrupt, TerminationRequested))
+        return EXIT_INTERRUPTED if interrupted else exc.exit_code
+    except RigError as exc:
+        print(f"rig: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print("rig: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED

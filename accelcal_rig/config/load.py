@@ -1,0 +1,90 @@
+"""Load and validate procedure and rig config files; every problem becomes `file:line: key: message`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Generic, TypeVar
+
+from pydantic import BaseModel, ValidationError
+
+from accelcal_rig.config.procedure import Procedure
+from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.config.yaml_lines import KeyPath, format_key, load_yaml_with_lines, locate
+from accelcal_rig.errors import ConfigError
+
+ModelT = TypeVar("ModelT", bound=BaseModel)
+
+
+@dataclass(frozen=True)
+class LoadedConfig(Generic[ModelT]):
+    """A validated model with the file it came from, so later checks can point at its lines."""
+
+    model: ModelT
+    path: Path
+    text: str
+    lines: dict[KeyPath, int]
+
+    def error(self, key_path: KeyPath, message: str) -> ConfigError:
+        """A ConfigError naming this file, the line of `key_path` (or its nearest parent) and the key."""
+        shown, line = locate(self.lines, key_path)
+        return ConfigError(f"{self.path}:{line}: {format_key(shown)}: {message}")
+
+
+def _load(path: Path, model: type[ModelT]) -> LoadedConfig[ModelT]:
+    data, lines, text = load_yaml_with_lines(path)
+    try:
+        validated = model.model_validate(data)
+    except ValidationError as exc:
+        messages = []
+        for err in exc.errors(include_url=False):
+            shown, line = locate(lines, tuple(err["loc"]))
+            message = str(err["msg"]).removeprefix("Value error, ")
+            messages.append(f"{path}:{line}: {format_key(shown)}: {message}")
+        raise ConfigError("\n".join(messages)) from None
+    return LoadedConfig(validated, path, text, lines)
+
+
+def load_procedure(path: Path) -> LoadedConfig[Procedure]:
+    return _load(path, Procedure)
+
+
+def load_rig(path: Path) -> LoadedConfig[RigConfig]:
+    return _load(path, RigConfig)
+
+
+def resolve_rig_path(procedure: LoadedConfig[Procedure], override: Path | None) -> Path:
+    """The rig config to use: `--config` if given, else the procedure's `rig`, relative to the procedure."""
+    if override is not None:
+        return override
+    return (procedure.path.parent / procedure.model.rig).resolve()
+
+
+def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedConfig[RigConfig]) -> None:
+    """Cross-file checks that neither file can make alone: setpoints and angles inside the rig's limits."""
+    chamber = rig.model.chamber
+    for index, setpoint in enumerate(procedure.model.setpoints_c):
+        if not chamber.min_setpoint_c <= setpoint <= chamber.max_setpoint_c:
+            raise procedure.error(
+                ("setpoints_c", index),
+                f"{setpoint:g} °C is outside the chamber limits {chamber.min_setpoint_c:g}…"
+                f"{chamber.max_setpoint_c:g} °C of {rig.path}",
+            )
+    safe = procedure.model.safe_setpoint_c
+    if safe is not None and not chamber.min_setpoint_c <= safe <= chamber.max_setpoint_c:
+        raise procedure.error(("safe_setpoint_c",), f"{safe:g} °C is outside the chamber limits of {rig.path}")
+    schedule = procedure.model.schedule
+    if schedule.kind == "explicit":
+        axes = rig.model.turntable.axes
+        for pose, angles in enumerate(schedule.angles_deg):
+            if len(angles) != len(axes):
+                raise procedure.error(
+                    ("schedule", "angles_deg", pose),
+                    f"{len(angles)} angles given, the turntable of {rig.path} has {len(axes)} axes",
+                )
+            for axis, angle in zip(axes, angles):
+                if not axis.continuous and not axis.min_deg <= angle <= axis.max_deg:
+                    raise procedure.error(
+                        ("schedule", "angles_deg", pose),
+                        f"axis {axis.name} angle {angle:g}° is outside its limits {axis.min_deg:g}…{axis.max_deg:g}°",
+                    )

@@ -1,0 +1,132 @@
+"""The procedure: what a campaign does (setpoints, soak criterion, pose schedule, acquisition, fit)."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+from accelcal_rig.instruments.adxl355 import OUTPUT_DATA_RATES_HZ
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class SoakCriterion(_Strict):
+    """When the DUTs count as thermally stable at a setpoint (every wait has a deadline: `timeout_min`)."""
+
+    min_dwell_min: float = Field(30.0, ge=0, description="least time at setpoint before stability counts")
+    window_min: float = Field(10.0, gt=0, description="trailing window over which stability is judged")
+    band_c: float = Field(0.3, gt=0, description="max−min of each DUT's own temperature over the window")
+    chamber_tolerance_c: float = Field(1.0, gt=0, description="chamber air within this of the setpoint")
+    poll_s: float = Field(10.0, gt=0, le=600, description="temperature polling interval")
+    timeout_min: float = Field(240.0, gt=0, description="soak deadline, counted from reaching the setpoint")
+    ramp_timeout_factor: float = Field(
+        2.0, ge=1, description="ramp deadline = factor × |Δ| / rig ramp rate + ramp_timeout_margin_min"
+    )
+    ramp_timeout_margin_min: float = Field(15.0, ge=0)
+
+    @model_validator(mode="after")
+    def _fits_in_timeout(self) -> SoakCriterion:
+        if max(self.min_dwell_min, self.window_min) > self.timeout_min:
+            raise ValueError("timeout_min must be at least min_dwell_min and window_min")
+        return self
+
+
+class Paper24Schedule(_Strict):
+    """Table 1 of the paper: eight 45° steps about each of the sensor's z, y and x axes."""
+
+    kind: Literal["paper-24"]
+
+
+class SixPositionSchedule(_Strict):
+    """The classic six positions: each sensor axis up, then down."""
+
+    kind: Literal["six-position"]
+
+
+class SphereSchedule(_Strict):
+    """`count` gravity directions spread evenly over the sphere (Fibonacci lattice)."""
+
+    kind: Literal["sphere"]
+    count: int = Field(ge=6, le=20000)
+
+
+class ExplicitSchedule(_Strict):
+    """Turntable axis angles given pose by pose, in degrees, in the rig's axis order."""
+
+    kind: Literal["explicit"]
+    angles_deg: list[list[float]] = Field(min_length=1)
+
+
+Schedule = Annotated[
+    Paper24Schedule | SixPositionSchedule | SphereSchedule | ExplicitSchedule, Field(discriminator="kind")
+]
+
+
+class Acquisition(_Strict):
+    """How each pose is measured."""
+
+    samples_per_pose: int = Field(200, ge=2, le=1_000_000)
+    range_g: Literal[2, 4, 8] = 2
+    odr_hz: float = Field(125.0, description="ADXL355 output data rate, one of its ODR_LPF settings")
+    settle_s: float = Field(5.0, ge=0, le=3600, description="wait after the turntable is in position")
+
+    @field_validator("odr_hz")
+    @classmethod
+    def _known_rate(cls, value: float) -> float:
+        if not any(abs(value - rate) < 1e-3 for rate in OUTPUT_DATA_RATES_HZ):
+            rates = ", ".join(f"{r:g}" for r in OUTPUT_DATA_RATES_HZ)
+            raise ValueError(f"{value:g} Hz is not an ADXL355 output data rate ({rates})")
+        return value
+
+
+class FitOptions(_Strict):
+    """How the campaign's data will be fitted (paper §3)."""
+
+    mode: Literal["reference", "norm-only"] = "reference"
+    polynomial_degree: int = Field(3, ge=0, le=6)
+
+
+class Procedure(_Strict):
+    """A whole campaign. Setpoints run in the order given."""
+
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_.-]+$")
+    description: str = ""
+    rig: str = Field(min_length=1, description="rig config path, relative to this file")
+    setpoints_c: list[float] = Field(min_length=1, max_length=1000)
+    soak: SoakCriterion = SoakCriterion()
+    schedule: Schedule
+    acquisition: Acquisition = Acquisition()
+    safe_setpoint_c: float | None = Field(None, description="overrides the rig's chamber.safe_setpoint_c")
+    fit: FitOptions = FitOptions()
+
+    @field_validator("setpoints_c", mode="before")
+    @classmethod
+    def _expand_range(cls, value: object) -> object:
+        """Accept `{from_c, to_c, step_c}` as a shorthand for an evenly stepped list."""
+        if not isinstance(value, dict):
+            return value
+        unknown = set(value) - {"from_c", "to_c", "step_c"}
+        missing = {"from_c", "to_c", "step_c"} - set(value)
+        if unknown or missing:
+            raise ValueError("a setpoint range needs exactly the keys from_c, to_c and step_c")
+        try:
+            start, stop, step = (float(value[k]) for k in ("from_c", "to_c", "step_c"))
+        except (TypeError, ValueError):
+            raise ValueError("from_c, to_c and step_c must be numbers") from None
+        if step == 0 or (stop - start) / step < 0:
+            raise ValueError("step_c must be non-zero and lead from from_c to to_c")
+        count = int(np.floor((stop - start) / step + 1e-9)) + 1
+        if count > 1000:
+            raise ValueError("a setpoint range may hold at most 1000 setpoints")
+        return [round(start + i * step, 9) for i in range(count)]
+
+    @field_validator("setpoints_c")
+    @classmethod
+    def _distinct(cls, value: list[float]) -> list[float]:
+        if len(set(value)) != len(value):
+            raise ValueError("setpoints must be distinct")
+        return value

@@ -1,0 +1,116 @@
+"""The rig config: what the rig is (chamber, turntable kinematics, fixture of DUTs, simulated physics)."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class ChamberConfig(_Strict):
+    """Thermal chamber limits and dynamics (paper Table 3: −55…+100 °C, 0.1…5 °C/min)."""
+
+    driver: Literal["simulated"] = "simulated"
+    min_setpoint_c: float = -55.0
+    max_setpoint_c: float = 100.0
+    safe_setpoint_c: float = 23.0
+    ramp_rate_c_per_min: float = Field(3.0, gt=0, le=50)
+
+    @model_validator(mode="after")
+    def _ordered_limits(self) -> ChamberConfig:
+        if self.min_setpoint_c >= self.max_setpoint_c:
+            raise ValueError("min_setpoint_c must be below max_setpoint_c")
+        if not self.min_setpoint_c <= self.safe_setpoint_c <= self.max_setpoint_c:
+            raise ValueError("safe_setpoint_c must lie within the setpoint limits")
+        return self
+
+
+class TurntableAxis(_Strict):
+    """One rotary axis of the kinematic chain, its direction given in its parent's frame at zero angles."""
+
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_.-]+$")
+    axis: tuple[float, float, float]
+    min_deg: float = -180.0
+    max_deg: float = 180.0
+    continuous: bool = Field(False, description="endless axis: angles wrap into [min_deg, max_deg)")
+    speed_deg_s: float = Field(10.0, gt=0, le=1000)
+
+    @field_validator("axis")
+    @classmethod
+    def _nonzero(cls, value: tuple[float, float, float]) -> tuple[float, float, float]:
+        norm = float(np.linalg.norm(value))
+        if norm < 1e-9:
+            raise ValueError("axis direction must not be zero")
+        return tuple(float(v) / norm for v in value)  # type: ignore[return-value]
+
+    @model_validator(mode="after")
+    def _limits(self) -> TurntableAxis:
+        if self.min_deg >= self.max_deg:
+            raise ValueError("min_deg must be below max_deg")
+        if self.continuous and self.max_deg - self.min_deg != 360.0:
+            raise ValueError("a continuous axis wraps over exactly 360°: set max_deg = min_deg + 360")
+        return self
+
+
+class TurntableConfig(_Strict):
+    """A chain of rotary axes, outermost first; the fixture sits on the innermost axis."""
+
+    driver: Literal["simulated"] = "simulated"
+    axes: list[TurntableAxis] = Field(min_length=1, max_length=6)
+    position_tolerance_deg: float = Field(0.01, gt=0, le=5)
+
+    @field_validator("axes")
+    @classmethod
+    def _unique_names(cls, value: list[TurntableAxis]) -> list[TurntableAxis]:
+        names = [a.name for a in value]
+        if len(set(names)) != len(names):
+            raise ValueError("axis names must be distinct")
+        return value
+
+
+class SensorConfig(_Strict):
+    """One DUT on the fixture. `mount_euler_deg`: rotation of the DUT frame in the fixture frame (xyz)."""
+
+    serial: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.-]+$")
+    name: str = Field("", max_length=64)
+    driver: Literal["simulated"] = "simulated"
+    mount_euler_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+class FixtureConfig(_Strict):
+    sensors: list[SensorConfig] = Field(min_length=1, max_length=64)
+
+    @field_validator("sensors")
+    @classmethod
+    def _unique_serials(cls, value: list[SensorConfig]) -> list[SensorConfig]:
+        serials = [s.serial for s in value]
+        if len(set(serials)) != len(serials):
+            raise ValueError("sensor serial numbers must be distinct")
+        return value
+
+
+class SimulationConfig(_Strict):
+    """Physics of the virtual lab used by `--dry-run` (DESIGN §3)."""
+
+    ambient_c: float = 23.0
+    chamber_time_constant_min: float = Field(3.0, gt=0)
+    chamber_noise_c: float = Field(0.05, ge=0)
+    fixture_time_constant_min: float = Field(10.0, gt=0)
+    self_heating_c: float = Field(0.2, ge=0)
+    noise_density_ug_per_rthz: float = Field(25.0, ge=0)
+    turntable_accuracy_arcsec: float = Field(3.0, ge=0)
+    turntable_settle_s: float = Field(0.5, ge=0)
+
+
+class RigConfig(_Strict):
+    name: str = Field(min_length=1)
+    description: str = ""
+    chamber: ChamberConfig
+    turntable: TurntableConfig
+    fixture: FixtureConfig
+    simulation: SimulationConfig = SimulationConfig()

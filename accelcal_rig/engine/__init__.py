@@ -1,0 +1,1 @@
+"""The campaign engine: an explicit state machine driven by one injectable clock."""

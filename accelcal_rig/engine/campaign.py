@@ -1,0 +1,266 @@
+"""Execute a compiled plan: ramp, soak, then move–settle–acquire–store for every pose, then safe state.
+
+Every wait has a deadline; any fault or signal leads through ABORTING to the safe state, is written to
+the campaign file's event log, and is raised again as CampaignAborted with a one-line reason.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from itertools import groupby
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from accelcal_rig.config.procedure import Procedure
+from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.engine.clock import Clock
+from accelcal_rig.engine.events import LOGGER, EventLog, format_duration
+from accelcal_rig.engine.safe_state import apply_safe_state
+from accelcal_rig.engine.soak import SoakDetector
+from accelcal_rig.engine.states import ACTIVE_STATES, State, StateMachine
+from accelcal_rig.engine.waits import wait_until
+from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, WaitTimeout
+from accelcal_rig.instruments import adxl355
+from accelcal_rig.instruments.interfaces import RigInstruments, SampleBlock
+from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable
+from accelcal_rig.plan.compile import Plan, PlanStep, setpoint_label
+from accelcal_rig.store.campaign_file import CampaignWriter
+from accelcal_rig.store.records import DutPoseRecord, PoseRecord, SoakTrace
+
+#: Turntable position polling interval; a move's deadline is 1.5 × its travel time plus this margin.
+MOVE_POLL_S = 0.5
+MOVE_MARGIN_S = 30.0
+
+
+class TerminationRequested(BaseException):
+    """SIGTERM arrived: stop like Ctrl-C, through the safe state."""
+
+
+@dataclass(frozen=True)
+class CampaignSummary:
+    state: str
+    setpoints_c: tuple[float, ...]
+    poses_done: int
+    poses_total: int
+    n_duts: int
+    virtual_duration_s: float
+
+
+class CampaignRunner:
+    def __init__(self, procedure: Procedure, rig: RigConfig, plan: Plan, instruments: RigInstruments,
+                 writer: CampaignWriter, clock: Clock, events: EventLog) -> None:
+        self.procedure = procedure
+        self.rig = rig
+        self.plan = plan
+        self.chamber = LimitedChamber(instruments.chamber, rig.chamber)
+        self.turntable = LimitedTurntable(instruments.turntable, rig.turntable)
+        self.sensors = instruments.sensors
+        self.truth = instruments.truth
+        self.writer = writer
+        self.clock = clock
+        self.events = events
+        self.machine = StateMachine(self._record_transition)
+        self.poses_done = 0
+        self._mounts = {s.serial: Rotation.from_euler("xyz", s.mount_euler_deg, degrees=True)
+                        for s in rig.fixture.sensors}
+        self._settled_dut_c = np.zeros(len(self.sensors))
+        safe = procedure.safe_setpoint_c
+        self.safe_setpoint_c = rig.chamber.safe_setpoint_c if safe is None else safe
+
+    # ----------------------------------------------------------------- top level
+    def run(self) -> CampaignSummary:
+        self.writer.set_state("running")
+        try:
+            self.machine.go(State.PREFLIGHT)
+            self._preflight()
+            for setpoint, steps in groupby(self.plan.steps, key=lambda s: s.setpoint_c):
+                self._run_setpoint(setpoint, list(steps))
+            self.machine.go(State.SAFE, "campaign complete")
+            apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
+            self.machine.go(State.DONE)
+            self.writer.set_state("done", finished=True)
+            return self._summary("done")
+        except BaseException as exc:  # noqa: BLE001 - every exit path goes through the safe state
+            reason = _one_line_reason(exc)
+            self._abort(reason)
+            raise CampaignAborted(reason) from exc
+
+    def _abort(self, reason: str) -> None:
+        """Safe state first, bookkeeping after: a broken file must not keep the rig unsafe."""
+        if self.machine.state in ACTIVE_STATES:
+            self.machine.go(State.ABORTING, reason)
+            self.machine.go(State.SAFE, "abort")
+        self.events.error("fault", f"campaign aborted: {reason}")
+        apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
+        if self.machine.state is State.SAFE:
+            self.machine.go(State.ABORTED)
+        try:
+            self.writer.set_state("aborted", reason=reason, finished=True)
+        except Exception as exc:  # noqa: BLE001 - the reason still reaches the operator through the exception
+            LOGGER.error("could not record the abort in the campaign file: %s", exc)
+
+    def _summary(self, state: str) -> CampaignSummary:
+        return CampaignSummary(state, self.plan.setpoints_c, self.poses_done, len(self.plan.pose_steps),
+                               len(self.sensors), self.clock.now())
+
+    def _record_transition(self, previous: State, target: State, reason: str) -> None:
+        suffix = f" ({reason})" if reason else ""
+        self.events.debug("transition", f"{previous} → {target}{suffix}")
+
+    # ----------------------------------------------------------------- preflight
+    def _preflight(self) -> None:
+        """Check identities and configure every DUT before anything moves."""
+        self.events.info("preflight", f"chamber: {self.chamber.identify()} ({self.chamber.endpoint})")
+        self.events.info("preflight", f"turntable: {self.turntable.identify()} ({self.turntable.endpoint})")
+        acquisition = self.procedure.acquisition
+        for sensor in self.sensors:
+            identity = sensor.identify()
+            expected = (adxl355.DEVID_AD, adxl355.DEVID_MST, adxl355.PARTID)
+            found = (identity.devid_ad, identity.devid_mst, identity.partid)
+            if found != expected:
+                raise InstrumentError(
+                    f"sensor {sensor.serial} ({sensor.endpoint}): identity {_hex(found)} is not an ADXL355 "
+                    f"({_hex(expected)})"
+                )
+            sensor.standby()
+            sensor.configure(acquisition.range_g, acquisition.odr_hz)
+            sensor.start_measurement()
+            self.events.info("preflight", f"sensor {sensor.serial}: ADXL355 rev {identity.revid}, "
+                                          f"±{acquisition.range_g} g, {acquisition.odr_hz:g} Hz")
+
+    # ----------------------------------------------------------------- one setpoint
+    def _run_setpoint(self, setpoint_c: float, steps: list[PlanStep]) -> None:
+        label = setpoint_label(setpoint_c)
+        self.machine.go(State.RAMP, label)
+        t_reached = self._ramp(setpoint_c)
+        self.machine.go(State.SOAK, label)
+        self._soak(setpoint_c, label, t_reached)
+        pose_steps = [s for s in steps if s.kind == "pose"]
+        for step in pose_steps:
+            self._measure_pose(step)
+        total = len(self.plan.pose_steps)
+        self.events.info("setpoint", f"{label}: {len(pose_steps)} poses stored ({self.poses_done}/{total} in all)")
+
+    def _ramp(self, setpoint_c: float) -> float:
+        soak = self.procedure.soak
+        start_c = self.chamber.read_temperature_c()
+        self.chamber.write_setpoint_c(setpoint_c)
+        ramp_s = abs(setpoint_c - start_c) / (self.rig.chamber.ramp_rate_c_per_min / 60.0)
+        timeout_s = soak.ramp_timeout_factor * ramp_s + soak.ramp_timeout_margin_min * 60.0
+        self.events.info("ramp", f"ramp {start_c:.1f} → {setpoint_c:g} °C (deadline {format_duration(timeout_s)})")
+        t_reached = wait_until(
+            self.clock,
+            lambda: abs(self.chamber.read_temperature_c() - setpoint_c) <= soak.chamber_tolerance_c,
+            timeout_s=timeout_s, poll_s=soak.poll_s,
+            what=f"chamber ({self.chamber.endpoint}) reaching {setpoint_c:g} °C",
+        )
+        return t_reached
+
+    def _soak(self, setpoint_c: float, label: str, t_reached: float) -> None:
+        criterion = self.procedure.soak
+        detector = SoakDetector(criterion, setpoint_c, t_reached)
+
+        def poll() -> bool:
+            dut_c = np.array([s.read_temperature_c() for s in self.sensors])
+            detector.add(self.clock.now(), self.chamber.read_temperature_c(), dut_c)
+            return detector.is_stable()
+
+        outcome = "stable"
+        try:
+            t_stable = wait_until(self.clock, poll, timeout_s=criterion.timeout_min * 60.0, poll_s=criterion.poll_s,
+                                  what=f"{label}: DUT temperatures stable within {criterion.band_c:g} °C")
+        except WaitTimeout:
+            outcome, t_stable = "timeout", self.clock.now()
+            raise
+        finally:
+            t, chamber, dut = detector.trace()
+            self._settled_dut_c = detector.settled_dut_c() if len(t) else np.full(len(self.sensors), np.nan)
+            self.writer.write_soak(SoakTrace(label, setpoint_c, outcome, t, chamber, dut, t_reached, t_stable,
+                                             self._settled_dut_c))
+        spans = detector.dut_spans_c()
+        self.events.info("soak", f"{label}: stable after {format_duration(t_stable - t_reached)} at "
+                                 f"DUT {np.round(self._settled_dut_c, 2).tolist()} °C "
+                                 f"(spans ≤ {spans.max():.2f} °C)")
+
+    # ----------------------------------------------------------------- one pose
+    def _measure_pose(self, step: PlanStep) -> None:
+        assert step.pose is not None
+        commanded = np.array(step.pose.angles_deg)
+        self.machine.go(State.MOVE, step.key)
+        self._move(commanded)
+        self.machine.go(State.SETTLE, step.key)
+        self.clock.sleep(self.procedure.acquisition.settle_s)
+        self.machine.go(State.ACQUIRE, step.key)
+        measured = self.turntable.read_angles_deg()
+        chamber_before = self.chamber.read_temperature_c()
+        blocks = [s.acquire(self.procedure.acquisition.samples_per_pose) for s in self.sensors]
+        chamber_after = self.chamber.read_temperature_c()
+        self.machine.go(State.STORE, step.key)
+        gravity_fixture = np.array(step.pose.gravity_fixture)
+        record = PoseRecord(
+            step_key=step.key, setpoint_c=step.setpoint_c, pose_number=step.pose.number,
+            commanded_angles_deg=commanded, measured_angles_deg=measured, gravity_fixture=gravity_fixture,
+            t_start_s=min(b.t_start_s for b in blocks), t_end_s=max(b.t_end_s for b in blocks),
+            chamber_temperature_c=(chamber_before, chamber_after),
+            duts=[self._dut_record(i, block, gravity_fixture) for i, block in enumerate(blocks)],
+        )
+        self.writer.append_pose(record)
+        self.poses_done += 1
+        self.events.debug("pose", f"{step.key} stored")
+
+    def _move(self, commanded: np.ndarray) -> None:
+        current = self.turntable.read_angles_deg()
+        speeds = np.array([a.speed_deg_s for a in self.rig.turntable.axes])
+        travel_s = float(np.max(np.abs(commanded - current) / speeds))
+        self.turntable.move_to(commanded)
+        tolerance = self.rig.turntable.position_tolerance_deg
+
+        def arrived() -> bool:
+            if not self.turntable.in_position():
+                return False
+            error = _angle_difference(self.turntable.read_angles_deg(), commanded)
+            return bool(np.all(np.abs(error) <= tolerance))
+
+        wait_until(self.clock, arrived, timeout_s=1.5 * travel_s + MOVE_MARGIN_S, poll_s=MOVE_POLL_S,
+                   what=f"turntable ({self.turntable.endpoint}) reaching {np.round(commanded, 3).tolist()}°")
+
+    def _dut_record(self, index: int, block: SampleBlock, gravity_fixture: np.ndarray) -> DutPoseRecord:
+        sensor = self.sensors[index]
+        lsb = adxl355.lsb_g(self.procedure.acquisition.range_g)
+        codes = block.codes_xyz
+        n = codes.shape[0]
+        mean_g = codes.mean(axis=0) * lsb
+        stderr_g = codes.std(axis=0, ddof=1) * lsb / np.sqrt(n)
+        band = self.procedure.soak.band_c
+        in_band = bool(np.all(np.abs(np.array(block.temperature_c) - self._settled_dut_c[index]) <= band))
+        if not in_band:
+            self.events.warning("pose", f"sensor {sensor.serial}: temperature {block.temperature_c} °C left the "
+                                        f"soak band around {self._settled_dut_c[index]:.2f} °C")
+        return DutPoseRecord(
+            serial=sensor.serial, codes_xyz=codes, mean_g=mean_g, stderr_g=stderr_g,
+            temperature_c=block.temperature_c,
+            gravity_reference_g=self._mounts[sensor.serial].inv().apply(gravity_fixture),
+            temperature_in_band=in_band,
+            truth=self.truth.last_block_truth(sensor.serial) if self.truth is not None else None,
+        )
+
+
+def _angle_difference(a_deg: np.ndarray, b_deg: np.ndarray) -> np.ndarray:
+    """a − b wrapped into [−180, 180)."""
+    return (np.asarray(a_deg) - np.asarray(b_deg) + 180.0) % 360.0 - 180.0
+
+
+def _hex(values: tuple[int, ...]) -> str:
+    return "/".join(f"{v:02X}" for v in values)
+
+
+def _one_line_reason(exc: BaseException) -> str:
+    if isinstance(exc, KeyboardInterrupt):
+        return "interrupted by operator (Ctrl-C)"
+    if isinstance(exc, TerminationRequested):
+        return "terminated by signal (SIGTERM)"
+    if isinstance(exc, RigError):
+        return str(exc).splitlines()[0]
+    text = str(exc).splitlines()[0] if str(exc) else ""
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__

@@ -1,0 +1,92 @@
+"""From files to a finished campaign: validate, compile, connect, create the file, run."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from accelcal_rig.config.load import (
+    LoadedConfig, check_procedure_against_rig, load_procedure, load_rig, resolve_rig_path,
+)
+from accelcal_rig.config.procedure import Procedure
+from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary
+from accelcal_rig.engine.clock import VirtualClock
+from accelcal_rig.engine.events import EventLog
+from accelcal_rig.instruments import adxl355
+from accelcal_rig.plan.compile import Plan, compile_plan
+from accelcal_rig.plan.kinematics import UnreachablePose
+from accelcal_rig.sim.devices import build_simulated_rig
+from accelcal_rig.store.campaign_file import CampaignWriter
+
+
+@dataclass(frozen=True)
+class PreparedCampaign:
+    """Both files validated against each other and the plan compiled: nothing has moved yet."""
+
+    procedure: LoadedConfig[Procedure]
+    rig: LoadedConfig[RigConfig]
+    plan: Plan
+
+
+def prepare(procedure_path: Path, rig_override: Path | None = None) -> PreparedCampaign:
+    procedure = load_procedure(procedure_path)
+    rig = load_rig(resolve_rig_path(procedure, rig_override))
+    check_procedure_against_rig(procedure, rig)
+    try:
+        plan = compile_plan(procedure.model, rig.model)
+    except UnreachablePose as exc:
+        raise procedure.error(("schedule",), f"{exc} of {rig.path}") from None
+    return PreparedCampaign(procedure, rig, plan)
+
+
+@dataclass(frozen=True)
+class RunResult:
+    summary: CampaignSummary
+    wall_s: float
+    output: Path
+
+
+def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, seed: int,
+                 overwrite: bool) -> RunResult:
+    """Run the whole campaign into `output`. Raises CampaignAborted after reaching the safe state."""
+    rig = prepared.rig
+    if not dry_run:
+        raise rig.error(("chamber", "driver"),
+                        "the 'simulated' drivers have no hardware behind them: run with --dry-run")
+    wall_start = time.perf_counter()
+    clock = VirtualClock()
+    instruments = build_simulated_rig(rig.model, clock, seed)
+    procedure = prepared.procedure.model
+    acquisition = procedure.acquisition
+    mounts = {s.serial: s for s in rig.model.fixture.sensors}
+    duts = [
+        {"serial": s.serial, "name": mounts[s.serial].name, "mount_euler_deg": list(mounts[s.serial].mount_euler_deg),
+         "range_g": acquisition.range_g, "odr_hz": acquisition.odr_hz, "lsb_g": adxl355.lsb_g(acquisition.range_g),
+         "driver": type(s).__name__, "endpoint": s.endpoint}
+        for s in instruments.sensors
+    ]
+    instrument_info = {
+        "chamber": {"driver": type(instruments.chamber).__name__, "endpoint": instruments.chamber.endpoint},
+        "turntable": {"driver": type(instruments.turntable).__name__, "endpoint": instruments.turntable.endpoint},
+    }
+    writer = CampaignWriter.create(
+        output, overwrite=overwrite,
+        attrs={"procedure_name": procedure.name, "procedure_path": str(prepared.procedure.path),
+               "rig_name": rig.model.name, "rig_path": str(rig.path), "dry_run": dry_run, "seed": seed,
+               "clock": clock.kind, "samples_per_pose": acquisition.samples_per_pose,
+               "fit_mode": procedure.fit.mode, "polynomial_degree": procedure.fit.polynomial_degree},
+        procedure_yaml=prepared.procedure.text, rig_yaml=rig.text, plan=prepared.plan, duts=duts,
+        instruments=instrument_info, samples_per_pose=acquisition.samples_per_pose,
+    )
+    try:
+        if instruments.truth is not None:
+            for sensor in instruments.sensors:
+                writer.write_truth_header(sensor.serial, instruments.truth.describe(sensor.serial))
+        events = EventLog(clock, writer)
+        runner = CampaignRunner(procedure, rig.model, prepared.plan, instruments, writer, clock, events)
+        summary = runner.run()
+    finally:
+        writer.close()
+    return RunResult(summary, time.perf_counter() - wall_start, output)

@@ -1,0 +1,59 @@
+"""Engine states and the transition table: the only moves the engine may make, each one logged."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from enum import StrEnum
+
+
+class State(StrEnum):
+    IDLE = "idle"
+    PREFLIGHT = "preflight"
+    RAMP = "ramp"
+    SOAK = "soak"
+    MOVE = "move"
+    SETTLE = "settle"
+    ACQUIRE = "acquire"
+    STORE = "store"
+    SAFE = "safe"
+    DONE = "done"
+    ABORTING = "aborting"
+    ABORTED = "aborted"
+
+
+ACTIVE_STATES = frozenset({State.IDLE, State.PREFLIGHT, State.RAMP, State.SOAK, State.MOVE, State.SETTLE, State.ACQUIRE,
+           State.STORE})
+
+TRANSITIONS: dict[State, frozenset[State]] = {
+    State.IDLE: frozenset({State.PREFLIGHT}),
+    State.PREFLIGHT: frozenset({State.RAMP}),
+    State.RAMP: frozenset({State.SOAK}),
+    State.SOAK: frozenset({State.MOVE}),
+    State.MOVE: frozenset({State.SETTLE}),
+    State.SETTLE: frozenset({State.ACQUIRE}),
+    State.ACQUIRE: frozenset({State.STORE}),
+    State.STORE: frozenset({State.MOVE, State.RAMP, State.SAFE}),
+    State.SAFE: frozenset({State.DONE, State.ABORTED}),
+    State.ABORTING: frozenset({State.SAFE}),
+    State.DONE: frozenset(),
+    State.ABORTED: frozenset(),
+}
+# A fault or a signal may strike in any active state; it always leads through ABORTING to SAFE.
+for _state in ACTIVE_STATES:
+    TRANSITIONS[_state] = TRANSITIONS[_state] | {State.ABORTING}
+
+
+class IllegalTransition(RuntimeError):
+    """The engine tried a move the table does not allow: a bug, never an instrument fault."""
+
+
+class StateMachine:
+    def __init__(self, on_transition: Callable[[State, State, str], None]) -> None:
+        self.state = State.IDLE
+        self._on_transition = on_transition
+
+    def go(self, target: State, reason: str = "") -> None:
+        if target not in TRANSITIONS[self.state]:
+            raise IllegalTransition(f"{self.state} → {target} is not in the transition table")
+        previous, self.state = self.state, target
+        self._on_transition(previous, target, reason)

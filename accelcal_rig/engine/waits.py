@@ -1,0 +1,24 @@
+"""The one way to wait: poll a condition on the clock until it holds or its deadline passes."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from accelcal_rig.engine.clock import Clock
+from accelcal_rig.errors import WaitTimeout
+
+
+def wait_until(clock: Clock, condition: Callable[[], bool], *, timeout_s: float, poll_s: float,
+               what: str) -> float:
+    """Return the clock time at which `condition()` first held; raise WaitTimeout naming `what` if never.
+
+    The condition is evaluated once more at the deadline itself, so a wait never gives up early.
+    """
+    deadline = clock.now() + timeout_s
+    while True:
+        if condition():
+            return clock.now()
+        remaining = deadline - clock.now()
+        if remaining <= 0:
+            raise WaitTimeout(f"{what}: not reached within {timeout_s:.0f} s")
+        clock.sleep(min(poll_s, remaining))

@@ -1,0 +1,1 @@
+"""Calibration math on arrays: the sensor-frame error model of the paper (Eq. 1)."""

@@ -1,0 +1,1 @@
+"""Instrument interfaces and datasheet facts shared by drivers and simulators."""

@@ -1,0 +1,90 @@
+"""What the engine needs from each instrument. Simulated and hardware drivers implement the same shapes."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class DeviceIdentity:
+    """ADXL355 identification registers (DEVID_AD, DEVID_MST, PARTID, REVID)."""
+
+    devid_ad: int
+    devid_mst: int
+    partid: int
+    revid: int
+
+
+@dataclass(frozen=True)
+class SampleBlock:
+    """A gap-free block of raw samples from one DUT.
+
+    `codes_xyz` holds signed 20-bit codes, shape (n, 3); `t_start_s`/`t_end_s` are clock times of the first
+    and last sample; `temperature_c` is the DUT's own temperature sensor read before and after the block.
+    """
+
+    codes_xyz: np.ndarray
+    t_start_s: float
+    t_end_s: float
+    temperature_c: tuple[float, float]
+
+
+class Chamber(Protocol):
+    """Thermal chamber controller. Setpoint writes are range-checked by the caller and read back here."""
+
+    endpoint: str
+
+    def identify(self) -> str: ...
+    def read_temperature_c(self) -> float: ...
+    def write_setpoint_c(self, setpoint_c: float) -> None: ...
+    def read_setpoint_c(self) -> float: ...
+    def alarm_active(self) -> bool: ...
+    def close(self) -> None: ...
+
+
+class Turntable(Protocol):
+    """Positioning turntable; angles in degrees in the rig config's axis order."""
+
+    endpoint: str
+
+    def identify(self) -> str: ...
+    def move_to(self, angles_deg: np.ndarray) -> None: ...
+    def read_angles_deg(self) -> np.ndarray: ...
+    def in_position(self) -> bool: ...
+    def stop(self) -> None: ...
+    def close(self) -> None: ...
+
+
+class Accelerometer(Protocol):
+    """One ADXL355 DUT."""
+
+    serial: str
+    endpoint: str
+
+    def identify(self) -> DeviceIdentity: ...
+    def configure(self, range_g: int, odr_hz: float) -> None: ...
+    def start_measurement(self) -> None: ...
+    def standby(self) -> None: ...
+    def read_temperature_c(self) -> float: ...
+    def acquire(self, n_samples: int) -> SampleBlock: ...
+    def close(self) -> None: ...
+
+
+@dataclass
+class RigInstruments:
+    """Everything the engine drives, plus an optional source of simulation truth for the file."""
+
+    chamber: Chamber
+    turntable: Turntable
+    sensors: list[Accelerometer]
+    truth: TruthSource | None = None
+
+
+class TruthSource(Protocol):
+    """Only a simulated rig has one: the hidden parameters behind the last block each DUT returned."""
+
+    def describe(self, serial: str) -> dict[str, np.ndarray | str | float]: ...
+    def last_block_truth(self, serial: str) -> dict[str, np.ndarray]: ...

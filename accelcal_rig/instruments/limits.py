@@ -1,0 +1,61 @@
+"""Write-safety gates in front of any driver: nothing outside the rig's limits reaches the wire."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from accelcal_rig.config.rig import ChamberConfig, TurntableConfig
+from accelcal_rig.errors import InstrumentError
+from accelcal_rig.instruments.interfaces import Chamber, Turntable
+
+#: A setpoint read back further than this from what was written means the controller did not take it.
+SETPOINT_READBACK_TOLERANCE_C = 0.05
+
+
+class LimitedChamber:
+    """Refuses setpoints outside the rig's chamber limits before writing; verifies each write by reading back."""
+
+    def __init__(self, chamber: Chamber, limits: ChamberConfig) -> None:
+        self._chamber = chamber
+        self._limits = limits
+        self.endpoint = chamber.endpoint
+
+    def write_setpoint_c(self, setpoint_c: float) -> None:
+        low, high = self._limits.min_setpoint_c, self._limits.max_setpoint_c
+        if not low <= setpoint_c <= high:
+            raise InstrumentError(
+                f"chamber ({self.endpoint}): setpoint {setpoint_c:g} °C refused, limits are {low:g}…{high:g} °C"
+            )
+        self._chamber.write_setpoint_c(setpoint_c)
+        readback = self._chamber.read_setpoint_c()
+        if abs(readback - setpoint_c) > SETPOINT_READBACK_TOLERANCE_C:
+            raise InstrumentError(
+                f"chamber ({self.endpoint}): setpoint {setpoint_c:g} °C written but {readback:g} °C read back"
+            )
+
+    def __getattr__(self, name: str):
+        return getattr(self._chamber, name)
+
+
+class LimitedTurntable:
+    """Refuses moves outside the axis limits (continuous axes excepted) or with the wrong axis count."""
+
+    def __init__(self, turntable: Turntable, config: TurntableConfig) -> None:
+        self._turntable = turntable
+        self._axes = config.axes
+        self.endpoint = turntable.endpoint
+
+    def move_to(self, angles_deg: np.ndarray) -> None:
+        angles = np.asarray(angles_deg, dtype=float)
+        if angles.shape != (len(self._axes),):
+            raise InstrumentError(f"turntable ({self.endpoint}): {angles.size} angles for {len(self._axes)} axes")
+        for axis, angle in zip(self._axes, angles):
+            if not axis.continuous and not axis.min_deg <= angle <= axis.max_deg:
+                raise InstrumentError(
+                    f"turntable ({self.endpoint}): axis {axis.name} to {angle:g}° refused, "
+                    f"limits are {axis.min_deg:g}…{axis.max_deg:g}°"
+                )
+        self._turntable.move_to(angles)
+
+    def __getattr__(self, name: str):
+        return getattr(self._turntable, name)

@@ -1,0 +1,1 @@
+"""Pose schedules, turntable kinematics and the compiled campaign plan."""

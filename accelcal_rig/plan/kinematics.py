@@ -1,0 +1,112 @@
+"""Turntable kinematic chain: axis angles ↔ the gravity direction seen in the fixture frame.
+
+"Gravity direction" here is what a perfect accelerometer at rest reads, in g: the specific force, +1 g
+along world up. The world frame has z up; at all-zero angles the fixture frame equals the world frame.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from accelcal_rig.config.rig import TurntableAxis
+
+WORLD_UP = np.array([0.0, 0.0, 1.0])
+
+#: Largest gravity-direction error (rad) accepted from the inverse kinematics: 0.002″.
+_IK_TOLERANCE_RAD = 1e-8
+
+
+class UnreachablePose(ValueError):
+    """No angles inside the axis limits put gravity along the requested fixture direction."""
+
+
+class TurntableKinematics:
+    """Axes listed outermost first; each turns about its direction in its parent's frame."""
+
+    def __init__(self, axes: Sequence[TurntableAxis]):
+        self.axes = tuple(axes)
+        self._directions = np.array([a.axis for a in self.axes], dtype=float)
+
+    @property
+    def axis_names(self) -> tuple[str, ...]:
+        return tuple(a.name for a in self.axes)
+
+    def fixture_orientation(self, angles_deg: np.ndarray) -> Rotation:
+        """Rotation taking fixture-frame vectors to the world frame, for one pose or a stack (..., n_axes)."""
+        angles = np.deg2rad(np.asarray(angles_deg, dtype=float))
+        flat = angles.reshape(-1, len(self.axes))
+        per_axis = Rotation.from_rotvec((flat[:, :, None] * self._directions).reshape(-1, 3)).as_matrix()
+        per_axis = per_axis.reshape(flat.shape[0], len(self.axes), 3, 3)
+        chain = per_axis[:, 0]
+        for k in range(1, len(self.axes)):
+            chain = chain @ per_axis[:, k]
+        total = Rotation.from_matrix(chain)
+        return total if angles.ndim > 1 else total[0]
+
+    def gravity_in_fixture(self, angles_deg: np.ndarray) -> np.ndarray:
+        """Unit specific-force direction (+1 g up) in the fixture frame, shape (..., 3)."""
+        angles = np.asarray(angles_deg, dtype=float)
+        up = self.fixture_orientation(angles.reshape(-1, len(self.axes))).inv().apply(WORLD_UP)
+        return up.reshape(angles.shape[:-1] + (3,))
+
+    def wrap(self, angles_deg: np.ndarray) -> np.ndarray:
+        """Bring continuous axes into [min_deg, min_deg + 360)."""
+        wrapped = np.array(angles_deg, dtype=float)
+        for k, axis in enumerate(self.axes):
+            if axis.continuous:
+                wrapped[..., k] = (wrapped[..., k] - axis.min_deg) % 360.0 + axis.min_deg
+        return wrapped
+
+    def within_limits(self, angles_deg: np.ndarray) -> bool:
+        angles = np.asarray(angles_deg, dtype=float)
+        return all(
+            axis.continuous or axis.min_deg - 1e-9 <= angles[..., k].min() and angles[..., k].max() <= axis.max_deg + 1e-9
+            for k, axis in enumerate(self.axes)
+        )
+
+    def solve(self, gravity_fixture: np.ndarray, near_deg: np.ndarray) -> np.ndarray:
+        """Angles that put gravity along `gravity_fixture`, preferring the solution nearest `near_deg`.
+
+        A table with more axes than gravity has degrees of freedom (2) leaves some free; a pull towards
+        `near_deg` fixes them (least travel): strong to choose the branch, then weak (bias ~1e-12 rad)
+        to make the direction exact without drifting along the free directions.
+        """
+        target = np.asarray(gravity_fixture, dtype=float)
+        target = target / np.linalg.norm(target)
+        near = np.deg2rad(np.asarray(near_deg, dtype=float))
+        lower = np.array([-np.inf if a.continuous else np.deg2rad(a.min_deg) for a in self.axes])
+        upper = np.array([np.inf if a.continuous else np.deg2rad(a.max_deg) for a in self.axes])
+
+        def direction_error(angles_rad: np.ndarray) -> np.ndarray:
+            return self.gravity_in_fixture(np.rad2deg(angles_rad)) - target
+
+        def pulled(weight: float):
+            return lambda angles_rad: np.concatenate([direction_error(angles_rad), weight * (angles_rad - near)])
+
+        best: tuple[float, np.ndarray] | None = None
+        for start in self._starts(near, lower, upper):
+            trial = least_squares(pulled(1e-2), start, bounds=(lower, upper), method="trf")
+            final = least_squares(pulled(1e-6), trial.x, bounds=(lower, upper), method="trf",
+                                  xtol=1e-14, ftol=1e-14, gtol=1e-14)
+            if np.linalg.norm(direction_error(final.x)) < _IK_TOLERANCE_RAD:
+                travel = float(np.abs(final.x - near).sum())
+                if best is None or travel < best[0] - 1e-9:
+                    best = (travel, final.x)
+                if start is near or np.array_equal(start, near):
+                    break  # the solution reached from the current angles is the least-travel branch
+        if best is None:
+            raise UnreachablePose(
+                f"gravity direction {np.round(target, 4).tolist()} is out of reach of the turntable's axis limits"
+            )
+        return self.wrap(np.rad2deg(best[1]))
+
+    def _starts(self, near: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> list[np.ndarray]:
+        """The current angles first, then a coarse grid, so a branch behind a limit is still found."""
+        grid = np.deg2rad([-135.0, -45.0, 45.0, 135.0])
+        n = len(self.axes)
+        mesh = np.stack(np.meshgrid(*([grid] * n), indexing="ij"), axis=-1).reshape(-1, n)
+        return [np.clip(near, lower, upper)] + [np.clip(s, lower + 1e-9, upper - 1e-9) for s in mesh]

@@ -1,0 +1,37 @@
+"""Pose schedules as gravity directions in the fixture frame (what a perfect DUT would read, in g)."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+_STEPS_DEG = np.arange(8) * 45.0
+
+
+def _circle(axis: str, start: np.ndarray) -> np.ndarray:
+    """The DUT turned in eight 45° steps about its `axis`: gravity in its frame turns the other way."""
+    return Rotation.from_euler(axis, _STEPS_DEG[:, None], degrees=True).inv().apply(start)
+
+
+def paper_24() -> np.ndarray:
+    """Table 1 of the paper, in its row order.
+
+    Rows 1–8 keep z fixed with y starting vertical (steps about z); rows 9–16 keep y fixed with z
+    starting vertical (steps about y); rows 17–24 keep x fixed with z starting vertical (steps about x).
+    """
+    x_hat, y_hat, z_hat = np.eye(3)
+    return np.vstack([_circle("z", y_hat), _circle("y", z_hat), _circle("x", z_hat)])
+
+
+def six_position() -> np.ndarray:
+    """+x, −x, +y, −y, +z, −z up."""
+    return np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=float)
+
+
+def sphere(count: int) -> np.ndarray:
+    """`count` directions spread evenly over the sphere (Fibonacci lattice, deterministic)."""
+    index = np.arange(count) + 0.5
+    z = 1.0 - 2.0 * index / count
+    radius = np.sqrt(1.0 - z**2)
+    azimuth = np.pi * (1.0 + np.sqrt(5.0)) * index
+    return np.column_stack([radius * np.cos(azimuth), radius * np.sin(azimuth), z])

@@ -1,0 +1,156 @@
+"""In-process simulated instruments backed by the virtual lab, implementing the driver interfaces."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.engine.clock import Clock
+from accelcal_rig.errors import InstrumentError
+from accelcal_rig.fit.sfem import PARAMETER_NAMES, distort
+from accelcal_rig.instruments import adxl355
+from accelcal_rig.instruments.interfaces import DeviceIdentity, RigInstruments, SampleBlock
+from accelcal_rig.sim.lab import VirtualLab
+from accelcal_rig.sim.truth import HALF_RANGE_C, T_REF_C
+
+ENDPOINT = "in-process virtual lab"
+
+
+class SimulatedChamber:
+    endpoint = ENDPOINT
+
+    def __init__(self, lab: VirtualLab) -> None:
+        self._lab = lab
+
+    def identify(self) -> str:
+        return "simulated thermal chamber"
+
+    def read_temperature_c(self) -> float:
+        return self._lab.chamber_reading_c()
+
+    def write_setpoint_c(self, setpoint_c: float) -> None:
+        self._lab.thermal.set_setpoint(self._lab.clock.now(), setpoint_c)
+
+    def read_setpoint_c(self) -> float:
+        return self._lab.thermal.setpoint_c
+
+    def alarm_active(self) -> bool:
+        return False
+
+    def close(self) -> None:
+        """Nothing to release: the lab lives in this process."""
+
+
+class SimulatedTurntable:
+    endpoint = ENDPOINT
+
+    def __init__(self, lab: VirtualLab) -> None:
+        self._lab = lab
+
+    def identify(self) -> str:
+        return f"simulated {len(self._lab.kinematics.axes)}-axis turntable"
+
+    def move_to(self, angles_deg: np.ndarray) -> None:
+        self._lab.motion.command(self._lab.clock.now(), angles_deg)
+
+    def read_angles_deg(self) -> np.ndarray:
+        return self._lab.motion.position_deg(self._lab.clock.now())
+
+    def in_position(self) -> bool:
+        return self._lab.motion.in_position(self._lab.clock.now())
+
+    def stop(self) -> None:
+        self._lab.motion.stop(self._lab.clock.now())
+
+    def close(self) -> None:
+        """Nothing to release: the lab lives in this process."""
+
+
+class SimulatedAccelerometer:
+    """An ADXL355 whose samples come from its hidden truth, the table's true angles and white noise."""
+
+    endpoint = ENDPOINT
+
+    def __init__(self, lab: VirtualLab, index: int) -> None:
+        self._lab = lab
+        self._index = index
+        self.serial = lab.duts[index].serial
+        self._range_g = 2
+        self._odr_hz = 125.0
+        self._measuring = False
+        self.last_truth: dict[str, np.ndarray] | None = None
+
+    def identify(self) -> DeviceIdentity:
+        return DeviceIdentity(adxl355.DEVID_AD, adxl355.DEVID_MST, adxl355.PARTID, 1)
+
+    def configure(self, range_g: int, odr_hz: float) -> None:
+        if self._measuring:
+            raise InstrumentError(f"sensor {self.serial}: range and filter can only change in standby")
+        self._range_g = range_g
+        self._odr_hz = odr_hz
+
+    def start_measurement(self) -> None:
+        self._measuring = True
+
+    def standby(self) -> None:
+        self._measuring = False
+
+    def read_temperature_c(self) -> float:
+        return self._lab.dut_reading_c(self._index)
+
+    def noise_g(self) -> float:
+        """Per-sample white noise: density × √(equivalent noise bandwidth of the ODR/4 low-pass, ×π/2)."""
+        return self._lab.noise_density_g_per_rthz * float(np.sqrt(np.pi / 2 * self._odr_hz / 4))
+
+    def acquire(self, n_samples: int) -> SampleBlock:
+        if not self._measuring:
+            raise InstrumentError(f"sensor {self.serial}: acquire while in standby")
+        clock = self._lab.clock
+        temperature_before = self.read_temperature_c()
+        true_before = self._lab.dut_true_c(self._index)
+        gravity = self._lab.gravity_in_dut(self._index)
+        t_start = clock.now()
+        clock.sleep(n_samples / self._odr_hz)
+        true_mean = 0.5 * (true_before + self._lab.dut_true_c(self._index))
+        params = self._lab.duts[self._index].truth.parameters_at(true_mean)
+        noise = self._lab.rng.normal(0.0, self.noise_g(), (n_samples, 3))
+        codes = adxl355.quantise_g(distort(gravity, params) + noise, self._range_g)
+        self.last_truth = {"parameters": params, "gravity_g": gravity, "temperature_c": np.float64(true_mean)}
+        return SampleBlock(codes, t_start, t_start + (n_samples - 1) / self._odr_hz,
+                           (temperature_before, self.read_temperature_c()))
+
+    def close(self) -> None:
+        """Nothing to release: the lab lives in this process."""
+
+
+class SimulationTruth:
+    """The hidden truth of a simulated rig, for the campaign file's `simulation_truth` group."""
+
+    def __init__(self, lab: VirtualLab, sensors: list[SimulatedAccelerometer]) -> None:
+        self._lab = lab
+        self._sensors = {s.serial: s for s in sensors}
+
+    def describe(self, serial: str) -> dict[str, np.ndarray | str | float]:
+        dut = next(d for d in self._lab.duts if d.serial == serial)
+        return {
+            "polynomial_coefficients": dut.truth.coefficients,
+            "parameter_names": ",".join(PARAMETER_NAMES),
+            "t_ref_c": T_REF_C,
+            "half_range_c": HALF_RANGE_C,
+            "fixture_time_constant_s": dut.tau_s,
+            "noise_g_per_sample": self._sensors[serial].noise_g(),
+        }
+
+    def last_block_truth(self, serial: str) -> dict[str, np.ndarray]:
+        truth = self._sensors[serial].last_truth
+        if truth is None:
+            raise InstrumentError(f"sensor {serial}: no block acquired yet")
+        return truth
+
+
+def build_simulated_rig(rig: RigConfig, clock: Clock, seed: int) -> RigInstruments:
+    """The whole rig as in-process simulations on `clock`, reproducible for a given `seed`."""
+    lab = VirtualLab(rig, clock, seed)
+    sensors = [SimulatedAccelerometer(lab, i) for i in range(len(lab.duts))]
+    return RigInstruments(SimulatedChamber(lab), SimulatedTurntable(lab), list(sensors),
+                          SimulationTruth(lab, sensors))

@@ -1,0 +1,76 @@
+"""One virtual lab: the chamber, the turntable and every DUT, all evaluated at the shared clock's time."""
+
+from __future__ import annotations
+
+import hashlib
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.engine.clock import Clock
+from accelcal_rig.instruments.adxl355 import raw_from_temperature_c, temperature_c_from_raw
+from accelcal_rig.plan.kinematics import TurntableKinematics
+from accelcal_rig.sim.thermal import ThermalModel
+from accelcal_rig.sim.truth import DutTruth, truth_for_serial
+from accelcal_rig.sim.turntable_motion import TurntableMotion
+
+#: Noise of the DUT temperature reading before its 12-bit quantisation (dithers the 0.11 °C LSB).
+TEMPERATURE_READ_NOISE_C = 0.05
+
+
+class SimulatedDut:
+    """A DUT's place on the fixture, its hidden truth and its own thermal time constant."""
+
+    def __init__(self, serial: str, mount_euler_deg: tuple[float, float, float], fixture_tau_s: float) -> None:
+        self.serial = serial
+        self.truth: DutTruth = truth_for_serial(serial)
+        self.mount = Rotation.from_euler("xyz", mount_euler_deg, degrees=True)
+        # Fixtures are never quite uniform: each DUT lags the air by its own ±10 % of the nominal constant.
+        spread = int.from_bytes(hashlib.sha256(f"tau:{serial}".encode()).digest()[:4], "little") / 2**32
+        self.tau_s = fixture_tau_s * (0.9 + 0.2 * spread)
+
+
+class VirtualLab:
+    def __init__(self, rig: RigConfig, clock: Clock, seed: int) -> None:
+        sim = rig.simulation
+        self.clock = clock
+        self.rng = np.random.default_rng(seed)
+        self.chamber_noise_c = sim.chamber_noise_c
+        self.noise_density_g_per_rthz = sim.noise_density_ug_per_rthz * 1e-6
+        self.kinematics = TurntableKinematics(rig.turntable.axes)
+        self.duts = [
+            SimulatedDut(s.serial, s.mount_euler_deg, sim.fixture_time_constant_min * 60.0)
+            for s in rig.fixture.sensors
+        ]
+        self.thermal = ThermalModel(
+            ambient_c=sim.ambient_c,
+            ramp_rate_c_per_s=rig.chamber.ramp_rate_c_per_min / 60.0,
+            chamber_tau_s=sim.chamber_time_constant_min * 60.0,
+            dut_tau_s=[d.tau_s for d in self.duts],
+            self_heating_c=sim.self_heating_c,
+        )
+        self.motion = TurntableMotion(
+            speeds_deg_s=np.array([a.speed_deg_s for a in rig.turntable.axes]),
+            accuracy_deg=sim.turntable_accuracy_arcsec / 3600.0,
+            settle_s=sim.turntable_settle_s,
+            rng=self.rng,
+        )
+
+    def chamber_reading_c(self) -> float:
+        """Chamber air as its controller reads it, with regulation noise."""
+        return self.thermal.air_c(self.clock.now()) + float(self.rng.normal(0.0, self.chamber_noise_c))
+
+    def dut_true_c(self, index: int) -> float:
+        return self.thermal.dut_c(self.clock.now(), index)
+
+    def dut_reading_c(self, index: int) -> float:
+        """What the ADXL355 temperature sensor reports: 12-bit code, datasheet conversion."""
+        noisy = self.dut_true_c(index) + float(self.rng.normal(0.0, TEMPERATURE_READ_NOISE_C))
+        return float(temperature_c_from_raw(raw_from_temperature_c(noisy)))
+
+    def gravity_in_dut(self, index: int) -> np.ndarray:
+        """True specific-force direction (+1 g up) in DUT `index`'s frame at the table's actual angles."""
+        angles = self.motion.position_deg(self.clock.now())
+        gravity_fixture = self.kinematics.gravity_in_fixture(angles)
+        return self.duts[index].mount.inv().apply(gravity_fixture)

@@ -1,0 +1,67 @@
+"""Chamber air and DUT temperatures: a rate-limited setpoint, a first-order air lag, first-order DUT lags.
+
+Advanced lazily to the clock time of each query in sub-steps of at most `MAX_STEP_S`; each sub-step
+solves the lag exactly for an input that is linear over it.
+"""
+
+from __future__ import annotations
+
+import math
+
+MAX_STEP_S = 10.0
+
+
+def _lag(state: float, input_start: float, input_end: float, step_s: float, tau_s: float) -> float:
+    """First-order lag after `step_s` with its input moving linearly from `input_start` to `input_end`."""
+    slope = (input_end - input_start) / step_s
+    return input_end - slope * tau_s + (state - input_start + slope * tau_s) * math.exp(-step_s / tau_s)
+
+
+class ThermalModel:
+    """Temperatures in °C, times in clock seconds."""
+
+    def __init__(self, ambient_c: float, ramp_rate_c_per_s: float, chamber_tau_s: float,
+                 dut_tau_s: list[float], self_heating_c: float) -> None:
+        self.ramp_rate_c_per_s = ramp_rate_c_per_s
+        self.chamber_tau_s = chamber_tau_s
+        self.dut_tau_s = list(dut_tau_s)
+        self.self_heating_c = self_heating_c
+        self._t = 0.0
+        self.setpoint_c = ambient_c
+        self._reference_c = ambient_c
+        self._air_c = ambient_c
+        self._dut_c = [ambient_c + self_heating_c] * len(dut_tau_s)
+
+    def set_setpoint(self, t_s: float, setpoint_c: float) -> None:
+        self.advance_to(t_s)
+        self.setpoint_c = setpoint_c
+
+    def air_c(self, t_s: float) -> float:
+        self.advance_to(t_s)
+        return self._air_c
+
+    def dut_c(self, t_s: float, index: int) -> float:
+        self.advance_to(t_s)
+        return self._dut_c[index]
+
+    def advance_to(self, t_s: float) -> None:
+        while self._t < t_s:
+            step = min(MAX_STEP_S, t_s - self._t)
+            gap = self.setpoint_c - self._reference_c
+            if gap != 0.0:
+                step = min(step, abs(gap) / self.ramp_rate_c_per_s) or step
+            self._step(step)
+
+    def _step(self, step_s: float) -> None:
+        gap = self.setpoint_c - self._reference_c
+        move = math.copysign(min(abs(gap), self.ramp_rate_c_per_s * step_s), gap)
+        reference_end = self._reference_c + move
+        air_end = _lag(self._air_c, self._reference_c, reference_end, step_s, self.chamber_tau_s)
+        target_start = self._air_c + self.self_heating_c
+        target_end = air_end + self.self_heating_c
+        self._dut_c = [
+            _lag(dut, target_start, target_end, step_s, tau) for dut, tau in zip(self._dut_c, self.dut_tau_s)
+        ]
+        self._reference_c = reference_end
+        self._air_c = air_end
+        self._t += step_s

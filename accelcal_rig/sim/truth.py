@@ -1,0 +1,53 @@
+"""Each simulated DUT's hidden truth: Eq. 1 parameters that vary with temperature as smooth cubics.
+
+Seeded by the serial number, so a DUT is the same sensor in every run. Magnitudes follow the paper's
+ADXL355: bias within ±25 mg at 25 °C with 10–20 mg of drift over −40…60 °C, scale within ±1 %,
+non-orthogonality and misalignment of a few tenths of a degree.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.polynomial import polynomial
+
+T_REF_C = 25.0
+HALF_RANGE_C = 50.0
+#: The drift spans below are set over this range (the paper's campaign).
+DRIFT_RANGE_C = (-40.0, 60.0)
+
+_DEG = np.pi / 180.0
+# (value at 25 °C: ± half-width, drift over DRIFT_RANGE_C: low…high) per parameter group.
+_NOMINAL_HALF_WIDTH = np.repeat([25e-3, 0.01, 0.4 * _DEG, 0.5 * _DEG], 3)
+_NOMINAL_CENTRE = np.repeat([0.0, 1.0, 0.0, 0.0], 3)
+_DRIFT_LOW = np.repeat([10e-3, 100e-6, 0.005 * _DEG, 0.005 * _DEG], 3)
+_DRIFT_HIGH = np.repeat([20e-3, 800e-6, 0.02 * _DEG, 0.02 * _DEG], 3)
+
+
+@dataclass(frozen=True)
+class DutTruth:
+    """`coefficients[k]` are parameter k's cubic in x = (T − 25 °C) / 50 °C, increasing powers."""
+
+    serial: str
+    coefficients: np.ndarray
+
+    def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:
+        """Eq. 1 parameters (see fit.sfem.PARAMETER_NAMES) at each temperature, shape (..., 12)."""
+        x = (np.asarray(temperature_c, dtype=float) - T_REF_C) / HALF_RANGE_C
+        return np.moveaxis(polynomial.polyval(x, self.coefficients.T), 0, -1)
+
+
+def truth_for_serial(serial: str) -> DutTruth:
+    """The deterministic hidden truth of the DUT with this serial number."""
+    seed = int.from_bytes(hashlib.sha256(serial.encode()).digest()[:8], "little")
+    rng = np.random.default_rng(seed)
+    nominal = _NOMINAL_CENTRE + rng.uniform(-1, 1, 12) * _NOMINAL_HALF_WIDTH
+    drift = rng.uniform(_DRIFT_LOW, _DRIFT_HIGH) * rng.choice([-1.0, 1.0], 12)
+    shape = np.column_stack([np.ones(12), rng.uniform(-0.4, 0.4, (12, 2))])  # x + a2 x² + a3 x³
+    x = (np.linspace(*DRIFT_RANGE_C, 201) - T_REF_C) / HALF_RANGE_C
+    curves = polynomial.polyval(x, np.column_stack([np.zeros(12), shape]).T)
+    span = curves.max(axis=1) - curves.min(axis=1)
+    coefficients = np.column_stack([nominal, shape * (drift / span)[:, None]])
+    return DutTruth(serial, coefficients)

@@ -1,0 +1,196 @@
+"""Write the campaign file (layout: docs/hdf5-layout.md).
+
+Every dataset that grows is created empty and resizable when the file is created, then appended to and
+flushed after each pose, so the file on disk always holds every pose measured so far. Events are
+buffered and written with the next pose, soak or state change (the run's log file has them at once).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from accelcal_rig import __version__
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.plan.compile import Plan
+from accelcal_rig.store.records import Event, PoseRecord, SoakTrace
+
+FORMAT_NAME = "accelcal-rig campaign"
+FORMAT_VERSION = 1
+TEXT = h5py.string_dtype("utf-8")
+
+
+def utc_now() -> str:
+    return dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
+
+
+def _growable(group: h5py.Group, name: str, tail: tuple[int, ...], dtype: Any, unit: str | None = None,
+              chunk_rows: int = 64) -> h5py.Dataset:
+    dataset = group.create_dataset(name, shape=(0,) + tail, maxshape=(None,) + tail, dtype=dtype,
+                                   chunks=(chunk_rows,) + tail)
+    if unit:
+        dataset.attrs["unit"] = unit
+    return dataset
+
+
+def _append_rows(dataset: h5py.Dataset, rows: Any) -> None:
+    rows = np.asarray(rows) if dataset.dtype != TEXT else rows
+    n = dataset.shape[0]
+    dataset.resize(n + len(rows), axis=0)
+    dataset[n:] = rows
+
+
+class CampaignWriter:
+    """Owns the open campaign file for the length of a run."""
+
+    def __init__(self, file: h5py.File) -> None:
+        self._file = file
+        self._datasets: dict[str, h5py.Dataset] = {}
+        self._pending_events: list[tuple[float, str, str, str, str]] = []
+
+    def _append(self, path: str, row: Any) -> None:
+        """Append one row to the growable dataset at `path` (handles cached: lookups cost more than writes)."""
+        dataset = self._datasets.get(path)
+        if dataset is None:
+            dataset = self._datasets[path] = self._file[path]
+        _append_rows(dataset, [row])
+
+    @classmethod
+    def create(cls, path: Path, *, overwrite: bool, attrs: dict[str, Any], procedure_yaml: str,
+               rig_yaml: str, plan: Plan, duts: list[dict[str, Any]], instruments: dict[str, dict[str, str]],
+               samples_per_pose: int) -> CampaignWriter:
+        if path.exists() and not overwrite:
+            raise ConfigError(f"{path}: campaign file exists; choose another -o or pass --overwrite")
+        try:
+            file = h5py.File(path, "w")
+        except OSError as exc:
+            raise ConfigError(f"{path}: cannot create campaign file: {exc}") from None
+        file.attrs.update({"format": FORMAT_NAME, "format_version": FORMAT_VERSION,
+                           "software_version": __version__, "state": "created", "started": utc_now(),
+                           "finished": "", "abort_reason": "", **attrs})
+        config = file.create_group("config")
+        config.create_dataset("procedure_yaml", data=procedure_yaml, dtype=TEXT)
+        config.create_dataset("rig_yaml", data=rig_yaml, dtype=TEXT)
+        cls._write_plan(file.create_group("plan"), plan)
+        cls._create_poses(file.create_group("poses"), len(plan.axis_names))
+        duts_group = file.create_group("duts")
+        for dut in duts:
+            cls._create_dut(duts_group.create_group(dut["serial"]), dut, samples_per_pose)
+        group = file.create_group("instruments")
+        for name, info in instruments.items():
+            group.create_group(name).attrs.update(info)
+        file.create_group("soaks")
+        events = file.create_group("events")
+        _growable(events, "t_s", (), "f8", "s", chunk_rows=256)
+        for name in ("wall_time", "level", "kind", "message"):
+            _growable(events, name, (), TEXT, chunk_rows=256)
+        file.flush()
+        return cls(file)
+
+    @staticmethod
+    def _write_plan(group: h5py.Group, plan: Plan) -> None:
+        n_axes = len(plan.axis_names)
+        steps = plan.steps
+        group.attrs["fingerprint"] = plan.fingerprint
+        group.attrs["axis_names"] = list(plan.axis_names)
+        group.create_dataset("step_key", data=[s.key for s in steps], dtype=TEXT)
+        group.create_dataset("kind", data=[s.kind for s in steps], dtype=TEXT)
+        group.create_dataset("setpoint_c", data=[s.setpoint_c for s in steps]).attrs["unit"] = "degC"
+        group.create_dataset("pose_number", data=[s.pose.number if s.pose else 0 for s in steps])
+        nan_angles = (np.nan,) * n_axes
+        angles = [s.pose.angles_deg if s.pose else nan_angles for s in steps]
+        group.create_dataset("angles_deg", data=np.array(angles).reshape(len(steps), n_axes)).attrs["unit"] = "deg"
+        gravity = [s.pose.gravity_fixture if s.pose else (np.nan,) * 3 for s in steps]
+        group.create_dataset("gravity_fixture", data=np.array(gravity)).attrs["unit"] = "g"
+
+    @staticmethod
+    def _create_poses(group: h5py.Group, n_axes: int) -> None:
+        _growable(group, "step_key", (), TEXT)
+        _growable(group, "setpoint_c", (), "f8", "degC")
+        _growable(group, "pose_number", (), "i4")
+        _growable(group, "commanded_angles_deg", (n_axes,), "f8", "deg")
+        _growable(group, "measured_angles_deg", (n_axes,), "f8", "deg")
+        _growable(group, "gravity_fixture", (3,), "f8", "g")
+        _growable(group, "t_start_s", (), "f8", "s")
+        _growable(group, "t_end_s", (), "f8", "s")
+        _growable(group, "chamber_temperature_c", (2,), "f8", "degC")
+
+    @staticmethod
+    def _create_dut(group: h5py.Group, dut: dict[str, Any], samples_per_pose: int) -> None:
+        group.attrs.update(dut)
+        _growable(group, "raw_codes", (samples_per_pose, 3), "i4", "LSB", chunk_rows=1)
+        _growable(group, "mean_g", (3,), "f8", "g")
+        _growable(group, "stderr_g", (3,), "f8", "g")
+        _growable(group, "temperature_c", (2,), "f8", "degC")
+        _growable(group, "gravity_reference_g", (3,), "f8", "g")
+        _growable(group, "temperature_in_band", (), "?")
+
+    def write_truth_header(self, serial: str, description: dict[str, Any]) -> None:
+        """Open `simulation_truth/<serial>`: the hidden model of a simulated DUT, never a measurement."""
+        root = self._file.require_group("simulation_truth")
+        root.attrs["note"] = "SIMULATION TRUTH: hidden parameters of simulated DUTs, not measured data"
+        group = root.create_group(serial)
+        group.create_dataset("polynomial_coefficients", data=description.pop("polynomial_coefficients"))
+        group.attrs.update(description)
+        _growable(group, "parameters", (12,), "f8")
+        _growable(group, "gravity_g", (3,), "f8", "g")
+        _growable(group, "temperature_c", (), "f8", "degC")
+
+    def append_pose(self, pose: PoseRecord) -> None:
+        """Store one pose for every DUT, then flush: after this returns, the pose is on disk."""
+        for name in ("step_key", "setpoint_c", "pose_number", "commanded_angles_deg", "measured_angles_deg",
+                     "gravity_fixture", "t_start_s", "t_end_s", "chamber_temperature_c"):
+            self._append(f"poses/{name}", getattr(pose, name))
+        for dut in pose.duts:
+            prefix = f"duts/{dut.serial}"
+            self._append(f"{prefix}/raw_codes", dut.codes_xyz)
+            for name in ("mean_g", "stderr_g", "temperature_c", "gravity_reference_g", "temperature_in_band"):
+                self._append(f"{prefix}/{name}", getattr(dut, name))
+            if dut.truth is not None:
+                for name in ("parameters", "gravity_g", "temperature_c"):
+                    self._append(f"simulation_truth/{dut.serial}/{name}", dut.truth[name])
+        self._file.attrs["poses_done"] = self._datasets["poses/step_key"].shape[0]
+        self.flush()
+
+    def flush(self) -> None:
+        """Write buffered events and push everything to disk."""
+        if self._pending_events:
+            columns = list(zip(*self._pending_events))
+            for name, column in zip(("t_s", "wall_time", "level", "kind", "message"), columns):
+                _append_rows(self._file[f"events/{name}"], list(column))
+            self._pending_events.clear()
+        self._file.flush()
+
+    def write_soak(self, soak: SoakTrace) -> None:
+        group = self._file["soaks"].create_group(soak.label)
+        group.attrs.update({"setpoint_c": soak.setpoint_c, "outcome": soak.outcome,
+                            "t_reached_s": soak.t_reached_s, "t_stable_s": soak.t_stable_s})
+        group.create_dataset("t_s", data=soak.t_s).attrs["unit"] = "s"
+        group.create_dataset("chamber_c", data=soak.chamber_c).attrs["unit"] = "degC"
+        group.create_dataset("dut_c", data=soak.dut_c).attrs["unit"] = "degC"
+        group.create_dataset("settled_dut_c", data=soak.settled_dut_c).attrs["unit"] = "degC"
+        self.flush()
+
+    def log_event(self, event: Event) -> None:
+        """Buffer an event; it reaches the file with the next pose, soak or state change."""
+        self._pending_events.append((event.t_s, utc_now(), event.level, event.kind, event.message))
+
+    def set_state(self, state: str, *, reason: str = "", finished: bool = False,
+                  extra: dict[str, Any] | None = None) -> None:
+        self._file.attrs["state"] = state
+        if reason:
+            self._file.attrs["abort_reason"] = reason
+        if finished:
+            self._file.attrs["finished"] = utc_now()
+        if extra:
+            self._file.attrs.update(extra)
+        self.flush()
+
+    def close(self) -> None:
+        if self._file.id.valid:
+            self.flush()
+            self._file.close()
