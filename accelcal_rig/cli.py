@@ -11,7 +11,7 @@ from pathlib import Path
 from accelcal_rig import __version__
 from accelcal_rig.engine.campaign import TerminationRequested
 from accelcal_rig.engine.events import LOGGER, format_duration
-from accelcal_rig.errors import CampaignAborted, RigError
+from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
 
 EXIT_INTERRUPTED = 130
 
@@ -70,7 +70,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
     prepared = prepare(args.procedure, args.config)
     if args.output.exists() and not args.overwrite:
-        raise RigError(f"{args.output}: campaign file exists; choose another -o or pass --overwrite")
+        raise ConfigError(f"{args.output}: campaign file exists; choose another -o or pass --overwrite")
     _configure_logging(args.output, args.verbose, args.quiet)
     signal.signal(signal.SIGTERM, _terminate)
     result = run_campaign(prepared, args.output, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite)

@@ -35,8 +35,8 @@ class TurntableKinematics:
     def axis_names(self) -> tuple[str, ...]:
         return tuple(a.name for a in self.axes)
 
-    def fixture_orientation(self, angles_deg: np.ndarray) -> Rotation:
-        """Rotation taking fixture-frame vectors to the world frame, for one pose or a stack (..., n_axes)."""
+    def chain_matrices(self, angles_deg: np.ndarray) -> np.ndarray:
+        """Rotation matrices taking fixture-frame vectors to the world frame, shape (..., 3, 3)."""
         angles = np.deg2rad(np.asarray(angles_deg, dtype=float))
         flat = angles.reshape(-1, len(self.axes))
         per_axis = Rotation.from_rotvec((flat[:, :, None] * self._directions).reshape(-1, 3)).as_matrix()
@@ -44,14 +44,14 @@ class TurntableKinematics:
         chain = per_axis[:, 0]
         for k in range(1, len(self.axes)):
             chain = chain @ per_axis[:, k]
-        total = Rotation.from_matrix(chain)
-        return total if angles.ndim > 1 else total[0]
+        return chain.reshape(angles.shape[:-1] + (3, 3))
 
     def gravity_in_fixture(self, angles_deg: np.ndarray) -> np.ndarray:
-        """Unit specific-force direction (+1 g up) in the fixture frame, shape (..., 3)."""
-        angles = np.asarray(angles_deg, dtype=float)
-        up = self.fixture_orientation(angles.reshape(-1, len(self.axes))).inv().apply(WORLD_UP)
-        return up.reshape(angles.shape[:-1] + (3,))
+        """Unit specific-force direction (+1 g up) in the fixture frame, shape (..., 3).
+
+        World up expressed in the fixture frame is Rᵀ·ẑ, the third row of the chain matrix R.
+        """
+        return self.chain_matrices(angles_deg)[..., 2, :]
 
     def wrap(self, angles_deg: np.ndarray) -> np.ndarray:
         """Bring continuous axes into [min_deg, min_deg + 360)."""
@@ -87,26 +87,35 @@ class TurntableKinematics:
         def pulled(weight: float):
             return lambda angles_rad: np.concatenate([direction_error(angles_rad), weight * (angles_rad - near)])
 
-        best: tuple[float, np.ndarray] | None = None
+        best: np.ndarray | None = None
         for start in self._starts(near, lower, upper):
             trial = least_squares(pulled(1e-2), start, bounds=(lower, upper), method="trf")
+            if np.linalg.norm(direction_error(trial.x)) > 1e-2:
+                continue  # stuck away from the target: this start leads nowhere
             final = least_squares(pulled(1e-6), trial.x, bounds=(lower, upper), method="trf",
                                   xtol=1e-14, ftol=1e-14, gtol=1e-14)
             if np.linalg.norm(direction_error(final.x)) < _IK_TOLERANCE_RAD:
-                travel = float(np.abs(final.x - near).sum())
-                if best is None or travel < best[0] - 1e-9:
-                    best = (travel, final.x)
-                if start is near or np.array_equal(start, near):
-                    break  # the solution reached from the current angles is the least-travel branch
+                best = final.x
+                break  # starts come nearest first: the first exact solution is the least-travel one
         if best is None:
             raise UnreachablePose(
                 f"gravity direction {np.round(target, 4).tolist()} is out of reach of the turntable's axis limits"
             )
-        return self.wrap(np.rad2deg(best[1]))
+        return self.wrap(np.rad2deg(best))
 
     def _starts(self, near: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> list[np.ndarray]:
-        """The current angles first, then a coarse grid, so a branch behind a limit is still found."""
-        grid = np.deg2rad([-135.0, -45.0, 45.0, 135.0])
+        """Nearest first: the current angles, then one axis turned by ±90° or 180°, then a coarse grid.
+
+        Antipodal targets (gravity reversed) have a zero gradient at the current angles; the offsets get
+        the solver off that saddle, the grid finds a branch hidden behind an axis limit.
+        """
         n = len(self.axes)
-        mesh = np.stack(np.meshgrid(*([grid] * n), indexing="ij"), axis=-1).reshape(-1, n)
-        return [np.clip(near, lower, upper)] + [np.clip(s, lower + 1e-9, upper - 1e-9) for s in mesh]
+        starts = [near]
+        for offset in np.deg2rad([90.0, -90.0, 180.0]):
+            for k in range(n):
+                start = near.copy()
+                start[k] += offset
+                starts.append(start)
+        grid = np.deg2rad([-120.0, 0.0, 120.0])
+        starts.extend(np.stack(np.meshgrid(*([grid] * n), indexing="ij"), axis=-1).reshape(-1, n))
+        return [np.clip(s, lower + 1e-9, upper - 1e-9) for s in starts]

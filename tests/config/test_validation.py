@@ -1,0 +1,90 @@
+"""Every bad procedure or rig file is refused with `file:line: key: message` before anything moves."""
+
+from pathlib import Path
+
+import pytest
+
+from accelcal_rig.config.load import load_procedure, load_rig
+from accelcal_rig.engine.session import prepare
+from accelcal_rig.errors import ConfigError
+from tests.conftest import REPO, TINY_PROCEDURE
+
+
+@pytest.mark.parametrize("path", sorted((REPO / "procedures").glob("*.yaml")))
+def test_shipped_procedures_prepare(path: Path) -> None:
+    prepared = prepare(path)
+    assert prepared.plan.pose_steps
+
+
+def test_setpoint_range_shorthand_expands() -> None:
+    procedure = load_procedure(REPO / "procedures" / "paper-24pos-thermal.yaml").model
+    assert procedure.setpoints_c == [-40, -30, -20, -10, 0, 10, 20, 30, 40, 50, 60]
+
+
+@pytest.mark.parametrize(
+    ("replace", "by", "expected"),
+    [
+        ("samples_per_pose: 20", "samples_per_pose: 1", r"tiny.yaml:6: acquisition.samples_per_pose: .*greater than or equal to 2"),
+        ("odr_hz: 125", "odr_hz: 100", r"tiny.yaml:6: acquisition.odr_hz: 100 Hz is not an ADXL355 output data rate"),
+        ("range_g: 2", "range_g: 3", r"tiny.yaml:6: acquisition.range_g: "),
+        ("kind: six-position", "kind: seven-position", r"tiny.yaml:5: schedule: "),
+        ("kind: six-position", "kind: sphere", r"tiny.yaml:5: schedule.count: Field required"),
+        ("band_c: 0.3", "band_c: wide", r"tiny.yaml:4: soak.band_c: .*valid number"),
+        ("band_c: 0.3", "bnad_c: 0.3", r"tiny.yaml:4: soak.bnad_c: Extra inputs are not permitted"),
+        ("timeout_min: 120", "timeout_min: 1", r"tiny.yaml:4: soak: timeout_min must be at least"),
+        ("setpoints_c: [30]", "setpoints_c: [30, 30]", r"tiny.yaml:3: setpoints_c: setpoints must be distinct"),
+        ("setpoints_c: [30]", "setpoints_c: {from_c: 0, to_c: 10}", r"tiny.yaml:3: setpoints_c: a setpoint range needs"),
+    ],
+)
+def test_procedure_errors_name_file_line_and_key(write, replace: str, by: str, expected: str) -> None:
+    path = write("tiny.yaml", TINY_PROCEDURE.replace(replace, by))
+    with pytest.raises(ConfigError, match=expected):
+        prepare(path)
+
+
+def test_setpoint_outside_chamber_limits_points_at_the_setpoint(write) -> None:
+    path = write("tiny.yaml", TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c:\n  - 30\n  - 120\n"))
+    with pytest.raises(ConfigError, match=r"tiny.yaml:5: setpoints_c\[1\]: 120 °C is outside the chamber limits"):
+        prepare(path)
+
+
+def test_explicit_angles_checked_against_axis_count(write) -> None:
+    text = TINY_PROCEDURE.replace("schedule: {kind: six-position}",
+                                  "schedule:\n  kind: explicit\n  angles_deg:\n    - [0, 0, 0]\n    - [0, 90]\n")
+    with pytest.raises(ConfigError, match=r"tiny.yaml:9: schedule.angles_deg\[1\]: 2 angles given"):
+        prepare(write("tiny.yaml", text))
+
+
+def test_unreachable_schedule_is_a_config_error(write, workdir: Path) -> None:
+    rig = (workdir / "sim.yaml").read_text().replace(
+        "{name: middle, axis: [1, 0, 0], min_deg: -180, max_deg: 180, continuous: true, speed_deg_s: 20}",
+        "{name: middle, axis: [1, 0, 0], min_deg: -90, max_deg: 90, speed_deg_s: 20}",
+    )
+    (workdir / "sim.yaml").write_text(rig)
+    with pytest.raises(ConfigError, match=r"tiny.yaml:5: schedule: gravity direction .* out of reach"):
+        prepare(write("tiny.yaml", TINY_PROCEDURE))
+
+
+def test_missing_rig_file_is_named(write) -> None:
+    path = write("tiny.yaml", TINY_PROCEDURE.replace("rig: sim.yaml", "rig: nowhere.yaml"))
+    with pytest.raises(ConfigError, match=r"nowhere.yaml: file not found"):
+        prepare(path)
+
+
+@pytest.mark.parametrize(
+    ("replace", "by", "expected"),
+    [
+        ("safe_setpoint_c: 23", "safe_setpoint_c: 150", r"sim.yaml:\d+: chamber: safe_setpoint_c must lie within"),
+        ("serial: ADX355-A002", "serial: ADX355-A001", r"sim.yaml:\d+: fixture.sensors: sensor serial numbers must be distinct"),
+        ("axis: [1, 0, 0]", "axis: [0, 0, 0]", r"sim.yaml:\d+: turntable.axes\[1\].axis: axis direction must not be zero"),
+        ("ramp_rate_c_per_min: 3", "ramp_rate_c_per_min: -3", r"sim.yaml:\d+: chamber.ramp_rate_c_per_min: "),
+        ("driver: simulated\n  min_setpoint_c", "driver: watlow\n  min_setpoint_c", r"sim.yaml:\d+: chamber.driver: "),
+    ],
+)
+def test_rig_errors_name_file_line_and_key(workdir: Path, replace: str, by: str, expected: str) -> None:
+    path = workdir / "sim.yaml"
+    text = path.read_text()
+    assert replace in text
+    path.write_text(text.replace(replace, by, 1))
+    with pytest.raises(ConfigError, match=expected):
+        load_rig(path)

@@ -1,0 +1,37 @@
+"""Shared fixtures: the shipped files, and tiny procedures written next to a copy of the sim rig."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+SIM_RIG = REPO / "configs" / "sim.yaml"
+
+TINY_PROCEDURE = """\
+name: tiny
+rig: sim.yaml
+setpoints_c: [30]
+soak: {min_dwell_min: 5, window_min: 2, band_c: 0.3, poll_s: 10, timeout_min: 120}
+schedule: {kind: six-position}
+acquisition: {samples_per_pose: 20, range_g: 2, odr_hz: 125, settle_s: 1}
+"""
+
+
+@pytest.fixture
+def workdir(tmp_path: Path) -> Path:
+    """A folder holding a copy of the simulated rig config, for procedures that name `rig: sim.yaml`."""
+    shutil.copy(SIM_RIG, tmp_path / "sim.yaml")
+    return tmp_path
+
+
+@pytest.fixture
+def write(workdir: Path):
+    def _write(name: str, text: str) -> Path:
+        path = workdir / name
+        path.write_text(text)
+        return path
+
+    return _write

@@ -1,0 +1,61 @@
+import numpy as np
+import pytest
+
+from accelcal_rig.config.rig import ChamberConfig, TurntableAxis, TurntableConfig
+from accelcal_rig.errors import InstrumentError
+from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable
+
+
+class RecordingChamber:
+    endpoint = "test-chamber"
+
+    def __init__(self, readback_offset_c: float = 0.0) -> None:
+        self.writes: list[float] = []
+        self._offset = readback_offset_c
+
+    def write_setpoint_c(self, setpoint_c: float) -> None:
+        self.writes.append(setpoint_c)
+
+    def read_setpoint_c(self) -> float:
+        return self.writes[-1] + self._offset
+
+
+class RecordingTurntable:
+    endpoint = "test-table"
+
+    def __init__(self) -> None:
+        self.moves: list[np.ndarray] = []
+
+    def move_to(self, angles_deg: np.ndarray) -> None:
+        self.moves.append(angles_deg)
+
+
+def test_out_of_limit_setpoint_is_refused_before_anything_is_written() -> None:
+    inner = RecordingChamber()
+    chamber = LimitedChamber(inner, ChamberConfig(min_setpoint_c=-40, max_setpoint_c=85, safe_setpoint_c=20))
+    with pytest.raises(InstrumentError, match=r"test-chamber.*-50 °C refused, limits are -40…85"):
+        chamber.write_setpoint_c(-50)
+    assert inner.writes == []
+    chamber.write_setpoint_c(85)
+    assert inner.writes == [85]
+
+
+def test_setpoint_that_does_not_read_back_is_an_error() -> None:
+    chamber = LimitedChamber(RecordingChamber(readback_offset_c=0.5), ChamberConfig())
+    with pytest.raises(InstrumentError, match="written but .* read back"):
+        chamber.write_setpoint_c(10)
+
+
+def test_turntable_limits_apply_to_limited_axes_only() -> None:
+    config = TurntableConfig(axes=[
+        TurntableAxis(name="tilt", axis=(1, 0, 0), min_deg=-90, max_deg=90),
+        TurntableAxis(name="spin", axis=(0, 0, 1), min_deg=-180, max_deg=180, continuous=True),
+    ])
+    inner = RecordingTurntable()
+    table = LimitedTurntable(inner, config)
+    table.move_to(np.array([45.0, 700.0]))
+    with pytest.raises(InstrumentError, match="axis tilt to 95° refused"):
+        table.move_to(np.array([95.0, 0.0]))
+    with pytest.raises(InstrumentError, match="3 angles for 2 axes"):
+        table.move_to(np.array([0.0, 0.0, 0.0]))
+    assert len(inner.moves) == 1

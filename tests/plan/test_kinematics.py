@@ -1,0 +1,70 @@
+import numpy as np
+import pytest
+
+from accelcal_rig.config.rig import TurntableAxis
+from accelcal_rig.plan import schedules
+from accelcal_rig.plan.kinematics import TurntableKinematics, UnreachablePose
+
+
+def gimbal(middle_limits: tuple[float, float] | None = None) -> TurntableKinematics:
+    middle = (
+        TurntableAxis(name="middle", axis=(1, 0, 0), min_deg=-180, max_deg=180, continuous=True)
+        if middle_limits is None
+        else TurntableAxis(name="middle", axis=(1, 0, 0), min_deg=middle_limits[0], max_deg=middle_limits[1])
+    )
+    return TurntableKinematics([
+        TurntableAxis(name="outer", axis=(0, 0, 1), min_deg=-180, max_deg=180, continuous=True),
+        middle,
+        TurntableAxis(name="inner", axis=(0, 0, 1), min_deg=-180, max_deg=180, continuous=True),
+    ])
+
+
+def test_zero_angles_leave_gravity_along_fixture_z() -> None:
+    np.testing.assert_allclose(gimbal().gravity_in_fixture(np.zeros(3)), [0, 0, 1], atol=1e-15)
+
+
+def test_tilting_the_middle_axis_by_90_puts_gravity_on_y() -> None:
+    # Tilting the platform +90° about world x raises its +y axis to point up.
+    np.testing.assert_allclose(gimbal().gravity_in_fixture(np.array([0, 90, 0])), [0, 1, 0], atol=1e-12)
+
+
+def test_outer_vertical_axis_does_not_change_gravity() -> None:
+    k = gimbal()
+    np.testing.assert_allclose(k.gravity_in_fixture(np.array([73.0, 30, 10])),
+                               k.gravity_in_fixture(np.array([0.0, 30, 10])), atol=1e-12)
+
+
+def test_forward_kinematics_is_vectorised() -> None:
+    k = gimbal()
+    angles = np.random.default_rng(0).uniform(-180, 180, (5, 4, 3))
+    stacked = k.gravity_in_fixture(angles)
+    assert stacked.shape == (5, 4, 3)
+    np.testing.assert_allclose(stacked[2, 3], k.gravity_in_fixture(angles[2, 3]))
+
+
+def test_inverse_kinematics_reaches_every_sphere_direction() -> None:
+    k = gimbal()
+    current = np.zeros(3)
+    for direction in schedules.sphere(60):
+        current = k.solve(direction, current)
+        np.testing.assert_allclose(k.gravity_in_fixture(current), direction, atol=1e-8)
+        assert np.all((current >= -180) & (current < 180))
+
+
+def test_inverse_kinematics_prefers_least_travel() -> None:
+    k = gimbal()
+    angles = k.solve(np.array([0, 1.0, 0]), np.zeros(3))
+    np.testing.assert_allclose(angles, [0, 90, 0], atol=1e-6)
+
+
+def test_limited_axis_makes_the_lower_hemisphere_unreachable() -> None:
+    k = gimbal(middle_limits=(-90, 90))
+    angles = k.solve(np.array([0.8, 0, 0.6]), np.zeros(3))  # tilted 53° is still in reach
+    assert -90 <= angles[1] <= 90
+    with pytest.raises(UnreachablePose, match="out of reach"):
+        k.solve(np.array([0, 0, -1.0]), np.zeros(3))
+
+
+def test_wrap_keeps_continuous_axes_in_range_only() -> None:
+    k = gimbal(middle_limits=(-90, 90))
+    np.testing.assert_allclose(k.wrap(np.array([190.0, 80.0, -540.0])), [-170.0, 80.0, -180.0])

@@ -1,0 +1,90 @@
+import numpy as np
+import pytest
+
+from accelcal_rig.config.load import load_rig
+from accelcal_rig.engine.clock import VirtualClock
+from accelcal_rig.errors import InstrumentError
+from accelcal_rig.fit.sfem import distort
+from accelcal_rig.instruments import adxl355
+from accelcal_rig.sim.devices import build_simulated_rig
+from tests.conftest import SIM_RIG
+
+
+@pytest.fixture
+def rig():
+    clock = VirtualClock()
+    return clock, build_simulated_rig(load_rig(SIM_RIG).model, clock, seed=7)
+
+
+def test_block_mean_matches_the_truth_within_the_noise(rig) -> None:
+    clock, instruments = rig
+    sensor = instruments.sensors[1]
+    sensor.configure(2, 125.0)
+    sensor.start_measurement()
+    block = sensor.acquire(2000)
+    assert block.codes_xyz.shape == (2000, 3) and block.codes_xyz.dtype == np.int32
+    truth = instruments.truth.last_block_truth(sensor.serial)
+    expected = distort(truth["gravity_g"], truth["parameters"])
+    lsb = adxl355.lsb_g(2)
+    measured = block.codes_xyz * lsb
+    noise = sensor.noise_g()
+    np.testing.assert_allclose(measured.mean(axis=0), expected, atol=5 * noise / np.sqrt(2000))
+    np.testing.assert_allclose(measured.std(axis=0), noise, rtol=0.1)
+
+
+def test_noise_follows_the_datasheet_density_and_data_rate(rig) -> None:
+    _, instruments = rig
+    sensor = instruments.sensors[0]
+    sensor.configure(2, 125.0)
+    slow = sensor.noise_g()
+    sensor.configure(2, 4000.0)
+    assert sensor.noise_g() == pytest.approx(slow * np.sqrt(32))
+    assert 0.15e-3 < slow < 0.25e-3  # 25 µg/√Hz over a 31 Hz corner
+
+
+def test_acquire_takes_its_time_on_the_clock(rig) -> None:
+    clock, instruments = rig
+    sensor = instruments.sensors[0]
+    sensor.start_measurement()
+    block = sensor.acquire(250)
+    assert clock.now() == pytest.approx(2.0)
+    assert block.t_end_s - block.t_start_s == pytest.approx(249 / 125)
+
+
+def test_standby_rules_of_the_part(rig) -> None:
+    _, instruments = rig
+    sensor = instruments.sensors[0]
+    with pytest.raises(InstrumentError, match="standby"):
+        sensor.acquire(10)
+    sensor.start_measurement()
+    with pytest.raises(InstrumentError, match="only change in standby"):
+        sensor.configure(4, 125.0)
+
+
+def test_turntable_moves_at_its_speed_then_settles(rig) -> None:
+    clock, instruments = rig
+    table = instruments.turntable
+    table.move_to(np.array([0.0, 90.0, 0.0]))  # 90° at 20°/s: 4.5 s, then 0.5 s settle
+    clock.sleep(2.0)
+    assert not table.in_position()
+    assert table.read_angles_deg()[1] == pytest.approx(40.0, abs=0.01)
+    clock.sleep(3.1)
+    assert table.in_position()
+    assert table.read_angles_deg()[1] == pytest.approx(90.0, abs=3 / 3600 + 1e-12)
+
+
+def test_turntable_stop_holds_the_current_angle(rig) -> None:
+    clock, instruments = rig
+    table = instruments.turntable
+    table.move_to(np.array([0.0, 90.0, 0.0]))
+    clock.sleep(1.0)
+    table.stop()
+    clock.sleep(10.0)
+    assert table.read_angles_deg()[1] == pytest.approx(20.0, abs=0.01)
+
+
+def test_temperature_reading_is_quantised_like_the_adxl355(rig) -> None:
+    _, instruments = rig
+    readings = {instruments.sensors[0].read_temperature_c() for _ in range(50)}
+    raws = [(25 - t) * 9.05 + 1885 for t in readings]
+    np.testing.assert_allclose(raws, np.round(raws), atol=1e-9)

@@ -1,0 +1,43 @@
+import numpy as np
+
+from accelcal_rig.sim.thermal import ThermalModel
+
+
+def model(**overrides) -> ThermalModel:
+    settings = dict(ambient_c=23.0, ramp_rate_c_per_s=3 / 60, chamber_tau_s=180.0, dut_tau_s=[600.0, 900.0],
+                    self_heating_c=0.2)
+    settings.update(overrides)
+    return ThermalModel(**settings)
+
+
+def test_starts_at_ambient_with_self_heating() -> None:
+    m = model()
+    assert m.air_c(0.0) == 23.0
+    assert m.dut_c(0.0, 0) == 23.2
+
+
+def test_air_change_is_limited_by_the_ramp_rate() -> None:
+    m = model()
+    m.set_setpoint(0.0, -40.0)
+    times = np.arange(0.0, 1200.0, 10.0)
+    air = np.array([m.air_c(t) for t in times])
+    assert np.all(np.diff(air) <= 0)  # monotonic, no overshoot
+    assert np.all(np.abs(np.diff(air)) / 10.0 <= 3 / 60 + 1e-9)
+
+
+def test_settles_at_setpoint_and_duts_lag_the_air_by_their_time_constants() -> None:
+    m = model()
+    m.set_setpoint(0.0, 60.0)
+    t_ramp_end = 37 / (3 / 60)
+    assert m.dut_c(t_ramp_end, 1) < m.dut_c(t_ramp_end, 0) < m.air_c(t_ramp_end)  # slower DUT lags more
+    assert abs(m.air_c(t_ramp_end + 3600) - 60.0) < 1e-3
+    assert abs(m.dut_c(t_ramp_end + 3 * 3600, 1) - 60.2) < 1e-3
+
+
+def test_query_granularity_does_not_change_the_answer() -> None:
+    coarse, fine = model(), model()
+    coarse.set_setpoint(0.0, -20.0)
+    fine.set_setpoint(0.0, -20.0)
+    for t in np.arange(0.0, 2000.0, 1.0):
+        fine.dut_c(t, 0)
+    assert abs(coarse.dut_c(2000.0, 0) - fine.dut_c(2000.0, 0)) < 0.01
