@@ -235,8 +235,9 @@ class CampaignRunner:
         band = self.procedure.soak.band_c
         in_band = bool(np.all(np.abs(np.array(block.temperature_c) - self._settled_dut_c[index]) <= band))
         if not in_band:
-            self.events.warning("pose", f"sensor {sensor.serial}: temperature {block.temperature_c} °C left the "
-                                        f"soak band around {self._settled_dut_c[index]:.2f} °C")
+            before, after = block.temperature_c
+            self.events.warning("pose", f"sensor {sensor.serial}: temperature {before:.2f}/{after:.2f} °C left the "
+                                        f"±{band:g} °C band around {self._settled_dut_c[index]:.2f} °C")
         return DutPoseRecord(
             serial=sensor.serial, codes_xyz=codes, mean_g=mean_g, stderr_g=stderr_g,
             temperature_c=block.temperature_c,

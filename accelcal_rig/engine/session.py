@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -12,9 +13,10 @@ from accelcal_rig.config.load import (
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary
-from accelcal_rig.engine.clock import VirtualClock
+from accelcal_rig.engine.clock import Clock, VirtualClock
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.instruments import adxl355
+from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.plan.compile import Plan, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
 from accelcal_rig.sim.devices import build_simulated_rig
@@ -48,16 +50,22 @@ class RunResult:
     output: Path
 
 
-def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, seed: int,
-                 overwrite: bool) -> RunResult:
-    """Run the whole campaign into `output`. Raises CampaignAborted after reaching the safe state."""
+InstrumentFactory = Callable[[RigConfig, Clock, int], RigInstruments]
+
+
+def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, seed: int, overwrite: bool,
+                 build_instruments: InstrumentFactory = build_simulated_rig) -> RunResult:
+    """Run the whole campaign into `output`. Raises CampaignAborted after reaching the safe state.
+
+    `build_instruments` connects the rig (the simulated one by default) on the campaign's clock.
+    """
     rig = prepared.rig
     if not dry_run:
         raise rig.error(("chamber", "driver"),
                         "the 'simulated' drivers have no hardware behind them: run with --dry-run")
     wall_start = time.perf_counter()
     clock = VirtualClock()
-    instruments = build_simulated_rig(rig.model, clock, seed)
+    instruments = build_instruments(rig.model, clock, seed)
     procedure = prepared.procedure.model
     acquisition = procedure.acquisition
     mounts = {s.serial: s for s in rig.model.fixture.sensors}

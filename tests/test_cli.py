@@ -1,0 +1,89 @@
+"""The `rig` command: a whole dry run through the installed console script, and its one-line errors."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from accelcal_rig.cli import main
+from tests.conftest import REPO, TINY_PROCEDURE
+
+
+def rig(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    beside_python = Path(sys.executable).parent / "rig"  # the venv's scripts, activated or not
+    executable = str(beside_python) if beside_python.exists() else shutil.which("rig")
+    assert executable, "the console script `rig` is installed with the package"
+    return subprocess.run([executable, *args], cwd=cwd, capture_output=True, text=True, timeout=300)
+
+
+def test_quick_6pos_dry_run_end_to_end(tmp_path: Path) -> None:
+    run = rig("run", str(REPO / "procedures" / "quick-6pos.yaml"), "--dry-run", "-o", "quick.h5", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert "campaign done: quick-6pos" in run.stdout
+    assert "12 of 12 × 4 DUTs × 200 samples" in run.stdout
+    assert "T35: stable after" in run.stderr  # progress while it runs
+    assert (tmp_path / "quick.h5.log").read_text().count("stored") >= 12
+    status = rig("status", "quick.h5", "--json", cwd=tmp_path)
+    assert status.returncode == 0
+    report = json.loads(status.stdout)
+    assert report["state"] == "done"
+    assert (report["poses_done"], report["poses_total"], report["samples_per_pose"]) == (12, 12, 200)
+    assert report["duts"] == ["ADX355-A001", "ADX355-A002", "ADX355-A003", "ADX355-A004"]
+    assert report["setpoints_c"] == [15.0, 35.0]
+    assert report["started"] and report["finished"]
+
+
+def one_line_error(capsys, argv: list[str], expected_code: int) -> str:
+    assert main(argv) == expected_code
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    return err
+
+
+def test_broken_yaml_is_one_line_with_exit_2(write, capsys) -> None:
+    path = write("tiny.yaml", TINY_PROCEDURE.replace("schedule: {kind: six-position}", "schedule: {kind: six"))
+    err = one_line_error(capsys, ["run", str(path), "--dry-run", "-o", str(path.with_suffix(".h5"))], 2)
+    assert f"{path}:" in err and "syntax" in err
+
+
+def test_invalid_value_is_one_line_with_exit_2(write, capsys) -> None:
+    path = write("tiny.yaml", TINY_PROCEDURE.replace("samples_per_pose: 20", "samples_per_pose: lots"))
+    err = one_line_error(capsys, ["run", str(path), "--dry-run", "-o", str(path.with_suffix(".h5"))], 2)
+    assert f"{path}:6: acquisition.samples_per_pose:" in err
+    assert not path.with_suffix(".h5").exists()  # nothing created, nothing moved
+
+
+def test_existing_campaign_is_never_overwritten_silently(write, capsys) -> None:
+    path = write("tiny.yaml", TINY_PROCEDURE)
+    output = path.with_suffix(".h5")
+    output.write_bytes(b"last night's campaign")
+    err = one_line_error(capsys, ["run", str(path), "--dry-run", "-o", str(output)], 2)
+    assert "exists" in err and output.read_bytes() == b"last night's campaign"
+
+
+def test_without_dry_run_the_simulated_drivers_are_refused(write, capsys) -> None:
+    path = write("tiny.yaml", TINY_PROCEDURE)
+    err = one_line_error(capsys, ["run", str(path), "-o", str(path.with_suffix(".h5"))], 2)
+    assert "sim.yaml:" in err and "chamber.driver" in err and "--dry-run" in err
+
+
+@pytest.mark.parametrize("content", [None, b"not hdf5"])
+def test_status_of_a_missing_or_foreign_file(tmp_path: Path, capsys, content: bytes | None) -> None:
+    path = tmp_path / "x.h5"
+    if content is not None:
+        path.write_bytes(content)
+    err = one_line_error(capsys, ["status", str(path)], 2)
+    assert str(path) in err
+
+
+def test_every_command_has_help_with_an_example(capsys) -> None:
+    for command in ("run", "status"):
+        with pytest.raises(SystemExit) as exit_info:
+            main([command, "--help"])
+        assert exit_info.value.code == 0
+        assert "example:" in capsys.readouterr().out
