@@ -87,3 +87,13 @@ def test_every_command_has_help_with_an_example(capsys) -> None:
             main([command, "--help"])
         assert exit_info.value.code == 0
         assert "example:" in capsys.readouterr().out
+
+
+def test_config_option_overrides_the_procedures_rig(write, workdir: Path, capsys) -> None:
+    procedure = write("tiny.yaml", TINY_PROCEDURE.replace("rig: sim.yaml", "rig: missing.yaml"))
+    rig_text = (workdir / "sim.yaml").read_text()
+    two_duts = rig_text.split("    - {serial: ADX355-A003")[0] + rig_text[rig_text.index("\nsimulation:"):]
+    other = write("two-duts.yaml", two_duts)
+    output = workdir / "out.h5"
+    assert main(["run", str(procedure), "--config", str(other), "--dry-run", "-o", str(output), "-q"]) == 0
+    assert "6 of 6 × 2 DUTs" in capsys.readouterr().out

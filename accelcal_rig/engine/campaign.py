@@ -72,6 +72,9 @@ class CampaignRunner:
     def run(self) -> CampaignSummary:
         self.writer.set_state("running")
         try:
+            self.events.info("plan", f"{len(self.plan.setpoints_c)} setpoints × {len(self.plan.poses)} poses = "
+                                     f"{len(self.plan.pose_steps)} poses, {len(self.sensors)} DUTs, "
+                                     f"{self.procedure.acquisition.samples_per_pose} samples per pose")
             self.machine.go(State.PREFLIGHT)
             self._preflight()
             for setpoint, steps in groupby(self.plan.steps, key=lambda s: s.setpoint_c):
@@ -144,14 +147,14 @@ class CampaignRunner:
 
     def _ramp(self, setpoint_c: float) -> float:
         soak = self.procedure.soak
-        start_c = self.chamber.read_temperature_c()
+        start_c = self._chamber_temperature_c()
         self.chamber.write_setpoint_c(setpoint_c)
         ramp_s = abs(setpoint_c - start_c) / (self.rig.chamber.ramp_rate_c_per_min / 60.0)
         timeout_s = soak.ramp_timeout_factor * ramp_s + soak.ramp_timeout_margin_min * 60.0
         self.events.info("ramp", f"ramp {start_c:.1f} → {setpoint_c:g} °C (deadline {format_duration(timeout_s)})")
         t_reached = wait_until(
             self.clock,
-            lambda: abs(self.chamber.read_temperature_c() - setpoint_c) <= soak.chamber_tolerance_c,
+            lambda: abs(self._chamber_temperature_c() - setpoint_c) <= soak.chamber_tolerance_c,
             timeout_s=timeout_s, poll_s=soak.poll_s,
             what=f"chamber ({self.chamber.endpoint}) reaching {setpoint_c:g} °C",
         )
@@ -163,7 +166,7 @@ class CampaignRunner:
 
         def poll() -> bool:
             dut_c = np.array([s.read_temperature_c() for s in self.sensors])
-            detector.add(self.clock.now(), self.chamber.read_temperature_c(), dut_c)
+            detector.add(self.clock.now(), self._chamber_temperature_c(), dut_c)
             return detector.is_stable()
 
         outcome = "stable"
@@ -183,6 +186,12 @@ class CampaignRunner:
                                  f"DUT {np.round(self._settled_dut_c, 2).tolist()} °C "
                                  f"(spans ≤ {spans.max():.2f} °C)")
 
+    def _chamber_temperature_c(self) -> float:
+        """Chamber air temperature; an active controller alarm is a fault, never a reading to wait out."""
+        if self.chamber.alarm_active():
+            raise InstrumentError(f"chamber ({self.chamber.endpoint}): controller alarm active")
+        return self.chamber.read_temperature_c()
+
     # ----------------------------------------------------------------- one pose
     def _measure_pose(self, step: PlanStep) -> None:
         assert step.pose is not None
@@ -193,9 +202,9 @@ class CampaignRunner:
         self.clock.sleep(self.procedure.acquisition.settle_s)
         self.machine.go(State.ACQUIRE, step.key)
         measured = self.turntable.read_angles_deg()
-        chamber_before = self.chamber.read_temperature_c()
+        chamber_before = self._chamber_temperature_c()
         blocks = [s.acquire(self.procedure.acquisition.samples_per_pose) for s in self.sensors]
-        chamber_after = self.chamber.read_temperature_c()
+        chamber_after = self._chamber_temperature_c()
         self.machine.go(State.STORE, step.key)
         gravity_fixture = np.array(step.pose.gravity_fixture)
         record = PoseRecord(

@@ -1,14 +1,14 @@
-"""The one clock: real in the lab, virtual in a dry run. Nothing else calls time.sleep.
+"""The one clock shared by the engine, the soak detector, the simulators and sample timestamps.
+
+In a lab it is real time; in a dry run it is virtual. Nothing else calls time.sleep.
 
 The virtual clock advances only when someone sleeps on it, so a fourteen-hour campaign costs only the
-requests made during it. It is shared by the engine, the soak detector, the simulators and the sample
-timestamps.
+requests made during it.
 """
 
 from __future__ import annotations
 
 import threading
-import time
 from typing import Protocol
 
 
@@ -20,20 +20,6 @@ class Clock(Protocol):
 
     def sleep(self, seconds: float) -> None:
         """Let `seconds` pass."""
-
-
-class RealClock:
-    kind = "real"
-
-    def __init__(self) -> None:
-        self._start = time.monotonic()
-
-    def now(self) -> float:
-        return time.monotonic() - self._start
-
-    def sleep(self, seconds: float) -> None:
-        if seconds > 0:
-            time.sleep(seconds)
 
 
 class VirtualClock:

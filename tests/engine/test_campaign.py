@@ -132,3 +132,27 @@ def test_soak_that_never_settles_stores_its_trace_and_aborts(write, workdir: Pat
         soak = f["soaks/T30"]
         assert soak.attrs["outcome"] == "timeout"
         assert soak["dut_c"].shape[1] == 4 and soak["t_s"].shape[0] > 100
+
+
+def test_chamber_alarm_during_the_soak_aborts(write, workdir: Path) -> None:
+    def alarm_after_ten_minutes(instruments):
+        lab_clock = instruments.chamber._lab.clock
+        instruments.chamber.alarm_active = lambda: lab_clock.now() > 600
+
+    output, instruments, error = run_tiny(write, workdir, alarm_after_ten_minutes)
+    assert "chamber (in-process virtual lab): controller alarm active" in str(error)
+    assert_safe(instruments, output)
+
+
+def test_same_seed_same_data_other_seed_other_noise(write, workdir: Path) -> None:
+    def raw_codes(seed: int, name: str) -> np.ndarray:
+        output = workdir / name
+        run_campaign(prepare(write("tiny.yaml", TINY_PROCEDURE)), output, dry_run=True, seed=seed, overwrite=False)
+        with h5py.File(output, "r") as f:
+            return f["duts/ADX355-A001/raw_codes"][:]
+
+    first, again, other = raw_codes(5, "a.h5"), raw_codes(5, "b.h5"), raw_codes(6, "c.h5")
+    np.testing.assert_array_equal(first, again)
+    assert not np.array_equal(first, other)
+    # Different noise, same sensor: the pose means agree within a few standard errors (0.2 mg / √20).
+    np.testing.assert_allclose(first.mean(axis=1), other.mean(axis=1), atol=5 * 0.2e-3 * 256000 / np.sqrt(20))
