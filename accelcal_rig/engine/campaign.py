@@ -169,12 +169,13 @@ class CampaignRunner:
             detector.add(self.clock.now(), self._chamber_temperature_c(), dut_c)
             return detector.is_stable()
 
-        outcome = "stable"
+        outcome, t_stable = "fault", float("nan")  # what the file says if anything but the deadline stops it
         try:
             t_stable = wait_until(self.clock, poll, timeout_s=criterion.timeout_min * 60.0, poll_s=criterion.poll_s,
                                   what=f"{label}: DUT temperatures stable within {criterion.band_c:g} °C")
+            outcome = "stable"
         except WaitTimeout:
-            outcome, t_stable = "timeout", self.clock.now()
+            outcome = "timeout"
             raise
         finally:
             t, chamber, dut = detector.trace()

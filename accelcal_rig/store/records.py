@@ -41,12 +41,12 @@ class SoakTrace:
 
     label: str
     setpoint_c: float
-    outcome: str                      # "stable" (the only outcome that lets poses follow, for now)
+    outcome: str                      # "stable"; "timeout" or "fault" when the campaign aborted during it
     t_s: np.ndarray                   # (n,)
     chamber_c: np.ndarray             # (n,)
     dut_c: np.ndarray                 # (n, n_dut)
     t_reached_s: float                # chamber air within tolerance of the setpoint
-    t_stable_s: float
+    t_stable_s: float                 # NaN unless stable
     settled_dut_c: np.ndarray         # (n_dut,) mean over the final window
 
 

@@ -142,6 +142,9 @@ def test_chamber_alarm_during_the_soak_aborts(write, workdir: Path) -> None:
     output, instruments, error = run_tiny(write, workdir, alarm_after_ten_minutes)
     assert "chamber (in-process virtual lab): controller alarm active" in str(error)
     assert_safe(instruments, output)
+    with h5py.File(output, "r") as f:
+        assert f["soaks/T30"].attrs["outcome"] == "fault"
+        assert np.isnan(f["soaks/T30"].attrs["t_stable_s"])
 
 
 def test_same_seed_same_data_other_seed_other_noise(write, workdir: Path) -> None:
