@@ -71,6 +71,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     prepared = prepare(args.procedure, args.config)
     if args.output.exists() and not args.overwrite:
         raise ConfigError(f"{args.output}: campaign file exists; choose another -o or pass --overwrite")
+    if not args.output.parent.is_dir():
+        raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
     _configure_logging(args.output, args.verbose, args.quiet)
     signal.signal(signal.SIGTERM, _terminate)
     result = run_campaign(prepared, args.output, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite)

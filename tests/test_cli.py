@@ -97,3 +97,38 @@ def test_config_option_overrides_the_procedures_rig(write, workdir: Path, capsys
     output = workdir / "out.h5"
     assert main(["run", str(procedure), "--config", str(other), "--dry-run", "-o", str(output), "-q"]) == 0
     assert "6 of 6 × 2 DUTs" in capsys.readouterr().out
+
+
+def test_missing_output_folder_is_one_line(write, workdir: Path, capsys) -> None:
+    path = write("tiny.yaml", TINY_PROCEDURE)
+    err = one_line_error(capsys, ["run", str(path), "--dry-run", "-o", str(workdir / "no" / "such.h5")], 2)
+    assert "does not exist" in err
+
+
+def test_sigterm_mid_campaign_reaches_the_safe_state_and_keeps_the_poses(tmp_path: Path) -> None:
+    import signal
+    import time
+
+    import h5py
+
+    beside_python = Path(sys.executable).parent / "rig"
+    process = subprocess.Popen([str(beside_python), "run", str(REPO / "procedures" / "paper-24pos-thermal.yaml"),
+                                "--dry-run", "-o", "c.h5"], cwd=tmp_path, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    log = tmp_path / "c.h5.log"
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not (log.exists() and "T-30: stable" in log.read_text()):
+        time.sleep(0.02)
+    process.send_signal(signal.SIGTERM)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130, err
+    assert err.strip().splitlines()[-1] == "rig: campaign aborted, rig in safe state: terminated by signal (SIGTERM)"
+    with h5py.File(tmp_path / "c.h5", "r") as f:
+        assert f.attrs["state"] == "aborted"
+        stored = f["poses/step_key"].shape[0]
+        assert 24 <= stored < 264
+        for dut in f["duts"].values():
+            assert dut["raw_codes"].shape[0] == stored
+        safe = [m.decode() for m, k in zip(f["events/message"][:], f["events/kind"][:]) if k.decode() == "safe"]
+    assert any("chamber" in m and "to 23 °C" in m for m in safe)
+    assert sum("standby" in m for m in safe) == 4

@@ -13,7 +13,11 @@ from accelcal_rig.instruments.interfaces import Accelerometer, Chamber, Turntabl
 
 def apply_safe_state(chamber: Chamber, turntable: Turntable, sensors: list[Accelerometer],
                      safe_setpoint_c: float, events: EventLog) -> bool:
-    """Run every safe action; return True when all succeeded (failures are logged, never raised)."""
+    """Run every safe action; return True when all succeeded.
+
+    Failures are logged, never raised, and that includes interrupts: an operator pressing Ctrl-C again
+    while the rig is being made safe must not leave the remaining devices as they were.
+    """
     actions: list[tuple[str, Callable[[], None]]] = [
         (f"chamber ({chamber.endpoint}) to {safe_setpoint_c:g} °C", lambda: chamber.write_setpoint_c(safe_setpoint_c)),
         (f"turntable ({turntable.endpoint}) stop", turntable.stop),
@@ -24,7 +28,7 @@ def apply_safe_state(chamber: Chamber, turntable: Turntable, sensors: list[Accel
         try:
             action()
             events.info("safe", f"safe state: {description}")
-        except Exception as exc:  # noqa: BLE001 - one device's failure must not stop the next device
+        except BaseException as exc:  # noqa: BLE001 - neither a fault nor a second Ctrl-C may skip a device
             all_ok = False
-            events.error("safe", f"safe state FAILED: {description}: {exc}")
+            events.error("safe", f"safe state FAILED: {description}: {type(exc).__name__}: {exc}")
     return all_ok

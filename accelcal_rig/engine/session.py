@@ -14,7 +14,7 @@ from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary
 from accelcal_rig.engine.clock import Clock, VirtualClock
-from accelcal_rig.engine.events import EventLog
+from accelcal_rig.engine.events import LOGGER, EventLog
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.plan.compile import Plan, compile_plan
@@ -66,6 +66,17 @@ def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, see
     wall_start = time.perf_counter()
     clock = VirtualClock()
     instruments = build_instruments(rig.model, clock, seed)
+    try:
+        return _run_with_instruments(prepared, output, instruments, clock, dry_run=dry_run, seed=seed,
+                                     overwrite=overwrite, wall_start=wall_start)
+    finally:
+        for failure in instruments.close():
+            LOGGER.error(failure)
+
+
+def _run_with_instruments(prepared: PreparedCampaign, output: Path, instruments: RigInstruments, clock: Clock, *,
+                          dry_run: bool, seed: int, overwrite: bool, wall_start: float) -> RunResult:
+    rig = prepared.rig
     procedure = prepared.procedure.model
     acquisition = procedure.acquisition
     mounts = {s.serial: s for s in rig.model.fixture.sensors}

@@ -82,6 +82,18 @@ class RigInstruments:
     sensors: list[Accelerometer]
     truth: TruthSource | None = None
 
+    def close(self) -> list[str]:
+        """Release every connection, each in its own guard; return the failures, one line each."""
+        failures = []
+        for name, device in [("chamber", self.chamber), ("turntable", self.turntable)] + [
+            (f"sensor {s.serial}", s) for s in self.sensors
+        ]:
+            try:
+                device.close()
+            except Exception as exc:  # noqa: BLE001 - one stuck port must not keep the others open
+                failures.append(f"{name} ({device.endpoint}): close failed: {exc}")
+        return failures
+
 
 class TruthSource(Protocol):
     """Only a simulated rig has one: the hidden parameters behind the last block each DUT returned."""

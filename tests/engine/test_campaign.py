@@ -159,3 +159,17 @@ def test_same_seed_same_data_other_seed_other_noise(write, workdir: Path) -> Non
     assert not np.array_equal(first, other)
     # Different noise, same sensor: the pose means agree within a few standard errors (0.2 mg / √20).
     np.testing.assert_allclose(first.mean(axis=1), other.mean(axis=1), atol=5 * 0.2e-3 * 256000 / np.sqrt(20))
+
+
+def test_second_interrupt_during_the_safe_state_skips_no_device(write, workdir: Path) -> None:
+    def interrupt_twice(instruments):
+        def interrupt(*_):
+            raise KeyboardInterrupt
+
+        instruments.sensors[0].acquire = interrupt
+        instruments.turntable.stop = interrupt  # the operator presses Ctrl-C again while the rig is made safe
+
+    output, instruments, error = run_tiny(write, workdir, interrupt_twice)
+    assert isinstance(error.__cause__, KeyboardInterrupt)
+    assert_safe(instruments, output)
+    assert any("FAILED: turntable" in m and "KeyboardInterrupt" in m for m in events(output, "safe"))
