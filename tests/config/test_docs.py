@@ -1,0 +1,35 @@
+"""docs/procedures.md documents every key the models accept."""
+
+import typing
+
+from pydantic import BaseModel
+
+from accelcal_rig.config.procedure import Procedure
+from accelcal_rig.config.rig import RigConfig
+from tests.conftest import REPO
+
+
+def keys(model: type[BaseModel], prefix: str = "") -> set[str]:
+    """Dotted leaf keys (`soak.band_c`, `turntable.axes[].name`); sections themselves are headings."""
+    found = set()
+    for name, field in model.model_fields.items():
+        key = f"{prefix}{name}"
+        annotation = field.annotation
+        is_list = typing.get_origin(annotation) is list
+        submodels = [
+            inner
+            for member in typing.get_args(annotation) or (annotation,)
+            for inner in typing.get_args(member) or (member,)
+            if isinstance(inner, type) and issubclass(inner, BaseModel)
+        ]
+        if not submodels:
+            found.add(key)
+        for submodel in submodels:
+            found |= keys(submodel, f"{key}[]." if is_list else f"{key}.")
+    return found
+
+
+def test_every_procedure_and_rig_key_is_documented() -> None:
+    doc = (REPO / "docs" / "procedures.md").read_text()
+    missing = sorted(k for k in keys(Procedure) | keys(RigConfig) if f"`{k}`" not in doc)
+    assert not missing, f"undocumented keys: {missing}"
