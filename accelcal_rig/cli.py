@@ -12,6 +12,7 @@ from accelcal_rig import __version__
 from accelcal_rig.engine.campaign import TerminationRequested
 from accelcal_rig.engine.events import LOGGER, format_duration
 from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
+from accelcal_rig.store.atomic import stop_when_safe
 
 EXIT_INTERRUPTED = 130
 
@@ -61,8 +62,18 @@ def _configure_logging(output: Path, verbose: bool, quiet: bool) -> None:
     LOGGER.addHandler(log_file)
 
 
-def _terminate(signum: int, frame: object) -> None:
-    raise TerminationRequested()
+class _StopOnFirstSignal:
+    """SIGINT or SIGTERM stops the campaign through its safe state; later signals must not cut that short."""
+
+    def __init__(self) -> None:
+        self.stopping = False
+
+    def __call__(self, signum: int, frame: object) -> None:
+        if self.stopping:
+            LOGGER.warning("%s ignored: already stopping, the rig is being made safe", signal.Signals(signum).name)
+            return
+        self.stopping = True
+        stop_when_safe(KeyboardInterrupt() if signum == signal.SIGINT else TerminationRequested())
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
@@ -74,8 +85,15 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
     _configure_logging(args.output, args.verbose, args.quiet)
-    signal.signal(signal.SIGTERM, _terminate)
-    result = run_campaign(prepared, args.output, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite)
+    stop = _StopOnFirstSignal()
+    signal.signal(signal.SIGINT, stop)
+    signal.signal(signal.SIGTERM, stop)
+    try:
+        result = run_campaign(prepared, args.output, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite)
+    finally:
+        # The campaign is recorded, safe or done: a late signal must not turn the exit into a crash.
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
     summary = result.summary
     setpoints = summary.setpoints_c
     size_mb = result.output.stat().st_size / 1e6

@@ -25,6 +25,7 @@ from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.interfaces import RigInstruments, SampleBlock
 from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable
 from accelcal_rig.plan.compile import Plan, PlanStep, setpoint_label
+from accelcal_rig.store.atomic import signals_deferred
 from accelcal_rig.store.campaign_file import CampaignWriter
 from accelcal_rig.store.records import DutPoseRecord, PoseRecord, SoakTrace
 
@@ -90,7 +91,14 @@ class CampaignRunner:
             raise CampaignAborted(reason) from exc
 
     def _abort(self, reason: str) -> None:
-        """Safe state first, bookkeeping after: a broken file must not keep the rig unsafe."""
+        """Safe state first, bookkeeping after: a broken file must not keep the rig unsafe.
+
+        Signals wait until the abort is complete: a Ctrl-C now cannot cut the safe state short.
+        """
+        with signals_deferred():
+            self._make_safe_and_record(reason)
+
+    def _make_safe_and_record(self, reason: str) -> None:
         if self.machine.state in ACTIVE_STATES:
             self.machine.go(State.ABORTING, reason)
             self.machine.go(State.SAFE, "abort")
@@ -249,7 +257,7 @@ class CampaignRunner:
             self.events.warning("pose", f"sensor {sensor.serial}: temperature {before:.2f}/{after:.2f} °C left the "
                                         f"±{band:g} °C band around {self._settled_dut_c[index]:.2f} °C")
         return DutPoseRecord(
-            serial=sensor.serial, codes_xyz=codes, mean_g=mean_g, stderr_g=stderr_g,
+            serial=sensor.serial, raw_codes=codes, mean_g=mean_g, stderr_g=stderr_g,
             temperature_c=block.temperature_c,
             gravity_reference_g=self._mounts[sensor.serial].inv().apply(gravity_fixture),
             temperature_in_band=in_band,

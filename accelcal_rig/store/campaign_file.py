@@ -17,9 +17,15 @@ import numpy as np
 from accelcal_rig import __version__
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.plan.compile import Plan
+from accelcal_rig.store.atomic import signals_deferred
 from accelcal_rig.store.records import Event, PoseRecord, SoakTrace
 
 FORMAT_NAME = "accelcal-rig campaign"
+_POSE_FIELDS = ("step_key", "setpoint_c", "pose_number", "commanded_angles_deg", "measured_angles_deg",
+                "gravity_fixture", "t_start_s", "t_end_s", "chamber_temperature_c")
+_DUT_FIELDS = ("raw_codes", "mean_g", "stderr_g", "temperature_c", "gravity_reference_g", "temperature_in_band")
+_TRUTH_FIELDS = ("parameters", "gravity_g", "temperature_c")
+_EVENT_FIELDS = ("t_s", "wall_time", "level", "kind", "message")
 FORMAT_VERSION = 1
 TEXT = h5py.string_dtype("utf-8")
 
@@ -52,12 +58,12 @@ class CampaignWriter:
         self._datasets: dict[str, h5py.Dataset] = {}
         self._pending_events: list[tuple[float, str, str, str, str]] = []
 
-    def _append(self, path: str, row: Any) -> None:
-        """Append one row to the growable dataset at `path` (handles cached: lookups cost more than writes)."""
+    def _dataset(self, path: str) -> h5py.Dataset:
+        """The dataset at `path`, its handle cached: lookups cost more than the writes themselves."""
         dataset = self._datasets.get(path)
         if dataset is None:
             dataset = self._datasets[path] = self._file[path]
-        _append_rows(dataset, [row])
+        return dataset
 
     @classmethod
     def create(cls, path: Path, *, overwrite: bool, attrs: dict[str, Any], procedure_yaml: str,
@@ -86,7 +92,7 @@ class CampaignWriter:
         file.create_group("soaks")
         events = file.create_group("events")
         _growable(events, "t_s", (), "f8", "s", chunk_rows=256)
-        for name in ("wall_time", "level", "kind", "message"):
+        for name in _EVENT_FIELDS[1:]:
             _growable(events, name, (), TEXT, chunk_rows=256)
         file.flush()
         return cls(file)
@@ -131,6 +137,10 @@ class CampaignWriter:
 
     def write_truth_header(self, serial: str, description: dict[str, Any]) -> None:
         """Open `simulation_truth/<serial>`: the hidden model of a simulated DUT, never a measurement."""
+        with signals_deferred():
+            self._write_truth_header(serial, description)
+
+    def _write_truth_header(self, serial: str, description: dict[str, Any]) -> None:
         root = self._file.require_group("simulation_truth")
         root.attrs["note"] = "SIMULATION TRUTH: hidden parameters of simulated DUTs, not measured data"
         group = root.create_group(serial)
@@ -141,31 +151,49 @@ class CampaignWriter:
         _growable(group, "temperature_c", (), "f8", "degC")
 
     def append_pose(self, pose: PoseRecord) -> None:
-        """Store one pose for every DUT, then flush: after this returns, the pose is on disk."""
-        for name in ("step_key", "setpoint_c", "pose_number", "commanded_angles_deg", "measured_angles_deg",
-                     "gravity_fixture", "t_start_s", "t_end_s", "chamber_temperature_c"):
-            self._append(f"poses/{name}", getattr(pose, name))
+        """Store one pose for every DUT, then flush: after this returns, the pose is on disk.
+
+        All or nothing: signals wait until the pose is written, and a write that fails midway is rolled
+        back, so every pose-aligned dataset always has the same number of rows.
+        """
+        rows = {f"poses/{name}": getattr(pose, name) for name in _POSE_FIELDS}
         for dut in pose.duts:
-            prefix = f"duts/{dut.serial}"
-            self._append(f"{prefix}/raw_codes", dut.codes_xyz)
-            for name in ("mean_g", "stderr_g", "temperature_c", "gravity_reference_g", "temperature_in_band"):
-                self._append(f"{prefix}/{name}", getattr(dut, name))
+            rows.update({f"duts/{dut.serial}/{name}": getattr(dut, name) for name in _DUT_FIELDS})
             if dut.truth is not None:
-                for name in ("parameters", "gravity_g", "temperature_c"):
-                    self._append(f"simulation_truth/{dut.serial}/{name}", dut.truth[name])
-        self._file.attrs["poses_done"] = self._datasets["poses/step_key"].shape[0]
-        self.flush()
+                rows.update({f"simulation_truth/{dut.serial}/{name}": dut.truth[name] for name in _TRUTH_FIELDS})
+        with signals_deferred():
+            before = self._dataset("poses/step_key").shape[0]
+            try:
+                for path, row in rows.items():
+                    _append_rows(self._dataset(path), [row])
+                self._file.attrs["poses_done"] = before + 1
+                self.flush()
+            except BaseException:
+                for path in rows:
+                    self._dataset(path).resize(before, axis=0)
+                raise
 
     def flush(self) -> None:
-        """Write buffered events and push everything to disk."""
-        if self._pending_events:
-            columns = list(zip(*self._pending_events))
-            for name, column in zip(("t_s", "wall_time", "level", "kind", "message"), columns):
-                _append_rows(self._file[f"events/{name}"], list(column))
-            self._pending_events.clear()
-        self._file.flush()
+        """Write buffered events (all columns or none) and push everything to disk."""
+        with signals_deferred():
+            if self._pending_events:
+                columns = dict(zip(_EVENT_FIELDS, zip(*self._pending_events)))
+                before = self._dataset("events/t_s").shape[0]
+                try:
+                    for name, column in columns.items():
+                        _append_rows(self._dataset(f"events/{name}"), list(column))
+                except BaseException:
+                    for name in columns:
+                        self._dataset(f"events/{name}").resize(before, axis=0)
+                    raise
+                self._pending_events.clear()
+            self._file.flush()
 
     def write_soak(self, soak: SoakTrace) -> None:
+        with signals_deferred():
+            self._write_soak(soak)
+
+    def _write_soak(self, soak: SoakTrace) -> None:
         group = self._file["soaks"].create_group(soak.label)
         group.attrs.update({"setpoint_c": soak.setpoint_c, "outcome": soak.outcome,
                             "t_reached_s": soak.t_reached_s, "t_stable_s": soak.t_stable_s})
@@ -179,16 +207,14 @@ class CampaignWriter:
         """Buffer an event; it reaches the file with the next pose, soak or state change."""
         self._pending_events.append((event.t_s, utc_now(), event.level, event.kind, event.message))
 
-    def set_state(self, state: str, *, reason: str = "", finished: bool = False,
-                  extra: dict[str, Any] | None = None) -> None:
-        self._file.attrs["state"] = state
-        if reason:
-            self._file.attrs["abort_reason"] = reason
-        if finished:
-            self._file.attrs["finished"] = utc_now()
-        if extra:
-            self._file.attrs.update(extra)
-        self.flush()
+    def set_state(self, state: str, *, reason: str = "", finished: bool = False) -> None:
+        with signals_deferred():
+            self._file.attrs["state"] = state
+            if reason:
+                self._file.attrs["abort_reason"] = reason
+            if finished:
+                self._file.attrs["finished"] = utc_now()
+            self.flush()
 
     def close(self) -> None:
         if self._file.id.valid:

@@ -12,7 +12,7 @@ class DutPoseRecord:
     """One DUT's measurement of one pose."""
 
     serial: str
-    codes_xyz: np.ndarray            # (n, 3) signed 20-bit codes
+    raw_codes: np.ndarray            # (n, 3) signed 20-bit codes
     mean_g: np.ndarray               # (3,)
     stderr_g: np.ndarray             # (3,) standard error of the mean
     temperature_c: tuple[float, float]  # DUT's own sensor, before and after the block

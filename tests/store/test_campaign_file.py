@@ -69,3 +69,38 @@ def test_the_documented_reading_snippet_runs(campaign: Path) -> None:
     snippet = re.search(r"```python\n(.*?)```", doc, re.S).group(1).replace("campaign.h5", str(campaign))
     result = subprocess.run([sys.executable, "-c", snippet], capture_output=True, text=True, check=True)
     assert result.stdout.count("(6, 3)") == 4
+
+
+def test_a_pose_write_that_fails_midway_is_rolled_back(write, workdir: Path) -> None:
+    """Disk trouble in the middle of a pose leaves no partial rows behind."""
+    from accelcal_rig.errors import CampaignAborted
+    from accelcal_rig.store import campaign_file
+
+    original = campaign_file._append_rows
+
+    def failing_append(dataset, rows):
+        if dataset.name == "/duts/ADX355-A003/mean_g" and dataset.shape[0] == 2:  # third pose, third DUT
+            raise OSError("no space left on device")
+        original(dataset, rows)
+
+    campaign_file._append_rows = failing_append
+    output = workdir / "campaign.h5"
+    try:
+        with pytest.raises(CampaignAborted, match="no space left"):
+            run_campaign(prepare(write("tiny.yaml", TINY_PROCEDURE)), output, dry_run=True, seed=3, overwrite=False)
+    finally:
+        campaign_file._append_rows = original
+    with h5py.File(output, "r") as f:
+        lengths = {name: d.shape[0] for name, d in _pose_aligned(f)}
+        assert set(lengths.values()) == {2}, lengths
+        assert f.attrs["poses_done"] == 2 and f.attrs["state"] == "aborted"
+
+
+def _pose_aligned(f: h5py.File):
+    for name in f["poses"]:
+        yield f"poses/{name}", f[f"poses/{name}"]
+    for group in ("duts", "simulation_truth"):
+        for serial in f[group]:
+            for name, dataset in f[f"{group}/{serial}"].items():
+                if dataset.maxshape[0] is None:
+                    yield f"{group}/{serial}/{name}", dataset
