@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import logging
 import signal
 import sys
@@ -34,6 +35,8 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--dry-run", action="store_true", help="simulated rig in virtual time")
     run.add_argument("--seed", type=int, default=0, help="seed of the simulated noise (default 0)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing campaign file")
+    run.add_argument("--calibration", type=Path,
+                     help="calibration file the final fit writes (default: beside the campaign, .calibration.yaml)")
     run.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
     run.add_argument("-q", "--quiet", action="store_true", help="print only warnings and the summary")
 
@@ -45,6 +48,22 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     status.add_argument("campaign", type=Path, help="campaign file (HDF5)")
     status.add_argument("--json", action="store_true", help="print one JSON object")
+
+    fit = commands.add_parser(
+        "fit", help="fit the error model of every DUT and write a calibration file",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="LM fit of Eq. 1 at each setpoint, polynomials over the sensor temperature (Eq. 8), metrics. "
+                    "Results also replace the campaign file's fit/ group; measured data are never touched.",
+        epilog="example:\n  rig fit campaign.h5 -o calibration.yaml --json",
+    )
+    fit.add_argument("campaign", type=Path, help="campaign file (HDF5)")
+    fit.add_argument("-o", "--output", type=Path, required=True, help="calibration file to write (YAML)")
+    fit.add_argument("--mode", choices=["reference", "norm-only"], help="default: the procedure's fit.mode")
+    fit.add_argument("--degree", type=int, choices=range(0, 7), metavar="0..6",
+                     help="polynomial degree (default: the procedure's fit.polynomial_degree)")
+    fit.add_argument("--parameters", choices=["all", "bias-scale"], help="default: the procedure's fit.parameters")
+    fit.add_argument("--out-of-range", choices=["clamp", "extrapolate"], help="default: the procedure's")
+    fit.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
     return parser
 
 
@@ -85,11 +104,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
     _configure_logging(args.output, args.verbose, args.quiet)
+    calibration = args.calibration or args.output.with_suffix(".calibration.yaml")
     stop = _StopOnFirstSignal()
     signal.signal(signal.SIGINT, stop)
     signal.signal(signal.SIGTERM, stop)
     try:
-        result = run_campaign(prepared, args.output, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite)
+        result = run_campaign(prepared, args.output, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite,
+                              calibration=calibration)
     finally:
         # The campaign is recorded, safe or done: a late signal must not turn the exit into a crash.
         signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -103,6 +124,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
           f"{prepared.procedure.model.acquisition.samples_per_pose} samples")
     print(f"  duration   {format_duration(summary.virtual_duration_s)} virtual, {result.wall_s:.1f} s wall")
     print(f"  output     {result.output} ({size_mb:.1f} MB)")
+    if summary.fit_failed:
+        print(f"rig: campaign done but the fit failed: {summary.fit}", file=sys.stderr)
+        return 1
+    print(f"  fit        {summary.fit}")
     return 0
 
 
@@ -118,9 +143,48 @@ def _cmd_status(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_fit(args: argparse.Namespace) -> int:
+    from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
+    from accelcal_rig.store.read import open_campaign_for_update
+
+    with open_campaign_for_update(args.campaign) as file:
+        attrs = file.attrs
+        options = FitOptions(
+            mode=args.mode or str(attrs.get("fit_mode", "reference")),
+            degree=args.degree if args.degree is not None else int(attrs.get("polynomial_degree", 3)),
+            free=args.parameters or str(attrs.get("fit_parameters", "all")),
+            out_of_range=args.out_of_range or str(attrs.get("fit_out_of_range", "clamp")),
+        )
+        state = str(attrs["state"])
+        try:
+            _, report = fit_and_save(file, args.campaign, args.output, options)
+        except ValueError as exc:
+            raise RigError(f"{args.campaign}: fit failed: {exc}") from None
+    if state != "done":
+        print(f"rig: warning: campaign state is {state}: fitted the poses stored so far", file=sys.stderr)
+    if args.json:
+        print(json.dumps(report))
+    else:
+        _print_fit_table(report)
+        print(summary_line(report, args.output))
+    return 0
+
+
+def _print_fit_table(report: dict) -> None:
+    print(f"{'sensor':14s} {'before mg':>10s} {'after mg':>9s} {'floor mg':>9s} {'drift before mg':>22s} "
+          f"{'drift after mg':>22s}")
+    for serial, r in report.items():
+        drift_before = " ".join(f"{v:6.2f}" for v in r["drift_before_mg"])
+        drift_after = " ".join(f"{v:6.3f}" for v in r["drift_after_mg"])
+        print(f"{serial:14s} {r['rmse_before_mg']:10.3f} {r['rmse_after_mg']:9.4f} {r['noise_floor_mg']:9.4f} "
+              f"{drift_before:>22s} {drift_after:>22s}")
+        for warning in r["warnings"]:
+            print(f"  warning: {warning}")
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _build_parser().parse_args(argv)
-    handler = {"run": _cmd_run, "status": _cmd_status}[args.command]
+    handler = {"run": _cmd_run, "status": _cmd_status, "fit": _cmd_fit}[args.command]
     try:
         return handler(args)
     except CampaignAborted as exc:

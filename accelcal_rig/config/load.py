@@ -31,7 +31,8 @@ class LoadedConfig(Generic[ModelT]):
         return ConfigError(f"{self.path}:{line}: {format_key(shown)}: {message}")
 
 
-def _load(path: Path, model: type[ModelT]) -> LoadedConfig[ModelT]:
+def load_validated(path: Path, model: type[ModelT]) -> LoadedConfig[ModelT]:
+    """Parse and validate any of the project's YAML files; errors read `file:line: key: message`."""
     data, lines, text = load_yaml_with_lines(path)
     try:
         validated = model.model_validate(data)
@@ -46,11 +47,11 @@ def _load(path: Path, model: type[ModelT]) -> LoadedConfig[ModelT]:
 
 
 def load_procedure(path: Path) -> LoadedConfig[Procedure]:
-    return _load(path, Procedure)
+    return load_validated(path, Procedure)
 
 
 def load_rig(path: Path) -> LoadedConfig[RigConfig]:
-    return _load(path, RigConfig)
+    return load_validated(path, RigConfig)
 
 
 def resolve_rig_path(procedure: LoadedConfig[Procedure], override: Path | None) -> Path:

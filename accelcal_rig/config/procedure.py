@@ -88,6 +88,8 @@ class FitOptions(_Strict):
 
     mode: Literal["reference", "norm-only"] = "reference"
     polynomial_degree: int = Field(3, ge=0, le=6)
+    parameters: Literal["all", "bias-scale"] = "all"
+    out_of_range: Literal["clamp", "extrapolate"] = "clamp"
 
 
 class Procedure(_Strict):

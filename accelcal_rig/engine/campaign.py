@@ -6,9 +6,11 @@ the campaign file's event log, and is raised again as CampaignAborted with a one
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import groupby
 
+import h5py
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -38,6 +40,10 @@ class TerminationRequested(BaseException):
     """SIGTERM arrived: stop like Ctrl-C, through the safe state."""
 
 
+#: Runs on the open campaign file once the rig is safe; returns a one-line summary of the calibration.
+FitStage = Callable[[h5py.File], str]
+
+
 @dataclass(frozen=True)
 class CampaignSummary:
     state: str
@@ -46,11 +52,13 @@ class CampaignSummary:
     poses_total: int
     n_duts: int
     virtual_duration_s: float
+    fit: str = ""                 # the fit stage's summary, or why it failed
+    fit_failed: bool = False
 
 
 class CampaignRunner:
     def __init__(self, procedure: Procedure, rig: RigConfig, plan: Plan, instruments: RigInstruments,
-                 writer: CampaignWriter, clock: Clock, events: EventLog) -> None:
+                 writer: CampaignWriter, clock: Clock, events: EventLog, fit_stage: FitStage | None = None) -> None:
         self.procedure = procedure
         self.rig = rig
         self.plan = plan
@@ -61,6 +69,7 @@ class CampaignRunner:
         self.writer = writer
         self.clock = clock
         self.events = events
+        self.fit_stage = fit_stage
         self.machine = StateMachine(self._record_transition)
         self.poses_done = 0
         self._mounts = {s.serial: Rotation.from_euler("xyz", s.mount_euler_deg, degrees=True)
@@ -82,9 +91,10 @@ class CampaignRunner:
                 self._run_setpoint(setpoint, list(steps))
             self.machine.go(State.SAFE, "campaign complete")
             apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
+            fit, fit_failed = self._fit() if self.fit_stage is not None else ("", False)
             self.machine.go(State.DONE)
             self.writer.set_state("done", finished=True)
-            return self._summary("done")
+            return self._summary("done", fit, fit_failed)
         except BaseException as exc:  # noqa: BLE001 - every exit path goes through the safe state
             reason = _one_line_reason(exc)
             self._abort(reason)
@@ -111,9 +121,21 @@ class CampaignRunner:
         except Exception as exc:  # noqa: BLE001 - the reason still reaches the operator through the exception
             LOGGER.error("could not record the abort in the campaign file: %s", exc)
 
-    def _summary(self, state: str) -> CampaignSummary:
+    def _fit(self) -> tuple[str, bool]:
+        """The measurements are complete and the rig is safe: a fit that fails is reported, not an abort."""
+        assert self.fit_stage is not None
+        self.machine.go(State.FIT)
+        try:
+            summary = self.fit_stage(self.writer.file)
+        except (ValueError, KeyError, np.linalg.LinAlgError) as exc:
+            self.events.error("fit", f"fit failed: {exc}")
+            return str(exc), True
+        self.events.info("fit", summary)
+        return summary, False
+
+    def _summary(self, state: str, fit: str = "", fit_failed: bool = False) -> CampaignSummary:
         return CampaignSummary(state, self.plan.setpoints_c, self.poses_done, len(self.plan.pose_steps),
-                               len(self.sensors), self.clock.now())
+                               len(self.sensors), self.clock.now(), fit, fit_failed)
 
     def _record_transition(self, previous: State, target: State, reason: str) -> None:
         suffix = f" ({reason})" if reason else ""

@@ -7,14 +7,17 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+import h5py
+
 from accelcal_rig.config.load import (
     LoadedConfig, check_procedure_against_rig, load_procedure, load_rig, resolve_rig_path,
 )
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary
+from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitStage
 from accelcal_rig.engine.clock import Clock, VirtualClock
 from accelcal_rig.engine.events import LOGGER, EventLog
+from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.plan.compile import Plan, compile_plan
@@ -54,9 +57,11 @@ InstrumentFactory = Callable[[RigConfig, Clock, int], RigInstruments]
 
 
 def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, seed: int, overwrite: bool,
+                 calibration: Path | None = None,
                  build_instruments: InstrumentFactory = build_simulated_rig) -> RunResult:
     """Run the whole campaign into `output`. Raises CampaignAborted after reaching the safe state.
 
+    With `calibration`, the fit stage runs once the rig is safe and writes the calibration file there.
     `build_instruments` connects the rig (the simulated one by default) on the campaign's clock.
     """
     rig = prepared.rig
@@ -68,14 +73,15 @@ def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, see
     instruments = build_instruments(rig.model, clock, seed)
     try:
         return _run_with_instruments(prepared, output, instruments, clock, dry_run=dry_run, seed=seed,
-                                     overwrite=overwrite, wall_start=wall_start)
+                                     overwrite=overwrite, wall_start=wall_start, calibration=calibration)
     finally:
         for failure in instruments.close():
             LOGGER.error(failure)
 
 
 def _run_with_instruments(prepared: PreparedCampaign, output: Path, instruments: RigInstruments, clock: Clock, *,
-                          dry_run: bool, seed: int, overwrite: bool, wall_start: float) -> RunResult:
+                          dry_run: bool, seed: int, overwrite: bool, wall_start: float,
+                          calibration: Path | None) -> RunResult:
     rig = prepared.rig
     procedure = prepared.procedure.model
     acquisition = procedure.acquisition
@@ -95,7 +101,8 @@ def _run_with_instruments(prepared: PreparedCampaign, output: Path, instruments:
         attrs={"procedure_name": procedure.name, "procedure_path": str(prepared.procedure.path),
                "rig_name": rig.model.name, "rig_path": str(rig.path), "dry_run": dry_run, "seed": seed,
                "clock": clock.kind, "samples_per_pose": acquisition.samples_per_pose,
-               "fit_mode": procedure.fit.mode, "polynomial_degree": procedure.fit.polynomial_degree},
+               "fit_mode": procedure.fit.mode, "polynomial_degree": procedure.fit.polynomial_degree,
+               "fit_parameters": procedure.fit.parameters, "fit_out_of_range": procedure.fit.out_of_range},
         procedure_yaml=prepared.procedure.text, rig_yaml=rig.text, plan=prepared.plan, duts=duts,
         instruments=instrument_info, samples_per_pose=acquisition.samples_per_pose,
     )
@@ -104,8 +111,20 @@ def _run_with_instruments(prepared: PreparedCampaign, output: Path, instruments:
             for sensor in instruments.sensors:
                 writer.write_truth_header(sensor.serial, instruments.truth.describe(sensor.serial))
         events = EventLog(clock, writer)
-        runner = CampaignRunner(procedure, rig.model, prepared.plan, instruments, writer, clock, events)
+        runner = CampaignRunner(procedure, rig.model, prepared.plan, instruments, writer, clock, events,
+                                fit_stage=_fit_stage(procedure, output, calibration) if calibration else None)
         summary = runner.run()
     finally:
         writer.close()
     return RunResult(summary, time.perf_counter() - wall_start, output)
+
+
+def _fit_stage(procedure: Procedure, output: Path, calibration: Path) -> FitStage:
+    options = FitOptions(mode=procedure.fit.mode, degree=procedure.fit.polynomial_degree,
+                         free=procedure.fit.parameters, out_of_range=procedure.fit.out_of_range)
+
+    def stage(file: h5py.File) -> str:
+        _, report = fit_and_save(file, output, calibration, options)
+        return summary_line(report, calibration)
+
+    return stage

@@ -16,13 +16,14 @@ class State(StrEnum):
     ACQUIRE = "acquire"
     STORE = "store"
     SAFE = "safe"
+    FIT = "fit"
     DONE = "done"
     ABORTING = "aborting"
     ABORTED = "aborted"
 
 
 ACTIVE_STATES = frozenset({State.IDLE, State.PREFLIGHT, State.RAMP, State.SOAK, State.MOVE, State.SETTLE, State.ACQUIRE,
-           State.STORE})
+           State.STORE, State.FIT})
 
 TRANSITIONS: dict[State, frozenset[State]] = {
     State.IDLE: frozenset({State.PREFLIGHT}),
@@ -33,7 +34,8 @@ TRANSITIONS: dict[State, frozenset[State]] = {
     State.SETTLE: frozenset({State.ACQUIRE}),
     State.ACQUIRE: frozenset({State.STORE}),
     State.STORE: frozenset({State.MOVE, State.RAMP, State.SAFE}),
-    State.SAFE: frozenset({State.DONE, State.ABORTED}),
+    State.SAFE: frozenset({State.FIT, State.DONE, State.ABORTED}),
+    State.FIT: frozenset({State.DONE}),
     State.ABORTING: frozenset({State.SAFE}),
     State.DONE: frozenset(),
     State.ABORTED: frozenset(),

@@ -48,3 +48,25 @@ def distort(true_g: np.ndarray, params: np.ndarray) -> np.ndarray:
     a_inv = np.linalg.inv(error_matrix(params))
     b = np.asarray(params, dtype=float)[..., 0:3]
     return np.einsum("...ij,...j->...i", a_inv, np.asarray(true_g, dtype=float)) + b
+
+
+def norm_only_gauge(params: np.ndarray) -> np.ndarray:
+    """The parameters in the norm-only gauge that describe the same |U_SF| everywhere.
+
+    |A·v| depends on A only through AᵀA, so the equivalent A' = C'·S' is the lower-triangular L with
+    LᵀL = AᵀA and a positive diagonal (M' = identity). With J the reversal permutation, J·AᵀA·J = K·Kᵀ
+    (Cholesky, K lower) gives L = J·Kᵀ·J. Bias is unchanged.
+    """
+    params = np.asarray(params, dtype=float)
+    a = error_matrix(params)
+    reverse = np.eye(3)[::-1]
+    k = np.linalg.cholesky(reverse @ np.swapaxes(a, -1, -2) @ a @ reverse)
+    lower = reverse @ np.swapaxes(k, -1, -2) @ reverse
+    scale = np.diagonal(lower, axis1=-2, axis2=-1)
+    gauged = np.array(params, copy=True)
+    gauged[..., 3:6] = scale
+    gauged[..., 6] = lower[..., 1, 0] / scale[..., 0]
+    gauged[..., 7] = lower[..., 2, 0] / scale[..., 0]
+    gauged[..., 8] = lower[..., 2, 1] / scale[..., 1]
+    gauged[..., 9:12] = 0.0
+    return gauged

@@ -58,6 +58,11 @@ class CampaignWriter:
         self._datasets: dict[str, h5py.Dataset] = {}
         self._pending_events: list[tuple[float, str, str, str, str]] = []
 
+    @property
+    def file(self) -> h5py.File:
+        """The open file, for stages that read what was stored (the fit) and add their own groups."""
+        return self._file
+
     def _dataset(self, path: str) -> h5py.Dataset:
         """The dataset at `path`, its handle cached: lookups cost more than the writes themselves."""
         dataset = self._datasets.get(path)

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import h5py
+import numpy as np
 
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.store.campaign_file import FORMAT_NAME
@@ -24,6 +27,15 @@ def open_campaign(path: Path) -> h5py.File:
         file.close()
         raise ConfigError(f"{path}: not an accelcal-rig campaign file")
     return file
+
+
+def open_campaign_for_update(path: Path) -> h5py.File:
+    """Open for adding results (the fit); refused while another process holds the file (a running campaign)."""
+    open_campaign(path).close()  # same existence and format checks
+    try:
+        return h5py.File(path, "a")
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot open for writing (is a campaign still running on it?): {exc}") from None
 
 
 def _text(value: Any) -> str:
@@ -61,3 +73,45 @@ def campaign_status(path: Path) -> dict[str, Any]:
 
 def status_json(path: Path) -> str:
     return json.dumps(campaign_status(path))
+
+
+@dataclass(frozen=True)
+class DutPoses:
+    """One DUT's stored poses as arrays (row i is pose i of `poses/`)."""
+
+    serial: str
+    range_g: int
+    lsb_g: float
+    setpoint_c: np.ndarray            # (N,)
+    temperature_c: np.ndarray         # (N,) DUT's own sensor, mean of before and after the block
+    mean_g: np.ndarray                # (N, 3)
+    stderr_g: np.ndarray              # (N, 3)
+    reference_g: np.ndarray           # (N, 3) expected reading from the turntable
+    truth_parameters: np.ndarray | None  # (N, 12) simulation truth, dry runs only
+
+
+def read_dut_poses(file: h5py.File, serial: str) -> DutPoses:
+    dut = file["duts"][serial]
+    truth = file.get(f"simulation_truth/{serial}/parameters")
+    return DutPoses(
+        serial=serial,
+        range_g=int(dut.attrs["range_g"]),
+        lsb_g=float(dut.attrs["lsb_g"]),
+        setpoint_c=file["poses/setpoint_c"][:],
+        temperature_c=dut["temperature_c"][:].mean(axis=1),
+        mean_g=dut["mean_g"][:],
+        stderr_g=dut["stderr_g"][:],
+        reference_g=dut["gravity_reference_g"][:],
+        truth_parameters=truth[:] if truth is not None else None,
+    )
+
+
+def measurements_sha256(file: h5py.File) -> str:
+    """Digest of the measured data (pose keys, raw codes, temperatures, references), not of the file:
+    fit results written into the file later leave it unchanged."""
+    digest = hashlib.sha256()
+    digest.update(b"".join(k if isinstance(k, bytes) else k.encode() for k in file["poses/step_key"][:]))
+    for serial in sorted(file["duts"]):
+        for name in ("raw_codes", "temperature_c", "gravity_reference_g"):
+            digest.update(np.ascontiguousarray(file["duts"][serial][name][:]).tobytes())
+    return digest.hexdigest()

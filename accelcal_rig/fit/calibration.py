@@ -1,0 +1,150 @@
+"""The calibration file: per sensor, the thermal polynomials of Eq. 1's parameters and how they were made.
+
+A versioned YAML artefact, checked on load. `apply` compensates raw readings with it.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, field_validator
+
+from accelcal_rig.config.load import load_validated
+from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
+
+FORMAT_NAME = "accelcal-rig calibration"
+FORMAT_VERSION = 1
+
+
+class CalibrationRangeWarning(UserWarning):
+    """Samples outside the calibrated temperature range were clamped or extrapolated."""
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class PolynomialModel(_Strict):
+    """Each parameter's coefficients in x = (T − mid(domain)) / half-width(domain), increasing powers."""
+
+    domain_c: tuple[float, float]
+    degree: int = Field(ge=0)
+    coefficients: dict[str, list[float]]
+
+    @field_validator("coefficients")
+    @classmethod
+    def _all_parameters(cls, value: dict[str, list[float]]) -> dict[str, list[float]]:
+        if set(value) != set(PARAMETER_NAMES):
+            raise ValueError(f"coefficients needed for exactly {', '.join(PARAMETER_NAMES)}")
+        return value
+
+    def matrix(self) -> np.ndarray:
+        width = max(len(c) for c in self.coefficients.values())
+        return np.array([self.coefficients[n] + [0.0] * (width - len(self.coefficients[n])) for n in PARAMETER_NAMES])
+
+
+class SetpointFit(_Strict):
+    setpoint_c: float
+    temperature_c: float
+    n_poses: int
+    chi2_reduced: float | None
+    parameters: dict[str, float]
+    sigma: dict[str, float | None]
+
+
+class SensorCalibration(_Strict):
+    serial: str
+    mode: Literal["reference", "norm-only"]
+    free_parameters: list[str]
+    range_g: Literal[2, 4, 8]
+    lsb_g: float = Field(gt=0)
+    validity_c: tuple[float, float]
+    out_of_range: Literal["clamp", "extrapolate"] = "clamp"
+    polynomial: PolynomialModel
+    setpoints: list[SetpointFit]
+    metrics: dict[str, Any] = {}
+    warnings: list[str] = []
+
+    def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:
+        """Eq. 1 parameters (..., 12) at each temperature, as the file's `out_of_range` says outside it."""
+        temperature_c = np.asarray(temperature_c, dtype=float)
+        low, high = self.validity_c
+        outside = (temperature_c < low) | (temperature_c > high)
+        if np.any(outside):
+            action = "clamped to" if self.out_of_range == "clamp" else "extrapolated beyond"
+            warnings.warn(CalibrationRangeWarning(
+                f"sensor {self.serial}: {int(outside.sum())} of {outside.size} temperatures {action} the "
+                f"calibrated {low:g}…{high:g} °C"), stacklevel=3)
+        if self.out_of_range == "clamp":
+            temperature_c = np.clip(temperature_c, low, high)
+        d_low, d_high = self.polynomial.domain_c
+        x = (temperature_c - 0.5 * (d_low + d_high)) / (0.5 * (d_high - d_low))
+        return np.moveaxis(np.polynomial.polynomial.polyval(x, self.polynomial.matrix().T), 0, -1)
+
+
+class CalibrationFile(_Strict):
+    format: str
+    format_version: int
+    model: Literal["sfem-eq1"] = "sfem-eq1"
+    created: str
+    software_version: str
+    source: dict[str, str]
+    sensors: dict[str, SensorCalibration] = Field(min_length=1)
+
+    @field_validator("format")
+    @classmethod
+    def _format(cls, value: str) -> str:
+        if value != FORMAT_NAME:
+            raise ValueError(f"not an accelcal-rig calibration file (format {value!r})")
+        return value
+
+    @field_validator("format_version")
+    @classmethod
+    def _version(cls, value: int) -> int:
+        if value != FORMAT_VERSION:
+            raise ValueError(f"calibration format version {value} is not supported (this software reads {FORMAT_VERSION})")
+        return value
+
+    def sensor(self, serial: str) -> SensorCalibration:
+        try:
+            return self.sensors[serial]
+        except KeyError:
+            raise KeyError(f"no calibration for sensor {serial} (file has {', '.join(self.sensors)})") from None
+
+
+def apply(calibration: SensorCalibration, accel_g: np.ndarray, temperature_c: np.ndarray | float) -> np.ndarray:
+    """Compensate raw readings (..., 3) in g taken at the sensor's own temperatures (...) → specific force in g."""
+    return correct(np.asarray(accel_g, dtype=float), calibration.parameters_at(temperature_c))
+
+
+def apply_codes(calibration: SensorCalibration, codes: np.ndarray, temperature_c: np.ndarray | float) -> np.ndarray:
+    """As `apply`, from signed 20-bit ADXL355 codes at the calibration's range."""
+    return apply(calibration, np.asarray(codes, dtype=float) * calibration.lsb_g, temperature_c)
+
+
+def save_calibration(calibration: CalibrationFile, path: Path) -> None:
+    text = yaml.safe_dump(calibration.model_dump(mode="json"), sort_keys=False, width=120)
+    path.write_text("# accelcal-rig calibration: Eq. 1 parameters as polynomials of the sensor temperature\n" + text)
+
+
+def load_calibration(path: Path) -> CalibrationFile:
+    return load_validated(path, CalibrationFile).model
+
+
+def plain(value: Any) -> Any:
+    """numpy scalars and arrays → Python floats and lists, NaN → None, for YAML and JSON."""
+    if isinstance(value, dict):
+        return {k: plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [plain(v) for v in value]
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return None if not np.isfinite(value) else float(value)
+    if isinstance(value, np.bool_):
+        return bool(value)
+    return value

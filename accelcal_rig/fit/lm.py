@@ -1,0 +1,121 @@
+"""Levenberg–Marquardt fit of the sensor-frame error model at one temperature (paper §3.1, Eq. 3–7).
+
+Two modes. *reference*: the turntable's orientation gives the expected specific force of each pose,
+and all 12 parameters are fitted. *norm-only*: only |U_SF| = 1 g is known (Eq. 3); a rotation of the
+sensor frame is then invisible (the 24-pose design has Fisher rank 9 for the 12 parameters), so the
+fit uses the paper's own gauge — C·S lower triangular, the sensor x axis as reference, M = identity —
+and fits 9. Either mode can be restricted to bias and scale alone (6 parameters), for designs that
+cannot see more (six positions). Residuals are weighted by each pose's standard error (W of Eq. 7).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from accelcal_rig.fit.sfem import IDENTITY_PARAMETERS, PARAMETER_NAMES, correct
+
+FitMode = Literal["reference", "norm-only"]
+FreeParameters = Literal["all", "bias-scale"]
+
+#: Columns of the normalised weighted Jacobian whose smallest/largest singular value falls below this
+#: are treated as not identified by the poses.
+CONDITION_LIMIT = 1e-7
+
+
+class DegenerateDesign(ValueError):
+    """The poses cannot determine the requested parameters."""
+
+
+def free_mask(mode: FitMode, free: FreeParameters = "all") -> np.ndarray:
+    """Which of the 12 parameters a fit determines; the others stay at their identity values."""
+    mask = np.ones(12, dtype=bool)
+    if mode == "norm-only":
+        mask[9:12] = False
+    if free == "bias-scale":
+        mask[6:12] = False
+    return mask
+
+
+@dataclass(frozen=True)
+class SfemFit:
+    """One temperature's fit. `sigma` is NaN for parameters the mode does not fit."""
+
+    parameters: np.ndarray        # (12,)
+    sigma: np.ndarray             # (12,) 1σ, scaled by √χ²_red when that exceeds 1
+    free: np.ndarray              # (12,) bool
+    chi2_reduced: float
+    residuals: np.ndarray         # weighted residuals at the solution
+    n_poses: int
+    mode: FitMode
+
+
+def _norm_sigma(mean_g: np.ndarray, stderr_g: np.ndarray) -> np.ndarray:
+    """Standard error of |U| per pose: each axis's error projected on the measured direction."""
+    direction = mean_g / np.linalg.norm(mean_g, axis=1, keepdims=True)
+    return np.sqrt(np.sum((direction * stderr_g) ** 2, axis=1))
+
+
+def fit_sfem(mean_g: np.ndarray, stderr_g: np.ndarray, reference_g: np.ndarray | None, mode: FitMode,
+             free: FreeParameters = "all") -> SfemFit:
+    """Fit Eq. 1 to per-pose means (n, 3) in g; `reference_g` (n, 3) is required in reference mode."""
+    mean_g = np.asarray(mean_g, dtype=float)
+    stderr_g = np.maximum(np.asarray(stderr_g, dtype=float), 1e-9)  # a noiseless pose must not divide by 0
+    mask = free_mask(mode, free)
+    n_free = int(mask.sum())
+    n_poses = mean_g.shape[0]
+    if mode == "reference":
+        if reference_g is None:
+            raise ValueError("reference mode needs the expected gravity of each pose")
+        reference_g = np.asarray(reference_g, dtype=float)
+
+        def residuals(theta: np.ndarray) -> np.ndarray:
+            return ((correct(mean_g, _full(theta, mask)) - reference_g) / stderr_g).ravel()
+
+        n_residuals = 3 * n_poses
+    else:
+        norm_sigma = _norm_sigma(mean_g, stderr_g)
+
+        def residuals(theta: np.ndarray) -> np.ndarray:
+            return (np.linalg.norm(correct(mean_g, _full(theta, mask)), axis=1) - 1.0) / norm_sigma
+
+        n_residuals = n_poses
+    if n_residuals < n_free:
+        raise DegenerateDesign(
+            f"too few poses: {n_poses} poses give {n_residuals} equations for {n_free} parameters in {mode} mode"
+        )
+    result = least_squares(residuals, IDENTITY_PARAMETERS[mask], method="lm", xtol=1e-12, ftol=1e-12)
+    jacobian = result.jac
+    _check_identified(jacobian, mask, n_poses)
+    dof = n_residuals - n_free
+    chi2_reduced = float(result.fun @ result.fun / dof) if dof > 0 else float("nan")
+    covariance = np.linalg.inv(jacobian.T @ jacobian) * (max(1.0, chi2_reduced) if dof > 0 else 1.0)
+    sigma = np.full(12, np.nan)
+    sigma[mask] = np.sqrt(np.diag(covariance))
+    return SfemFit(_full(result.x, mask), sigma, mask, chi2_reduced, result.fun, n_poses, mode)
+
+
+def _full(theta: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    params = IDENTITY_PARAMETERS.copy()
+    params[mask] = theta
+    return params
+
+
+def _check_identified(jacobian: np.ndarray, mask: np.ndarray, n_poses: int) -> None:
+    """Refuse a fit whose poses leave some combination of parameters undetermined, naming it."""
+    norms = np.linalg.norm(jacobian, axis=0)
+    names = [n for n, free in zip(PARAMETER_NAMES, mask) if free]
+    if np.any(norms == 0):
+        blind = [n for n, norm in zip(names, norms) if norm == 0]
+        raise DegenerateDesign(f"the {n_poses} poses do not constrain {', '.join(blind)}")
+    _, singular, vt = np.linalg.svd(jacobian / norms, full_matrices=False)
+    if singular[-1] < CONDITION_LIMIT * singular[0]:
+        weakest = np.abs(vt[-1])
+        involved = [names[i] for i in np.argsort(weakest)[::-1] if weakest[i] > 0.3]
+        raise DegenerateDesign(
+            f"the {n_poses} poses cannot separate {', '.join(involved)} (condition {singular[0] / singular[-1]:.1e}); "
+            "spread the poses over more axes"
+        )
