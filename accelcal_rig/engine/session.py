@@ -8,6 +8,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
+import numpy as np
+from scipy.spatial.transform import Rotation
 
 from accelcal_rig.config.load import (
     LoadedConfig, check_procedure_against_rig, load_procedure, load_rig, resolve_rig_path,
@@ -18,6 +20,7 @@ from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitSta
 from accelcal_rig.engine.clock import Clock, VirtualClock
 from accelcal_rig.engine.events import LOGGER, EventLog
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
+from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.plan.compile import Plan, compile_plan
@@ -43,7 +46,24 @@ def prepare(procedure_path: Path, rig_override: Path | None = None) -> PreparedC
         plan = compile_plan(procedure.model, rig.model)
     except UnreachablePose as exc:
         raise procedure.error(("schedule",), f"{exc} of {rig.path}") from None
+    _check_design_identifies_fit(procedure, rig.model, plan)
     return PreparedCampaign(procedure, rig, plan)
+
+
+def _check_design_identifies_fit(procedure: LoadedConfig[Procedure], rig: RigConfig, plan: Plan) -> None:
+    """Refuse, before a long campaign, a schedule that cannot determine the fit it asks for.
+
+    A perfect sensor's readings at the planned poses, as each DUT's mount sees them, go through the same
+    fit; a design the fit would refuse afterwards is refused now.
+    """
+    fit = procedure.model.fit
+    gravity_fixture = np.array([p.gravity_fixture for p in plan.poses])
+    for sensor in rig.fixture.sensors:
+        gravity = Rotation.from_euler("xyz", sensor.mount_euler_deg, degrees=True).inv().apply(gravity_fixture)
+        try:
+            fit_sfem(gravity, np.full_like(gravity, 1e-5), gravity, fit.mode, fit.parameters)
+        except DegenerateDesign as exc:
+            raise procedure.error(("fit", "mode"), f"{exc} (sensor {sensor.serial}, {fit.parameters} parameters)") from None
 
 
 @dataclass(frozen=True)

@@ -88,3 +88,10 @@ def test_rig_errors_name_file_line_and_key(workdir: Path, replace: str, by: str,
     path.write_text(text.replace(replace, by, 1))
     with pytest.raises(ConfigError, match=expected):
         load_rig(path)
+
+
+def test_a_schedule_that_cannot_determine_the_fit_is_refused_before_the_campaign(write) -> None:
+    text = TINY_PROCEDURE + "fit: {mode: norm-only}\n"  # six positions cannot fix nine parameters from |g|
+    with pytest.raises(ConfigError, match=r"tiny.yaml:\d+: fit.mode: too few poses: 6 poses give 6 equations"):
+        prepare(write("tiny.yaml", text))
+    prepare(write("tiny.yaml", TINY_PROCEDURE + "fit: {mode: norm-only, parameters: bias-scale}\n"))
