@@ -26,9 +26,9 @@ class LoadedConfig(Generic[ModelT]):
     lines: dict[KeyPath, int]
 
     def error(self, key_path: KeyPath, message: str) -> ConfigError:
-        """A ConfigError naming this file, the line of `key_path` (or its nearest parent) and the key."""
-        shown, line = locate(self.lines, key_path)
-        return ConfigError(f"{self.path}:{line}: {format_key(shown)}: {message}")
+        """A ConfigError naming this file, the key, and its line (its nearest parent's if left to default)."""
+        _, line = locate(self.lines, key_path)
+        return ConfigError(f"{self.path}:{line}: {format_key(key_path)}: {message}")
 
 
 def load_validated(path: Path, model: type[ModelT]) -> LoadedConfig[ModelT]:

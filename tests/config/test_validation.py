@@ -92,6 +92,6 @@ def test_rig_errors_name_file_line_and_key(workdir: Path, replace: str, by: str,
 
 def test_a_schedule_that_cannot_determine_the_fit_is_refused_before_the_campaign(write) -> None:
     text = TINY_PROCEDURE + "fit: {mode: norm-only}\n"  # six positions cannot fix nine parameters from |g|
-    with pytest.raises(ConfigError, match=r"tiny.yaml:\d+: fit.mode: too few poses: 6 poses give 6 equations"):
+    with pytest.raises(ConfigError, match=r"tiny.yaml:7: fit.mode: too few poses: 6 poses give 6 equations"):
         prepare(write("tiny.yaml", text))
     prepare(write("tiny.yaml", TINY_PROCEDURE + "fit: {mode: norm-only, parameters: bias-scale}\n"))
