@@ -35,3 +35,14 @@ def write(workdir: Path):
         return path
 
     return _write
+
+
+@pytest.fixture(scope="session")
+def paper_campaign(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """One dry run of the paper campaign (11 × 24 poses, 4 DUTs), shared by the tests that only read it."""
+    from accelcal_rig.engine.session import prepare, run_campaign
+
+    output = tmp_path_factory.mktemp("paper") / "campaign.h5"
+    run_campaign(prepare(REPO / "procedures" / "paper-24pos-thermal.yaml"), output, dry_run=True, seed=0,
+                 overwrite=False)
+    return output
