@@ -26,6 +26,8 @@ def test_quick_6pos_dry_run_end_to_end(tmp_path: Path) -> None:
     assert run.returncode == 0, run.stderr
     assert "campaign done: quick-6pos" in run.stdout
     assert "12 of 12 × 4 DUTs × 200 samples" in run.stdout
+    assert "calibration → quick.calibration.yaml" in run.stdout
+    assert (tmp_path / "quick.calibration.yaml").exists()
     assert "T35: stable after" in run.stderr  # progress while it runs
     assert (tmp_path / "quick.h5.log").read_text().count("stored") >= 12
     status = rig("status", "quick.h5", "--json", cwd=tmp_path)
@@ -132,3 +134,58 @@ def test_sigterm_mid_campaign_reaches_the_safe_state_and_keeps_the_poses(tmp_pat
         safe = [m.decode() for m, k in zip(f["events/message"][:], f["events/kind"][:]) if k.decode() == "safe"]
     assert any("chamber" in m and "to 23 °C" in m for m in safe)
     assert sum("standby" in m for m in safe) == 4
+
+
+def test_rig_fit_json_report_and_calibration_file(paper_campaign: Path, tmp_path: Path, capsys) -> None:
+    campaign = tmp_path / "campaign.h5"
+    shutil.copy(paper_campaign, campaign)
+    calibration = tmp_path / "cal.yaml"
+    assert main(["fit", str(campaign), "-o", str(calibration), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert sorted(report) == ["ADX355-A001", "ADX355-A002", "ADX355-A003", "ADX355-A004"]
+    for sensor in report.values():
+        for key in ("rmse_before_mg", "rmse_after_mg", "rmse_by_setpoint", "drift_before_mg", "drift_after_mg",
+                    "noise_floor_mg", "truth_error"):
+            assert key in sensor
+        assert set(sensor["rmse_by_setpoint"][0]) >= {"setpoint_c", "before_mg", "polynomial_mg", "measurement_mg"}
+        assert len(sensor["drift_after_mg"]) == 3
+    from accelcal_rig.fit.calibration import load_calibration
+
+    loaded = load_calibration(calibration)
+    assert loaded.source["campaign"] == str(campaign) and len(loaded.source["measurements_sha256"]) == 64
+
+
+def test_rig_fit_refuses_a_file_a_campaign_still_holds(paper_campaign: Path, tmp_path: Path, capsys) -> None:
+    campaign = tmp_path / "campaign.h5"
+    shutil.copy(paper_campaign, campaign)
+    holder = subprocess.Popen(  # another process with the file open for writing, as a running campaign has
+        [sys.executable, "-c", f"import h5py, time; f = h5py.File({str(campaign)!r}, 'a'); print('open', flush=True); "
+                               "time.sleep(60)"], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "open"
+        assert main(["fit", str(campaign), "-o", str(tmp_path / "cal.yaml")]) == 2
+    finally:
+        holder.kill()
+        holder.wait()
+    err = capsys.readouterr().err
+    assert "cannot open for writing (is a campaign still running on it?)" in err and "Traceback" not in err
+
+
+def test_rig_fit_on_a_file_without_poses_is_one_line(write, workdir: Path, capsys) -> None:
+    from accelcal_rig.engine.session import prepare, run_campaign
+    from accelcal_rig.errors import CampaignAborted
+
+    campaign = workdir / "empty.h5"
+
+    def no_sensors_answer(rig, clock, seed):
+        from accelcal_rig.sim.devices import build_simulated_rig
+
+        instruments = build_simulated_rig(rig, clock, seed)
+        instruments.sensors[0].identify = lambda: (_ for _ in ()).throw(OSError("bridge not answering"))
+        return instruments
+
+    with pytest.raises(CampaignAborted):
+        run_campaign(prepare(write("tiny.yaml", TINY_PROCEDURE)), campaign, dry_run=True, seed=0, overwrite=False,
+                     build_instruments=no_sensors_answer)
+    err = one_line_error(capsys, ["fit", str(campaign), "-o", str(workdir / "cal.yaml")], 1)
+    assert "no poses stored, nothing to fit" in err

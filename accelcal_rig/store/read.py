@@ -30,12 +30,17 @@ def open_campaign(path: Path) -> h5py.File:
 
 
 def open_campaign_for_update(path: Path) -> h5py.File:
-    """Open for adding results (the fit); refused while another process holds the file (a running campaign)."""
-    open_campaign(path).close()  # same existence and format checks
+    """Open for adding results (the fit); refused while a writer holds the file (a running campaign)."""
+    if not path.exists():
+        raise ConfigError(f"{path}: no such campaign file")
     try:
-        return h5py.File(path, "a")
+        file = h5py.File(path, "a")
     except OSError as exc:
         raise ConfigError(f"{path}: cannot open for writing (is a campaign still running on it?): {exc}") from None
+    if file.attrs.get("format") != FORMAT_NAME:
+        file.close()
+        raise ConfigError(f"{path}: not an accelcal-rig campaign file")
+    return file
 
 
 def _text(value: Any) -> str:

@@ -173,3 +173,16 @@ def test_second_interrupt_during_the_safe_state_skips_no_device(write, workdir: 
     assert isinstance(error.__cause__, KeyboardInterrupt)
     assert_safe(instruments, output)
     assert any("FAILED: turntable" in m and "KeyboardInterrupt" in m for m in events(output, "safe"))
+
+
+def test_fit_stage_runs_after_the_safe_state(write, workdir: Path) -> None:
+    output = workdir / "run.h5"
+    text = TINY_PROCEDURE + "fit: {mode: reference, polynomial_degree: 0}\n"
+    result = run_campaign(prepare(write("tiny.yaml", text)), output, dry_run=True, seed=1, overwrite=False,
+                          calibration=workdir / "cal.yaml")
+    assert not result.summary.fit_failed and "calibration → " in result.summary.fit
+    states = [m.split(" (")[0].split(" → ")[1] for m in events(output, "transition")]
+    assert states[-3:] == ["safe", "fit", "done"]
+    with h5py.File(output, "r") as f:
+        assert f.attrs["state"] == "done" and "fit" in f
+    assert (workdir / "cal.yaml").exists()
