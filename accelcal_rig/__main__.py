@@ -1,3 +1,3 @@
-from accelcal_rig.cli import main
+from accelcal_rig.cli import run_program
 
-raise SystemExit(main())
+run_program()

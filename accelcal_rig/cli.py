@@ -7,6 +7,8 @@ import json
 import logging
 import signal
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from accelcal_rig import __version__
@@ -67,18 +69,25 @@ def _build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _configure_logging(output: Path, verbose: bool, quiet: bool) -> None:
-    """Console on stderr at the chosen level; the full debug log in a file beside the campaign file."""
-    LOGGER.setLevel(logging.DEBUG)
-    LOGGER.propagate = False
-    LOGGER.handlers.clear()
+@contextmanager
+def _campaign_logging(output: Path, verbose: bool, quiet: bool) -> Iterator[None]:
+    """Console on stderr at the chosen level, the full debug log in a file beside the campaign file;
+    both detached and closed when the run ends."""
     console = logging.StreamHandler(sys.stderr)
     console.setLevel(logging.DEBUG if verbose else logging.WARNING if quiet else logging.INFO)
     console.setFormatter(logging.Formatter("%(message)s"))
-    LOGGER.addHandler(console)
     log_file = logging.FileHandler(output.with_suffix(output.suffix + ".log"), mode="w", encoding="utf-8")
     log_file.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s"))
-    LOGGER.addHandler(log_file)
+    LOGGER.setLevel(logging.DEBUG)
+    LOGGER.propagate = False
+    for handler in (console, log_file):
+        LOGGER.addHandler(handler)
+    try:
+        yield
+    finally:
+        for handler in (console, log_file):
+            LOGGER.removeHandler(handler)
+            handler.close()
 
 
 class _StopOnFirstSignal:
@@ -103,18 +112,16 @@ def _cmd_run(args: argparse.Namespace) -> int:
         raise ConfigError(f"{args.output}: campaign file exists; choose another -o or pass --overwrite")
     if not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
-    _configure_logging(args.output, args.verbose, args.quiet)
     calibration = args.calibration or args.output.with_suffix(".calibration.yaml")
     stop = _StopOnFirstSignal()
-    signal.signal(signal.SIGINT, stop)
-    signal.signal(signal.SIGTERM, stop)
+    previous = {signum: signal.signal(signum, stop) for signum in (signal.SIGINT, signal.SIGTERM)}
     try:
-        result = run_campaign(prepared, args.output, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite,
-                              calibration=calibration)
+        with _campaign_logging(args.output, args.verbose, args.quiet):
+            result = run_campaign(prepared, args.output, dry_run=args.dry_run, seed=args.seed,
+                                  overwrite=args.overwrite, calibration=calibration)
     finally:
-        # The campaign is recorded, safe or done: a late signal must not turn the exit into a crash.
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
     summary = result.summary
     setpoints = summary.setpoints_c
     size_mb = result.output.stat().st_size / 1e6
@@ -180,6 +187,18 @@ def _print_fit_table(report: dict) -> None:
               f"{drift_before:>22s} {drift_after:>22s}")
         for warning in r["warnings"]:
             print(f"  warning: {warning}")
+
+
+def run_program() -> None:
+    """The `rig` executable: run the command, then exit without letting a late signal crash the exit.
+
+    By the time a command returns, its campaign is recorded (done, or aborted and safe); a second
+    Ctrl-C arriving while the interpreter shuts down must not turn that into a kill by signal.
+    """
+    code = main()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    raise SystemExit(code)
 
 
 def main(argv: list[str] | None = None) -> int:
