@@ -177,10 +177,10 @@ def test_rig_fit_on_a_file_without_poses_is_one_line(write, workdir: Path, capsy
 
     campaign = workdir / "empty.h5"
 
-    def no_sensors_answer(rig, clock, seed):
+    def no_sensors_answer(rig, procedure, clock, seed):
         from accelcal_rig.sim.devices import build_simulated_rig
 
-        instruments = build_simulated_rig(rig, clock, seed)
+        instruments = build_simulated_rig(rig, procedure, clock, seed)
         instruments.sensors[0].identify = lambda: (_ for _ in ()).throw(OSError("bridge not answering"))
         return instruments
 

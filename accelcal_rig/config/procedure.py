@@ -92,6 +92,17 @@ class FitOptions(_Strict):
     out_of_range: Literal["clamp", "extrapolate"] = "clamp"
 
 
+class SimulatedEffects(_Strict):
+    """Effects of real sensors that Eq. 1 does not contain, for dry runs only (off by default).
+
+    They show how the fit copes with reality: a calibration on such a sensor cannot reach the noise floor.
+    """
+
+    hysteresis_mg: float = Field(0.0, ge=0, le=50, description="bias difference between approaching a "
+                                 "temperature from below and from above")
+    nonlinearity_mg_per_g2: float = Field(0.0, ge=0, le=50, description="square-law term per axis, ± per DUT")
+
+
 class Procedure(_Strict):
     """A whole campaign. Setpoints run in the order given."""
 
@@ -104,6 +115,7 @@ class Procedure(_Strict):
     acquisition: Acquisition = Acquisition()
     safe_setpoint_c: float | None = Field(None, description="overrides the rig's chamber.safe_setpoint_c")
     fit: FitOptions = FitOptions()
+    simulation: SimulatedEffects = SimulatedEffects()
 
     @field_validator("setpoints_c", mode="before")
     @classmethod

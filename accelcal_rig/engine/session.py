@@ -73,7 +73,8 @@ class RunResult:
     output: Path
 
 
-InstrumentFactory = Callable[[RigConfig, Clock, int], RigInstruments]
+#: Connects the rig on the campaign's clock: (rig config, procedure, clock, seed) → instruments.
+InstrumentFactory = Callable[[RigConfig, Procedure, Clock, int], RigInstruments]
 
 
 def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, seed: int, overwrite: bool,
@@ -90,7 +91,7 @@ def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, see
                         "the 'simulated' drivers have no hardware behind them: run with --dry-run")
     wall_start = time.perf_counter()
     clock = VirtualClock()
-    instruments = build_instruments(rig.model, clock, seed)
+    instruments = build_instruments(rig.model, prepared.procedure.model, clock, seed)
     try:
         return _run_with_instruments(prepared, output, instruments, clock, dry_run=dry_run, seed=seed,
                                      overwrite=overwrite, wall_start=wall_start, calibration=calibration)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.engine.clock import Clock
 from accelcal_rig.errors import InstrumentError
@@ -114,7 +115,8 @@ class SimulatedAccelerometer:
         true_mean = 0.5 * (true_before + self._lab.dut_true_c(self._index))
         params = self._lab.duts[self._index].truth.parameters_at(true_mean)
         noise = self._lab.rng.normal(0.0, self.noise_g(), (n_samples, 3))
-        codes = adxl355.quantise_g(distort(gravity, params) + noise, self._range_g)
+        raw_g = distort(gravity, params) + self._lab.unmodelled_g(self._index, gravity)
+        codes = adxl355.quantise_g(raw_g + noise, self._range_g)
         self.last_truth = {"parameters": params, "gravity_g": gravity, "temperature_c": np.float64(true_mean)}
         return SampleBlock(codes, t_start, t_start + (n_samples - 1) / self._odr_hz,
                            (temperature_before, self.read_temperature_c()))
@@ -148,9 +150,10 @@ class SimulationTruth:
         return truth
 
 
-def build_simulated_rig(rig: RigConfig, clock: Clock, seed: int) -> RigInstruments:
-    """The whole rig as in-process simulations on `clock`, reproducible for a given `seed`."""
-    lab = VirtualLab(rig, clock, seed)
+def build_simulated_rig(rig: RigConfig, procedure: Procedure, clock: Clock, seed: int) -> RigInstruments:
+    """The whole rig as in-process simulations on `clock`, reproducible for a given `seed`; the procedure
+    may switch on sensor effects beyond Eq. 1."""
+    lab = VirtualLab(rig, clock, seed, procedure.simulation)
     sensors = [SimulatedAccelerometer(lab, i) for i in range(len(lab.duts))]
     return RigInstruments(SimulatedChamber(lab), SimulatedTurntable(lab), list(sensors),
                           SimulationTruth(lab, sensors))

@@ -7,6 +7,7 @@ import hashlib
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from accelcal_rig.config.procedure import SimulatedEffects
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.engine.clock import Clock
 from accelcal_rig.instruments.adxl355 import raw_from_temperature_c, temperature_c_from_raw
@@ -29,12 +30,17 @@ class SimulatedDut:
         # Fixtures are never quite uniform: each DUT lags the air by its own ±10 % of the nominal constant.
         spread = int.from_bytes(hashlib.sha256(f"tau:{serial}".encode()).digest()[:4], "little") / 2**32
         self.tau_s = fixture_tau_s * (0.9 + 0.2 * spread)
+        # Signs of the unmodelled effects on each axis, fixed per DUT like its truth.
+        signs = hashlib.sha256(f"effects:{serial}".encode()).digest()
+        self.hysteresis_signs = np.array([1.0 if b & 1 else -1.0 for b in signs[:3]])
+        self.nonlinearity_signs = np.array([1.0 if b & 1 else -1.0 for b in signs[3:6]])
 
 
 class VirtualLab:
-    def __init__(self, rig: RigConfig, clock: Clock, seed: int) -> None:
+    def __init__(self, rig: RigConfig, clock: Clock, seed: int, effects: SimulatedEffects = SimulatedEffects()) -> None:
         sim = rig.simulation
         self.clock = clock
+        self.effects = effects
         self.rng = np.random.default_rng(seed)
         self.chamber_noise_c = sim.chamber_noise_c
         self.noise_density_g_per_rthz = sim.noise_density_ug_per_rthz * 1e-6
@@ -68,6 +74,13 @@ class VirtualLab:
         """What the ADXL355 temperature sensor reports: 12-bit code, datasheet conversion."""
         noisy = self.dut_true_c(index) + float(self.rng.normal(0.0, TEMPERATURE_READ_NOISE_C))
         return float(temperature_c_from_raw(raw_from_temperature_c(noisy)))
+
+    def unmodelled_g(self, index: int, gravity_g: np.ndarray) -> np.ndarray:
+        """What the DUT adds beyond Eq. 1 (zero unless the procedure switches effects on), in g."""
+        dut = self.duts[index]
+        hysteresis = 0.5e-3 * self.effects.hysteresis_mg * self.thermal.approach_sign[index] * dut.hysteresis_signs
+        nonlinearity = 1e-3 * self.effects.nonlinearity_mg_per_g2 * dut.nonlinearity_signs * gravity_g**2
+        return hysteresis + nonlinearity
 
     def gravity_in_dut(self, index: int) -> np.ndarray:
         """True specific-force direction (+1 g up) in DUT `index`'s frame at the table's actual angles."""

@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 
 MAX_STEP_S = 10.0
+#: A sub-step's change larger than this sets a DUT's direction of approach.
+_DIRECTION_THRESHOLD_C = 1e-4
 
 
 def _lag(state: float, input_start: float, input_end: float, step_s: float, tau_s: float) -> float:
@@ -31,6 +33,8 @@ class ThermalModel:
         self._reference_c = ambient_c
         self._air_c = ambient_c
         self._dut_c = [ambient_c + self_heating_c] * len(dut_tau_s)
+        #: +1 if each DUT last moved up in temperature, −1 if down: what a hysteretic sensor remembers.
+        self.approach_sign = [1.0] * len(dut_tau_s)
 
     def set_setpoint(self, t_s: float, setpoint_c: float) -> None:
         self.advance_to(t_s)
@@ -59,9 +63,12 @@ class ThermalModel:
         air_end = _lag(self._air_c, self._reference_c, reference_end, step_s, self.chamber_tau_s)
         target_start = self._air_c + self.self_heating_c
         target_end = air_end + self.self_heating_c
-        self._dut_c = [
-            _lag(dut, target_start, target_end, step_s, tau) for dut, tau in zip(self._dut_c, self.dut_tau_s)
+        new_dut_c = [_lag(dut, target_start, target_end, step_s, tau) for dut, tau in zip(self._dut_c, self.dut_tau_s)]
+        self.approach_sign = [
+            (1.0 if new > old else -1.0) if abs(new - old) > _DIRECTION_THRESHOLD_C else sign
+            for new, old, sign in zip(new_dut_c, self._dut_c, self.approach_sign)
         ]
+        self._dut_c = new_dut_c
         self._reference_c = reference_end
         self._air_c = air_end
         self._t += step_s

@@ -19,8 +19,8 @@ def run_tiny(write, workdir: Path, tamper=None, text: str = TINY_PROCEDURE):
     """Run the tiny procedure; `tamper(instruments)` may break the simulated rig before it starts."""
     built = {}
 
-    def factory(rig, clock, seed):
-        instruments = build_simulated_rig(rig, clock, seed)
+    def factory(rig, procedure, clock, seed):
+        instruments = build_simulated_rig(rig, procedure, clock, seed)
         if tamper:
             tamper(instruments)
         built["rig"] = instruments

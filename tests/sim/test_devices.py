@@ -1,19 +1,20 @@
 import numpy as np
 import pytest
 
-from accelcal_rig.config.load import load_rig
+from accelcal_rig.config.load import load_procedure, load_rig
 from accelcal_rig.engine.clock import VirtualClock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.sim.devices import build_simulated_rig
-from tests.conftest import SIM_RIG
+from tests.conftest import REPO, SIM_RIG
 
 
 @pytest.fixture
 def rig():
     clock = VirtualClock()
-    return clock, build_simulated_rig(load_rig(SIM_RIG).model, clock, seed=7)
+    procedure = load_procedure(REPO / "procedures" / "quick-6pos.yaml").model
+    return clock, build_simulated_rig(load_rig(SIM_RIG).model, procedure, clock, seed=7)
 
 
 def test_block_mean_matches_the_truth_within_the_noise(rig) -> None:
@@ -88,3 +89,22 @@ def test_temperature_reading_is_quantised_like_the_adxl355(rig) -> None:
     readings = {instruments.sensors[0].read_temperature_c() for _ in range(50)}
     raws = [(25 - t) * 9.05 + 1885 for t in readings]
     np.testing.assert_allclose(raws, np.round(raws), atol=1e-9)
+
+
+def test_unmodelled_effects_are_off_unless_the_procedure_asks() -> None:
+    from accelcal_rig.config.procedure import SimulatedEffects
+    from accelcal_rig.sim.lab import VirtualLab
+
+    rig = load_rig(SIM_RIG).model
+    gravity = np.array([0.0, 0.6, 0.8])
+    plain = VirtualLab(rig, VirtualClock(), 0)
+    np.testing.assert_array_equal(plain.unmodelled_g(0, gravity), 0.0)
+    lab = VirtualLab(rig, VirtualClock(), 0, SimulatedEffects(hysteresis_mg=1.0, nonlinearity_mg_per_g2=0.5))
+    effect = lab.unmodelled_g(0, gravity)
+    np.testing.assert_allclose(np.abs(effect - lab.unmodelled_g(0, np.zeros(3))), 0.5e-3 * gravity**2)
+    warm = lab.unmodelled_g(0, np.zeros(3))
+    lab.thermal.set_setpoint(0.0, -20.0)   # cooling: the sensor now approaches from above
+    lab.clock.sleep(600.0)
+    lab.dut_true_c(0)
+    np.testing.assert_allclose(lab.unmodelled_g(0, np.zeros(3)), -warm)
+    assert np.allclose(np.abs(warm), 0.5e-3)
