@@ -63,6 +63,8 @@ class TurntableConfig(_Strict):
     driver: Literal["simulated"] = "simulated"
     axes: list[TurntableAxis] = Field(min_length=1, max_length=6)
     position_tolerance_deg: float = Field(0.01, gt=0, le=5)
+    accuracy_arcsec: float = Field(3.0, ge=0, le=3600, description="angular position accuracy of each axis "
+                                   "(spec sheet, ±): the fit's reference-mode uncertainty, the simulated table's error")
 
     @field_validator("axes")
     @classmethod
@@ -103,7 +105,6 @@ class SimulationConfig(_Strict):
     fixture_time_constant_min: float = Field(10.0, gt=0)
     self_heating_c: float = Field(0.2, ge=0)
     noise_density_ug_per_rthz: float = Field(25.0, ge=0)
-    turntable_accuracy_arcsec: float = Field(3.0, ge=0)
     turntable_settle_s: float = Field(0.5, ge=0)
 
 

@@ -126,6 +126,7 @@ def _run_with_instruments(prepared: PreparedCampaign, output: Path, instruments:
                "fit_parameters": procedure.fit.parameters, "fit_out_of_range": procedure.fit.out_of_range},
         procedure_yaml=prepared.procedure.text, rig_yaml=rig.text, plan=prepared.plan, duts=duts,
         instruments=instrument_info, samples_per_pose=acquisition.samples_per_pose,
+        turntable_accuracy_arcsec=rig.model.turntable.accuracy_arcsec,
     )
     try:
         if instruments.truth is not None:

@@ -5,7 +5,10 @@ and all 12 parameters are fitted. *norm-only*: only |U_SF| = 1 g is known (Eq. 3
 sensor frame is then invisible (the 24-pose design has Fisher rank 9 for the 12 parameters), so the
 fit uses the paper's own gauge — C·S lower triangular, the sensor x axis as reference, M = identity —
 and fits 9. Either mode can be restricted to bias and scale alone (6 parameters), for designs that
-cannot see more (six positions). Residuals are weighted by each pose's standard error (W of Eq. 7).
+cannot see more (six positions). Residuals are weighted by each pose's standard error (W of Eq. 7),
+combined in reference mode with the turntable's stated accuracy. The covariance is that of the stated
+uncertainties; only when χ² exceeds its 99 % quantile (they are evidently too optimistic) is it scaled
+by χ²_red, so unexplained scatter widens the 1σ instead of hiding.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from typing import Literal
 
 import numpy as np
 from scipy.optimize import least_squares
+from scipy.stats import chi2
 
 from accelcal_rig.fit.sfem import IDENTITY_PARAMETERS, PARAMETER_NAMES, correct
 
@@ -45,7 +49,7 @@ class SfemFit:
     """One temperature's fit. `sigma` is NaN for parameters the mode does not fit."""
 
     parameters: np.ndarray        # (12,)
-    sigma: np.ndarray             # (12,) 1σ, scaled by √χ²_red when that exceeds 1
+    sigma: np.ndarray             # (12,) 1σ; scaled by √χ²_red when χ² exceeds its 99 % quantile
     free: np.ndarray              # (12,) bool
     chi2_reduced: float
     residuals: np.ndarray         # weighted residuals at the solution
@@ -60,8 +64,13 @@ def _norm_sigma(mean_g: np.ndarray, stderr_g: np.ndarray) -> np.ndarray:
 
 
 def fit_sfem(mean_g: np.ndarray, stderr_g: np.ndarray, reference_g: np.ndarray | None, mode: FitMode,
-             free: FreeParameters = "all") -> SfemFit:
-    """Fit Eq. 1 to per-pose means (n, 3) in g; `reference_g` (n, 3) is required in reference mode."""
+             free: FreeParameters = "all", reference_accuracy_rad: float = 0.0) -> SfemFit:
+    """Fit Eq. 1 to per-pose means (n, 3) in g; `reference_g` (n, 3) is required in reference mode.
+
+    `reference_accuracy_rad` is the turntable's ± accuracy per axis (uniform): the expected gravity then
+    turns by a small random rotation of variance a²/3 about each direction, adding (a²/3)(1 − g_i²) to
+    component i's variance.
+    """
     mean_g = np.asarray(mean_g, dtype=float)
     stderr_g = np.maximum(np.asarray(stderr_g, dtype=float), 1e-9)  # a noiseless pose must not divide by 0
     mask = free_mask(mode, free)
@@ -71,9 +80,10 @@ def fit_sfem(mean_g: np.ndarray, stderr_g: np.ndarray, reference_g: np.ndarray |
         if reference_g is None:
             raise ValueError("reference mode needs the expected gravity of each pose")
         reference_g = np.asarray(reference_g, dtype=float)
+        sigma_g = np.sqrt(stderr_g**2 + reference_accuracy_rad**2 / 3.0 * (1.0 - reference_g**2))
 
         def residuals(theta: np.ndarray) -> np.ndarray:
-            return ((correct(mean_g, _full(theta, mask)) - reference_g) / stderr_g).ravel()
+            return ((correct(mean_g, _full(theta, mask)) - reference_g) / sigma_g).ravel()
 
         n_residuals = 3 * n_poses
     else:
@@ -92,7 +102,9 @@ def fit_sfem(mean_g: np.ndarray, stderr_g: np.ndarray, reference_g: np.ndarray |
     _check_identified(jacobian, mask, n_poses)
     dof = n_residuals - n_free
     chi2_reduced = float(result.fun @ result.fun / dof) if dof > 0 else float("nan")
-    covariance = np.linalg.inv(jacobian.T @ jacobian) * (max(1.0, chi2_reduced) if dof > 0 else 1.0)
+    covariance = np.linalg.inv(jacobian.T @ jacobian)
+    if dof > 0 and chi2_reduced > chi2.ppf(0.99, dof) / dof:
+        covariance *= chi2_reduced  # the scatter exceeds what the stated uncertainties allow: widen, never hide
     sigma = np.full(12, np.nan)
     sigma[mask] = np.sqrt(np.diag(covariance))
     return SfemFit(_full(result.x, mask), sigma, mask, chi2_reduced, result.fun, n_poses, mode)

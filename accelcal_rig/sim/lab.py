@@ -58,7 +58,7 @@ class VirtualLab:
         )
         self.motion = TurntableMotion(
             speeds_deg_s=np.array([a.speed_deg_s for a in rig.turntable.axes]),
-            accuracy_deg=sim.turntable_accuracy_arcsec / 3600.0,
+            accuracy_deg=rig.turntable.accuracy_arcsec / 3600.0,
             settle_s=sim.turntable_settle_s,
             rng=self.rng,
         )

@@ -73,7 +73,7 @@ class CampaignWriter:
     @classmethod
     def create(cls, path: Path, *, overwrite: bool, attrs: dict[str, Any], procedure_yaml: str,
                rig_yaml: str, plan: Plan, duts: list[dict[str, Any]], instruments: dict[str, dict[str, str]],
-               samples_per_pose: int) -> CampaignWriter:
+               samples_per_pose: int, turntable_accuracy_arcsec: float) -> CampaignWriter:
         if path.exists() and not overwrite:
             raise ConfigError(f"{path}: campaign file exists; choose another -o or pass --overwrite")
         try:
@@ -87,7 +87,9 @@ class CampaignWriter:
         config.create_dataset("procedure_yaml", data=procedure_yaml, dtype=TEXT)
         config.create_dataset("rig_yaml", data=rig_yaml, dtype=TEXT)
         cls._write_plan(file.create_group("plan"), plan)
-        cls._create_poses(file.create_group("poses"), len(plan.axis_names))
+        poses = file.create_group("poses")
+        poses.attrs["turntable_accuracy_arcsec"] = turntable_accuracy_arcsec
+        cls._create_poses(poses, len(plan.axis_names))
         duts_group = file.create_group("duts")
         for dut in duts:
             cls._create_dut(duts_group.create_group(dut["serial"]), dut, samples_per_pose)

@@ -88,10 +88,12 @@ class DutPoses:
     range_g: int
     lsb_g: float
     setpoint_c: np.ndarray            # (N,)
+    t_s: np.ndarray                   # (N,) clock time of each pose's first sample
     temperature_c: np.ndarray         # (N,) DUT's own sensor, mean of before and after the block
     mean_g: np.ndarray                # (N, 3)
     stderr_g: np.ndarray              # (N, 3)
     reference_g: np.ndarray           # (N, 3) expected reading from the turntable
+    reference_accuracy_arcsec: float  # ± per turntable axis, from the rig config
     truth_parameters: np.ndarray | None  # (N, 12) simulation truth, dry runs only
 
 
@@ -103,10 +105,12 @@ def read_dut_poses(file: h5py.File, serial: str) -> DutPoses:
         range_g=int(dut.attrs["range_g"]),
         lsb_g=float(dut.attrs["lsb_g"]),
         setpoint_c=file["poses/setpoint_c"][:],
+        t_s=file["poses/t_start_s"][:],
         temperature_c=dut["temperature_c"][:].mean(axis=1),
         mean_g=dut["mean_g"][:],
         stderr_g=dut["stderr_g"][:],
         reference_g=dut["gravity_reference_g"][:],
+        reference_accuracy_arcsec=float(file["poses"].attrs.get("turntable_accuracy_arcsec", 0.0)),
         truth_parameters=truth[:] if truth is not None else None,
     )
 
