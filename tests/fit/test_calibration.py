@@ -83,3 +83,19 @@ def test_a_file_of_another_version_is_refused_with_its_line(calibration, tmp_pat
 def test_unknown_sensor_is_named(calibration) -> None:
     with pytest.raises(KeyError, match="no calibration for sensor SN-X"):
         calibration.sensor("SN-X")
+
+
+def test_the_documented_usage_snippet_runs(calibration, tmp_path: Path) -> None:
+    import re
+    import subprocess
+    import sys
+
+    from tests.conftest import REPO
+
+    save_calibration(calibration, tmp_path / "calibration.yaml")
+    doc = (REPO / "docs" / "calibration.md").read_text()
+    snippet = re.search(r"```python\n(.*?)```", doc, re.S).group(1)
+    result = subprocess.run([sys.executable, "-c", snippet + "\nprint(compensated_g.shape, compensated_from_codes.shape)"],
+                            cwd=tmp_path, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "(2, 3) (1, 3)"
