@@ -113,6 +113,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
     calibration = args.calibration or args.output.with_suffix(".calibration.yaml")
+    if not calibration.parent.is_dir():
+        raise ConfigError(f"{calibration}: folder {calibration.parent} does not exist")
     stop = _StopOnFirstSignal()
     previous = {signum: signal.signal(signum, stop) for signum in (signal.SIGINT, signal.SIGTERM)}
     try:
@@ -139,12 +141,14 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_status(args: argparse.Namespace) -> int:
+    from accelcal_rig.engine.clock import RealClock
     from accelcal_rig.store.read import campaign_status, status_json
 
+    sleep = RealClock().sleep  # a running campaign may be mid-flush: retry briefly for a consistent read
     if args.json:
-        print(status_json(args.campaign))
+        print(status_json(args.campaign, sleep))
         return 0
-    status = campaign_status(args.campaign)
+    status = campaign_status(args.campaign, sleep)
     for key, value in status.items():
         print(f"{key:17s}{value}")
     return 0

@@ -127,7 +127,7 @@ class CampaignRunner:
         self.machine.go(State.FIT)
         try:
             summary = self.fit_stage(self.writer.file)
-        except (ValueError, KeyError, np.linalg.LinAlgError) as exc:
+        except (ValueError, KeyError, OSError, np.linalg.LinAlgError) as exc:
             self.events.error("fit", f"fit failed: {exc}")
             return str(exc), True
         self.events.info("fit", summary)

@@ -9,6 +9,7 @@ requests made during it.
 from __future__ import annotations
 
 import threading
+import time
 from typing import Protocol
 
 
@@ -20,6 +21,20 @@ class Clock(Protocol):
 
     def sleep(self, seconds: float) -> None:
         """Let `seconds` pass."""
+
+
+class RealClock:
+    kind = "real"
+
+    def __init__(self) -> None:
+        self._start = time.monotonic()
+
+    def now(self) -> float:
+        return time.monotonic() - self._start
+
+    def sleep(self, seconds: float) -> None:
+        if seconds > 0:
+            time.sleep(seconds)
 
 
 class VirtualClock:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -15,40 +16,59 @@ from accelcal_rig.errors import ConfigError
 from accelcal_rig.store.campaign_file import FORMAT_NAME
 
 
-def open_campaign(path: Path) -> h5py.File:
-    """Open read-only without taking HDF5's file lock, so a running campaign can be inspected."""
+def _open_checked(path: Path, mode: str, cannot_open: str, **options: Any) -> h5py.File:
     if not path.exists():
         raise ConfigError(f"{path}: no such campaign file")
     try:
-        file = h5py.File(path, "r", locking=False)
+        file = h5py.File(path, mode, **options)
     except OSError as exc:
-        raise ConfigError(f"{path}: not a readable HDF5 file ({exc})") from None
+        raise ConfigError(f"{path}: {cannot_open} ({exc})") from None
     if file.attrs.get("format") != FORMAT_NAME:
         file.close()
         raise ConfigError(f"{path}: not an accelcal-rig campaign file")
     return file
+
+
+def open_campaign(path: Path) -> h5py.File:
+    """Open read-only without taking HDF5's file lock, so a running campaign can be inspected."""
+    return _open_checked(path, "r", "not a readable HDF5 file", locking=False)
 
 
 def open_campaign_for_update(path: Path) -> h5py.File:
     """Open for adding results (the fit); refused while a writer holds the file (a running campaign)."""
-    if not path.exists():
-        raise ConfigError(f"{path}: no such campaign file")
-    try:
-        file = h5py.File(path, "a")
-    except OSError as exc:
-        raise ConfigError(f"{path}: cannot open for writing (is a campaign still running on it?): {exc}") from None
-    if file.attrs.get("format") != FORMAT_NAME:
-        file.close()
-        raise ConfigError(f"{path}: not an accelcal-rig campaign file")
-    return file
+    return _open_checked(path, "a", "cannot open for writing (is a campaign still running on it?)")
 
 
 def _text(value: Any) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
-def campaign_status(path: Path) -> dict[str, Any]:
-    """The campaign's state and progress, as `rig status` prints it."""
+#: Attempts and first wait for a consistent read of a file a running campaign is writing.
+SNAPSHOT_ATTEMPTS = 6
+SNAPSHOT_FIRST_WAIT_S = 0.05
+
+
+def campaign_status(path: Path, sleep: Callable[[float], None] | None = None) -> dict[str, Any]:
+    """The campaign's state and progress, as `rig status` prints it.
+
+    A running campaign may be mid-flush when we read (the file is not opened in SWMR mode), which shows
+    as an HDF5 read error; with `sleep`, the read is retried with doubling waits (about 1.5 s in all).
+    """
+    if not path.exists():
+        raise ConfigError(f"{path}: no such campaign file")
+    for attempt in range(SNAPSHOT_ATTEMPTS if sleep else 1):
+        try:
+            return _read_status(path)
+        except (ConfigError, OSError, KeyError, ValueError) as exc:
+            last = exc
+            if sleep:
+                sleep(SNAPSHOT_FIRST_WAIT_S * 2**attempt)
+    if isinstance(last, ConfigError):
+        raise last
+    raise ConfigError(f"{path}: no consistent read (a campaign is writing it?): {last}")
+
+
+def _read_status(path: Path) -> dict[str, Any]:
     with open_campaign(path) as file:
         attrs = file.attrs
         plan_keys = [_text(k) for k in file["plan/step_key"][:]]
@@ -76,8 +96,8 @@ def campaign_status(path: Path) -> dict[str, Any]:
         }
 
 
-def status_json(path: Path) -> str:
-    return json.dumps(campaign_status(path))
+def status_json(path: Path, sleep: Callable[[float], None] | None = None) -> str:
+    return json.dumps(campaign_status(path, sleep))
 
 
 @dataclass(frozen=True)

@@ -186,3 +186,12 @@ def test_fit_stage_runs_after_the_safe_state(write, workdir: Path) -> None:
     with h5py.File(output, "r") as f:
         assert f.attrs["state"] == "done" and "fit" in f
     assert (workdir / "cal.yaml").exists()
+
+
+def test_a_fit_that_cannot_write_its_file_leaves_the_campaign_done(write, workdir: Path) -> None:
+    output = workdir / "run.h5"
+    result = run_campaign(prepare(write("tiny.yaml", TINY_PROCEDURE)), output, dry_run=True, seed=1,
+                          overwrite=False, calibration=workdir / "gone" / "cal.yaml")
+    assert result.summary.fit_failed and "No such file or directory" in result.summary.fit
+    with h5py.File(output, "r") as f:
+        assert f.attrs["state"] == "done" and f["poses/step_key"].shape == (6,)

@@ -104,3 +104,23 @@ def _pose_aligned(f: h5py.File):
             for name, dataset in f[f"{group}/{serial}"].items():
                 if dataset.maxshape[0] is None:
                     yield f"{group}/{serial}/{name}", dataset
+
+
+def test_status_retries_a_read_that_catches_the_writer_mid_flush(campaign: Path, monkeypatch) -> None:
+    from accelcal_rig.errors import ConfigError
+    from accelcal_rig.store import read
+
+    real, failures, waits = read._read_status, [OSError("addr overflow"), KeyError("poses")], []
+
+    def flaky(path):
+        if failures:
+            raise failures.pop(0)
+        return real(path)
+
+    monkeypatch.setattr(read, "_read_status", flaky)
+    assert campaign_status(campaign, waits.append)["state"] == "done"
+    assert waits == [0.05, 0.1]
+    monkeypatch.setattr(read, "_read_status", lambda path: (_ for _ in ()).throw(OSError("bad object header")))
+    with pytest.raises(ConfigError, match="no consistent read .*bad object header"):
+        campaign_status(campaign, waits.append)
+    assert len(waits) == 2 + read.SNAPSHOT_ATTEMPTS
