@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import threading
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -41,6 +42,8 @@ class VirtualLab:
         sim = rig.simulation
         self.clock = clock
         self.effects = effects
+        #: Simulators answer from their own threads (wire-level servers): one lab, one request at a time.
+        self.lock = threading.RLock()
         self.rng = np.random.default_rng(seed)
         self.chamber_noise_c = sim.chamber_noise_c
         self.noise_density_g_per_rthz = sim.noise_density_ug_per_rthz * 1e-6

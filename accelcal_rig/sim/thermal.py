@@ -29,6 +29,8 @@ class ThermalModel:
         self.dut_tau_s = list(dut_tau_s)
         self.self_heating_c = self_heating_c
         self._t = 0.0
+        self.ambient_c = ambient_c
+        self.powered = True
         self.setpoint_c = ambient_c
         self._reference_c = ambient_c
         self._air_c = ambient_c
@@ -39,6 +41,15 @@ class ThermalModel:
     def set_setpoint(self, t_s: float, setpoint_c: float) -> None:
         self.advance_to(t_s)
         self.setpoint_c = setpoint_c
+
+    def set_power(self, t_s: float, on: bool) -> None:
+        """A chamber switched off drifts towards ambient at its ramp rate, whatever its set point."""
+        self.advance_to(t_s)
+        self.powered = on
+
+    @property
+    def _target_c(self) -> float:
+        return self.setpoint_c if self.powered else self.ambient_c
 
     def air_c(self, t_s: float) -> float:
         self.advance_to(t_s)
@@ -51,13 +62,13 @@ class ThermalModel:
     def advance_to(self, t_s: float) -> None:
         while self._t < t_s:
             step = min(MAX_STEP_S, t_s - self._t)
-            gap = self.setpoint_c - self._reference_c
+            gap = self._target_c - self._reference_c
             if gap != 0.0:
                 step = min(step, abs(gap) / self.ramp_rate_c_per_s) or step
             self._step(step)
 
     def _step(self, step_s: float) -> None:
-        gap = self.setpoint_c - self._reference_c
+        gap = self._target_c - self._reference_c
         move = math.copysign(min(abs(gap), self.ramp_rate_c_per_s * step_s), gap)
         reference_end = self._reference_c + move
         air_end = _lag(self._air_c, self._reference_c, reference_end, step_s, self.chamber_tau_s)

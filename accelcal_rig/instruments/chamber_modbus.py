@@ -1,0 +1,144 @@
+"""Thermal chamber controller over Modbus (pymodbus): TCP, or RTU on a serial port or pyserial URL.
+
+Every failure becomes an InstrumentError naming the chamber and its endpoint: a refused connection,
+a missing reply, a Modbus exception (a register the controller does not have: a wrong map), an identity,
+decimals or units register that disagrees with the map, or values no chamber reads.
+"""
+
+from __future__ import annotations
+
+import math
+
+from pymodbus.client import ModbusSerialClient, ModbusTcpClient
+from pymodbus.client.base import ModbusBaseSyncClient
+from pymodbus.exceptions import ModbusException
+
+from accelcal_rig.errors import InstrumentError
+from accelcal_rig.instruments.chamber_registers import ChamberRegisterMap
+
+#: Readings outside this are not a chamber's air: the map or word order must be wrong.
+PLAUSIBLE_C = (-100.0, 300.0)
+
+
+class ModbusChamber:
+    def __init__(self, client: ModbusBaseSyncClient, endpoint: str, registers: ChamberRegisterMap,
+                 device_id: int = 1) -> None:
+        self._client = client
+        self.endpoint = endpoint
+        self.registers = registers
+        self.device_id = device_id
+
+    @classmethod
+    def tcp(cls, host: str, port: int, registers: ChamberRegisterMap, device_id: int = 1,
+            timeout_s: float = 1.0) -> ModbusChamber:
+        client = ModbusTcpClient(host, port=port, timeout=timeout_s, retries=0)
+        return cls._connected(client, f"modbus-tcp {host}:{port}", registers, device_id)
+
+    @classmethod
+    def rtu(cls, port: str, registers: ChamberRegisterMap, device_id: int = 1, baudrate: int = 9600,
+            parity: str = "N", stopbits: int = 1, timeout_s: float = 1.0) -> ModbusChamber:
+        client = ModbusSerialClient(port, baudrate=baudrate, parity=parity, stopbits=stopbits, timeout=timeout_s,
+                                    retries=0)
+        return cls._connected(client, f"modbus-rtu {port}", registers, device_id)
+
+    @classmethod
+    def _connected(cls, client: ModbusBaseSyncClient, endpoint: str, registers: ChamberRegisterMap,
+                   device_id: int) -> ModbusChamber:
+        if not client.connect():
+            raise InstrumentError(f"chamber ({endpoint}): cannot connect")
+        return cls(client, endpoint, registers, device_id)
+
+    # ------------------------------------------------------------------ the Chamber interface
+    def identify(self) -> str:
+        """Check the controller is the one the map describes; describe it."""
+        m = self.registers
+        if m.identity_register is not None and m.identity_value is not None:
+            found = self._read(m.identity_register, 1)[0]
+            if found != m.identity_value:
+                raise self._error(f"register {m.identity_register} reads {found}, the map expects model "
+                                  f"{m.identity_value}: wrong register map or controller")
+        if m.decimals_register is not None:
+            found = self._read(m.decimals_register, 1)[0]
+            if found != m.decimals:
+                raise self._error(f"controller shows {found} decimal places (register {m.decimals_register}), "
+                                  f"the map expects {m.decimals}")
+        if m.units_register is not None:
+            found = self._read(m.units_register, 1)[0]
+            if found != m.units_celsius:
+                raise self._error(f"controller is not in °C (register {m.units_register} reads {found})")
+        temperature, setpoint = self.read_temperature_c(), self.read_setpoint_c()
+        model = f"model {m.identity_value}, " if m.identity_value is not None else ""
+        return f"{m.encoding} controller ({model}PV {temperature:.1f} °C, SP {setpoint:.1f} °C)"
+
+    def read_temperature_c(self) -> float:
+        return self._plausible(self._read_temperature(self.registers.process_value), "process value")
+
+    def read_setpoint_c(self) -> float:
+        return self._plausible(self._read_temperature(self.registers.setpoint), "set point")
+
+    def write_setpoint_c(self, setpoint_c: float) -> None:
+        """Write the static set point (both float words in one request). Limits are the caller's gate."""
+        self._write(self.registers.setpoint, self._encode(setpoint_c))
+
+    def set_power(self, on: bool) -> None:
+        m = self.registers
+        if m.power_register is None:
+            raise self._error("the register map has no power event")
+        self._write(m.power_register, [m.power_on if on else m.power_off])
+
+    def alarm_active(self) -> bool:
+        m = self.registers
+        if m.alarm_register is None:
+            return False
+        return self._read(m.alarm_register, 1)[0] not in m.alarm_inactive
+
+    def close(self) -> None:
+        self._client.close()
+
+    # ------------------------------------------------------------------ encoding
+    def _read_temperature(self, address: int) -> float:
+        m = self.registers
+        if m.encoding == "float32":
+            words = self._read(address, 2)
+            return float(self._client.convert_from_registers(words, self._client.DATATYPE.FLOAT32,
+                                                             word_order=m.word_order))
+        raw = self._client.convert_from_registers(self._read(address, 1), self._client.DATATYPE.INT16)
+        return float(raw) / 10**m.decimals
+
+    def _encode(self, temperature_c: float) -> list[int]:
+        m = self.registers
+        if m.encoding == "float32":
+            return self._client.convert_to_registers(float(temperature_c), self._client.DATATYPE.FLOAT32,
+                                                     word_order=m.word_order)
+        scaled = round(temperature_c * 10**m.decimals)
+        if not -32768 <= scaled <= 32767:
+            raise self._error(f"{temperature_c:g} °C does not fit a 16-bit register at {m.decimals} decimals")
+        return self._client.convert_to_registers(scaled, self._client.DATATYPE.INT16)
+
+    def _plausible(self, value: float, what: str) -> float:
+        """Swapped float words give NaN, huge values or, for round temperatures (zero low word), denormals."""
+        tiny = value != 0.0 and abs(value) < 1e-6
+        if tiny or not (math.isfinite(value) and PLAUSIBLE_C[0] <= value <= PLAUSIBLE_C[1]):
+            raise self._error(f"{what} reads {value:g} °C: wrong register map or word order")
+        return value
+
+    # ------------------------------------------------------------------ wire
+    def _read(self, address: int, count: int) -> list[int]:
+        try:
+            reply = self._client.read_holding_registers(address, count=count, device_id=self.device_id)
+        except ModbusException as exc:
+            raise self._error(f"no reply reading register {address}: {exc}") from None
+        if reply.isError():
+            raise self._error(f"register {address} refused ({reply}): wrong register map?")
+        return list(reply.registers)
+
+    def _write(self, address: int, values: list[int]) -> None:
+        try:
+            reply = self._client.write_registers(address, values, device_id=self.device_id)
+        except ModbusException as exc:
+            raise self._error(f"no reply writing register {address}: {exc}") from None
+        if reply.isError():
+            raise self._error(f"write to register {address} refused ({reply})")
+
+    def _error(self, message: str) -> InstrumentError:
+        return InstrumentError(f"chamber ({self.endpoint}): {message}")

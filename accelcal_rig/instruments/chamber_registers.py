@@ -1,0 +1,60 @@
+"""Chamber controller register maps as data, with built-in profiles (facts: docs/instruments.md).
+
+Addresses are zero-based Modbus PDU addresses (what goes on the wire), not "4xxxx" numbers.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+
+class ChamberRegisterMap(BaseModel):
+    """Where a controller keeps each value, and how it encodes temperatures.
+
+    `scaled-int16`: one signed register, value × 10^decimals (the decimals either fixed by `decimals` or
+    read from `decimals_register`). `float32`: IEEE-754 in two registers, `word_order` of the two words.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    encoding: Literal["scaled-int16", "float32"]
+    word_order: Literal["little", "big"] = "little"
+    process_value: int = Field(ge=0, le=65535)
+    setpoint: int = Field(ge=0, le=65535)
+    decimals: int = Field(1, ge=0, le=3, description="scaled-int16: implied decimal places expected")
+    decimals_register: int | None = Field(None, ge=0, le=65535, description="checked against `decimals`")
+    units_register: int | None = Field(None, ge=0, le=65535)
+    units_celsius: int = Field(1, description="value of `units_register` that means °C")
+    identity_register: int | None = Field(None, ge=0, le=65535)
+    identity_value: int | None = None
+    power_register: int | None = Field(None, ge=0, le=65535, description="event output that runs the chamber")
+    power_on: int = 1
+    power_off: int = 0
+    alarm_register: int | None = Field(None, ge=0, le=65535)
+    alarm_inactive: list[int] = [0]
+
+
+#: Watlow F4 (TestEquity, Thermotron, Cincinnati Sub-Zero): signed 16-bit, decimals from register 606,
+#: units at 901 (1 = °C), model code 5270 at 0, event 1 (chamber power) at 2000, alarm 1 at 102.
+WATLOW_F4 = ChamberRegisterMap(
+    encoding="scaled-int16", process_value=100, setpoint=300, decimals=1, decimals_register=606,
+    units_register=901, units_celsius=1, identity_register=0, identity_value=5270,
+    power_register=2000, power_on=1, power_off=0, alarm_register=102, alarm_inactive=[0],
+)
+
+#: Watlow F4T (Data Map 1): float32, low word first by default; set point 2782, process value 2820;
+#: event 1 "Power" at 16594 (63 on, 62 off); alarm 1 state at 1356 (88, 61 and 12 inactive). It has no
+#: identity or units register in its map, so only the values' plausibility identifies it.
+WATLOW_F4T = ChamberRegisterMap(
+    encoding="float32", word_order="little", process_value=2820, setpoint=2782,
+    power_register=16594, power_on=63, power_off=62, alarm_register=1356, alarm_inactive=[88, 61, 12],
+)
+
+PROFILES: dict[str, ChamberRegisterMap] = {"watlow-f4": WATLOW_F4, "watlow-f4t": WATLOW_F4T}
+
+
+def register_map(profile: str, overrides: dict[str, object] | None = None) -> ChamberRegisterMap:
+    """A built-in profile, with any fields the rig config overrides."""
+    return PROFILES[profile].model_copy(update=overrides or {})

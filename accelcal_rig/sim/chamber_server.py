@@ -1,0 +1,147 @@
+"""A simulated chamber controller on the wire: a pymodbus TCP server on 127.0.0.1 serving a register map.
+
+Any Modbus master can talk to it. Each request is answered from the virtual lab at the shared clock's
+time; a set-point or power write goes into the lab. Registers outside the map do not exist (Modbus
+exception 2), as on a real controller.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import struct
+import threading
+
+from pymodbus.constants import ExcCodes
+from pymodbus.server import ModbusTcpServer
+from pymodbus.simulator import DataType, SimData, SimDevice
+
+from accelcal_rig.instruments.chamber_registers import ChamberRegisterMap
+from accelcal_rig.sim.lab import VirtualLab
+
+_STARTUP_TIMEOUT_S = 10.0
+
+
+class SimulatedChamberServer:
+    def __init__(self, lab: VirtualLab, registers: ChamberRegisterMap, device_id: int = 1,
+                 host: str = "127.0.0.1", port: int = 0) -> None:
+        self._lab = lab
+        self._map = registers
+        self._device_id = device_id
+        self._address = (host, port)
+        self._loop = asyncio.new_event_loop()
+        self._server: ModbusTcpServer | None = None
+        self._thread = threading.Thread(target=self._run, name="simulated-chamber", daemon=True)
+        self._ready = threading.Event()
+        self._startup_error: BaseException | None = None
+        self.host, self.port = host, port
+        #: The last set point written over the wire, for tests that check the safe state.
+        self.last_setpoint_c: float | None = None
+
+    @property
+    def endpoint(self) -> str:
+        return f"{self.host}:{self.port}"
+
+    def start(self) -> SimulatedChamberServer:
+        self._thread.start()
+        if not self._ready.wait(_STARTUP_TIMEOUT_S):
+            raise RuntimeError("simulated chamber server did not start")
+        if self._startup_error is not None:
+            raise self._startup_error
+        return self
+
+    def stop(self) -> None:
+        if self._server is not None and self._loop.is_running():
+            asyncio.run_coroutine_threadsafe(self._server.shutdown(), self._loop).result(_STARTUP_TIMEOUT_S)
+            self._loop.call_soon_threadsafe(self._loop.stop)
+        self._thread.join(_STARTUP_TIMEOUT_S)
+
+    # ------------------------------------------------------------------ server thread
+    def _run(self) -> None:
+        asyncio.set_event_loop(self._loop)
+        try:
+            self._loop.run_until_complete(self._listen())
+        except BaseException as exc:  # noqa: BLE001 - handed to start(), which raises it in the caller
+            self._startup_error = exc
+            self._ready.set()
+            return
+        self._ready.set()
+        self._loop.run_forever()
+        self._loop.close()
+
+    async def _listen(self) -> None:
+        device = SimDevice(id=self._device_id, simdata=self._blocks(), action=self._action)
+        self._server = ModbusTcpServer(device, address=self._address)
+        await self._server.serve_forever(background=True)
+        self.host, self.port = self._server.transport.sockets[0].getsockname()[:2]
+
+    def _blocks(self) -> list[SimData]:
+        m = self._map
+        width = 2 if m.encoding == "float32" else 1
+        addresses = {m.process_value: width, m.setpoint: width}
+        for register in (m.identity_register, m.decimals_register, m.units_register, m.power_register,
+                         m.alarm_register):
+            if register is not None:
+                addresses[register] = 1
+        return [SimData(address=a, count=n, datatype=DataType.REGISTERS) for a, n in sorted(addresses.items())]
+
+    async def _action(self, function_code: int, start_address: int, address: int, count: int,
+                      current_registers: list[int], set_values: list[int] | list[bool] | None) -> ExcCodes | None:
+        requested = range(address, address + count)
+        with self._lab.lock:
+            if set_values is not None:
+                return self._write(requested, [int(v) for v in set_values], address)
+            for register, words in self._values().items():
+                for offset, word in enumerate(words):
+                    if register + offset in requested:
+                        current_registers[register + offset - start_address] = word
+        return None
+
+    def _write(self, requested: range, values: list[int], address: int) -> ExcCodes | None:
+        m = self._map
+        now = self._lab.clock.now()
+        width = 2 if m.encoding == "float32" else 1
+        if m.setpoint in requested:
+            if m.setpoint + width - 1 not in requested:
+                return ExcCodes.ILLEGAL_VALUE  # half a float: real controllers refuse it too
+            offset = m.setpoint - address
+            setpoint = self._decode(values[offset:offset + width])
+            self._lab.thermal.set_setpoint(now, setpoint)
+            self.last_setpoint_c = setpoint
+        if m.power_register is not None and m.power_register in requested:
+            value = values[m.power_register - address]
+            if value not in (m.power_on, m.power_off):
+                return ExcCodes.ILLEGAL_VALUE
+            self._lab.thermal.set_power(now, value == m.power_on)
+        return None
+
+    def _values(self) -> dict[int, list[int]]:
+        m = self._map
+        values = {
+            m.process_value: self._encode(self._lab.chamber_reading_c()),
+            m.setpoint: self._encode(self._lab.thermal.setpoint_c),
+        }
+        if m.identity_register is not None and m.identity_value is not None:
+            values[m.identity_register] = [m.identity_value]
+        if m.decimals_register is not None:
+            values[m.decimals_register] = [m.decimals]
+        if m.units_register is not None:
+            values[m.units_register] = [m.units_celsius]
+        if m.power_register is not None:
+            values[m.power_register] = [m.power_on if self._lab.thermal.powered else m.power_off]
+        if m.alarm_register is not None:
+            values[m.alarm_register] = [m.alarm_inactive[0]]
+        return values
+
+    def _encode(self, temperature_c: float) -> list[int]:
+        m = self._map
+        if m.encoding == "float32":
+            high, low = struct.unpack(">HH", struct.pack(">f", temperature_c))
+            return [low, high] if m.word_order == "little" else [high, low]
+        return [int(round(temperature_c * 10**m.decimals)) & 0xFFFF]
+
+    def _decode(self, words: list[int]) -> float:
+        m = self._map
+        if m.encoding == "float32":
+            high, low = (words[1], words[0]) if m.word_order == "little" else (words[0], words[1])
+            return struct.unpack(">f", struct.pack(">HH", high, low))[0]
+        return struct.unpack(">h", struct.pack(">H", words[0]))[0] / 10**m.decimals
