@@ -1,4 +1,7 @@
-"""Turntable motion: every axis moves at its own limited speed, then the table settles; a stop holds."""
+"""Turntable motion: every axis moves at its own limited speed, then the table settles; a stop holds.
+
+Axes are commanded one at a time (line protocols move one axis per command) or all together.
+"""
 
 from __future__ import annotations
 
@@ -14,27 +17,32 @@ class TurntableMotion:
         self.accuracy_deg = accuracy_deg
         self.settle_s = settle_s
         self._rng = rng
-        self._start = np.zeros_like(self.speeds_deg_s)
-        self._target = np.zeros_like(self.speeds_deg_s)
-        self._t0 = 0.0
-        self.last_command_deg: np.ndarray | None = None
+        n = len(self.speeds_deg_s)
+        self._start = np.zeros(n)
+        self._target = np.zeros(n)
+        self._t0 = np.zeros(n)
+        self.last_command_deg = np.full(n, np.nan)
 
     def position_deg(self, t_s: float) -> np.ndarray:
-        travelled = self.speeds_deg_s * max(t_s - self._t0, 0.0)
+        travelled = self.speeds_deg_s * np.maximum(t_s - self._t0, 0.0)
         delta = self._target - self._start
         return self._start + np.sign(delta) * np.minimum(np.abs(delta), travelled)
 
+    def command_axis(self, t_s: float, axis: int, target_deg: float) -> None:
+        self._start[axis] = self.position_deg(t_s)[axis]
+        self._target[axis] = target_deg + self._rng.uniform(-self.accuracy_deg, self.accuracy_deg)
+        self._t0[axis] = t_s
+        self.last_command_deg[axis] = target_deg
+
     def command(self, t_s: float, target_deg: np.ndarray) -> None:
-        self._start = self.position_deg(t_s)
-        error = self._rng.uniform(-self.accuracy_deg, self.accuracy_deg, self._start.shape)
-        self._target = np.asarray(target_deg, dtype=float) + error
-        self._t0 = t_s
-        self.last_command_deg = np.array(target_deg, dtype=float)
+        for axis, target in enumerate(np.asarray(target_deg, dtype=float)):
+            self.command_axis(t_s, axis, float(target))
 
     def stop(self, t_s: float) -> None:
-        self._start = self._target = self.position_deg(t_s)
-        self._t0 = t_s
+        here = self.position_deg(t_s)
+        self._start, self._target = here.copy(), here.copy()
+        self._t0 = np.full_like(self._t0, t_s)
 
     def in_position(self, t_s: float) -> bool:
-        travel_s = np.max(np.abs(self._target - self._start) / self.speeds_deg_s)
-        return t_s >= self._t0 + travel_s + self.settle_s
+        arrival = self._t0 + np.abs(self._target - self._start) / self.speeds_deg_s
+        return t_s >= arrival.max() + self.settle_s

@@ -1,0 +1,77 @@
+"""Turntable controller line protocols as data: command templates, reply patterns, terminators.
+
+A profile says, for each operation, what to send (a template with `{axis}`, 1-based, and `{angle}`),
+the pattern a good reply must match (named groups carry values), and — so that a simulator can speak
+the same profile — the answer template a controller gives. Any reply matching `error_pattern` is a
+controller error.
+"""
+
+from __future__ import annotations
+
+import re
+import string
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator
+
+
+class Command(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    send: str = Field(min_length=1)
+    reply: str = Field(min_length=1, description="regular expression a good reply matches in full")
+    answer: str = Field(min_length=1, description="what a controller answers (template), for simulators")
+
+    @field_validator("reply")
+    @classmethod
+    def _compiles(cls, value: str) -> str:
+        try:
+            re.compile(value)
+        except re.error as exc:
+            raise ValueError(f"not a regular expression: {exc}") from None
+        return value
+
+    def request_pattern(self) -> re.Pattern[str]:
+        """The `send` template as a pattern, for a simulator to recognise the request."""
+        pattern = ""
+        for literal, field, _, _ in string.Formatter().parse(self.send):
+            pattern += re.escape(literal)
+            if field is not None:
+                pattern += rf"(?P<{field}>\S+)"
+        return re.compile(pattern)
+
+
+class TurntableProtocol(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    write_terminator: str = "\n"
+    read_terminator: str = "\n"
+    error_pattern: str = "^ERR"
+    identify: Command
+    move: Command
+    position: Command
+    busy: Command
+    stop: Command
+    home: Command
+    fault: Command
+    busy_values: list[str] = ["1"]
+    fault_ok: list[str] = ["0"]
+
+
+#: The built-in profile: a plain SCPI-like line protocol, one command per line, one reply per command.
+ACCELCAL_LINE = TurntableProtocol(
+    identify=Command(send="*IDN?", reply=r"(?P<identity>.+)", answer="{identity}"),
+    move=Command(send="MOV {axis} {angle:.5f}", reply="OK", answer="OK"),
+    position=Command(send="POS? {axis}", reply=r"(?P<angle>[-+]?\d+(\.\d*)?([eE][-+]?\d+)?)", answer="{angle:.6f}"),
+    busy=Command(send="BUSY?", reply=r"(?P<busy>[01])", answer="{busy}"),
+    stop=Command(send="STOP", reply="OK", answer="OK"),
+    home=Command(send="HOME", reply="OK", answer="OK"),
+    fault=Command(send="FAULT?", reply=r"(?P<fault>\d+)", answer="{fault}"),
+)
+
+PROTOCOLS: dict[str, TurntableProtocol] = {"accelcal-line": ACCELCAL_LINE}
+
+
+def turntable_protocol(name: str, overrides: dict[str, object] | None = None) -> TurntableProtocol:
+    """A built-in profile with any fields the rig config overrides (validated)."""
+    merged = {**PROTOCOLS[name].model_dump(), **(overrides or {})}
+    return TurntableProtocol.model_validate(merged)

@@ -1,0 +1,51 @@
+"""A serial device with a real path: a pseudo-terminal whose far end a simulator answers line by line."""
+
+from __future__ import annotations
+
+import os
+import select
+import threading
+import tty
+from collections.abc import Callable
+
+#: How often the server thread looks up from a quiet line to see whether it should stop.
+_POLL_S = 0.2
+
+
+class PtyLineServer:
+    """Reads requests ending in `terminator` from the pty and writes back `handle(request) + terminator`."""
+
+    def __init__(self, handle: Callable[[str], str], terminator: bytes = b"\n", name: str = "pty") -> None:
+        self._handle = handle
+        self._terminator = terminator
+        self._master, self._slave = os.openpty()
+        tty.setraw(self._master)
+        tty.setraw(self._slave)  # the slave stays open so the path keeps working between clients
+        self.path = os.ttyname(self._slave)
+        self._stopping = threading.Event()
+        self._thread = threading.Thread(target=self._serve, name=name, daemon=True)
+
+    def start(self) -> PtyLineServer:
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        self._stopping.set()
+        self._thread.join(5.0)
+        os.close(self._master)
+        os.close(self._slave)
+
+    def _serve(self) -> None:
+        pending = b""
+        while not self._stopping.is_set():
+            readable, _, _ = select.select([self._master], [], [], _POLL_S)
+            if not readable:
+                continue
+            try:
+                pending += os.read(self._master, 65536)
+            except OSError:
+                return
+            while self._terminator in pending:
+                line, pending = pending.split(self._terminator, 1)
+                reply = self._handle(line.decode(errors="replace").strip())
+                os.write(self._master, reply.encode() + self._terminator)

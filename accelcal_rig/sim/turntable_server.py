@@ -1,0 +1,63 @@
+"""A simulated turntable controller on a pseudo-terminal, speaking a line-protocol profile."""
+
+from __future__ import annotations
+
+from accelcal_rig.instruments.turntable_protocol import TurntableProtocol
+from accelcal_rig.sim.lab import VirtualLab
+from accelcal_rig.sim.pty_line_server import PtyLineServer
+
+
+class SimulatedTurntableServer:
+    """Answers each request from the lab's turntable motion at the shared clock's time."""
+
+    def __init__(self, lab: VirtualLab, protocol: TurntableProtocol, identity: str = "accelcal-rig simulated turntable"):
+        self._lab = lab
+        self._protocol = protocol
+        self._identity = identity
+        self._patterns = [(name, getattr(protocol, name), getattr(protocol, name).request_pattern())
+                          for name in ("identify", "move", "position", "busy", "stop", "home", "fault")]
+        if protocol.write_terminator != protocol.read_terminator:
+            raise ValueError("the simulated turntable needs one terminator for both directions")
+        self._server = PtyLineServer(self._handle, protocol.write_terminator.encode(), "simulated-turntable")
+        self.path = self._server.path
+        #: Fault code the controller reports (fault injection sets it).
+        self.fault = self._protocol.fault_ok[0]
+
+    def start(self) -> SimulatedTurntableServer:
+        self._server.start()
+        return self
+
+    def stop(self) -> None:
+        self._server.stop()
+
+    def _handle(self, request: str) -> str:
+        for name, command, pattern in self._patterns:
+            match = pattern.fullmatch(request)
+            if match is not None:
+                try:
+                    return self._answer(name, command.answer, match.groupdict())
+                except (ValueError, IndexError) as exc:
+                    return f"ERR {exc}"
+        return f"ERR unknown command {request!r}"
+
+    def _answer(self, name: str, template: str, fields: dict[str, str]) -> str:
+        lab, motion = self._lab, self._lab.motion
+        with lab.lock:
+            now = lab.clock.now()
+            n_axes = len(motion.speeds_deg_s)
+            axis = int(fields["axis"]) - 1 if "axis" in fields else None
+            if axis is not None and not 0 <= axis < n_axes:
+                raise ValueError(f"no axis {axis + 1}")
+            if name == "move":
+                motion.command_axis(now, axis, float(fields["angle"]))
+            elif name == "stop":
+                motion.stop(now)
+            elif name == "home":
+                motion.command(now, [0.0] * n_axes)
+            values = {
+                "identity": self._identity,
+                "angle": float(motion.position_deg(now)[axis]) if axis is not None else 0.0,
+                "busy": "0" if motion.in_position(now) else self._protocol.busy_values[0],
+                "fault": self.fault,
+            }
+        return template.format(**values)
