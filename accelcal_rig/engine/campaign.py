@@ -283,7 +283,7 @@ class CampaignRunner:
             temperature_c=block.temperature_c,
             gravity_reference_g=self._mounts[sensor.serial].inv().apply(gravity_fixture),
             temperature_in_band=in_band,
-            truth=self.truth.last_block_truth(sensor.serial) if self.truth is not None else None,
+            truth=self.truth.block_truth(sensor.serial, block) if self.truth is not None else None,
         )
 
 

@@ -131,7 +131,7 @@ def _run_with_instruments(prepared: PreparedCampaign, output: Path, instruments:
     try:
         if instruments.truth is not None:
             for sensor in instruments.sensors:
-                writer.write_truth_header(sensor.serial, instruments.truth.describe(sensor.serial))
+                writer.write_truth_header(sensor.serial, instruments.truth.describe(sensor.serial, acquisition.odr_hz))
         events = EventLog(clock, writer)
         runner = CampaignRunner(procedure, rig.model, prepared.plan, instruments, writer, clock, events,
                                 fit_stage=_fit_stage(procedure, output, calibration) if calibration else None)

@@ -51,3 +51,69 @@ def quantise_g(accel_g: np.ndarray, range_g: int) -> np.ndarray:
     """Acceleration in g → signed 20-bit codes as the ADC would output them (rounded, saturating)."""
     codes = np.rint(np.asarray(accel_g, dtype=float) * RANGE_LSB_PER_G[range_g])
     return np.clip(codes, CODE_MIN, CODE_MAX).astype(np.int32)
+
+
+# ---------------------------------------------------------------------- register map
+REG_DEVID_AD = 0x00
+REG_STATUS = 0x04
+REG_FIFO_ENTRIES = 0x05
+REG_TEMP2 = 0x06
+REG_XDATA3 = 0x08
+REG_FIFO_DATA = 0x11
+REG_FILTER = 0x28
+REG_FIFO_SAMPLES = 0x29
+REG_RANGE = 0x2C
+REG_POWER_CTL = 0x2D
+REG_RESET = 0x2F
+
+RESET_CODE = 0x52
+STATUS_NVM_BUSY = 0x10
+STATUS_FIFO_OVR = 0x04
+STATUS_DATA_RDY = 0x01
+POWER_CTL_STANDBY = 0x01
+RANGE_CODES: dict[int, int] = {2: 0b01, 4: 0b10, 8: 0b11}
+FIFO_CAPACITY_ENTRIES = 96  # one entry is one axis: 32 xyz samples
+
+_ENTRY_X_MARKER = 0x01
+_ENTRY_EMPTY = 0x02
+
+
+def odr_code(odr_hz: float) -> int:
+    """FILTER register ODR_LPF code for an output data rate."""
+    return int(np.argmin(np.abs(np.array(OUTPUT_DATA_RATES_HZ) - odr_hz)))
+
+
+def decode_data_bytes(raw: bytes) -> np.ndarray:
+    """3-byte big-endian fields, 20-bit two's complement left-justified → signed codes (vectorised)."""
+    triplets = np.frombuffer(raw, dtype=np.uint8).reshape(-1, 3).astype(np.int32)
+    codes = (triplets[:, 0] << 12) | (triplets[:, 1] << 4) | (triplets[:, 2] >> 4)
+    return np.where(codes & 0x80000, codes - (1 << 20), codes).astype(np.int32)
+
+
+def decode_fifo(raw: bytes) -> np.ndarray:
+    """FIFO entries (3 bytes each) → (n, 3) codes: empty entries dropped, resynchronised on the X marker,
+    an incomplete trailing sample dropped."""
+    entries = np.frombuffer(raw, dtype=np.uint8).reshape(-1, 3)
+    entries = entries[(entries[:, 2] & _ENTRY_EMPTY) == 0]
+    x_marks = np.flatnonzero(entries[:, 2] & _ENTRY_X_MARKER)
+    if x_marks.size == 0:
+        return np.empty((0, 3), dtype=np.int32)
+    entries = entries[x_marks[0]:]
+    whole = entries.shape[0] // 3 * 3
+    return decode_data_bytes(entries[:whole].tobytes()).reshape(-1, 3)
+
+
+def encode_fifo(codes_xyz: np.ndarray) -> bytes:
+    """(n, 3) codes → FIFO entry bytes, X entries marked (what the part puts out; for simulators)."""
+    codes = np.asarray(codes_xyz, dtype=np.int64).reshape(-1) & 0xFFFFF
+    entries = np.empty((codes.size, 3), dtype=np.uint8)
+    entries[:, 0] = codes >> 12
+    entries[:, 1] = (codes >> 4) & 0xFF
+    entries[:, 2] = (codes & 0x0F) << 4
+    entries[0::3, 2] |= _ENTRY_X_MARKER
+    return entries.tobytes()
+
+
+def empty_fifo_entries(count: int) -> bytes:
+    """What reading an empty FIFO returns: entries with the empty flag set."""
+    return bytes([0, 0, _ENTRY_EMPTY] * count)

@@ -8,7 +8,7 @@ from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.engine.clock import Clock
 from accelcal_rig.errors import InstrumentError
-from accelcal_rig.fit.sfem import PARAMETER_NAMES, distort
+from accelcal_rig.fit.sfem import PARAMETER_NAMES
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.interfaces import DeviceIdentity, RigInstruments, SampleBlock
 from accelcal_rig.sim.lab import VirtualLab
@@ -79,7 +79,6 @@ class SimulatedAccelerometer:
         self._range_g = 2
         self._odr_hz = 125.0
         self._measuring = False
-        self.last_truth: dict[str, np.ndarray] | None = None
 
     def identify(self) -> DeviceIdentity:
         return DeviceIdentity(adxl355.DEVID_AD, adxl355.DEVID_MST, adxl355.PARTID, 1)
@@ -100,24 +99,16 @@ class SimulatedAccelerometer:
         return self._lab.dut_reading_c(self._index)
 
     def noise_g(self) -> float:
-        """Per-sample white noise: density × √(equivalent noise bandwidth of the ODR/4 low-pass, ×π/2)."""
-        return self._lab.noise_density_g_per_rthz * float(np.sqrt(np.pi / 2 * self._odr_hz / 4))
+        return self._lab.noise_g(self._odr_hz)
 
     def acquire(self, n_samples: int) -> SampleBlock:
         if not self._measuring:
             raise InstrumentError(f"sensor {self.serial}: acquire while in standby")
         clock = self._lab.clock
         temperature_before = self.read_temperature_c()
-        true_before = self._lab.dut_true_c(self._index)
-        gravity = self._lab.gravity_in_dut(self._index)
         t_start = clock.now()
         clock.sleep(n_samples / self._odr_hz)
-        true_mean = 0.5 * (true_before + self._lab.dut_true_c(self._index))
-        params = self._lab.duts[self._index].truth.parameters_at(true_mean)
-        noise = self._lab.rng.normal(0.0, self.noise_g(), (n_samples, 3))
-        raw_g = distort(gravity, params) + self._lab.unmodelled_g(self._index, gravity)
-        codes = adxl355.quantise_g(raw_g + noise, self._range_g)
-        self.last_truth = {"parameters": params, "gravity_g": gravity, "temperature_c": np.float64(true_mean)}
+        codes = self._lab.dut_samples(self._index, t_start, n_samples, self._odr_hz, self._range_g)
         return SampleBlock(codes, t_start, t_start + (n_samples - 1) / self._odr_hz,
                            (temperature_before, self.read_temperature_c()))
 
@@ -128,26 +119,23 @@ class SimulatedAccelerometer:
 class SimulationTruth:
     """The hidden truth of a simulated rig, for the campaign file's `simulation_truth` group."""
 
-    def __init__(self, lab: VirtualLab, sensors: list[SimulatedAccelerometer]) -> None:
+    def __init__(self, lab: VirtualLab) -> None:
         self._lab = lab
-        self._sensors = {s.serial: s for s in sensors}
+        self._index = {d.serial: i for i, d in enumerate(lab.duts)}
 
-    def describe(self, serial: str) -> dict[str, np.ndarray | str | float]:
-        dut = next(d for d in self._lab.duts if d.serial == serial)
+    def describe(self, serial: str, odr_hz: float) -> dict[str, np.ndarray | str | float]:
+        dut = self._lab.duts[self._index[serial]]
         return {
             "polynomial_coefficients": dut.truth.coefficients,
             "parameter_names": ",".join(PARAMETER_NAMES),
             "t_ref_c": T_REF_C,
             "half_range_c": HALF_RANGE_C,
             "fixture_time_constant_s": dut.tau_s,
-            "noise_g_per_sample": self._sensors[serial].noise_g(),
+            "noise_g_per_sample": self._lab.noise_g(odr_hz),
         }
 
-    def last_block_truth(self, serial: str) -> dict[str, np.ndarray]:
-        truth = self._sensors[serial].last_truth
-        if truth is None:
-            raise InstrumentError(f"sensor {serial}: no block acquired yet")
-        return truth
+    def block_truth(self, serial: str, block: SampleBlock) -> dict[str, np.ndarray]:
+        return self._lab.truth_between(self._index[serial], block.t_start_s, block.t_end_s)
 
 
 def build_simulated_rig(rig: RigConfig, procedure: Procedure, clock: Clock, seed: int) -> RigInstruments:
@@ -155,5 +143,4 @@ def build_simulated_rig(rig: RigConfig, procedure: Procedure, clock: Clock, seed
     may switch on sensor effects beyond Eq. 1."""
     lab = VirtualLab(rig, clock, seed, procedure.simulation)
     sensors = [SimulatedAccelerometer(lab, i) for i in range(len(lab.duts))]
-    return RigInstruments(SimulatedChamber(lab), SimulatedTurntable(lab), list(sensors),
-                          SimulationTruth(lab, sensors))
+    return RigInstruments(SimulatedChamber(lab), SimulatedTurntable(lab), list(sensors), SimulationTruth(lab))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import threading
+from collections import deque
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -11,7 +12,8 @@ from scipy.spatial.transform import Rotation
 from accelcal_rig.config.procedure import SimulatedEffects
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.engine.clock import Clock
-from accelcal_rig.instruments.adxl355 import raw_from_temperature_c, temperature_c_from_raw
+from accelcal_rig.fit.sfem import distort
+from accelcal_rig.instruments.adxl355 import quantise_g, raw_from_temperature_c, temperature_c_from_raw
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.sim.thermal import ThermalModel
 from accelcal_rig.sim.truth import DutTruth, truth_for_serial
@@ -35,6 +37,8 @@ class SimulatedDut:
         signs = hashlib.sha256(f"effects:{serial}".encode()).digest()
         self.hysteresis_signs = np.array([1.0 if b & 1 else -1.0 for b in signs[:3]])
         self.nonlinearity_signs = np.array([1.0 if b & 1 else -1.0 for b in signs[3:6]])
+        #: (t_start, t_end, n, parameters, gravity, temperature) of recently generated sample chunks.
+        self.truth_log: deque[tuple] = deque(maxlen=4096)
 
 
 class VirtualLab:
@@ -84,6 +88,31 @@ class VirtualLab:
         hysteresis = 0.5e-3 * self.effects.hysteresis_mg * self.thermal.approach_sign[index] * dut.hysteresis_signs
         nonlinearity = 1e-3 * self.effects.nonlinearity_mg_per_g2 * dut.nonlinearity_signs * gravity_g**2
         return hysteresis + nonlinearity
+
+    def noise_g(self, odr_hz: float) -> float:
+        """Per-sample white noise: density × √(equivalent noise bandwidth of the ODR/4 low-pass, ×π/2)."""
+        return self.noise_density_g_per_rthz * float(np.sqrt(np.pi / 2 * odr_hz / 4))
+
+    def dut_samples(self, index: int, t_start_s: float, n_samples: int, odr_hz: float, range_g: int) -> np.ndarray:
+        """`n_samples` codes (n, 3) of DUT `index` from `t_start_s` on, at the DUT's state now (temperature
+        and orientation change negligibly within a FIFO's worth); the truth behind them is recorded."""
+        dut = self.duts[index]
+        temperature = self.dut_true_c(index)
+        params = dut.truth.parameters_at(temperature)
+        gravity = self.gravity_in_dut(index)
+        noise = self.rng.normal(0.0, self.noise_g(odr_hz), (n_samples, 3))
+        raw_g = distort(gravity, params) + self.unmodelled_g(index, gravity) + noise
+        dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, params, gravity, temperature))
+        return quantise_g(raw_g, range_g)
+
+    def truth_between(self, index: int, t_start_s: float, t_end_s: float) -> dict[str, np.ndarray]:
+        """The truth behind the samples of [t_start_s, t_end_s], averaged over the chunks that made them."""
+        chunks = [c for c in self.duts[index].truth_log if c[0] <= t_end_s and c[1] > t_start_s]
+        if not chunks:
+            raise ValueError(f"no samples of {self.duts[index].serial} between {t_start_s:g} and {t_end_s:g} s")
+        weights = np.array([c[2] for c in chunks], dtype=float)
+        mean = lambda k: np.average(np.array([c[k] for c in chunks]), axis=0, weights=weights)  # noqa: E731
+        return {"parameters": mean(3), "gravity_g": mean(4), "temperature_c": np.float64(mean(5))}
 
     def gravity_in_dut(self, index: int) -> np.ndarray:
         """True specific-force direction (+1 g up) in DUT `index`'s frame at the table's actual angles."""

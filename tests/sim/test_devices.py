@@ -24,7 +24,7 @@ def test_block_mean_matches_the_truth_within_the_noise(rig) -> None:
     sensor.start_measurement()
     block = sensor.acquire(2000)
     assert block.codes_xyz.shape == (2000, 3) and block.codes_xyz.dtype == np.int32
-    truth = instruments.truth.last_block_truth(sensor.serial)
+    truth = instruments.truth.block_truth(sensor.serial, block)
     expected = distort(truth["gravity_g"], truth["parameters"])
     lsb = adxl355.lsb_g(2)
     measured = block.codes_xyz * lsb
