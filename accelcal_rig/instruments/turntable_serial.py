@@ -5,15 +5,15 @@ from __future__ import annotations
 import re
 
 import numpy as np
-import serial
 
 from accelcal_rig.errors import InstrumentError
+from accelcal_rig.instruments.line_port import LinePort
 from accelcal_rig.instruments.turntable_protocol import Command, TurntableProtocol
 
 
 class SerialTurntable:
-    def __init__(self, port: serial.SerialBase, endpoint: str, protocol: TurntableProtocol, n_axes: int) -> None:
-        self._port = port
+    def __init__(self, line: LinePort, endpoint: str, protocol: TurntableProtocol, n_axes: int) -> None:
+        self._line = line
         self.endpoint = endpoint
         self.protocol = protocol
         self.n_axes = n_axes
@@ -22,11 +22,9 @@ class SerialTurntable:
     @classmethod
     def open(cls, endpoint: str, protocol: TurntableProtocol, n_axes: int, baudrate: int = 9600,
              timeout_s: float = 2.0) -> SerialTurntable:
-        try:
-            port = serial.serial_for_url(endpoint, baudrate=baudrate, timeout=timeout_s, write_timeout=timeout_s)
-        except (serial.SerialException, ValueError) as exc:
-            raise InstrumentError(f"turntable (serial {endpoint}): cannot open: {exc}") from None
-        return cls(port, f"serial {endpoint}", protocol, n_axes)
+        line = LinePort.open(endpoint, "turntable", baudrate, timeout_s, protocol.write_terminator,
+                             protocol.read_terminator)
+        return cls(line, f"serial {endpoint}", protocol, n_axes)
 
     # ------------------------------------------------------------------ the Turntable interface
     def identify(self) -> str:
@@ -55,21 +53,12 @@ class SerialTurntable:
         self._ask(self.protocol.home)
 
     def close(self) -> None:
-        self._port.close()
+        self._line.close()
 
     # ------------------------------------------------------------------ wire
     def _ask(self, command: Command, **fields: object) -> dict[str, str]:
         request = command.send.format(**fields)
-        terminator = self.protocol.read_terminator.encode()
-        try:
-            self._port.reset_input_buffer()  # a late reply to an earlier, timed-out request is stale
-            self._port.write((request + self.protocol.write_terminator).encode())
-            raw = self._port.read_until(terminator)
-        except (serial.SerialException, OSError) as exc:
-            raise InstrumentError(f"turntable ({self.endpoint}): {request!r}: port failed: {exc}") from None
-        if not raw.endswith(terminator):
-            raise InstrumentError(f"turntable ({self.endpoint}): {request!r}: no reply within the timeout")
-        reply = raw[: -len(terminator)].decode(errors="replace").strip()
+        reply = self._line.ask(request)
         if self._error.search(reply):
             raise InstrumentError(f"turntable ({self.endpoint}): {request!r} refused: {reply}")
         match = re.fullmatch(command.reply, reply)

@@ -1,0 +1,110 @@
+"""ADXL355 at register level over any RegisterTransport: bring-up, configuration, temperature, and
+gap-free blocks of samples drained from the FIFO (decoded with numpy, not per sample)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from accelcal_rig.engine.clock import Clock
+from accelcal_rig.engine.waits import wait_until
+from accelcal_rig.errors import InstrumentError, WaitTimeout
+from accelcal_rig.instruments import adxl355
+from accelcal_rig.instruments.adxl355_transport import RegisterTransport
+from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
+
+#: Samples to let accumulate between FIFO drains: under its 32, so a drain is never late.
+DRAIN_EVERY_SAMPLES = 30
+#: Attempts at a gap-free block before a FIFO overflow is reported as a fault.
+OVERFLOW_ATTEMPTS = 3
+
+
+class Adxl355:
+    def __init__(self, transport: RegisterTransport, serial: str, clock: Clock) -> None:
+        self._bus = transport
+        self.serial = serial
+        self.endpoint = transport.endpoint
+        self._clock = clock
+        self._odr_hz = 125.0
+
+    # ------------------------------------------------------------------ the Accelerometer interface
+    def identify(self) -> DeviceIdentity:
+        ad, mst, part, rev = self._bus.read(adxl355.REG_DEVID_AD, 4)
+        return DeviceIdentity(ad, mst, part, rev)
+
+    def reset(self) -> None:
+        """Software reset, then wait (with a deadline) for the NVM to load."""
+        self._bus.write(adxl355.REG_RESET, adxl355.RESET_CODE)
+        try:
+            wait_until(self._clock, lambda: not self._status() & adxl355.STATUS_NVM_BUSY,
+                       timeout_s=0.1, poll_s=0.005, what=f"sensor {self.serial} ({self.endpoint}) NVM load after reset")
+        except WaitTimeout as exc:
+            raise InstrumentError(str(exc)) from None
+
+    def configure(self, range_g: int, odr_hz: float) -> None:
+        """Range and filter, written explicitly; the part takes them only in standby."""
+        if not self._bus.read(adxl355.REG_POWER_CTL, 1)[0] & adxl355.POWER_CTL_STANDBY:
+            raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): range and filter can only change in standby")
+        self._bus.write(adxl355.REG_RANGE, adxl355.RANGE_CODES[range_g])
+        self._bus.write(adxl355.REG_FILTER, adxl355.odr_code(odr_hz))
+        readback = self._bus.read(adxl355.REG_FILTER, 1)[0], self._bus.read(adxl355.REG_RANGE, 1)[0] & 0x03
+        if readback != (adxl355.odr_code(odr_hz), adxl355.RANGE_CODES[range_g]):
+            raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): range/filter did not read back")
+        self._odr_hz = odr_hz
+
+    def start_measurement(self) -> None:
+        self._bus.write(adxl355.REG_POWER_CTL, 0x00)  # measure, temperature on, DRDY on
+
+    def standby(self) -> None:
+        self._bus.write(adxl355.REG_POWER_CTL, adxl355.POWER_CTL_STANDBY)
+
+    def read_temperature_c(self) -> float:
+        high, low = self._bus.read(adxl355.REG_TEMP2, 2)
+        return float(adxl355.temperature_c_from_raw(((high & 0x0F) << 8) | low))
+
+    def acquire(self, n_samples: int) -> SampleBlock:
+        """`n_samples` consecutive samples: drain stale entries, then drain the FIFO as it fills."""
+        for _ in range(OVERFLOW_ATTEMPTS):
+            block = self._try_acquire(n_samples)
+            if block is not None:
+                return block
+        raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): FIFO overflowed in "
+                              f"{OVERFLOW_ATTEMPTS} attempts: the link cannot keep up with {self._odr_hz:g} Hz")
+
+    def close(self) -> None:
+        self._bus.close()
+
+    # ------------------------------------------------------------------ FIFO
+    def _try_acquire(self, n_samples: int) -> SampleBlock | None:
+        temperature_before = self.read_temperature_c()
+        self._drain(self._status_and_entries()[1])  # stale samples from before this block; clears FIFO_OVR
+        t_start = self._clock.now()
+        blocks, have = [], 0
+        deadline = t_start + 2.0 * n_samples / self._odr_hz + 1.0
+        while have < n_samples:
+            if self._clock.now() > deadline:
+                raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {have} of {n_samples} samples "
+                                      "before the deadline: is it measuring?")
+            self._clock.sleep(min(DRAIN_EVERY_SAMPLES, n_samples - have) / self._odr_hz)
+            status, entries = self._status_and_entries()
+            if status & adxl355.STATUS_FIFO_OVR:
+                return None
+            codes = self._drain(entries)
+            blocks.append(codes)
+            have += len(codes)
+        codes = np.concatenate(blocks)[:n_samples]
+        t_end = t_start + (n_samples - 1) / self._odr_hz
+        return SampleBlock(codes, t_start, t_end, (temperature_before, self.read_temperature_c()))
+
+    def _status_and_entries(self) -> tuple[int, int]:
+        """STATUS and FIFO_ENTRIES are neighbours: one burst, one round trip."""
+        status, entries = self._bus.read(adxl355.REG_STATUS, 2)
+        return status, entries & 0x7F
+
+    def _drain(self, entries: int) -> np.ndarray:
+        whole = entries // 3 * 3  # only complete xyz samples: the rest is still being written
+        if whole == 0:
+            return np.empty((0, 3), dtype=np.int32)
+        return adxl355.decode_fifo(self._bus.read(adxl355.REG_FIFO_DATA, 3 * whole))
+
+    def _status(self) -> int:
+        return self._bus.read(adxl355.REG_STATUS, 1)[0]

@@ -1,0 +1,101 @@
+"""Ways to reach an ADXL355's registers: a serial bridge speaking a small line protocol, or Linux spidev.
+
+The bridge protocol (docs/instruments.md): one ASCII request per line, one reply per request.
+    ?                    → `ADXL355-BRIDGE <version> <free text>`
+    R <addr> <count>     → `=<hex bytes>`   read `count` registers from `addr` (hex); FIFO_DATA (0x11)
+                                            does not auto-increment, so a burst of it drains the FIFO
+    W <addr> <value>     → `=`              write one register (both hex)
+    any failure          → `!<message>`
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+from accelcal_rig.errors import InstrumentError
+from accelcal_rig.instruments.line_port import LinePort
+
+BRIDGE_GREETING = "ADXL355-BRIDGE"
+
+
+class RegisterTransport(Protocol):
+    endpoint: str
+
+    def read(self, address: int, count: int) -> bytes: ...
+    def write(self, address: int, value: int) -> None: ...
+    def close(self) -> None: ...
+
+
+class SerialBridge:
+    """The bridge line protocol over pyserial (a device path or any pyserial URL)."""
+
+    def __init__(self, line: LinePort, endpoint: str) -> None:
+        self._line = line
+        self.endpoint = endpoint
+
+    @classmethod
+    def open(cls, endpoint: str, baudrate: int = 921600, timeout_s: float = 1.0) -> SerialBridge:
+        bridge = cls(LinePort.open(endpoint, "sensor bridge", baudrate, timeout_s), f"serial {endpoint}")
+        greeting = bridge._ask("?")
+        if not greeting.startswith(BRIDGE_GREETING):
+            bridge.close()
+            raise InstrumentError(f"sensor bridge (serial {endpoint}): not an ADXL355 bridge (answers {greeting!r})")
+        return bridge
+
+    def read(self, address: int, count: int) -> bytes:
+        reply = self._ask(f"R {address:02X} {count}")
+        try:
+            data = bytes.fromhex(reply[1:])
+        except ValueError:
+            raise InstrumentError(f"sensor bridge ({self.endpoint}): garbled reply {reply[:40]!r}") from None
+        if not reply.startswith("=") or len(data) != count:
+            raise InstrumentError(f"sensor bridge ({self.endpoint}): read of {count} bytes at 0x{address:02X} "
+                                  f"answered {reply[:40]!r}")
+        return data
+
+    def write(self, address: int, value: int) -> None:
+        reply = self._ask(f"W {address:02X} {value:02X}")
+        if reply != "=":
+            raise InstrumentError(f"sensor bridge ({self.endpoint}): write 0x{value:02X} to 0x{address:02X} "
+                                  f"answered {reply[:40]!r}")
+
+    def close(self) -> None:
+        self._line.close()
+
+    def _ask(self, request: str) -> str:
+        reply = self._line.ask(request)
+        if reply.startswith("!"):
+            raise InstrumentError(f"sensor bridge ({self.endpoint}): {request!r} refused: {reply[1:]}")
+        return reply
+
+
+class SpidevBus:
+    """Linux spidev (optional extra `spidev`): mode 0; command byte (addr << 1) | 1 reads, addr << 1 writes."""
+
+    def __init__(self, device: object, endpoint: str) -> None:
+        self._device = device
+        self.endpoint = endpoint
+
+    @classmethod
+    def open(cls, bus: int, chip_select: int, speed_hz: int = 5_000_000) -> SpidevBus:
+        try:
+            import spidev  # type: ignore[import-not-found]
+        except ImportError:
+            raise InstrumentError("spidev is not installed: pip install 'accelcal-rig[spidev]'") from None
+        device = spidev.SpiDev()
+        try:
+            device.open(bus, chip_select)
+        except OSError as exc:
+            raise InstrumentError(f"sensor (spidev {bus}.{chip_select}): cannot open: {exc}") from None
+        device.mode = 0
+        device.max_speed_hz = speed_hz
+        return cls(device, f"spidev {bus}.{chip_select}")
+
+    def read(self, address: int, count: int) -> bytes:
+        return bytes(self._device.xfer2([(address << 1) | 1] + [0] * count)[1:])
+
+    def write(self, address: int, value: int) -> None:
+        self._device.xfer2([address << 1, value])
+
+    def close(self) -> None:
+        self._device.close()

@@ -1,0 +1,54 @@
+"""Request/reply over a serial line (a device path or any pyserial URL), one line each way.
+
+pyserial's read_until reads a byte per system call; replies here can be hundreds of characters (a FIFO
+burst in hex), so lines are read in whatever chunks have arrived.
+"""
+
+from __future__ import annotations
+
+import serial
+
+from accelcal_rig.errors import InstrumentError
+
+
+class LinePort:
+    def __init__(self, port: serial.SerialBase, name: str, write_terminator: str = "\n",
+                 read_terminator: str = "\n") -> None:
+        self._port = port
+        self.name = name  # "turntable (serial /dev/ttyUSB0)": how errors name the instrument
+        self._write_terminator = write_terminator.encode()
+        self._read_terminator = read_terminator.encode()
+
+    @classmethod
+    def open(cls, endpoint: str, instrument: str, baudrate: int, timeout_s: float, write_terminator: str = "\n",
+             read_terminator: str = "\n") -> LinePort:
+        name = f"{instrument} (serial {endpoint})"
+        try:
+            port = serial.serial_for_url(endpoint, baudrate=baudrate, timeout=timeout_s, write_timeout=timeout_s)
+        except (serial.SerialException, ValueError) as exc:
+            raise InstrumentError(f"{name}: cannot open: {exc}") from None
+        return cls(port, name, write_terminator, read_terminator)
+
+    def ask(self, request: str) -> str:
+        """Send one request, return its reply line without the terminator (stripped)."""
+        try:
+            self._port.reset_input_buffer()  # a late reply to an earlier, timed-out request is stale
+            self._port.write(request.encode() + self._write_terminator)
+            raw = self._read_line()
+        except (serial.SerialException, OSError) as exc:
+            raise InstrumentError(f"{self.name}: {request!r}: port failed: {exc}") from None
+        if not raw.endswith(self._read_terminator):
+            raise InstrumentError(f"{self.name}: {request!r}: no reply within the timeout")
+        return raw[: -len(self._read_terminator)].decode(errors="replace").strip()
+
+    def close(self) -> None:
+        self._port.close()
+
+    def _read_line(self) -> bytes:
+        line = bytearray()
+        while not line.endswith(self._read_terminator):
+            chunk = self._port.read(max(1, self._port.in_waiting))  # waits up to the timeout for the first byte
+            if not chunk:
+                break
+            line += chunk
+        return bytes(line)

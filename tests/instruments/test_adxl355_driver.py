@@ -1,0 +1,137 @@
+"""The ADXL355 driver through the serial bridge, against the simulated part on a pseudo-terminal."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from accelcal_rig.config.load import load_rig
+from accelcal_rig.engine.clock import VirtualClock
+from accelcal_rig.errors import InstrumentError
+from accelcal_rig.fit.sfem import distort
+from accelcal_rig.instruments import adxl355
+from accelcal_rig.instruments.adxl355_driver import Adxl355
+from accelcal_rig.instruments.adxl355_transport import SerialBridge, SpidevBus
+from accelcal_rig.sim.adxl355_bridge_server import SimulatedBridgeServer
+from accelcal_rig.sim.lab import VirtualLab
+from accelcal_rig.sim.pty_line_server import PtyLineServer
+from tests.conftest import SIM_RIG
+
+
+@pytest.fixture
+def sensor():
+    clock = VirtualClock()
+    lab = VirtualLab(load_rig(SIM_RIG).model, clock, 3)
+    server = SimulatedBridgeServer(lab, 1).start()
+    driver = Adxl355(SerialBridge.open(server.path), "ADX355-A002", clock)
+    yield driver, server, lab, clock
+    driver.close()
+    server.stop()
+
+
+def bring_up(driver: Adxl355, range_g: int = 2, odr_hz: float = 125.0) -> None:
+    driver.reset()
+    driver.standby()
+    driver.configure(range_g, odr_hz)
+    driver.start_measurement()
+
+
+def test_identity_and_temperature(sensor) -> None:
+    driver, _, lab, _ = sensor
+    identity = driver.identify()
+    assert (identity.devid_ad, identity.devid_mst, identity.partid) == (0xAD, 0x1D, 0xED)
+    assert driver.read_temperature_c() == pytest.approx(lab.dut_true_c(1), abs=0.3)
+
+
+def test_blocks_are_gap_free_and_match_the_truth(sensor) -> None:
+    driver, _, lab, clock = sensor
+    bring_up(driver)
+    block = driver.acquire(1000)
+    assert block.codes_xyz.shape == (1000, 3) and block.codes_xyz.dtype == np.int32
+    assert block.t_end_s - block.t_start_s == pytest.approx(999 / 125)
+    truth = lab.truth_between(1, block.t_start_s, block.t_end_s)
+    expected = distort(truth["gravity_g"], truth["parameters"])
+    measured = block.codes_xyz * adxl355.lsb_g(2)
+    noise = lab.noise_g(125.0)
+    np.testing.assert_allclose(measured.mean(axis=0), expected, atol=5 * noise / np.sqrt(1000))
+    # gap-free white noise: no step between drains, lag-1 correlation ≈ 0
+    centred = measured - measured.mean(axis=0)
+    lag1 = np.sum(centred[1:] * centred[:-1], axis=0) / np.sum(centred**2, axis=0)
+    assert np.all(np.abs(lag1) < 0.1)
+
+
+def test_range_setting_changes_the_codes(sensor) -> None:
+    driver, _, _, _ = sensor
+    bring_up(driver, range_g=8)
+    block = driver.acquire(100)
+    assert np.abs(block.codes_xyz.mean(axis=0)).max() == pytest.approx(64000, rel=0.05)  # ~1 g at ±8 g
+
+
+def test_configure_outside_standby_is_refused(sensor) -> None:
+    driver, _, _, _ = sensor
+    bring_up(driver)
+    with pytest.raises(InstrumentError, match="only change in standby"):
+        driver.configure(4, 125.0)
+
+
+def test_a_fifo_the_link_cannot_keep_up_with_is_a_fault(sensor, monkeypatch) -> None:
+    driver, _, _, clock = sensor
+    bring_up(driver, odr_hz=4000.0)
+    monkeypatch.setattr("accelcal_rig.instruments.adxl355_driver.DRAIN_EVERY_SAMPLES", 80)  # > 32: overflows
+    with pytest.raises(InstrumentError, match="FIFO overflowed in 3 attempts"):
+        driver.acquire(200)
+
+
+def test_a_sensor_in_standby_gives_no_samples_before_the_deadline(sensor) -> None:
+    driver, _, _, _ = sensor
+    driver.standby()
+    with pytest.raises(InstrumentError, match="0 of 50 samples before the deadline: is it measuring"):
+        driver.acquire(50)
+
+
+def test_bridge_protocol_bytes_and_refusals() -> None:
+    seen = []
+
+    def bridge(request: str) -> str:
+        seen.append(request)
+        if request == "?":
+            return "ADXL355-BRIDGE 1 test"
+        if request.startswith("R 00"):
+            return "=AD1DE901"  # an ADXL359
+        return "!not supported"
+
+    server = PtyLineServer(bridge).start()
+    try:
+        transport = SerialBridge.open(server.path)
+        identity = Adxl355(transport, "SN-9", VirtualClock()).identify()
+        assert identity.partid == 0xE9
+        with pytest.raises(InstrumentError, match=r"'W 2D 00' refused: not supported"):
+            transport.write(0x2D, 0x00)
+        transport.close()
+    finally:
+        server.stop()
+    assert seen == ["?", "R 00 4", "W 2D 00"]
+
+
+def test_something_that_is_not_a_bridge_is_named() -> None:
+    server = PtyLineServer(lambda request: "hello from a modem").start()
+    try:
+        with pytest.raises(InstrumentError, match=r"sensor bridge \(serial /dev/pts/\d+\): not an ADXL355 bridge"):
+            SerialBridge.open(server.path, timeout_s=0.5)
+    finally:
+        server.stop()
+
+
+def test_spidev_missing_is_a_clear_error(monkeypatch) -> None:
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_spidev(name, *args, **kwargs):
+        if name == "spidev":
+            raise ImportError("no spidev")
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_spidev)
+    with pytest.raises(InstrumentError, match=r"spidev is not installed: pip install 'accelcal-rig\[spidev\]'"):
+        SpidevBus.open(0, 0)
