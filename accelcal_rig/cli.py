@@ -51,6 +51,27 @@ def _build_parser() -> argparse.ArgumentParser:
     status.add_argument("campaign", type=Path, help="campaign file (HDF5)")
     status.add_argument("--json", action="store_true", help="print one JSON object")
 
+    check = commands.add_parser(
+        "check", help="contact every instrument of a rig and describe each in one line",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Connect to the chamber, the turntable and every sensor of a rig config, check their "
+                    "identities and print what they report. Run it before leaving a campaign overnight.",
+        epilog="example:\n  rig check configs/example-lab.yaml",
+    )
+    check.add_argument("rig", type=Path, help="rig config YAML")
+    check.add_argument("--dry-run", action="store_true", help="check the rig's simulators instead")
+
+    sim = commands.add_parser(
+        "sim", help="serve the simulated rig as real endpoints until interrupted",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Start the simulated rig of a rig config: the chamber on Modbus TCP (127.0.0.1), the "
+                    "turntable and each sensor bridge on a pseudo-terminal, in real time. The first line on "
+                    "stdout is one JSON object with the endpoints. Ctrl-C stops it.",
+        epilog="example:\n  rig sim configs/sim.yaml",
+    )
+    sim.add_argument("rig", type=Path, help="rig config YAML")
+    sim.add_argument("--seed", type=int, default=0, help="seed of the simulated noise (default 0)")
+
     fit = commands.add_parser(
         "fit", help="fit the error model of every DUT and write a calibration file",
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -154,6 +175,55 @@ def _cmd_status(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_check(args: argparse.Namespace) -> int:
+    from accelcal_rig.config.load import load_rig
+    from accelcal_rig.engine.check import check_lines
+    from accelcal_rig.engine.clock import RealClock
+    from accelcal_rig.instruments.connect import configured_endpoints, connect_rig
+    from accelcal_rig.sim.wire_rig import SimulatedRig
+
+    rig = load_rig(args.rig)
+    clock = RealClock()
+    simulated = SimulatedRig(rig.model, clock, 0) if args.dry_run else None
+    endpoints = simulated.start() if simulated else configured_endpoints(rig)
+    try:
+        instruments = connect_rig(rig.model, endpoints, clock)
+        try:
+            for line in check_lines(instruments):
+                print(line, flush=True)
+        finally:
+            instruments.close()
+    finally:
+        if simulated:
+            simulated.stop()
+    print(f"rig {rig.model.name}: every instrument answered as configured")
+    return 0
+
+
+def _cmd_sim(args: argparse.Namespace) -> int:
+    import threading
+
+    from accelcal_rig.config.load import load_rig
+    from accelcal_rig.engine.clock import RealClock
+    from accelcal_rig.sim.wire_rig import SimulatedRig
+
+    rig = load_rig(args.rig)
+    simulated = SimulatedRig(rig.model, RealClock(), args.seed)
+    simulated.start()
+    stop = threading.Event()
+    previous = {signum: signal.signal(signum, lambda *_: stop.set()) for signum in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        print(json.dumps(simulated.describe()), flush=True)
+        while not stop.wait(0.5):
+            pass
+    finally:
+        simulated.stop()
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+    print("rig sim: stopped", file=sys.stderr)
+    return 0
+
+
 def _cmd_fit(args: argparse.Namespace) -> int:
     from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
     from accelcal_rig.store.read import open_campaign_for_update
@@ -207,7 +277,10 @@ def run_program() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     args = _build_parser().parse_args(argv)
-    handler = {"run": _cmd_run, "status": _cmd_status, "fit": _cmd_fit}[args.command]
+    # Driver libraries log their own view of a failure; ours is the one line that names the instrument.
+    logging.getLogger("pymodbus").addHandler(logging.NullHandler())
+    logging.getLogger("pymodbus").propagate = False
+    handler = {"run": _cmd_run, "status": _cmd_status, "fit": _cmd_fit, "check": _cmd_check, "sim": _cmd_sim}[args.command]
     try:
         return handler(args)
     except CampaignAborted as exc:

@@ -68,10 +68,11 @@ def test_existing_campaign_is_never_overwritten_silently(write, capsys) -> None:
     assert "exists" in err and output.read_bytes() == b"last night's campaign"
 
 
-def test_without_dry_run_the_simulated_drivers_are_refused(write, capsys) -> None:
+def test_without_dry_run_a_rig_without_endpoints_is_refused(write, capsys) -> None:
     path = write("tiny.yaml", TINY_PROCEDURE)
     err = one_line_error(capsys, ["run", str(path), "-o", str(path.with_suffix(".h5"))], 2)
-    assert "sim.yaml:" in err and "chamber.driver" in err and "--dry-run" in err
+    assert "sim.yaml:" in err and "chamber.endpoint: no endpoint given" in err and "--dry-run" in err
+    assert not path.with_suffix(".h5").exists()
 
 
 @pytest.mark.parametrize("content", [None, b"not hdf5"])

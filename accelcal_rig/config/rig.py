@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from accelcal_rig.instruments.chamber_registers import ChamberRegisterMap, register_map
+from accelcal_rig.instruments.turntable_protocol import TurntableProtocol, turntable_protocol
 
 
 class _Strict(BaseModel):
@@ -13,16 +16,34 @@ class _Strict(BaseModel):
 
 
 class ChamberConfig(_Strict):
-    """Thermal chamber limits and dynamics (paper Table 3: −55…+100 °C, 0.1…5 °C/min)."""
+    """Thermal chamber: how to reach its controller, its register map, limits and dynamics."""
 
-    driver: Literal["simulated"] = "simulated"
+    driver: Literal["modbus-tcp", "modbus-rtu"] = "modbus-tcp"
+    endpoint: str | None = Field(None, description="modbus-tcp: host:port; modbus-rtu: serial device or URL")
+    device_id: int = Field(1, ge=0, le=247)
+    profile: Literal["watlow-f4", "watlow-f4t"] = "watlow-f4t"
+    registers: dict[str, Any] = Field({}, description="fields of the profile's register map to override")
+    timeout_s: float = Field(1.0, gt=0, le=60)
+    baudrate: int = Field(9600, gt=0)
+    parity: Literal["N", "E", "O"] = "N"
+    stopbits: Literal[1, 2] = 1
     min_setpoint_c: float = -55.0
     max_setpoint_c: float = 100.0
     safe_setpoint_c: float = 23.0
     ramp_rate_c_per_min: float = Field(3.0, gt=0, le=50)
 
+    def register_map(self) -> ChamberRegisterMap:
+        return register_map(self.profile, self.registers)
+
     @model_validator(mode="after")
     def _ordered_limits(self) -> ChamberConfig:
+        try:
+            self.register_map()
+        except ValidationError as exc:
+            first = exc.errors(include_url=False)[0]
+            raise ValueError(f"registers.{'.'.join(map(str, first['loc']))}: {first['msg']}") from None
+        if self.driver == "modbus-tcp" and self.endpoint and not _is_host_port(self.endpoint):
+            raise ValueError(f"modbus-tcp endpoint {self.endpoint!r} is not host:port")
         if self.min_setpoint_c >= self.max_setpoint_c:
             raise ValueError("min_setpoint_c must be below max_setpoint_c")
         if not self.min_setpoint_c <= self.safe_setpoint_c <= self.max_setpoint_c:
@@ -60,7 +81,12 @@ class TurntableAxis(_Strict):
 class TurntableConfig(_Strict):
     """A chain of rotary axes, outermost first; the fixture sits on the innermost axis."""
 
-    driver: Literal["simulated"] = "simulated"
+    driver: Literal["serial"] = "serial"
+    endpoint: str | None = Field(None, description="serial device or pyserial URL (socket://host:port, …)")
+    baudrate: int = Field(9600, gt=0)
+    protocol: Literal["accelcal-line"] = "accelcal-line"
+    protocol_overrides: dict[str, Any] = Field({}, description="fields of the line protocol to override")
+    timeout_s: float = Field(2.0, gt=0, le=60)
     axes: list[TurntableAxis] = Field(min_length=1, max_length=6)
     position_tolerance_deg: float = Field(0.01, gt=0, le=5)
     accuracy_arcsec: float = Field(3.0, ge=0, le=3600, description="angular position accuracy of each axis "
@@ -74,14 +100,35 @@ class TurntableConfig(_Strict):
             raise ValueError("axis names must be distinct")
         return value
 
+    def line_protocol(self) -> TurntableProtocol:
+        return turntable_protocol(self.protocol, self.protocol_overrides)
+
+    @model_validator(mode="after")
+    def _valid_protocol(self) -> TurntableConfig:
+        try:
+            self.line_protocol()
+        except ValidationError as exc:
+            first = exc.errors(include_url=False)[0]
+            raise ValueError(f"protocol_overrides.{'.'.join(map(str, first['loc']))}: {first['msg']}") from None
+        return self
+
 
 class SensorConfig(_Strict):
     """One DUT on the fixture. `mount_euler_deg`: rotation of the DUT frame in the fixture frame (xyz)."""
 
     serial: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.-]+$")
     name: str = Field("", max_length=64)
-    driver: Literal["simulated"] = "simulated"
+    driver: Literal["serial-bridge", "spidev"] = "serial-bridge"
+    endpoint: str | None = Field(None, description="serial-bridge: device or URL; spidev: bus.chip_select")
+    baudrate: int = Field(921600, gt=0)
+    spi_speed_hz: int = Field(5_000_000, gt=0, le=10_000_000)
+    timeout_s: float = Field(1.0, gt=0, le=60)
     mount_euler_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+def _is_host_port(endpoint: str) -> bool:
+    host, _, port = endpoint.rpartition(":")
+    return bool(host) and port.isdigit() and 0 < int(port) < 65536
 
 
 class FixtureConfig(_Strict):

@@ -31,7 +31,8 @@ from accelcal_rig.store.atomic import signals_deferred
 from accelcal_rig.store.campaign_file import CampaignWriter
 from accelcal_rig.store.records import DutPoseRecord, PoseRecord, SoakTrace
 
-#: Turntable position polling interval; a move's deadline is 1.5 × its travel time plus this margin.
+#: Turntable position polling interval, from the time a move could first have arrived (its travel at the
+#: configured speeds); its deadline is 1.5 × that travel time plus this margin.
 MOVE_POLL_S = 0.5
 MOVE_MARGIN_S = 30.0
 
@@ -156,6 +157,7 @@ class CampaignRunner:
                     f"sensor {sensor.serial} ({sensor.endpoint}): identity {_hex(found)} is not an ADXL355 "
                     f"({_hex(expected)})"
                 )
+            sensor.reset()
             sensor.standby()
             sensor.configure(acquisition.range_g, acquisition.odr_hz)
             sensor.start_measurement()
@@ -254,6 +256,7 @@ class CampaignRunner:
         speeds = np.array([a.speed_deg_s for a in self.rig.turntable.axes])
         travel_s = float(np.max(np.abs(commanded - current) / speeds))
         self.turntable.move_to(commanded)
+        self.clock.sleep(travel_s)  # no axis arrives sooner at its configured speed: poll only after
         tolerance = self.rig.turntable.position_tolerance_deg
 
         def arrived() -> bool:
@@ -262,7 +265,7 @@ class CampaignRunner:
             error = _angle_difference(self.turntable.read_angles_deg(), commanded)
             return bool(np.all(np.abs(error) <= tolerance))
 
-        wait_until(self.clock, arrived, timeout_s=1.5 * travel_s + MOVE_MARGIN_S, poll_s=MOVE_POLL_S,
+        wait_until(self.clock, arrived, timeout_s=0.5 * travel_s + MOVE_MARGIN_S, poll_s=MOVE_POLL_S,
                    what=f"turntable ({self.turntable.endpoint}) reaching {np.round(commanded, 3).tolist()}°")
 
     def _dut_record(self, index: int, block: SampleBlock, gravity_fixture: np.ndarray) -> DutPoseRecord:

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,7 +18,7 @@ from accelcal_rig.config.load import (
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitStage
-from accelcal_rig.engine.clock import Clock, VirtualClock
+from accelcal_rig.engine.clock import Clock, RealClock, VirtualClock
 from accelcal_rig.engine.events import LOGGER, EventLog
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
@@ -25,7 +26,8 @@ from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.plan.compile import Plan, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
-from accelcal_rig.sim.devices import build_simulated_rig
+from accelcal_rig.instruments.connect import configured_endpoints, connect_rig
+from accelcal_rig.sim.wire_rig import SimulatedRig
 from accelcal_rig.store.campaign_file import CampaignWriter
 
 
@@ -78,26 +80,50 @@ InstrumentFactory = Callable[[RigConfig, Procedure, Clock, int], RigInstruments]
 
 
 def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, seed: int, overwrite: bool,
-                 calibration: Path | None = None,
-                 build_instruments: InstrumentFactory = build_simulated_rig) -> RunResult:
+                 calibration: Path | None = None, build_instruments: InstrumentFactory | None = None) -> RunResult:
     """Run the whole campaign into `output`. Raises CampaignAborted after reaching the safe state.
 
-    With `calibration`, the fit stage runs once the rig is safe and writes the calibration file there.
-    `build_instruments` connects the rig (the simulated one by default) on the campaign's clock.
+    The instruments: with `build_instruments`, whatever it builds (a test double); with `dry_run`, the
+    real drivers talking to wire-level simulators of this rig on a virtual clock; otherwise the real
+    drivers at the rig config's endpoints, in real time. With `calibration`, the fit stage runs once the
+    rig is safe and writes the calibration file there.
     """
-    rig = prepared.rig
-    if not dry_run:
-        raise rig.error(("chamber", "driver"),
-                        "the 'simulated' drivers have no hardware behind them: run with --dry-run")
     wall_start = time.perf_counter()
-    clock = VirtualClock()
-    instruments = build_instruments(rig.model, prepared.procedure.model, clock, seed)
-    try:
+    with _connected(prepared, dry_run, seed, build_instruments) as (instruments, clock):
         return _run_with_instruments(prepared, output, instruments, clock, dry_run=dry_run, seed=seed,
                                      overwrite=overwrite, wall_start=wall_start, calibration=calibration)
+
+
+@contextmanager
+def _connected(prepared: PreparedCampaign, dry_run: bool, seed: int,
+               build_instruments: InstrumentFactory | None) -> Iterator[tuple[RigInstruments, Clock]]:
+    rig, procedure = prepared.rig, prepared.procedure.model
+    stop_simulators: list[Callable[[], None]] = []
+    clock: Clock
+    if build_instruments is not None:
+        clock = VirtualClock()
+        instruments = build_instruments(rig.model, procedure, clock, seed)
+    elif dry_run:
+        clock = VirtualClock()
+        simulated = SimulatedRig(rig.model, clock, seed, procedure.simulation)
+        endpoints = simulated.start()
+        stop_simulators.append(simulated.stop)
+        try:
+            instruments = connect_rig(rig.model, endpoints, clock)
+        except BaseException:
+            simulated.stop()
+            raise
+        instruments.truth = simulated.truth
+    else:
+        clock = RealClock()
+        instruments = connect_rig(rig.model, configured_endpoints(rig), clock)
+    try:
+        yield instruments, clock
     finally:
         for failure in instruments.close():
             LOGGER.error(failure)
+        for stop in stop_simulators:
+            stop()
 
 
 def _run_with_instruments(prepared: PreparedCampaign, output: Path, instruments: RigInstruments, clock: Clock, *,

@@ -57,6 +57,15 @@ class Adxl355:
     def standby(self) -> None:
         self._bus.write(adxl355.REG_POWER_CTL, adxl355.POWER_CTL_STANDBY)
 
+    def read_settings(self) -> tuple[int, float]:
+        """(range in g, output data rate in Hz) as the part is configured now."""
+        filter_code = self._bus.read(adxl355.REG_FILTER, 1)[0] & 0x0F
+        range_code = self._bus.read(adxl355.REG_RANGE, 1)[0] & 0x03
+        ranges = {code: g for g, code in adxl355.RANGE_CODES.items()}
+        if range_code not in ranges or filter_code >= len(adxl355.OUTPUT_DATA_RATES_HZ):
+            raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): RANGE/FILTER read back invalid codes")
+        return ranges[range_code], adxl355.OUTPUT_DATA_RATES_HZ[filter_code]
+
     def read_temperature_c(self) -> float:
         high, low = self._bus.read(adxl355.REG_TEMP2, 2)
         return float(adxl355.temperature_c_from_raw(((high & 0x0F) << 8) | low))
@@ -75,30 +84,31 @@ class Adxl355:
 
     # ------------------------------------------------------------------ FIFO
     def _try_acquire(self, n_samples: int) -> SampleBlock | None:
-        temperature_before = self.read_temperature_c()
-        self._drain(self._status_and_entries()[1])  # stale samples from before this block; clears FIFO_OVR
+        _, entries, temperature_before = self._status_entries_temperature()  # clears FIFO_OVR
+        self._drain(entries)  # stale samples from before this block
         t_start = self._clock.now()
-        blocks, have = [], 0
+        blocks, have, temperatures = [], 0, [temperature_before]
         deadline = t_start + 2.0 * n_samples / self._odr_hz + 1.0
         while have < n_samples:
             if self._clock.now() > deadline:
                 raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {have} of {n_samples} samples "
                                       "before the deadline: is it measuring?")
             self._clock.sleep(min(DRAIN_EVERY_SAMPLES, n_samples - have) / self._odr_hz)
-            status, entries = self._status_and_entries()
+            status, entries, temperature = self._status_entries_temperature()
             if status & adxl355.STATUS_FIFO_OVR:
                 return None
+            temperatures.append(temperature)
             codes = self._drain(entries)
             blocks.append(codes)
             have += len(codes)
         codes = np.concatenate(blocks)[:n_samples]
         t_end = t_start + (n_samples - 1) / self._odr_hz
-        return SampleBlock(codes, t_start, t_end, (temperature_before, self.read_temperature_c()))
+        return SampleBlock(codes, t_start, t_end, _ends_of(np.array(temperatures)))
 
-    def _status_and_entries(self) -> tuple[int, int]:
-        """STATUS and FIFO_ENTRIES are neighbours: one burst, one round trip."""
-        status, entries = self._bus.read(adxl355.REG_STATUS, 2)
-        return status, entries & 0x7F
+    def _status_entries_temperature(self) -> tuple[int, int, float]:
+        """STATUS, FIFO_ENTRIES, TEMP2 and TEMP1 are neighbours: one burst, one round trip."""
+        status, entries, high, low = self._bus.read(adxl355.REG_STATUS, 4)
+        return status, entries & 0x7F, float(adxl355.temperature_c_from_raw(((high & 0x0F) << 8) | low))
 
     def _drain(self, entries: int) -> np.ndarray:
         whole = entries // 3 * 3  # only complete xyz samples: the rest is still being written
@@ -108,3 +118,12 @@ class Adxl355:
 
     def _status(self) -> int:
         return self._bus.read(adxl355.REG_STATUS, 1)[0]
+
+
+def _ends_of(readings_c: np.ndarray) -> tuple[float, float]:
+    """The temperature at the start and the end of a block from the readings taken with each drain:
+    a straight line through them, as one 0.11 °C-step reading at each end would be noisier."""
+    if len(readings_c) < 3:
+        return float(readings_c[0]), float(readings_c[-1])
+    line = np.polynomial.Polynomial.fit(np.arange(len(readings_c)), readings_c, 1)
+    return float(line(0)), float(line(len(readings_c) - 1))

@@ -45,7 +45,7 @@ class ModbusChamber:
     def _connected(cls, client: ModbusBaseSyncClient, endpoint: str, registers: ChamberRegisterMap,
                    device_id: int) -> ModbusChamber:
         if not client.connect():
-            raise InstrumentError(f"chamber ({endpoint}): cannot connect")
+            raise InstrumentError(f"chamber ({endpoint}): cannot connect (is it on, the address right, the port free?)")
         return cls(client, endpoint, registers, device_id)
 
     # ------------------------------------------------------------------ the Chamber interface

@@ -56,5 +56,5 @@ PROFILES: dict[str, ChamberRegisterMap] = {"watlow-f4": WATLOW_F4, "watlow-f4t":
 
 
 def register_map(profile: str, overrides: dict[str, object] | None = None) -> ChamberRegisterMap:
-    """A built-in profile, with any fields the rig config overrides."""
-    return PROFILES[profile].model_copy(update=overrides or {})
+    """A built-in profile, with any fields the rig config overrides (validated)."""
+    return ChamberRegisterMap.model_validate({**PROFILES[profile].model_dump(), **(overrides or {})})

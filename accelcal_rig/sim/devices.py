@@ -83,6 +83,10 @@ class SimulatedAccelerometer:
     def identify(self) -> DeviceIdentity:
         return DeviceIdentity(adxl355.DEVID_AD, adxl355.DEVID_MST, adxl355.PARTID, 1)
 
+    def reset(self) -> None:
+        self._measuring = False
+        self._range_g, self._odr_hz = 2, 4000.0  # the part's reset state
+
     def configure(self, range_g: int, odr_hz: float) -> None:
         if self._measuring:
             raise InstrumentError(f"sensor {self.serial}: range and filter can only change in standby")
@@ -94,6 +98,9 @@ class SimulatedAccelerometer:
 
     def standby(self) -> None:
         self._measuring = False
+
+    def read_settings(self) -> tuple[int, float]:
+        return self._range_g, self._odr_hz
 
     def read_temperature_c(self) -> float:
         return self._lab.dut_reading_c(self._index)

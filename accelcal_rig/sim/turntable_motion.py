@@ -20,7 +20,7 @@ class TurntableMotion:
         n = len(self.speeds_deg_s)
         self._start = np.zeros(n)
         self._target = np.zeros(n)
-        self._t0 = np.zeros(n)
+        self._t0 = np.full(n, -1e9)  # at rest and settled since long before the clock started
         self.last_command_deg = np.full(n, np.nan)
 
     def position_deg(self, t_s: float) -> np.ndarray:

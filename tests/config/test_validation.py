@@ -78,7 +78,15 @@ def test_missing_rig_file_is_named(write) -> None:
         ("serial: ADX355-A002", "serial: ADX355-A001", r"sim.yaml:\d+: fixture.sensors: sensor serial numbers must be distinct"),
         ("axis: [1, 0, 0]", "axis: [0, 0, 0]", r"sim.yaml:\d+: turntable.axes\[1\].axis: axis direction must not be zero"),
         ("ramp_rate_c_per_min: 3", "ramp_rate_c_per_min: -3", r"sim.yaml:\d+: chamber.ramp_rate_c_per_min: "),
-        ("driver: simulated\n  min_setpoint_c", "driver: watlow\n  min_setpoint_c", r"sim.yaml:\d+: chamber.driver: "),
+        ("driver: modbus-tcp\n", "driver: modbus\n", r"sim.yaml:\d+: chamber.driver: "),
+        ("profile: watlow-f4t", "profile: watlow-f4t\n  registers: {process_value: -1}",
+         r"sim.yaml:\d+: chamber: registers.process_value: Input should be greater than or equal to 0"),
+        ("profile: watlow-f4t", "profile: watlow-f4t\n  registers: {setpiont: 300}",
+         r"sim.yaml:\d+: chamber: registers.setpiont: Extra inputs are not permitted"),
+        ("profile: watlow-f4t", "profile: watlow-f4t\n  endpoint: chamber.local",
+         r"sim.yaml:\d+: chamber: modbus-tcp endpoint 'chamber.local' is not host:port"),
+        ("protocol: accelcal-line", "protocol: accelcal-line\n  protocol_overrides: {busy: {send: B, reply: '(', answer: '0'}}",
+         r"sim.yaml:\d+: turntable: protocol_overrides.busy.reply: Value error, not a regular expression"),
     ],
 )
 def test_rig_errors_name_file_line_and_key(workdir: Path, replace: str, by: str, expected: str) -> None:

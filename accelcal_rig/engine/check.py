@@ -1,0 +1,29 @@
+"""`rig check`: contact every instrument of a rig and describe it in one line, before a campaign."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+from accelcal_rig.errors import InstrumentError
+from accelcal_rig.instruments import adxl355
+from accelcal_rig.instruments.interfaces import RigInstruments
+
+
+def check_lines(instruments: RigInstruments) -> Iterator[str]:
+    """One line per instrument; the first wrong answer raises InstrumentError naming it."""
+    chamber, turntable = instruments.chamber, instruments.turntable
+    yield (f"chamber    {chamber.endpoint}: {chamber.identify()}, alarm "
+           f"{'ACTIVE' if chamber.alarm_active() else 'clear'}")
+    angles = " ".join(f"{a:.3f}" for a in turntable.read_angles_deg())
+    yield (f"turntable  {turntable.endpoint}: {turntable.identify()}, angles {angles}°, "
+           f"{'in position' if turntable.in_position() else 'moving'}")
+    expected = (adxl355.DEVID_AD, adxl355.DEVID_MST, adxl355.PARTID)
+    for sensor in instruments.sensors:
+        identity = sensor.identify()
+        found = (identity.devid_ad, identity.devid_mst, identity.partid)
+        if found != expected:
+            raise InstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): identity "
+                                  f"{'/'.join(f'{v:02X}' for v in found)} is not an ADXL355 (AD/1D/ED)")
+        range_g, odr_hz = sensor.read_settings()
+        yield (f"sensor {sensor.serial}  {sensor.endpoint}: ADXL355 rev {identity.revid}, ±{range_g} g, "
+               f"{odr_hz:g} Hz, {sensor.read_temperature_c():.1f} °C")
