@@ -1,17 +1,19 @@
 """Wall time, peak memory, virtual duration and file size of the paper campaign's dry run.
 
-Runs `rig run procedures/paper-24pos-thermal.yaml --dry-run` as a separate process several times (as a
-user would) and prints one line per run and a summary. Usage:
+Two measurements. (1) `rig run procedures/paper-24pos-thermal.yaml --dry-run` as a separate process, as a
+user runs it: the real drivers talking to wire-level simulators (Modbus TCP on loopback, pseudo-terminals).
+(2) The campaign alone (run_campaign, imports excluded) through those wires against the in-process
+simulated instruments. Usage:
 
-    python bench/dry_run_paper.py [--runs 3] [--procedure procedures/paper-24pos-thermal.yaml]
+    python bench/dry_run_paper.py [--runs 3]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import logging
 import os
-import resource
 import subprocess
 import sys
 import tempfile
@@ -19,17 +21,18 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
+PAPER = REPO / "procedures" / "paper-24pos-thermal.yaml"
 
 
-def run_once(procedure: Path, output: Path, seed: int) -> tuple[float, float, dict]:
-    """(wall seconds, peak RSS of this child in MB, status) for one CLI run."""
+def cli_run(output: Path, seed: int) -> tuple[float, float, dict]:
+    """(wall seconds, peak RSS of the process in MB, status) for one `rig run` process."""
     rig = Path(sys.executable).parent / "rig"
     start = time.perf_counter()
     pid = os.fork()
     if pid == 0:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, 1)  # keep the bench's own output to one line per run
-        os.execv(str(rig), [str(rig), "run", str(procedure), "--dry-run", "-o", str(output), "--seed", str(seed),
+        os.execv(str(rig), [str(rig), "run", str(PAPER), "--dry-run", "-o", str(output), "--seed", str(seed),
                             "-q", "--overwrite"])
     _, status, usage = os.wait4(pid, 0)
     wall = time.perf_counter() - start
@@ -40,29 +43,47 @@ def run_once(procedure: Path, output: Path, seed: int) -> tuple[float, float, di
     return wall, usage.ru_maxrss / 1024, report
 
 
-def virtual_duration_h(output: Path) -> float:
-    import h5py
+def campaign_only(output: Path, seed: int, in_process: bool) -> float:
+    from accelcal_rig.engine.session import prepare, run_campaign
+    from accelcal_rig.sim.devices import build_simulated_rig
 
-    with h5py.File(output, "r") as f:
-        return float(f["poses/t_end_s"][-1]) / 3600
+    prepared = prepare(PAPER)
+    start = time.perf_counter()
+    run_campaign(prepared, output, dry_run=True, seed=seed, overwrite=True,
+                 calibration=output.with_suffix(".calibration.yaml"),
+                 build_instruments=build_simulated_rig if in_process else None)
+    return time.perf_counter() - start
 
 
 def main() -> None:
+    import h5py
+
+    from accelcal_rig.engine.events import LOGGER
+
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3)
-    parser.add_argument("--procedure", type=Path, default=REPO / "procedures" / "paper-24pos-thermal.yaml")
     args = parser.parse_args()
+    LOGGER.addHandler(logging.NullHandler())
+    LOGGER.propagate = False
     walls = []
     with tempfile.TemporaryDirectory() as folder:
         output = Path(folder) / "campaign.h5"
         for seed in range(args.runs):
-            wall, peak_mb, report = run_once(args.procedure, output, seed)
+            wall, peak_mb, report = cli_run(output, seed)
             walls.append(wall)
-            print(f"run {seed}: wall {wall:.2f} s, peak RSS {peak_mb:.0f} MB, "
+            with h5py.File(output, "r") as f:
+                virtual_h = float(f["poses/t_end_s"][-1]) / 3600
+                chamber = f["instruments/chamber"].attrs["driver"]
+            print(f"rig run (process, {chamber} over the wire) {seed}: wall {wall:.2f} s, peak RSS {peak_mb:.0f} MB, "
                   f"{report['poses_done']}/{report['poses_total']} poses × {len(report['duts'])} DUTs, "
-                  f"virtual {virtual_duration_h(output):.2f} h, file {output.stat().st_size / 1e6:.2f} MB")
-    print(f"summary: wall median {sorted(walls)[len(walls) // 2]:.2f} s (min {min(walls):.2f}, max {max(walls):.2f}) "
-          f"over {len(walls)} runs on {os.cpu_count()} cores")
+                  f"virtual {virtual_h:.2f} h, file {output.stat().st_size / 1e6:.2f} MB")
+        print(f"summary: process wall median {sorted(walls)[len(walls) // 2]:.2f} s (min {min(walls):.2f}, "
+              f"max {max(walls):.2f}) over {len(walls)} runs on {os.cpu_count()} cores")
+        wire = [campaign_only(output, seed, in_process=False) for seed in range(args.runs)]
+        local = [campaign_only(output, seed, in_process=True) for seed in range(args.runs)]
+        median = lambda values: sorted(values)[len(values) // 2]  # noqa: E731
+        print(f"campaign alone (incl. fit): through the wire median {median(wire):.2f} s, in-process "
+              f"median {median(local):.2f} s, ratio {median(wire) / median(local):.2f}")
 
 
 if __name__ == "__main__":

@@ -90,17 +90,20 @@ def decode_data_bytes(raw: bytes) -> np.ndarray:
     return np.where(codes & 0x80000, codes - (1 << 20), codes).astype(np.int32)
 
 
-def decode_fifo(raw: bytes) -> np.ndarray:
-    """FIFO entries (3 bytes each) → (n, 3) codes: empty entries dropped, resynchronised on the X marker,
-    an incomplete trailing sample dropped."""
-    entries = np.frombuffer(raw, dtype=np.uint8).reshape(-1, 3)
+def decode_fifo(raw: bytes, carried: bytes = b"") -> tuple[np.ndarray, bytes]:
+    """FIFO entries (3 bytes each) → ((n, 3) codes, entries of an incomplete trailing sample).
+
+    Empty entries are dropped and the stream is resynchronised on the X marker. Pass the returned tail
+    as `carried` with the next burst, so a sample the part was still writing is completed, not lost.
+    """
+    entries = np.frombuffer(carried + raw, dtype=np.uint8).reshape(-1, 3)
     entries = entries[(entries[:, 2] & _ENTRY_EMPTY) == 0]
     x_marks = np.flatnonzero(entries[:, 2] & _ENTRY_X_MARKER)
     if x_marks.size == 0:
-        return np.empty((0, 3), dtype=np.int32)
+        return np.empty((0, 3), dtype=np.int32), b""
     entries = entries[x_marks[0]:]
     whole = entries.shape[0] // 3 * 3
-    return decode_data_bytes(entries[:whole].tobytes()).reshape(-1, 3)
+    return decode_data_bytes(entries[:whole].tobytes()).reshape(-1, 3), entries[whole:].tobytes()
 
 
 def encode_fifo(codes_xyz: np.ndarray) -> bytes:

@@ -12,7 +12,7 @@ from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import RegisterTransport
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
 
-#: Samples to let accumulate between FIFO drains: under its 32, so a drain is never late.
+#: Samples to let accumulate between FIFO bursts: under its 32, so a burst is never late.
 DRAIN_EVERY_SAMPLES = 30
 #: Attempts at a gap-free block before a FIFO overflow is reported as a fault.
 OVERFLOW_ATTEMPTS = 3
@@ -84,46 +84,39 @@ class Adxl355:
 
     # ------------------------------------------------------------------ FIFO
     def _try_acquire(self, n_samples: int) -> SampleBlock | None:
-        _, entries, temperature_before = self._status_entries_temperature()  # clears FIFO_OVR
-        self._drain(entries)  # stale samples from before this block
+        """One attempt: a whole-FIFO burst every DRAIN_EVERY_SAMPLES samples (empty entries are marked, a
+        sample still being written is carried to the next burst); FIFO_OVR, latched until STATUS is
+        read, is checked at the end, so a block that lost samples anywhere is never returned."""
+        self._status_and_temperature()  # clears a stale FIFO_OVR
+        self._burst(b"")  # stale samples from before this block
         t_start = self._clock.now()
-        blocks, have, temperatures = [], 0, [temperature_before]
+        _, temperature_before = self._status_and_temperature()
+        blocks, have, carried = [], 0, b""
         deadline = t_start + 2.0 * n_samples / self._odr_hz + 1.0
         while have < n_samples:
             if self._clock.now() > deadline:
                 raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {have} of {n_samples} samples "
                                       "before the deadline: is it measuring?")
             self._clock.sleep(min(DRAIN_EVERY_SAMPLES, n_samples - have) / self._odr_hz)
-            status, entries, temperature = self._status_entries_temperature()
-            if status & adxl355.STATUS_FIFO_OVR:
-                return None
-            temperatures.append(temperature)
-            codes = self._drain(entries)
+            codes, carried = self._burst(carried)
             blocks.append(codes)
             have += len(codes)
+        status, temperature_after = self._status_and_temperature()
+        if status & adxl355.STATUS_FIFO_OVR:
+            return None
         codes = np.concatenate(blocks)[:n_samples]
         t_end = t_start + (n_samples - 1) / self._odr_hz
-        return SampleBlock(codes, t_start, t_end, _ends_of(np.array(temperatures)))
+        return SampleBlock(codes, t_start, t_end, (temperature_before, temperature_after))
 
-    def _status_entries_temperature(self) -> tuple[int, int, float]:
+    def _burst(self, carried: bytes) -> tuple[np.ndarray, bytes]:
+        """Read the whole FIFO in one burst."""
+        raw = self._bus.read(adxl355.REG_FIFO_DATA, 3 * adxl355.FIFO_CAPACITY_ENTRIES)
+        return adxl355.decode_fifo(raw, carried)
+
+    def _status_and_temperature(self) -> tuple[int, float]:
         """STATUS, FIFO_ENTRIES, TEMP2 and TEMP1 are neighbours: one burst, one round trip."""
-        status, entries, high, low = self._bus.read(adxl355.REG_STATUS, 4)
-        return status, entries & 0x7F, float(adxl355.temperature_c_from_raw(((high & 0x0F) << 8) | low))
-
-    def _drain(self, entries: int) -> np.ndarray:
-        whole = entries // 3 * 3  # only complete xyz samples: the rest is still being written
-        if whole == 0:
-            return np.empty((0, 3), dtype=np.int32)
-        return adxl355.decode_fifo(self._bus.read(adxl355.REG_FIFO_DATA, 3 * whole))
+        status, _, high, low = self._bus.read(adxl355.REG_STATUS, 4)
+        return status, float(adxl355.temperature_c_from_raw(((high & 0x0F) << 8) | low))
 
     def _status(self) -> int:
         return self._bus.read(adxl355.REG_STATUS, 1)[0]
-
-
-def _ends_of(readings_c: np.ndarray) -> tuple[float, float]:
-    """The temperature at the start and the end of a block from the readings taken with each drain:
-    a straight line through them, as one 0.11 °C-step reading at each end would be noisier."""
-    if len(readings_c) < 3:
-        return float(readings_c[0]), float(readings_c[-1])
-    line = np.polynomial.Polynomial.fit(np.arange(len(readings_c)), readings_c, 1)
-    return float(line(0)), float(line(len(readings_c) - 1))

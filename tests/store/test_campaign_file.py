@@ -124,3 +124,13 @@ def test_status_retries_a_read_that_catches_the_writer_mid_flush(campaign: Path,
     with pytest.raises(ConfigError, match="no consistent read .*bad object header"):
         campaign_status(campaign, waits.append)
     assert len(waits) == 2 + read.SNAPSHOT_ATTEMPTS
+
+
+def test_the_file_records_each_instruments_driver_and_endpoint(campaign: Path) -> None:
+    with h5py.File(campaign, "r") as f:
+        chamber = dict(f["instruments/chamber"].attrs)
+        turntable = dict(f["instruments/turntable"].attrs)
+        assert chamber["driver"] == "ModbusChamber" and chamber["endpoint"].startswith("modbus-tcp 127.0.0.1:")
+        assert turntable["driver"] == "SerialTurntable" and turntable["endpoint"].startswith("serial /dev/pts/")
+        for dut in f["duts"].values():
+            assert dut.attrs["driver"] == "Adxl355" and dut.attrs["endpoint"].startswith("serial /dev/pts/")

@@ -1,0 +1,81 @@
+"""`rig sim` serves the simulated rig as real endpoints; `rig check` talks to them like to a real rig."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from accelcal_rig.config.load import load_rig
+from accelcal_rig.sim.pty_line_server import PtyLineServer
+from tests.conftest import REPO, SIM_RIG
+
+RIG = str(Path(sys.executable).parent / "rig")
+
+
+@pytest.fixture(scope="module")
+def running_sim():
+    process = subprocess.Popen([RIG, "sim", str(SIM_RIG)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    endpoints = json.loads(process.stdout.readline())
+    yield endpoints
+    process.send_signal(signal.SIGINT)
+    process.wait(timeout=20)
+    assert process.returncode == 0
+
+
+def rig_config_for(endpoints: dict, folder: Path, sensor_endpoints: dict[str, str] | None = None) -> Path:
+    config = yaml.safe_load(SIM_RIG.read_text())
+    config["chamber"]["endpoint"] = f"{endpoints['chamber']['host']}:{endpoints['chamber']['port']}"
+    config["turntable"]["endpoint"] = endpoints["turntable"]["device"]
+    for sensor in config["fixture"]["sensors"]:
+        sensor["endpoint"] = (sensor_endpoints or {}).get(sensor["serial"], endpoints["sensors"][sensor["serial"]]["device"])
+    path = folder / "lab.yaml"
+    path.write_text(yaml.safe_dump(config))
+    return path
+
+
+def test_rig_sim_prints_its_endpoints_first(running_sim: dict) -> None:
+    assert running_sim["chamber"]["host"] == "127.0.0.1" and running_sim["chamber"]["port"] > 0
+    assert running_sim["turntable"]["device"].startswith("/dev/pts/")
+    assert sorted(running_sim["sensors"]) == ["ADX355-A001", "ADX355-A002", "ADX355-A003", "ADX355-A004"]
+
+
+def test_rig_check_describes_every_instrument(running_sim: dict, tmp_path: Path) -> None:
+    result = subprocess.run([RIG, "check", str(rig_config_for(running_sim, tmp_path))], capture_output=True,
+                            text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[0].startswith(f"chamber    modbus-tcp 127.0.0.1:{running_sim['chamber']['port']}: float32 controller")
+    assert lines[1].startswith("turntable  serial /dev/pts/") and "angles 0.000 0.000 0.000°" in lines[1]
+    assert sum(line.startswith("sensor ADX355-A") and "ADXL355 rev 1" in line for line in lines) == 4
+
+
+def test_rig_check_names_a_sensor_with_the_wrong_identity(running_sim: dict, tmp_path: Path) -> None:
+    impostor = PtyLineServer(lambda r: "ADXL355-BRIDGE 1 x" if r == "?" else "=AD1DE901").start()  # an ADXL359
+    try:
+        config = rig_config_for(running_sim, tmp_path, {"ADX355-A003": impostor.path})
+        result = subprocess.run([RIG, "check", str(config)], capture_output=True, text=True, timeout=60)
+    finally:
+        impostor.stop()
+    assert result.returncode == 2
+    assert result.stderr.strip() == (f"rig: error: sensor ADX355-A003 (serial {impostor.path}): identity AD/1D/E9 "
+                                     "is not an ADXL355 (AD/1D/ED)")
+
+
+def test_rig_check_names_a_dead_port(running_sim: dict, tmp_path: Path) -> None:
+    config = rig_config_for(running_sim, tmp_path, {"ADX355-A002": "/dev/nonexistent-bridge"})
+    result = subprocess.run([RIG, "check", str(config)], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2
+    assert result.stderr.startswith("rig: error: sensor bridge (serial /dev/nonexistent-bridge): cannot open")
+    assert len(result.stderr.strip().splitlines()) == 1
+
+
+def test_the_example_lab_config_is_valid() -> None:
+    rig = load_rig(REPO / "configs" / "example-lab.yaml").model
+    assert rig.chamber.driver == "modbus-rtu" and rig.chamber.register_map().encoding == "scaled-int16"
+    assert rig.turntable.line_protocol().write_terminator == "\r\n"
