@@ -290,6 +290,6 @@ def main(argv: list[str] | None = None) -> int:
     except RigError as exc:
         print(f"rig: error: {exc}", file=sys.stderr)
         return exc.exit_code
-    except KeyboardInterrupt:
-        print("rig: interrupted", file=sys.stderr)
+    except (KeyboardInterrupt, TerminationRequested):
+        print("rig: interrupted before the campaign started; nothing was moved", file=sys.stderr)
         return EXIT_INTERRUPTED

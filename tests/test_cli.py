@@ -190,3 +190,17 @@ def test_rig_fit_on_a_file_without_poses_is_one_line(write, workdir: Path, capsy
                      build_instruments=no_sensors_answer)
     err = one_line_error(capsys, ["fit", str(campaign), "-o", str(workdir / "cal.yaml")], 1)
     assert "no poses stored, nothing to fit" in err
+
+
+def test_a_signal_before_the_campaign_starts_is_one_line_and_leaves_no_file(write, capsys, monkeypatch) -> None:
+    from accelcal_rig.engine import session
+    from accelcal_rig.engine.campaign import TerminationRequested
+
+    def terminated(*_):
+        raise TerminationRequested()
+
+    monkeypatch.setattr(session, "connect_rig", terminated)  # SIGTERM while connecting to the instruments
+    path = write("tiny.yaml", TINY_PROCEDURE)
+    err = one_line_error(capsys, ["run", str(path), "--dry-run", "-o", str(path.with_suffix(".h5"))], 130)
+    assert "interrupted before the campaign started" in err
+    assert not path.with_suffix(".h5").exists()
