@@ -20,17 +20,22 @@ from accelcal_rig.store.atomic import stop_when_safe
 EXIT_INTERRUPTED = 130
 
 
+def _command(commands: argparse._SubParsersAction, name: str, summary: str, description: str,
+             example: str) -> argparse.ArgumentParser:
+    """A subcommand whose --help ends with an example."""
+    return commands.add_parser(name, help=summary, description=description, epilog=f"example:\n  {example}",
+                               formatter_class=argparse.RawDescriptionHelpFormatter)
+
+
 def _build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="rig", description="Run MEMS accelerometer calibration campaigns.")
     parser.add_argument("--version", action="version", version=f"accelcal-rig {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    run = commands.add_parser(
-        "run", help="run a campaign from a procedure file",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-        description="Run a campaign: ramp and soak at each setpoint, measure every pose, store pose by pose.",
-        epilog="example:\n  rig run procedures/paper-24pos-thermal.yaml --dry-run -o campaign.h5",
-    )
+    run = _command(commands, "run", "run a campaign from a procedure file",
+                   "Run a campaign: ramp and soak at each setpoint, measure every pose, store pose by pose, "
+                   "make the rig safe, fit.",
+                   "rig run procedures/paper-24pos-thermal.yaml --dry-run -o campaign.h5")
     run.add_argument("procedure", type=Path, help="procedure YAML file")
     run.add_argument("-o", "--output", type=Path, required=True, help="campaign file to create (HDF5)")
     run.add_argument("--config", type=Path, help="rig config YAML (overrides the procedure's `rig`)")
@@ -42,43 +47,31 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
     run.add_argument("-q", "--quiet", action="store_true", help="print only warnings and the summary")
 
-    status = commands.add_parser(
-        "status", help="show a campaign file's state and progress",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-        description="Show a campaign's state and progress (works on finished, aborted and running files).",
-        epilog="example:\n  rig status campaign.h5 --json",
-    )
+    status = _command(commands, "status", "show a campaign file's state and progress",
+                      "Show a campaign's state and progress (works on finished, aborted and running files).",
+                      "rig status campaign.h5 --json")
     status.add_argument("campaign", type=Path, help="campaign file (HDF5)")
     status.add_argument("--json", action="store_true", help="print one JSON object")
 
-    check = commands.add_parser(
-        "check", help="contact every instrument of a rig and describe each in one line",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-        description="Connect to the chamber, the turntable and every sensor of a rig config, check their "
-                    "identities and print what they report. Run it before leaving a campaign overnight.",
-        epilog="example:\n  rig check configs/example-lab.yaml",
-    )
+    check = _command(commands, "check", "contact every instrument of a rig and describe each in one line",
+                     "Connect to the chamber, the turntable and every sensor of a rig config, check their "
+                     "identities and print what they report. Run it before leaving a campaign overnight.",
+                     "rig check configs/example-lab.yaml")
     check.add_argument("rig", type=Path, help="rig config YAML")
     check.add_argument("--dry-run", action="store_true", help="check the rig's simulators instead")
 
-    sim = commands.add_parser(
-        "sim", help="serve the simulated rig as real endpoints until interrupted",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-        description="Start the simulated rig of a rig config: the chamber on Modbus TCP (127.0.0.1), the "
-                    "turntable and each sensor bridge on a pseudo-terminal, in real time. The first line on "
-                    "stdout is one JSON object with the endpoints. Ctrl-C stops it.",
-        epilog="example:\n  rig sim configs/sim.yaml",
-    )
+    sim = _command(commands, "sim", "serve the simulated rig as real endpoints until interrupted",
+                   "Start the simulated rig of a rig config: the chamber on Modbus TCP (127.0.0.1), the "
+                   "turntable and each sensor bridge on a pseudo-terminal, in real time. The first line on "
+                   "stdout is one JSON object with the endpoints. Ctrl-C stops it.",
+                   "rig sim configs/sim.yaml")
     sim.add_argument("rig", type=Path, help="rig config YAML")
     sim.add_argument("--seed", type=int, default=0, help="seed of the simulated noise (default 0)")
 
-    fit = commands.add_parser(
-        "fit", help="fit the error model of every DUT and write a calibration file",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-        description="LM fit of Eq. 1 at each setpoint, polynomials over the sensor temperature (Eq. 8), metrics. "
-                    "Results also replace the campaign file's fit/ group; measured data are never touched.",
-        epilog="example:\n  rig fit campaign.h5 -o calibration.yaml --json",
-    )
+    fit = _command(commands, "fit", "fit the error model of every DUT and write a calibration file",
+                   "LM fit of Eq. 1 at each setpoint, polynomials over the sensor temperature (Eq. 8), metrics. "
+                   "Results also replace the campaign file's fit/ group; measured data are never touched.",
+                   "rig fit campaign.h5 -o calibration.yaml --json")
     fit.add_argument("campaign", type=Path, help="campaign file (HDF5)")
     fit.add_argument("-o", "--output", type=Path, required=True, help="calibration file to write (YAML)")
     fit.add_argument("--mode", choices=["reference", "norm-only"], help="default: the procedure's fit.mode")

@@ -85,7 +85,7 @@ def test_status_of_a_missing_or_foreign_file(tmp_path: Path, capsys, content: by
 
 
 def test_every_command_has_help_with_an_example(capsys) -> None:
-    for command in ("run", "status"):
+    for command in ("run", "status", "fit", "check", "sim"):
         with pytest.raises(SystemExit) as exit_info:
             main([command, "--help"])
         assert exit_info.value.code == 0

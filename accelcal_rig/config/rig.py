@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any, Literal
 
 import numpy as np
@@ -36,12 +37,8 @@ class ChamberConfig(_Strict):
         return register_map(self.profile, self.registers)
 
     @model_validator(mode="after")
-    def _ordered_limits(self) -> ChamberConfig:
-        try:
-            self.register_map()
-        except ValidationError as exc:
-            first = exc.errors(include_url=False)[0]
-            raise ValueError(f"registers.{'.'.join(map(str, first['loc']))}: {first['msg']}") from None
+    def _consistent(self) -> ChamberConfig:
+        _first_error_as_value_error("registers", self.register_map)
         if self.driver == "modbus-tcp" and self.endpoint and not _is_host_port(self.endpoint):
             raise ValueError(f"modbus-tcp endpoint {self.endpoint!r} is not host:port")
         if self.min_setpoint_c >= self.max_setpoint_c:
@@ -105,11 +102,7 @@ class TurntableConfig(_Strict):
 
     @model_validator(mode="after")
     def _valid_protocol(self) -> TurntableConfig:
-        try:
-            self.line_protocol()
-        except ValidationError as exc:
-            first = exc.errors(include_url=False)[0]
-            raise ValueError(f"protocol_overrides.{'.'.join(map(str, first['loc']))}: {first['msg']}") from None
+        _first_error_as_value_error("protocol_overrides", self.line_protocol)
         return self
 
 
@@ -124,6 +117,15 @@ class SensorConfig(_Strict):
     spi_speed_hz: int = Field(5_000_000, gt=0, le=10_000_000)
     timeout_s: float = Field(1.0, gt=0, le=60)
     mount_euler_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+def _first_error_as_value_error(key: str, build: Callable[[], object]) -> None:
+    """Build a nested model from overrides; report its first problem under `key` in the config's error."""
+    try:
+        build()
+    except ValidationError as exc:
+        first = exc.errors(include_url=False)[0]
+        raise ValueError(f"{key}.{'.'.join(map(str, first['loc']))}: {first['msg']}") from None
 
 
 def _is_host_port(endpoint: str) -> bool:

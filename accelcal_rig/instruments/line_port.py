@@ -1,10 +1,13 @@
 """Request/reply over a serial line (a device path or any pyserial URL), one line each way.
 
 pyserial's read_until reads a byte per system call; replies here can be hundreds of characters (a FIFO
-burst in hex), so lines are read in whatever chunks have arrived.
+burst in hex), so lines are read in whatever chunks have arrived. The wall clock bounds a reply: it is
+the wire's timeout, not campaign time (which is virtual in a dry run).
 """
 
 from __future__ import annotations
+
+import time
 
 import serial
 
@@ -45,10 +48,13 @@ class LinePort:
         self._port.close()
 
     def _read_line(self) -> bytes:
+        """Bytes up to the terminator; stops short at the port's timeout or, for a device that keeps
+        talking without ever ending its line, at a deadline of the same length."""
         line = bytearray()
+        deadline = time.monotonic() + (self._port.timeout or 0.0)
         while not line.endswith(self._read_terminator):
             chunk = self._port.read(max(1, self._port.in_waiting))  # waits up to the timeout for the first byte
-            if not chunk:
+            if not chunk or time.monotonic() > deadline:
                 break
             line += chunk
         return bytes(line)

@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import os
+import threading
+import time
+import tty
+
 import numpy as np
 import pytest
 
@@ -117,3 +122,30 @@ def test_limits_gate_the_serial_driver(table) -> None:
     with pytest.raises(InstrumentError, match="axis b to 120° refused"):
         LimitedTurntable(driver, config).move_to(np.array([0.0, 120.0, 0.0]))
     assert np.all(np.isnan(lab.motion.last_command_deg))  # nothing reached the controller
+
+
+def test_a_device_that_never_ends_its_line_is_cut_off_at_the_timeout() -> None:
+    master, slave = os.openpty()
+    tty.setraw(master)
+    tty.setraw(slave)
+    stop = threading.Event()
+
+    def babble() -> None:  # a controller stuck sending bytes, never a terminator
+        while not stop.is_set():
+            os.write(master, b"garbage ")
+            time.sleep(0.001)
+
+    writer = threading.Thread(target=babble, daemon=True)
+    writer.start()
+    driver = SerialTurntable.open(os.ttyname(slave), ACCELCAL_LINE, n_axes=1, timeout_s=0.3)
+    try:
+        started = time.monotonic()
+        with pytest.raises(InstrumentError, match="no reply within the timeout"):
+            driver.identify()
+        assert time.monotonic() - started < 1.0
+    finally:
+        stop.set()
+        writer.join(2)
+        driver.close()
+        os.close(master)
+        os.close(slave)
