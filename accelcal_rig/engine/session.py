@@ -23,10 +23,10 @@ from accelcal_rig.engine.events import LOGGER, EventLog
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
 from accelcal_rig.instruments import adxl355
+from accelcal_rig.instruments.connect import configured_endpoints, connect_rig
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.plan.compile import Plan, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
-from accelcal_rig.instruments.connect import configured_endpoints, connect_rig
 from accelcal_rig.sim.wire_rig import SimulatedRig
 from accelcal_rig.store.campaign_file import CampaignWriter
 

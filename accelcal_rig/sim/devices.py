@@ -1,4 +1,9 @@
-"""In-process simulated instruments backed by the virtual lab, implementing the driver interfaces."""
+"""In-process simulated instruments backed by the virtual lab, implementing the driver interfaces.
+
+A test double: the engine's tests break them on purpose (wrong identity, stuck chamber, failing
+port) without a wire in between. Dry runs do not use them: they go through the real drivers and the
+wire-level simulators (`sim/wire_rig.py`). `SimulationTruth` serves both.
+"""
 
 from __future__ import annotations
 
