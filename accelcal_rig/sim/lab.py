@@ -48,7 +48,9 @@ class VirtualLab:
         self.effects = effects
         #: Simulators answer from their own threads (wire-level servers): one lab, one request at a time.
         self.lock = threading.RLock()
-        self.rng = np.random.default_rng(seed)
+        self.rng = np.random.default_rng(seed)  # chamber and turntable: one request at a time
+        # One stream per DUT: sensors read concurrently draw their noise in their own order only.
+        self.dut_rngs = [np.random.default_rng([seed, index]) for index in range(len(rig.fixture.sensors))]
         self.chamber_noise_c = sim.chamber_noise_c
         self.noise_density_g_per_rthz = sim.noise_density_ug_per_rthz * 1e-6
         self.kinematics = TurntableKinematics(rig.turntable.axes)
@@ -79,7 +81,7 @@ class VirtualLab:
 
     def dut_reading_c(self, index: int) -> float:
         """What the ADXL355 temperature sensor reports: 12-bit code, datasheet conversion."""
-        noisy = self.dut_true_c(index) + float(self.rng.normal(0.0, TEMPERATURE_READ_NOISE_C))
+        noisy = self.dut_true_c(index) + float(self.dut_rngs[index].normal(0.0, TEMPERATURE_READ_NOISE_C))
         return float(temperature_c_from_raw(raw_from_temperature_c(noisy)))
 
     def unmodelled_g(self, index: int, gravity_g: np.ndarray) -> np.ndarray:
@@ -100,7 +102,7 @@ class VirtualLab:
         temperature = self.dut_true_c(index)
         params = dut.truth.parameters_at(temperature)
         gravity = self.gravity_in_dut(index)
-        noise = self.rng.normal(0.0, self.noise_g(odr_hz), (n_samples, 3))
+        noise = self.dut_rngs[index].normal(0.0, self.noise_g(odr_hz), (n_samples, 3))
         raw_g = distort(gravity, params) + self.unmodelled_g(index, gravity) + noise
         dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, params, gravity, temperature))
         return quantise_g(raw_g, range_g)

@@ -23,3 +23,39 @@ def test_deadline_passes_with_the_named_outcome_after_a_final_check() -> None:
 def test_virtual_clock_refuses_to_go_backwards() -> None:
     with pytest.raises(ValueError):
         VirtualClock().sleep(-1)
+
+
+def test_concurrent_tasks_share_virtual_time_like_real_parallel_work() -> None:
+    clock = VirtualClock()
+    seen = []
+
+    def task(step_s: float, steps: int) -> list[float]:
+        times = []
+        for _ in range(steps):
+            clock.sleep(step_s)
+            times.append(round(clock.now(), 9))
+        seen.append(step_s)
+        return times
+
+    results = clock.run_concurrently([lambda: task(0.25, 3), lambda: task(0.1, 5), lambda: task(1.0, 1)])
+    assert results == [[0.25, 0.5, 0.75], [0.1, 0.2, 0.3, 0.4, 0.5], [1.0]]
+    assert clock.now() == 1.0            # the longest task's time, not the sum (2.25 s)
+    clock.sleep(0.5)                     # outside a concurrent section: plain sleeping again
+    assert clock.now() == 1.5
+
+
+def test_a_failing_task_is_raised_after_every_task_has_ended() -> None:
+    clock = VirtualClock()
+    finished = []
+
+    def fails() -> None:
+        clock.sleep(0.1)
+        raise OSError("port gone")
+
+    def slow() -> None:
+        clock.sleep(5.0)
+        finished.append(clock.now())
+
+    with pytest.raises(OSError, match="port gone"):
+        clock.run_concurrently([fails, slow])
+    assert finished == [5.0]             # no thread left behind, using an instrument
