@@ -113,8 +113,8 @@ def _run_in_threads(tasks: list[Callable[[], T]], on_start: Callable[[], None],
 
     def work(index: int) -> None:
         on_start()
-        registered.wait()  # every task counts as awake before any may sleep
         try:
+            registered.wait()  # every task counts as awake before any may sleep
             results[index] = tasks[index]()
         except BaseException as exc:  # noqa: BLE001 - handed to the caller below
             errors[index] = exc
@@ -124,13 +124,15 @@ def _run_in_threads(tasks: list[Callable[[], T]], on_start: Callable[[], None],
     threads = [threading.Thread(target=work, args=(i,), daemon=True) for i in range(len(tasks))]
     for thread in threads:
         thread.start()
-    registered.wait()
     try:
+        registered.wait()
         for thread in threads:
             thread.join()
-    finally:
-        for thread in threads:  # an interrupt in the caller still waits for the tasks to end
+    except BaseException:
+        registered.abort()  # interrupted before the start: tasks not yet begun never begin
+        for thread in threads:  # and none is left using an instrument when the caller goes on
             thread.join()
+        raise
     for error in errors:
         if error is not None:
             raise error

@@ -59,3 +59,23 @@ def test_a_failing_task_is_raised_after_every_task_has_ended() -> None:
     with pytest.raises(OSError, match="port gone"):
         clock.run_concurrently([fails, slow])
     assert finished == [5.0]             # no thread left behind, using an instrument
+
+
+def test_an_interrupt_before_the_tasks_start_leaves_no_thread_waiting(monkeypatch) -> None:
+    import threading
+
+    from accelcal_rig.engine import clock as clock_module
+
+    class InterruptedInCaller(threading.Barrier):
+        def wait(self, timeout=None):
+            if threading.current_thread() is threading.main_thread():
+                raise KeyboardInterrupt  # Ctrl-C while the caller waits for the tasks to register
+            return super().wait(timeout)
+
+    monkeypatch.setattr(clock_module.threading, "Barrier", InterruptedInCaller)
+    started = []
+    before = threading.active_count()
+    with pytest.raises(KeyboardInterrupt):
+        VirtualClock().run_concurrently([lambda: started.append(1), lambda: started.append(2)])
+    assert started == []                          # no task began after the interrupt
+    assert threading.active_count() == before     # and no thread is left blocked
