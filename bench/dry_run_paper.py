@@ -79,8 +79,10 @@ def main() -> None:
                   f"virtual {virtual_h:.2f} h, file {output.stat().st_size / 1e6:.2f} MB")
         print(f"summary: process wall median {sorted(walls)[len(walls) // 2]:.2f} s (min {min(walls):.2f}, "
               f"max {max(walls):.2f}) over {len(walls)} runs on {os.cpu_count()} cores")
-        wire = [campaign_only(output, seed, in_process=False) for seed in range(args.runs)]
-        local = [campaign_only(output, seed, in_process=True) for seed in range(args.runs)]
+        wire, local = [], []
+        for seed in range(args.runs):  # interleaved, so a busier spell of the machine hits both alike
+            wire.append(campaign_only(output, seed, in_process=False))
+            local.append(campaign_only(output, seed, in_process=True))
         median = lambda values: sorted(values)[len(values) // 2]  # noqa: E731
         print(f"campaign alone (incl. fit): through the wire median {median(wire):.2f} s, in-process "
               f"median {median(local):.2f} s, ratio {median(wire) / median(local):.2f}")

@@ -1,5 +1,6 @@
 """ADXL355 at register level over any RegisterTransport: bring-up, configuration, temperature, and
-gap-free blocks of samples drained from the FIFO (decoded with numpy, not per sample)."""
+gap-free blocks of samples (decoded with numpy, not per sample) — captured by the bridge where it can,
+else drained from the FIFO by the host."""
 
 from __future__ import annotations
 
@@ -9,13 +10,15 @@ from accelcal_rig.engine.clock import Clock
 from accelcal_rig.engine.waits import wait_until
 from accelcal_rig.errors import InstrumentError, WaitTimeout
 from accelcal_rig.instruments import adxl355
-from accelcal_rig.instruments.adxl355_transport import RegisterTransport
+from accelcal_rig.instruments.adxl355_transport import BlockCapture, CaptureOverflow, RegisterTransport
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
 
 #: Samples to let accumulate between FIFO bursts: under its 32, so a burst is never late.
 DRAIN_EVERY_SAMPLES = 30
 #: Attempts at a gap-free block before a FIFO overflow is reported as a fault.
 OVERFLOW_ATTEMPTS = 3
+#: Share of a bridge's capture buffer to let fill between fetches.
+FETCH_AT_CAPTURE_FRACTION = 0.5
 
 
 class Adxl355:
@@ -71,9 +74,10 @@ class Adxl355:
         return float(adxl355.temperature_c_from_raw(((high & 0x0F) << 8) | low))
 
     def acquire(self, n_samples: int) -> SampleBlock:
-        """`n_samples` consecutive samples: drain stale entries, then drain the FIFO as it fills."""
+        """`n_samples` consecutive samples, captured by the bridge if it can, else drained from the FIFO."""
+        attempt = self._try_capture if self._bus.capture_capacity_samples > 0 else self._try_drain
         for _ in range(OVERFLOW_ATTEMPTS):
-            block = self._try_acquire(n_samples)
+            block = attempt(n_samples)
             if block is not None:
                 return block
         raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): FIFO overflowed in "
@@ -82,8 +86,32 @@ class Adxl355:
     def close(self) -> None:
         self._bus.close()
 
-    # ------------------------------------------------------------------ FIFO
-    def _try_acquire(self, n_samples: int) -> SampleBlock | None:
+    # ------------------------------------------------------------------ blocks
+    def _try_capture(self, n_samples: int) -> SampleBlock | None:
+        """One attempt through the bridge's own capture, fetched before its buffer fills; the bridge
+        drains the FIFO and reports any lost sample as an overflow."""
+        capture: BlockCapture = self._bus  # type: ignore[assignment]
+        _, temperature_before = self._status_and_temperature()
+        capture.start_capture(n_samples)
+        t_start = self._clock.now()
+        fetch_every = max(1, int(self._bus.capture_capacity_samples * FETCH_AT_CAPTURE_FRACTION))
+        blocks, have, carried = [], 0, b""
+        deadline = t_start + 2.0 * n_samples / self._odr_hz + 1.0
+        while have < n_samples:
+            if self._clock.now() > deadline:
+                raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {have} of {n_samples} samples "
+                                      "before the deadline: is it measuring?")
+            self._clock.sleep(min(fetch_every, n_samples - have) / self._odr_hz)
+            try:
+                codes, carried = adxl355.decode_fifo(capture.fetch_capture(), carried)
+            except CaptureOverflow:
+                return None
+            blocks.append(codes)
+            have += len(codes)
+        _, temperature_after = self._status_and_temperature()
+        return self._block(blocks, n_samples, t_start, (temperature_before, temperature_after))
+
+    def _try_drain(self, n_samples: int) -> SampleBlock | None:
         """One attempt: a whole-FIFO burst every DRAIN_EVERY_SAMPLES samples (empty entries are marked, a
         sample still being written is carried to the next burst); FIFO_OVR, latched until STATUS is
         read, is checked at the end, so a block that lost samples anywhere is never returned."""
@@ -104,9 +132,12 @@ class Adxl355:
         status, temperature_after = self._status_and_temperature()
         if status & adxl355.STATUS_FIFO_OVR:
             return None
+        return self._block(blocks, n_samples, t_start, (temperature_before, temperature_after))
+
+    def _block(self, blocks: list[np.ndarray], n_samples: int, t_start: float,
+               temperature_c: tuple[float, float]) -> SampleBlock:
         codes = np.concatenate(blocks)[:n_samples]
-        t_end = t_start + (n_samples - 1) / self._odr_hz
-        return SampleBlock(codes, t_start, t_end, (temperature_before, temperature_after))
+        return SampleBlock(codes, t_start, t_start + (n_samples - 1) / self._odr_hz, temperature_c)
 
     def _burst(self, carried: bytes) -> tuple[np.ndarray, bytes]:
         """Read the whole FIFO in one burst."""

@@ -5,7 +5,14 @@ The bridge protocol (docs/instruments.md): one ASCII request per line, one reply
     R <addr> <count>     → `=<hex bytes>`   read `count` registers from `addr` (hex); FIFO_DATA (0x11)
                                             does not auto-increment, so a burst of it drains the FIFO
     W <addr> <value>     → `=`              write one register (both hex)
+    C <count>            → `=`              (version 2) empty the FIFO, then capture the next `count`
+                                            samples into the bridge's own memory, draining the FIFO itself
+    G                    → `=<hex bytes>`   (version 2) the captured samples not fetched yet, 9 bytes each
+                                            in FIFO format; `!overflow …` if the capture lost samples
     any failure          → `!<message>`
+
+A version 2 bridge greets with `capture=<samples>` (its buffer). At high data rates a host behind USB
+serial cannot drain a 32-sample FIFO in time (at 4 kHz it fills in 8 ms), the bridge's firmware can.
 """
 
 from __future__ import annotations
@@ -20,10 +27,23 @@ BRIDGE_GREETING = "ADXL355-BRIDGE"
 
 class RegisterTransport(Protocol):
     endpoint: str
+    #: Samples the transport can capture on its own (0: none; the host drains the FIFO itself).
+    capture_capacity_samples: int
 
     def read(self, address: int, count: int) -> bytes: ...
     def write(self, address: int, value: int) -> None: ...
     def close(self) -> None: ...
+
+
+class CaptureOverflow(InstrumentError):
+    """A bridge-side capture lost samples (its buffer was not fetched in time)."""
+
+
+class BlockCapture(Protocol):
+    """A transport that captures gap-free blocks itself (a version 2 serial bridge)."""
+
+    def start_capture(self, n_samples: int) -> None: ...
+    def fetch_capture(self) -> bytes: ...
 
 
 class SerialBridge:
@@ -32,6 +52,7 @@ class SerialBridge:
     def __init__(self, line: LinePort, endpoint: str) -> None:
         self._line = line
         self.endpoint = endpoint
+        self.capture_capacity_samples = 0
 
     @classmethod
     def open(cls, endpoint: str, baudrate: int = 921600, timeout_s: float = 1.0) -> SerialBridge:
@@ -40,6 +61,7 @@ class SerialBridge:
         if not greeting.startswith(BRIDGE_GREETING):
             bridge.close()
             raise InstrumentError(f"sensor bridge (serial {endpoint}): not an ADXL355 bridge (answers {greeting!r})")
+        bridge.capture_capacity_samples = _capture_capacity(greeting)
         return bridge
 
     def read(self, address: int, count: int) -> bytes:
@@ -59,18 +81,50 @@ class SerialBridge:
             raise InstrumentError(f"sensor bridge ({self.endpoint}): write 0x{value:02X} to 0x{address:02X} "
                                   f"answered {reply[:40]!r}")
 
+    def start_capture(self, n_samples: int) -> None:
+        reply = self._ask(f"C {n_samples}")
+        if reply != "=":
+            raise InstrumentError(f"sensor bridge ({self.endpoint}): capture of {n_samples} answered {reply[:40]!r}")
+
+    def fetch_capture(self) -> bytes:
+        reply = self._line.ask("G")
+        if reply.startswith("!overflow"):
+            raise CaptureOverflow(f"sensor bridge ({self.endpoint}): {reply[1:]}")
+        reply = self._refusal_raised("G", reply)
+        try:
+            data = bytes.fromhex(reply[1:])
+        except ValueError:
+            data = b"?"
+        if not reply.startswith("=") or len(data) % 9:
+            raise InstrumentError(f"sensor bridge ({self.endpoint}): garbled capture {reply[:40]!r}")
+        return data
+
     def close(self) -> None:
         self._line.close()
 
     def _ask(self, request: str) -> str:
-        reply = self._line.ask(request)
+        return self._refusal_raised(request, self._line.ask(request))
+
+    def _refusal_raised(self, request: str, reply: str) -> str:
         if reply.startswith("!"):
             raise InstrumentError(f"sensor bridge ({self.endpoint}): {request!r} refused: {reply[1:]}")
         return reply
 
 
+def _capture_capacity(greeting: str) -> int:
+    """`ADXL355-BRIDGE 2 capture=4096 …` → 4096; a version 1 bridge captures nothing."""
+    words = greeting.split()
+    if len(words) < 3 or not words[1].isdigit() or int(words[1]) < 2 or not words[2].startswith("capture="):
+        return 0
+    value = words[2].removeprefix("capture=")
+    return int(value) if value.isdigit() else 0
+
+
 class SpidevBus:
-    """Linux spidev (optional extra `spidev`): mode 0; command byte (addr << 1) | 1 reads, addr << 1 writes."""
+    """Linux spidev (optional extra `spidev`): mode 0; command byte (addr << 1) | 1 reads, addr << 1 writes.
+    The host is on the SPI bus itself and drains the FIFO in time: no capture of its own."""
+
+    capture_capacity_samples = 0
 
     def __init__(self, device: object, endpoint: str) -> None:
         self._device = device

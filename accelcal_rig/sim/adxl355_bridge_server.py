@@ -1,5 +1,6 @@
 """A simulated ADXL355 behind a serial bridge, on a pseudo-terminal: the register map, including the
-96-entry FIFO that fills at the output data rate on the shared clock, fed by the lab's sensor model."""
+96-entry FIFO that fills at the output data rate on the shared clock, fed by the lab's sensor model,
+and the bridge's own block capture (protocol version 2), which drains the FIFO as firmware would."""
 
 from __future__ import annotations
 
@@ -10,9 +11,12 @@ from accelcal_rig.instruments.adxl355_transport import BRIDGE_GREETING
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 
-_READ_ONLY_BELOW = 0x1E  # ID, status, data and FIFO registers
+_READ_ONLY_BELOW = 0x1E
+_FIFO_REGISTERS = frozenset({adxl355.REG_STATUS, adxl355.REG_FIFO_ENTRIES, adxl355.REG_FIFO_DATA})  # ID, status, data and FIFO registers
 _FIFO_CAPACITY_BYTES = 3 * adxl355.FIFO_CAPACITY_ENTRIES
 _SAMPLES_IN_FIFO = adxl355.FIFO_CAPACITY_ENTRIES // 3
+#: Samples the simulated bridge's capture buffer holds (9 bytes each: 36 kB, a small microcontroller's RAM).
+CAPTURE_CAPACITY_SAMPLES = 4096
 
 
 class SimulatedAdxl355:
@@ -32,6 +36,9 @@ class SimulatedAdxl355:
         self._fifo = bytearray()
         self._overflow = False
         self._next_sample_s: float | None = None
+        self._capture_left = 0
+        self._captured = bytearray()
+        self._capture_overflow = False
 
     @property
     def _measuring(self) -> bool:
@@ -46,7 +53,8 @@ class SimulatedAdxl355:
         return {code: g for g, code in adxl355.RANGE_CODES.items()}[self._regs[adxl355.REG_RANGE] & 0x03]
 
     def read(self, address: int, count: int) -> bytes:
-        self._fill_fifo()
+        if not _FIFO_REGISTERS.isdisjoint(range(address, address + count)):
+            self._fill_fifo()  # a temperature or ID read leaves the FIFO to be filled when it is looked at
         if address == adxl355.REG_FIFO_DATA:  # no auto-increment: a burst drains the FIFO
             taken, self._fifo = bytes(self._fifo[:count]), self._fifo[count:]
             return taken + adxl355.empty_fifo_entries((count - len(taken)) // 3)
@@ -77,14 +85,38 @@ class SimulatedAdxl355:
         if address == adxl355.REG_POWER_CTL and was_measuring != self._measuring:
             self._fifo.clear()  # standby resets the FIFO; measuring starts a fresh one
             self._overflow = False
+            self._capture_left = 0
             self._next_sample_s = self._lab.clock.now() if self._measuring else None
 
+    def start_capture(self, n_samples: int) -> None:
+        """The bridge empties the FIFO and captures the next `n_samples` itself."""
+        if not self._measuring:
+            raise ValueError("capture needs the part measuring")
+        if n_samples <= 0:
+            raise ValueError(f"capture count {n_samples} must be positive")
+        self._fill_fifo()
+        self._fifo.clear()
+        self._overflow = False
+        self._capture_left, self._captured, self._capture_overflow = n_samples, bytearray(), False
+
+    def fetch_capture(self) -> bytes:
+        """Captured samples not fetched yet."""
+        self._fill_fifo()
+        if self._capture_overflow:
+            self._capture_overflow = False
+            raise ValueError(f"overflow: more than {CAPTURE_CAPACITY_SAMPLES} samples were not fetched")
+        taken, self._captured = bytes(self._captured), bytearray()
+        return taken
+
     def _fill_fifo(self) -> None:
-        """Add the samples due since the last look; beyond 32 samples the FIFO overflows (oldest lost)."""
+        """Add the samples due since the last look: first to a capture under way, then to the FIFO, which
+        beyond 32 samples overflows (oldest lost)."""
         if self._next_sample_s is None:
             return
         now = self._lab.clock.now()
         due = math.floor((now - self._next_sample_s) * self._odr_hz + 1e-9)
+        if due > 0 and self._capture_left > 0:
+            due -= self._capture(min(due, self._capture_left))
         if due <= 0:
             return
         room = _SAMPLES_IN_FIFO - len(self._fifo) // 9
@@ -97,12 +129,25 @@ class SimulatedAdxl355:
             self._fifo = self._fifo[-_FIFO_CAPACITY_BYTES:]
         self._next_sample_s += due / self._odr_hz
 
+    def _capture(self, count: int) -> int:
+        """Move the next `count` samples into the capture buffer; returns how many samples were due."""
+        assert self._next_sample_s is not None
+        self._capture_left -= count
+        if len(self._captured) // 9 + count > CAPTURE_CAPACITY_SAMPLES:
+            self._capture_overflow, self._capture_left = True, 0
+        else:
+            codes = self._lab.dut_samples(self._index, self._next_sample_s, count, self._odr_hz, self._range_g)
+            self._captured += adxl355.encode_fifo(codes)
+        self._next_sample_s += count / self._odr_hz
+        return count
+
 
 class SimulatedBridgeServer:
     """The bridge line protocol on a pseudo-terminal, in front of one simulated ADXL355."""
 
-    def __init__(self, lab: VirtualLab, index: int) -> None:
+    def __init__(self, lab: VirtualLab, index: int, protocol_version: int = 2) -> None:
         self._lab = lab
+        self._version = protocol_version
         self.device = SimulatedAdxl355(lab, index)
         self._server = PtyLineServer(self._handle, b"\n", f"simulated-bridge-{lab.duts[index].serial}")
         self.path = self._server.path
@@ -119,12 +164,18 @@ class SimulatedBridgeServer:
         try:
             with self._lab.lock:
                 if parts == ["?"]:
-                    return f"{BRIDGE_GREETING} 1 accelcal-rig simulated bridge"
+                    capture = f" capture={CAPTURE_CAPACITY_SAMPLES}" if self._version >= 2 else ""
+                    return f"{BRIDGE_GREETING} {self._version}{capture} accelcal-rig simulated bridge"
                 if len(parts) == 3 and parts[0] == "R":
                     return "=" + self.device.read(int(parts[1], 16), int(parts[2])).hex().upper()
                 if len(parts) == 3 and parts[0] == "W":
                     self.device.write(int(parts[1], 16), int(parts[2], 16))
                     return "="
+                if self._version >= 2 and len(parts) == 2 and parts[0] == "C":
+                    self.device.start_capture(int(parts[1]))
+                    return "="
+                if self._version >= 2 and parts == ["G"]:
+                    return "=" + self.device.fetch_capture().hex().upper()
         except ValueError as exc:
             return f"!{exc}"
         return f"!unknown request {request!r}"

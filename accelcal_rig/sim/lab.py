@@ -29,7 +29,8 @@ class SimulatedDut:
     def __init__(self, serial: str, mount_euler_deg: tuple[float, float, float], fixture_tau_s: float) -> None:
         self.serial = serial
         self.truth: DutTruth = truth_for_serial(serial)
-        self.mount = Rotation.from_euler("xyz", mount_euler_deg, degrees=True)
+        #: Fixture frame → DUT frame.
+        self.fixture_to_dut = Rotation.from_euler("xyz", mount_euler_deg, degrees=True).inv().as_matrix()
         # Fixtures are never quite uniform: each DUT lags the air by its own ±10 % of the nominal constant.
         spread = int.from_bytes(hashlib.sha256(f"tau:{serial}".encode()).digest()[:4], "little") / 2**32
         self.tau_s = fixture_tau_s * (0.9 + 0.2 * spread)
@@ -71,6 +72,8 @@ class VirtualLab:
             settle_s=sim.turntable_settle_s,
             rng=self.rng,
         )
+        self._gravity_angles_key = b""
+        self._gravity_fixture = np.array([0.0, 0.0, 1.0])
 
     def chamber_reading_c(self) -> float:
         """Chamber air as its controller reads it, with regulation noise."""
@@ -119,5 +122,7 @@ class VirtualLab:
     def gravity_in_dut(self, index: int) -> np.ndarray:
         """True specific-force direction (+1 g up) in DUT `index`'s frame at the table's actual angles."""
         angles = self.motion.position_deg(self.clock.now())
-        gravity_fixture = self.kinematics.gravity_in_fixture(angles)
-        return self.duts[index].mount.inv().apply(gravity_fixture)
+        key = angles.tobytes()
+        if key != self._gravity_angles_key:  # the table stands still between moves: one chain per pose
+            self._gravity_angles_key, self._gravity_fixture = key, self.kinematics.gravity_in_fixture(angles)
+        return self.duts[index].fixture_to_dut @ self._gravity_fixture

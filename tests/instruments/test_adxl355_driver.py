@@ -18,13 +18,35 @@ from accelcal_rig.sim.pty_line_server import PtyLineServer
 from tests.conftest import SIM_RIG
 
 
-@pytest.fixture
-def sensor():
+def open_sensor(protocol_version: int):
     clock = VirtualClock()
     lab = VirtualLab(load_rig(SIM_RIG).model, clock, 3)
-    server = SimulatedBridgeServer(lab, 1).start()
-    driver = Adxl355(SerialBridge.open(server.path), "ADX355-A002", clock)
+    server = SimulatedBridgeServer(lab, 1, protocol_version).start()
+    return Adxl355(SerialBridge.open(server.path), "ADX355-A002", clock), server, lab, clock
+
+
+@pytest.fixture(params=[1, 2], ids=["host-drains-fifo", "bridge-captures"])
+def sensor(request):
+    """Both ways to a block: the host draining the FIFO (a version 1 bridge, as spidev) and the bridge's
+    own capture (version 2)."""
+    driver, server, lab, clock = open_sensor(request.param)
     yield driver, server, lab, clock
+    driver.close()
+    server.stop()
+
+
+@pytest.fixture
+def fifo_sensor():
+    driver, server, lab, clock = open_sensor(1)
+    yield driver
+    driver.close()
+    server.stop()
+
+
+@pytest.fixture
+def capturing_sensor():
+    driver, server, lab, clock = open_sensor(2)
+    yield driver
     driver.close()
     server.stop()
 
@@ -74,19 +96,37 @@ def test_configure_outside_standby_is_refused(sensor) -> None:
         driver.configure(4, 125.0)
 
 
-def test_a_fifo_the_link_cannot_keep_up_with_is_a_fault(sensor, monkeypatch) -> None:
-    driver, _, _, clock = sensor
-    bring_up(driver, odr_hz=4000.0)
+def test_the_greeting_says_whether_the_bridge_captures(sensor) -> None:
+    driver, server, _, _ = sensor
+    expected = 4096 if server._version >= 2 else 0
+    assert driver._bus.capture_capacity_samples == expected
+
+
+def test_a_fifo_the_link_cannot_keep_up_with_is_a_fault(fifo_sensor, monkeypatch) -> None:
+    bring_up(fifo_sensor, odr_hz=4000.0)
     monkeypatch.setattr("accelcal_rig.instruments.adxl355_driver.DRAIN_EVERY_SAMPLES", 80)  # > 32: overflows
     with pytest.raises(InstrumentError, match="FIFO overflowed in 3 attempts"):
-        driver.acquire(200)
+        fifo_sensor.acquire(200)
 
 
-def test_a_sensor_in_standby_gives_no_samples_before_the_deadline(sensor) -> None:
-    driver, _, _, _ = sensor
-    driver.standby()
+def test_a_capture_fetched_too_late_is_a_fault(capturing_sensor, monkeypatch) -> None:
+    bring_up(capturing_sensor, odr_hz=4000.0)
+    monkeypatch.setattr(capturing_sensor._bus, "capture_capacity_samples", 20000)  # the driver waits too long
+    monkeypatch.setattr("accelcal_rig.instruments.adxl355_driver.FETCH_AT_CAPTURE_FRACTION", 1.0)
+    with pytest.raises(InstrumentError, match="FIFO overflowed in 3 attempts"):
+        capturing_sensor.acquire(10000)
+
+
+def test_a_sensor_in_standby_gives_no_samples_before_the_deadline(fifo_sensor) -> None:
+    fifo_sensor.standby()
     with pytest.raises(InstrumentError, match="0 of 50 samples before the deadline: is it measuring"):
-        driver.acquire(50)
+        fifo_sensor.acquire(50)
+
+
+def test_a_bridge_refuses_to_capture_from_a_sensor_in_standby(capturing_sensor) -> None:
+    capturing_sensor.standby()
+    with pytest.raises(InstrumentError, match=r"'C 50' refused: capture needs the part measuring"):
+        capturing_sensor.acquire(50)
 
 
 def test_bridge_protocol_bytes_and_refusals() -> None:
@@ -135,3 +175,16 @@ def test_spidev_missing_is_a_clear_error(monkeypatch) -> None:
     monkeypatch.setattr(builtins, "__import__", no_spidev)
     with pytest.raises(InstrumentError, match=r"spidev is not installed: pip install 'accelcal-rig\[spidev\]'"):
         SpidevBus.open(0, 0)
+
+
+@pytest.mark.parametrize(("greeting", "capacity"), [
+    ("ADXL355-BRIDGE 1 test", 0), ("ADXL355-BRIDGE 2 capture=512 fw 0.3", 512),
+    ("ADXL355-BRIDGE 2 fw 0.3", 0), ("ADXL355-BRIDGE 2 capture=lots", 0)])
+def test_capture_capacity_comes_from_the_greeting(greeting: str, capacity: int) -> None:
+    server = PtyLineServer(lambda request: greeting).start()
+    try:
+        transport = SerialBridge.open(server.path)
+        assert transport.capture_capacity_samples == capacity
+        transport.close()
+    finally:
+        server.stop()
