@@ -77,6 +77,8 @@ class CampaignRunner:
         self._mounts = {s.serial: Rotation.from_euler("xyz", s.mount_euler_deg, degrees=True)
                         for s in rig.fixture.sensors}
         self._settled_dut_c = np.zeros(len(self.sensors))
+        #: The table's angles as last read within this setpoint's poses (None: read before moving).
+        self._table_angles_deg: np.ndarray | None = None
         safe = procedure.safe_setpoint_c
         self.safe_setpoint_c = rig.chamber.safe_setpoint_c if safe is None else safe
 
@@ -173,6 +175,7 @@ class CampaignRunner:
         self.machine.go(State.SOAK, label)
         self._soak(setpoint_c, label, t_reached)
         pose_steps = [s for s in steps if s.kind == "pose"]
+        self._table_angles_deg = None  # hours of soak: ask the table where it is
         for step in pose_steps:
             self._measure_pose(step)
         total = len(self.plan.pose_steps)
@@ -235,7 +238,7 @@ class CampaignRunner:
         self.machine.go(State.SETTLE, step.key)
         self.clock.sleep(self.procedure.acquisition.settle_s)
         self.machine.go(State.ACQUIRE, step.key)
-        measured = self.turntable.read_angles_deg()
+        measured = self._table_angles_deg = self.turntable.read_angles_deg()
         chamber_before = self._chamber_temperature_c()
         n = self.procedure.acquisition.samples_per_pose
         # Every DUT at once, each on its own port: they sample the same pose at the same instants, and a
@@ -256,7 +259,7 @@ class CampaignRunner:
         self.events.debug("pose", f"{step.key} stored")
 
     def _move(self, commanded: np.ndarray) -> None:
-        current = self.turntable.read_angles_deg()
+        current = self.turntable.read_angles_deg() if self._table_angles_deg is None else self._table_angles_deg
         speeds = np.array([a.speed_deg_s for a in self.rig.turntable.axes])
         travel_s = float(np.max(np.abs(commanded - current) / speeds))
         self.turntable.move_to(commanded)

@@ -34,6 +34,7 @@ class SimulatedAdxl355:
         self._regs[adxl355.REG_POWER_CTL] = adxl355.POWER_CTL_STANDBY
         self._regs[adxl355.REG_FIFO_SAMPLES] = 0x60
         self._fifo = bytearray()
+        self._fifo_pending = 0  # the newest samples in the FIFO, made only when FIFO_DATA is read
         self._overflow = False
         self._next_sample_s: float | None = None
         self._capture_left = 0
@@ -56,14 +57,16 @@ class SimulatedAdxl355:
         if not _FIFO_REGISTERS.isdisjoint(range(address, address + count)):
             self._fill_fifo()  # a temperature or ID read leaves the FIFO to be filled when it is looked at
         if address == adxl355.REG_FIFO_DATA:  # no auto-increment: a burst drains the FIFO
+            self._make_pending_samples()
             taken, self._fifo = bytes(self._fifo[:count]), self._fifo[count:]
             return taken + adxl355.empty_fifo_entries((count - len(taken)) // 3)
+        held = self._samples_in_fifo()
         self._regs[adxl355.REG_STATUS] = (
             (adxl355.STATUS_FIFO_OVR if self._overflow else 0)
-            | (0x02 if len(self._fifo) >= _FIFO_CAPACITY_BYTES else 0)
-            | (adxl355.STATUS_DATA_RDY if self._fifo else 0)
+            | (0x02 if held >= _SAMPLES_IN_FIFO else 0)
+            | (adxl355.STATUS_DATA_RDY if held else 0)
         )
-        self._regs[adxl355.REG_FIFO_ENTRIES] = len(self._fifo) // 3
+        self._regs[adxl355.REG_FIFO_ENTRIES] = 3 * held
         raw = int(adxl355.raw_from_temperature_c(self._lab.dut_reading_c(self._index)))
         self._regs[adxl355.REG_TEMP2], self._regs[adxl355.REG_TEMP2 + 1] = raw >> 8, raw & 0xFF
         if address <= adxl355.REG_STATUS < address + count:
@@ -84,6 +87,7 @@ class SimulatedAdxl355:
         self._regs[address] = value
         if address == adxl355.REG_POWER_CTL and was_measuring != self._measuring:
             self._fifo.clear()  # standby resets the FIFO; measuring starts a fresh one
+            self._fifo_pending = 0
             self._overflow = False
             self._capture_left = 0
             self._next_sample_s = self._lab.clock.now() if self._measuring else None
@@ -96,6 +100,7 @@ class SimulatedAdxl355:
             raise ValueError(f"capture count {n_samples} must be positive")
         self._fill_fifo()
         self._fifo.clear()
+        self._fifo_pending = 0
         self._overflow = False
         self._capture_left, self._captured, self._capture_overflow = n_samples, bytearray(), False
 
@@ -119,15 +124,23 @@ class SimulatedAdxl355:
             due -= self._capture(min(due, self._capture_left))
         if due <= 0:
             return
-        room = _SAMPLES_IN_FIFO - len(self._fifo) // 9
-        kept = min(due, _SAMPLES_IN_FIFO)
-        t_first = self._next_sample_s + (due - kept) / self._odr_hz
-        codes = self._lab.dut_samples(self._index, t_first, kept, self._odr_hz, self._range_g)
-        self._fifo += adxl355.encode_fifo(codes)
-        if due > room:
+        excess = self._samples_in_fifo() + due - _SAMPLES_IN_FIFO
+        if excess > 0:
             self._overflow = True
-            self._fifo = self._fifo[-_FIFO_CAPACITY_BYTES:]
+            self._fifo = self._fifo[9 * min(excess, len(self._fifo) // 9):]
+        self._fifo_pending = min(self._fifo_pending + due, _SAMPLES_IN_FIFO - len(self._fifo) // 9)
         self._next_sample_s += due / self._odr_hz
+
+    def _samples_in_fifo(self) -> int:
+        return len(self._fifo) // 9 + self._fifo_pending
+
+    def _make_pending_samples(self) -> None:
+        """The FIFO's newest samples, from the lab's state now (as filling at each look would)."""
+        if self._fifo_pending and self._next_sample_s is not None:
+            t_first = self._next_sample_s - self._fifo_pending / self._odr_hz
+            codes = self._lab.dut_samples(self._index, t_first, self._fifo_pending, self._odr_hz, self._range_g)
+            self._fifo += adxl355.encode_fifo(codes)
+            self._fifo_pending = 0
 
     def _capture(self, count: int) -> int:
         """Move the next `count` samples into the capture buffer; returns how many samples were due."""

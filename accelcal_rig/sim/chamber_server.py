@@ -90,7 +90,7 @@ class SimulatedChamberServer:
         with self._lab.lock:
             if set_values is not None:
                 return self._write(requested, [int(v) for v in set_values], address)
-            for register, words in self._values().items():
+            for register, words in self._values(requested).items():
                 for offset, word in enumerate(words):
                     if register + offset in requested:
                         current_registers[register + offset - start_address] = word
@@ -114,12 +114,12 @@ class SimulatedChamberServer:
             self._lab.thermal.set_power(now, value == m.power_on)
         return None
 
-    def _values(self) -> dict[int, list[int]]:
+    def _values(self, requested: range) -> dict[int, list[int]]:
+        """The map's registers; the process value is measured only when asked for (it draws noise)."""
         m = self._map
-        values = {
-            m.process_value: self._encode(self._lab.chamber_reading_c()),
-            m.setpoint: self._encode(self._lab.thermal.setpoint_c),
-        }
+        values = {m.setpoint: self._encode(self._lab.thermal.setpoint_c)}
+        if not set(requested).isdisjoint((m.process_value, m.process_value + 1)):
+            values[m.process_value] = self._encode(self._lab.chamber_reading_c())
         if m.identity_register is not None and m.identity_value is not None:
             values[m.identity_register] = [m.identity_value]
         if m.decimals_register is not None:

@@ -1,0 +1,86 @@
+"""The simulated ADXL355 at register level: FIFO filling, overflow and status bits, and the bridge's capture."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from accelcal_rig.config.load import load_rig
+from accelcal_rig.engine.clock import VirtualClock
+from accelcal_rig.instruments import adxl355
+from accelcal_rig.sim.adxl355_bridge_server import CAPTURE_CAPACITY_SAMPLES, SimulatedAdxl355
+from accelcal_rig.sim.lab import VirtualLab
+from tests.conftest import SIM_RIG
+
+ODR_HZ = 125.0
+
+
+@pytest.fixture
+def part():
+    clock = VirtualClock()
+    lab = VirtualLab(load_rig(SIM_RIG).model, clock, 5)
+    device = SimulatedAdxl355(lab, 0)
+    device.write(adxl355.REG_FILTER, adxl355.odr_code(ODR_HZ))
+    device.write(adxl355.REG_POWER_CTL, 0x00)  # measure
+    return device, clock
+
+
+def status_and_entries(device: SimulatedAdxl355) -> tuple[int, int]:
+    status, entries = device.read(adxl355.REG_STATUS, 2)
+    return status, entries
+
+
+def test_the_fifo_fills_at_the_data_rate(part) -> None:
+    device, clock = part
+    clock.sleep(10 / ODR_HZ)
+    status, entries = status_and_entries(device)
+    assert entries == 30 and status & adxl355.STATUS_DATA_RDY and not status & adxl355.STATUS_FIFO_OVR
+    codes, carried = adxl355.decode_fifo(device.read(adxl355.REG_FIFO_DATA, 288))
+    assert codes.shape == (10, 3) and carried == b""
+    assert status_and_entries(device)[1] == 0
+
+
+def test_an_undrained_fifo_overflows_keeps_the_newest_and_status_read_clears_the_flag(part) -> None:
+    device, clock = part
+    clock.sleep(100 / ODR_HZ)
+    device.read(adxl355.REG_TEMP2, 2)  # a temperature read changes nothing about the FIFO
+    status, entries = status_and_entries(device)
+    assert entries == 96 and status & adxl355.STATUS_FIFO_OVR and status & 0x02
+    assert not status_and_entries(device)[0] & adxl355.STATUS_FIFO_OVR  # cleared by the read above
+    codes, _ = adxl355.decode_fifo(device.read(adxl355.REG_FIFO_DATA, 288))
+    assert codes.shape == (32, 3)
+    newest = device._lab.duts[0].truth_log[-1]
+    assert newest[0] == pytest.approx(68 / ODR_HZ) and newest[2] == 32  # samples 68…99, not 0…31
+
+
+def test_a_capture_delivers_consecutive_samples_in_pieces(part) -> None:
+    device, clock = part
+    clock.sleep(50 / ODR_HZ)  # stale samples: the capture starts after them
+    device.start_capture(200)
+    clock.sleep(120 / ODR_HZ)
+    first = device.fetch_capture()
+    clock.sleep(200 / ODR_HZ)  # more than the rest: the capture stops at 200
+    second = device.fetch_capture()
+    assert (len(first) // 9, len(second) // 9) == (120, 80)
+    codes, _ = adxl355.decode_fifo(first + second)
+    assert codes.shape == (200, 3) and np.abs(codes).max() < adxl355.CODE_MAX
+    log = [entry for entry in device._lab.duts[0].truth_log if entry[0] >= 50 / ODR_HZ]
+    assert [entry[2] for entry in log] == [120, 80]
+    assert log[1][0] == pytest.approx(log[0][1])  # the second piece starts where the first ended
+
+
+def test_a_capture_not_fetched_in_time_reports_an_overflow(part) -> None:
+    device, clock = part
+    device.start_capture(2 * CAPTURE_CAPACITY_SAMPLES)
+    clock.sleep((CAPTURE_CAPACITY_SAMPLES + 10) / ODR_HZ)
+    with pytest.raises(ValueError, match="overflow"):
+        device.fetch_capture()
+
+
+def test_standby_refuses_a_capture_and_clears_the_fifo(part) -> None:
+    device, clock = part
+    clock.sleep(10 / ODR_HZ)
+    device.write(adxl355.REG_POWER_CTL, adxl355.POWER_CTL_STANDBY)
+    assert status_and_entries(device)[1] == 0
+    with pytest.raises(ValueError, match="capture needs the part measuring"):
+        device.start_capture(10)
