@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import partial
 from itertools import groupby
 
 import h5py
@@ -17,6 +16,7 @@ from scipy.spatial.transform import Rotation
 
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.engine.acquisition import acquire_together
 from accelcal_rig.engine.clock import Clock
 from accelcal_rig.engine.events import LOGGER, EventLog, format_duration
 from accelcal_rig.engine.safe_state import apply_safe_state
@@ -241,9 +241,7 @@ class CampaignRunner:
         measured = self._table_angles_deg = self.turntable.read_angles_deg()
         chamber_before = self._chamber_temperature_c()
         n = self.procedure.acquisition.samples_per_pose
-        # Every DUT at once, each on its own port: they sample the same pose at the same instants, and a
-        # pose costs one block's time instead of one per DUT.
-        blocks = self.clock.run_concurrently([partial(s.acquire, n) for s in self.sensors])
+        blocks = acquire_together(self.sensors, n, self.clock)
         chamber_after = self._chamber_temperature_c()
         self.machine.go(State.STORE, step.key)
         gravity_fixture = np.array(step.pose.gravity_fixture)

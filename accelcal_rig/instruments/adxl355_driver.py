@@ -4,21 +4,34 @@ else drained from the FIFO by the host."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
+from accelcal_rig.engine.acquisition import OVERFLOW_ATTEMPTS, capture_together
 from accelcal_rig.engine.clock import Clock
 from accelcal_rig.engine.waits import wait_until
 from accelcal_rig.errors import InstrumentError, WaitTimeout
 from accelcal_rig.instruments import adxl355
-from accelcal_rig.instruments.adxl355_transport import BlockCapture, CaptureOverflow, RegisterTransport
+from accelcal_rig.instruments.adxl355_transport import BlockCapture, RegisterTransport
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
 
 #: Samples to let accumulate between FIFO bursts: under its 32, so a burst is never late.
 DRAIN_EVERY_SAMPLES = 30
-#: Attempts at a gap-free block before a FIFO overflow is reported as a fault.
-OVERFLOW_ATTEMPTS = 3
 #: Share of a bridge's capture buffer to let fill between fetches.
 FETCH_AT_CAPTURE_FRACTION = 0.5
+
+
+@dataclass
+class _Capture:
+    """A block being captured by the bridge: what is known so far."""
+
+    n_samples: int
+    t_start_s: float
+    temperature_before_c: float
+    blocks: list[np.ndarray] = field(default_factory=list)
+    have: int = 0
+    carried: bytes = b""
 
 
 class Adxl355:
@@ -28,6 +41,12 @@ class Adxl355:
         self.endpoint = transport.endpoint
         self._clock = clock
         self._odr_hz = 125.0
+        self._capture: _Capture | None = None
+
+    @property
+    def captures_blocks(self) -> bool:
+        """Whether the bridge captures blocks itself (then several DUTs are read by one thread)."""
+        return self._bus.capture_capacity_samples > 0
 
     # ------------------------------------------------------------------ the Accelerometer interface
     def identify(self) -> DeviceIdentity:
@@ -75,41 +94,57 @@ class Adxl355:
 
     def acquire(self, n_samples: int) -> SampleBlock:
         """`n_samples` consecutive samples, captured by the bridge if it can, else drained from the FIFO."""
-        attempt = self._try_capture if self._bus.capture_capacity_samples > 0 else self._try_drain
+        if self.captures_blocks:
+            return capture_together([self], n_samples, self._clock)[0]
         for _ in range(OVERFLOW_ATTEMPTS):
-            block = attempt(n_samples)
+            block = self._try_drain(n_samples)
             if block is not None:
                 return block
-        raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): FIFO overflowed in "
-                              f"{OVERFLOW_ATTEMPTS} attempts: the link cannot keep up with {self._odr_hz:g} Hz")
+        raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): FIFO overflowed in {OVERFLOW_ATTEMPTS} "
+                              f"attempts: the link cannot keep up with {self._odr_hz:g} Hz")
 
     def close(self) -> None:
         self._bus.close()
 
-    # ------------------------------------------------------------------ blocks
-    def _try_capture(self, n_samples: int) -> SampleBlock | None:
-        """One attempt through the bridge's own capture, fetched before its buffer fills; the bridge
-        drains the FIFO and reports any lost sample as an overflow."""
+    # ------------------------------------------------------------------ bridge-side capture
+    def begin_capture(self, n_samples: int) -> None:
+        """Temperature, then the bridge starts capturing the next `n_samples`."""
         capture: BlockCapture = self._bus  # type: ignore[assignment]
         _, temperature_before = self._status_and_temperature()
         capture.start_capture(n_samples)
-        t_start = self._clock.now()
+        self._capture = _Capture(n_samples, self._clock.now(), temperature_before)
+
+    def capture_wait_s(self) -> float:
+        """Clock time until the next fetch is worth making: the rest of the block, or before the bridge's
+        buffer is half full."""
+        assert self._capture is not None
         fetch_every = max(1, int(self._bus.capture_capacity_samples * FETCH_AT_CAPTURE_FRACTION))
-        blocks, have, carried = [], 0, b""
-        deadline = t_start + 2.0 * n_samples / self._odr_hz + 1.0
-        while have < n_samples:
-            if self._clock.now() > deadline:
-                raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {have} of {n_samples} samples "
-                                      "before the deadline: is it measuring?")
-            self._clock.sleep(min(fetch_every, n_samples - have) / self._odr_hz)
-            try:
-                codes, carried = adxl355.decode_fifo(capture.fetch_capture(), carried)
-            except CaptureOverflow:
-                return None
-            blocks.append(codes)
-            have += len(codes)
+        return min(fetch_every, self._capture.n_samples - self._capture.have) / self._odr_hz
+
+    def fetch_capture(self) -> bool:
+        """Fetch what the bridge has captured; True once the block is complete. A capture that lost
+        samples raises CaptureOverflow; one that stalls past its deadline is a fault."""
+        capture, bridge = self._capture, self._bus
+        assert capture is not None
+        codes, capture.carried = adxl355.decode_fifo(bridge.fetch_capture(), capture.carried)  # type: ignore[attr-defined]
+        capture.blocks.append(codes)
+        capture.have += len(codes)
+        done = capture.have >= capture.n_samples
+        if not done and self._clock.now() > capture.t_start_s + 2.0 * capture.n_samples / self._odr_hz + 1.0:
+            raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {capture.have} of {capture.n_samples} "
+                                  "samples before the deadline: is it measuring?")
+        return done
+
+    def end_capture(self) -> SampleBlock:
+        """The completed block, with the temperature after it."""
+        capture = self._capture
+        assert capture is not None and capture.have >= capture.n_samples
+        self._capture = None
         _, temperature_after = self._status_and_temperature()
-        return self._block(blocks, n_samples, t_start, (temperature_before, temperature_after))
+        return self._block(capture.blocks, capture.n_samples, capture.t_start_s,
+                           (capture.temperature_before_c, temperature_after))
+
+    # ------------------------------------------------------------------ host-drained FIFO
 
     def _try_drain(self, n_samples: int) -> SampleBlock | None:
         """One attempt: a whole-FIFO burst every DRAIN_EVERY_SAMPLES samples (empty entries are marked, a
@@ -151,3 +186,4 @@ class Adxl355:
 
     def _status(self) -> int:
         return self._bus.read(adxl355.REG_STATUS, 1)[0]
+

@@ -8,10 +8,6 @@ import threading
 import tty
 from collections.abc import Callable
 
-#: How often the server thread looks up from a quiet line to see whether it should stop.
-_POLL_S = 0.2
-
-
 class PtyLineServer:
     """Reads requests ending in `terminator` from the pty and writes back `handle(request) + terminator`."""
 
@@ -22,7 +18,7 @@ class PtyLineServer:
         tty.setraw(self._master)
         tty.setraw(self._slave)  # the slave stays open so the path keeps working between clients
         self.path = os.ttyname(self._slave)
-        self._stopping = threading.Event()
+        self._wake_read, self._wake_write = os.pipe()  # stop() writes here: the thread wakes at once
         self._thread = threading.Thread(target=self._serve, name=name, daemon=True)
 
     def start(self) -> PtyLineServer:
@@ -30,17 +26,17 @@ class PtyLineServer:
         return self
 
     def stop(self) -> None:
-        self._stopping.set()
+        os.write(self._wake_write, b"x")
         self._thread.join(5.0)
-        os.close(self._master)
-        os.close(self._slave)
+        for fd in (self._master, self._slave, self._wake_read, self._wake_write):
+            os.close(fd)
 
     def _serve(self) -> None:
         pending = b""
-        while not self._stopping.is_set():
-            readable, _, _ = select.select([self._master], [], [], _POLL_S)
-            if not readable:
-                continue
+        while True:
+            readable, _, _ = select.select([self._master, self._wake_read], [], [])
+            if self._wake_read in readable:
+                return
             try:
                 pending += os.read(self._master, 65536)
             except OSError:
