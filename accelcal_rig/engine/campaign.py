@@ -239,7 +239,7 @@ class CampaignRunner:
         self.clock.sleep(self.procedure.acquisition.settle_s)
         self.machine.go(State.ACQUIRE, step.key)
         measured = self._table_angles_deg = self.turntable.read_angles_deg()
-        chamber_before = self._chamber_temperature_c()
+        chamber_before = self.chamber.read_temperature_c()  # the alarm is checked once per pose, after it
         n = self.procedure.acquisition.samples_per_pose
         blocks = acquire_together(self.sensors, n, self.clock)
         chamber_after = self._chamber_temperature_c()

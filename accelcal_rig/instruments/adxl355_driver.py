@@ -32,6 +32,7 @@ class _Capture:
     blocks: list[np.ndarray] = field(default_factory=list)
     have: int = 0
     carried: bytes = b""
+    temperature_after_c: float | None = None
 
 
 class Adxl355:
@@ -108,10 +109,9 @@ class Adxl355:
 
     # ------------------------------------------------------------------ bridge-side capture
     def begin_capture(self, n_samples: int) -> None:
-        """Temperature, then the bridge starts capturing the next `n_samples`."""
+        """The bridge starts capturing the next `n_samples` (and says the temperature then)."""
         capture: BlockCapture = self._bus  # type: ignore[assignment]
-        _, temperature_before = self._status_and_temperature()
-        capture.start_capture(n_samples)
+        temperature_before = float(adxl355.temperature_c_from_raw(capture.start_capture(n_samples)))
         self._capture = _Capture(n_samples, self._clock.now(), temperature_before)
 
     def capture_wait_s(self) -> float:
@@ -126,9 +126,12 @@ class Adxl355:
         samples raises CaptureOverflow; one that stalls past its deadline is a fault."""
         capture, bridge = self._capture, self._bus
         assert capture is not None
-        codes, capture.carried = adxl355.decode_fifo(bridge.fetch_capture(), capture.carried)  # type: ignore[attr-defined]
+        raw, temperature_raw = bridge.fetch_capture()  # type: ignore[attr-defined]
+        codes, capture.carried = adxl355.decode_fifo(raw, capture.carried)
         capture.blocks.append(codes)
         capture.have += len(codes)
+        if temperature_raw is not None:
+            capture.temperature_after_c = float(adxl355.temperature_c_from_raw(temperature_raw))
         done = capture.have >= capture.n_samples
         if not done and self._clock.now() > capture.t_start_s + 2.0 * capture.n_samples / self._odr_hz + 1.0:
             raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {capture.have} of {capture.n_samples} "
@@ -136,13 +139,15 @@ class Adxl355:
         return done
 
     def end_capture(self) -> SampleBlock:
-        """The completed block, with the temperature after it."""
+        """The completed block, with the temperature the bridge read as it completed."""
         capture = self._capture
         assert capture is not None and capture.have >= capture.n_samples
         self._capture = None
-        _, temperature_after = self._status_and_temperature()
+        if capture.temperature_after_c is None:
+            raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): the bridge completed a capture "
+                                  "without its end temperature")
         return self._block(capture.blocks, capture.n_samples, capture.t_start_s,
-                           (capture.temperature_before_c, temperature_after))
+                           (capture.temperature_before_c, capture.temperature_after_c))
 
     # ------------------------------------------------------------------ host-drained FIFO
 

@@ -5,10 +5,13 @@ The bridge protocol (docs/instruments.md): one ASCII request per line, one reply
     R <addr> <count>     → `=<hex bytes>`   read `count` registers from `addr` (hex); FIFO_DATA (0x11)
                                             does not auto-increment, so a burst of it drains the FIFO
     W <addr> <value>     → `=`              write one register (both hex)
-    C <count>            → `=`              (version 2) empty the FIFO, then capture the next `count`
-                                            samples into the bridge's own memory, draining the FIFO itself
+    C <count>            → `=<TEMP2 TEMP1>` (version 2) empty the FIFO, then capture the next `count`
+                                            samples into the bridge's own memory, draining the FIFO
+                                            itself; the reply is the temperature as the capture starts
     G                    → `=<hex bytes>`   (version 2) the captured samples not fetched yet, 9 bytes each
-                                            in FIFO format; `!overflow …` if the capture lost samples
+                                            in FIFO format; the reply that completes the capture ends in
+                                            `T<TEMP2 TEMP1>`, the temperature as the last sample came;
+                                            `!overflow …` if the capture lost samples
     any failure          → `!<message>`
 
 A version 2 bridge greets with `capture=<samples>` (its buffer). At high data rates a host behind USB
@@ -42,8 +45,11 @@ class CaptureOverflow(InstrumentError):
 class BlockCapture(Protocol):
     """A transport that captures gap-free blocks itself (a version 2 serial bridge)."""
 
-    def start_capture(self, n_samples: int) -> None: ...
-    def fetch_capture(self) -> bytes: ...
+    def start_capture(self, n_samples: int) -> int:
+        """Start capturing; returns the raw 12-bit temperature as the capture starts."""
+
+    def fetch_capture(self) -> tuple[bytes, int | None]:
+        """(captured FIFO bytes not fetched yet, raw temperature at the end if this completed the capture)."""
 
 
 class SerialBridge:
@@ -81,23 +87,27 @@ class SerialBridge:
             raise InstrumentError(f"sensor bridge ({self.endpoint}): write 0x{value:02X} to 0x{address:02X} "
                                   f"answered {reply[:40]!r}")
 
-    def start_capture(self, n_samples: int) -> None:
+    def start_capture(self, n_samples: int) -> int:
         reply = self._ask(f"C {n_samples}")
-        if reply != "=":
+        temperature = _raw_temperature(reply[1:]) if reply.startswith("=") else None
+        if temperature is None:
             raise InstrumentError(f"sensor bridge ({self.endpoint}): capture of {n_samples} answered {reply[:40]!r}")
+        return temperature
 
-    def fetch_capture(self) -> bytes:
+    def fetch_capture(self) -> tuple[bytes, int | None]:
         reply = self._line.ask("G")
         if reply.startswith("!overflow"):
             raise CaptureOverflow(f"sensor bridge ({self.endpoint}): {reply[1:]}")
         reply = self._refusal_raised("G", reply)
+        samples, end_marker, temperature_hex = reply[1:].partition("T")
+        temperature = _raw_temperature(temperature_hex) if end_marker else None
         try:
-            data = bytes.fromhex(reply[1:])
+            data = bytes.fromhex(samples)
         except ValueError:
             data = b"?"
-        if not reply.startswith("=") or len(data) % 9:
+        if not reply.startswith("=") or len(data) % 9 or (end_marker and temperature is None):
             raise InstrumentError(f"sensor bridge ({self.endpoint}): garbled capture {reply[:40]!r}")
-        return data
+        return data, temperature
 
     def close(self) -> None:
         self._line.close()
@@ -109,6 +119,15 @@ class SerialBridge:
         if reply.startswith("!"):
             raise InstrumentError(f"sensor bridge ({self.endpoint}): {request!r} refused: {reply[1:]}")
         return reply
+
+
+def _raw_temperature(hex_digits: str) -> int | None:
+    """TEMP2, TEMP1 as 4 hex digits → the 12-bit raw temperature; None if malformed."""
+    try:
+        high, low = bytes.fromhex(hex_digits)
+    except ValueError:
+        return None
+    return ((high & 0x0F) << 8) | low
 
 
 def _capture_capacity(greeting: str) -> int:

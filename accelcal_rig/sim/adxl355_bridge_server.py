@@ -40,6 +40,7 @@ class SimulatedAdxl355:
         self._capture_left = 0
         self._captured = bytearray()
         self._capture_overflow = False
+        self._capture_end_temperature_raw: int | None = None
 
     @property
     def _measuring(self) -> bool:
@@ -67,7 +68,7 @@ class SimulatedAdxl355:
             | (adxl355.STATUS_DATA_RDY if held else 0)
         )
         self._regs[adxl355.REG_FIFO_ENTRIES] = 3 * held
-        raw = int(adxl355.raw_from_temperature_c(self._lab.dut_reading_c(self._index)))
+        raw = self._temperature_raw()
         self._regs[adxl355.REG_TEMP2], self._regs[adxl355.REG_TEMP2 + 1] = raw >> 8, raw & 0xFF
         if address <= adxl355.REG_STATUS < address + count:
             self._overflow = False  # reading STATUS clears FIFO_OVR
@@ -92,8 +93,9 @@ class SimulatedAdxl355:
             self._capture_left = 0
             self._next_sample_s = self._lab.clock.now() if self._measuring else None
 
-    def start_capture(self, n_samples: int) -> None:
-        """The bridge empties the FIFO and captures the next `n_samples` itself."""
+    def start_capture(self, n_samples: int) -> int:
+        """The bridge empties the FIFO and captures the next `n_samples` itself; returns the raw
+        temperature as it starts."""
         if not self._measuring:
             raise ValueError("capture needs the part measuring")
         if n_samples <= 0:
@@ -103,15 +105,18 @@ class SimulatedAdxl355:
         self._fifo_pending = 0
         self._overflow = False
         self._capture_left, self._captured, self._capture_overflow = n_samples, bytearray(), False
+        self._capture_end_temperature_raw = None
+        return self._temperature_raw()
 
-    def fetch_capture(self) -> bytes:
-        """Captured samples not fetched yet."""
+    def fetch_capture(self) -> tuple[bytes, int | None]:
+        """(captured samples not fetched yet, raw temperature at the end once the capture completed)."""
         self._fill_fifo()
         if self._capture_overflow:
             self._capture_overflow = False
             raise ValueError(f"overflow: more than {CAPTURE_CAPACITY_SAMPLES} samples were not fetched")
         taken, self._captured = bytes(self._captured), bytearray()
-        return taken
+        end_temperature, self._capture_end_temperature_raw = self._capture_end_temperature_raw, None
+        return taken, end_temperature
 
     def _fill_fifo(self) -> None:
         """Add the samples due since the last look: first to a capture under way, then to the FIFO, which
@@ -130,6 +135,9 @@ class SimulatedAdxl355:
             self._fifo = self._fifo[9 * min(excess, len(self._fifo) // 9):]
         self._fifo_pending = min(self._fifo_pending + due, _SAMPLES_IN_FIFO - len(self._fifo) // 9)
         self._next_sample_s += due / self._odr_hz
+
+    def _temperature_raw(self) -> int:
+        return int(adxl355.raw_from_temperature_c(self._lab.dut_reading_c(self._index)))
 
     def _samples_in_fifo(self) -> int:
         return len(self._fifo) // 9 + self._fifo_pending
@@ -151,6 +159,8 @@ class SimulatedAdxl355:
         else:
             codes = self._lab.dut_samples(self._index, self._next_sample_s, count, self._odr_hz, self._range_g)
             self._captured += adxl355.encode_fifo(codes)
+            if self._capture_left == 0:
+                self._capture_end_temperature_raw = self._temperature_raw()
         self._next_sample_s += count / self._odr_hz
         return count
 
@@ -185,10 +195,11 @@ class SimulatedBridgeServer:
                     self.device.write(int(parts[1], 16), int(parts[2], 16))
                     return "="
                 if self._version >= 2 and len(parts) == 2 and parts[0] == "C":
-                    self.device.start_capture(int(parts[1]))
-                    return "="
+                    return f"={self.device.start_capture(int(parts[1])):04X}"
                 if self._version >= 2 and parts == ["G"]:
-                    return "=" + self.device.fetch_capture().hex().upper()
+                    samples, end_temperature = self.device.fetch_capture()
+                    end = "" if end_temperature is None else f"T{end_temperature:04X}"
+                    return "=" + samples.hex().upper() + end
         except ValueError as exc:
             return f"!{exc}"
         return f"!unknown request {request!r}"

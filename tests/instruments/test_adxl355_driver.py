@@ -188,3 +188,25 @@ def test_capture_capacity_comes_from_the_greeting(greeting: str, capacity: int) 
         transport.close()
     finally:
         server.stop()
+
+
+@pytest.mark.parametrize(("request_kind", "reply", "message"), [
+    ("C", "=", r"capture of 10 answered '='"),
+    ("G", "=00112", "garbled capture"),
+    ("G", "=T07", "garbled capture"),
+    ("G", "!overflow: 4097 samples", r"overflow: 4097 samples")])
+def test_capture_replies_are_checked(request_kind: str, reply: str, message: str) -> None:
+    def bridge(request: str) -> str:
+        if request == "?":
+            return "ADXL355-BRIDGE 2 capture=64 test"
+        return reply if request.startswith(request_kind) else "=0761"
+
+    server = PtyLineServer(bridge).start()
+    try:
+        transport = SerialBridge.open(server.path)
+        with pytest.raises(InstrumentError, match=message):
+            transport.start_capture(10)
+            transport.fetch_capture()
+        transport.close()
+    finally:
+        server.stop()

@@ -56,12 +56,16 @@ def test_an_undrained_fifo_overflows_keeps_the_newest_and_status_read_clears_the
 def test_a_capture_delivers_consecutive_samples_in_pieces(part) -> None:
     device, clock = part
     clock.sleep(50 / ODR_HZ)  # stale samples: the capture starts after them
-    device.start_capture(200)
+    start_raw = device.start_capture(200)
     clock.sleep(120 / ODR_HZ)
-    first = device.fetch_capture()
+    first, not_yet = device.fetch_capture()
     clock.sleep(200 / ODR_HZ)  # more than the rest: the capture stops at 200
-    second = device.fetch_capture()
+    second, end_raw = device.fetch_capture()
     assert (len(first) // 9, len(second) // 9) == (120, 80)
+    assert not_yet is None and end_raw is not None  # the end temperature comes with the completing piece
+    true_c = device._lab.dut_true_c(0)
+    for raw in (start_raw, end_raw):
+        assert float(adxl355.temperature_c_from_raw(raw)) == pytest.approx(true_c, abs=0.3)
     codes, _ = adxl355.decode_fifo(first + second)
     assert codes.shape == (200, 3) and np.abs(codes).max() < adxl355.CODE_MAX
     log = [entry for entry in device._lab.duts[0].truth_log if entry[0] >= 50 / ODR_HZ]
