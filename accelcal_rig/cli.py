@@ -10,12 +10,16 @@ import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from accelcal_rig import __version__
 from accelcal_rig.engine.campaign import TerminationRequested
 from accelcal_rig.engine.events import LOGGER, format_duration
 from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
 from accelcal_rig.store.atomic import stop_when_safe
+
+if TYPE_CHECKING:
+    from accelcal_rig.engine.session import PreparedCampaign
 
 EXIT_INTERRUPTED = 130
 
@@ -42,10 +46,27 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--dry-run", action="store_true", help="simulated rig in virtual time")
     run.add_argument("--seed", type=int, default=0, help="seed of the simulated noise (default 0)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing campaign file")
+    run.add_argument("--resume", action="store_true",
+                     help="continue the campaign in the output file if it exists (after a crash, a fault or "
+                          "Ctrl-C), else start it")
     run.add_argument("--calibration", type=Path,
                      help="calibration file the final fit writes (default: beside the campaign, .calibration.yaml)")
     run.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
     run.add_argument("-q", "--quiet", action="store_true", help="print only warnings and the summary")
+
+    resume = _command(commands, "resume", "continue a campaign that stopped before it was complete",
+                      "Continue a campaign from its file: with the procedure it was started with (its path is "
+                      "in the file) and the same rig (ports may differ), the rig made safe first if the last "
+                      "run died, a fresh soak at the first setpoint with poses missing, then every pose not "
+                      "stored yet. A dry run resumes as a dry run.",
+                      "rig resume campaign.h5")
+    resume.add_argument("campaign", type=Path, help="campaign file (HDF5)")
+    resume.add_argument("--procedure", type=Path, help="procedure YAML (default: the path stored in the file)")
+    resume.add_argument("--config", type=Path, help="rig config YAML (overrides the procedure's `rig`)")
+    resume.add_argument("--calibration", type=Path,
+                        help="calibration file the final fit writes (default: beside the campaign, .calibration.yaml)")
+    resume.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
+    resume.add_argument("-q", "--quiet", action="store_true", help="print only warnings and the summary")
 
     status = _command(commands, "status", "show a campaign file's state and progress",
                       "Show a campaign's state and progress (works on finished, aborted and running files).",
@@ -84,13 +105,14 @@ def _build_parser() -> argparse.ArgumentParser:
 
 
 @contextmanager
-def _campaign_logging(output: Path, verbose: bool, quiet: bool) -> Iterator[None]:
-    """Console on stderr at the chosen level, the full debug log in a file beside the campaign file;
-    both detached and closed when the run ends."""
+def _campaign_logging(output: Path, verbose: bool, quiet: bool, append: bool) -> Iterator[None]:
+    """Console on stderr at the chosen level, the full debug log in a file beside the campaign file
+    (appended to by a resumed run); both detached and closed when the run ends."""
     console = logging.StreamHandler(sys.stderr)
     console.setLevel(logging.DEBUG if verbose else logging.WARNING if quiet else logging.INFO)
     console.setFormatter(logging.Formatter("%(message)s"))
-    log_file = logging.FileHandler(output.with_suffix(output.suffix + ".log"), mode="w", encoding="utf-8")
+    log_file = logging.FileHandler(output.with_suffix(output.suffix + ".log"), mode="a" if append else "w",
+                                   encoding="utf-8")
     log_file.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s"))
     LOGGER.setLevel(logging.DEBUG)
     LOGGER.propagate = False
@@ -119,22 +141,49 @@ class _StopOnFirstSignal:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from accelcal_rig.engine.session import prepare, run_campaign
+    from accelcal_rig.engine.session import prepare
 
     prepared = prepare(args.procedure, args.config)
-    if args.output.exists() and not args.overwrite:
-        raise ConfigError(f"{args.output}: campaign file exists; choose another -o or pass --overwrite")
+    if args.output.exists() and not (args.overwrite or args.resume):
+        raise ConfigError(f"{args.output}: campaign file exists; continue it with --resume, or choose another -o "
+                          "or pass --overwrite")
     if not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
-    calibration = args.calibration or args.output.with_suffix(".calibration.yaml")
+    return _execute(prepared, args.output, args, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite,
+                    resume=args.resume and args.output.exists())
+
+
+def _cmd_resume(args: argparse.Namespace) -> int:
+    from accelcal_rig.engine.session import prepare
+    from accelcal_rig.store.read import read_stored_campaign
+
+    stored = read_stored_campaign(args.campaign)
+    procedure = args.procedure or stored.procedure_path
+    if not procedure.exists():
+        raise ConfigError(f"{args.campaign}: its procedure {procedure} is gone; pass --procedure with the same "
+                          "procedure")
+    prepared = prepare(procedure, args.config)
+    return _execute(prepared, args.campaign, args, dry_run=stored.dry_run, seed=stored.seed, overwrite=False,
+                    resume=True)
+
+
+def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace, *, dry_run: bool, seed: int,
+             overwrite: bool, resume: bool) -> int:
+    """Run or resume under the CLI's signal handling and logging; print the summary."""
+    from accelcal_rig.engine.session import NothingToResume, run_campaign
+
+    calibration = args.calibration or output.with_suffix(".calibration.yaml")
     if not calibration.parent.is_dir():
         raise ConfigError(f"{calibration}: folder {calibration.parent} does not exist")
     stop = _StopOnFirstSignal()
     previous = {signum: signal.signal(signum, stop) for signum in (signal.SIGINT, signal.SIGTERM)}
     try:
-        with _campaign_logging(args.output, args.verbose, args.quiet):
-            result = run_campaign(prepared, args.output, dry_run=args.dry_run, seed=args.seed,
-                                  overwrite=args.overwrite, calibration=calibration)
+        with _campaign_logging(output, args.verbose, args.quiet, append=resume):
+            result = run_campaign(prepared, output, dry_run=dry_run, seed=seed, overwrite=overwrite,
+                                  calibration=calibration, resume=resume)
+    except NothingToResume as done:
+        print(done)
+        return 0
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
@@ -145,7 +194,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     print(f"  setpoints  {len(setpoints)} ({min(setpoints):g} … {max(setpoints):g} °C)")
     print(f"  poses      {summary.poses_done} of {summary.poses_total} × {summary.n_duts} DUTs × "
           f"{prepared.procedure.model.acquisition.samples_per_pose} samples")
-    print(f"  duration   {format_duration(summary.virtual_duration_s)} virtual, {result.wall_s:.1f} s wall")
+    print(f"  duration   {format_duration(summary.virtual_duration_s)} {'virtual' if dry_run else 'clock'}, "
+          f"{result.wall_s:.1f} s wall")
     print(f"  output     {result.output} ({size_mb:.1f} MB)")
     if summary.fit_failed:
         print(f"rig: campaign done but the fit failed: {summary.fit}", file=sys.stderr)
@@ -273,7 +323,8 @@ def main(argv: list[str] | None = None) -> int:
     # Driver libraries log their own view of a failure; ours is the one line that names the instrument.
     logging.getLogger("pymodbus").addHandler(logging.NullHandler())
     logging.getLogger("pymodbus").propagate = False
-    handler = {"run": _cmd_run, "status": _cmd_status, "fit": _cmd_fit, "check": _cmd_check, "sim": _cmd_sim}[args.command]
+    handler = {"run": _cmd_run, "resume": _cmd_resume, "status": _cmd_status, "fit": _cmd_fit, "check": _cmd_check,
+               "sim": _cmd_sim}[args.command]
     try:
         return handler(args)
     except CampaignAborted as exc:

@@ -19,6 +19,7 @@ from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.engine.acquisition import acquire_together
 from accelcal_rig.engine.clock import Clock
 from accelcal_rig.engine.events import LOGGER, EventLog, format_duration
+from accelcal_rig.engine.resume import ResumePoint
 from accelcal_rig.engine.safe_state import apply_safe_state
 from accelcal_rig.engine.soak import SoakDetector
 from accelcal_rig.engine.states import ACTIVE_STATES, State, StateMachine
@@ -60,7 +61,8 @@ class CampaignSummary:
 
 class CampaignRunner:
     def __init__(self, procedure: Procedure, rig: RigConfig, plan: Plan, instruments: RigInstruments,
-                 writer: CampaignWriter, clock: Clock, events: EventLog, fit_stage: FitStage | None = None) -> None:
+                 writer: CampaignWriter, clock: Clock, events: EventLog, fit_stage: FitStage | None = None,
+                 resume: ResumePoint | None = None) -> None:
         self.procedure = procedure
         self.rig = rig
         self.plan = plan
@@ -73,7 +75,9 @@ class CampaignRunner:
         self.events = events
         self.fit_stage = fit_stage
         self.machine = StateMachine(self._record_transition)
-        self.poses_done = 0
+        self.resume = resume
+        self._stored_keys = resume.done_keys if resume is not None else frozenset()
+        self.poses_done = len(self._stored_keys)
         self._mounts = {s.serial: Rotation.from_euler("xyz", s.mount_euler_deg, degrees=True)
                         for s in rig.fixture.sensors}
         self._settled_dut_c = np.zeros(len(self.sensors))
@@ -89,10 +93,14 @@ class CampaignRunner:
             self.events.info("plan", f"{len(self.plan.setpoints_c)} setpoints × {len(self.plan.poses)} poses = "
                                      f"{len(self.plan.pose_steps)} poses, {len(self.sensors)} DUTs, "
                                      f"{self.procedure.acquisition.samples_per_pose} samples per pose")
+            if self.resume is not None and self.resume.unclean:
+                self.events.warning("resume", "the last run ended without closing the file (its process died): "
+                                              "safe state first")
+                apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
             self.machine.go(State.PREFLIGHT)
             self._preflight()
             for setpoint, steps in groupby(self.plan.steps, key=lambda s: s.setpoint_c):
-                self._run_setpoint(setpoint, list(steps))
+                self._run_setpoint(setpoint, [s for s in steps if s.key not in self._stored_keys])
             self.machine.go(State.SAFE, "campaign complete")
             apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
             fit, fit_failed = self._fit() if self.fit_stage is not None else ("", False)
@@ -169,7 +177,11 @@ class CampaignRunner:
 
     # ----------------------------------------------------------------- one setpoint
     def _run_setpoint(self, setpoint_c: float, steps: list[PlanStep]) -> None:
+        """Ramp, soak and measure the poses in `steps` (those not stored yet); nothing if none are left."""
         label = setpoint_label(setpoint_c)
+        if not any(s.kind == "pose" for s in steps):
+            self.events.info("setpoint", f"{label}: every pose already stored")
+            return
         self.machine.go(State.RAMP, label)
         t_reached = self._ramp(setpoint_c)
         self.machine.go(State.SOAK, label)

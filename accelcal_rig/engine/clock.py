@@ -33,11 +33,12 @@ class Clock(Protocol):
 class RealClock:
     kind = "real"
 
-    def __init__(self) -> None:
-        self._start = time.monotonic()
+    def __init__(self, start_s: float = 0.0) -> None:
+        """`start_s`: the clock's reading now (a resumed campaign continues its time line)."""
+        self._origin = time.monotonic() - start_s
 
     def now(self) -> float:
-        return time.monotonic() - self._start
+        return time.monotonic() - self._origin
 
     def sleep(self, seconds: float) -> None:
         if seconds > 0:

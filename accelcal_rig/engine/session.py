@@ -20,6 +20,7 @@ from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitStage
 from accelcal_rig.engine.clock import Clock, RealClock, VirtualClock
 from accelcal_rig.engine.events import LOGGER, EventLog
+from accelcal_rig.engine.resume import ResumePoint, check_same_campaign
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
 from accelcal_rig.instruments import adxl355
@@ -29,6 +30,7 @@ from accelcal_rig.plan.compile import Plan, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
 from accelcal_rig.sim.wire_rig import SimulatedRig
 from accelcal_rig.store.campaign_file import CampaignWriter
+from accelcal_rig.store.read import read_stored_campaign
 
 
 @dataclass(frozen=True)
@@ -80,31 +82,67 @@ InstrumentFactory = Callable[[RigConfig, Procedure, Clock, int], RigInstruments]
 
 
 def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, seed: int, overwrite: bool,
-                 calibration: Path | None = None, build_instruments: InstrumentFactory | None = None) -> RunResult:
+                 calibration: Path | None = None, build_instruments: InstrumentFactory | None = None,
+                 resume: bool = False) -> RunResult:
     """Run the whole campaign into `output`. Raises CampaignAborted after reaching the safe state.
 
     The instruments: with `build_instruments`, whatever it builds (a test double); with `dry_run`, the
     real drivers talking to wire-level simulators of this rig on a virtual clock; otherwise the real
     drivers at the rig config's endpoints, in real time. With `calibration`, the fit stage runs once the
-    rig is safe and writes the calibration file there.
+    rig is safe and writes the calibration file there. With `resume` and an existing `output`, the
+    campaign in it continues (see resume_campaign); without one, a new campaign starts.
     """
     wall_start = time.perf_counter()
+    if resume and output.exists():
+        return resume_campaign(prepared, output, dry_run=dry_run, calibration=calibration,
+                               build_instruments=build_instruments)
     with _connected(prepared, dry_run, seed, build_instruments) as (instruments, clock):
-        return _run_with_instruments(prepared, output, instruments, clock, dry_run=dry_run, seed=seed,
-                                     overwrite=overwrite, wall_start=wall_start, calibration=calibration)
+        writer = _create_file(prepared, output, instruments, clock, dry_run=dry_run, seed=seed, overwrite=overwrite)
+        return _run(prepared, output, writer, instruments, clock, None, calibration, wall_start)
+
+
+class NothingToResume(Exception):
+    """The campaign in the file is complete."""
+
+
+def resume_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, calibration: Path | None = None,
+                    build_instruments: InstrumentFactory | None = None) -> RunResult:
+    """Continue the campaign in `output`: the same procedure and rig (refused otherwise, before anything is
+    touched), poses cut back to those stored whole, the rig made safe first if the last run died, then a
+    fresh soak at the first setpoint with poses missing and on from the first pose not stored."""
+    wall_start = time.perf_counter()
+    stored = read_stored_campaign(output)
+    check_same_campaign(output, stored, prepared.procedure, prepared.rig, prepared.plan, dry_run)
+    if stored.state == "done":
+        raise NothingToResume(f"{output}: the campaign is complete: nothing to resume")
+    writer, reopened = CampaignWriter.reopen(output)
+    try:
+        # Noise of a resumed dry run is new noise (the same sensors, not a replay of the first run).
+        seed = stored.seed + 1000 * (reopened.run - 1)
+        with _connected(prepared, dry_run, seed, build_instruments, reopened.clock_now_s) as (instruments, clock):
+            writer.record_instruments(_instrument_info(instruments))
+            point = ResumePoint(frozenset(writer.stored_step_keys()), reopened.previous_state in ("created", "running"),
+                                reopened.run)
+            cut = f"; {reopened.rows_cut} rows of a pose written in part removed" if reopened.rows_cut else ""
+            EventLog(clock, writer).info(
+                "resume", f"run {reopened.run} resumes after {reopened.poses_stored} stored poses (the last run "
+                          f"left the file {reopened.previous_state!r}{cut})")
+            return _run(prepared, output, writer, instruments, clock, point, calibration, wall_start)
+    finally:
+        writer.close()
 
 
 @contextmanager
-def _connected(prepared: PreparedCampaign, dry_run: bool, seed: int,
-               build_instruments: InstrumentFactory | None) -> Iterator[tuple[RigInstruments, Clock]]:
+def _connected(prepared: PreparedCampaign, dry_run: bool, seed: int, build_instruments: InstrumentFactory | None,
+               clock_start_s: float = 0.0) -> Iterator[tuple[RigInstruments, Clock]]:
     rig, procedure = prepared.rig, prepared.procedure.model
     stop_simulators: list[Callable[[], None]] = []
     clock: Clock
     if build_instruments is not None:
-        clock = VirtualClock()
+        clock = VirtualClock(clock_start_s)
         instruments = build_instruments(rig.model, procedure, clock, seed)
     elif dry_run:
-        clock = VirtualClock()
+        clock = VirtualClock(clock_start_s)
         simulated = SimulatedRig(rig.model, clock, seed, procedure.simulation)
         endpoints = simulated.start()
         stop_simulators.append(simulated.stop)
@@ -115,7 +153,7 @@ def _connected(prepared: PreparedCampaign, dry_run: bool, seed: int,
             raise
         instruments.truth = simulated.truth
     else:
-        clock = RealClock()
+        clock = RealClock(clock_start_s)
         instruments = connect_rig(rig.model, configured_endpoints(rig), clock)
     try:
         yield instruments, clock
@@ -126,9 +164,15 @@ def _connected(prepared: PreparedCampaign, dry_run: bool, seed: int,
             stop()
 
 
-def _run_with_instruments(prepared: PreparedCampaign, output: Path, instruments: RigInstruments, clock: Clock, *,
-                          dry_run: bool, seed: int, overwrite: bool, wall_start: float,
-                          calibration: Path | None) -> RunResult:
+def _instrument_info(instruments: RigInstruments) -> dict[str, dict[str, str]]:
+    return {
+        "chamber": {"driver": type(instruments.chamber).__name__, "endpoint": instruments.chamber.endpoint},
+        "turntable": {"driver": type(instruments.turntable).__name__, "endpoint": instruments.turntable.endpoint},
+    }
+
+
+def _create_file(prepared: PreparedCampaign, output: Path, instruments: RigInstruments, clock: Clock, *,
+                 dry_run: bool, seed: int, overwrite: bool) -> CampaignWriter:
     rig = prepared.rig
     procedure = prepared.procedure.model
     acquisition = procedure.acquisition
@@ -139,10 +183,6 @@ def _run_with_instruments(prepared: PreparedCampaign, output: Path, instruments:
          "driver": type(s).__name__, "endpoint": s.endpoint}
         for s in instruments.sensors
     ]
-    instrument_info = {
-        "chamber": {"driver": type(instruments.chamber).__name__, "endpoint": instruments.chamber.endpoint},
-        "turntable": {"driver": type(instruments.turntable).__name__, "endpoint": instruments.turntable.endpoint},
-    }
     writer = CampaignWriter.create(
         output, overwrite=overwrite,
         attrs={"procedure_name": procedure.name, "procedure_path": str(prepared.procedure.path),
@@ -151,16 +191,27 @@ def _run_with_instruments(prepared: PreparedCampaign, output: Path, instruments:
                "fit_mode": procedure.fit.mode, "polynomial_degree": procedure.fit.polynomial_degree,
                "fit_parameters": procedure.fit.parameters, "fit_out_of_range": procedure.fit.out_of_range},
         procedure_yaml=prepared.procedure.text, rig_yaml=rig.text, plan=prepared.plan, duts=duts,
-        instruments=instrument_info, samples_per_pose=acquisition.samples_per_pose,
+        instruments=_instrument_info(instruments), samples_per_pose=acquisition.samples_per_pose,
         turntable_accuracy_arcsec=rig.model.turntable.accuracy_arcsec,
     )
     try:
         if instruments.truth is not None:
             for sensor in instruments.sensors:
                 writer.write_truth_header(sensor.serial, instruments.truth.describe(sensor.serial, acquisition.odr_hz))
+    except BaseException:
+        writer.close()
+        raise
+    return writer
+
+
+def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, instruments: RigInstruments,
+         clock: Clock, resume: ResumePoint | None, calibration: Path | None, wall_start: float) -> RunResult:
+    procedure = prepared.procedure.model
+    try:
         events = EventLog(clock, writer)
-        runner = CampaignRunner(procedure, rig.model, prepared.plan, instruments, writer, clock, events,
-                                fit_stage=_fit_stage(procedure, output, calibration) if calibration else None)
+        runner = CampaignRunner(procedure, prepared.rig.model, prepared.plan, instruments, writer, clock, events,
+                                fit_stage=_fit_stage(procedure, output, calibration) if calibration else None,
+                                resume=resume)
         summary = runner.run()
     finally:
         writer.close()

@@ -3,11 +3,16 @@
 Every dataset that grows is created empty and resizable when the file is created, then appended to and
 flushed after each pose, so the file on disk always holds every pose measured so far. Events are
 buffered and written with the next pose, soak or state change (the run's log file has them at once).
+A process killed in the middle of a pose can leave some pose-aligned datasets one row longer than the
+others; reopening the file to resume cuts them back to the poses stored whole.
 """
 
 from __future__ import annotations
 
 import datetime as dt
+import os
+import socket
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +46,18 @@ def _growable(group: h5py.Group, name: str, tail: tuple[int, ...], dtype: Any, u
     if unit:
         dataset.attrs["unit"] = unit
     return dataset
+
+
+@dataclass(frozen=True)
+class Reopened:
+    """What reopening a campaign file to resume it found."""
+
+    previous_state: str        # the state the last run left: "running" means it never closed the file
+    run: int                   # this run's number (1 was the run that created the file)
+    poses_stored: int
+    rows_cut: int              # rows of a pose killed mid-write, removed
+    clock_now_s: float         # where the campaign's clock resumes: its latest time in the file, plus the
+                               # wall time since then when the clock is real
 
 
 def _append_rows(dataset: h5py.Dataset, rows: Any) -> None:
@@ -82,7 +99,7 @@ class CampaignWriter:
             raise ConfigError(f"{path}: cannot create campaign file: {exc}") from None
         file.attrs.update({"format": FORMAT_NAME, "format_version": FORMAT_VERSION,
                            "software_version": __version__, "state": "created", "started": utc_now(),
-                           "finished": "", "abort_reason": "", **attrs})
+                           "finished": "", "abort_reason": "", "runs": 1, **_writer_attrs(), **attrs})
         config = file.create_group("config")
         config.create_dataset("procedure_yaml", data=procedure_yaml, dtype=TEXT)
         config.create_dataset("rig_yaml", data=rig_yaml, dtype=TEXT)
@@ -103,6 +120,66 @@ class CampaignWriter:
             _growable(events, name, (), TEXT, chunk_rows=256)
         file.flush()
         return cls(file)
+
+    @classmethod
+    def reopen(cls, path: Path) -> tuple[CampaignWriter, Reopened]:
+        """Open an existing campaign to continue it: cut any pose written only in part, count this run."""
+        if not path.exists():
+            raise ConfigError(f"{path}: no such campaign file to resume")
+        try:
+            file = h5py.File(path, "a")
+        except OSError as exc:
+            raise ConfigError(f"{path}: cannot open to resume (is a campaign still running on it?): {exc}") from None
+        if file.attrs.get("format") != FORMAT_NAME:
+            file.close()
+            raise ConfigError(f"{path}: not an accelcal-rig campaign file")
+        writer = cls(file)
+        previous = str(file.attrs["state"])
+        stored, cut = writer._cut_to_whole_poses()
+        run = int(file.attrs.get("runs", 1)) + 1
+        file.attrs.update({"runs": run, "finished": "", "abort_reason": "", **_writer_attrs()})
+        file.flush()
+        return writer, Reopened(previous, run, stored, cut, writer._clock_now_s())
+
+    def _pose_aligned(self) -> list[h5py.Dataset]:
+        datasets = [d for d in self._file["poses"].values()]
+        for group in ("duts", "simulation_truth"):
+            for serial in self._file.get(group, {}):
+                datasets += [d for d in self._file[group][serial].values() if isinstance(d, h5py.Dataset)
+                             and d.maxshape[0] is None]
+        return datasets
+
+    def _cut_to_whole_poses(self) -> tuple[int, int]:
+        """(poses stored whole, rows removed): every pose-aligned dataset and event column cut to the
+        shortest, the length every one of them reached."""
+        cut = 0
+        for datasets in (self._pose_aligned(), list(self._file["events"].values())):
+            whole = min(d.shape[0] for d in datasets)
+            for dataset in datasets:
+                cut += dataset.shape[0] - whole
+                dataset.resize(whole, axis=0)
+        stored = self._file["poses/step_key"].shape[0]
+        self._file.attrs["poses_done"] = stored
+        return stored, cut
+
+    def _clock_now_s(self) -> float:
+        times = [self._file["events/t_s"][-1:], self._file["poses/t_end_s"][-1:]]
+        times += [soak["t_s"][-1:] for soak in self._file["soaks"].values() if "t_s" in soak]
+        last_t_s = float(max((float(t[0]) for t in times if len(t)), default=0.0))
+        wall_times = self._file["events/wall_time"]
+        if self._file.attrs.get("clock") != "real" or not wall_times.shape[0]:
+            return last_t_s
+        last_wall = dt.datetime.fromisoformat(_text(wall_times[-1]))
+        return last_t_s + max(0.0, (dt.datetime.now(dt.timezone.utc) - last_wall).total_seconds())
+
+    def record_instruments(self, instruments: dict[str, dict[str, str]]) -> None:
+        """The drivers and endpoints of this run (a resumed run may reach an instrument another way)."""
+        with signals_deferred():
+            for name, info in instruments.items():
+                self._file.require_group(f"instruments/{name}").attrs.update(info)
+
+    def stored_step_keys(self) -> set[str]:
+        return {_text(k) for k in self._file["poses/step_key"][:]}
 
     @staticmethod
     def _write_plan(group: h5py.Group, plan: Plan) -> None:
@@ -201,7 +278,12 @@ class CampaignWriter:
             self._write_soak(soak)
 
     def _write_soak(self, soak: SoakTrace) -> None:
-        group = self._file["soaks"].create_group(soak.label)
+        soaks = self._file["soaks"]
+        name, again = soak.label, 1
+        while name in soaks:  # soaked again after a resume: T-40#2, T-40#3, …
+            again += 1
+            name = f"{soak.label}#{again}"
+        group = soaks.create_group(name)
         group.attrs.update({"setpoint_c": soak.setpoint_c, "outcome": soak.outcome,
                             "t_reached_s": soak.t_reached_s, "t_stable_s": soak.t_stable_s})
         group.create_dataset("t_s", data=soak.t_s).attrs["unit"] = "s"
@@ -227,3 +309,12 @@ class CampaignWriter:
         if self._file.id.valid:
             self.flush()
             self._file.close()
+
+
+def _text(value: Any) -> str:
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _writer_attrs() -> dict[str, Any]:
+    """Who writes the file now, so `rig status` can tell a running campaign from one whose process died."""
+    return {"writer_pid": os.getpid(), "writer_host": socket.gethostname()}

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
+import socket
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -78,10 +80,13 @@ def _read_status(path: Path) -> dict[str, Any]:
         setpoints = list(dict.fromkeys(float(v) for v in file["plan/setpoint_c"][:]))  # plan order
         events = file["events"]
         last_event = _text(events["message"][-1]) if events["message"].shape[0] else ""
+        state = _text(attrs["state"])
         return {
             "file": str(path),
             "procedure": _text(attrs.get("procedure_name", "")),
-            "state": _text(attrs["state"]),
+            "state": state,
+            "writer": _writer_liveness(attrs) if state in ("created", "running") else None,
+            "runs": int(attrs.get("runs", 1)),
             "poses_done": int(file["poses/step_key"].shape[0]),
             "poses_total": plan_kinds.count("pose"),
             "next_step": pending[0] if pending else None,
@@ -94,6 +99,48 @@ def _read_status(path: Path) -> dict[str, Any]:
             "abort_reason": _text(attrs["abort_reason"]) or None,
             "last_event": last_event,
         }
+
+
+@dataclass(frozen=True)
+class StoredCampaign:
+    """What a resume needs to know of a campaign before touching it or the rig."""
+
+    procedure_yaml: str
+    rig_yaml: str
+    plan_fingerprint: str
+    procedure_path: Path
+    dry_run: bool
+    seed: int
+    state: str
+
+
+def read_stored_campaign(path: Path) -> StoredCampaign:
+    with open_campaign(path) as file:
+        attrs = file.attrs
+        return StoredCampaign(
+            procedure_yaml=_text(file["config/procedure_yaml"][()]),
+            rig_yaml=_text(file["config/rig_yaml"][()]),
+            plan_fingerprint=_text(file["plan"].attrs["fingerprint"]),
+            procedure_path=Path(_text(attrs["procedure_path"])),
+            dry_run=bool(attrs.get("dry_run", False)),
+            seed=int(attrs.get("seed", 0)),
+            state=_text(attrs["state"]),
+        )
+
+
+def _writer_liveness(attrs: h5py.AttributeManager) -> str:
+    """Whether the process writing a `running` file is still there: `alive`, `gone (resume it)`, or
+    `unknown` when it ran on another host."""
+    pid, host = int(attrs.get("writer_pid", 0)), _text(attrs.get("writer_host", ""))
+    if not pid or host != socket.gethostname():
+        return f"unknown (pid {pid} on {host or 'an unknown host'})"
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return f"gone (pid {pid} ended without closing the file: continue with rig resume)"
+    except PermissionError:
+        pass  # exists, owned by someone else
+    return f"alive (pid {pid})"
 
 
 def status_json(path: Path, sleep: Callable[[float], None] | None = None) -> str:
