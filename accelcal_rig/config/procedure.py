@@ -23,6 +23,9 @@ class SoakCriterion(_Strict):
     chamber_tolerance_c: float = Field(1.0, gt=0, description="chamber air within this of the setpoint")
     poll_s: float = Field(10.0, gt=0, le=600, description="temperature polling interval")
     timeout_min: float = Field(240.0, gt=0, description="soak deadline, counted from reaching the setpoint")
+    on_timeout: Literal["abort", "skip", "proceed"] = Field(
+        "abort", description="a soak not stable by its deadline: abort the campaign, skip the setpoint "
+                             "(recorded; a resume tries it again), or measure its poses anyway with a warning")
     ramp_timeout_factor: float = Field(
         2.0, ge=1, description="ramp deadline = factor × |Δ| / rig ramp rate + ramp_timeout_margin_min"
     )

@@ -185,8 +185,9 @@ class CampaignRunner:
         self.machine.go(State.RAMP, label)
         t_reached = self._ramp(setpoint_c)
         self.machine.go(State.SOAK, label)
-        self._soak(setpoint_c, label, t_reached)
         pose_steps = [s for s in steps if s.kind == "pose"]
+        if not self._soak(setpoint_c, label, t_reached, len(pose_steps)):
+            return
         self._table_angles_deg = None  # hours of soak: ask the table where it is
         for step in pose_steps:
             self._measure_pose(step)
@@ -208,7 +209,8 @@ class CampaignRunner:
         )
         return t_reached
 
-    def _soak(self, setpoint_c: float, label: str, t_reached: float) -> None:
+    def _soak(self, setpoint_c: float, label: str, t_reached: float, n_poses: int) -> bool:
+        """Wait for thermal stability; False when the setpoint is to be skipped (`soak.on_timeout: skip`)."""
         criterion = self.procedure.soak
         detector = SoakDetector(criterion, setpoint_c, t_reached)
 
@@ -222,18 +224,28 @@ class CampaignRunner:
             t_stable = wait_until(self.clock, poll, timeout_s=criterion.timeout_min * 60.0, poll_s=criterion.poll_s,
                                   what=f"{label}: DUT temperatures stable within {criterion.band_c:g} °C")
             outcome = "stable"
-        except WaitTimeout:
+        except WaitTimeout as exc:
             outcome = "timeout"
-            raise
+            if criterion.on_timeout == "abort":
+                raise
+            timed_out = exc
         finally:
             t, chamber, dut = detector.trace()
             self._settled_dut_c = detector.settled_dut_c() if len(t) else np.full(len(self.sensors), np.nan)
             self.writer.write_soak(SoakTrace(label, setpoint_c, outcome, t, chamber, dut, t_reached, t_stable,
                                              self._settled_dut_c))
+        if outcome == "timeout":
+            if criterion.on_timeout == "skip":
+                self.events.warning("soak", f"{timed_out}; setpoint skipped, its {n_poses} poses not measured "
+                                            "(soak.on_timeout: skip)")
+                return False
+            self.events.warning("soak", f"{timed_out}; measuring its poses anyway (soak.on_timeout: proceed)")
+            return True
         spans = detector.dut_spans_c()
         self.events.info("soak", f"{label}: stable after {format_duration(t_stable - t_reached)} at "
                                  f"DUT {np.round(self._settled_dut_c, 2).tolist()} °C "
                                  f"(spans ≤ {spans.max():.2f} °C)")
+        return True
 
     def _chamber_temperature_c(self) -> float:
         """Chamber air temperature; an active controller alarm is a fault, never a reading to wait out."""

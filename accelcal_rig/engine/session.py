@@ -113,7 +113,7 @@ def resume_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, 
     wall_start = time.perf_counter()
     stored = read_stored_campaign(output)
     check_same_campaign(output, stored, prepared.procedure, prepared.rig, prepared.plan, dry_run)
-    if stored.state == "done":
+    if stored.state == "done" and stored.poses_stored == stored.poses_planned:
         raise NothingToResume(f"{output}: the campaign is complete: nothing to resume")
     writer, reopened = CampaignWriter.reopen(output)
     try:

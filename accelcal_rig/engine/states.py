@@ -27,9 +27,9 @@ ACTIVE_STATES = frozenset({State.IDLE, State.PREFLIGHT, State.RAMP, State.SOAK, 
 
 TRANSITIONS: dict[State, frozenset[State]] = {
     State.IDLE: frozenset({State.PREFLIGHT}),
-    State.PREFLIGHT: frozenset({State.RAMP}),
+    State.PREFLIGHT: frozenset({State.RAMP, State.SAFE}),  # SAFE: a resumed run with every pose stored
     State.RAMP: frozenset({State.SOAK}),
-    State.SOAK: frozenset({State.MOVE}),
+    State.SOAK: frozenset({State.MOVE, State.RAMP, State.SAFE}),  # RAMP, SAFE: a setpoint skipped
     State.MOVE: frozenset({State.SETTLE}),
     State.SETTLE: frozenset({State.ACQUIRE}),
     State.ACQUIRE: frozenset({State.STORE}),

@@ -112,6 +112,8 @@ class StoredCampaign:
     dry_run: bool
     seed: int
     state: str
+    poses_stored: int
+    poses_planned: int
 
 
 def read_stored_campaign(path: Path) -> StoredCampaign:
@@ -125,6 +127,8 @@ def read_stored_campaign(path: Path) -> StoredCampaign:
             dry_run=bool(attrs.get("dry_run", False)),
             seed=int(attrs.get("seed", 0)),
             state=_text(attrs["state"]),
+            poses_stored=int(file["poses/step_key"].shape[0]),
+            poses_planned=int(np.count_nonzero(file["plan/kind"][:] == b"pose")),
         )
 
 

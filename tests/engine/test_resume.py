@@ -140,3 +140,50 @@ def test_first_difference_skips_connection_keys() -> None:
                                   "sensors": [{"serial": "x", "baudrate": 115200}]}, frozenset({"endpoint", "baudrate"})) is None
     assert first_difference(old, {"chamber": {"endpoint": "a", "limits": [1, 3]}, "sensors": old["sensors"]},
                             frozenset()) == (("chamber", "limits", 1), 2, 3)
+
+
+def never_stable_at_20(instruments) -> None:
+    """DUT temperatures that wander by 1 °C while the chamber is at 20 °C (a soak there never settles)."""
+    for sensor in instruments.sensors:
+        real = sensor.read_temperature_c
+        flip = [0.0]
+
+        def wandering(real=real, flip=flip) -> float:
+            value = real()
+            if abs(instruments.chamber.read_setpoint_c() - 20.0) < 0.01:
+                flip[0] = 1.0 - flip[0]
+                return value + flip[0]
+            return value
+
+        sensor.read_temperature_c = wandering
+
+
+def run_with(procedure: Path, output: Path, tamper, resume: bool = False) -> None:
+    def factory(rig, procedure_model, clock, seed):
+        instruments = build_simulated_rig(rig, procedure_model, clock, seed)
+        tamper(instruments)
+        return instruments
+
+    run_campaign(prepare(procedure), output, dry_run=True, seed=1, overwrite=False, build_instruments=factory,
+                 resume=resume)
+
+
+@pytest.mark.parametrize("policy", ["skip", "proceed"])
+def test_a_soak_that_times_out_is_skipped_or_measured_as_the_procedure_says(write, workdir: Path, policy) -> None:
+    text = TWO_SETPOINTS.replace("timeout_min: 120", f"timeout_min: 30, on_timeout: {policy}")
+    procedure, output = write("two.yaml", text), workdir / "c.h5"
+    run_with(procedure, output, never_stable_at_20)
+    with h5py.File(output, "r") as f:
+        assert f.attrs["state"] == "done"
+        assert f["soaks/T20"].attrs["outcome"] == "timeout" and f["soaks/T30"].attrs["outcome"] == "stable"
+        setpoints = f["poses/setpoint_c"][:]
+    warnings = [m for m in events(output, "soak") if "not reached within 1800 s" in m]
+    if policy == "skip":
+        assert sorted(set(setpoints)) == [30.0] and len(setpoints) == 6
+        assert warnings == ["T20: DUT temperatures stable within 0.3 °C: not reached within 1800 s; setpoint "
+                            "skipped, its 6 poses not measured (soak.on_timeout: skip)"]
+        run_with(procedure, output, lambda instruments: None, resume=True)  # chamber fixed: resume retries T20
+        assert sorted(stored_keys(output)) == sorted(plan_pose_keys(output))
+    else:
+        assert sorted(set(setpoints)) == [20.0, 30.0] and len(setpoints) == 12
+        assert len(warnings) == 1 and warnings[0].endswith("measuring its poses anyway (soak.on_timeout: proceed)")
