@@ -204,3 +204,39 @@ def test_a_signal_before_the_campaign_starts_is_one_line_and_leaves_no_file(writ
     err = one_line_error(capsys, ["run", str(path), "--dry-run", "-o", str(path.with_suffix(".h5"))], 130)
     assert "interrupted before the campaign started" in err
     assert not path.with_suffix(".h5").exists()
+
+
+@pytest.mark.parametrize("kill_after_s", [0.0, 0.15])
+def test_kill_9_then_resume_stores_every_pose_exactly_once(tmp_path: Path, kill_after_s: float) -> None:
+    """Killed at two moments after the first soak (the benchmark kills the paper campaign at random ones)."""
+    import signal
+    import time
+
+    import h5py
+
+    from accelcal_rig.store.read import integrity_problems
+
+    beside_python = Path(sys.executable).parent / "rig"
+    process = subprocess.Popen([str(beside_python), "run", str(REPO / "procedures" / "quick-6pos.yaml"),
+                                "--dry-run", "-o", "c.h5"], cwd=tmp_path, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    log = tmp_path / "c.h5.log"
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not (log.exists() and "T15: stable" in log.read_text()):
+        time.sleep(0.01)
+    time.sleep(kill_after_s)
+    process.send_signal(signal.SIGKILL)
+    process.wait(timeout=10)
+    with h5py.File(tmp_path / "c.h5", "r") as f:  # readable as the kill left it
+        assert f.attrs["state"] in ("created", "running")
+    status = json.loads(rig("status", "c.h5", "--json", cwd=tmp_path).stdout)
+    assert status["writer"].startswith("gone (pid")
+    resumed = rig("resume", "c.h5", cwd=tmp_path)
+    assert resumed.returncode == 0, resumed.stderr
+    assert "12 of 12 × 4 DUTs" in resumed.stdout
+    with h5py.File(tmp_path / "c.h5", "r") as f:
+        assert f.attrs["state"] == "done" and f.attrs["runs"] == 2
+        assert integrity_problems(f) == []
+        assert f["poses/step_key"].shape[0] == 12
+    assert "run 2 resumes" in (tmp_path / "c.h5.log").read_text()  # the log goes on, not replaced
+    assert "rig resume" not in rig("status", "c.h5", cwd=tmp_path).stdout

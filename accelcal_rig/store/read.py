@@ -6,6 +6,7 @@ import hashlib
 import json
 import os
 import socket
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -98,6 +99,7 @@ def _read_status(path: Path) -> dict[str, Any]:
             "finished": _text(attrs["finished"]) or None,
             "abort_reason": _text(attrs["abort_reason"]) or None,
             "last_event": last_event,
+            "integrity": "; ".join(integrity_problems(file)) or "ok",
         }
 
 
@@ -145,6 +147,28 @@ def _writer_liveness(attrs: h5py.AttributeManager) -> str:
     except PermissionError:
         pass  # exists, owned by someone else
     return f"alive (pid {pid})"
+
+
+def integrity_problems(file: h5py.File) -> list[str]:
+    """What is wrong with a campaign file's poses, one line each (empty when every pose-aligned dataset
+    has one row per stored pose and no pose of the plan is stored twice or is foreign to it)."""
+    problems = []
+    keys = [_text(k) for k in file["poses/step_key"][:]]
+    n = len(keys)
+    aligned = {f"poses/{name}": d for name, d in file["poses"].items()}
+    for group in ("duts", "simulation_truth"):
+        for serial, sub in file.get(group, {}).items():
+            aligned.update({f"{group}/{serial}/{name}": d for name, d in sub.items()
+                            if isinstance(d, h5py.Dataset) and d.maxshape[0] is None})
+    problems += [f"{path}: {d.shape[0]} rows for {n} poses" for path, d in aligned.items() if d.shape[0] != n]
+    duplicates = sorted(k for k, count in Counter(keys).items() if count > 1)
+    if duplicates:
+        problems.append(f"poses stored more than once: {', '.join(duplicates)}")
+    planned = {_text(k) for k, kind in zip(file["plan/step_key"][:], file["plan/kind"][:]) if _text(kind) == "pose"}
+    foreign = sorted(set(keys) - planned)
+    if foreign:
+        problems.append(f"poses not in the plan: {', '.join(foreign)}")
+    return problems
 
 
 def status_json(path: Path, sleep: Callable[[float], None] | None = None) -> str:
