@@ -19,6 +19,15 @@ class InstrumentError(RigError):
     exit_code = 2
 
 
+class TransientInstrumentError(InstrumentError):
+    """A failure worth retrying: no reply in time, a garbled reply, a port that went away. `reconnect`:
+    the connection itself failed and should be opened again before the next attempt."""
+
+    def __init__(self, message: str, reconnect: bool = False) -> None:
+        super().__init__(message)
+        self.reconnect = reconnect
+
+
 class WaitTimeout(RigError):
     """A wait passed its deadline: the awaited condition (setpoint, soak, position) never held."""
 

@@ -145,6 +145,25 @@ class FixtureConfig(_Strict):
         return value
 
 
+class FaultInjection(_Strict):
+    """Faults the simulators inject (dry runs and `rig sim`), to prove the engine survives them.
+
+    Transient faults hit each reply with probability `rate`, the kind drawn from `kinds`; persistent ones
+    switch on after a time on the campaign's clock (None: never).
+    """
+
+    rate: float = Field(0.0, ge=0, le=1, description="share of replies hit by a transient fault")
+    kinds: list[Literal["drop", "delay", "corrupt", "disconnect", "busy"]] = ["drop", "delay", "corrupt", "disconnect"]
+    delay_s: float = Field(0.05, ge=0, description="wall-clock delay of a delayed reply")
+    disconnect_s: float = Field(0.3, ge=0, description="wall-clock time a disconnected line stays dead")
+    seed: int = 0
+    chamber_stall_after_min: float | None = Field(None, ge=0, description="the chamber stops following its setpoint")
+    turntable_stall_after_min: float | None = Field(None, ge=0, description="the turntable stops moving")
+    sensor_wrong_id: str | None = Field(None, description="serial of a DUT whose part ID reads wrong")
+    sensor_stuck: str | None = Field(None, description="serial of a DUT whose samples freeze")
+    sensor_stuck_after_min: float = Field(0.0, ge=0, description="when that DUT's samples freeze")
+
+
 class SimulationConfig(_Strict):
     """Physics of the virtual lab used by `--dry-run` (DESIGN §3)."""
 
@@ -155,6 +174,15 @@ class SimulationConfig(_Strict):
     self_heating_c: float = Field(0.2, ge=0)
     noise_density_ug_per_rthz: float = Field(25.0, ge=0)
     turntable_settle_s: float = Field(0.5, ge=0)
+    faults: FaultInjection = FaultInjection()
+
+
+class RetryPolicy(_Strict):
+    """Transient communication failures (no reply, garbled reply, a port gone) are retried this way."""
+
+    attempts: int = Field(5, ge=1, le=20, description="tries in all, the first included")
+    first_backoff_s: float = Field(0.5, ge=0, description="wait before the second try; doubles each time")
+    max_backoff_s: float = Field(8.0, ge=0, description="longest wait between tries")
 
 
 class RigConfig(_Strict):
@@ -163,4 +191,5 @@ class RigConfig(_Strict):
     chamber: ChamberConfig
     turntable: TurntableConfig
     fixture: FixtureConfig
+    retry: RetryPolicy = RetryPolicy()
     simulation: SimulationConfig = SimulationConfig()

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from itertools import groupby
 
 import h5py
@@ -16,17 +17,18 @@ from scipy.spatial.transform import Rotation
 
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.engine.acquisition import acquire_together
+from accelcal_rig.engine.acquisition import CAPTURE_STEPS, acquire_together
 from accelcal_rig.engine.clock import Clock
 from accelcal_rig.engine.events import LOGGER, EventLog, format_duration
 from accelcal_rig.engine.resume import ResumePoint
+from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.engine.safe_state import apply_safe_state
 from accelcal_rig.engine.soak import SoakDetector
 from accelcal_rig.engine.states import ACTIVE_STATES, State, StateMachine
 from accelcal_rig.engine.waits import wait_until
-from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, WaitTimeout
+from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, TransientInstrumentError, WaitTimeout
 from accelcal_rig.instruments import adxl355
-from accelcal_rig.instruments.interfaces import RigInstruments, SampleBlock
+from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity, RigInstruments, SampleBlock
 from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable
 from accelcal_rig.plan.compile import Plan, PlanStep, setpoint_label
 from accelcal_rig.store.atomic import signals_deferred
@@ -66,9 +68,11 @@ class CampaignRunner:
         self.procedure = procedure
         self.rig = rig
         self.plan = plan
-        self.chamber = LimitedChamber(instruments.chamber, rig.chamber)
-        self.turntable = LimitedTurntable(instruments.turntable, rig.turntable)
-        self.sensors = instruments.sensors
+        # Transient failures are retried below the safety limits, so a retried write is checked too.
+        self.retrier = Retrier(rig.retry, clock, events)
+        self.chamber = LimitedChamber(self.retrier.wrap(instruments.chamber), rig.chamber)
+        self.turntable = LimitedTurntable(self.retrier.wrap(instruments.turntable), rig.turntable)
+        self.sensors = [self.retrier.wrap(s, not_retried=CAPTURE_STEPS) for s in instruments.sensors]
         self.truth = instruments.truth
         self.writer = writer
         self.clock = clock
@@ -160,14 +164,7 @@ class CampaignRunner:
         self.events.info("preflight", f"turntable: {self.turntable.identify()} ({self.turntable.endpoint})")
         acquisition = self.procedure.acquisition
         for sensor in self.sensors:
-            identity = sensor.identify()
-            expected = (adxl355.DEVID_AD, adxl355.DEVID_MST, adxl355.PARTID)
-            found = (identity.devid_ad, identity.devid_mst, identity.partid)
-            if found != expected:
-                raise InstrumentError(
-                    f"sensor {sensor.serial} ({sensor.endpoint}): identity {_hex(found)} is not an ADXL355 "
-                    f"({_hex(expected)})"
-                )
+            identity = self.retrier.call(partial(_checked_identity, sensor))
             sensor.reset()
             sensor.standby()
             sensor.configure(acquisition.range_g, acquisition.odr_hz)
@@ -265,7 +262,8 @@ class CampaignRunner:
         measured = self._table_angles_deg = self.turntable.read_angles_deg()
         chamber_before = self.chamber.read_temperature_c()  # the alarm is checked once per pose, after it
         n = self.procedure.acquisition.samples_per_pose
-        blocks = acquire_together(self.sensors, n, self.clock)
+        blocks = self.retrier.call(partial(acquire_together, self.sensors, n, self.clock,
+                                           self.procedure.acquisition.range_g))
         chamber_after = self._chamber_temperature_c()
         self.machine.go(State.STORE, step.key)
         gravity_fixture = np.array(step.pose.gravity_fixture)
@@ -322,6 +320,18 @@ class CampaignRunner:
 def _angle_difference(a_deg: np.ndarray, b_deg: np.ndarray) -> np.ndarray:
     """a − b wrapped into [−180, 180)."""
     return (np.asarray(a_deg) - np.asarray(b_deg) + 180.0) % 360.0 - 180.0
+
+
+def _checked_identity(sensor: Accelerometer) -> DeviceIdentity:
+    """The sensor's identity registers; anything but an ADXL355's may be a glitch on the line (retried),
+    and is a fault when it persists."""
+    identity = sensor.identify()
+    expected = (adxl355.DEVID_AD, adxl355.DEVID_MST, adxl355.PARTID)
+    found = (identity.devid_ad, identity.devid_mst, identity.partid)
+    if found != expected:
+        raise TransientInstrumentError(
+            f"sensor {sensor.serial} ({sensor.endpoint}): identity {_hex(found)} is not an ADXL355 ({_hex(expected)})")
+    return identity
 
 
 def _hex(values: tuple[int, ...]) -> str:

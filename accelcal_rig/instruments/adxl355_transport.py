@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from accelcal_rig.errors import InstrumentError
+from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.line_port import LinePort
 
 BRIDGE_GREETING = "ADXL355-BRIDGE"
@@ -75,9 +75,9 @@ class SerialBridge:
         try:
             data = bytes.fromhex(reply[1:])
         except ValueError:
-            raise InstrumentError(f"sensor bridge ({self.endpoint}): garbled reply {reply[:40]!r}") from None
+            raise TransientInstrumentError(f"sensor bridge ({self.endpoint}): garbled reply {reply[:40]!r}") from None
         if not reply.startswith("=") or len(data) != count:
-            raise InstrumentError(f"sensor bridge ({self.endpoint}): read of {count} bytes at 0x{address:02X} "
+            raise TransientInstrumentError(f"sensor bridge ({self.endpoint}): read of {count} bytes at 0x{address:02X} "
                                   f"answered {reply[:40]!r}")
         return data
 
@@ -91,7 +91,8 @@ class SerialBridge:
         reply = self._ask(f"C {n_samples}")
         temperature = _raw_temperature(reply[1:]) if reply.startswith("=") else None
         if temperature is None:
-            raise InstrumentError(f"sensor bridge ({self.endpoint}): capture of {n_samples} answered {reply[:40]!r}")
+            raise TransientInstrumentError(f"sensor bridge ({self.endpoint}): capture of {n_samples} answered "
+                                           f"{reply[:40]!r}")
         return temperature
 
     def fetch_capture(self) -> tuple[bytes, int | None]:
@@ -106,11 +107,14 @@ class SerialBridge:
         except ValueError:
             data = b"?"
         if not reply.startswith("=") or len(data) % 9 or (end_marker and temperature is None):
-            raise InstrumentError(f"sensor bridge ({self.endpoint}): garbled capture {reply[:40]!r}")
+            raise TransientInstrumentError(f"sensor bridge ({self.endpoint}): garbled capture {reply[:40]!r}")
         return data, temperature
 
     def close(self) -> None:
         self._line.close()
+
+    def reconnect(self) -> None:
+        self._line.reconnect()
 
     def _ask(self, request: str) -> str:
         return self._refusal_raised(request, self._line.ask(request))

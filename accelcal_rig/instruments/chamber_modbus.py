@@ -13,11 +13,13 @@ from pymodbus.client import ModbusSerialClient, ModbusTcpClient
 from pymodbus.client.base import ModbusBaseSyncClient
 from pymodbus.exceptions import ModbusException
 
-from accelcal_rig.errors import InstrumentError
+from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.chamber_registers import ChamberRegisterMap
 
 #: Readings outside this are not a chamber's air: the map or word order must be wrong.
 PLAUSIBLE_C = (-100.0, 300.0)
+#: Modbus exception codes that mean "try again": 5 acknowledge (still working), 6 server device busy.
+_BUSY_CODES = (5, 6)
 
 
 class ModbusChamber:
@@ -95,6 +97,11 @@ class ModbusChamber:
     def close(self) -> None:
         self._client.close()
 
+    def reconnect(self) -> None:
+        self._client.close()
+        if not self._client.connect():
+            raise TransientInstrumentError(f"chamber ({self.endpoint}): cannot connect", reconnect=True)
+
     # ------------------------------------------------------------------ encoding
     def _read_temperature(self, address: int) -> float:
         m = self.registers
@@ -127,8 +134,10 @@ class ModbusChamber:
         try:
             reply = self._client.read_holding_registers(address, count=count, device_id=self.device_id)
         except ModbusException as exc:
-            raise self._error(f"no reply reading register {address}: {exc}") from None
+            raise self._lost(f"no reply reading register {address}: {exc}") from None
         if reply.isError():
+            if getattr(reply, "exception_code", None) in _BUSY_CODES:
+                raise TransientInstrumentError(f"chamber ({self.endpoint}): busy reading register {address} ({reply})")
             raise self._error(f"register {address} refused ({reply}): wrong register map?")
         return list(reply.registers)
 
@@ -136,9 +145,14 @@ class ModbusChamber:
         try:
             reply = self._client.write_registers(address, values, device_id=self.device_id)
         except ModbusException as exc:
-            raise self._error(f"no reply writing register {address}: {exc}") from None
+            raise self._lost(f"no reply writing register {address}: {exc}") from None
         if reply.isError():
+            if getattr(reply, "exception_code", None) in _BUSY_CODES:
+                raise TransientInstrumentError(f"chamber ({self.endpoint}): busy writing register {address} ({reply})")
             raise self._error(f"write to register {address} refused ({reply})")
+
+    def _lost(self, message: str) -> TransientInstrumentError:
+        return TransientInstrumentError(f"chamber ({self.endpoint}): {message}", reconnect=True)
 
     def _error(self, message: str) -> InstrumentError:
         return InstrumentError(f"chamber ({self.endpoint}): {message}")

@@ -11,13 +11,14 @@ import time
 
 import serial
 
-from accelcal_rig.errors import InstrumentError
+from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 
 
 class LinePort:
     def __init__(self, port: serial.SerialBase, name: str, write_terminator: str = "\n",
-                 read_terminator: str = "\n") -> None:
+                 read_terminator: str = "\n", endpoint: str = "", baudrate: int = 9600) -> None:
         self._port = port
+        self._endpoint, self._baudrate = endpoint, baudrate
         self.name = name  # "turntable (serial /dev/ttyUSB0)": how errors name the instrument
         self._write_terminator = write_terminator.encode()
         self._read_terminator = read_terminator.encode()
@@ -26,11 +27,8 @@ class LinePort:
     def open(cls, endpoint: str, instrument: str, baudrate: int, timeout_s: float, write_terminator: str = "\n",
              read_terminator: str = "\n") -> LinePort:
         name = f"{instrument} (serial {endpoint})"
-        try:
-            port = serial.serial_for_url(endpoint, baudrate=baudrate, timeout=timeout_s, write_timeout=timeout_s)
-        except (serial.SerialException, ValueError) as exc:
-            raise InstrumentError(f"{name}: cannot open: {exc}") from None
-        return cls(port, name, write_terminator, read_terminator)
+        return cls(_open_port(name, endpoint, baudrate, timeout_s), name, write_terminator, read_terminator,
+                   endpoint, baudrate)
 
     def ask(self, request: str) -> str:
         """Send one request, return its reply line without the terminator (stripped)."""
@@ -39,13 +37,19 @@ class LinePort:
             self._port.write(request.encode() + self._write_terminator)
             raw = self._read_line()
         except (serial.SerialException, OSError) as exc:
-            raise InstrumentError(f"{self.name}: {request!r}: port failed: {exc}") from None
+            raise TransientInstrumentError(f"{self.name}: {request!r}: port failed: {exc}", reconnect=True) from None
         if not raw.endswith(self._read_terminator):
-            raise InstrumentError(f"{self.name}: {request!r}: no reply within the timeout")
+            raise TransientInstrumentError(f"{self.name}: {request!r}: no reply within the timeout")
         return raw[: -len(self._read_terminator)].decode(errors="replace").strip()
 
     def close(self) -> None:
         self._port.close()
+
+    def reconnect(self) -> None:
+        """Close and open the port again (a USB adapter that dropped off the bus and came back)."""
+        timeout_s = self._port.timeout or 1.0
+        self._port.close()
+        self._port = _open_port(self.name, self._endpoint, self._baudrate, timeout_s)
 
     def _read_line(self) -> bytes:
         """Bytes up to the terminator; stops short at the port's timeout or, for a device that keeps
@@ -58,3 +62,10 @@ class LinePort:
                 break
             line += chunk
         return bytes(line)
+
+
+def _open_port(name: str, endpoint: str, baudrate: int, timeout_s: float) -> serial.SerialBase:
+    try:
+        return serial.serial_for_url(endpoint, baudrate=baudrate, timeout=timeout_s, write_timeout=timeout_s)
+    except (serial.SerialException, ValueError) as exc:
+        raise InstrumentError(f"{name}: cannot open: {exc}") from None

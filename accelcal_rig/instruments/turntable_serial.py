@@ -6,7 +6,7 @@ import re
 
 import numpy as np
 
-from accelcal_rig.errors import InstrumentError
+from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.line_port import LinePort
 from accelcal_rig.instruments.turntable_protocol import Command, TurntableProtocol
 
@@ -55,6 +55,9 @@ class SerialTurntable:
     def close(self) -> None:
         self._line.close()
 
+    def reconnect(self) -> None:
+        self._line.reconnect()
+
     # ------------------------------------------------------------------ wire
     def _ask(self, command: Command, **fields: object) -> dict[str, str]:
         request = command.send.format(**fields)
@@ -63,5 +66,5 @@ class SerialTurntable:
             raise InstrumentError(f"turntable ({self.endpoint}): {request!r} refused: {reply}")
         match = re.fullmatch(command.reply, reply)
         if match is None:
-            raise InstrumentError(f"turntable ({self.endpoint}): {request!r}: unexpected reply {reply!r}")
+            raise TransientInstrumentError(f"turntable ({self.endpoint}): {request!r}: unexpected reply {reply!r}")
         return {k: v for k, v in match.groupdict().items() if v is not None}

@@ -6,8 +6,11 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import BRIDGE_GREETING
+from accelcal_rig.sim.faults import ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 
@@ -22,14 +25,18 @@ CAPTURE_CAPACITY_SAMPLES = 4096
 class SimulatedAdxl355:
     """One DUT's ADXL355 at register level."""
 
-    def __init__(self, lab: VirtualLab, index: int) -> None:
+    def __init__(self, lab: VirtualLab, index: int, wrong_part_id: bool = False,
+                 stuck_after_s: float | None = None) -> None:
         self._lab = lab
         self._index = index
+        self._part_id = 0xE9 if wrong_part_id else adxl355.PARTID  # 0xE9: an ADXL359 fitted by mistake
+        self._stuck_after_s = stuck_after_s
+        self._stuck_codes: np.ndarray | None = None
         self.reset()
 
     def reset(self) -> None:
         self._regs = bytearray(0x30)
-        self._regs[0:4] = bytes([adxl355.DEVID_AD, adxl355.DEVID_MST, adxl355.PARTID, 0x01])
+        self._regs[0:4] = bytes([adxl355.DEVID_AD, adxl355.DEVID_MST, self._part_id, 0x01])
         self._regs[adxl355.REG_RANGE] = 0x81
         self._regs[adxl355.REG_POWER_CTL] = adxl355.POWER_CTL_STANDBY
         self._regs[adxl355.REG_FIFO_SAMPLES] = 0x60
@@ -136,6 +143,15 @@ class SimulatedAdxl355:
         self._fifo_pending = min(self._fifo_pending + due, _SAMPLES_IN_FIFO - len(self._fifo) // 9)
         self._next_sample_s += due / self._odr_hz
 
+    def _samples(self, t_first_s: float, count: int) -> np.ndarray:
+        """`count` codes from the lab's sensor model; a part whose output froze repeats one sample."""
+        codes = self._lab.dut_samples(self._index, t_first_s, count, self._odr_hz, self._range_g)
+        if self._stuck_after_s is not None and self._lab.clock.now() >= self._stuck_after_s:
+            if self._stuck_codes is None:
+                self._stuck_codes = codes[0].copy()
+            codes = np.broadcast_to(self._stuck_codes, codes.shape)
+        return codes
+
     def _temperature_raw(self) -> int:
         return int(adxl355.raw_from_temperature_c(self._lab.dut_reading_c(self._index)))
 
@@ -146,8 +162,7 @@ class SimulatedAdxl355:
         """The FIFO's newest samples, from the lab's state now (as filling at each look would)."""
         if self._fifo_pending and self._next_sample_s is not None:
             t_first = self._next_sample_s - self._fifo_pending / self._odr_hz
-            codes = self._lab.dut_samples(self._index, t_first, self._fifo_pending, self._odr_hz, self._range_g)
-            self._fifo += adxl355.encode_fifo(codes)
+            self._fifo += adxl355.encode_fifo(self._samples(t_first, self._fifo_pending))
             self._fifo_pending = 0
 
     def _capture(self, count: int) -> int:
@@ -157,8 +172,7 @@ class SimulatedAdxl355:
         if len(self._captured) // 9 + count > CAPTURE_CAPACITY_SAMPLES:
             self._capture_overflow, self._capture_left = True, 0
         else:
-            codes = self._lab.dut_samples(self._index, self._next_sample_s, count, self._odr_hz, self._range_g)
-            self._captured += adxl355.encode_fifo(codes)
+            self._captured += adxl355.encode_fifo(self._samples(self._next_sample_s, count))
             if self._capture_left == 0:
                 self._capture_end_temperature_raw = self._temperature_raw()
         self._next_sample_s += count / self._odr_hz
@@ -168,11 +182,12 @@ class SimulatedAdxl355:
 class SimulatedBridgeServer:
     """The bridge line protocol on a pseudo-terminal, in front of one simulated ADXL355."""
 
-    def __init__(self, lab: VirtualLab, index: int, protocol_version: int = 2) -> None:
+    def __init__(self, lab: VirtualLab, index: int, protocol_version: int = 2, faults: ReplyFaults | None = None,
+                 wrong_part_id: bool = False, stuck_after_s: float | None = None) -> None:
         self._lab = lab
         self._version = protocol_version
-        self.device = SimulatedAdxl355(lab, index)
-        self._server = PtyLineServer(self._handle, b"\n", f"simulated-bridge-{lab.duts[index].serial}")
+        self.device = SimulatedAdxl355(lab, index, wrong_part_id, stuck_after_s)
+        self._server = PtyLineServer(self._handle, b"\n", f"simulated-bridge-{lab.duts[index].serial}", faults)
         self.path = self._server.path
 
     def start(self) -> SimulatedBridgeServer:

@@ -16,15 +16,22 @@ from pymodbus.server import ModbusTcpServer
 from pymodbus.simulator import DataType, SimData, SimDevice
 
 from accelcal_rig.instruments.chamber_registers import ChamberRegisterMap
+from accelcal_rig.sim.faults import ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 
 _STARTUP_TIMEOUT_S = 10.0
+#: A dropped request is answered this late (wall clock): after any sane client timeout, to a client that
+#: has reconnected by then.
+_DROPPED_REPLY_LATE_S = 5.0
 
 
 class SimulatedChamberServer:
     def __init__(self, lab: VirtualLab, registers: ChamberRegisterMap, device_id: int = 1,
-                 host: str = "127.0.0.1", port: int = 0) -> None:
+                 host: str = "127.0.0.1", port: int = 0, faults: ReplyFaults | None = None,
+                 stall_after_s: float | None = None) -> None:
         self._lab = lab
+        self._faults = faults
+        self._stall_after_s = stall_after_s
         self._map = registers
         self._device_id = device_id
         self._address = (host, port)
@@ -36,6 +43,7 @@ class SimulatedChamberServer:
         self.host, self.port = host, port
         #: The last set point written over the wire, for tests that check the safe state.
         self.last_setpoint_c: float | None = None
+        self._shown_setpoint_c: float | None = None  # what a stalled controller shows it was given
 
     @property
     def endpoint(self) -> str:
@@ -86,6 +94,13 @@ class SimulatedChamberServer:
 
     async def _action(self, function_code: int, start_address: int, address: int, count: int,
                       current_registers: list[int], set_values: list[int] | list[bool] | None) -> ExcCodes | None:
+        fault = self._faults.draw(("drop", "delay", "busy", "disconnect")) if self._faults else None
+        if fault == "drop":
+            await asyncio.sleep(_DROPPED_REPLY_LATE_S)
+        elif fault == "delay":
+            await asyncio.sleep(self._faults.faults.delay_s)  # type: ignore[union-attr]
+        elif fault == "busy":
+            return ExcCodes.DEVICE_BUSY
         requested = range(address, address + count)
         with self._lab.lock:
             if set_values is not None:
@@ -105,7 +120,8 @@ class SimulatedChamberServer:
                 return ExcCodes.ILLEGAL_VALUE  # half a float: real controllers refuse it too
             offset = m.setpoint - address
             setpoint = self._decode(values[offset:offset + width])
-            self._lab.thermal.set_setpoint(now, setpoint)
+            if self._stall_after_s is None or now < self._stall_after_s:
+                self._lab.thermal.set_setpoint(now, setpoint)  # a stalled chamber takes it but does not follow
             self.last_setpoint_c = setpoint
         if m.power_register is not None and m.power_register in requested:
             value = values[m.power_register - address]
@@ -117,7 +133,8 @@ class SimulatedChamberServer:
     def _values(self, requested: range) -> dict[int, list[int]]:
         """The map's registers; the process value is measured only when asked for (it draws noise)."""
         m = self._map
-        values = {m.setpoint: self._encode(self._lab.thermal.setpoint_c)}
+        shown = self.last_setpoint_c if self.last_setpoint_c is not None else self._lab.thermal.setpoint_c
+        values = {m.setpoint: self._encode(shown)}
         if not set(requested).isdisjoint((m.process_value, m.process_value + 1)):
             values[m.process_value] = self._encode(self._lab.chamber_reading_c())
         if m.identity_register is not None and m.identity_value is not None:

@@ -5,14 +5,19 @@ from __future__ import annotations
 import os
 import select
 import threading
+import time
 import tty
 from collections.abc import Callable
+
+from accelcal_rig.sim.faults import ReplyFaults
 
 class PtyLineServer:
     """Reads requests ending in `terminator` from the pty and writes back `handle(request) + terminator`."""
 
-    def __init__(self, handle: Callable[[str], str], terminator: bytes = b"\n", name: str = "pty") -> None:
+    def __init__(self, handle: Callable[[str], str], terminator: bytes = b"\n", name: str = "pty",
+                 faults: ReplyFaults | None = None) -> None:
         self._handle = handle
+        self._faults = faults
         self._terminator = terminator
         self._master, self._slave = os.openpty()
         tty.setraw(self._master)
@@ -43,5 +48,15 @@ class PtyLineServer:
                 return
             while self._terminator in pending:
                 line, pending = pending.split(self._terminator, 1)
-                reply = self._handle(line.decode(errors="replace").strip())
-                os.write(self._master, reply.encode() + self._terminator)
+                reply = self._handle(line.decode(errors="replace").strip()).encode() + self._terminator
+                self._send(reply)
+
+    def _send(self, reply: bytes) -> None:
+        fault = self._faults.draw(("drop", "delay", "corrupt", "disconnect")) if self._faults else None
+        if fault == "drop":
+            return
+        if fault == "delay":
+            time.sleep(self._faults.faults.delay_s)  # type: ignore[union-attr]
+        elif fault == "corrupt":
+            reply = self._faults.corrupt(reply)  # type: ignore[union-attr]
+        os.write(self._master, reply)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from accelcal_rig.instruments.turntable_protocol import TurntableProtocol
+from accelcal_rig.sim.faults import ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 
@@ -10,15 +11,19 @@ from accelcal_rig.sim.pty_line_server import PtyLineServer
 class SimulatedTurntableServer:
     """Answers each request from the lab's turntable motion at the shared clock's time."""
 
-    def __init__(self, lab: VirtualLab, protocol: TurntableProtocol, identity: str = "accelcal-rig simulated turntable"):
+    def __init__(self, lab: VirtualLab, protocol: TurntableProtocol, identity: str = "accelcal-rig simulated turntable",
+                 faults: ReplyFaults | None = None, stall_after_s: float | None = None):
         self._lab = lab
+        self._stall_after_s = stall_after_s
+        #: The last motion command (move, stop, home) as received, for tests that check the safe state.
+        self.last_command: str | None = None
         self._protocol = protocol
         self._identity = identity
         self._patterns = [(name, getattr(protocol, name), getattr(protocol, name).request_pattern())
                           for name in ("identify", "move", "position", "busy", "stop", "home", "fault")]
         if protocol.write_terminator != protocol.read_terminator:
             raise ValueError("the simulated turntable needs one terminator for both directions")
-        self._server = PtyLineServer(self._handle, protocol.write_terminator.encode(), "simulated-turntable")
+        self._server = PtyLineServer(self._handle, protocol.write_terminator.encode(), "simulated-turntable", faults)
         self.path = self._server.path
         #: Fault code the controller reports (fault injection sets it).
         self.fault = self._protocol.fault_ok[0]
@@ -34,6 +39,8 @@ class SimulatedTurntableServer:
         for name, command, pattern in self._patterns:
             match = pattern.fullmatch(request)
             if match is not None:
+                if name in ("move", "stop", "home"):
+                    self.last_command = request
                 try:
                     return self._answer(name, command.answer, match.groupdict())
                 except (ValueError, IndexError) as exc:
@@ -48,7 +55,8 @@ class SimulatedTurntableServer:
             axis = int(fields["axis"]) - 1 if "axis" in fields else None
             if axis is not None and not 0 <= axis < n_axes:
                 raise ValueError(f"no axis {axis + 1}")
-            if name == "move":
+            stalled = self._stall_after_s is not None and now >= self._stall_after_s
+            if name == "move" and not stalled:  # a stalled table says OK and stays where it is
                 motion.command_axis(now, axis, float(fields["angle"]))
             elif name == "stop":
                 motion.stop(now)

@@ -17,6 +17,7 @@ from accelcal_rig.instruments.connect import Endpoints
 from accelcal_rig.sim.adxl355_bridge_server import SimulatedBridgeServer
 from accelcal_rig.sim.chamber_server import SimulatedChamberServer
 from accelcal_rig.sim.devices import SimulationTruth
+from accelcal_rig.sim.faults import ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.turntable_server import SimulatedTurntableServer
 
@@ -27,9 +28,26 @@ class SimulatedRig:
         self.rig = rig
         self.lab = VirtualLab(rig, clock, seed, effects)
         self.truth = SimulationTruth(self.lab)
-        self.chamber = SimulatedChamberServer(self.lab, rig.chamber.register_map(), rig.chamber.device_id)
-        self.turntable = SimulatedTurntableServer(self.lab, rig.turntable.line_protocol())
-        self.bridges = {s.serial: SimulatedBridgeServer(self.lab, i) for i, s in enumerate(rig.fixture.sensors)}
+        faults = rig.simulation.faults
+
+        def reply_faults(name: str) -> ReplyFaults | None:
+            return ReplyFaults(faults, name) if faults.rate > 0 else None
+
+        def after_s(minutes: float | None) -> float | None:
+            return None if minutes is None else minutes * 60.0
+
+        self.chamber = SimulatedChamberServer(self.lab, rig.chamber.register_map(), rig.chamber.device_id,
+                                              faults=reply_faults("chamber"),
+                                              stall_after_s=after_s(faults.chamber_stall_after_min))
+        self.turntable = SimulatedTurntableServer(self.lab, rig.turntable.line_protocol(),
+                                                  faults=reply_faults("turntable"),
+                                                  stall_after_s=after_s(faults.turntable_stall_after_min))
+        self.bridges = {
+            s.serial: SimulatedBridgeServer(
+                self.lab, i, faults=reply_faults(s.serial), wrong_part_id=s.serial == faults.sensor_wrong_id,
+                stuck_after_s=after_s(faults.sensor_stuck_after_min) if s.serial == faults.sensor_stuck else None)
+            for i, s in enumerate(rig.fixture.sensors)
+        }
         self._started: list = []
 
     def start(self) -> Endpoints:
