@@ -45,6 +45,7 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--config", type=Path, help="rig config YAML (overrides the procedure's `rig`)")
     run.add_argument("--dry-run", action="store_true", help="simulated rig in virtual time")
     run.add_argument("--seed", type=int, default=0, help="seed of the simulated noise (default 0)")
+    run.add_argument("--faults", metavar="KEY=VALUE,...", help="fault injection into the simulators, e.g. rate=0.05,kinds=drop+corrupt or chamber_stall_after_min=60 (keys of simulation.faults)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing campaign file")
     run.add_argument("--resume", action="store_true",
                      help="continue the campaign in the output file if it exists (after a crash, a fault or "
@@ -63,6 +64,7 @@ def _build_parser() -> argparse.ArgumentParser:
     resume.add_argument("campaign", type=Path, help="campaign file (HDF5)")
     resume.add_argument("--procedure", type=Path, help="procedure YAML (default: the path stored in the file)")
     resume.add_argument("--config", type=Path, help="rig config YAML (overrides the procedure's `rig`)")
+    resume.add_argument("--faults", metavar="KEY=VALUE,...", help="fault injection into the simulators, e.g. rate=0.05,kinds=drop+corrupt or chamber_stall_after_min=60 (keys of simulation.faults)")
     resume.add_argument("--calibration", type=Path,
                         help="calibration file the final fit writes (default: beside the campaign, .calibration.yaml)")
     resume.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
@@ -80,6 +82,7 @@ def _build_parser() -> argparse.ArgumentParser:
                      "rig check configs/example-lab.yaml")
     check.add_argument("rig", type=Path, help="rig config YAML")
     check.add_argument("--dry-run", action="store_true", help="check the rig's simulators instead")
+    check.add_argument("--faults", metavar="KEY=VALUE,...", help="fault injection into the simulators, e.g. rate=0.05,kinds=drop+corrupt or chamber_stall_after_min=60 (keys of simulation.faults)")
 
     sim = _command(commands, "sim", "serve the simulated rig as real endpoints until interrupted",
                    "Start the simulated rig of a rig config: the chamber on Modbus TCP (127.0.0.1), the "
@@ -88,6 +91,7 @@ def _build_parser() -> argparse.ArgumentParser:
                    "rig sim configs/sim.yaml")
     sim.add_argument("rig", type=Path, help="rig config YAML")
     sim.add_argument("--seed", type=int, default=0, help="seed of the simulated noise (default 0)")
+    sim.add_argument("--faults", metavar="KEY=VALUE,...", help="fault injection into the simulators, e.g. rate=0.05,kinds=drop+corrupt or chamber_stall_after_min=60 (keys of simulation.faults)")
 
     fit = _command(commands, "fit", "fit the error model of every DUT and write a calibration file",
                    "LM fit of Eq. 1 at each setpoint, polynomials over the sensor temperature (Eq. 8), metrics. "
@@ -143,7 +147,7 @@ class _StopOnFirstSignal:
 def _cmd_run(args: argparse.Namespace) -> int:
     from accelcal_rig.engine.session import prepare
 
-    prepared = prepare(args.procedure, args.config)
+    prepared = prepare(args.procedure, args.config, args.faults)
     if args.output.exists() and not (args.overwrite or args.resume):
         raise ConfigError(f"{args.output}: campaign file exists; continue it with --resume, or choose another -o "
                           "or pass --overwrite")
@@ -162,7 +166,7 @@ def _cmd_resume(args: argparse.Namespace) -> int:
     if not procedure.exists():
         raise ConfigError(f"{args.campaign}: its procedure {procedure} is gone; pass --procedure with the same "
                           "procedure")
-    prepared = prepare(procedure, args.config)
+    prepared = prepare(procedure, args.config, args.faults)
     return _execute(prepared, args.campaign, args, dry_run=stored.dry_run, seed=stored.seed, overwrite=False,
                     resume=True)
 
@@ -219,13 +223,13 @@ def _cmd_status(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from accelcal_rig.config.load import load_rig
+    from accelcal_rig.config.load import load_rig, with_faults
     from accelcal_rig.engine.check import check_lines
     from accelcal_rig.engine.clock import RealClock
     from accelcal_rig.instruments.connect import configured_endpoints, connect_rig
     from accelcal_rig.sim.wire_rig import SimulatedRig
 
-    rig = load_rig(args.rig)
+    rig = with_faults(load_rig(args.rig), args.faults)
     clock = RealClock()
     simulated = SimulatedRig(rig.model, clock, 0) if args.dry_run else None
     endpoints = simulated.start() if simulated else configured_endpoints(rig)
@@ -246,11 +250,11 @@ def _cmd_check(args: argparse.Namespace) -> int:
 def _cmd_sim(args: argparse.Namespace) -> int:
     import threading
 
-    from accelcal_rig.config.load import load_rig
+    from accelcal_rig.config.load import load_rig, with_faults
     from accelcal_rig.engine.clock import RealClock
     from accelcal_rig.sim.wire_rig import SimulatedRig
 
-    rig = load_rig(args.rig)
+    rig = with_faults(load_rig(args.rig), args.faults)
     simulated = SimulatedRig(rig.model, RealClock(), args.seed)
     simulated.start()
     stop = threading.Event()

@@ -94,8 +94,10 @@ def resume_cost(events: list[tuple[float, str]]) -> dict[str, float]:
     between the end of that soak and the first pose stored."""
     index = next(i for i, (_, m) in enumerate(events) if "resumes after" in m)
     t_resume, after = events[index][0], events[index:]
-    t_ramp = next(t for t, m in after if m.startswith("preflight → ramp") or m.startswith("store → ramp")
-                  or m.startswith("soak → ramp"))
+    ramps = [t for t, m in after if "→ ramp" in m]
+    if not ramps:
+        return {}  # every pose was stored when the kill came: the resume only made safe and fitted
+    t_ramp = ramps[0]
     t_soak_end = next(t for t, m in after if m.startswith("soak → move"))
     t_first_pose = next(t for t, m in after if m.endswith(" stored"))
     return {"before_ramp_s": t_ramp - t_resume, "ramp_and_soak_s": t_soak_end - t_ramp,

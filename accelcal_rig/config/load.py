@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Generic, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
 from accelcal_rig.config.procedure import Procedure
-from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.config.rig import FaultInjection, RigConfig
 from accelcal_rig.config.yaml_lines import KeyPath, format_key, load_yaml_with_lines, locate
 from accelcal_rig.errors import ConfigError
 
@@ -89,3 +89,23 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
                         ("schedule", "angles_deg", pose),
                         f"axis {axis.name} angle {angle:g}° is outside its limits {axis.min_deg:g}…{axis.max_deg:g}°",
                     )
+
+
+def with_faults(rig: LoadedConfig[RigConfig], spec: str | None) -> LoadedConfig[RigConfig]:
+    """The rig with `simulation.faults` keys set from the command line: `rate=0.05,kinds=drop+corrupt`."""
+    if not spec:
+        return rig
+    faults = rig.model.simulation.faults.model_dump()
+    for item in spec.split(","):
+        key, sep, value = item.partition("=")
+        key = key.strip().replace("-", "_")
+        if not sep or key not in faults:
+            raise ConfigError(f"--faults: {item.strip()!r}: expected key=value with key one of {', '.join(faults)}")
+        faults[key] = value.split("+") if key == "kinds" else (None if value in ("", "none") else value)
+    try:
+        validated = FaultInjection.model_validate(faults)
+    except ValidationError as exc:
+        err = exc.errors(include_url=False)[0]
+        raise ConfigError(f"--faults: {format_key(tuple(err['loc']))}: {err['msg']}") from None
+    simulation = rig.model.simulation.model_copy(update={"faults": validated})
+    return replace(rig, model=rig.model.model_copy(update={"simulation": simulation}))

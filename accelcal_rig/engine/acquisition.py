@@ -19,15 +19,13 @@ from accelcal_rig.instruments.interfaces import Accelerometer, BlockCapturing, S
 
 #: Attempts at a gap-free block before lost samples are reported as a fault.
 OVERFLOW_ATTEMPTS = 3
-#: Steps of a bridge-side capture: a failure in one restarts the whole capture, so none is retried alone.
-CAPTURE_STEPS = frozenset({"begin_capture", "capture_wait_s", "fetch_capture", "end_capture"})
 
 
 def acquire_together(sensors: Sequence[Accelerometer], n_samples: int, clock: Clock,
                      range_g: int) -> list[SampleBlock]:
     """One gap-free block of `n_samples` from each sensor, over the same instants, each checked by the
     data watchdog (a transient failure: the caller's retry takes a new block)."""
-    if all(sensor.captures_blocks for sensor in sensors):
+    if all(0 < n_samples <= sensor.capture_capacity_samples for sensor in sensors):
         blocks = capture_together(sensors, n_samples, clock)  # type: ignore[arg-type]
     else:
         blocks = clock.run_concurrently([partial(sensor.acquire, n_samples) for sensor in sensors])

@@ -17,7 +17,7 @@ from scipy.spatial.transform import Rotation
 
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.engine.acquisition import CAPTURE_STEPS, acquire_together
+from accelcal_rig.engine.acquisition import acquire_together
 from accelcal_rig.engine.clock import Clock
 from accelcal_rig.engine.events import LOGGER, EventLog, format_duration
 from accelcal_rig.engine.resume import ResumePoint
@@ -72,7 +72,7 @@ class CampaignRunner:
         self.retrier = Retrier(rig.retry, clock, events)
         self.chamber = LimitedChamber(self.retrier.wrap(instruments.chamber), rig.chamber)
         self.turntable = LimitedTurntable(self.retrier.wrap(instruments.turntable), rig.turntable)
-        self.sensors = [self.retrier.wrap(s, not_retried=CAPTURE_STEPS) for s in instruments.sensors]
+        self.sensors = [self.retrier.wrap(s) for s in instruments.sensors]
         self.truth = instruments.truth
         self.writer = writer
         self.clock = clock

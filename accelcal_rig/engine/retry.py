@@ -43,19 +43,18 @@ class Retrier:
                         self._events.warning("retry", f"reconnect failed: {failed}")
         raise AssertionError("unreachable")
 
-    def wrap(self, device: T, not_retried: frozenset[str] = frozenset()) -> T:
-        """The device with every method retried, except those in `not_retried` (steps of a larger
-        operation that is retried whole instead)."""
-        return _RetryingInstrument(device, self, not_retried)  # type: ignore[return-value]
+    def wrap(self, device: T) -> T:
+        """The device with every method retried (each must be safe to repeat)."""
+        return _RetryingInstrument(device, self)  # type: ignore[return-value]
 
 
 class _RetryingInstrument:
     """Stands in for an instrument: attributes pass through, method calls go through the Retrier."""
 
-    def __init__(self, device: Any, retrier: Retrier, not_retried: frozenset[str]) -> None:
+    def __init__(self, device: Any, retrier: Retrier) -> None:
         self._device = device
         self._retrier = retrier
-        self._not_retried = not_retried | {"close", "reconnect"}
+        self._not_retried = frozenset({"close", "reconnect"})
 
     def __getattr__(self, name: str) -> Any:
         attribute = getattr(self._device, name)

@@ -13,7 +13,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from accelcal_rig.config.load import (
-    LoadedConfig, check_procedure_against_rig, load_procedure, load_rig, resolve_rig_path,
+    LoadedConfig, check_procedure_against_rig, load_procedure, load_rig, resolve_rig_path, with_faults,
 )
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
@@ -42,9 +42,10 @@ class PreparedCampaign:
     plan: Plan
 
 
-def prepare(procedure_path: Path, rig_override: Path | None = None) -> PreparedCampaign:
+def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str | None = None) -> PreparedCampaign:
+    """`faults`: fault injection for the simulators, `key=value,…` (see with_faults)."""
     procedure = load_procedure(procedure_path)
-    rig = load_rig(resolve_rig_path(procedure, rig_override))
+    rig = with_faults(load_rig(resolve_rig_path(procedure, rig_override)), faults)
     check_procedure_against_rig(procedure, rig)
     try:
         plan = compile_plan(procedure.model, rig.model)

@@ -18,8 +18,6 @@ from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
 
 #: Samples to let accumulate between FIFO bursts: under its 32, so a burst is never late.
 DRAIN_EVERY_SAMPLES = 30
-#: Share of a bridge's capture buffer to let fill between fetches.
-FETCH_AT_CAPTURE_FRACTION = 0.5
 
 
 @dataclass
@@ -45,9 +43,9 @@ class Adxl355:
         self._capture: _Capture | None = None
 
     @property
-    def captures_blocks(self) -> bool:
-        """Whether the bridge captures blocks itself (then several DUTs are read by one thread)."""
-        return self._bus.capture_capacity_samples > 0
+    def capture_capacity_samples(self) -> int:
+        """The largest block the bridge captures itself (0: none; the host drains the FIFO)."""
+        return self._bus.capture_capacity_samples
 
     # ------------------------------------------------------------------ the Accelerometer interface
     def identify(self) -> DeviceIdentity:
@@ -95,7 +93,7 @@ class Adxl355:
 
     def acquire(self, n_samples: int) -> SampleBlock:
         """`n_samples` consecutive samples, captured by the bridge if it can, else drained from the FIFO."""
-        if self.captures_blocks:
+        if 0 < n_samples <= self.capture_capacity_samples:
             return capture_together([self], n_samples, self._clock)[0]
         for _ in range(OVERFLOW_ATTEMPTS):
             block = self._try_drain(n_samples)
@@ -115,18 +113,17 @@ class Adxl355:
         self._capture = _Capture(n_samples, self._clock.now(), temperature_before)
 
     def capture_wait_s(self) -> float:
-        """Clock time until the next fetch is worth making: the rest of the block, or before the bridge's
-        buffer is half full."""
+        """Clock time until the rest of the block has been captured."""
         assert self._capture is not None
-        fetch_every = max(1, int(self._bus.capture_capacity_samples * FETCH_AT_CAPTURE_FRACTION))
-        return min(fetch_every, self._capture.n_samples - self._capture.have) / self._odr_hz
+        return (self._capture.n_samples - self._capture.have) / self._odr_hz
 
     def fetch_capture(self) -> bool:
-        """Fetch what the bridge has captured; True once the block is complete. A capture that lost
-        samples raises CaptureOverflow; one that stalls past its deadline is a fault."""
+        """Fetch what the bridge has captured since the last fetch (asked for by index, so a retry after
+        a lost reply loses nothing); True once the block is complete. A capture that lost samples raises
+        CaptureOverflow; one that stalls past its deadline is a fault."""
         capture, bridge = self._capture, self._bus
         assert capture is not None
-        raw, temperature_raw = bridge.fetch_capture()  # type: ignore[attr-defined]
+        raw, temperature_raw = bridge.fetch_capture(capture.have)  # type: ignore[attr-defined]
         codes, capture.carried = adxl355.decode_fifo(raw, capture.carried)
         capture.blocks.append(codes)
         capture.have += len(codes)

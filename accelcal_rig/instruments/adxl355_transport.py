@@ -8,14 +8,16 @@ The bridge protocol (docs/instruments.md): one ASCII request per line, one reply
     C <count>            → `=<TEMP2 TEMP1>` (version 2) empty the FIFO, then capture the next `count`
                                             samples into the bridge's own memory, draining the FIFO
                                             itself; the reply is the temperature as the capture starts
-    G                    → `=<hex bytes>`   (version 2) the captured samples not fetched yet, 9 bytes each
-                                            in FIFO format; the reply that completes the capture ends in
-                                            `T<TEMP2 TEMP1>`, the temperature as the last sample came;
-                                            `!overflow …` if the capture lost samples
+    G <first>            → `=<hex bytes>`   (version 2) the captured samples from index `first` on, 9 bytes
+                                            each in FIFO format; once the capture is complete the reply
+                                            ends in `T<TEMP2 TEMP1>`, the temperature as the last sample
+                                            came; `!overflow …` if the capture lost samples. The capture
+                                            stays until the next `C`, so a lost reply is asked for again
     any failure          → `!<message>`
 
-A version 2 bridge greets with `capture=<samples>` (its buffer). At high data rates a host behind USB
-serial cannot drain a 32-sample FIFO in time (at 4 kHz it fills in 8 ms), the bridge's firmware can.
+A version 2 bridge greets with `capture=<samples>`, its buffer and the largest `count`. At high data rates
+a host behind USB serial cannot drain a 32-sample FIFO in time (at 4 kHz it fills in 8 ms); the bridge's
+firmware can.
 """
 
 from __future__ import annotations
@@ -48,8 +50,8 @@ class BlockCapture(Protocol):
     def start_capture(self, n_samples: int) -> int:
         """Start capturing; returns the raw 12-bit temperature as the capture starts."""
 
-    def fetch_capture(self) -> tuple[bytes, int | None]:
-        """(captured FIFO bytes not fetched yet, raw temperature at the end if this completed the capture)."""
+    def fetch_capture(self, first: int) -> tuple[bytes, int | None]:
+        """(captured FIFO bytes from sample `first` on, raw temperature at the end once it is complete)."""
 
 
 class SerialBridge:
@@ -95,11 +97,12 @@ class SerialBridge:
                                            f"{reply[:40]!r}")
         return temperature
 
-    def fetch_capture(self) -> tuple[bytes, int | None]:
-        reply = self._line.ask("G")
+    def fetch_capture(self, first: int) -> tuple[bytes, int | None]:
+        request = f"G {first}"
+        reply = self._line.ask(request)
         if reply.startswith("!overflow"):
             raise CaptureOverflow(f"sensor bridge ({self.endpoint}): {reply[1:]}")
-        reply = self._refusal_raised("G", reply)
+        reply = self._refusal_raised(request, reply)
         samples, end_marker, temperature_hex = reply[1:].partition("T")
         temperature = _raw_temperature(temperature_hex) if end_marker else None
         try:

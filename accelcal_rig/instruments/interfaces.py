@@ -65,8 +65,8 @@ class Accelerometer(Protocol):
     endpoint: str
 
     @property
-    def captures_blocks(self) -> bool:
-        """True when it also implements BlockCapturing (its bridge captures blocks by itself)."""
+    def capture_capacity_samples(self) -> int:
+        """The largest block its bridge captures by itself (then it implements BlockCapturing); 0: none."""
 
     def identify(self) -> DeviceIdentity: ...
     def reset(self) -> None: ...

@@ -46,7 +46,6 @@ class SimulatedAdxl355:
         self._next_sample_s: float | None = None
         self._capture_left = 0
         self._captured = bytearray()
-        self._capture_overflow = False
         self._capture_end_temperature_raw: int | None = None
 
     @property
@@ -105,25 +104,22 @@ class SimulatedAdxl355:
         temperature as it starts."""
         if not self._measuring:
             raise ValueError("capture needs the part measuring")
-        if n_samples <= 0:
-            raise ValueError(f"capture count {n_samples} must be positive")
+        if not 0 < n_samples <= CAPTURE_CAPACITY_SAMPLES:
+            raise ValueError(f"capture count {n_samples} must be 1…{CAPTURE_CAPACITY_SAMPLES}")
         self._fill_fifo()
         self._fifo.clear()
         self._fifo_pending = 0
         self._overflow = False
-        self._capture_left, self._captured, self._capture_overflow = n_samples, bytearray(), False
+        self._capture_left, self._captured = n_samples, bytearray()
         self._capture_end_temperature_raw = None
         return self._temperature_raw()
 
-    def fetch_capture(self) -> tuple[bytes, int | None]:
-        """(captured samples not fetched yet, raw temperature at the end once the capture completed)."""
+    def fetch_capture(self, first: int) -> tuple[bytes, int | None]:
+        """(the capture's samples from index `first` on, raw temperature at its end once it is complete).
+        The capture stays until the next one starts, so a reply lost on the line can be asked for again."""
         self._fill_fifo()
-        if self._capture_overflow:
-            self._capture_overflow = False
-            raise ValueError(f"overflow: more than {CAPTURE_CAPACITY_SAMPLES} samples were not fetched")
-        taken, self._captured = bytes(self._captured), bytearray()
-        end_temperature, self._capture_end_temperature_raw = self._capture_end_temperature_raw, None
-        return taken, end_temperature
+        taken = bytes(self._captured[9 * first:])
+        return taken, self._capture_end_temperature_raw if self._capture_left == 0 else None
 
     def _fill_fifo(self) -> None:
         """Add the samples due since the last look: first to a capture under way, then to the FIFO, which
@@ -169,12 +165,9 @@ class SimulatedAdxl355:
         """Move the next `count` samples into the capture buffer; returns how many samples were due."""
         assert self._next_sample_s is not None
         self._capture_left -= count
-        if len(self._captured) // 9 + count > CAPTURE_CAPACITY_SAMPLES:
-            self._capture_overflow, self._capture_left = True, 0
-        else:
-            self._captured += adxl355.encode_fifo(self._samples(self._next_sample_s, count))
-            if self._capture_left == 0:
-                self._capture_end_temperature_raw = self._temperature_raw()
+        self._captured += adxl355.encode_fifo(self._samples(self._next_sample_s, count))
+        if self._capture_left == 0:
+            self._capture_end_temperature_raw = self._temperature_raw()
         self._next_sample_s += count / self._odr_hz
         return count
 
@@ -211,8 +204,8 @@ class SimulatedBridgeServer:
                     return "="
                 if self._version >= 2 and len(parts) == 2 and parts[0] == "C":
                     return f"={self.device.start_capture(int(parts[1])):04X}"
-                if self._version >= 2 and parts == ["G"]:
-                    samples, end_temperature = self.device.fetch_capture()
+                if self._version >= 2 and len(parts) == 2 and parts[0] == "G":
+                    samples, end_temperature = self.device.fetch_capture(int(parts[1]))
                     end = "" if end_temperature is None else f"T{end_temperature:04X}"
                     return "=" + samples.hex().upper() + end
         except ValueError as exc:

@@ -76,7 +76,7 @@ class SimulatedAccelerometer:
     """An ADXL355 whose samples come from its hidden truth, the table's true angles and white noise."""
 
     endpoint = ENDPOINT
-    captures_blocks = False  # read one thread per DUT, as a host draining FIFOs would
+    capture_capacity_samples = 0  # read one thread per DUT, as a host draining FIFOs would
 
     def __init__(self, lab: VirtualLab, index: int) -> None:
         self._lab = lab

@@ -99,7 +99,7 @@ def test_configure_outside_standby_is_refused(sensor) -> None:
 def test_the_greeting_says_whether_the_bridge_captures(sensor) -> None:
     driver, server, _, _ = sensor
     expected = 4096 if server._version >= 2 else 0
-    assert driver._bus.capture_capacity_samples == expected
+    assert driver.capture_capacity_samples == expected
 
 
 def test_a_fifo_the_link_cannot_keep_up_with_is_a_fault(fifo_sensor, monkeypatch) -> None:
@@ -109,12 +109,39 @@ def test_a_fifo_the_link_cannot_keep_up_with_is_a_fault(fifo_sensor, monkeypatch
         fifo_sensor.acquire(200)
 
 
-def test_a_capture_fetched_too_late_is_a_fault(capturing_sensor, monkeypatch) -> None:
-    bring_up(capturing_sensor, odr_hz=4000.0)
-    monkeypatch.setattr(capturing_sensor._bus, "capture_capacity_samples", 20000)  # the driver waits too long
-    monkeypatch.setattr("accelcal_rig.instruments.adxl355_driver.FETCH_AT_CAPTURE_FRACTION", 1.0)
-    with pytest.raises(InstrumentError, match="FIFO overflowed in 3 attempts"):
-        capturing_sensor.acquire(10000)
+def test_a_capture_that_keeps_losing_samples_is_a_fault() -> None:
+    clock = VirtualClock()
+    replies = {"?": "ADXL355-BRIDGE 2 capture=512 test", "R": "=000007A0", "C": "=07A0", "G": "!overflow: FIFO"}
+    server = PtyLineServer(lambda request: replies[request[0]]).start()
+    try:
+        driver = Adxl355(SerialBridge.open(server.path), "SN-1", clock)
+        with pytest.raises(InstrumentError, match="FIFO overflowed in 3 attempts"):
+            driver.acquire(100)
+        driver.close()
+    finally:
+        server.stop()
+
+
+def test_a_lost_fetch_reply_is_asked_for_again_without_losing_samples(capturing_sensor) -> None:
+    bring_up(capturing_sensor)
+    bridge = capturing_sensor._bus
+    real_fetch, calls = bridge.fetch_capture, []
+
+    def lossy_fetch(first: int):
+        calls.append(first)
+        reply = real_fetch(first)
+        if len(calls) == 1:
+            raise InstrumentError("reply lost on the line")  # the bridge answered; the host never heard it
+        return reply
+
+    bridge.fetch_capture = lossy_fetch
+    capturing_sensor.begin_capture(100)
+    capturing_sensor._clock.sleep(capturing_sensor.capture_wait_s())
+    with pytest.raises(InstrumentError):
+        capturing_sensor.fetch_capture()
+    assert capturing_sensor.fetch_capture()  # asked again from the same index: complete
+    block = capturing_sensor.end_capture()
+    assert calls == [0, 0] and block.codes_xyz.shape == (100, 3)
 
 
 def test_a_sensor_in_standby_gives_no_samples_before_the_deadline(fifo_sensor) -> None:
@@ -192,8 +219,8 @@ def test_capture_capacity_comes_from_the_greeting(greeting: str, capacity: int) 
 
 @pytest.mark.parametrize(("request_kind", "reply", "message"), [
     ("C", "=", r"capture of 10 answered '='"),
-    ("G", "=00112", "garbled capture"),
-    ("G", "=T07", "garbled capture"),
+    ("G 0", "=00112", "garbled capture"),
+    ("G 0", "=T07", "garbled capture"),
     ("G", "!overflow: 4097 samples", r"overflow: 4097 samples")])
 def test_capture_replies_are_checked(request_kind: str, reply: str, message: str) -> None:
     def bridge(request: str) -> str:
@@ -206,7 +233,7 @@ def test_capture_replies_are_checked(request_kind: str, reply: str, message: str
         transport = SerialBridge.open(server.path)
         with pytest.raises(InstrumentError, match=message):
             transport.start_capture(10)
-            transport.fetch_capture()
+            transport.fetch_capture(0)
         transport.close()
     finally:
         server.stop()
