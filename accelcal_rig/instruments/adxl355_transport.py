@@ -28,6 +28,8 @@ from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.line_port import LinePort
 
 BRIDGE_GREETING = "ADXL355-BRIDGE"
+#: Tries of the greeting when a bridge is opened (a board may still be booting, or the line noisy).
+GREETING_ATTEMPTS = 3
 
 
 class RegisterTransport(Protocol):
@@ -65,7 +67,14 @@ class SerialBridge:
     @classmethod
     def open(cls, endpoint: str, baudrate: int = 921600, timeout_s: float = 1.0) -> SerialBridge:
         bridge = cls(LinePort.open(endpoint, "sensor bridge", baudrate, timeout_s), f"serial {endpoint}")
-        greeting = bridge._ask("?")
+        for attempt in range(1, GREETING_ATTEMPTS + 1):  # before any event log exists: retried here, quietly
+            try:
+                greeting = bridge._ask("?")
+                break
+            except TransientInstrumentError:
+                if attempt == GREETING_ATTEMPTS:
+                    bridge.close()
+                    raise
         if not greeting.startswith(BRIDGE_GREETING):
             bridge.close()
             raise InstrumentError(f"sensor bridge (serial {endpoint}): not an ADXL355 bridge (answers {greeting!r})")

@@ -59,9 +59,17 @@ class SimulatedChamberServer:
 
     def stop(self) -> None:
         if self._server is not None and self._loop.is_running():
-            asyncio.run_coroutine_threadsafe(self._server.shutdown(), self._loop).result(_STARTUP_TIMEOUT_S)
+            asyncio.run_coroutine_threadsafe(self._shutdown(), self._loop).result(_STARTUP_TIMEOUT_S)
             self._loop.call_soon_threadsafe(self._loop.stop)
         self._thread.join(_STARTUP_TIMEOUT_S)
+
+    async def _shutdown(self) -> None:
+        """Stop serving; requests still held back by a fault are dropped for good."""
+        assert self._server is not None
+        await self._server.shutdown()
+        for task in asyncio.all_tasks():
+            if task is not asyncio.current_task():
+                task.cancel()
 
     # ------------------------------------------------------------------ server thread
     def _run(self) -> None:

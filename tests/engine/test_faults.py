@@ -1,0 +1,95 @@
+"""Faults injected into the wire-level simulators: transient ones are retried and the campaign completes
+with every pose stored once; persistent ones end in the safe state, recorded in the file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+import pytest
+
+from accelcal_rig.engine.session import prepare
+from accelcal_rig.errors import CampaignAborted
+from accelcal_rig.sim.wire_rig import SimulatedRig
+from accelcal_rig.store.read import integrity_problems
+from tests.conftest import TINY_PROCEDURE
+from tests.engine.test_campaign import events
+
+#: Short wire timeouts: the simulators answer in a millisecond, and a dropped reply costs one timeout.
+FAST_TIMEOUTS = {"chamber:\n": "chamber:\n  timeout_s: 0.3\n", "turntable:\n": "turntable:\n  timeout_s: 0.3\n"}
+
+
+def fast_rig(workdir: Path) -> None:
+    rig = (workdir / "sim.yaml").read_text()
+    for old, new in FAST_TIMEOUTS.items():
+        rig = rig.replace(old, new, 1)
+    rig = rig.replace("name: dut1}", "name: dut1, timeout_s: 0.3}").replace("name: dut2,", "name: dut2, timeout_s: 0.3,")
+    rig = rig.replace("name: dut3,", "name: dut3, timeout_s: 0.3,").replace("name: dut4,", "name: dut4, timeout_s: 0.3,")
+    (workdir / "sim.yaml").write_text(rig + "retry: {attempts: 8}\n")
+
+
+def run_wired(write, workdir: Path, faults: str) -> tuple[Path, SimulatedRig, CampaignAborted | None]:
+    """A dry run through the wires with `faults`; returns the simulated rig to inspect its last commands."""
+    from accelcal_rig.engine import session
+
+    fast_rig(workdir)
+    prepared = prepare(write("tiny.yaml", TINY_PROCEDURE), faults=faults)
+    kept: dict[str, SimulatedRig] = {}
+    real = session.SimulatedRig
+
+    def keep(*args, **kwargs):
+        kept["rig"] = real(*args, **kwargs)
+        return kept["rig"]
+
+    output, error = workdir / "run.h5", None
+    session.SimulatedRig = keep
+    try:
+        session.run_campaign(prepared, output, dry_run=True, seed=2, overwrite=False)
+    except CampaignAborted as exc:
+        error = exc
+    finally:
+        session.SimulatedRig = real
+    return output, kept["rig"], error
+
+
+def test_transient_faults_are_retried_and_every_pose_is_stored_once(write, workdir: Path) -> None:
+    output, rig, error = run_wired(write, workdir, "rate=0.1,seed=3")
+    assert error is None
+    with h5py.File(output, "r") as f:
+        assert f.attrs["state"] == "done" and f["poses/step_key"].shape[0] == 6
+        assert integrity_problems(f) == []
+    retries = events(output, "retry")
+    assert len(retries) >= 10
+    for instrument in ("chamber (modbus-tcp", "turntable (serial", "sensor bridge (serial"):
+        assert any(m.startswith(instrument) for m in retries), instrument
+    assert any("no reply within the timeout" in m for m in retries)
+    assert any("garbled" in m or "answered" in m or "unexpected reply" in m for m in retries)
+
+
+def assert_safe_and_recorded(output: Path, rig: SimulatedRig, error: CampaignAborted | None, reason: str) -> None:
+    assert error is not None and reason in str(error)
+    assert rig.chamber.last_setpoint_c == 23.0  # what the simulator last heard: the safe setpoint
+    assert rig.turntable.last_command == "STOP"
+    assert all(not bridge.device._measuring for bridge in rig.bridges.values())
+    with h5py.File(output, "r") as f:
+        assert f.attrs["state"] == "aborted" and reason in f.attrs["abort_reason"]
+        assert integrity_problems(f) == []
+
+
+@pytest.mark.parametrize(("faults", "reason"), [
+    ("chamber_stall_after_min=0", "reaching 30 °C: not reached within"),
+    ("turntable_stall_after_min=0", "turntable (serial /dev/pts/"),
+    ("sensor_wrong_id=ADX355-A002", "identity AD/1D/E9 is not an ADXL355"),
+    ("sensor_stuck=ADX355-A003", "data stuck"),
+])
+def test_persistent_faults_end_in_the_safe_state(write, workdir: Path, faults: str, reason: str) -> None:
+    output, rig, error = run_wired(write, workdir, faults)
+    assert_safe_and_recorded(output, rig, error, reason)
+
+
+def test_instruments_that_never_answer_are_refused_before_the_campaign_starts(write, workdir: Path) -> None:
+    from accelcal_rig.errors import InstrumentError
+
+    with pytest.raises(InstrumentError, match=r"sensor bridge \(serial /dev/pts/\d+\): '\?': no reply within the timeout"):
+        run_wired(write, workdir, "rate=1,kinds=drop")
+    assert not (workdir / "run.h5").exists()
