@@ -2,6 +2,7 @@
 
     python bench/reliability.py crash --trials 50     # kill -9 the paper dry run at a random moment, resume
     python bench/reliability.py signals --trials 20   # SIGINT / SIGTERM at a random moment
+    python bench/reliability.py faults --trials 3     # injected faults, transient and persistent
 
 Crash trials: `rig run procedures/paper-24pos-thermal.yaml --dry-run` is killed with SIGKILL at a moment
 drawn uniformly over an uninterrupted run's wall time; the file must open with h5py as the kill left
@@ -9,7 +10,12 @@ it; `rig resume` must finish the campaign with every pose of the plan stored exa
 good as an uninterrupted run's (|g| RMSE after calibration within 1.2 × the noise floor, the figure the
 accuracy benchmark holds every fit to). Signal trials: the run must exit 130 with the file `aborted`, the
 poses stored whole, and the simulators' last chamber setpoint the safe one, each sensor in standby and
-the turntable stopped, as the file's event log records.
+the turntable stopped, as the file's event log records. Fault trials: with 1 %, 5 % and 20 % of all
+replies spoiled (dropped, late, corrupted, a line dead for 2 s of campaign time) the campaign must complete with every
+pose stored once; with a persistent fault (chamber or turntable stall at a random time, a wrong part ID,
+a DUT whose data freeze at a random time) it must end `aborted` with the safe state recorded. Fault
+trials use a copy of the simulated rig with 0.05 s wire timeouts and 10 tries per request (a lab with a
+link this bad would configure the same), so that a dropped reply costs 0.05 s of wall time.
 """
 
 from __future__ import annotations
@@ -130,15 +136,75 @@ def signal_trial(folder: Path, send_at_s: float, signum: int) -> tuple[bool, str
                f"sensors {standby}{'; ' + '; '.join(problems) if problems else ''}"
 
 
+def lossy_rig(folder: Path) -> Path:
+    """The paper procedure on a copy of the simulated rig with short timeouts and more retries."""
+    rig = (REPO / "configs" / "sim.yaml").read_text()
+    for section in ("chamber:\n", "turntable:\n"):
+        rig = rig.replace(section, section + "  timeout_s: 0.05\n", 1)
+    for n in range(1, 5):
+        rig = rig.replace(f"name: dut{n}", f"name: dut{n}, timeout_s: 0.05", 1)
+    (folder / "sim.yaml").write_text(rig + "retry: {attempts: 10}\n")
+    procedure = folder / "paper.yaml"
+    procedure.write_text(PAPER.read_text().replace("rig: ../configs/sim.yaml", "rig: sim.yaml"))
+    return procedure
+
+
+def fault_trial(procedure: Path, faults: str, persistent: bool) -> tuple[bool, str, float]:
+    output = procedure.parent / "faults.h5"
+    for stale in (output, output.with_suffix(".h5.log")):
+        stale.unlink(missing_ok=True)
+    start = time.perf_counter()
+    run = subprocess.run([RIG, "run", str(procedure), "--dry-run", "-o", str(output), "-q", "--faults", faults],
+                         capture_output=True, text=True)
+    wall = time.perf_counter() - start
+    with h5py.File(output, "r") as f:
+        state, problems = str(f.attrs["state"]), integrity_problems(f)
+        stored, planned = f["poses/step_key"].shape[0], int((f["plan/kind"][:] == b"pose").sum())
+        kinds = [k.decode() for k in f["events/kind"][:]]
+        messages = [m.decode() for m in f["events/message"][:]]
+        reason = str(f.attrs["abort_reason"])
+    retries = kinds.count("retry")
+    if persistent:
+        safe = messages[-8:]
+        recorded = (any("to 23 °C" in m for m in safe) and any("turntable" in m and "stop" in m for m in safe)
+                    and sum("standby" in m for m in safe) == 4)
+        ok = run.returncode != 0 and state == "aborted" and recorded and not problems
+        return ok, f"aborted after {stored} poses ({reason[:90]}); safe state recorded: {recorded}", wall
+    ok = run.returncode == 0 and state == "done" and stored == planned and not problems
+    return ok, f"{state}, {stored}/{planned} poses, {retries} retries logged{'; ' + run.stderr[-120:] if not ok else ''}", wall
+
+
+def fault_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, int]:
+    procedure = lossy_rig(folder)
+    passed = total = 0
+    for rate in (0.01, 0.05, 0.2):
+        for trial in range(trials):
+            ok, note, wall = fault_trial(procedure, f"rate={rate},seed={trial}", persistent=False)
+            passed, total = passed + ok, total + 1
+            print(f"transient {rate:4.0%} seed {trial}: {'pass' if ok else 'FAIL'} in {wall:5.1f} s  {note}", flush=True)
+    for trial in range(trials):
+        minutes = rng.uniform(0, 600)
+        for faults in (f"chamber_stall_after_min={minutes:.0f}", f"turntable_stall_after_min={minutes:.0f}",
+                       "sensor_wrong_id=ADX355-A002", f"sensor_stuck=ADX355-A003,sensor_stuck_after_min={minutes:.0f}"):
+            ok, note, wall = fault_trial(procedure, faults, persistent=True)
+            passed, total = passed + ok, total + 1
+            print(f"persistent {faults}: {'pass' if ok else 'FAIL'} in {wall:5.1f} s  {note}", flush=True)
+    return passed, total
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("kind", choices=["crash", "signals"])
+    parser.add_argument("kind", choices=["crash", "signals", "faults"])
     parser.add_argument("--trials", type=int, default=50)
     parser.add_argument("--seed", type=int, default=1)
     args = parser.parse_args()
     rng = random.Random(args.seed)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
+        if args.kind == "faults":
+            passed, total = fault_trials(folder, args.trials, rng)
+            print(f"faults: {passed}/{total} trials passed")
+            sys.exit(0 if passed == total else 1)
         wall_s, reference = uninterrupted(folder)
         worst_reference = max(rmse / floor for rmse, floor in reference.values())
         print(f"uninterrupted run: {wall_s:.1f} s wall, rmse_after / noise floor worst {worst_reference:.2f}")

@@ -155,7 +155,7 @@ class FaultInjection(_Strict):
     rate: float = Field(0.0, ge=0, le=1, description="share of replies hit by a transient fault")
     kinds: list[Literal["drop", "delay", "corrupt", "disconnect", "busy"]] = ["drop", "delay", "corrupt", "disconnect"]
     delay_s: float = Field(0.05, ge=0, description="wall-clock delay of a delayed reply")
-    disconnect_s: float = Field(0.3, ge=0, description="wall-clock time a disconnected line stays dead")
+    disconnect_s: float = Field(2.0, ge=0, description="campaign time a disconnected line stays dead")
     seed: int = 0
     chamber_stall_after_min: float | None = Field(None, ge=0, description="the chamber stops following its setpoint")
     turntable_stall_after_min: float | None = Field(None, ge=0, description="the turntable stops moving")

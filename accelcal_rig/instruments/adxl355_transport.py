@@ -22,6 +22,7 @@ firmware can.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Protocol
 
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
@@ -65,16 +66,21 @@ class SerialBridge:
         self.capture_capacity_samples = 0
 
     @classmethod
-    def open(cls, endpoint: str, baudrate: int = 921600, timeout_s: float = 1.0) -> SerialBridge:
+    def open(cls, endpoint: str, baudrate: int = 921600, timeout_s: float = 1.0,
+             attempts: int = GREETING_ATTEMPTS, sleep: Callable[[float], None] | None = None) -> SerialBridge:
+        """Open and greet: `attempts` tries of the greeting, `sleep` (the campaign clock's) waiting 0.5 s,
+        1 s, 2 s … between them (before any event log exists: quietly)."""
         bridge = cls(LinePort.open(endpoint, "sensor bridge", baudrate, timeout_s), f"serial {endpoint}")
-        for attempt in range(1, GREETING_ATTEMPTS + 1):  # before any event log exists: retried here, quietly
+        for attempt in range(1, attempts + 1):
             try:
                 greeting = bridge._ask("?")
                 break
             except TransientInstrumentError:
-                if attempt == GREETING_ATTEMPTS:
+                if attempt == attempts:
                     bridge.close()
                     raise
+                if sleep is not None:
+                    sleep(0.5 * 2 ** (attempt - 1))
         if not greeting.startswith(BRIDGE_GREETING):
             bridge.close()
             raise InstrumentError(f"sensor bridge (serial {endpoint}): not an ADXL355 bridge (answers {greeting!r})")
@@ -95,7 +101,7 @@ class SerialBridge:
     def write(self, address: int, value: int) -> None:
         reply = self._ask(f"W {address:02X} {value:02X}")
         if reply != "=":
-            raise InstrumentError(f"sensor bridge ({self.endpoint}): write 0x{value:02X} to 0x{address:02X} "
+            raise TransientInstrumentError(f"sensor bridge ({self.endpoint}): write 0x{value:02X} to 0x{address:02X} "
                                   f"answered {reply[:40]!r}")
 
     def start_capture(self, n_samples: int) -> int:

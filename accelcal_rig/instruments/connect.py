@@ -51,7 +51,8 @@ def connect_rig(rig: RigConfig, endpoints: Endpoints, clock: Clock) -> RigInstru
                                            len(rig.turntable.axes), rig.turntable.baudrate,
                                            rig.turntable.timeout_s))
         for sensor in rig.fixture.sensors:
-            opened.append(Adxl355(_transport(sensor, endpoints.sensors[sensor.serial]), sensor.serial, clock))
+            transport = _transport(sensor, endpoints.sensors[sensor.serial], rig.retry.attempts, clock)
+            opened.append(Adxl355(transport, sensor.serial, clock))
     except BaseException:
         for device in opened:
             device.close()
@@ -70,10 +71,10 @@ def _chamber(config: ChamberConfig, endpoints: Endpoints) -> ModbusChamber:
                              config.stopbits, config.timeout_s)
 
 
-def _transport(sensor: SensorConfig, endpoint: str) -> RegisterTransport:
+def _transport(sensor: SensorConfig, endpoint: str, attempts: int, clock: Clock) -> RegisterTransport:
     if sensor.driver == "spidev":
         bus, _, chip_select = endpoint.partition(".")
         if not (bus.isdigit() and chip_select.isdigit()):
             raise InstrumentError(f"sensor {sensor.serial} (spidev {endpoint}): endpoint is not bus.chip_select")
         return SpidevBus.open(int(bus), int(chip_select), sensor.spi_speed_hz)
-    return SerialBridge.open(endpoint, sensor.baudrate, sensor.timeout_s)
+    return SerialBridge.open(endpoint, sensor.baudrate, sensor.timeout_s, attempts, clock.sleep)

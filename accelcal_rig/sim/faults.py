@@ -1,14 +1,15 @@
 """Transient faults on a simulated instrument's replies: dropped, delayed, corrupted, a dead line.
 
 Each simulator draws from its own random stream (seeded from the fault seed and the instrument's name),
-so a fault run is repeatable. Times here are wall-clock: they act on the wire, whose timeouts are real.
+so a fault run is repeatable. A delay is wall-clock time (it acts on the wire, whose timeouts are real); a
+dead line lasts campaign time, the clock the engine's retry backoff runs on.
 """
 
 from __future__ import annotations
 
 import hashlib
 import threading
-import time
+from collections.abc import Callable
 
 import numpy as np
 
@@ -21,8 +22,10 @@ _JUNK = bytes([0x00, 0x7F, 0xFF, 0x1B])
 class ReplyFaults:
     """Decides, reply by reply, whether and how to spoil it."""
 
-    def __init__(self, faults: FaultInjection, name: str) -> None:
+    def __init__(self, faults: FaultInjection, name: str, now: Callable[[], float]) -> None:
+        """`now`: the campaign clock's time in seconds."""
         self.faults = faults
+        self._now = now
         digest = hashlib.sha256(f"{faults.seed}:{name}".encode()).digest()
         self._rng = np.random.default_rng(int.from_bytes(digest[:8], "little"))
         self._dead_until = 0.0
@@ -33,7 +36,7 @@ class ReplyFaults:
     def draw(self, allowed: tuple[str, ...]) -> str | None:
         """The fault for the next reply (None: answer normally)."""
         with self._lock:
-            if time.monotonic() < self._dead_until:
+            if self._now() < self._dead_until:
                 return "drop"
             kinds = [k for k in self.faults.kinds if k in allowed]
             if not kinds or self._rng.random() >= self.faults.rate:
@@ -41,7 +44,7 @@ class ReplyFaults:
             kind = str(kinds[int(self._rng.integers(len(kinds)))])
             self.counts[kind] = self.counts.get(kind, 0) + 1
             if kind == "disconnect":
-                self._dead_until = time.monotonic() + self.faults.disconnect_s
+                self._dead_until = self._now() + self.faults.disconnect_s
                 return "drop"
             return kind
 

@@ -31,7 +31,7 @@ class SimulatedRig:
         faults = rig.simulation.faults
 
         def reply_faults(name: str) -> ReplyFaults | None:
-            return ReplyFaults(faults, name) if faults.rate > 0 else None
+            return ReplyFaults(faults, name, clock.now) if faults.rate > 0 else None
 
         def after_s(minutes: float | None) -> float | None:
             return None if minutes is None else minutes * 60.0
