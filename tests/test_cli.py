@@ -240,3 +240,23 @@ def test_kill_9_then_resume_stores_every_pose_exactly_once(tmp_path: Path, kill_
         assert f["poses/step_key"].shape[0] == 12
     assert "run 2 resumes" in (tmp_path / "c.h5.log").read_text()  # the log goes on, not replaced
     assert "rig resume" not in rig("status", "c.h5", cwd=tmp_path).stdout
+
+
+def test_resume_of_a_foreign_file_or_bad_faults_is_one_line(write, capsys) -> None:
+    path = write("tiny.yaml", TINY_PROCEDURE)
+    output = path.with_suffix(".h5")
+    output.write_bytes(b"last night's campaign")
+    err = one_line_error(capsys, ["run", str(path), "--dry-run", "-o", str(output), "--resume"], 2)
+    assert "not a readable HDF5 file" in err and output.read_bytes() == b"last night's campaign"
+    err = one_line_error(capsys, ["run", str(path), "--dry-run", "-o", str(path.with_suffix(".x.h5")),
+                                  "--faults", "rate=0.1,colour=red"], 2)
+    assert "--faults: 'colour=red': expected key=value" in err
+
+
+def test_resume_of_a_complete_campaign_says_so_and_exits_0(write, capsys) -> None:
+    path = write("tiny.yaml", TINY_PROCEDURE)
+    output = path.with_suffix(".h5")
+    assert main(["run", str(path), "--dry-run", "-o", str(output), "-q"]) == 0
+    capsys.readouterr()
+    assert main(["resume", str(output), "-q"]) == 0
+    assert "the campaign is complete: nothing to resume" in capsys.readouterr().out
