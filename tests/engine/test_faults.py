@@ -93,3 +93,26 @@ def test_instruments_that_never_answer_are_refused_before_the_campaign_starts(wr
     with pytest.raises(InstrumentError, match=r"sensor bridge \(serial /dev/pts/\d+\): '\?': no reply within the timeout"):
         run_wired(write, workdir, "rate=1,kinds=drop")
     assert not (workdir / "run.h5").exists()
+
+
+@pytest.mark.parametrize(("stop", "at_pose"), [(KeyboardInterrupt, 2), (SystemExit, 5)])
+def test_a_stop_mid_campaign_leaves_the_simulators_safe(write, workdir: Path, monkeypatch, stop, at_pose) -> None:
+    """As a signal surfaces (stop_when_safe raises it between two poses): the simulators at the far end of
+    the wires last heard the safe setpoint and a STOP, and every sensor is in standby."""
+    from accelcal_rig.store.campaign_file import CampaignWriter
+
+    real_append, stored = CampaignWriter.append_pose, []
+
+    def append_then_stop(self, pose):
+        real_append(self, pose)
+        stored.append(pose.step_key)
+        if len(stored) == at_pose:
+            raise stop()
+
+    monkeypatch.setattr(CampaignWriter, "append_pose", append_then_stop)
+    output, rig, error = run_wired(write, workdir, "rate=0")
+    assert error is not None
+    assert rig.chamber.last_setpoint_c == 23.0 and rig.turntable.last_command == "STOP"
+    assert all(not bridge.device._measuring for bridge in rig.bridges.values())
+    with h5py.File(output, "r") as f:
+        assert f.attrs["state"] == "aborted" and f["poses/step_key"].shape[0] == at_pose
