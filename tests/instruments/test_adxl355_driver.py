@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 import numpy as np
 import pytest
 
@@ -18,37 +20,38 @@ from accelcal_rig.sim.pty_line_server import PtyLineServer
 from tests.conftest import SIM_RIG
 
 
-def open_sensor(protocol_version: int):
+@contextmanager
+def opened_sensor(protocol_version: int):
+    """(driver, server, lab, clock) of DUT 2 behind a simulated bridge speaking `protocol_version`."""
     clock = VirtualClock()
     lab = VirtualLab(load_rig(SIM_RIG).model, clock, 3)
     server = SimulatedBridgeServer(lab, 1, protocol_version).start()
-    return Adxl355(SerialBridge.open(server.path), "ADX355-A002", clock), server, lab, clock
+    driver = Adxl355(SerialBridge.open(server.path), "ADX355-A002", clock)
+    try:
+        yield driver, server, lab, clock
+    finally:
+        driver.close()
+        server.stop()
 
 
 @pytest.fixture(params=[1, 2], ids=["host-drains-fifo", "bridge-captures"])
 def sensor(request):
     """Both ways to a block: the host draining the FIFO (a version 1 bridge, as spidev) and the bridge's
     own capture (version 2)."""
-    driver, server, lab, clock = open_sensor(request.param)
-    yield driver, server, lab, clock
-    driver.close()
-    server.stop()
+    with opened_sensor(request.param) as opened:
+        yield opened
 
 
 @pytest.fixture
 def fifo_sensor():
-    driver, server, lab, clock = open_sensor(1)
-    yield driver
-    driver.close()
-    server.stop()
+    with opened_sensor(1) as (driver, *_):
+        yield driver
 
 
 @pytest.fixture
 def capturing_sensor():
-    driver, server, lab, clock = open_sensor(2)
-    yield driver
-    driver.close()
-    server.stop()
+    with opened_sensor(2) as (driver, *_):
+        yield driver
 
 
 def bring_up(driver: Adxl355, range_g: int = 2, odr_hz: float = 125.0) -> None:
