@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import os
 import signal
 import sys
 from collections.abc import Iterator
@@ -316,7 +317,14 @@ def run_program() -> None:
     By the time a command returns, its campaign is recorded (done, or aborted and safe); a second
     Ctrl-C arriving while the interpreter shuts down must not turn that into a kill by signal.
     """
-    code = main()
+    try:
+        code = main()
+    except KeyboardInterrupt:  # a signal between start and the command's own handling
+        print("rig: interrupted before the campaign started; nothing was moved", file=sys.stderr)
+        code = EXIT_INTERRUPTED
+    except BrokenPipeError:  # `rig status … | head`: the reader has gone; so has the need to print
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        code = 0
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     raise SystemExit(code)

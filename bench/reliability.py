@@ -24,6 +24,7 @@ import argparse
 import json
 import os
 import random
+import re
 import signal
 import subprocess
 import sys
@@ -105,7 +106,7 @@ def resume_cost(events: list[tuple[float, str]]) -> dict[str, float]:
         return {}  # every pose was stored when the kill came: the resume only made safe and fitted
     t_ramp = ramps[0]
     t_soak_end = next(t for t, m in after if m.startswith("soak → move"))
-    t_first_pose = next(t for t, m in after if m.endswith(" stored"))
+    t_first_pose = next(t for t, m in after if re.fullmatch(r"\S+/pose\d+ stored", m))
     return {"before_ramp_s": t_ramp - t_resume, "ramp_and_soak_s": t_soak_end - t_ramp,
             "first_pose_after_soak_s": t_first_pose - t_soak_end}
 

@@ -39,8 +39,11 @@ class LinePort:
         except (serial.SerialException, OSError) as exc:
             raise TransientInstrumentError(f"{self.name}: {request!r}: port failed: {exc}", reconnect=True) from None
         if not raw.endswith(self._read_terminator):
+            self._let_late_reply_pass()
             raise TransientInstrumentError(f"{self.name}: {request!r}: no reply within the timeout")
-        return raw[: -len(self._read_terminator)].decode(errors="replace").strip()
+        # Lines before the last are late replies to earlier requests that arrived with this one.
+        last = raw[: -len(self._read_terminator)].split(self._read_terminator)[-1]
+        return last.decode(errors="replace").strip()
 
     def close(self) -> None:
         self._port.close()
@@ -50,6 +53,15 @@ class LinePort:
         timeout_s = self._port.timeout or 1.0
         self._port.close()
         self._port = _open_port(self.name, self._endpoint, self._baudrate, timeout_s)
+
+    def _let_late_reply_pass(self) -> None:
+        """After a timeout, wait one more timeout and discard what comes: a reply that was only late must
+        not be read as the answer to the next request (a line protocol has no request numbers)."""
+        try:
+            self._read_line()
+            self._port.reset_input_buffer()
+        except (serial.SerialException, OSError):
+            pass  # the port itself failed: the next request says so
 
     def _read_line(self) -> bytes:
         """Bytes up to the terminator; stops short at the port's timeout or, for a device that keeps
