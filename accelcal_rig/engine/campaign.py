@@ -70,9 +70,9 @@ class CampaignRunner:
         self.plan = plan
         # Transient failures are retried below the safety limits, so a retried write is checked too.
         self.retrier = Retrier(rig.retry, clock, events)
-        self.chamber = LimitedChamber(self.retrier.wrap(instruments.chamber), rig.chamber)
-        self.turntable = LimitedTurntable(self.retrier.wrap(instruments.turntable), rig.turntable)
-        self.sensors = [self.retrier.wrap(s) for s in instruments.sensors]
+        self.chamber = LimitedChamber(self.retrier.retried(instruments.chamber), rig.chamber)
+        self.turntable = LimitedTurntable(self.retrier.retried(instruments.turntable), rig.turntable)
+        self.sensors = [self.retrier.retried(s) for s in instruments.sensors]
         self.truth = instruments.truth
         self.writer = writer
         self.clock = clock

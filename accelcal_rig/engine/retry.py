@@ -7,12 +7,13 @@ A failure that outlasts its retries becomes a plain InstrumentError, so no outer
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any, TypeVar
+from typing import TypeVar
 
 from accelcal_rig.config.rig import RetryPolicy
 from accelcal_rig.engine.clock import Clock
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.instruments.retrying import Retrying
 
 T = TypeVar("T")
 
@@ -43,26 +44,10 @@ class Retrier:
                         self._events.warning("retry", f"reconnect failed: {failed}")
         raise AssertionError("unreachable")
 
-    def wrap(self, device: T) -> T:
-        """The device with every method retried (each must be safe to repeat)."""
-        return _RetryingInstrument(device, self)  # type: ignore[return-value]
-
-
-class _RetryingInstrument:
-    """Stands in for an instrument: attributes pass through, method calls go through the Retrier."""
-
-    def __init__(self, device: Any, retrier: Retrier) -> None:
-        self._device = device
-        self._retrier = retrier
-        self._not_retried = frozenset({"close", "reconnect"})
-
-    def __getattr__(self, name: str) -> Any:
-        attribute = getattr(self._device, name)
-        if not callable(attribute) or name.startswith("_") or name in self._not_retried:
-            return attribute
-        reconnect = getattr(self._device, "reconnect", None)
-
-        def retried(*args: Any, **kwargs: Any) -> Any:
-            return self._retrier.call(lambda: attribute(*args, **kwargs), reconnect)
-
-        return retried
+    def retried(self, device: T) -> T:
+        """The device with its wire exchanges retried: a driver retries its own exchanges (one request and
+        its reply each, safe to repeat); a device without them (a test double) is retried method by method."""
+        if hasattr(device, "retry_exchanges"):
+            device.retry_exchanges(self.call)  # type: ignore[attr-defined]
+            return device
+        return Retrying(device, self.call)  # type: ignore[return-value]

@@ -15,6 +15,7 @@ from accelcal_rig.errors import InstrumentError, WaitTimeout
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import BlockCapture, RegisterTransport
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
+from accelcal_rig.instruments.retrying import RetryCall, Retrying
 
 #: Samples to let accumulate between FIFO bursts: under its 32, so a burst is never late.
 DRAIN_EVERY_SAMPLES = 30
@@ -36,6 +37,7 @@ class _Capture:
 class Adxl355:
     def __init__(self, transport: RegisterTransport, serial: str, clock: Clock) -> None:
         self._bus = transport
+        self._fifo_bus = transport  # FIFO bursts are never retried alone: a lost reply took samples with it
         self.serial = serial
         self.endpoint = transport.endpoint
         self._clock = clock
@@ -104,6 +106,16 @@ class Adxl355:
 
     def close(self) -> None:
         self._bus.close()
+
+    def retry_exchanges(self, call: RetryCall) -> None:
+        """Retry each register access and capture request on its own (the capture is fetched by index, so
+        that is safe); a FIFO burst is not, its block is taken again whole by the caller."""
+        self._bus = Retrying(self._fifo_bus, call)  # type: ignore[assignment]
+
+    def reconnect(self) -> None:
+        reopen = getattr(self._fifo_bus, "reconnect", None)
+        if reopen is not None:
+            reopen()
 
     # ------------------------------------------------------------------ bridge-side capture
     def begin_capture(self, n_samples: int) -> None:
@@ -178,7 +190,7 @@ class Adxl355:
 
     def _burst(self, carried: bytes) -> tuple[np.ndarray, bytes]:
         """Read the whole FIFO in one burst."""
-        raw = self._bus.read(adxl355.REG_FIFO_DATA, 3 * adxl355.FIFO_CAPACITY_ENTRIES)
+        raw = self._fifo_bus.read(adxl355.REG_FIFO_DATA, 3 * adxl355.FIFO_CAPACITY_ENTRIES)
         return adxl355.decode_fifo(raw, carried)
 
     def _status_and_temperature(self) -> tuple[int, float]:

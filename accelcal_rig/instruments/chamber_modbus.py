@@ -14,6 +14,7 @@ from pymodbus.client.base import ModbusBaseSyncClient
 from pymodbus.exceptions import ModbusException
 
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.instruments.retrying import RetryCall
 from accelcal_rig.instruments.chamber_registers import ChamberRegisterMap
 
 #: Readings outside this are not a chamber's air: the map or word order must be wrong.
@@ -26,6 +27,7 @@ class ModbusChamber:
     def __init__(self, client: ModbusBaseSyncClient, endpoint: str, registers: ChamberRegisterMap,
                  device_id: int = 1) -> None:
         self._client = client
+        self._retry: RetryCall = lambda operation, reconnect: operation()
         self.endpoint = endpoint
         self.registers = registers
         self.device_id = device_id
@@ -97,6 +99,10 @@ class ModbusChamber:
     def close(self) -> None:
         self._client.close()
 
+    def retry_exchanges(self, call: RetryCall) -> None:
+        """Retry each Modbus request on its own (reads, and writes of absolute values, are safe to repeat)."""
+        self._retry = call
+
     def reconnect(self) -> None:
         self._client.close()
         if not self._client.connect():
@@ -131,6 +137,12 @@ class ModbusChamber:
 
     # ------------------------------------------------------------------ wire
     def _read(self, address: int, count: int) -> list[int]:
+        return self._retry(lambda: self._read_once(address, count), self.reconnect)
+
+    def _write(self, address: int, values: list[int]) -> None:
+        self._retry(lambda: self._write_once(address, values), self.reconnect)
+
+    def _read_once(self, address: int, count: int) -> list[int]:
         try:
             reply = self._client.read_holding_registers(address, count=count, device_id=self.device_id)
         except ModbusException as exc:
@@ -141,7 +153,7 @@ class ModbusChamber:
             raise self._error(f"register {address} refused ({reply}): wrong register map?")
         return list(reply.registers)
 
-    def _write(self, address: int, values: list[int]) -> None:
+    def _write_once(self, address: int, values: list[int]) -> None:
         try:
             reply = self._client.write_registers(address, values, device_id=self.device_id)
         except ModbusException as exc:

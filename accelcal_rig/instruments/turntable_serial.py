@@ -8,6 +8,7 @@ import numpy as np
 
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.line_port import LinePort
+from accelcal_rig.instruments.retrying import RetryCall
 from accelcal_rig.instruments.turntable_protocol import Command, TurntableProtocol
 
 
@@ -18,6 +19,7 @@ class SerialTurntable:
         self.protocol = protocol
         self.n_axes = n_axes
         self._error = re.compile(protocol.error_pattern)
+        self._retry: RetryCall = lambda operation, reconnect: operation()
 
     @classmethod
     def open(cls, endpoint: str, protocol: TurntableProtocol, n_axes: int, baudrate: int = 9600,
@@ -55,11 +57,18 @@ class SerialTurntable:
     def close(self) -> None:
         self._line.close()
 
+    def retry_exchanges(self, call: RetryCall) -> None:
+        """Retry each request on its own (a move of three axes is three requests, each safe to repeat)."""
+        self._retry = call
+
     def reconnect(self) -> None:
         self._line.reconnect()
 
     # ------------------------------------------------------------------ wire
     def _ask(self, command: Command, **fields: object) -> dict[str, str]:
+        return self._retry(lambda: self._ask_once(command, **fields), self.reconnect)
+
+    def _ask_once(self, command: Command, **fields: object) -> dict[str, str]:
         request = command.send.format(**fields)
         reply = self._line.ask(request)
         if self._error.search(reply):

@@ -50,9 +50,9 @@ def retrier(attempts: int = 5) -> tuple[Retrier, VirtualClock, RecordingEvents]:
 
 def test_transient_failures_are_retried_with_doubling_capped_backoff() -> None:
     retry, clock, events = retrier()
-    device = retry.wrap(FlakyDevice(failures=4))
+    device = retry.retried(FlakyDevice(failures=4))
     assert device.read(21) == 42
-    assert device._device.calls == 5 and device._device.reconnects == 1
+    assert device._target.calls == 5 and device._target.reconnects == 1
     assert clock.now() == pytest.approx(0.5 + 1.0 + 2.0 + 2.0)  # capped at max_backoff_s
     assert events.warnings[0] == "device (serial /dev/ttyUSB0): no reply; attempt 2 of 5 in 0.5 s after reconnecting"
     assert [w.split("; ")[1] for w in events.warnings[1:]] == ["attempt 3 of 5 in 1 s", "attempt 4 of 5 in 2 s",
@@ -61,17 +61,17 @@ def test_transient_failures_are_retried_with_doubling_capped_backoff() -> None:
 
 def test_a_failure_that_outlasts_its_retries_is_a_plain_fault() -> None:
     retry, _, events = retrier(attempts=3)
-    device = retry.wrap(FlakyDevice(failures=10))
+    device = retry.retried(FlakyDevice(failures=10))
     with pytest.raises(InstrumentError, match=r"no reply \(still failing after 3 attempts\)") as raised:
         device.read(1)
     assert not isinstance(raised.value, TransientInstrumentError)  # an outer retry does not retry it again
-    assert device._device.calls == 3 and len(events.warnings) == 2
+    assert device._target.calls == 3 and len(events.warnings) == 2
 
 
 def test_refusals_are_not_retried_and_attributes_pass_through() -> None:
     retry, clock, events = retrier()
-    device = retry.wrap(FlakyDevice(failures=0))
+    device = retry.retried(FlakyDevice(failures=0))
     with pytest.raises(InstrumentError, match="command refused"):
         device.refuse()
-    assert device._device.calls == 1 and clock.now() == 0.0 and events.warnings == []
+    assert device._target.calls == 1 and clock.now() == 0.0 and events.warnings == []
     assert device.endpoint == "serial /dev/ttyUSB0"
