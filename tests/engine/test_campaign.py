@@ -6,7 +6,6 @@ from pathlib import Path
 
 import h5py
 import numpy as np
-import pytest
 
 from accelcal_rig.engine.session import prepare, run_campaign
 from accelcal_rig.errors import CampaignAborted
