@@ -121,7 +121,7 @@ def signal_trial(folder: Path, send_at_s: float, signum: int) -> tuple[bool, str
     process.send_signal(signum)
     _, err = process.communicate()
     if not output.exists():
-        ok = process.returncode == 130 and "nothing was moved" in err
+        ok = process.returncode == 130 and len(err.strip().splitlines()) == 1 and "interrupted" in err
         return ok, f"before the file existed: exit {process.returncode} {err.strip()[-80:]}"
     with h5py.File(output, "r") as f:
         state = str(f.attrs["state"])
