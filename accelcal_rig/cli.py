@@ -23,6 +23,8 @@ if TYPE_CHECKING:
     from accelcal_rig.engine.session import PreparedCampaign
 
 EXIT_INTERRUPTED = 130
+FAULTS_HELP = ("fault injection into the simulators, e.g. rate=0.05,kinds=drop+corrupt or "
+               "chamber_stall_after_min=60 (keys of simulation.faults)")
 
 
 def _command(commands: argparse._SubParsersAction, name: str, summary: str, description: str,
@@ -46,7 +48,7 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--config", type=Path, help="rig config YAML (overrides the procedure's `rig`)")
     run.add_argument("--dry-run", action="store_true", help="simulated rig in virtual time")
     run.add_argument("--seed", type=int, default=0, help="seed of the simulated noise (default 0)")
-    run.add_argument("--faults", metavar="KEY=VALUE,...", help="fault injection into the simulators, e.g. rate=0.05,kinds=drop+corrupt or chamber_stall_after_min=60 (keys of simulation.faults)")
+    run.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
     run.add_argument("--overwrite", action="store_true", help="replace an existing campaign file")
     run.add_argument("--resume", action="store_true",
                      help="continue the campaign in the output file if it exists (after a crash, a fault or "
@@ -65,7 +67,7 @@ def _build_parser() -> argparse.ArgumentParser:
     resume.add_argument("campaign", type=Path, help="campaign file (HDF5)")
     resume.add_argument("--procedure", type=Path, help="procedure YAML (default: the path stored in the file)")
     resume.add_argument("--config", type=Path, help="rig config YAML (overrides the procedure's `rig`)")
-    resume.add_argument("--faults", metavar="KEY=VALUE,...", help="fault injection into the simulators, e.g. rate=0.05,kinds=drop+corrupt or chamber_stall_after_min=60 (keys of simulation.faults)")
+    resume.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
     resume.add_argument("--calibration", type=Path,
                         help="calibration file the final fit writes (default: beside the campaign, .calibration.yaml)")
     resume.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
@@ -83,7 +85,7 @@ def _build_parser() -> argparse.ArgumentParser:
                      "rig check configs/example-lab.yaml")
     check.add_argument("rig", type=Path, help="rig config YAML")
     check.add_argument("--dry-run", action="store_true", help="check the rig's simulators instead")
-    check.add_argument("--faults", metavar="KEY=VALUE,...", help="fault injection into the simulators, e.g. rate=0.05,kinds=drop+corrupt or chamber_stall_after_min=60 (keys of simulation.faults)")
+    check.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
 
     sim = _command(commands, "sim", "serve the simulated rig as real endpoints until interrupted",
                    "Start the simulated rig of a rig config: the chamber on Modbus TCP (127.0.0.1), the "
@@ -92,7 +94,7 @@ def _build_parser() -> argparse.ArgumentParser:
                    "rig sim configs/sim.yaml")
     sim.add_argument("rig", type=Path, help="rig config YAML")
     sim.add_argument("--seed", type=int, default=0, help="seed of the simulated noise (default 0)")
-    sim.add_argument("--faults", metavar="KEY=VALUE,...", help="fault injection into the simulators, e.g. rate=0.05,kinds=drop+corrupt or chamber_stall_after_min=60 (keys of simulation.faults)")
+    sim.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
 
     fit = _command(commands, "fit", "fit the error model of every DUT and write a calibration file",
                    "LM fit of Eq. 1 at each setpoint, polynomials over the sensor temperature (Eq. 8), metrics. "

@@ -33,6 +33,14 @@ _TRUTH_FIELDS = ("parameters", "gravity_g", "temperature_c")
 _EVENT_FIELDS = ("t_s", "wall_time", "level", "kind", "message")
 FORMAT_VERSION = 1
 TEXT = h5py.string_dtype("utf-8")
+#: Text that grows row by row is fixed-length UTF-8 (bytes per row), kept in the dataset's own chunks:
+#: variable-length strings live in a file-wide heap, which a process killed while flushing can leave
+#: damaged for the next writer. Longer text is cut at a character boundary.
+GROWING_TEXT_BYTES = {"step_key": 64, "wall_time": 32, "level": 8, "kind": 16, "message": 1024}
+
+
+def growing_text(name: str) -> np.dtype:
+    return h5py.string_dtype("utf-8", length=GROWING_TEXT_BYTES[name])
 
 
 def utc_now() -> str:
@@ -61,7 +69,11 @@ class Reopened:
 
 
 def _append_rows(dataset: h5py.Dataset, rows: Any) -> None:
-    rows = np.asarray(rows) if dataset.dtype != TEXT else rows
+    if dataset.dtype.kind == "S":
+        width = dataset.dtype.itemsize
+        rows = np.array([str(r).encode()[:width].decode(errors="ignore").encode() for r in rows], dtype=dataset.dtype)
+    else:
+        rows = np.asarray(rows)
     n = dataset.shape[0]
     dataset.resize(n + len(rows), axis=0)
     dataset[n:] = rows
@@ -117,7 +129,7 @@ class CampaignWriter:
         events = file.create_group("events")
         _growable(events, "t_s", (), "f8", "s", chunk_rows=256)
         for name in _EVENT_FIELDS[1:]:
-            _growable(events, name, (), TEXT, chunk_rows=256)
+            _growable(events, name, (), growing_text(name), chunk_rows=256)
         file.flush()
         return cls(file)
 
@@ -199,7 +211,7 @@ class CampaignWriter:
 
     @staticmethod
     def _create_poses(group: h5py.Group, n_axes: int) -> None:
-        _growable(group, "step_key", (), TEXT)
+        _growable(group, "step_key", (), growing_text("step_key"))
         _growable(group, "setpoint_c", (), "f8", "degC")
         _growable(group, "pose_number", (), "i4")
         _growable(group, "commanded_angles_deg", (n_axes,), "f8", "deg")
