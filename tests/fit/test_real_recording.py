@@ -1,4 +1,4 @@
-"""Against another tool: imucal's published calibration of a real IMU session (shared/data/real).
+"""Against another tool: imucal's published calibration of a real IMU session (tests/data/real).
 
 Six static poses (found here from the recording's labels) identify bias and scale from |g| alone; the
 comparison is of those gauge-invariant quantities, and the 9-parameter fit must be refused.
@@ -16,7 +16,7 @@ import pytest
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
 from tests.conftest import REPO
 
-DATA = REPO.parent / "shared" / "data" / "real"
+DATA = REPO / "tests" / "data" / "real"  # imucal (MIT): see its README
 COUNTS_PER_G_NOMINAL = 2048.0  # the recording's ADC: roughly 2045 counts per g
 
 
@@ -37,7 +37,7 @@ def static_poses() -> tuple[np.ndarray, np.ndarray]:
 @pytest.fixture(scope="module")
 def poses() -> tuple[np.ndarray, np.ndarray]:
     if not (DATA / "imucal-annotated-session.csv").exists():
-        pytest.fail(f"the shared real recording is missing: {DATA}")
+        pytest.fail(f"the real recording is missing: {DATA}")
     return static_poses()
 
 
