@@ -8,14 +8,16 @@ decimals or units register that disagrees with the map, or values no chamber rea
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Any
 
 from pymodbus.client import ModbusSerialClient, ModbusTcpClient
 from pymodbus.client.base import ModbusBaseSyncClient
 from pymodbus.exceptions import ModbusException
 
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
-from accelcal_rig.instruments.retrying import RetryCall
 from accelcal_rig.instruments.chamber_registers import ChamberRegisterMap
+from accelcal_rig.instruments.retrying import RetryCall
 
 #: Readings outside this are not a chamber's air: the map or word order must be wrong.
 PLAUSIBLE_C = (-100.0, 300.0)
@@ -143,25 +145,27 @@ class ModbusChamber:
         self._retry(lambda: self._write_once(address, values), self.reconnect)
 
     def _read_once(self, address: int, count: int) -> list[int]:
-        try:
-            reply = self._client.read_holding_registers(address, count=count, device_id=self.device_id)
-        except ModbusException as exc:
-            raise self._lost(f"no reply reading register {address}: {exc}") from None
-        if reply.isError():
-            if getattr(reply, "exception_code", None) in _BUSY_CODES:
-                raise TransientInstrumentError(f"chamber ({self.endpoint}): busy reading register {address} ({reply})")
-            raise self._error(f"register {address} refused ({reply}): wrong register map?")
+        reply = self._exchange(f"reading register {address}", f"register {address} refused ({{}}): wrong register map?",
+                               lambda: self._client.read_holding_registers(address, count=count,
+                                                                           device_id=self.device_id))
         return list(reply.registers)
 
     def _write_once(self, address: int, values: list[int]) -> None:
+        self._exchange(f"writing register {address}", f"write to register {address} refused ({{}})",
+                       lambda: self._client.write_registers(address, values, device_id=self.device_id))
+
+    def _exchange(self, what: str, refused: str, request: Callable[[], Any]) -> Any:
+        """One Modbus request: no reply is transient (reconnect), busy is transient, any other exception
+        response is a refusal (`refused`, with `{}` for the response)."""
         try:
-            reply = self._client.write_registers(address, values, device_id=self.device_id)
+            reply = request()
         except ModbusException as exc:
-            raise self._lost(f"no reply writing register {address}: {exc}") from None
+            raise self._lost(f"no reply {what}: {exc}") from None
         if reply.isError():
             if getattr(reply, "exception_code", None) in _BUSY_CODES:
-                raise TransientInstrumentError(f"chamber ({self.endpoint}): busy writing register {address} ({reply})")
-            raise self._error(f"write to register {address} refused ({reply})")
+                raise TransientInstrumentError(f"chamber ({self.endpoint}): busy {what} ({reply})")
+            raise self._error(refused.format(reply))
+        return reply
 
     def _lost(self, message: str) -> TransientInstrumentError:
         return TransientInstrumentError(f"chamber ({self.endpoint}): {message}", reconnect=True)
