@@ -149,7 +149,7 @@ class CampaignWriter:
         previous = str(file.attrs["state"])
         stored, cut = writer._cut_to_whole_poses()
         run = int(file.attrs.get("runs", 1)) + 1
-        file.attrs.update({"runs": run, "finished": "", "abort_reason": "", **_writer_attrs()})
+        file.attrs.update({"runs": run, **_writer_attrs()})  # the last abort reason stays until this run starts
         file.flush()
         return writer, Reopened(previous, run, stored, cut, writer._clock_now_s())
 
@@ -311,6 +311,8 @@ class CampaignWriter:
     def set_state(self, state: str, *, reason: str = "", finished: bool = False) -> None:
         with signals_deferred():
             self._file.attrs["state"] = state
+            if state == "running":  # a resumed run starts afresh: the last run's ending no longer applies
+                self._file.attrs.update({"abort_reason": "", "finished": ""})
             if reason:
                 self._file.attrs["abort_reason"] = reason
             if finished:

@@ -187,3 +187,21 @@ def test_a_soak_that_times_out_is_skipped_or_measured_as_the_procedure_says(writ
     else:
         assert sorted(set(setpoints)) == [20.0, 30.0] and len(setpoints) == 12
         assert len(warnings) == 1 and warnings[0].endswith("measuring its poses anyway (soak.on_timeout: proceed)")
+
+
+def test_a_resume_that_cannot_connect_keeps_the_last_abort_reason(write, workdir: Path) -> None:
+    procedure, output = write("two.yaml", TWO_SETPOINTS), workdir / "c.h5"
+    with pytest.raises(CampaignAborted):
+        run(procedure, output, fail_at_pose=3)
+
+    def unreachable(rig, procedure_model, clock, seed):
+        raise ConfigError("chamber (modbus-tcp 10.0.0.9:502): cannot connect")
+
+    with pytest.raises(ConfigError, match="cannot connect"):
+        run_campaign(prepare(procedure), output, dry_run=True, seed=1, overwrite=False,
+                     build_instruments=unreachable, resume=True)
+    with h5py.File(output, "r") as f:
+        assert "turntable link lost" in f.attrs["abort_reason"] and f.attrs["finished"]
+    run(procedure, output, resume=True)
+    with h5py.File(output, "r") as f:
+        assert f.attrs["state"] == "done" and f.attrs["abort_reason"] == "" and f.attrs["runs"] == 3
