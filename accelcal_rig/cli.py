@@ -20,6 +20,7 @@ from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
 from accelcal_rig.store.atomic import stop_when_safe
 
 if TYPE_CHECKING:
+    from accelcal_rig.engine.progress import ProgressListener
     from accelcal_rig.engine.session import PreparedCampaign
 
 EXIT_INTERRUPTED = 130
@@ -57,6 +58,15 @@ def _build_parser() -> argparse.ArgumentParser:
                      help="calibration file the final fit writes (default: beside the campaign, .calibration.yaml)")
     run.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
     run.add_argument("-q", "--quiet", action="store_true", help="print only warnings and the summary")
+
+    plan = _command(commands, "plan", "validate a procedure, show its schedule and estimate its duration",
+                    "Validate the procedure and its rig config, compile the plan and print it: setpoints, soak "
+                    "criterion, every pose with its turntable angles and gravity direction, samples, and the "
+                    "time each setpoint's ramp, soak and poses will take. Touches no instrument.",
+                    "rig plan procedures/paper-24pos-thermal.yaml")
+    plan.add_argument("procedure", type=Path, help="procedure YAML file")
+    plan.add_argument("--config", type=Path, help="rig config YAML (overrides the procedure's `rig`)")
+    plan.add_argument("--json", action="store_true", help="print one JSON object")
 
     resume = _command(commands, "resume", "continue a campaign that stopped before it was complete",
                       "Continue a campaign from its file: with the procedure it was started with (its path is "
@@ -112,25 +122,39 @@ def _build_parser() -> argparse.ArgumentParser:
 
 
 @contextmanager
-def _campaign_logging(output: Path, verbose: bool, quiet: bool, append: bool) -> Iterator[None]:
-    """Console on stderr at the chosen level, the full debug log in a file beside the campaign file
-    (appended to by a resumed run); both detached and closed when the run ends."""
-    console = logging.StreamHandler(sys.stderr)
+def _campaign_logging(output: Path, verbose: bool, quiet: bool, append: bool,
+                      real_clock: bool) -> Iterator[ProgressListener]:
+    """Console on stderr at the chosen level (a live status line on a terminal, timestamped lines
+    otherwise), the full debug log with progress lines in a file beside the campaign file (appended to by
+    a resumed run); yields the progress listener. Everything is detached and closed when the run ends."""
+    from accelcal_rig.report.live import ProgressLines, StatusLine, TerminalHandler, listeners
+
+    status = StatusLine(sys.stderr, real_clock) if sys.stderr.isatty() and not quiet else None
+    console: logging.Handler
+    if status is not None:
+        console = TerminalHandler(status)
+        console.setFormatter(logging.Formatter("%(message)s"))
+    else:
+        console = logging.StreamHandler(sys.stderr)
+        console.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s", "%Y-%m-%d %H:%M:%S"))
     console.setLevel(logging.DEBUG if verbose else logging.WARNING if quiet else logging.INFO)
-    console.setFormatter(logging.Formatter("%(message)s"))
     log_file = logging.FileHandler(output.with_suffix(output.suffix + ".log"), mode="a" if append else "w",
                                    encoding="utf-8")
     log_file.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s"))
     LOGGER.setLevel(logging.DEBUG)
-    LOGGER.propagate = False
+    propagate, LOGGER.propagate = LOGGER.propagate, False
     for handler in (console, log_file):
         LOGGER.addHandler(handler)
+    lines = ProgressLines(real_clock)
     try:
-        yield
+        yield listeners(lines, status) if status is not None else lines
     finally:
+        if status is not None:
+            status.close()
         for handler in (console, log_file):
             LOGGER.removeHandler(handler)
             handler.close()
+        LOGGER.propagate = propagate
 
 
 class _StopOnFirstSignal:
@@ -160,6 +184,20 @@ def _cmd_run(args: argparse.Namespace) -> int:
                     resume=args.resume and args.output.exists())
 
 
+def _cmd_plan(args: argparse.Namespace) -> int:
+    from accelcal_rig.engine.estimate import estimate_duration
+    from accelcal_rig.engine.session import prepare
+    from accelcal_rig.report.plan_summary import plan_json, plan_lines
+
+    prepared = prepare(args.procedure, args.config)
+    estimate = estimate_duration(prepared.procedure.model, prepared.rig.model, prepared.plan)
+    if args.json:
+        print(json.dumps(plan_json(prepared, estimate)))
+    else:
+        print("\n".join(plan_lines(prepared, estimate)))
+    return 0
+
+
 def _cmd_resume(args: argparse.Namespace) -> int:
     from accelcal_rig.engine.session import prepare
     from accelcal_rig.store.read import read_stored_campaign
@@ -185,9 +223,9 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
     stop = _StopOnFirstSignal()
     previous = {signum: signal.signal(signum, stop) for signum in (signal.SIGINT, signal.SIGTERM)}
     try:
-        with _campaign_logging(output, args.verbose, args.quiet, append=resume):
+        with _campaign_logging(output, args.verbose, args.quiet, append=resume, real_clock=not dry_run) as progress:
             result = run_campaign(prepared, output, dry_run=dry_run, seed=seed, overwrite=overwrite,
-                                  calibration=calibration, resume=resume)
+                                  calibration=calibration, resume=resume, progress=progress)
     except NothingToResume as done:
         print(done)
         return 0
@@ -337,7 +375,7 @@ def main(argv: list[str] | None = None) -> int:
     # Driver libraries log their own view of a failure; ours is the one line that names the instrument.
     logging.getLogger("pymodbus").addHandler(logging.NullHandler())
     logging.getLogger("pymodbus").propagate = False
-    handler = {"run": _cmd_run, "resume": _cmd_resume, "status": _cmd_status, "fit": _cmd_fit, "check": _cmd_check,
+    handler = {"run": _cmd_run, "plan": _cmd_plan, "resume": _cmd_resume, "status": _cmd_status, "fit": _cmd_fit, "check": _cmd_check,
                "sim": _cmd_sim}[args.command]
     try:
         return handler(args)

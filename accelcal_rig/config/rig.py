@@ -185,6 +185,19 @@ class RetryPolicy(_Strict):
     max_backoff_s: float = Field(8.0, ge=0, description="longest wait between tries")
 
 
+NotifyEvent = Literal["start", "soak", "fault", "safe", "finish"]
+
+
+class NotifyConfig(_Strict):
+    """Who hears about an unattended run: a webhook (JSON POST) and/or a local command (JSON on stdin)."""
+
+    webhook_url: str | None = Field(None, pattern=r"^https?://", description="http(s) URL to POST each event to")
+    command: list[str] = Field([], description="program and arguments to run for each event")
+    events: list[NotifyEvent] = Field(["start", "soak", "fault", "safe", "finish"],
+                                      description="which events to send")
+    timeout_s: float = Field(10.0, gt=0, le=120, description="longest one delivery may take")
+
+
 class RigConfig(_Strict):
     name: str = Field(min_length=1)
     description: str = ""
@@ -192,4 +205,5 @@ class RigConfig(_Strict):
     turntable: TurntableConfig
     fixture: FixtureConfig
     retry: RetryPolicy = RetryPolicy()
+    notify: NotifyConfig = NotifyConfig()
     simulation: SimulationConfig = SimulationConfig()

@@ -19,13 +19,16 @@ from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.engine.acquisition import acquire_together
 from accelcal_rig.engine.clock import Clock
+from accelcal_rig.engine.estimate import DurationEstimate
 from accelcal_rig.engine.events import LOGGER, EventLog, format_duration
+from accelcal_rig.engine.notify import Notification, Notifier
+from accelcal_rig.engine.progress import PHASES, Progress, ProgressListener
 from accelcal_rig.engine.resume import ResumePoint
 from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.engine.safe_state import apply_safe_state
 from accelcal_rig.engine.soak import SoakDetector
 from accelcal_rig.engine.states import ACTIVE_STATES, State, StateMachine
-from accelcal_rig.engine.waits import wait_until
+from accelcal_rig.engine.waits import MOVE_POLL_S, wait_until
 from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, TransientInstrumentError, WaitTimeout
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity, RigInstruments, SampleBlock
@@ -35,10 +38,13 @@ from accelcal_rig.store.atomic import signals_deferred
 from accelcal_rig.store.campaign_file import CampaignWriter
 from accelcal_rig.store.records import DutPoseRecord, PoseRecord, SoakTrace
 
-#: Turntable position polling interval, from the time a move could first have arrived (its travel at the
-#: configured speeds); its deadline is 1.5 × that travel time plus this margin.
-MOVE_POLL_S = 0.5
+#: A move's deadline is 1.5 × its travel time at the configured speeds plus this margin.
 MOVE_MARGIN_S = 30.0
+
+
+#: States in which the campaign still has measuring ahead of it (the time left is estimated).
+_MEASURING_STATES = frozenset({State.IDLE, State.PREFLIGHT, State.RAMP, State.SOAK, State.MOVE, State.SETTLE,
+                               State.ACQUIRE, State.STORE})
 
 
 class TerminationRequested(BaseException):
@@ -47,6 +53,17 @@ class TerminationRequested(BaseException):
 
 #: Runs on the open campaign file once the rig is safe; returns a one-line summary of the calibration.
 FitStage = Callable[[h5py.File], str]
+
+
+@dataclass(frozen=True)
+class Audience:
+    """Who follows the run besides the file and the log: a progress listener (the estimate gives it the
+    time left) and a notifier. Neither can stop the campaign: their failures are logged."""
+
+    progress: ProgressListener | None = None
+    estimate: DurationEstimate | None = None
+    notifier: Notifier | None = None
+    campaign: str = ""
 
 
 @dataclass(frozen=True)
@@ -64,7 +81,7 @@ class CampaignSummary:
 class CampaignRunner:
     def __init__(self, procedure: Procedure, rig: RigConfig, plan: Plan, instruments: RigInstruments,
                  writer: CampaignWriter, clock: Clock, events: EventLog, fit_stage: FitStage | None = None,
-                 resume: ResumePoint | None = None) -> None:
+                 resume: ResumePoint | None = None, audience: Audience = Audience()) -> None:
         self.procedure = procedure
         self.rig = rig
         self.plan = plan
@@ -89,6 +106,16 @@ class CampaignRunner:
         self._table_angles_deg: np.ndarray | None = None
         safe = procedure.safe_setpoint_c
         self.safe_setpoint_c = rig.chamber.safe_setpoint_c if safe is None else safe
+        self.audience = audience
+        #: What the progress display shows: where in the plan, and the last temperatures read.
+        self._setpoint_index = -1
+        self._setpoint_start_s = 0.0
+        self._phase = ("idle", 0.0)  # (phase, clock time it began)
+        self._chamber_c: float | None = None
+        self._dut_c: tuple[float, ...] = ()
+        self._poses_left = [sum(1 for s in plan.pose_steps if s.setpoint_c == setpoint and s.key not in self._stored_keys)
+                            for setpoint in plan.setpoints_c]
+        self._progress_failed = False
 
     # ----------------------------------------------------------------- top level
     def run(self) -> CampaignSummary:
@@ -97,6 +124,10 @@ class CampaignRunner:
             self.events.info("plan", f"{len(self.plan.setpoints_c)} setpoints × {len(self.plan.poses)} poses = "
                                      f"{len(self.plan.pose_steps)} poses, {len(self.sensors)} DUTs, "
                                      f"{self.procedure.acquisition.samples_per_pose} samples per pose")
+            run = f" (run {self.resume.run}, resuming after {self.poses_done} stored poses)" if self.resume else ""
+            self._notify("start", f"campaign started{run}: {len(self.plan.pose_steps) - self.poses_done} poses to "
+                                  f"measure" + (f", about {format_duration(self._remaining_s() or 0.0)}"
+                                                if self.audience.estimate else ""))
             if self.resume is not None and self.resume.unclean:
                 self.events.warning("resume", "the last run ended without closing the file (its process died): "
                                               "safe state first")
@@ -106,10 +137,13 @@ class CampaignRunner:
             for setpoint, steps in groupby(self.plan.steps, key=lambda s: s.setpoint_c):
                 self._run_setpoint(setpoint, [s for s in steps if s.key not in self._stored_keys])
             self.machine.go(State.SAFE, "campaign complete")
-            apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
+            safe = apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
+            self._notify("safe", "every pose measured; rig in its safe state" if safe else
+                                 "every pose measured; safe state INCOMPLETE: see the event log")
             fit, fit_failed = self._fit() if self.fit_stage is not None else ("", False)
             self.machine.go(State.DONE)
             self.writer.set_state("done", finished=True)
+            self._notify("finish", f"campaign done; fit failed: {fit}" if fit_failed else f"campaign done; {fit}")
             return self._summary("done", fit, fit_failed)
         except BaseException as exc:  # noqa: BLE001 - every exit path goes through the safe state
             reason = _one_line_reason(exc)
@@ -129,7 +163,10 @@ class CampaignRunner:
             self.machine.go(State.ABORTING, reason)
             self.machine.go(State.SAFE, "abort")
         self.events.error("fault", f"campaign aborted: {reason}")
-        apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
+        self._notify("fault", f"campaign aborted: {reason}")
+        safe = apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
+        self._notify("safe", f"rig in its safe state; {self.poses_done} of {len(self.plan.pose_steps)} poses stored"
+                     if safe else "safe state INCOMPLETE: check the rig; see the event log")
         if self.machine.state is State.SAFE:
             self.machine.go(State.ABORTED)
         try:
@@ -156,6 +193,44 @@ class CampaignRunner:
     def _record_transition(self, previous: State, target: State, reason: str) -> None:
         suffix = f" ({reason})" if reason else ""
         self.events.debug("transition", f"{previous} → {target}{suffix}")
+        self._publish()
+
+    # ----------------------------------------------------------------- audience
+    def _remaining_s(self) -> float | None:
+        """The estimate of the time left, while there is measuring left to do."""
+        estimate, state = self.audience.estimate, self.machine.state
+        if estimate is None or state not in _MEASURING_STATES:
+            return None
+        in_poses = PHASES.get(str(state)) == "poses"
+        return estimate.remaining_s(self._poses_left, max(self._setpoint_index, 0),
+                                    self.clock.now() - self._setpoint_start_s if self._setpoint_index >= 0 else 0.0,
+                                    in_poses)
+
+    def _publish(self) -> None:
+        """Hand the progress listener a snapshot; a listener that fails is reported once and ignored."""
+        if self.audience.progress is None or self._progress_failed:
+            return
+        now = self.clock.now()
+        phase = PHASES.get(str(self.machine.state), str(self.machine.state))
+        if phase != self._phase[0]:
+            self._phase = (phase, now)
+        index = self._setpoint_index
+        active = 0 <= index and self.machine.state in _MEASURING_STATES
+        try:
+            self.audience.progress(Progress(
+                state=str(self.machine.state), phase=phase, setpoint_c=self.plan.setpoints_c[index] if active else None,
+                setpoint_number=index + 1, setpoints_total=len(self.plan.setpoints_c),
+                phase_elapsed_s=now - self._phase[1], chamber_c=self._chamber_c, dut_c=self._dut_c,
+                poses_done=self.poses_done, poses_total=len(self.plan.pose_steps), clock_s=now,
+                remaining_s=self._remaining_s()))
+        except Exception as exc:  # noqa: BLE001 - a display must never stop a campaign
+            self._progress_failed = True
+            LOGGER.error("progress display failed, no more progress shown: %s", exc)
+
+    def _notify(self, event: str, message: str) -> None:
+        if self.audience.notifier is not None:
+            self.audience.notifier.send(Notification(event, message, self.audience.campaign, self.procedure.name,
+                                                     self.clock.now(), self.poses_done, len(self.plan.pose_steps)))
 
     # ----------------------------------------------------------------- preflight
     def _preflight(self) -> None:
@@ -179,6 +254,8 @@ class CampaignRunner:
         if not any(s.kind == "pose" for s in steps):
             self.events.info("setpoint", f"{label}: every pose already stored")
             return
+        self._setpoint_index = self.plan.setpoints_c.index(setpoint_c)
+        self._setpoint_start_s = self.clock.now()
         self.machine.go(State.RAMP, label)
         t_reached = self._ramp(setpoint_c)
         self.machine.go(State.SOAK, label)
@@ -198,9 +275,13 @@ class CampaignRunner:
         ramp_s = abs(setpoint_c - start_c) / (self.rig.chamber.ramp_rate_c_per_min / 60.0)
         timeout_s = soak.ramp_timeout_factor * ramp_s + soak.ramp_timeout_margin_min * 60.0
         self.events.info("ramp", f"ramp {start_c:.1f} → {setpoint_c:g} °C (deadline {format_duration(timeout_s)})")
+        def reached() -> bool:
+            within = abs(self._chamber_temperature_c() - setpoint_c) <= soak.chamber_tolerance_c
+            self._publish()
+            return within
+
         t_reached = wait_until(
-            self.clock,
-            lambda: abs(self._chamber_temperature_c() - setpoint_c) <= soak.chamber_tolerance_c,
+            self.clock, reached,
             timeout_s=timeout_s, poll_s=soak.poll_s,
             what=f"chamber ({self.chamber.endpoint}) reaching {setpoint_c:g} °C",
         )
@@ -214,6 +295,8 @@ class CampaignRunner:
         def poll() -> bool:
             dut_c = np.array([s.read_temperature_c() for s in self.sensors])
             detector.add(self.clock.now(), self._chamber_temperature_c(), dut_c)
+            self._dut_c = tuple(dut_c.tolist())
+            self._publish()
             return detector.is_stable()
 
         outcome, t_stable = "fault", float("nan")  # what the file says if anything but the deadline stops it
@@ -235,20 +318,25 @@ class CampaignRunner:
             if criterion.on_timeout == "skip":
                 self.events.warning("soak", f"{timed_out}; setpoint skipped, its {n_poses} poses not measured "
                                             "(soak.on_timeout: skip)")
+                self._notify("soak", f"{timed_out}; setpoint skipped (soak.on_timeout: skip)")
+                self._poses_left[self._setpoint_index] = 0
                 return False
             self.events.warning("soak", f"{timed_out}; measuring its poses anyway (soak.on_timeout: proceed)")
+            self._notify("soak", f"{timed_out}; measuring its poses anyway (soak.on_timeout: proceed)")
             return True
         spans = detector.dut_spans_c()
-        self.events.info("soak", f"{label}: stable after {format_duration(t_stable - t_reached)} at "
-                                 f"DUT {np.round(self._settled_dut_c, 2).tolist()} °C "
-                                 f"(spans ≤ {spans.max():.2f} °C)")
+        message = (f"{label}: stable after {format_duration(t_stable - t_reached)} at DUT "
+                   f"{np.round(self._settled_dut_c, 2).tolist()} °C (spans ≤ {spans.max():.2f} °C)")
+        self.events.info("soak", message)
+        self._notify("soak", message)
         return True
 
     def _chamber_temperature_c(self) -> float:
         """Chamber air temperature; an active controller alarm is a fault, never a reading to wait out."""
         if self.chamber.alarm_active():
             raise InstrumentError(f"chamber ({self.chamber.endpoint}): controller alarm active")
-        return self.chamber.read_temperature_c()
+        self._chamber_c = self.chamber.read_temperature_c()
+        return self._chamber_c
 
     # ----------------------------------------------------------------- one pose
     def _measure_pose(self, step: PlanStep) -> None:
@@ -276,7 +364,11 @@ class CampaignRunner:
         )
         self.writer.append_pose(record)
         self.poses_done += 1
+        self._poses_left[self._setpoint_index] -= 1
+        self._chamber_c = chamber_after
+        self._dut_c = tuple(float(np.mean(b.temperature_c)) for b in blocks)
         self.events.debug("pose", f"{step.key} stored")
+        self._publish()
 
     def _move(self, commanded: np.ndarray) -> None:
         current = self.turntable.read_angles_deg() if self._table_angles_deg is None else self._table_angles_deg

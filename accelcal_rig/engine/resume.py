@@ -21,10 +21,10 @@ from accelcal_rig.errors import ConfigError
 from accelcal_rig.plan.compile import Plan
 from accelcal_rig.store.read import StoredCampaign
 
-#: Rig keys that say how to reach an instrument (or how to retry it, or what faults a simulator injects),
-#: not what it is or how it measures.
+#: Rig keys that say how to reach an instrument (or how to retry it, what faults a simulator injects, whom
+#: to notify), not what it is or how it measures.
 CONNECTION_KEYS = frozenset({"endpoint", "timeout_s", "baudrate", "parity", "stopbits", "spi_speed_hz", "retry",
-                             "faults"})
+                             "faults", "notify"})
 #: Procedure keys that name files rather than shape the campaign.
 PROCEDURE_FILE_KEYS = frozenset({"rig"})
 

@@ -17,9 +17,12 @@ from accelcal_rig.config.load import (
 )
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitStage
+from accelcal_rig.engine.campaign import Audience, CampaignRunner, CampaignSummary, FitStage
 from accelcal_rig.engine.clock import Clock, RealClock, VirtualClock
+from accelcal_rig.engine.estimate import estimate_duration
 from accelcal_rig.engine.events import LOGGER, EventLog
+from accelcal_rig.engine.notify import Notifier
+from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.resume import ResumePoint, check_same_campaign
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
@@ -84,22 +87,23 @@ InstrumentFactory = Callable[[RigConfig, Procedure, Clock, int], RigInstruments]
 
 def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, seed: int, overwrite: bool,
                  calibration: Path | None = None, build_instruments: InstrumentFactory | None = None,
-                 resume: bool = False) -> RunResult:
+                 resume: bool = False, progress: ProgressListener | None = None) -> RunResult:
     """Run the whole campaign into `output`. Raises CampaignAborted after reaching the safe state.
 
     The instruments: with `build_instruments`, whatever it builds (a test double); with `dry_run`, the
     real drivers talking to wire-level simulators of this rig on a virtual clock; otherwise the real
     drivers at the rig config's endpoints, in real time. With `calibration`, the fit stage runs once the
     rig is safe and writes the calibration file there. With `resume` and an existing `output`, the
-    campaign in it continues (see resume_campaign); without one, a new campaign starts.
+    campaign in it continues (see resume_campaign); without one, a new campaign starts. `progress` gets a
+    snapshot at every transition, temperature poll and pose; the rig config's `notify` is sent events.
     """
     wall_start = time.perf_counter()
     if resume and output.exists():
         return resume_campaign(prepared, output, dry_run=dry_run, calibration=calibration,
-                               build_instruments=build_instruments)
+                               build_instruments=build_instruments, progress=progress)
     with _connected(prepared, dry_run, seed, build_instruments) as (instruments, clock):
         writer = _create_file(prepared, output, instruments, clock, dry_run=dry_run, seed=seed, overwrite=overwrite)
-        return _run(prepared, output, writer, instruments, clock, None, calibration, wall_start)
+        return _run(prepared, output, writer, instruments, clock, None, calibration, wall_start, progress)
 
 
 class NothingToResume(Exception):
@@ -107,7 +111,8 @@ class NothingToResume(Exception):
 
 
 def resume_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, calibration: Path | None = None,
-                    build_instruments: InstrumentFactory | None = None) -> RunResult:
+                    build_instruments: InstrumentFactory | None = None,
+                    progress: ProgressListener | None = None) -> RunResult:
     """Continue the campaign in `output`: the same procedure and rig (refused otherwise, before anything is
     touched), poses cut back to those stored whole, the rig made safe first if the last run died, then a
     fresh soak at the first setpoint with poses missing and on from the first pose not stored."""
@@ -128,7 +133,7 @@ def resume_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, 
             EventLog(clock, writer).info(
                 "resume", f"run {reopened.run} resumes after {reopened.poses_stored} stored poses (the last run "
                           f"left the file {reopened.previous_state!r}{cut})")
-            return _run(prepared, output, writer, instruments, clock, point, calibration, wall_start)
+            return _run(prepared, output, writer, instruments, clock, point, calibration, wall_start, progress)
     finally:
         writer.close()
 
@@ -206,16 +211,22 @@ def _create_file(prepared: PreparedCampaign, output: Path, instruments: RigInstr
 
 
 def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, instruments: RigInstruments,
-         clock: Clock, resume: ResumePoint | None, calibration: Path | None, wall_start: float) -> RunResult:
-    procedure = prepared.procedure.model
+         clock: Clock, resume: ResumePoint | None, calibration: Path | None, wall_start: float,
+         progress: ProgressListener | None) -> RunResult:
+    procedure, rig = prepared.procedure.model, prepared.rig.model
+    notify = rig.notify
+    notifier = Notifier(notify) if notify.webhook_url or notify.command else None
     try:
         events = EventLog(clock, writer)
-        runner = CampaignRunner(procedure, prepared.rig.model, prepared.plan, instruments, writer, clock, events,
+        estimate = estimate_duration(procedure, rig, prepared.plan) if progress or notifier else None
+        runner = CampaignRunner(procedure, rig, prepared.plan, instruments, writer, clock, events,
                                 fit_stage=_fit_stage(procedure, output, calibration) if calibration else None,
-                                resume=resume)
+                                resume=resume, audience=Audience(progress, estimate, notifier, str(output)))
         summary = runner.run()
     finally:
         writer.close()
+        if notifier is not None:
+            notifier.close()
     return RunResult(summary, time.perf_counter() - wall_start, output)
 
 

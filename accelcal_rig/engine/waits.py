@@ -7,6 +7,10 @@ from collections.abc import Callable
 from accelcal_rig.engine.clock import Clock
 from accelcal_rig.errors import WaitTimeout
 
+#: Turntable position polling interval, from the time a move could first have arrived (its travel at the
+#: configured speeds).
+MOVE_POLL_S = 0.5
+
 
 def wait_until(clock: Clock, condition: Callable[[], bool], *, timeout_s: float, poll_s: float,
                what: str) -> float:

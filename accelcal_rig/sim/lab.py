@@ -23,6 +23,12 @@ from accelcal_rig.sim.turntable_motion import TurntableMotion
 TEMPERATURE_READ_NOISE_C = 0.05
 
 
+def dut_time_constant_s(serial: str, fixture_tau_s: float) -> float:
+    """Fixtures are never quite uniform: each DUT lags the air by its own ±10 % of the nominal constant."""
+    spread = int.from_bytes(hashlib.sha256(f"tau:{serial}".encode()).digest()[:4], "little") / 2**32
+    return fixture_tau_s * (0.9 + 0.2 * spread)
+
+
 class SimulatedDut:
     """A DUT's place on the fixture, its hidden truth and its own thermal time constant."""
 
@@ -31,9 +37,7 @@ class SimulatedDut:
         self.truth: DutTruth = truth_for_serial(serial)
         #: Fixture frame → DUT frame.
         self.fixture_to_dut = Rotation.from_euler("xyz", mount_euler_deg, degrees=True).inv().as_matrix()
-        # Fixtures are never quite uniform: each DUT lags the air by its own ±10 % of the nominal constant.
-        spread = int.from_bytes(hashlib.sha256(f"tau:{serial}".encode()).digest()[:4], "little") / 2**32
-        self.tau_s = fixture_tau_s * (0.9 + 0.2 * spread)
+        self.tau_s = dut_time_constant_s(serial, fixture_tau_s)
         # Signs of the unmodelled effects on each axis, fixed per DUT like its truth.
         signs = hashlib.sha256(f"effects:{serial}".encode()).digest()
         self.hysteresis_signs = np.array([1.0 if b & 1 else -1.0 for b in signs[:3]])

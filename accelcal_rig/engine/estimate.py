@@ -1,0 +1,144 @@
+"""How long a campaign will take, before it starts: the engine's own waits played against the rig's model.
+
+The chamber ramps at the rig's ramp rate and its air lags with `simulation.chamber_time_constant_min`;
+each DUT lags the air with `simulation.fixture_time_constant_min` (the same thermal model a dry run uses,
+so set those two to a real rig's measured values). The ramp and soak are polled exactly as the engine
+polls them, through the same soak detector, fed with what an ADXL355 reads (0.11 °C steps, with noise):
+the soak is the median over `SOAK_DRAWS` draws of that noise, since the band is a few steps wide and the
+noise moves the moment it is met by minutes. Each pose costs its turntable travel at the axes' speeds, the
+table's settling, the procedure's settle time and the samples at the data rate. Instrument communication
+time is not included (a few milliseconds per exchange on a real rig, none in virtual time).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from itertools import groupby
+
+import numpy as np
+
+from accelcal_rig.config.procedure import Procedure
+from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.engine.soak import SoakDetector
+from accelcal_rig.engine.waits import MOVE_POLL_S
+from accelcal_rig.instruments.adxl355 import raw_from_temperature_c, temperature_c_from_raw
+from accelcal_rig.plan.compile import Plan
+from accelcal_rig.sim.lab import TEMPERATURE_READ_NOISE_C, dut_time_constant_s
+from accelcal_rig.sim.thermal import ThermalModel
+
+#: Draws of the temperature reading noise over which the soak duration is a median.
+SOAK_DRAWS = 9
+
+
+@dataclass(frozen=True)
+class SetpointEstimate:
+    setpoint_c: float
+    ramp_s: float
+    soak_s: float
+    poses_s: float
+    n_poses: int
+    soak_outcome: str           # "stable"; "timeout" (soak deadline passed) or "ramp timeout" (ramp deadline)
+    settled_dut_c: tuple[float, ...]
+
+    @property
+    def total_s(self) -> float:
+        return self.ramp_s + self.soak_s + self.poses_s
+
+    @property
+    def pose_s(self) -> float:
+        """Mean time of one pose at this setpoint."""
+        return self.poses_s / self.n_poses if self.n_poses else 0.0
+
+
+@dataclass(frozen=True)
+class DurationEstimate:
+    setpoints: tuple[SetpointEstimate, ...]
+
+    @property
+    def total_s(self) -> float:
+        return sum(s.total_s for s in self.setpoints)
+
+    def remaining_s(self, poses_left: Sequence[int], current: int, phase_elapsed_s: float = 0.0,
+                    in_pose_phase: bool = False) -> float:
+        """Estimated time left at setpoint index `current`, with `poses_left[k]` poses still to measure at
+        setpoint k. The current setpoint's ramp and soak count less `phase_elapsed_s` until its poses
+        start; a later setpoint counts its ramp, soak and missing poses, or nothing if none are missing.
+        """
+        left = 0.0
+        for k in range(current, len(self.setpoints)):
+            row = self.setpoints[k]
+            if k == current:
+                left += poses_left[k] * row.pose_s
+                if not in_pose_phase:
+                    left += max(row.ramp_s + row.soak_s - phase_elapsed_s, 0.0)
+            elif poses_left[k]:
+                left += row.ramp_s + row.soak_s + poses_left[k] * row.pose_s
+        return left
+
+
+def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> DurationEstimate:
+    sim = rig.simulation
+    soak = procedure.soak
+    acquisition = procedure.acquisition
+    thermal = ThermalModel(
+        ambient_c=sim.ambient_c, ramp_rate_c_per_s=rig.chamber.ramp_rate_c_per_min / 60.0,
+        chamber_tau_s=sim.chamber_time_constant_min * 60.0,
+        dut_tau_s=[dut_time_constant_s(s.serial, sim.fixture_time_constant_min * 60.0) for s in rig.fixture.sensors],
+        self_heating_c=sim.self_heating_c,
+    )
+    speeds = np.array([a.speed_deg_s for a in rig.turntable.axes])
+    settle_polls_s = MOVE_POLL_S * math.ceil(sim.turntable_settle_s / MOVE_POLL_S)
+    pose_fixed_s = settle_polls_s + acquisition.settle_s + acquisition.samples_per_pose / acquisition.odr_hz
+    table_deg = np.zeros(len(speeds))
+    t = 0.0
+    rows = []
+    for setpoint, steps in groupby(plan.pose_steps, key=lambda s: s.setpoint_c):
+        angles = np.array([s.pose.angles_deg for s in steps if s.pose is not None])
+        thermal.set_setpoint(t, setpoint)
+        ramp_start = t
+        ramp_deadline = t + soak.ramp_timeout_factor * abs(setpoint - thermal.air_c(t)) / (
+            rig.chamber.ramp_rate_c_per_min / 60.0) + soak.ramp_timeout_margin_min * 60.0
+        while abs(thermal.air_c(t) - setpoint) > soak.chamber_tolerance_c and t < ramp_deadline:
+            t = min(t + soak.poll_s, ramp_deadline)
+        t_reached = t
+        if abs(thermal.air_c(t) - setpoint) > soak.chamber_tolerance_c:
+            rows.append(SetpointEstimate(setpoint, t - ramp_start, 0.0, 0.0, len(angles), "ramp timeout", ()))
+            break  # the engine would abort here
+        soak_s, outcome, settled = _soak(thermal, procedure, setpoint, t_reached)
+        t_stable = t = t_reached + soak_s
+        path = np.vstack([table_deg, angles])
+        travel_s = np.max(np.abs(np.diff(path, axis=0)) / speeds, axis=1)
+        t += float(travel_s.sum()) + len(angles) * pose_fixed_s
+        table_deg = angles[-1]
+        rows.append(SetpointEstimate(setpoint, t_reached - ramp_start, soak_s, t - t_stable, len(angles), outcome,
+                                     settled))
+    return DurationEstimate(tuple(rows))
+
+
+def _soak(thermal: ThermalModel, procedure: Procedure, setpoint_c: float,
+          t_reached_s: float) -> tuple[float, str, tuple[float, ...]]:
+    """(soak duration s, outcome, settled DUT temperatures °C): the median over noise draws of the soak."""
+    soak = procedure.soak
+    n_polls = int(math.ceil(soak.timeout_min * 60.0 / soak.poll_s)) + 1
+    t = np.minimum(t_reached_s + soak.poll_s * np.arange(n_polls), t_reached_s + soak.timeout_min * 60.0)
+    ahead = copy.deepcopy(thermal)  # looks ahead to the deadline; the campaign's model stays at t_reached
+    air_and_dut = np.array([[ahead.air_c(ti), *(ahead.dut_c(ti, i) for i in range(len(ahead.dut_tau_s)))]
+                            for ti in t])  # the model only advances: every query at one time before the next
+    air, dut = air_and_dut[:, 0], air_and_dut[:, 1:]
+    rng = np.random.default_rng(0)
+    outcomes = []
+    for _ in range(SOAK_DRAWS):
+        read = temperature_c_from_raw(raw_from_temperature_c(dut + rng.normal(0.0, TEMPERATURE_READ_NOISE_C, dut.shape)))
+        detector = SoakDetector(soak, setpoint_c, t_reached_s)
+        for k in range(n_polls):
+            detector.add(float(t[k]), float(air[k]), read[k])
+            if detector.is_stable():
+                outcomes.append((float(t[k] - t_reached_s), "stable", detector.settled_dut_c()))
+                break
+        else:
+            outcomes.append((float(t[-1] - t_reached_s), "timeout", detector.settled_dut_c()))
+    soak_s, outcome, settled = sorted(outcomes, key=lambda o: o[0])[SOAK_DRAWS // 2]
+    return soak_s, outcome, tuple(round(float(c), 3) for c in settled)

@@ -1,0 +1,49 @@
+"""What the campaign is doing now, for whoever watches: a snapshot the runner hands to a listener."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from accelcal_rig.engine.events import format_duration
+from accelcal_rig.plan.compile import setpoint_label
+
+
+#: Engine states as an operator names the phase they belong to.
+PHASES = {"move": "poses", "settle": "poses", "acquire": "poses", "store": "poses"}
+
+
+@dataclass(frozen=True)
+class Progress:
+    state: str                        # the engine state (engine.states.State)
+    phase: str                        # what an operator calls it: ramp, soak, poses, safe, …
+    setpoint_c: float | None          # None before the first ramp and after the last pose
+    setpoint_number: int              # 1-based; 0 before the first ramp
+    setpoints_total: int
+    phase_elapsed_s: float            # since this phase began
+    chamber_c: float | None           # last chamber air reading
+    dut_c: tuple[float, ...]          # last DUT readings (empty before the first)
+    poses_done: int
+    poses_total: int
+    clock_s: float                    # campaign clock
+    remaining_s: float | None         # estimate; None without one
+
+    def line(self) -> str:
+        """`T-20 (3/11) soak 0:23:10 · chamber -20.1 °C · DUT -19.61…-19.42 °C · pose 48/264 · 6:12:00 left`."""
+        parts = [self.phase]
+        if self.setpoint_c is not None:
+            parts = [f"{setpoint_label(self.setpoint_c)} ({self.setpoint_number}/{self.setpoints_total}) {self.phase} "
+                     f"{format_duration(self.phase_elapsed_s)}"]
+        if self.chamber_c is not None:
+            parts.append(f"chamber {self.chamber_c:.1f} °C")
+        if self.dut_c:
+            low, high = min(self.dut_c), max(self.dut_c)
+            parts.append(f"DUT {low:.2f} °C" if high - low < 0.005 else f"DUT {low:.2f}…{high:.2f} °C")
+        parts.append(f"pose {self.poses_done}/{self.poses_total}")
+        if self.remaining_s is not None:
+            parts.append(f"{format_duration(self.remaining_s)} left")
+        return " · ".join(parts)
+
+
+#: Receives a snapshot at every transition, temperature poll and stored pose; must return quickly.
+ProgressListener = Callable[[Progress], None]

@@ -1,0 +1,1 @@
+"""What people at the rig read: the plan preview, the live progress, the campaign report, exports."""

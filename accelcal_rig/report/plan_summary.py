@@ -1,0 +1,71 @@
+"""`rig plan`: what a campaign will do and how long it will take, as text or one JSON object."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from accelcal_rig.engine.estimate import DurationEstimate
+from accelcal_rig.engine.events import format_duration
+from accelcal_rig.engine.session import PreparedCampaign
+from accelcal_rig.plan.compile import setpoint_label
+
+
+def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[str]:
+    procedure, rig, plan = prepared.procedure.model, prepared.rig.model, prepared.plan
+    soak, acquisition = procedure.soak, procedure.acquisition
+    setpoints = plan.setpoints_c
+    lines = [
+        f"procedure  {procedure.name} ({prepared.procedure.path})",
+        f"rig        {rig.name} ({prepared.rig.path}): chamber {rig.chamber.profile} over {rig.chamber.driver} "
+        f"(ramp {rig.chamber.ramp_rate_c_per_min:g} °C/min, limits {rig.chamber.min_setpoint_c:g}…"
+        f"{rig.chamber.max_setpoint_c:g} °C, safe {procedure.safe_setpoint_c or rig.chamber.safe_setpoint_c:g} °C), "
+        f"turntable {len(rig.turntable.axes)} axes, {len(rig.fixture.sensors)} DUTs "
+        f"({', '.join(s.serial for s in rig.fixture.sensors)})",
+        f"setpoints  {len(setpoints)}, in this order: {', '.join(f'{s:g}' for s in setpoints)} °C",
+        f"soak       at least {soak.min_dwell_min:g} min at setpoint, then each DUT within {soak.band_c:g} °C over "
+        f"{soak.window_min:g} min with the chamber within {soak.chamber_tolerance_c:g} °C; polled every "
+        f"{soak.poll_s:g} s; deadline {soak.timeout_min:g} min ({soak.on_timeout})",
+        f"poses      {len(plan.poses)} per setpoint ({procedure.schedule.kind}), {len(plan.pose_steps)} in all; "
+        f"{acquisition.samples_per_pose} samples at {acquisition.odr_hz:g} Hz, ±{acquisition.range_g} g, "
+        f"settle {acquisition.settle_s:g} s",
+        f"fit        {procedure.fit.mode}, {procedure.fit.parameters} parameters, polynomial degree "
+        f"{procedure.fit.polynomial_degree}",
+        "",
+        "pose  " + " ".join(f"{name + ' °':>9s}" for name in plan.axis_names) + "   gravity in the fixture frame (g)",
+    ]
+    for pose in plan.poses:
+        angles = " ".join(f"{a:9.3f}" for a in pose.angles_deg)
+        gravity = " ".join(f"{g:+7.4f}" for g in pose.gravity_fixture)
+        lines.append(f"{pose.number:4d}  {angles}   {gravity}")
+    lines += ["", f"{'setpoint':>8s} {'ramp':>8s} {'soak':>8s} {'poses':>8s} {'ends at':>9s}  DUTs settle at (°C)"]
+    t = 0.0
+    for row in estimate.setpoints:
+        t += row.total_s
+        outcome = "" if row.soak_outcome == "stable" else f"  {row.soak_outcome.upper()}: the campaign would stop"
+        settled = ", ".join(f"{c:.2f}" for c in row.settled_dut_c)
+        lines.append(f"{setpoint_label(row.setpoint_c):>8s} {format_duration(row.ramp_s):>8s} "
+                     f"{format_duration(row.soak_s):>8s} {format_duration(row.poses_s):>8s} "
+                     f"{format_duration(t):>9s}  {settled}{outcome}")
+    lines += ["", f"estimated duration {format_duration(estimate.total_s)} (h:mm:ss; from the rig's ramp rate, "
+                  "thermal time constants and axis speeds; instrument communication not included)"]
+    return lines
+
+
+def plan_json(prepared: PreparedCampaign, estimate: DurationEstimate) -> dict[str, Any]:
+    procedure, plan = prepared.procedure.model, prepared.plan
+    return {
+        "procedure": procedure.name, "procedure_path": str(prepared.procedure.path),
+        "rig": prepared.rig.model.name, "rig_path": str(prepared.rig.path),
+        "setpoints_c": list(plan.setpoints_c),
+        "soak": procedure.soak.model_dump(), "acquisition": procedure.acquisition.model_dump(),
+        "axes": list(plan.axis_names),
+        "poses": [{"number": p.number, "angles_deg": list(p.angles_deg), "gravity_fixture": list(p.gravity_fixture)}
+                  for p in plan.poses],
+        "poses_total": len(plan.pose_steps),
+        "estimate": {
+            "total_s": estimate.total_s,
+            "setpoints": [{"setpoint_c": r.setpoint_c, "ramp_s": r.ramp_s, "soak_s": r.soak_s, "poses_s": r.poses_s,
+                           "soak_outcome": r.soak_outcome, "settled_dut_c": list(r.settled_dut_c)}
+                          for r in estimate.setpoints],
+        },
+    }
