@@ -118,6 +118,14 @@ def _build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--parameters", choices=["all", "bias-scale"], help="default: the procedure's fit.parameters")
     fit.add_argument("--out-of-range", choices=["clamp", "extrapolate"], help="default: the procedure's")
     fit.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
+    export = _command(commands, "export", "write a calibration file as JSON, CSV or a C header for firmware",
+                      "Write the coefficients of a calibration file for other tools (json: the same structure; "
+                      "csv: one row per sensor and parameter) or for firmware (c-header: every sensor's "
+                      "polynomials and C99 functions that apply them, accelcal_apply and accelcal_apply_codes).",
+                      "rig export campaign.calibration.yaml --format c-header -o accel_calibration.h")
+    export.add_argument("calibration", type=Path, help="calibration file (YAML, from rig run or rig fit)")
+    export.add_argument("--format", required=True, choices=["json", "csv", "c-header"], help="what to write")
+    export.add_argument("-o", "--output", type=Path, help="file to write (default: standard output)")
     return parser
 
 
@@ -339,6 +347,23 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_export(args: argparse.Namespace) -> int:
+    from accelcal_rig.export.c_header import to_c_header
+    from accelcal_rig.export.tables import to_csv, to_json
+    from accelcal_rig.fit.calibration import load_calibration
+
+    calibration = load_calibration(args.calibration)
+    text = {"json": to_json, "csv": to_csv, "c-header": to_c_header}[args.format](calibration)
+    if args.output is None:
+        sys.stdout.write(text)
+        return 0
+    if not args.output.parent.is_dir():
+        raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
+    args.output.write_text(text)
+    print(f"{args.format} of {len(calibration.sensors)} sensors → {args.output}")
+    return 0
+
+
 def _print_fit_table(report: dict) -> None:
     print(f"{'sensor':14s} {'before mg':>10s} {'after mg':>9s} {'floor mg':>9s} {'drift before mg':>22s} "
           f"{'drift after mg':>22s}")
@@ -376,7 +401,7 @@ def main(argv: list[str] | None = None) -> int:
     logging.getLogger("pymodbus").addHandler(logging.NullHandler())
     logging.getLogger("pymodbus").propagate = False
     handler = {"run": _cmd_run, "plan": _cmd_plan, "resume": _cmd_resume, "status": _cmd_status, "fit": _cmd_fit, "check": _cmd_check,
-               "sim": _cmd_sim}[args.command]
+               "sim": _cmd_sim, "export": _cmd_export}[args.command]
     try:
         return handler(args)
     except CampaignAborted as exc:

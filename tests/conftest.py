@@ -46,3 +46,18 @@ def paper_campaign(tmp_path_factory: pytest.TempPathFactory) -> Path:
     run_campaign(prepare(REPO / "procedures" / "paper-24pos-thermal.yaml"), output, dry_run=True, seed=0,
                  overwrite=False)
     return output
+
+
+@pytest.fixture(scope="session")
+def fitted_paper_campaign(paper_campaign: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """A copy of the paper campaign with its fit done: (campaign file, calibration file)."""
+    import h5py
+
+    from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save
+
+    folder = tmp_path_factory.mktemp("fitted")
+    campaign, calibration = folder / "campaign.h5", folder / "campaign.calibration.yaml"
+    shutil.copy(paper_campaign, campaign)
+    with h5py.File(campaign, "a") as file:
+        fit_and_save(file, campaign, calibration, FitOptions())
+    return campaign, calibration
