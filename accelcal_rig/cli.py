@@ -118,6 +118,17 @@ def _build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--parameters", choices=["all", "bias-scale"], help="default: the procedure's fit.parameters")
     fit.add_argument("--out-of-range", choices=["clamp", "extrapolate"], help="default: the procedure's")
     fit.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
+    report = _command(commands, "report", "write an HTML report with figures of a campaign",
+                      "Write REPORT/index.html and REPORT/figures/*.png: the campaign's summary, |g| per pose "
+                      "before and after calibration, the raw ellipsoid and calibrated sphere, every parameter "
+                      "over temperature with its polynomial, offset drift before and after compensation, RMSE "
+                      "per setpoint, the soak traces and the event log. Opens in a browser with no network. "
+                      "Needs matplotlib (pip install 'accelcal-rig[report]'). The fit is redone in memory with "
+                      "the campaign's options; the file is only read, so a running or aborted campaign works.",
+                      "rig report campaign.h5 -o report/")
+    report.add_argument("campaign", type=Path, help="campaign file (HDF5)")
+    report.add_argument("-o", "--output", type=Path, required=True, help="folder to write (created if needed)")
+
     export = _command(commands, "export", "write a calibration file as JSON, CSV or a C header for firmware",
                       "Write the coefficients of a calibration file for other tools (json: the same structure; "
                       "csv: one row per sensor and parameter) or for firmware (c-header: every sensor's "
@@ -347,6 +358,18 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_report(args: argparse.Namespace) -> int:
+    from accelcal_rig.report.figures import pyplot
+    from accelcal_rig.report.html_report import write_report
+
+    pyplot()  # before reading anything: a missing extra is a one-line error
+    if args.output.exists() and not args.output.is_dir():
+        raise ConfigError(f"{args.output}: exists and is not a folder")
+    page = write_report(args.campaign, args.output)
+    print(f"report → {page}")
+    return 0
+
+
 def _cmd_export(args: argparse.Namespace) -> int:
     from accelcal_rig.export.c_header import to_c_header
     from accelcal_rig.export.tables import to_csv, to_json
@@ -401,7 +424,7 @@ def main(argv: list[str] | None = None) -> int:
     logging.getLogger("pymodbus").addHandler(logging.NullHandler())
     logging.getLogger("pymodbus").propagate = False
     handler = {"run": _cmd_run, "plan": _cmd_plan, "resume": _cmd_resume, "status": _cmd_status, "fit": _cmd_fit, "check": _cmd_check,
-               "sim": _cmd_sim, "export": _cmd_export}[args.command]
+               "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export}[args.command]
     try:
         return handler(args)
     except CampaignAborted as exc:

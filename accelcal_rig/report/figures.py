@@ -1,0 +1,246 @@
+"""The report's figures, standing in for the paper's Fig. 6, 7, 10 and 11 and showing the soaks.
+
+matplotlib is an optional extra (`pip install 'accelcal-rig[report]'`); it is drawn off-screen (Agg).
+Each function writes one PNG and returns its path.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, distort, norm_only_gauge
+from accelcal_rig.report.campaign_data import CampaignData
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+DPI = 100
+#: How each parameter's change is shown: (label, scale from the model's unit).
+PARAMETER_DISPLAY = {
+    "bias": ("Δ bias {axis} (mg)", 1e3),
+    "scale": ("Δ scale {axis} (ppm)", 1e6),
+    "nonorth": ("Δ non-orthogonality {axis} (µrad)", 1e6),
+    "misalign": ("Δ misalignment {axis} (µrad)", 1e6),
+}
+
+
+def pyplot():  # noqa: ANN201 - matplotlib's module
+    """matplotlib.pyplot on the off-screen backend, or a one-line error saying how to install it."""
+    try:
+        import matplotlib
+    except ImportError:
+        raise ConfigError("rig report needs matplotlib: pip install 'accelcal-rig[report]'") from None
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(figure: Figure, path: Path) -> Path:
+    figure.savefig(path, dpi=DPI, bbox_inches="tight")
+    pyplot().close(figure)
+    return path
+
+
+def _temperature_colours(data: CampaignData):  # noqa: ANN202 - (colormap, norm)
+    plt = pyplot()
+    setpoints = sorted({float(s) for d in data.duts.values() for s in d.poses.setpoint_c})
+    norm = plt.Normalize(min(setpoints, default=0.0) - 1e-9, max(setpoints, default=1.0) + 1e-9)
+    return plt.get_cmap("coolwarm"), norm
+
+
+def norm_deviation(data: CampaignData, path: Path) -> Path:
+    """Fig. 6: |g| − 1 at every pose of every setpoint, raw (top) and compensated (bottom), per DUT."""
+    plt = pyplot()
+    cmap, norm = _temperature_colours(data)
+    serials = list(data.duts)
+    figure, axes = plt.subplots(2, len(serials), figsize=(3.6 * len(serials) + 1, 6.4), squeeze=False,
+                                sharex=True, constrained_layout=True)
+    for column, serial in enumerate(serials):
+        dut = data.duts[serial]
+        raw = (np.linalg.norm(dut.poses.mean_g, axis=1) - 1.0) * 1e3
+        after = (np.linalg.norm(dut.fit.compensated_g, axis=1) - 1.0) * 1e3 if dut.fit else None
+        for setpoint in dict.fromkeys(dut.poses.setpoint_c.tolist()):
+            rows = dut.poses.setpoint_c == setpoint
+            colour = cmap(norm(setpoint))
+            axes[0, column].plot(dut.pose_numbers[rows], raw[rows], "o-", ms=3, lw=0.8, color=colour)
+            if after is not None:
+                axes[1, column].plot(dut.pose_numbers[rows], after[rows], "o-", ms=3, lw=0.8, color=colour)
+        title = serial
+        if dut.fit:
+            title += f"\nRMSE {dut.fit.metrics['rmse_before_mg']:.2f} → {dut.fit.metrics['rmse_after_mg']:.4f} mg"
+        axes[0, column].set_title(title, fontsize=9)
+        axes[1, column].set_xlabel("pose")
+        if after is None:
+            axes[1, column].text(0.5, 0.5, "no fit", ha="center", transform=axes[1, column].transAxes)
+    axes[0, 0].set_ylabel("|g| − 1 before (mg)")
+    axes[1, 0].set_ylabel("|g| − 1 after (mg)")
+    figure.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=axes, label="setpoint (°C)", shrink=0.8)
+    figure.suptitle("Norm of gravity at each pose, before and after calibration (paper Fig. 6)")
+    return _save(figure, path)
+
+
+def _sphere_grid(n: int = 24) -> np.ndarray:
+    """Points (n, n, 3) on the unit sphere, for wireframes."""
+    azimuth, polar = np.meshgrid(np.linspace(0, 2 * np.pi, n), np.linspace(0, np.pi, n))
+    return np.stack([np.sin(polar) * np.cos(azimuth), np.sin(polar) * np.sin(azimuth), np.cos(polar)], axis=-1)
+
+
+def _exaggerated(accel_g: np.ndarray, reference_g: np.ndarray | None, gain: float) -> np.ndarray:
+    """Readings with their error magnified `gain` times so millig errors show: the whole deviation from
+    the reference direction when there is one, else only the radial deviation from 1 g."""
+    if reference_g is not None:
+        return reference_g + gain * (accel_g - reference_g)
+    norm = np.linalg.norm(accel_g, axis=-1, keepdims=True)
+    return accel_g / norm * (1.0 + gain * (norm - 1.0))
+
+
+def ellipsoid(data: CampaignData, path: Path) -> Path:
+    """Fig. 7: raw readings on their ellipsoid and compensated readings on the unit sphere, the error
+    magnified by the same factor in both panels (the deviation from the turntable's reference direction in
+    reference mode; the radial deviation from 1 g in norm-only mode, which has no reference)."""
+    plt = pyplot()
+    cmap, norm = _temperature_colours(data)
+    fitted = [s for s, d in data.duts.items() if d.fit is not None]
+    rows = max((len(fitted) + 1) // 2, 1)
+    figure = plt.figure(figsize=(16, 4.2 * rows), constrained_layout=True)
+    sphere = _sphere_grid()
+    with_reference = data.options.mode == "reference"
+    for index, serial in enumerate(fitted):
+        dut = data.duts[serial]
+        assert dut.fit is not None
+        raw, compensated = dut.poses.mean_g, dut.fit.compensated_g
+        reference = dut.poses.reference_g if with_reference else None
+        error = raw - reference if reference is not None else np.linalg.norm(raw, axis=1) - 1.0
+        gain = 0.3 / max(float(np.max(np.abs(error))), 1e-9)
+        middle = len(dut.fit.fits) // 2
+        surface = _exaggerated(distort(sphere, dut.fit.fits[middle].parameters), sphere if with_reference else None,
+                               gain)
+        colours = cmap(norm(dut.poses.setpoint_c))
+        for column, (points, mesh, title) in enumerate([
+                (raw, surface, f"{serial} raw; ellipsoid at {dut.fit.setpoints_c[middle]:g} °C"),
+                (compensated, sphere, f"{serial} calibrated; unit sphere")]):
+            axis = figure.add_subplot(rows, 4, 2 * index + column + 1, projection="3d")
+            axis.plot_wireframe(*np.moveaxis(mesh, -1, 0), color="0.75", lw=0.4)
+            axis.scatter(*_exaggerated(points, reference, gain).T, c=colours, s=12, depthshade=False)
+            axis.set_title(f"{title}\nerror × {gain:,.0f}", fontsize=9)
+            axis.set_box_aspect((1, 1, 1))
+            for setter, name in ((axis.set_xlabel, "x"), (axis.set_ylabel, "y"), (axis.set_zlabel, "z")):
+                setter(f"{name} (g)", fontsize=8)
+            axis.tick_params(labelsize=7)
+    if not fitted:
+        figure.text(0.5, 0.5, f"no fit: {data.no_fit_reason}", ha="center")
+    figure.suptitle("Raw ellipsoid and calibrated sphere, errors magnified (paper Fig. 7); colour: setpoint")
+    return _save(figure, path)
+
+
+def parameters(data: CampaignData, path: Path) -> Path:
+    """Fig. 10: each Eq. 1 parameter at each setpoint (±1σ) and its polynomial over temperature, per DUT,
+    as the change from the polynomial's value mid-range (DUTs differ far more from each other than over
+    temperature); the simulated truth as crosses in a dry run."""
+    plt = pyplot()
+    figure, axes = plt.subplots(4, 3, figsize=(12, 11), constrained_layout=True)
+    colours = plt.get_cmap("tab10")
+    for index, (serial, dut) in enumerate(data.duts.items()):
+        if dut.fit is None:
+            continue
+        fit, colour = dut.fit, colours(index % 10)
+        estimates = np.array([f.parameters for f in fit.fits])
+        sigmas = np.array([f.sigma for f in fit.fits])
+        dense = np.linspace(*fit.thermal.domain_c, 200)
+        curve = fit.thermal.parameters_at(dense, "extrapolate")
+        middle = fit.thermal.parameters_at(0.5 * sum(fit.thermal.domain_c), "extrapolate")
+        truth = dut.truth_by_setpoint
+        if truth is not None and data.options.mode == "norm-only":
+            truth = norm_only_gauge(truth)
+        for k, name in enumerate(PARAMETER_NAMES):
+            axis = axes[k // 3, k % 3]
+            group, axis_name = name.split("_")[0], name.split("_")[1]
+            label, scale = PARAMETER_DISPLAY[group]
+            axis.errorbar(fit.temperatures_c, (estimates[:, k] - middle[k]) * scale, yerr=sigmas[:, k] * scale,
+                          fmt="o", ms=3, color=colour, label=serial if k == 0 else None)
+            axis.plot(dense, (curve[:, k] - middle[k]) * scale, "-", lw=1, color=colour)
+            if truth is not None:
+                axis.plot(fit.temperatures_c, (truth[:, k] - middle[k]) * scale, "x", ms=5, color="k",
+                          label="simulated truth" if k == 0 and index == 0 else None)
+            axis.set_title(label.format(axis=axis_name), fontsize=9)
+            axis.tick_params(labelsize=8)
+    for axis in axes[-1]:
+        axis.set_xlabel("sensor temperature (°C)")
+    if any(d.fit for d in data.duts.values()):
+        axes[0, 0].legend(fontsize=7)
+    figure.suptitle(f"Change of each error parameter over temperature from its mid-range value, with the "
+                    f"degree-{data.options.degree} polynomials (paper Fig. 10)")
+    return _save(figure, path)
+
+
+def drift(data: CampaignData, path: Path) -> Path:
+    """Fig. 11: zero-g offset per axis over temperature, before compensation (the fitted raw bias, mg) and
+    after (what the polynomial model makes of that raw zero-g reading, µg), each relative to its mean."""
+    plt = pyplot()
+    figure, axes = plt.subplots(2, 3, figsize=(12, 7), sharex=True, constrained_layout=True)
+    colours = plt.get_cmap("tab10")
+    for index, (serial, dut) in enumerate(data.duts.items()):
+        if dut.fit is None:
+            continue
+        fit = dut.fit
+        bias = np.array([f.parameters[0:3] for f in fit.fits])
+        after = correct(bias, fit.thermal.parameters_at(fit.temperatures_c, "extrapolate"))
+        for axis_index in range(3):
+            for row, (values, scale, unit, key) in enumerate(((bias, 1e3, "mg", "drift_before_mg"),
+                                                              (after, 1e6, "µg", "drift_after_mg"))):
+                spread = fit.metrics[key][axis_index] * scale / 1e3
+                axes[row, axis_index].plot(fit.temperatures_c, (values[:, axis_index] - values[:, axis_index].mean())
+                                           * scale, "o-", ms=3, color=colours(index % 10),
+                                           label=f"{serial}: {spread:.{2 if unit == 'mg' else 1}f} {unit}")
+    for axis_index, name in enumerate("xyz"):
+        axes[0, axis_index].set_title(f"{name} axis", fontsize=10)
+        for row in range(2):
+            if axes[row, axis_index].has_data():
+                axes[row, axis_index].legend(fontsize=7, title="max − min", title_fontsize=7)
+        axes[1, axis_index].set_xlabel("sensor temperature (°C)")
+    axes[0, 0].set_ylabel("offset before compensation, minus its mean (mg)")
+    axes[1, 0].set_ylabel("offset after compensation, minus its mean (µg)")
+    figure.suptitle("Zero-g offset drift per axis before and after thermal compensation (paper Fig. 11)")
+    return _save(figure, path)
+
+
+def soak_traces(data: CampaignData, band_c: float, path: Path) -> Path:
+    """The chamber air and every DUT through each soak on the campaign clock (top), and each soak's DUT
+    temperatures relative to where they settled, against time since the setpoint was reached (bottom)."""
+    plt = pyplot()
+    cmap, norm = _temperature_colours(data)
+    figure, (top, bottom) = plt.subplots(2, 1, figsize=(11, 8), constrained_layout=True)
+    for soak in data.soaks:
+        hours = soak.t_s / 3600.0
+        top.plot(hours, soak.chamber_c, "-", color="k", lw=1.0)
+        for column in range(soak.dut_c.shape[1] if soak.dut_c.ndim == 2 else 0):
+            top.plot(hours, soak.dut_c[:, column], "-", lw=0.7, color=cmap(norm(soak.setpoint_c)))
+        if np.isfinite(soak.t_stable_s):
+            top.axvline(soak.t_stable_s / 3600.0, color="0.6", ls=":", lw=0.8)
+        if len(soak.t_s) and soak.dut_c.ndim == 2:
+            settled = soak.dut_c[-max(1, len(soak.t_s) // 5):].mean(axis=0)
+            bottom.plot((soak.t_s - soak.t_reached_s) / 60.0, soak.dut_c - settled, "-", lw=0.7,
+                        color=cmap(norm(soak.setpoint_c)))
+    for dut in data.duts.values():
+        top.plot(dut.poses.t_s / 3600.0, dut.poses.temperature_c, ".", ms=2, color="tab:green")
+    top.plot([], [], "-", color="k", label="chamber air")
+    top.plot([], [], ".", color="tab:green", label="DUTs during poses")
+    top.plot([], [], ":", color="0.6", label="soak criterion met")
+    top.legend(fontsize=8)
+    top.set_xlabel("campaign time (h)")
+    top.set_ylabel("temperature (°C)")
+    top.set_title("Soaks: chamber air (black) and each DUT (coloured by setpoint)", fontsize=10)
+    for sign in (-1, 1):
+        bottom.axhline(sign * band_c / 2, color="0.5", ls="--", lw=0.8)
+    bottom.set_ylim(-5 * band_c, 5 * band_c)
+    bottom.set_xlabel("time since the chamber reached the setpoint (min)")
+    bottom.set_ylabel("DUT − its settled temperature (°C)")
+    bottom.set_title(f"Settling of every DUT at every setpoint; dashed: the soak band, {band_c:g} °C wide (max − min "
+                     "over the window)", fontsize=10)
+    figure.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=[top, bottom], label="setpoint (°C)", shrink=0.6)
+    return _save(figure, path)

@@ -1,0 +1,212 @@
+"""`rig report`: one self-contained HTML page and its PNG figures in a folder, readable with no network.
+
+No scripts, no web fonts, no remote anything: inline CSS and `<img>` tags pointing at files beside it.
+"""
+
+from __future__ import annotations
+
+import html
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+from accelcal_rig import __version__
+from accelcal_rig.engine.events import format_duration
+from accelcal_rig.report import figures
+from accelcal_rig.report.campaign_data import CampaignData, read_campaign_data
+from accelcal_rig.store.campaign_file import utc_now
+
+STYLE = """
+body { font-family: sans-serif; margin: 2em auto; max-width: 1200px; color: #222; }
+h1 { font-size: 1.5em; } h2 { font-size: 1.2em; margin-top: 2em; border-bottom: 1px solid #ccc; }
+table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0; }
+th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: right; }
+th { background: #f0f0f0; } td.text, th.text { text-align: left; }
+tr.warning td { background: #fff6d5; } tr.error td { background: #fde0e0; }
+img { max-width: 100%; border: 1px solid #eee; } .note { color: #555; font-size: 0.9em; }
+.state-done { color: #106010; } .state-aborted, .state-running { color: #a01010; }
+"""
+
+FIGURES = {
+    "norm_deviation": "norm_deviation.png",
+    "ellipsoid": "ellipsoid.png",
+    "parameters": "parameters.png",
+    "drift": "drift.png",
+    "soaks": "soak_traces.png",
+}
+
+
+def _e(value: object) -> str:
+    return html.escape(str(value))
+
+
+def _table(header: list[str], rows: list[list[object]], text_columns: int = 1,
+           row_classes: list[str] | None = None) -> str:
+    def cell(tag: str, index: int, value: object) -> str:
+        css = ' class="text"' if index < text_columns else ""
+        return f"<{tag}{css}>{_e(value)}</{tag}>"
+
+    head = "".join(cell("th", i, h) for i, h in enumerate(header))
+    body = []
+    for r, row in enumerate(rows):
+        css = f' class="{row_classes[r]}"' if row_classes and row_classes[r] else ""
+        body.append(f"<tr{css}>" + "".join(cell("td", i, v) for i, v in enumerate(row)) + "</tr>")
+    return f"<table><tr>{head}</tr>{''.join(body)}</table>"
+
+
+def _figure(name: str, caption: str) -> str:
+    return f'<figure><img src="figures/{FIGURES[name]}" alt="{_e(caption)}"><figcaption class="note">{_e(caption)}' \
+           "</figcaption></figure>"
+
+
+def write_report(campaign: Path, output: Path) -> Path:
+    """Write `output/index.html` and `output/figures/*.png` for a campaign file; return the HTML path."""
+    data = read_campaign_data(campaign)
+    folder = output / "figures"
+    folder.mkdir(parents=True, exist_ok=True)
+    figures.norm_deviation(data, folder / FIGURES["norm_deviation"])
+    figures.ellipsoid(data, folder / FIGURES["ellipsoid"])
+    figures.parameters(data, folder / FIGURES["parameters"])
+    figures.drift(data, folder / FIGURES["drift"])
+    figures.soak_traces(data, data.soak_band_c, folder / FIGURES["soaks"])
+    page = output / "index.html"
+    page.write_text(_page(data), encoding="utf-8")
+    return page
+
+
+def _page(data: CampaignData) -> str:
+    status = data.status
+    title = f"Calibration campaign {status.get('procedure', data.path.name)}"
+    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{_e(title)}</title>",
+             f"<style>{STYLE}</style></head><body>", f"<h1>{_e(title)}</h1>",
+             f"<p class='note'>{_e(data.path)} — report by accelcal-rig {__version__} at {_e(utc_now())}</p>"]
+    parts += _summary(data)
+    fitted = any(d.fit for d in data.duts.values())
+    if not fitted:
+        parts.append(f"<p><b>No calibration:</b> {_e(data.no_fit_reason)}. The figures below show what was "
+                     "measured.</p>")
+    parts += ["<h2>Norm of gravity per pose</h2>",
+              _figure("norm_deviation", "|g| − 1 at each pose, every setpoint coloured by temperature: raw readings "
+                                        "(top) and compensated with the thermal model (bottom). Paper Fig. 6.")]
+    parts += ["<h2>Raw ellipsoid and calibrated sphere</h2>",
+              _figure("ellipsoid", "Per-pose mean readings with their error magnified by the same factor in both "
+                                   "panels: the deviation from the turntable's reference direction (reference "
+                                   "mode) or from 1 g (norm-only mode). Paper Fig. 7.")]
+    parts += ["<h2>RMSE of |g| per setpoint</h2>", _rmse_table(data)]
+    parts += ["<h2>Error parameters over temperature</h2>",
+              _figure("parameters", "Each Eq. 1 parameter fitted at each setpoint (±1σ) and its polynomial over "
+                                    "the sensor temperature (Eq. 8); crosses: the simulated truth (dry runs). "
+                                    "Paper Fig. 10.")]
+    parts += ["<h2>Offset drift before and after compensation</h2>",
+              _figure("drift", "Zero-g offset per axis over temperature: the raw bias (top), and what the "
+                               "compensation makes of the raw zero-g reading (bottom). Paper Fig. 11."),
+              _drift_table(data)]
+    parts += ["<h2>Soaks</h2>", _figure("soaks", "Temperature traces of every soak."), _soak_table(data)]
+    if any(d.fit is not None and "truth_error" in d.fit.metrics for d in data.duts.values()):
+        parts += ["<h2>Against the simulated truth</h2>", _truth_table(data)]
+    parts += ["<h2>Event log</h2>", _event_table(data), "</body></html>"]
+    return "\n".join(parts)
+
+
+def _summary(data: CampaignData) -> list[str]:
+    s = data.status
+    state = str(s.get("state", "?"))
+    rows = [
+        ["state", f"{state}" + (f": {s['abort_reason']}" if s.get("abort_reason") else "")],
+        ["procedure", f"{s.get('procedure')} ({data.procedure_path})"],
+        ["rig", data.rig_name + (" — simulated (dry run)" if s.get("dry_run") else "")],
+        ["poses", f"{s.get('poses_done')} of {s.get('poses_total')} × {len(data.duts)} DUTs × "
+                  f"{s.get('samples_per_pose')} samples"],
+        ["setpoints (°C)", ", ".join(f"{t:g}" for t in s.get("setpoints_c", []))],
+        ["started / finished", f"{s.get('started')} / {s.get('finished') or '—'}"],
+        ["campaign time", format_duration(float(data.pose_t_s.max())) if len(data.pose_t_s) else "—"],
+        ["fit", f"{data.options.mode}, {data.options.free} parameters, polynomial degree {data.options.degree}, "
+                f"{data.options.out_of_range} outside the calibrated range"],
+        ["integrity", s.get("integrity", "?")],
+    ]
+    out = ["<h2>Campaign</h2>", _table(["", ""], rows, text_columns=2)]
+    sensors = []
+    for serial, dut in data.duts.items():
+        if dut.fit is None:
+            sensors.append([serial, "—", "—", "—", "—", "—", "no fit"])
+            continue
+        m = dut.fit.metrics
+        sensors.append([serial, f"{m['rmse_before_mg']:.3f}", f"{m['rmse_after_mg']:.4f}", f"{m['noise_floor_mg']:.4f}",
+                        " / ".join(f"{v:.2f}" for v in m["drift_before_mg"]),
+                        " / ".join(f"{v * 1e3:.1f}" for v in m["drift_after_mg"]),
+                        "; ".join(dut.fit.thermal.warnings) or "—"])
+    out += ["<h2>Calibration</h2>",
+            _table(["DUT", "|g| RMSE before (mg)", "after (mg)", "noise floor (mg)", "drift before x/y/z (mg)",
+                    "drift after x/y/z (µg)", "warnings"], sensors),
+            "<p class='note'>After: every pose compensated with the polynomial model at its own temperature. "
+            "Noise floor: the RMSE the per-pose standard errors alone would leave after a perfect fit.</p>"]
+    return out
+
+
+def _rmse_table(data: CampaignData) -> str:
+    """Table 6 of the paper: per setpoint, RMSE before, with the setpoint's own fit, with the polynomials."""
+    fitted = {s: d.fit for s, d in data.duts.items() if d.fit is not None}
+    if not fitted:
+        return "<p>No fit.</p>"
+    setpoints = sorted({r["setpoint_c"] for f in fitted.values() for r in f.metrics["rmse_by_setpoint"]})
+    header = ["setpoint (°C)"] + [f"{serial} {what}" for serial in fitted for what in ("before", "own fit", "polynomial")]
+    rows = []
+    for setpoint in setpoints:
+        row: list[object] = [f"{setpoint:g}"]
+        for fit in fitted.values():
+            record = next((r for r in fit.metrics["rmse_by_setpoint"] if r["setpoint_c"] == setpoint), None)
+            row += [f"{record['before_mg']:.3f}", f"{record['measurement_mg']:.4f}", f"{record['polynomial_mg']:.4f}"] \
+                if record else ["—"] * 3
+        rows.append(row)
+    return _table(header, rows) + ("<p class='note'>mg. Own fit: the setpoint's LM estimate applied to its poses; "
+                                   "polynomial: the thermal model at each pose's temperature. Paper Table 6.</p>")
+
+
+def _drift_table(data: CampaignData) -> str:
+    rows = []
+    for serial, dut in data.duts.items():
+        if dut.fit is None:
+            continue
+        m = dut.fit.metrics
+        low, high = m["temperature_range_c"]
+        rows.append([serial, f"{low:.1f} … {high:.1f}", *(f"{v:.3f}" for v in m["drift_before_mg"]),
+                     *(f"{v * 1e3:.1f}" for v in m["drift_after_mg"])])
+    return _table(["DUT", "range (°C)", "before x (mg)", "before y (mg)", "before z (mg)", "after x (µg)",
+                   "after y (µg)", "after z (µg)"], rows, text_columns=2) if rows else ""
+
+
+def _soak_table(data: CampaignData) -> str:
+    rows, classes = [], []
+    for soak in data.soaks:
+        to_stable = format_duration(soak.t_stable_s - soak.t_reached_s) if np.isfinite(soak.t_stable_s) else "—"
+        settled = soak.dut_c[-1] if soak.dut_c.ndim == 2 and len(soak.dut_c) else []
+        rows.append([soak.label, f"{soak.setpoint_c:g}", soak.outcome, format_duration(soak.t_reached_s), to_stable,
+                     ", ".join(f"{v:.2f}" for v in settled)])
+        classes.append("" if soak.outcome == "stable" else "warning")
+    return _table(["soak", "setpoint (°C)", "outcome", "reached at", "stable after", "last DUT readings (°C)"],
+                  rows, text_columns=1, row_classes=classes)
+
+
+def _truth_table(data: CampaignData) -> str:
+    rows = []
+    for serial, dut in data.duts.items():
+        if dut.fit is None or "truth_error" not in dut.fit.metrics:
+            continue
+        z = np.array([r["z"] for r in dut.fit.metrics["truth_error"]])
+        rows.append([serial, len(z), f"{np.mean(np.abs(z) <= 3) * 100:.1f} %", f"{np.max(np.abs(z)):.2f}",
+                     f"{np.sqrt(np.mean(z ** 2)):.2f}"])
+    return _table(["DUT", "estimates", "within 3σ of truth", "max |z|", "RMS z"], rows) + (
+        "<p class='note'>Every fitted parameter at every setpoint against the simulated sensor's hidden truth; "
+        "z = (estimate − truth) / σ. RMS z near 1 means the stated uncertainties are honest.</p>")
+
+
+def _event_table(data: CampaignData) -> str:
+    shown = [e for e in data.events if e.level != "debug"]
+    counts = Counter(e.level for e in data.events)
+    rows = [[format_duration(e.t_s), e.wall_time, e.level, e.kind, e.message] for e in shown]
+    classes = [e.level if e.level in ("warning", "error") else "" for e in shown]
+    summary = ", ".join(f"{n} {level}" for level, n in sorted(counts.items()))
+    return (f"<p class='note'>{_e(summary)} events; debug events (transitions, each pose) are in the file and "
+            "its log, not shown here.</p>" + _table(["campaign time", "wall time", "level", "kind", "message"], rows,
+                                                    text_columns=5, row_classes=classes))

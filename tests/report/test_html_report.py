@@ -1,0 +1,89 @@
+"""`rig report`: every figure a valid PNG of sensible size, every file the page refers to present, nothing
+fetched from a network; a campaign with too few poses to fit still gets a report that says so."""
+
+from __future__ import annotations
+
+import re
+import struct
+import sys
+from pathlib import Path
+
+import pytest
+
+from accelcal_rig.cli import main
+from accelcal_rig.engine.session import prepare, run_campaign
+from accelcal_rig.errors import CampaignAborted
+from accelcal_rig.report.html_report import FIGURES, write_report
+from tests.conftest import TINY_PROCEDURE
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def png_size(path: Path) -> tuple[int, int]:
+    """(width, height) from the IHDR chunk, after checking the signature."""
+    head = path.read_bytes()[:24]
+    assert head[:8] == PNG_SIGNATURE and head[12:16] == b"IHDR", f"{path} is not a PNG"
+    return struct.unpack(">II", head[16:24])
+
+
+def referenced_files(page: Path) -> list[str]:
+    return re.findall(r'(?:src|href)="([^"]+)"', page.read_text(encoding="utf-8"))
+
+
+@pytest.fixture(scope="module")
+def paper_report(paper_campaign: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return write_report(paper_campaign, tmp_path_factory.mktemp("report") / "report")
+
+
+def test_every_figure_is_a_png_of_sensible_size(paper_report: Path) -> None:
+    for name in FIGURES.values():
+        path = paper_report.parent / "figures" / name
+        width, height = png_size(path)
+        assert 600 <= width <= 4000 and 400 <= height <= 4000, (name, width, height)
+        assert path.stat().st_size > 20_000, name  # a drawn figure, not an empty canvas
+
+
+def test_the_page_refers_only_to_files_beside_it(paper_report: Path) -> None:
+    references = referenced_files(paper_report)
+    assert sorted(references) == sorted(f"figures/{name}" for name in FIGURES.values())
+    for reference in references:
+        assert not re.match(r"^[a-z]+:|^//", reference)  # no network, no absolute paths
+        assert (paper_report.parent / reference).is_file()
+    text = paper_report.read_text(encoding="utf-8")
+    assert "<script" not in text and "http://" not in text and "https://" not in text
+
+
+def test_the_page_holds_the_tables_an_engineer_looks_for(paper_report: Path) -> None:
+    text = paper_report.read_text(encoding="utf-8")
+    for heading in ("Campaign", "Calibration", "RMSE of |g| per setpoint", "Error parameters over temperature",
+                    "Offset drift before and after compensation", "Soaks", "Against the simulated truth", "Event log"):
+        assert f"<h2>{heading}</h2>" in text
+    assert text.count("<td class=\"text\">T") >= 11  # one soak row per setpoint
+    assert "264 of 264 × 4 DUTs × 200 samples" in text
+    assert "safe state: sensor ADX355-A004" in text  # the event log, info and above
+
+
+def test_an_aborted_campaign_with_too_few_poses_gets_a_report_saying_why(write, workdir: Path) -> None:
+    prepared = prepare(write("tiny.yaml", TINY_PROCEDURE), faults="turntable_stall_after_min=20")
+    campaign = workdir / "aborted.h5"
+    with pytest.raises(CampaignAborted):
+        run_campaign(prepared, campaign, dry_run=True, seed=0, overwrite=False)
+    page = write_report(campaign, workdir / "report")
+    text = page.read_text(encoding="utf-8")
+    assert "No calibration:" in text and "aborted" in text
+    for reference in referenced_files(page):
+        png_size(page.parent / reference)
+
+
+def test_rig_report_cli(paper_campaign: Path, tmp_path: Path, capsys) -> None:
+    assert main(["report", str(paper_campaign), "-o", str(tmp_path / "out")]) == 0
+    assert capsys.readouterr().out.strip() == f"report → {tmp_path / 'out' / 'index.html'}"
+
+
+def test_without_matplotlib_the_error_says_how_to_install_it(paper_campaign: Path, tmp_path: Path, capsys,
+                                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # import fails as if not installed
+    assert main(["report", str(paper_campaign), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.strip() == "rig: error: rig report needs matplotlib: pip install 'accelcal-rig[report]'"
+    assert not (tmp_path / "out").exists()
