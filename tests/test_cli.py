@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -29,7 +30,11 @@ def test_quick_6pos_dry_run_end_to_end(tmp_path: Path) -> None:
     assert "calibration → quick.calibration.yaml" in run.stdout
     assert (tmp_path / "quick.calibration.yaml").exists()
     assert "T35: stable after" in run.stderr  # progress while it runs
-    assert (tmp_path / "quick.h5.log").read_text().count("stored") >= 12
+    # Not a terminal: every line carries the wall-clock time, and progress lines come at each phase.
+    assert all(re.match(r"^\d{4}-\d\d-\d\d \d\d:\d\d:\d\d (INFO|WARNING|ERROR) ", line) for line in run.stderr.splitlines())
+    assert re.search(r"progress: T35 \(2/2\) soak .* · pose 6/12 · \d+:\d\d:\d\d left", run.stderr)
+    log = (tmp_path / "quick.h5.log").read_text()
+    assert log.count("stored") >= 12 and "progress: T15 (1/2) poses" in log
     status = rig("status", "quick.h5", "--json", cwd=tmp_path)
     assert status.returncode == 0
     report = json.loads(status.stdout)
@@ -85,11 +90,18 @@ def test_status_of_a_missing_or_foreign_file(tmp_path: Path, capsys, content: by
 
 
 def test_every_command_has_help_with_an_example(capsys) -> None:
-    for command in ("run", "status", "fit", "check", "sim"):
+    import argparse
+
+    from accelcal_rig.cli import _build_parser
+
+    commands = next(a for a in _build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices
+    assert {"run", "plan", "resume", "status", "check", "sim", "fit", "report", "export"} <= set(commands)
+    for command in commands:
         with pytest.raises(SystemExit) as exit_info:
             main([command, "--help"])
         assert exit_info.value.code == 0
-        assert "example:" in capsys.readouterr().out
+        out = capsys.readouterr().out
+        assert f"example:\n  rig {command} " in out, command
 
 
 def test_config_option_overrides_the_procedures_rig(write, workdir: Path, capsys) -> None:
@@ -260,3 +272,63 @@ def test_resume_of_a_complete_campaign_says_so_and_exits_0(write, capsys) -> Non
     capsys.readouterr()
     assert main(["resume", str(output), "-q"]) == 0
     assert "the campaign is complete: nothing to resume" in capsys.readouterr().out
+
+
+def test_rig_plan_prints_every_pose_and_an_estimate_without_touching_instruments(write, workdir: Path, capsys) -> None:
+    rig_text = (workdir / "sim.yaml").read_text().replace("driver: modbus-tcp\n", "driver: modbus-tcp\n  endpoint: 127.0.0.1:9\n")
+    (workdir / "sim.yaml").write_text(rig_text)  # an endpoint nobody answers: plan must not care
+    path = write("tiny.yaml", TINY_PROCEDURE)
+    assert main(["plan", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "setpoints  1, in this order: 30 °C" in out and "poses      6 per setpoint (six-position)" in out
+    pose_rows = [line for line in out.splitlines() if re.match(r"^\s+[1-6]\s+-?\d", line)]
+    assert len(pose_rows) == 6 and all(len(row.split()) == 1 + 3 + 3 for row in pose_rows)
+    assert re.search(r"^\s+T30\s+\d:\d\d:\d\d\s+\d:\d\d:\d\d\s+\d:\d\d:\d\d\s+\d:\d\d:\d\d", out, re.M)
+    assert re.search(r"^estimated duration \d+:\d\d:\d\d ", out, re.M)
+    assert main(["plan", str(path), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert len(report["poses"]) == 6 and report["poses_total"] == 6
+    assert report["estimate"]["total_s"] == pytest.approx(sum(
+        s["ramp_s"] + s["soak_s"] + s["poses_s"] for s in report["estimate"]["setpoints"]))
+
+
+@pytest.mark.parametrize("change, where", [
+    ("schedule: {kind: six-position}", "syntax"),                          # broken YAML
+    ("soak: {", "syntax"),
+])
+def test_rig_plan_bad_yaml_is_one_line(write, capsys, change: str, where: str) -> None:
+    path = write("tiny.yaml", TINY_PROCEDURE.replace("schedule: {kind: six-position}", "schedule: {kind: six")
+                 if change.startswith("schedule") else TINY_PROCEDURE.replace("soak: {", "soak: {{"))
+    err = one_line_error(capsys, ["plan", str(path)], 2)
+    assert f"{path}:" in err and where in err
+
+
+@pytest.mark.parametrize("text, expected", [
+    (TINY_PROCEDURE + "colour: blue\n", ":7: colour: Extra inputs are not permitted"),      # unknown key
+    (TINY_PROCEDURE.replace("settle_s: 1", "settle_s: soon"), ":6: acquisition.settle_s:"),  # wrong type
+    (TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c: [300]"), ":3: setpoints_c[0]: 300 °C is outside"),
+])
+def test_rig_plan_config_errors_name_file_line_and_key(write, capsys, text: str, expected: str) -> None:
+    path = write("tiny.yaml", text)
+    err = one_line_error(capsys, ["plan", str(path)], 2)
+    assert f"{path}{expected}" in err
+
+
+def test_rig_export_writes_each_format(fitted_paper_campaign: tuple[Path, Path], tmp_path: Path, capsys) -> None:
+    calibration = fitted_paper_campaign[1]
+    for fmt, name in (("json", "cal.json"), ("csv", "cal.csv"), ("c-header", "cal.h")):
+        assert main(["export", str(calibration), "--format", fmt, "-o", str(tmp_path / name)]) == 0
+        assert capsys.readouterr().out.strip() == f"{fmt} of 4 sensors → {tmp_path / name}"
+    assert json.loads((tmp_path / "cal.json").read_text())["format"] == "accelcal-rig calibration"
+    assert (tmp_path / "cal.csv").read_text().count("\n") == 1 + 4 * 12
+    assert "accelcal_apply(" in (tmp_path / "cal.h").read_text()
+    assert main(["export", str(calibration), "--format", "csv"]) == 0  # standard output
+    assert capsys.readouterr().out.startswith("serial,parameter,")
+
+
+def test_rig_export_of_a_broken_calibration_is_one_line(tmp_path: Path, capsys) -> None:
+    broken = tmp_path / "cal.yaml"
+    broken.write_text("format: accelcal-rig calibration\nformat_version: 7\n")
+    err = one_line_error(capsys, ["export", str(broken), "--format", "json"], 2)
+    assert f"{broken}:2: format_version: calibration format version 7 is not supported" in err
+    assert err.strip().endswith("(and 4 more problems)")  # created, software_version, source, sensors

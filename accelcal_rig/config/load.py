@@ -32,7 +32,8 @@ class LoadedConfig(Generic[ModelT]):
 
 
 def load_validated(path: Path, model: type[ModelT]) -> LoadedConfig[ModelT]:
-    """Parse and validate any of the project's YAML files; errors read `file:line: key: message`."""
+    """Parse and validate any of the project's YAML files; an error is one line, `file:line: key: message`
+    for the first problem, with how many more there are (fix one, run again)."""
     data, lines, text = load_yaml_with_lines(path)
     try:
         validated = model.model_validate(data)
@@ -42,7 +43,8 @@ def load_validated(path: Path, model: type[ModelT]) -> LoadedConfig[ModelT]:
             shown, line = locate(lines, tuple(err["loc"]))
             message = str(err["msg"]).removeprefix("Value error, ")
             messages.append(f"{path}:{line}: {format_key(shown)}: {message}")
-        raise ConfigError("\n".join(messages)) from None
+        more = f" (and {len(messages) - 1} more problems)" if len(messages) > 1 else ""
+        raise ConfigError(messages[0] + more) from None
     return LoadedConfig(validated, path, text, lines)
 
 
