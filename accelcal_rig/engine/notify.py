@@ -16,6 +16,7 @@ import subprocess
 import threading
 import urllib.error
 import urllib.request
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -74,13 +75,14 @@ class Notifier:
         while (notification := self._queue.get()) is not None:
             payload = notification.payload()
             if self.config.webhook_url:
-                self._guarded("webhook", notification, lambda: self._post(payload))
+                self._guarded("webhook", notification, self._post, payload)
             if self.config.command:
-                self._guarded("command", notification, lambda: self._run_command(payload))
+                self._guarded("command", notification, self._run_command, payload)
 
-    def _guarded(self, channel: str, notification: Notification, deliver: Any) -> None:
+    def _guarded(self, channel: str, notification: Notification, deliver: Callable[[dict[str, Any]], None],
+                 payload: dict[str, Any]) -> None:
         try:
-            deliver()
+            deliver(payload)
             LOGGER.debug("notification %s sent by %s", notification.event, channel)
         except Exception as exc:  # noqa: BLE001 - a notification must never affect the campaign
             self.failures += 1
