@@ -332,3 +332,31 @@ def test_rig_export_of_a_broken_calibration_is_one_line(tmp_path: Path, capsys) 
     err = one_line_error(capsys, ["export", str(broken), "--format", "json"], 2)
     assert f"{broken}:2: format_version: calibration format version 7 is not supported" in err
     assert err.strip().endswith("(and 4 more problems)")  # created, software_version, source, sensors
+
+
+def test_on_a_terminal_a_live_status_line_shows_progress(tmp_path: Path) -> None:
+    import os
+    import pty
+
+    controller, terminal = pty.openpty()
+    beside_python = Path(sys.executable).parent / "rig"
+    process = subprocess.Popen([str(beside_python), "run", str(REPO / "procedures" / "quick-6pos.yaml"), "--dry-run",
+                                "-o", "q.h5"], cwd=tmp_path, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                               stderr=terminal, env={**os.environ, "COLUMNS": "200"})
+    os.close(terminal)
+    seen = b""
+    while True:
+        try:
+            chunk = os.read(controller, 65536)
+        except OSError:  # the terminal closed: the process has exited
+            break
+        if not chunk:
+            break
+        seen += chunk
+    os.close(controller)
+    assert process.wait(timeout=60) == 0
+    text = seen.decode()
+    assert re.search(r"\r\x1b\[KT15 \(1/2\) (ramp|soak) \d:\d\d:\d\d · .*pose 0/12 · \d:\d\d:\d\d left", text)
+    assert re.search(r"\r\x1b\[K\[\d:\d\d:\d\d\] T15: stable after", text)  # messages above the line
+    assert "progress: " not in text  # the status line replaces the progress lines on a terminal
+    assert text.endswith("\r\x1b[K")  # cleared at the end, the summary follows on stdout

@@ -193,7 +193,8 @@ class CampaignRunner:
     def _record_transition(self, previous: State, target: State, reason: str) -> None:
         suffix = f" ({reason})" if reason else ""
         self.events.debug("transition", f"{previous} → {target}{suffix}")
-        self._publish()
+        if PHASES.get(str(target), str(target)) != PHASES.get(str(previous), str(previous)):
+            self._publish()  # within a pose the snapshot after storing it says all
 
     # ----------------------------------------------------------------- audience
     def _remaining_s(self) -> float | None:

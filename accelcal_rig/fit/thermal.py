@@ -47,8 +47,9 @@ def fit_thermal(temperature_c: np.ndarray, parameters: np.ndarray, sigma: np.nda
     used_degree = min(degree, n - 1)
     if used_degree < degree:
         warnings.append(f"{n} temperatures cannot fix a degree-{degree} polynomial: degree {used_degree} used")
-    elif n == degree + 1:
-        warnings.append(f"{n} temperatures for degree {degree}: the polynomial interpolates, with no check left")
+    if n == used_degree + 1 and n > 1:
+        warnings.append(f"{n} temperatures for degree {used_degree}: the polynomial interpolates, with no check "
+                        "left (drift after compensation is zero by construction)")
     domain = (float(temperature_c.min()), float(temperature_c.max()))
     if domain[1] - domain[0] < 1e-9:
         domain = (domain[0] - 0.5, domain[0] + 0.5)  # one temperature: a constant over a nominal 1 °C

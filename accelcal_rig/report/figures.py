@@ -48,7 +48,7 @@ def _save(figure: Figure, path: Path) -> Path:
 
 def _temperature_colours(data: CampaignData):  # noqa: ANN202 - (colormap, norm)
     plt = pyplot()
-    setpoints = sorted({float(s) for d in data.duts.values() for s in d.poses.setpoint_c})
+    setpoints = [float(s) for s in data.status.get("setpoints_c", [])]  # planned: soaks may have no poses
     norm = plt.Normalize(min(setpoints, default=0.0) - 1e-9, max(setpoints, default=1.0) + 1e-9)
     return plt.get_cmap("coolwarm"), norm
 
