@@ -118,6 +118,39 @@ def _build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--parameters", choices=["all", "bias-scale"], help="default: the procedure's fit.parameters")
     fit.add_argument("--out-of-range", choices=["clamp", "extrapolate"], help="default: the procedure's")
     fit.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
+    recording = _command(
+        commands, "fit-recording", "calibrate from a continuous recording of a sensor turned by hand (no turntable)",
+        "Find the static intervals of a continuous recording (windowed variance against a threshold set from "
+        "its first, still seconds), fit the norm-only model (|g| = 1 in every interval) and write the same "
+        "calibration file as rig fit, for one temperature. The recording is a CSV file (one row per sample) "
+        "or a campaign file's raw samples of one sensor at one setpoint. Record at least 9 orientations "
+        "(12 or more, every axis up and down) for all 9 parameters, 6 for bias and scale alone.",
+        "rig fit-recording session.csv --columns samples,acc_x,acc_y,acc_z --time-unit samples --rate-hz 204.8 "
+        "--units counts --counts-per-g 2048 --parameters bias-scale -o imu.calibration.yaml")
+    recording.add_argument("recording", type=Path, help="CSV file, or a campaign file (.h5)")
+    recording.add_argument("-o", "--output", type=Path, required=True, help="calibration file to write (YAML)")
+    recording.add_argument("--columns", default="time,x,y,z", metavar="TIME,X,Y,Z[,TEMPERATURE]",
+                           help="CSV column names, in this order (default: time,x,y,z)")
+    recording.add_argument("--time-unit", choices=["s", "ms", "samples"], default="s", help="of the time column")
+    recording.add_argument("--rate-hz", type=float, help="sample rate, when the time column counts samples")
+    recording.add_argument("--units", choices=["g", "counts", "m/s2"], default="g", help="of x, y, z (default g)")
+    recording.add_argument("--counts-per-g", type=float, help="with --units counts (ADXL355 at ±2 g: 256000)")
+    recording.add_argument("--zero-code", type=float, default=0.0,
+                           help="code of 0 g: 0 for signed codes (default), 32768 for a 16-bit offset-binary ADC")
+    recording.add_argument("--serial", help="sensor name in the calibration (default: the file's name; campaign "
+                                            "files: the first DUT)")
+    recording.add_argument("--setpoint", type=float, help="campaign files: the setpoint whose poses to use")
+    recording.add_argument("--parameters", choices=["all", "bias-scale"], default="all",
+                           help="all: bias, scale, non-orthogonality (9); bias-scale: 6 (default all)")
+    recording.add_argument("--temperature-c", type=float, help="the recording's temperature, if it has none")
+    recording.add_argument("--window-s", type=float, default=0.5, help="variance window (default 0.5 s)")
+    recording.add_argument("--init-s", type=float, default=2.0,
+                           help="initial still period that sets the threshold (default 2 s)")
+    recording.add_argument("--threshold-factor", type=float, default=10.0,
+                           help="threshold = this × the initial period's variance (default 10)")
+    recording.add_argument("--min-interval-s", type=float, default=1.0, help="shortest static interval (default 1 s)")
+    recording.add_argument("--json", action="store_true", help="print the intervals and results as one JSON object")
+
     report = _command(commands, "report", "write an HTML report with figures of a campaign",
                       "Write REPORT/index.html and REPORT/figures/*.png: the campaign's summary, |g| per pose "
                       "before and after calibration, the raw ellipsoid and calibrated sphere, every parameter "
@@ -358,6 +391,53 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_fit_recording(args: argparse.Namespace) -> int:
+    from accelcal_rig.fit.calibration import save_calibration
+    from accelcal_rig.handheld.calibrate import fit_recording
+    from accelcal_rig.handheld.recording import CsvLayout, read_campaign_recording, read_csv_recording
+    from accelcal_rig.handheld.static_intervals import DetectorSettings, detect_static_intervals
+
+    if not args.recording.exists():
+        raise ConfigError(f"{args.recording}: no such file")
+    if not args.output.parent.is_dir():
+        raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
+    settings = DetectorSettings(args.window_s, args.init_s, args.threshold_factor, args.min_interval_s)
+    for name, value in vars(settings).items():
+        if value <= 0:
+            raise ConfigError(f"--{name.replace('_', '-')}: must be positive, not {value:g}")
+    if args.recording.suffix in (".h5", ".hdf5"):
+        recording = read_campaign_recording(args.recording, args.serial, args.setpoint)
+        serial = args.serial or recording.source.split(" sensor ")[1].split(" at ")[0]
+    else:
+        layout = CsvLayout.parse_columns(args.columns, time_unit=args.time_unit, rate_hz=args.rate_hz,
+                                         units=args.units, counts_per_g=args.counts_per_g, zero_code=args.zero_code)
+        recording = read_csv_recording(args.recording, layout)
+        serial = args.serial or args.recording.stem
+    detection = detect_static_intervals(recording.t_s, recording.accel_g, recording.temperature_c, settings,
+                                        recording.source)
+    result = fit_recording(recording, detection, args.parameters, serial, args.temperature_c)
+    save_calibration(result.calibration, args.output)
+    if args.json:
+        print(json.dumps(result.report))
+        return 0
+    report = result.report
+    print(f"{len(report['intervals'])} static intervals in {recording.source} ({report['samples']} samples at "
+          f"{report['rate_hz']:.4g} Hz; threshold {report['threshold_g2']:.3g} g², {args.threshold_factor:g} × the "
+          f"first {args.init_s:g} s)")
+    print(f"{'#':>3s} {'start s':>9s} {'end s':>9s} {'samples':>8s} {'mean x, y, z (g)':>29s} {'|g|−1 before':>13s} "
+          f"{'after (mg)':>11s}")
+    for k, interval in enumerate(report["intervals"], start=1):
+        mean = " ".join(f"{v:+9.5f}" for v in interval["mean_g"])
+        print(f"{k:3d} {interval['start_s']:9.2f} {interval['end_s']:9.2f} {interval['samples']:8d} {mean:>29s} "
+              f"{interval['norm_before_mg']:13.3f} {interval['norm_after_mg']:11.4f}")
+    for warning in report["warnings"]:
+        print(f"warning: {warning}")
+    print(f"calibration → {args.output}: norm-only, {args.parameters} parameters, |g| RMSE "
+          f"{report['rmse_before_mg']:.3f} → {report['rmse_after_mg']:.4f} mg (noise floor "
+          f"{report['noise_floor_mg']:.4f} mg) at {report['temperature_c']:.1f} °C")
+    return 0
+
+
 def _cmd_report(args: argparse.Namespace) -> int:
     from accelcal_rig.report.figures import pyplot
     from accelcal_rig.report.html_report import write_report
@@ -424,7 +504,8 @@ def main(argv: list[str] | None = None) -> int:
     logging.getLogger("pymodbus").addHandler(logging.NullHandler())
     logging.getLogger("pymodbus").propagate = False
     handler = {"run": _cmd_run, "plan": _cmd_plan, "resume": _cmd_resume, "status": _cmd_status, "fit": _cmd_fit, "check": _cmd_check,
-               "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export}[args.command]
+               "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export,
+               "fit-recording": _cmd_fit_recording}[args.command]
     try:
         return handler(args)
     except CampaignAborted as exc:

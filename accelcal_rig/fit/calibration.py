@@ -60,8 +60,8 @@ class SensorCalibration(_Strict):
     serial: str
     mode: Literal["reference", "norm-only"]
     free_parameters: list[str]
-    range_g: Literal[2, 4, 8]
-    lsb_g: float = Field(gt=0)
+    range_g: float = Field(gt=0, description="measuring range, ± g (2, 4 or 8 for an ADXL355)")
+    lsb_g: float = Field(gt=0, description="g per code, for compensating raw codes")
     validity_c: tuple[float, float]
     out_of_range: Literal["clamp", "extrapolate"] = "clamp"
     polynomial: PolynomialModel

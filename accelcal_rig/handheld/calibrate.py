@@ -1,0 +1,123 @@
+"""A norm-only calibration from the static intervals of a recording, written as the same calibration
+file as `rig fit` (one temperature: every parameter a constant)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from accelcal_rig import __version__
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.fit.calibration import FORMAT_NAME, FORMAT_VERSION, CalibrationFile, PolynomialModel, \
+    SensorCalibration, SetpointFit, plain
+from accelcal_rig.fit.lm import DegenerateDesign, FreeParameters, SfemFit, fit_sfem
+from accelcal_rig.fit.metrics import noise_floor_mg, norm_rmse_mg
+from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
+from accelcal_rig.handheld.recording import Recording
+from accelcal_rig.handheld.static_intervals import Detection
+from accelcal_rig.store.campaign_file import utc_now
+
+#: A half-axis counts as visited when some interval puts at least this much gravity along it.
+VISITED_G = 0.5
+#: Temperature assumed when a recording has none (and none is given).
+NOMINAL_TEMPERATURE_C = 25.0
+
+
+class RecordingUnusable(ConfigError):
+    """Too few static intervals, or too poorly spread, for the fit asked for: bad input (exit code 2)."""
+
+
+@dataclass(frozen=True)
+class RecordingFit:
+    fit: SfemFit
+    calibration: CalibrationFile
+    report: dict[str, Any]
+
+
+def missing_orientations(mean_g: np.ndarray) -> list[str]:
+    """Half-axes no interval points along: `x down` when no interval has x ≤ −0.5 g, and so on."""
+    direction = mean_g / np.linalg.norm(mean_g, axis=1, keepdims=True)
+    missing = []
+    for axis, name in enumerate("xyz"):
+        if not np.any(direction[:, axis] >= VISITED_G):
+            missing.append(f"{name} up")
+        if not np.any(direction[:, axis] <= -VISITED_G):
+            missing.append(f"{name} down")
+    return missing
+
+
+def fit_recording(recording: Recording, detection: Detection, free: FreeParameters, serial: str,
+                  temperature_c: float | None = None) -> RecordingFit:
+    intervals = detection.intervals
+    needed = 6 if free == "bias-scale" else 9
+    if len(intervals) < needed:
+        raise RecordingUnusable(
+            f"{recording.source}: {len(intervals)} static intervals found, a {needed}-parameter norm-only fit needs "
+            f"at least {needed} (12 or more recommended)" + (
+                ", or fit bias and scale only with --parameters bias-scale" if free == "all" and len(intervals) >= 6
+                else ": hold the sensor still longer in each orientation, or lower --min-interval-s"))
+    mean = np.array([i.mean_g for i in intervals])
+    stderr = np.array([i.stderr_g for i in intervals])
+    missing = missing_orientations(mean)
+    if missing:
+        raise RecordingUnusable(f"{recording.source}: {len(intervals)} static intervals, but none with "
+                                f"{', '.join(missing)} (≥ {VISITED_G:g} g along it): record orientations with every "
+                                "axis pointing up and down")
+    try:
+        fit = fit_sfem(mean, stderr, None, "norm-only", free)
+    except DegenerateDesign as exc:
+        raise RecordingUnusable(f"{recording.source}: {exc}") from None
+    temperatures = np.array([i.temperature_c for i in intervals])
+    warnings = list(recording.notes)
+    if len(intervals) == int(fit.free.sum()):
+        warnings.append(f"{len(intervals)} intervals for {len(intervals)} parameters: the fit passes through every "
+                        "one, with no check left (record more orientations)")
+    if np.all(np.isfinite(temperatures)):
+        temperature = float(temperatures.mean())
+        low, high = float(temperatures.min()), float(temperatures.max())
+    else:
+        temperature = NOMINAL_TEMPERATURE_C if temperature_c is None else temperature_c
+        low = high = temperature
+        if temperature_c is None:
+            warnings.append(f"no temperature in the recording: {NOMINAL_TEMPERATURE_C:g} °C assumed "
+                            "(give it with --temperature-c)")
+    if high - low < 1.0:
+        low, high = temperature - 0.5, temperature + 0.5  # one temperature: valid within ±0.5 °C of it
+    compensated = correct(mean, fit.parameters)
+    metrics = {
+        "rmse_before_mg": norm_rmse_mg(mean), "rmse_after_mg": norm_rmse_mg(compensated),
+        "noise_floor_mg": noise_floor_mg(mean, stderr), "chi2_reduced": fit.chi2_reduced,
+        "n_intervals": len(intervals), "temperature_c": temperature,
+    }
+    calibration = SensorCalibration(
+        serial=serial, mode="norm-only", free_parameters=[n for n, f in zip(PARAMETER_NAMES, fit.free) if f],
+        range_g=max(2.0, float(np.ceil(np.abs(recording.accel_g).max()))), lsb_g=recording.lsb_g,
+        validity_c=(low, high), out_of_range="clamp",
+        polynomial=PolynomialModel(domain_c=(low, high), degree=0,
+                                   coefficients={n: [float(p)] for n, p in zip(PARAMETER_NAMES, fit.parameters)}),
+        setpoints=[SetpointFit(setpoint_c=temperature, temperature_c=temperature, n_poses=len(intervals),
+                               chi2_reduced=plain(fit.chi2_reduced),
+                               parameters=dict(zip(PARAMETER_NAMES, plain(fit.parameters))),
+                               sigma=dict(zip(PARAMETER_NAMES, plain(fit.sigma))))],
+        metrics=plain(metrics), warnings=warnings,
+    )
+    calibration_file = CalibrationFile(
+        format=FORMAT_NAME, format_version=FORMAT_VERSION, created=utc_now(), software_version=__version__,
+        source={"recording": recording.source, "measurements_sha256": recording.sha256,
+                "procedure": "hand-held recording, norm-only"},
+        sensors={serial: calibration},
+    )
+    report = plain({
+        "source": recording.source, "rate_hz": detection.rate_hz, "samples": len(recording.t_s),
+        "threshold_g2": detection.threshold_g2, "init_variance_g2": detection.init_variance_g2,
+        "intervals": [{"start_s": i.start_s, "end_s": i.end_s, "samples": i.n_samples, "mean_g": i.mean_g,
+                       "norm_before_mg": float((np.linalg.norm(i.mean_g) - 1.0) * 1e3),
+                       "norm_after_mg": float((np.linalg.norm(c) - 1.0) * 1e3), "temperature_c": i.temperature_c}
+                      for i, c in zip(intervals, compensated)],
+        "parameters": dict(zip(PARAMETER_NAMES, fit.parameters)),
+        "sigma": dict(zip(PARAMETER_NAMES, fit.sigma)),
+        **metrics, "warnings": warnings,
+    })
+    return RecordingFit(fit, calibration_file, report)

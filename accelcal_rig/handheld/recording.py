@@ -1,0 +1,132 @@
+"""A continuous recording of one accelerometer, from a CSV file or from a campaign file's raw samples."""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.store.read import open_campaign
+
+STANDARD_GRAVITY_M_S2 = 9.80665
+Units = Literal["g", "counts", "m/s2"]
+TimeUnit = Literal["s", "ms", "samples"]
+
+
+@dataclass(frozen=True)
+class Recording:
+    source: str
+    t_s: np.ndarray                    # (n,) increasing
+    accel_g: np.ndarray                # (n, 3) raw readings in g (counts × lsb_g)
+    temperature_c: np.ndarray | None   # (n,) the sensor's own temperature, if recorded
+    lsb_g: float                       # g per count (for codes); 1.0 when given in g
+    sha256: str                        # of the source data, for the calibration's provenance
+    notes: list[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class CsvLayout:
+    """Which CSV columns hold time, x, y, z (and temperature), and in what units."""
+
+    time: str
+    x: str
+    y: str
+    z: str
+    temperature: str | None = None
+    time_unit: TimeUnit = "s"
+    rate_hz: float | None = None       # needed when time_unit is "samples"
+    units: Units = "g"
+    counts_per_g: float | None = None  # needed for counts
+    zero_code: float = 0.0             # code of 0 g: 0 for signed codes, e.g. 32768 for 16-bit offset binary
+
+    @classmethod
+    def parse_columns(cls, spec: str, **options: object) -> CsvLayout:
+        """`time,x,y,z[,temperature]` column names, in that order."""
+        names = [n.strip() for n in spec.split(",")]
+        if len(names) not in (4, 5) or not all(names):
+            raise ConfigError(f"--columns: {spec!r}: expected time,x,y,z or time,x,y,z,temperature column names")
+        return cls(*names[:4], names[4] if len(names) == 5 else None, **options)  # type: ignore[arg-type]
+
+
+def read_csv_recording(path: Path, layout: CsvLayout) -> Recording:
+    if layout.units == "counts" and not layout.counts_per_g:
+        raise ConfigError("--counts-per-g is needed with --units counts (ADXL355: 256000 at ±2 g)")
+    if layout.time_unit == "samples" and not layout.rate_hz:
+        raise ConfigError("--rate-hz is needed when the time column counts samples")
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot read ({exc.strerror})") from None
+    reader = csv.reader(raw.decode("utf-8", errors="replace").splitlines())
+    header = next(reader, None)
+    if header is None:
+        raise ConfigError(f"{path}: empty file")
+    header = [h.strip() for h in header]
+    wanted = [layout.time, layout.x, layout.y, layout.z] + ([layout.temperature] if layout.temperature else [])
+    missing = [c for c in wanted if c not in header]
+    if missing:
+        raise ConfigError(f"{path}: no column {', '.join(missing)} (columns: {', '.join(header)}); map them with "
+                          "--columns time,x,y,z[,temperature]")
+    index = [header.index(c) for c in wanted]
+    values = []
+    for line, row in enumerate(reader, start=2):
+        if not row:
+            continue
+        try:
+            values.append([float(row[i]) for i in index])
+        except (ValueError, IndexError):
+            raise ConfigError(f"{path}:{line}: not a number in columns {', '.join(wanted)}") from None
+    data = np.array(values, dtype=float).reshape(-1, len(wanted))
+    if len(data) < 10:
+        raise ConfigError(f"{path}: {len(data)} rows: too short to be a calibration recording")
+    notes = []
+    order = np.argsort(data[:, 0], kind="stable")
+    if np.any(order != np.arange(len(order))):
+        data = data[order]
+        notes.append("rows were not in time order: sorted by the time column")
+    t = data[:, 0] * {"s": 1.0, "ms": 1e-3, "samples": 1.0 / (layout.rate_hz or 1.0)}[layout.time_unit]
+    if np.any(np.diff(t) <= 0):
+        raise ConfigError(f"{path}: column {layout.time} repeats a time: one row per sample expected")
+    lsb_g = {"g": 1.0, "m/s2": 1.0 / STANDARD_GRAVITY_M_S2, "counts": 1.0 / (layout.counts_per_g or 1.0)}[layout.units]
+    accel_g = (data[:, 1:4] - (layout.zero_code if layout.units == "counts" else 0.0)) * lsb_g
+    temperature = data[:, 4] if layout.temperature else None
+    return Recording(str(path), t, accel_g, temperature, lsb_g, hashlib.sha256(raw).hexdigest(), notes)
+
+
+def read_campaign_recording(path: Path, serial: str | None, setpoint_c: float | None) -> Recording:
+    """One DUT's raw samples at one setpoint of a campaign file, pose after pose, as one recording (the
+    gaps between poses are where the turntable moved)."""
+    with open_campaign(path) as file:
+        serials = list(file["duts"])
+        if serial is None:
+            serial = serials[0]
+        if serial not in serials:
+            raise ConfigError(f"{path}: no sensor {serial} (the file has {', '.join(serials)})")
+        setpoints = file["poses/setpoint_c"][:]
+        available = list(dict.fromkeys(setpoints.tolist()))
+        if not available:
+            raise ConfigError(f"{path}: no poses stored")
+        if setpoint_c is None:
+            if len(available) > 1:
+                raise ConfigError(f"{path}: poses at {len(available)} setpoints ({', '.join(f'{s:g}' for s in available)}"
+                                  " °C): choose one with --setpoint")
+            setpoint_c = available[0]
+        rows = np.flatnonzero(setpoints == setpoint_c)
+        if not len(rows):
+            raise ConfigError(f"{path}: no poses at {setpoint_c:g} °C (setpoints: {', '.join(f'{s:g}' for s in available)})")
+        dut = file["duts"][serial]
+        lsb_g, odr_hz = float(dut.attrs["lsb_g"]), float(dut.attrs["odr_hz"])
+        codes = dut["raw_codes"][rows]
+        pose_temperature = dut["temperature_c"][rows].mean(axis=1)
+        t_start = file["poses/t_start_s"][rows]
+    n = codes.shape[1]
+    t = (t_start[:, None] + np.arange(n)[None, :] / odr_hz).ravel()
+    accel_g = codes.reshape(-1, 3).astype(float) * lsb_g
+    digest = hashlib.sha256(np.ascontiguousarray(codes).tobytes()).hexdigest()
+    return Recording(f"{path} sensor {serial} at {setpoint_c:g} °C", t, accel_g, np.repeat(pose_temperature, n), lsb_g,
+                     digest)
