@@ -151,6 +151,27 @@ def _build_parser() -> argparse.ArgumentParser:
     recording.add_argument("--min-interval-s", type=float, default=1.0, help="shortest static interval (default 1 s)")
     recording.add_argument("--json", action="store_true", help="print the intervals and results as one JSON object")
 
+    analyze = _command(commands, "analyze", "the paper's other experiments on a campaign file: positions, tilt, cooldown",
+                       "Analyses of campaign files beyond the calibration: how many positions a calibration "
+                       "needs (positions), tilt angles before and after calibration (tilt), the temperature "
+                       "coefficient during a free cool-down (cooldown).",
+                       "rig analyze positions campaign.h5 --figure positions.png")
+    analyses = analyze.add_subparsers(dest="analysis", required=True, metavar="ANALYSIS")
+    positions = _command(analyses, "positions", "refit on subsets of 1296 … 12 positions, score on the rest",
+                         "Refit the error model on subsets of the poses of one setpoint, of the sizes of the "
+                         "paper's Table 4 (several random subsets and one evenly spread subset each), and "
+                         "report the RMSE of |g| on the poses each fit did not use (paper Fig. 8). Made for "
+                         "procedures/positions-study.yaml (1296 orientations).",
+                         "rig analyze positions campaign.h5 --figure positions.png")
+    positions.add_argument("campaign", type=Path, help="campaign file (HDF5)")
+    positions.add_argument("--setpoint", type=float, help="the setpoint to analyse (default: the file's only one)")
+    positions.add_argument("--sizes", help="comma-separated subset sizes (default: the paper's 1296,648,…,12)")
+    positions.add_argument("--subsets", type=int, default=10, help="random subsets per size (default 10)")
+    positions.add_argument("--seed", type=int, default=0, help="seed of the random subsets (default 0)")
+    positions.add_argument("--mode", choices=["reference", "norm-only"], help="default: the campaign's fit mode")
+    positions.add_argument("--figure", type=Path, help="write the figure (PNG) here")
+    positions.add_argument("--json", action="store_true", help="print one JSON object")
+
     report = _command(commands, "report", "write an HTML report with figures of a campaign",
                       "Write REPORT/index.html and REPORT/figures/*.png: the campaign's summary, |g| per pose "
                       "before and after calibration, the raw ellipsoid and calibrated sphere, every parameter "
@@ -438,6 +459,67 @@ def _cmd_fit_recording(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_analyze(args: argparse.Namespace) -> int:
+    return {"positions": _analyze_positions}[args.analysis](args)
+
+
+def _analyze_positions(args: argparse.Namespace) -> int:
+    import dataclasses
+
+    import numpy as np
+
+    from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
+    from accelcal_rig.analysis.positions import PAPER_SIZES, floor_mg, score_subsets, summarise
+    from accelcal_rig.fit.calibration import plain
+    from accelcal_rig.store.read import open_campaign
+
+    try:
+        sizes = tuple(int(v) for v in args.sizes.split(",")) if args.sizes else PAPER_SIZES
+    except ValueError:
+        raise ConfigError(f"--sizes: {args.sizes!r}: expected whole numbers separated by commas") from None
+    if min(sizes) < 6 or args.subsets < 1:
+        raise ConfigError("--sizes: at least 6 positions per subset; --subsets: at least 1")
+    if args.figure is not None:
+        _check_figure_path(args.figure)
+    setpoint, duts, _ = poses_at_setpoint(args.campaign, args.setpoint)
+    with open_campaign(args.campaign) as file:
+        mode = args.mode or str(file.attrs.get("fit_mode", "reference"))
+        free = str(file.attrs.get("fit_parameters", "all"))
+    rows, floors = [], {}
+    for serial, poses in duts.items():
+        scores = score_subsets(poses, sizes, mode, free, args.subsets, np.random.default_rng(args.seed))  # type: ignore[arg-type]
+        rows += summarise(serial, scores)
+        floors[serial] = floor_mg(poses)
+    if args.figure is not None:
+        from accelcal_rig.report.analysis_figures import positions_figure
+
+        positions_figure(rows, floors, mode, args.figure)
+    if args.json:
+        print(json.dumps(plain({"setpoint_c": setpoint, "mode": mode, "noise_floor_mg": floors,
+                                "sizes": [dataclasses.asdict(r) for r in rows]})))
+        return 0
+    print(f"{args.campaign}: {mode} fits at {setpoint:g} °C, RMSE of |g| on the poses each fit left out (mg); "
+          f"{args.subsets} random subsets per size")
+    print(f"{'sensor':14s} {'positions':>9s} {'before':>8s} {'evenly spread':>14s} {'random median':>14s} "
+          f"{'random worst':>13s} {'failed':>7s}")
+    for r in rows:
+        print(f"{r.serial:14s} {r.size:9d} {r.before_mg:8.3f} {r.structured_mg:14.4f} {r.random_median_mg:14.4f} "
+              f"{r.random_max_mg:13.4f} {r.failed:7d}")
+    print("noise floor (mg): " + ", ".join(f"{k} {v:.4f}" for k, v in floors.items())
+          + "; the full set is scored on its own poses")
+    if args.figure is not None:
+        print(f"figure → {args.figure}")
+    return 0
+
+
+def _check_figure_path(path: Path) -> None:
+    from accelcal_rig.report.figures import pyplot
+
+    pyplot()  # a missing extra is a one-line error before any work
+    if not path.parent.is_dir():
+        raise ConfigError(f"{path}: folder {path.parent} does not exist")
+
+
 def _cmd_report(args: argparse.Namespace) -> int:
     from accelcal_rig.report.figures import pyplot
     from accelcal_rig.report.html_report import write_report
@@ -505,7 +587,7 @@ def main(argv: list[str] | None = None) -> int:
     logging.getLogger("pymodbus").propagate = False
     handler = {"run": _cmd_run, "plan": _cmd_plan, "resume": _cmd_resume, "status": _cmd_status, "fit": _cmd_fit, "check": _cmd_check,
                "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export,
-               "fit-recording": _cmd_fit_recording}[args.command]
+               "fit-recording": _cmd_fit_recording, "analyze": _cmd_analyze}[args.command]
     try:
         return handler(args)
     except CampaignAborted as exc:

@@ -6,7 +6,8 @@ so set those two to a real rig's measured values). The ramp and soak are polled 
 polls them, through the same soak detector, fed with what an ADXL355 reads (0.11 °C steps, with noise):
 the soak is the median over `SOAK_DRAWS` draws of that noise, since the band is a few steps wide and the
 noise moves the moment it is met by minutes. Each pose costs its turntable travel at the axes' speeds, the
-table's settling, the procedure's settle time and the samples at the data rate. Instrument communication
+table's settling (`simulation.turntable_settle_s`) and half a position poll, the procedure's settle time
+and the samples at the data rate. Instrument communication
 time is not included (a few milliseconds per exchange on a real rig, none in virtual time).
 """
 
@@ -90,8 +91,10 @@ def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> Durat
         self_heating_c=sim.self_heating_c,
     )
     speeds = np.array([a.speed_deg_s for a in rig.turntable.axes])
-    settle_polls_s = MOVE_POLL_S * math.ceil(sim.turntable_settle_s / MOVE_POLL_S)
-    pose_fixed_s = settle_polls_s + acquisition.settle_s + acquisition.samples_per_pose / acquisition.odr_hz
+    # The table reports in position its settling time after arriving; the engine's position polls find
+    # that moment half a polling interval late on average.
+    in_position_s = sim.turntable_settle_s + MOVE_POLL_S / 2
+    pose_fixed_s = in_position_s + acquisition.settle_s + acquisition.samples_per_pose / acquisition.odr_hz
     table_deg = np.zeros(len(speeds))
     t = 0.0
     rows = []

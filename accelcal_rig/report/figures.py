@@ -40,7 +40,7 @@ def pyplot():  # noqa: ANN201 - matplotlib's module
     return plt
 
 
-def _save(figure: Figure, path: Path) -> Path:
+def save(figure: Figure, path: Path) -> Path:
     figure.savefig(path, dpi=DPI, bbox_inches="tight")
     pyplot().close(figure)
     return path
@@ -81,7 +81,7 @@ def norm_deviation(data: CampaignData, path: Path) -> Path:
     axes[1, 0].set_ylabel("|g| − 1 after (mg)")
     figure.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=axes, label="setpoint (°C)", shrink=0.8)
     figure.suptitle("Norm of gravity at each pose, before and after calibration (paper Fig. 6)")
-    return _save(figure, path)
+    return save(figure, path)
 
 
 def _sphere_grid(n: int = 24) -> np.ndarray:
@@ -135,7 +135,7 @@ def ellipsoid(data: CampaignData, path: Path) -> Path:
     if not fitted:
         figure.text(0.5, 0.5, f"no fit: {data.no_fit_reason}", ha="center")
     figure.suptitle("Raw ellipsoid and calibrated sphere, errors magnified (paper Fig. 7); colour: setpoint")
-    return _save(figure, path)
+    return save(figure, path)
 
 
 def parameters(data: CampaignData, path: Path) -> Path:
@@ -175,7 +175,7 @@ def parameters(data: CampaignData, path: Path) -> Path:
         axes[0, 0].legend(fontsize=7)
     figure.suptitle(f"Change of each error parameter over temperature from its mid-range value, with the "
                     f"degree-{data.options.degree} polynomials (paper Fig. 10)")
-    return _save(figure, path)
+    return save(figure, path)
 
 
 def drift(data: CampaignData, path: Path) -> Path:
@@ -206,7 +206,7 @@ def drift(data: CampaignData, path: Path) -> Path:
     axes[0, 0].set_ylabel("offset before compensation, minus its mean (mg)")
     axes[1, 0].set_ylabel("offset after compensation, minus its mean (µg)")
     figure.suptitle("Zero-g offset drift per axis before and after thermal compensation (paper Fig. 11)")
-    return _save(figure, path)
+    return save(figure, path)
 
 
 def soak_traces(data: CampaignData, band_c: float, path: Path) -> Path:
@@ -243,4 +243,4 @@ def soak_traces(data: CampaignData, band_c: float, path: Path) -> Path:
     bottom.set_title(f"Settling of every DUT at every setpoint; dashed: the soak band, {band_c:g} °C wide (max − min "
                      "over the window)", fontsize=10)
     figure.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=[top, bottom], label="setpoint (°C)", shrink=0.6)
-    return _save(figure, path)
+    return save(figure, path)

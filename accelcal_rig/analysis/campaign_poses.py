@@ -1,0 +1,38 @@
+"""The poses of one setpoint of a campaign file, for analyses that work at one temperature."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.store.read import DutPoses, open_campaign, read_dut_poses
+
+
+def poses_at_setpoint(path: Path, setpoint_c: float | None) -> tuple[float, dict[str, DutPoses], np.ndarray]:
+    """(setpoint, each DUT's poses there, their pose numbers); `setpoint_c` None: the file's only one."""
+    with open_campaign(path) as file:
+        setpoints = file["poses/setpoint_c"][:]
+        available = list(dict.fromkeys(setpoints.tolist()))
+        if not available:
+            raise ConfigError(f"{path}: no poses stored")
+        if setpoint_c is None:
+            if len(available) > 1:
+                raise ConfigError(f"{path}: poses at {len(available)} setpoints "
+                                  f"({', '.join(f'{s:g}' for s in available)} °C): choose one with --setpoint")
+            setpoint_c = available[0]
+        rows = setpoints == setpoint_c
+        if not rows.any():
+            raise ConfigError(f"{path}: no poses at {setpoint_c:g} °C "
+                              f"(setpoints: {', '.join(f'{s:g}' for s in available)})")
+        numbers = file["poses/pose_number"][:][rows]
+        duts = {serial: _select(read_dut_poses(file, serial), rows) for serial in file["duts"]}
+    return float(setpoint_c), duts, numbers
+
+
+def _select(poses: DutPoses, rows: np.ndarray) -> DutPoses:
+    return replace(poses, setpoint_c=poses.setpoint_c[rows], t_s=poses.t_s[rows], temperature_c=poses.temperature_c[rows],
+                   mean_g=poses.mean_g[rows], stderr_g=poses.stderr_g[rows], reference_g=poses.reference_g[rows],
+                   truth_parameters=None if poses.truth_parameters is None else poses.truth_parameters[rows])
