@@ -172,6 +172,17 @@ def _build_parser() -> argparse.ArgumentParser:
     positions.add_argument("--figure", type=Path, help="write the figure (PNG) here")
     positions.add_argument("--json", action="store_true", help="print one JSON object")
 
+    tilt = _command(analyses, "tilt", "pitch and roll before and after a calibration, against the reference",
+                    "For every pose of one setpoint and every DUT: the reference pitch and roll (paper Eq. 10) "
+                    "from the orientation the turntable set, those measured raw and after compensation with "
+                    "the calibration, and the SEOQ (|before − after| relative to 30°), as in the paper's "
+                    "Table 5. Made for procedures/tilt-check.yaml.",
+                    "rig analyze tilt tilt.h5 --calibration campaign.calibration.yaml")
+    tilt.add_argument("campaign", type=Path, help="campaign file (HDF5)")
+    tilt.add_argument("--calibration", type=Path, required=True, help="calibration file (YAML) of the same DUTs")
+    tilt.add_argument("--setpoint", type=float, help="the setpoint to analyse (default: the file's only one)")
+    tilt.add_argument("--json", action="store_true", help="print one JSON object")
+
     report = _command(commands, "report", "write an HTML report with figures of a campaign",
                       "Write REPORT/index.html and REPORT/figures/*.png: the campaign's summary, |g| per pose "
                       "before and after calibration, the raw ellipsoid and calibrated sphere, every parameter "
@@ -318,7 +329,7 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
     if summary.fit_failed:
         print(f"rig: campaign done but the fit failed: {summary.fit}", file=sys.stderr)
         return 1
-    print(f"  fit        {summary.fit}")
+    print(f"  fit        {summary.fit or 'none (the procedure measures only: fit.mode none)'}")
     return 0
 
 
@@ -397,6 +408,9 @@ def _cmd_fit(args: argparse.Namespace) -> int:
             free=args.parameters or str(attrs.get("fit_parameters", "all")),
             out_of_range=args.out_of_range or str(attrs.get("fit_out_of_range", "clamp")),
         )
+        if options.mode == "none":
+            raise ConfigError(f"{args.campaign}: its procedure asked for no fit (fit.mode: none); choose one with "
+                              "--mode reference or --mode norm-only")
         state = str(attrs["state"])
         try:
             _, report = fit_and_save(file, args.campaign, args.output, options)
@@ -460,7 +474,44 @@ def _cmd_fit_recording(args: argparse.Namespace) -> int:
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
-    return {"positions": _analyze_positions}[args.analysis](args)
+    return {"positions": _analyze_positions, "tilt": _analyze_tilt}[args.analysis](args)
+
+
+def _analyze_tilt(args: argparse.Namespace) -> int:
+    import dataclasses
+
+    from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
+    from accelcal_rig.analysis.tilt import tilt_rows, worst_errors_deg
+    from accelcal_rig.fit.calibration import load_calibration, plain
+
+    calibration = load_calibration(args.calibration)
+    setpoint, duts, numbers = poses_at_setpoint(args.campaign, args.setpoint)
+    missing = [serial for serial in duts if serial not in calibration.sensors]
+    if missing:
+        raise ConfigError(f"{args.calibration}: no calibration for {', '.join(missing)} of {args.campaign} "
+                          f"(it has {', '.join(calibration.sensors)})")
+    rows = {serial: tilt_rows(poses, numbers, calibration.sensors[serial]) for serial, poses in duts.items()}
+    outside = [f"{s} ({duts[s].temperature_c.min():.1f}…{duts[s].temperature_c.max():.1f} °C outside "
+               f"{calibration.sensors[s].validity_c[0]:.1f}…{calibration.sensors[s].validity_c[1]:.1f} °C)"
+               for s in duts if not (calibration.sensors[s].validity_c[0] <= duts[s].temperature_c.min()
+                                     and duts[s].temperature_c.max() <= calibration.sensors[s].validity_c[1])]
+    if args.json:
+        print(json.dumps(plain({"setpoint_c": setpoint, "calibration": str(args.calibration), "outside_range": outside,
+                                "rows": [dataclasses.asdict(r) for sensor in rows.values() for r in sensor]})))
+        return 0
+    print(f"{args.campaign} at {setpoint:g} °C with {args.calibration}: pitch; roll (degrees), paper Eq. 10")
+    print(f"{'sensor':14s} {'pose':>4s} {'reference':>16s} {'without calibration':>20s} {'after calibration':>20s} "
+          f"{'SEOQ (%)':>12s}")
+    for serial, sensor_rows in rows.items():
+        for r in sensor_rows:
+            pair = lambda v, d: f"{v[0]:.{d}f}; {v[1]:.{d}f}"  # noqa: E731
+            print(f"{serial:14s} {r.pose_number:4d} {pair(r.reference_deg, 2):>16s} {pair(r.before_deg, 3):>20s} "
+                  f"{pair(r.after_deg, 3):>20s} {pair(r.seoq_percent, 2):>12s}")
+        before, after = worst_errors_deg(sensor_rows)
+        print(f"{serial:14s} worst |error|: {before:.3f}° without, {after:.4f}° after calibration")
+    for note in outside:
+        print(f"warning: {note}: the calibration was clamped to its range")
+    return 0
 
 
 def _analyze_positions(args: argparse.Namespace) -> int:

@@ -57,6 +57,21 @@ class SphereSchedule(_Strict):
     count: int = Field(ge=6, le=20000)
 
 
+class TiltSchedule(_Strict):
+    """Poses given as pitch and roll of the fixture (paper Eq. 10, Table 5), in degrees: pitch tilts the
+    y axis up, roll tilts the x axis down; (0, 0) is level with z up."""
+
+    kind: Literal["tilt"]
+    pitch_roll_deg: list[tuple[float, float]] = Field(min_length=1)
+
+    @field_validator("pitch_roll_deg")
+    @classmethod
+    def _within_quarter_turn(cls, value: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        if any(not -90.0 <= p <= 90.0 or not -180.0 <= r <= 180.0 for p, r in value):
+            raise ValueError("pitch must lie within ±90° and roll within ±180°")
+        return value
+
+
 class ExplicitSchedule(_Strict):
     """Turntable axis angles given pose by pose, in degrees, in the rig's axis order."""
 
@@ -65,7 +80,8 @@ class ExplicitSchedule(_Strict):
 
 
 Schedule = Annotated[
-    Paper24Schedule | SixPositionSchedule | SphereSchedule | ExplicitSchedule, Field(discriminator="kind")
+    Paper24Schedule | SixPositionSchedule | SphereSchedule | TiltSchedule | ExplicitSchedule,
+    Field(discriminator="kind")
 ]
 
 
@@ -89,7 +105,8 @@ class Acquisition(_Strict):
 class FitOptions(_Strict):
     """How the campaign's data will be fitted (paper §3)."""
 
-    mode: Literal["reference", "norm-only"] = "reference"
+    mode: Literal["reference", "norm-only", "none"] = Field(
+        "reference", description="none: measure only (a tilt check, a cool-down), no calibration at the end")
     polynomial_degree: int = Field(3, ge=0, le=6)
     parameters: Literal["all", "bias-scale"] = "all"
     out_of_range: Literal["clamp", "extrapolate"] = "clamp"

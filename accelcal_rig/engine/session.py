@@ -65,6 +65,8 @@ def _check_design_identifies_fit(procedure: LoadedConfig[Procedure], rig: RigCon
     fit; a design the fit would refuse afterwards is refused now.
     """
     fit = procedure.model.fit
+    if fit.mode == "none":
+        return
     gravity_fixture = np.array([p.gravity_fixture for p in plan.poses])
     for sensor in rig.fixture.sensors:
         gravity = Rotation.from_euler("xyz", sensor.mount_euler_deg, degrees=True).inv().apply(gravity_fixture)
@@ -220,7 +222,8 @@ def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, instr
         events = EventLog(clock, writer)
         estimate = estimate_duration(procedure, rig, prepared.plan) if progress or notifier else None
         runner = CampaignRunner(procedure, rig, prepared.plan, instruments, writer, clock, events,
-                                fit_stage=_fit_stage(procedure, output, calibration) if calibration else None,
+                                fit_stage=_fit_stage(procedure, output, calibration)
+                                if calibration and procedure.fit.mode != "none" else None,
                                 resume=resume, audience=Audience(progress, estimate, notifier, str(output)))
         summary = runner.run()
     finally:

@@ -71,6 +71,8 @@ def pose_directions(procedure: Procedure, kinematics: TurntableKinematics) -> tu
         return schedules.six_position(), None
     if schedule.kind == "sphere":
         return schedules.sphere(schedule.count), None
+    if schedule.kind == "tilt":
+        return schedules.tilt(np.array(schedule.pitch_roll_deg)), None
     angles = np.array(schedule.angles_deg, dtype=float)
     return kinematics.gravity_in_fixture(angles), angles
 

@@ -28,6 +28,13 @@ def six_position() -> np.ndarray:
     return np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], dtype=float)
 
 
+def tilt(pitch_roll_deg: np.ndarray) -> np.ndarray:
+    """The reading (+1 g up) at each pitch φ and roll θ: Eq. 10 inverted on gravity g = −reading,
+    g = (cos φ sin θ, −sin φ, −cos φ cos θ)."""
+    pitch, roll = np.radians(np.asarray(pitch_roll_deg, dtype=float)).T
+    return np.column_stack([-np.cos(pitch) * np.sin(roll), np.sin(pitch), np.cos(pitch) * np.cos(roll)])
+
+
 def sphere(count: int) -> np.ndarray:
     """`count` directions spread evenly over the sphere (Fibonacci lattice, deterministic)."""
     index = np.arange(count) + 0.5

@@ -28,6 +28,7 @@ def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[s
         f"poses      {len(plan.poses)} per setpoint ({procedure.schedule.kind}), {len(plan.pose_steps)} in all; "
         f"{acquisition.samples_per_pose} samples at {acquisition.odr_hz:g} Hz, ±{acquisition.range_g} g, "
         f"settle {acquisition.settle_s:g} s",
+        "fit        none: measured only" if procedure.fit.mode == "none" else
         f"fit        {procedure.fit.mode}, {procedure.fit.parameters} parameters, polynomial degree "
         f"{procedure.fit.polynomial_degree}",
         "",
