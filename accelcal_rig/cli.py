@@ -183,6 +183,17 @@ def _build_parser() -> argparse.ArgumentParser:
     tilt.add_argument("--setpoint", type=float, help="the setpoint to analyse (default: the file's only one)")
     tilt.add_argument("--json", action="store_true", help="print one JSON object")
 
+    cooldown = _command(analyses, "cooldown", "temperature coefficient per axis during a free cool-down",
+                        "For every DUT of a cool-down campaign (procedures/cooldown-60c.yaml): the slope of each "
+                        "axis's output against the DUT's own temperature, in µg/K, before and after compensation "
+                        "with the calibration (paper: 1346 → 37 µg/K), and the output's span; the figure shows "
+                        "the outputs over the cool-down (paper Fig. 11).",
+                        "rig analyze cooldown cooldown.h5 --calibration campaign.calibration.yaml --figure cool.png")
+    cooldown.add_argument("campaign", type=Path, help="campaign file (HDF5) of a cool-down procedure")
+    cooldown.add_argument("--calibration", type=Path, required=True, help="calibration file (YAML) of the same DUTs")
+    cooldown.add_argument("--figure", type=Path, help="write the figure (PNG) here")
+    cooldown.add_argument("--json", action="store_true", help="print one JSON object")
+
     report = _command(commands, "report", "write an HTML report with figures of a campaign",
                       "Write REPORT/index.html and REPORT/figures/*.png: the campaign's summary, |g| per pose "
                       "before and after calibration, the raw ellipsoid and calibrated sphere, every parameter "
@@ -474,7 +485,54 @@ def _cmd_fit_recording(args: argparse.Namespace) -> int:
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
-    return {"positions": _analyze_positions, "tilt": _analyze_tilt}[args.analysis](args)
+    return {"positions": _analyze_positions, "tilt": _analyze_tilt, "cooldown": _analyze_cooldown}[args.analysis](args)
+
+
+def _calibrations_for(calibration_path: Path, campaign: Path, serials: list[str]):  # noqa: ANN202
+    from accelcal_rig.fit.calibration import load_calibration
+
+    calibration = load_calibration(calibration_path)
+    missing = [serial for serial in serials if serial not in calibration.sensors]
+    if missing:
+        raise ConfigError(f"{calibration_path}: no calibration for {', '.join(missing)} of {campaign} "
+                          f"(it has {', '.join(calibration.sensors)})")
+    return calibration
+
+
+def _analyze_cooldown(args: argparse.Namespace) -> int:
+    import dataclasses
+
+    from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
+    from accelcal_rig.analysis.cooldown import analyse_cooldown
+    from accelcal_rig.fit.calibration import plain
+
+    if args.figure is not None:
+        _check_figure_path(args.figure)
+    _, duts, _ = poses_at_setpoint(args.campaign, None)
+    calibration = _calibrations_for(args.calibration, args.campaign, list(duts))
+    results = [analyse_cooldown(poses, calibration.sensors[serial]) for serial, poses in duts.items()]
+    if args.figure is not None:
+        from accelcal_rig.report.analysis_figures import cooldown_figure
+
+        cooldown_figure(results, args.figure)
+    if args.json:
+        print(json.dumps(plain({"calibration": str(args.calibration), "sensors": [
+            {k: v for k, v in dataclasses.asdict(r).items() if k not in ("t_s", "before_g", "after_g")}
+            | {"records": len(r.t_s)} for r in results]})))
+        return 0
+    print(f"{args.campaign}: free cool-down, temperature coefficient per axis (µg/K) with {args.calibration}")
+    print(f"{'sensor':14s} {'records':>7s} {'from … to (°C)':>16s} {'before x, y, z':>26s} {'after x, y, z':>26s}")
+    for r in results:
+        before = " ".join(f"{v:+8.1f}" for v in r.coefficient_before_ug_per_k)
+        after = " ".join(f"{v:+8.2f}" for v in r.coefficient_after_ug_per_k)
+        print(f"{r.serial:14s} {len(r.t_s):7d} {r.temperature_c.max():7.1f} … {r.temperature_c.min():5.1f} "
+              f"{before:>26s} {after:>26s}")
+        if r.outside_range:
+            print(f"  warning: {r.outside_range} records outside the calibrated range: clamped or extrapolated as "
+                  "the calibration file says")
+    if args.figure is not None:
+        print(f"figure → {args.figure}")
+    return 0
 
 
 def _analyze_tilt(args: argparse.Namespace) -> int:
@@ -482,14 +540,10 @@ def _analyze_tilt(args: argparse.Namespace) -> int:
 
     from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
     from accelcal_rig.analysis.tilt import tilt_rows, worst_errors_deg
-    from accelcal_rig.fit.calibration import load_calibration, plain
+    from accelcal_rig.fit.calibration import plain
 
-    calibration = load_calibration(args.calibration)
     setpoint, duts, numbers = poses_at_setpoint(args.campaign, args.setpoint)
-    missing = [serial for serial in duts if serial not in calibration.sensors]
-    if missing:
-        raise ConfigError(f"{args.calibration}: no calibration for {', '.join(missing)} of {args.campaign} "
-                          f"(it has {', '.join(calibration.sensors)})")
+    calibration = _calibrations_for(args.calibration, args.campaign, list(duts))
     rows = {serial: tilt_rows(poses, numbers, calibration.sensors[serial]) for serial, poses in duts.items()}
     outside = [f"{s} ({duts[s].temperature_c.min():.1f}…{duts[s].temperature_c.max():.1f} °C outside "
                f"{calibration.sensors[s].validity_c[0]:.1f}…{calibration.sensors[s].validity_c[1]:.1f} °C)"

@@ -76,6 +76,10 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
     safe = procedure.model.safe_setpoint_c
     if safe is not None and not chamber.min_setpoint_c <= safe <= chamber.max_setpoint_c:
         raise procedure.error(("safe_setpoint_c",), f"{safe:g} °C is outside the chamber limits of {rig.path}")
+    cooldown = procedure.model.cooldown
+    if cooldown is not None and cooldown.chamber == "power-off" and chamber.register_map().power_register is None:
+        raise procedure.error(("cooldown", "chamber"), f"the chamber of {rig.path} has no power event in its register "
+                                                       "map to switch it off: use chamber: ambient")
     schedule = procedure.model.schedule
     if schedule.kind == "explicit":
         axes = rig.model.turntable.axes

@@ -123,6 +123,19 @@ class SimulatedEffects(_Strict):
     nonlinearity_mg_per_g2: float = Field(0.0, ge=0, le=50, description="square-law term per axis, ± per DUT")
 
 
+class Cooldown(_Strict):
+    """Free cool-down validation (paper §4.3, Fig. 11): after the soak at the procedure's one setpoint,
+    hold one pose, let the chamber go (switched off, or set to ambient) and record while the DUTs cool."""
+
+    pose: int = Field(1, ge=1, description="pose number of the schedule to hold")
+    chamber: Literal["power-off", "ambient"] = Field(
+        "power-off", description="power-off: the chamber switched off (its power event); ambient: its set point "
+                                 "to ambient_c")
+    ambient_c: float = Field(23.0, description="set point for chamber: ambient")
+    record_every_s: float = Field(60.0, gt=0, le=3600, description="one block of samples this often")
+    duration_min: float = Field(240.0, gt=0, le=7 * 24 * 60, description="how long to record")
+
+
 class Procedure(_Strict):
     """A whole campaign. Setpoints run in the order given."""
 
@@ -135,7 +148,19 @@ class Procedure(_Strict):
     acquisition: Acquisition = Acquisition()
     safe_setpoint_c: float | None = Field(None, description="overrides the rig's chamber.safe_setpoint_c")
     fit: FitOptions = FitOptions()
+    cooldown: Cooldown | None = Field(None, description="record a free cool-down instead of the schedule's poses")
     simulation: SimulatedEffects = SimulatedEffects()
+
+    @model_validator(mode="after")
+    def _cooldown_fits(self) -> Procedure:
+        if self.cooldown is not None:
+            if len(self.setpoints_c) != 1:
+                raise ValueError("a cool-down procedure has one setpoint: the temperature it cools from")
+            block_s = self.acquisition.settle_s + self.acquisition.samples_per_pose / self.acquisition.odr_hz
+            if self.cooldown.record_every_s < block_s:
+                raise ValueError(f"cooldown.record_every_s must be at least one record's {block_s:g} s (settle "
+                                 "and samples)")
+        return self
 
     @field_validator("setpoints_c", mode="before")
     @classmethod

@@ -171,6 +171,8 @@ class SimulationConfig(_Strict):
     chamber_time_constant_min: float = Field(3.0, gt=0)
     chamber_noise_c: float = Field(0.05, ge=0)
     fixture_time_constant_min: float = Field(10.0, gt=0)
+    free_cooling_time_constant_min: float = Field(45.0, gt=0, description="chamber switched off: its air "
+                                                  "relaxes to ambient with this time constant")
     self_heating_c: float = Field(0.2, ge=0)
     noise_density_ug_per_rthz: float = Field(25.0, ge=0)
     turntable_settle_s: float = Field(0.5, ge=0)

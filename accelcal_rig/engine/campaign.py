@@ -22,7 +22,7 @@ from accelcal_rig.engine.clock import Clock
 from accelcal_rig.engine.estimate import DurationEstimate
 from accelcal_rig.engine.events import LOGGER, EventLog, format_duration
 from accelcal_rig.engine.notify import Notification, Notifier
-from accelcal_rig.engine.progress import PHASES, Progress, ProgressListener
+from accelcal_rig.engine.progress import COOLDOWN_PHASES, PHASES, Progress, ProgressListener
 from accelcal_rig.engine.resume import ResumePoint
 from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.engine.safe_state import apply_safe_state
@@ -44,7 +44,7 @@ MOVE_MARGIN_S = 30.0
 
 #: States in which the campaign still has measuring ahead of it (the time left is estimated).
 _MEASURING_STATES = frozenset({State.IDLE, State.PREFLIGHT, State.RAMP, State.SOAK, State.MOVE, State.SETTLE,
-                               State.ACQUIRE, State.STORE})
+                               State.ACQUIRE, State.STORE, State.COOL})
 
 
 class TerminationRequested(BaseException):
@@ -116,6 +116,8 @@ class CampaignRunner:
         self._poses_left = [sum(1 for s in plan.pose_steps if s.setpoint_c == setpoint and s.key not in self._stored_keys)
                             for setpoint in plan.setpoints_c]
         self._progress_failed = False
+        self._phases = PHASES if procedure.cooldown is None else COOLDOWN_PHASES
+        self._cooling = False
 
     # ----------------------------------------------------------------- top level
     def run(self) -> CampaignSummary:
@@ -193,7 +195,7 @@ class CampaignRunner:
     def _record_transition(self, previous: State, target: State, reason: str) -> None:
         suffix = f" ({reason})" if reason else ""
         self.events.debug("transition", f"{previous} → {target}{suffix}")
-        if PHASES.get(str(target), str(target)) != PHASES.get(str(previous), str(previous)):
+        if self._phases.get(str(target), str(target)) != self._phases.get(str(previous), str(previous)):
             self._publish()  # within a pose the snapshot after storing it says all
 
     # ----------------------------------------------------------------- audience
@@ -202,7 +204,7 @@ class CampaignRunner:
         estimate, state = self.audience.estimate, self.machine.state
         if estimate is None or state not in _MEASURING_STATES:
             return None
-        in_poses = PHASES.get(str(state)) == "poses"
+        in_poses = self._phases.get(str(state)) in ("poses", "cool")
         return estimate.remaining_s(self._poses_left, max(self._setpoint_index, 0),
                                     self.clock.now() - self._setpoint_start_s if self._setpoint_index >= 0 else 0.0,
                                     in_poses)
@@ -212,7 +214,7 @@ class CampaignRunner:
         if self.audience.progress is None or self._progress_failed:
             return
         now = self.clock.now()
-        phase = PHASES.get(str(self.machine.state), str(self.machine.state))
+        phase = self._phases.get(str(self.machine.state), str(self.machine.state))
         if phase != self._phase[0]:
             self._phase = (phase, now)
         index = self._setpoint_index
@@ -264,13 +266,42 @@ class CampaignRunner:
         if not self._soak(setpoint_c, label, t_reached, len(pose_steps)):
             return
         self._table_angles_deg = None  # hours of soak: ask the table where it is
-        for step in pose_steps:
-            self._measure_pose(step)
+        if self.procedure.cooldown is not None:
+            self._cool_down(pose_steps)
+        else:
+            for step in pose_steps:
+                self._measure_pose(step)
         total = len(self.plan.pose_steps)
         self.events.info("setpoint", f"{label}: {len(pose_steps)} poses stored ({self.poses_done}/{total} in all)")
 
+    def _cool_down(self, steps: list[PlanStep]) -> None:
+        """Hold the pose, record once at the setpoint, let the chamber go, record on schedule while the DUTs
+        cool. A resumed cool-down records its missing blocks on a fresh schedule after a fresh soak."""
+        cooldown = self.procedure.cooldown
+        assert cooldown is not None
+        released_s = self.clock.now()
+        self._cooling = True
+        for index, step in enumerate(steps):
+            if index:  # every record_every_s from the moment the chamber was let go
+                self.machine.go(State.COOL, step.key)
+                self.clock.sleep(max(released_s + index * cooldown.record_every_s - self.clock.now(), 0.0))
+            self._measure_pose(step)
+            if index == 0:
+                released_s = self.clock.now()
+                if cooldown.chamber == "power-off":
+                    self.chamber.set_power(False)
+                    self.events.info("cooldown", "chamber switched off: the DUTs cool freely; recording every "
+                                                 f"{cooldown.record_every_s:g} s for {cooldown.duration_min:g} min")
+                else:
+                    self.chamber.write_setpoint_c(cooldown.ambient_c)
+                    self.events.info("cooldown", f"chamber set to ambient {cooldown.ambient_c:g} °C; recording every "
+                                                 f"{cooldown.record_every_s:g} s for {cooldown.duration_min:g} min")
+        self._cooling = False
+
     def _ramp(self, setpoint_c: float) -> float:
         soak = self.procedure.soak
+        if self.procedure.cooldown is not None and self.procedure.cooldown.chamber == "power-off":
+            self.chamber.set_power(True)  # a cool-down switches it off; a resumed one needs it on again
         start_c = self._chamber_temperature_c()
         self.chamber.write_setpoint_c(setpoint_c)
         ramp_s = abs(setpoint_c - start_c) / (self.rig.chamber.ramp_rate_c_per_min / 60.0)
@@ -397,7 +428,7 @@ class CampaignRunner:
         stderr_g = codes.std(axis=0, ddof=1) * lsb / np.sqrt(n)
         band = self.procedure.soak.band_c
         in_band = bool(np.all(np.abs(np.array(block.temperature_c) - self._settled_dut_c[index]) <= band))
-        if not in_band:
+        if not in_band and not self._cooling:
             before, after = block.temperature_c
             self.events.warning("pose", f"sensor {sensor.serial}: temperature {before:.2f}/{after:.2f} °C left the "
                                         f"±{band:g} °C band around {self._settled_dut_c[index]:.2f} °C")

@@ -114,7 +114,10 @@ def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> Durat
         t_stable = t = t_reached + soak_s
         path = np.vstack([table_deg, angles])
         travel_s = np.max(np.abs(np.diff(path, axis=0)) / speeds, axis=1)
-        t += float(travel_s.sum()) + len(angles) * pose_fixed_s
+        if procedure.cooldown is None:
+            t += float(travel_s.sum()) + len(angles) * pose_fixed_s
+        else:  # the records come on a schedule from the first
+            t += float(travel_s[0]) + (len(angles) - 1) * procedure.cooldown.record_every_s + pose_fixed_s
         table_deg = angles[-1]
         rows.append(SetpointEstimate(setpoint, t_reached - ramp_start, soak_s, t - t_stable, len(angles), outcome,
                                      settled))

@@ -11,6 +11,8 @@ from accelcal_rig.plan.compile import setpoint_label
 
 #: Engine states as an operator names the phase they belong to.
 PHASES = {"move": "poses", "settle": "poses", "acquire": "poses", "store": "poses"}
+#: A cool-down's records are all one phase, waits and measurements alike.
+COOLDOWN_PHASES = {"move": "cool", "settle": "cool", "acquire": "cool", "store": "cool", "cool": "cool"}
 
 
 @dataclass(frozen=True)

@@ -29,7 +29,7 @@ from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.connect import configured_endpoints, connect_rig
 from accelcal_rig.instruments.interfaces import RigInstruments
-from accelcal_rig.plan.compile import Plan, compile_plan
+from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
 from accelcal_rig.sim.wire_rig import SimulatedRig
 from accelcal_rig.store.campaign_file import CampaignWriter
@@ -54,6 +54,8 @@ def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str 
         plan = compile_plan(procedure.model, rig.model)
     except UnreachablePose as exc:
         raise procedure.error(("schedule",), f"{exc} of {rig.path}") from None
+    except CooldownPoseMissing as exc:
+        raise procedure.error(("cooldown", "pose"), str(exc)) from None
     _check_design_identifies_fit(procedure, rig.model, plan)
     return PreparedCampaign(procedure, rig, plan)
 

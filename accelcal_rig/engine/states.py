@@ -15,6 +15,7 @@ class State(StrEnum):
     SETTLE = "settle"
     ACQUIRE = "acquire"
     STORE = "store"
+    COOL = "cool"          # a cool-down: waiting for its next record
     SAFE = "safe"
     FIT = "fit"
     DONE = "done"
@@ -23,7 +24,7 @@ class State(StrEnum):
 
 
 ACTIVE_STATES = frozenset({State.IDLE, State.PREFLIGHT, State.RAMP, State.SOAK, State.MOVE, State.SETTLE, State.ACQUIRE,
-           State.STORE, State.FIT})
+           State.STORE, State.COOL, State.FIT})
 
 TRANSITIONS: dict[State, frozenset[State]] = {
     State.IDLE: frozenset({State.PREFLIGHT}),
@@ -33,7 +34,8 @@ TRANSITIONS: dict[State, frozenset[State]] = {
     State.MOVE: frozenset({State.SETTLE}),
     State.SETTLE: frozenset({State.ACQUIRE}),
     State.ACQUIRE: frozenset({State.STORE}),
-    State.STORE: frozenset({State.MOVE, State.RAMP, State.SAFE}),
+    State.STORE: frozenset({State.MOVE, State.RAMP, State.SAFE, State.COOL}),
+    State.COOL: frozenset({State.MOVE}),
     State.SAFE: frozenset({State.FIT, State.DONE, State.ABORTED}),
     State.FIT: frozenset({State.DONE}),
     State.ABORTING: frozenset({State.SAFE}),

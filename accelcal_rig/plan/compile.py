@@ -95,14 +95,34 @@ def compile_poses(procedure: Procedure, rig: RigConfig) -> tuple[Pose, ...]:
     )
 
 
+class CooldownPoseMissing(ValueError):
+    """The cool-down names a pose the schedule does not have."""
+
+
+def cooldown_records(procedure: Procedure) -> int:
+    """Blocks a cool-down records: one at its start, then one every `record_every_s` for its duration."""
+    assert procedure.cooldown is not None
+    return int(procedure.cooldown.duration_min * 60.0 // procedure.cooldown.record_every_s) + 1
+
+
 def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
-    """Setpoints in procedure order; at each, one soak step then every pose of the schedule."""
+    """Setpoints in procedure order; at each, one soak step then every pose of the schedule. A cool-down
+    procedure: its one soak, then its records (`T60/cool0001`, …), all at the pose it holds."""
     poses = compile_poses(procedure, rig)
+    names = tuple(a.name for a in rig.turntable.axes)
+    if procedure.cooldown is not None:
+        if procedure.cooldown.pose > len(poses):
+            raise CooldownPoseMissing(f"pose {procedure.cooldown.pose} asked for, the schedule has {len(poses)}")
+        held = poses[procedure.cooldown.pose - 1]
+        setpoint = procedure.setpoints_c[0]
+        label = setpoint_label(setpoint)
+        records = [PlanStep(f"{label}/cool{k:04d}", "pose", setpoint, held)
+                   for k in range(1, cooldown_records(procedure) + 1)]
+        return Plan((setpoint,), (held,), (PlanStep(f"{label}/soak", "soak", setpoint), *records), names)
     width = max(2, len(str(len(poses))))
     steps: list[PlanStep] = []
     for setpoint in procedure.setpoints_c:
         label = setpoint_label(setpoint)
         steps.append(PlanStep(f"{label}/soak", "soak", setpoint))
         steps.extend(PlanStep(f"{label}/pose{p.number:0{width}d}", "pose", setpoint, p) for p in poses)
-    names = tuple(a.name for a in rig.turntable.axes)
     return Plan(tuple(procedure.setpoints_c), poses, tuple(steps), names)

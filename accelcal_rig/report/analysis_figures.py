@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from accelcal_rig.analysis.cooldown import CooldownResult
 from accelcal_rig.analysis.positions import SizeSummary
 from accelcal_rig.report.figures import pyplot, save
 
@@ -39,4 +40,33 @@ def positions_figure(rows: list[SizeSummary], floors_mg: dict[str, float], mode:
     right.legend(fontsize=7, loc="upper right")
     figure.suptitle(f"How many positions a calibration needs ({mode} fit; shaded: median to worst of the random "
                     "subsets; dash-dot: noise floor) — paper Fig. 8")
+    return save(figure, path)
+
+
+def cooldown_figure(results: list[CooldownResult], path: Path) -> Path:
+    """Paper Fig. 11: each DUT's temperature during the cool-down (top), and each axis's output relative to
+    its value at the end (the mean of the last tenth), before (left) and after (right) compensation."""
+    plt = pyplot()
+    figure, axes = plt.subplots(4, 2, figsize=(12, 11), sharex=True, constrained_layout=True)
+    colours = plt.get_cmap("tab10")
+    for index, r in enumerate(results):
+        colour = colours(index % 10)
+        minutes = (r.t_s - r.t_s[0]) / 60.0
+        for column in range(2):
+            axes[0, column].plot(minutes, r.temperature_c, "-", color=colour, lw=1, label=r.serial)
+        for axis in range(3):
+            for column, (values, coefficients) in enumerate(((r.before_g, r.coefficient_before_ug_per_k),
+                                                             (r.after_g, r.coefficient_after_ug_per_k))):
+                final = values[-max(len(values) // 10, 1):, axis].mean()
+                axes[axis + 1, column].plot(minutes, (values[:, axis] - final) * 1e3, "-", color=colour,
+                                            lw=1, label=f"{r.serial}: {coefficients[axis]:+.1f} µg/K")
+    for column, title in enumerate(("before compensation", "after compensation")):
+        axes[0, column].set_title(f"{title}", fontsize=10)
+        axes[0, column].set_ylabel("DUT temperature (°C)")
+        for axis, name in enumerate("xyz"):
+            axes[axis + 1, column].set_ylabel(f"{name} output − its final value (mg)")
+            axes[axis + 1, column].legend(fontsize=7, title="slope over temperature", title_fontsize=7)
+        axes[3, column].set_xlabel("time since the chamber was let go (min)")
+    axes[0, 0].legend(fontsize=7)
+    figure.suptitle("Free cool-down: output per axis before and after thermal compensation (paper Fig. 11)")
     return save(figure, path)

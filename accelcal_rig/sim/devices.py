@@ -43,6 +43,9 @@ class SimulatedChamber:
     def alarm_active(self) -> bool:
         return False
 
+    def set_power(self, on: bool) -> None:
+        self._lab.thermal.set_power(self._lab.clock.now(), on)
+
     def close(self) -> None:
         """Nothing to release: the lab lives in this process."""
 

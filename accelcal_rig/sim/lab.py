@@ -69,6 +69,7 @@ class VirtualLab:
             chamber_tau_s=sim.chamber_time_constant_min * 60.0,
             dut_tau_s=[d.tau_s for d in self.duts],
             self_heating_c=sim.self_heating_c,
+            free_cooling_tau_s=sim.free_cooling_time_constant_min * 60.0,
         )
         self.motion = TurntableMotion(
             speeds_deg_s=np.array([a.speed_deg_s for a in rig.turntable.axes]),

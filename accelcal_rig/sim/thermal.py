@@ -23,8 +23,9 @@ class ThermalModel:
     """Temperatures in °C, times in clock seconds."""
 
     def __init__(self, ambient_c: float, ramp_rate_c_per_s: float, chamber_tau_s: float,
-                 dut_tau_s: list[float], self_heating_c: float) -> None:
+                 dut_tau_s: list[float], self_heating_c: float, free_cooling_tau_s: float = 2700.0) -> None:
         self.ramp_rate_c_per_s = ramp_rate_c_per_s
+        self.free_cooling_tau_s = free_cooling_tau_s
         self.chamber_tau_s = chamber_tau_s
         self.dut_tau_s = list(dut_tau_s)
         self.self_heating_c = self_heating_c
@@ -43,7 +44,8 @@ class ThermalModel:
         self.setpoint_c = setpoint_c
 
     def set_power(self, t_s: float, on: bool) -> None:
-        """A chamber switched off drifts towards ambient at its ramp rate, whatever its set point."""
+        """A chamber switched off relaxes towards ambient with `free_cooling_tau_s` (its walls and load
+        losing heat to the room), whatever its set point; switched on, it ramps to its set point again."""
         self.advance_to(t_s)
         self.powered = on
 
@@ -63,14 +65,16 @@ class ThermalModel:
         while self._t < t_s:
             step = min(MAX_STEP_S, t_s - self._t)
             gap = self._target_c - self._reference_c
-            if gap != 0.0:
+            if gap != 0.0 and self.powered:  # end a sub-step where the ramp arrives
                 step = min(step, abs(gap) / self.ramp_rate_c_per_s) or step
             self._step(step)
 
     def _step(self, step_s: float) -> None:
         gap = self._target_c - self._reference_c
-        move = math.copysign(min(abs(gap), self.ramp_rate_c_per_s * step_s), gap)
-        reference_end = self._reference_c + move
+        if self.powered:
+            reference_end = self._reference_c + math.copysign(min(abs(gap), self.ramp_rate_c_per_s * step_s), gap)
+        else:
+            reference_end = self.ambient_c - gap * math.exp(-step_s / self.free_cooling_tau_s)
         air_end = _lag(self._air_c, self._reference_c, reference_end, step_s, self.chamber_tau_s)
         target_start = self._air_c + self.self_heating_c
         target_end = air_end + self.self_heating_c
