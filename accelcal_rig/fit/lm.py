@@ -57,7 +57,7 @@ class SfemFit:
     mode: FitMode
 
 
-def _norm_sigma(mean_g: np.ndarray, stderr_g: np.ndarray) -> np.ndarray:
+def norm_sigma(mean_g: np.ndarray, stderr_g: np.ndarray) -> np.ndarray:
     """Standard error of |U| per pose: each axis's error projected on the measured direction."""
     direction = mean_g / np.linalg.norm(mean_g, axis=1, keepdims=True)
     return np.sqrt(np.sum((direction * stderr_g) ** 2, axis=1))
@@ -87,7 +87,7 @@ def fit_sfem(mean_g: np.ndarray, stderr_g: np.ndarray, reference_g: np.ndarray |
 
         n_residuals = 3 * n_poses
     else:
-        norm_sigma = _norm_sigma(mean_g, stderr_g)
+        norm_sigma = norm_sigma(mean_g, stderr_g)
 
         def residuals(theta: np.ndarray) -> np.ndarray:
             return (np.linalg.norm(correct(mean_g, _full(theta, mask)), axis=1) - 1.0) / norm_sigma
