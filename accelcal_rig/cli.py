@@ -117,6 +117,8 @@ def _build_parser() -> argparse.ArgumentParser:
                      help="polynomial degree (default: the procedure's fit.polynomial_degree)")
     fit.add_argument("--parameters", choices=["all", "bias-scale"], help="default: the procedure's fit.parameters")
     fit.add_argument("--out-of-range", choices=["clamp", "extrapolate"], help="default: the procedure's")
+    fit.add_argument("--temperature-model", choices=["per-setpoint", "joint"],
+                     help="default: the procedure's fit.temperature_model")
     fit.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
     recording = _command(
         commands, "fit-recording", "calibrate from a continuous recording of a sensor turned by hand (no turntable)",
@@ -418,6 +420,7 @@ def _cmd_fit(args: argparse.Namespace) -> int:
             degree=args.degree if args.degree is not None else int(attrs.get("polynomial_degree", 3)),
             free=args.parameters or str(attrs.get("fit_parameters", "all")),
             out_of_range=args.out_of_range or str(attrs.get("fit_out_of_range", "clamp")),
+            temperature_model=args.temperature_model or str(attrs.get("fit_temperature_model", "per-setpoint")),
         )
         if options.mode == "none":
             raise ConfigError(f"{args.campaign}: its procedure asked for no fit (fit.mode: none); choose one with "

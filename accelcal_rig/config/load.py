@@ -76,6 +76,10 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
     safe = procedure.model.safe_setpoint_c
     if safe is not None and not chamber.min_setpoint_c <= safe <= chamber.max_setpoint_c:
         raise procedure.error(("safe_setpoint_c",), f"{safe:g} °C is outside the chamber limits of {rig.path}")
+    ramp = procedure.model.ramp
+    if ramp is not None and ramp.rate_c_per_min > chamber.ramp_rate_c_per_min:
+        raise procedure.error(("ramp", "rate_c_per_min"), f"{ramp.rate_c_per_min:g} °C/min is faster than the chamber "
+                                                          f"of {rig.path} ramps ({chamber.ramp_rate_c_per_min:g} °C/min)")
     cooldown = procedure.model.cooldown
     if cooldown is not None and cooldown.chamber == "power-off" and chamber.register_map().power_register is None:
         raise procedure.error(("cooldown", "chamber"), f"the chamber of {rig.path} has no power event in its register "

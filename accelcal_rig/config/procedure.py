@@ -105,6 +105,9 @@ class Acquisition(_Strict):
 class FitOptions(_Strict):
     """How the campaign's data will be fitted (paper §3)."""
 
+    temperature_model: Literal["per-setpoint", "joint"] = Field(
+        "per-setpoint", description="per-setpoint: LM at each setpoint, then polynomials (Eq. 8); joint: the "
+                                    "polynomials fitted to every pose at its own temperature (the ramp method)")
     mode: Literal["reference", "norm-only", "none"] = Field(
         "reference", description="none: measure only (a tilt check, a cool-down), no calibration at the end")
     polynomial_degree: int = Field(3, ge=0, le=6)
@@ -136,6 +139,15 @@ class Cooldown(_Strict):
     duration_min: float = Field(240.0, gt=0, le=7 * 24 * 60, description="how long to record")
 
 
+class RampMethod(_Strict):
+    """Poses measured while the chamber ramps slowly, instead of soaking at each setpoint (paper §4.3 names
+    both methods). After a soak at the first setpoint the chamber setpoint moves at `rate_c_per_min`
+    towards the last; each setpoint's poses start once the ramp is half-way from the previous setpoint."""
+
+    rate_c_per_min: float = Field(gt=0, le=10, description="the software ramp of the chamber setpoint")
+    update_s: float = Field(30.0, gt=0, le=600, description="how often the chamber setpoint is moved on")
+
+
 class Procedure(_Strict):
     """A whole campaign. Setpoints run in the order given."""
 
@@ -149,7 +161,27 @@ class Procedure(_Strict):
     safe_setpoint_c: float | None = Field(None, description="overrides the rig's chamber.safe_setpoint_c")
     fit: FitOptions = FitOptions()
     cooldown: Cooldown | None = Field(None, description="record a free cool-down instead of the schedule's poses")
+    method: Literal["soak", "ramp"] = Field("soak", description="soak at every setpoint, or measure while ramping")
+    ramp: RampMethod | None = None
     simulation: SimulatedEffects = SimulatedEffects()
+
+    @model_validator(mode="after")
+    def _ramp_fits(self) -> Procedure:
+        if self.method == "soak":
+            if self.ramp is not None:
+                raise ValueError("ramp settings need method: ramp")
+            return self
+        if self.ramp is None:
+            raise ValueError("method: ramp needs ramp.rate_c_per_min")
+        if self.cooldown is not None:
+            raise ValueError("a cool-down procedure cannot use method: ramp")
+        steps = np.diff(self.setpoints_c)
+        if len(steps) == 0 or not (np.all(steps > 0) or np.all(steps < 0)):
+            raise ValueError("method: ramp needs at least two setpoints, all rising or all falling")
+        if self.fit.mode != "none" and self.fit.temperature_model != "joint":
+            raise ValueError("a ramp campaign's poses spread over each setpoint's temperatures: set "
+                             "fit.temperature_model: joint")
+        return self
 
     @model_validator(mode="after")
     def _cooldown_fits(self) -> Procedure:

@@ -117,7 +117,11 @@ class CampaignRunner:
                             for setpoint in plan.setpoints_c]
         self._progress_failed = False
         self._phases = PHASES if procedure.cooldown is None else COOLDOWN_PHASES
-        self._cooling = False
+        #: True while the DUT temperatures move on purpose (cool-down, ramp): no band warnings then.
+        self._temperature_moving = False
+        #: The ramp method's software ramp once running: (clock time, setpoint °C) it started from.
+        self._ramp_origin: tuple[float, float] | None = None
+        self._ramp_written_s = float("-inf")
 
     # ----------------------------------------------------------------- top level
     def run(self) -> CampaignSummary:
@@ -260,19 +264,71 @@ class CampaignRunner:
         self._setpoint_index = self.plan.setpoints_c.index(setpoint_c)
         self._setpoint_start_s = self.clock.now()
         self.machine.go(State.RAMP, label)
-        t_reached = self._ramp(setpoint_c)
-        self.machine.go(State.SOAK, label)
         pose_steps = [s for s in steps if s.kind == "pose"]
-        if not self._soak(setpoint_c, label, t_reached, len(pose_steps)):
-            return
-        self._table_angles_deg = None  # hours of soak: ask the table where it is
+        if self._ramp_origin is not None:
+            self._follow_ramp_to(self._cycle_start_c(setpoint_c))
+        else:
+            t_reached = self._ramp(setpoint_c)
+            self.machine.go(State.SOAK, label)
+            if not self._soak(setpoint_c, label, t_reached, len(pose_steps)):
+                return
+            self._table_angles_deg = None  # hours of soak: ask the table where it is
+            if self.procedure.method == "ramp":
+                self._start_software_ramp(setpoint_c)
         if self.procedure.cooldown is not None:
             self._cool_down(pose_steps)
         else:
             for step in pose_steps:
+                self._advance_software_ramp()
                 self._measure_pose(step)
         total = len(self.plan.pose_steps)
         self.events.info("setpoint", f"{label}: {len(pose_steps)} poses stored ({self.poses_done}/{total} in all)")
+
+    # ----------------------------------------------------------------- the ramp method
+    def _start_software_ramp(self, setpoint_c: float) -> None:
+        """From the soak at `setpoint_c` on, move the chamber setpoint at the procedure's rate towards the
+        last setpoint; the poses follow it."""
+        assert self.procedure.ramp is not None
+        self._ramp_origin = (self.clock.now(), setpoint_c)
+        self._temperature_moving = True
+        last = self.plan.setpoints_c[-1]
+        self.events.info("ramp", f"ramp method: chamber setpoint moving {setpoint_c:g} → {last:g} °C at "
+                                 f"{self.procedure.ramp.rate_c_per_min:g} °C/min, poses taken as it goes")
+
+    def _ramp_setpoint_c(self, t_s: float) -> float:
+        """Where the software ramp is at clock time `t_s`, stopping at the last setpoint."""
+        assert self._ramp_origin is not None and self.procedure.ramp is not None
+        t0, start_c = self._ramp_origin
+        last = self.plan.setpoints_c[-1]
+        travelled = self.procedure.ramp.rate_c_per_min / 60.0 * (t_s - t0)
+        return float(min(start_c + travelled, last) if last > start_c else max(start_c - travelled, last))
+
+    def _cycle_start_c(self, setpoint_c: float) -> float:
+        """A setpoint's poses begin half-way from the previous setpoint."""
+        index = self.plan.setpoints_c.index(setpoint_c)
+        return 0.5 * (self.plan.setpoints_c[index - 1] + setpoint_c) if index else setpoint_c
+
+    def _advance_software_ramp(self) -> None:
+        """Write the ramp's current setpoint, at most every `ramp.update_s`."""
+        if self._ramp_origin is None:
+            return
+        assert self.procedure.ramp is not None
+        now = self.clock.now()
+        if now - self._ramp_written_s >= self.procedure.ramp.update_s:
+            self.chamber.write_setpoint_c(round(self._ramp_setpoint_c(now), 3))
+            self._ramp_written_s = now
+
+    def _follow_ramp_to(self, target_c: float) -> None:
+        """Keep the software ramp moving until it reaches `target_c` (at once if it already has)."""
+        assert self._ramp_origin is not None and self.procedure.ramp is not None
+        t0, start_c = self._ramp_origin
+        arrival_s = t0 + abs(target_c - start_c) / (self.procedure.ramp.rate_c_per_min / 60.0)
+        while self.clock.now() < arrival_s:
+            self._advance_software_ramp()
+            self._chamber_temperature_c()  # the alarm, and what the progress display shows
+            self._publish()
+            self.clock.sleep(min(self.procedure.ramp.update_s, arrival_s - self.clock.now()))
+        self._advance_software_ramp()
 
     def _cool_down(self, steps: list[PlanStep]) -> None:
         """Hold the pose, record once at the setpoint, let the chamber go, record on schedule while the DUTs
@@ -280,7 +336,7 @@ class CampaignRunner:
         cooldown = self.procedure.cooldown
         assert cooldown is not None
         released_s = self.clock.now()
-        self._cooling = True
+        self._temperature_moving = True
         for index, step in enumerate(steps):
             if index:  # every record_every_s from the moment the chamber was let go
                 self.machine.go(State.COOL, step.key)
@@ -296,7 +352,7 @@ class CampaignRunner:
                     self.chamber.write_setpoint_c(cooldown.ambient_c)
                     self.events.info("cooldown", f"chamber set to ambient {cooldown.ambient_c:g} °C; recording every "
                                                  f"{cooldown.record_every_s:g} s for {cooldown.duration_min:g} min")
-        self._cooling = False
+        self._temperature_moving = False
 
     def _ramp(self, setpoint_c: float) -> float:
         soak = self.procedure.soak
@@ -428,7 +484,7 @@ class CampaignRunner:
         stderr_g = codes.std(axis=0, ddof=1) * lsb / np.sqrt(n)
         band = self.procedure.soak.band_c
         in_band = bool(np.all(np.abs(np.array(block.temperature_c) - self._settled_dut_c[index]) <= band))
-        if not in_band and not self._cooling:
+        if not in_band and not self._temperature_moving:
             before, after = block.temperature_c
             self.events.warning("pose", f"sensor {sensor.serial}: temperature {before:.2f}/{after:.2f} °C left the "
                                         f"±{band:g} °C band around {self._settled_dut_c[index]:.2f} °C")

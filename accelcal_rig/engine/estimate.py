@@ -41,7 +41,8 @@ class SetpointEstimate:
     soak_s: float
     poses_s: float
     n_poses: int
-    soak_outcome: str           # "stable"; "timeout" (soak deadline passed) or "ramp timeout" (ramp deadline)
+    soak_outcome: str           # "stable"; "timeout" (soak deadline), "ramp timeout" (ramp deadline); "ramp":
+                                # the ramp method's poses while ramping (ramp_s: the wait for the ramp)
     settled_dut_c: tuple[float, ...]
 
     @property
@@ -98,8 +99,20 @@ def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> Durat
     table_deg = np.zeros(len(speeds))
     t = 0.0
     rows = []
-    for setpoint, steps in groupby(plan.pose_steps, key=lambda s: s.setpoint_c):
+    ramp_origin: tuple[float, float] | None = None  # the ramp method, once its first soak is done
+    for index, (setpoint, steps) in enumerate(groupby(plan.pose_steps, key=lambda s: s.setpoint_c)):
         angles = np.array([s.pose.angles_deg for s in steps if s.pose is not None])
+        path = np.vstack([table_deg, angles])
+        travel_s = np.max(np.abs(np.diff(path, axis=0)) / speeds, axis=1)
+        table_deg = angles[-1]
+        if ramp_origin is not None:
+            assert procedure.ramp is not None
+            start_c = 0.5 * (plan.setpoints_c[index - 1] + setpoint)
+            wait_s = max(ramp_origin[0] + abs(start_c - ramp_origin[1]) / (procedure.ramp.rate_c_per_min / 60.0) - t, 0)
+            poses_s = float(travel_s.sum()) + len(angles) * pose_fixed_s
+            rows.append(SetpointEstimate(setpoint, wait_s, 0.0, poses_s, len(angles), "ramp", ()))
+            t += wait_s + poses_s
+            continue
         thermal.set_setpoint(t, setpoint)
         ramp_start = t
         ramp_deadline = t + soak.ramp_timeout_factor * abs(setpoint - thermal.air_c(t)) / (
@@ -112,13 +125,12 @@ def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> Durat
             break  # the engine would abort here
         soak_s, outcome, settled = _soak(thermal, procedure, setpoint, t_reached)
         t_stable = t = t_reached + soak_s
-        path = np.vstack([table_deg, angles])
-        travel_s = np.max(np.abs(np.diff(path, axis=0)) / speeds, axis=1)
+        if procedure.method == "ramp":
+            ramp_origin = (t, setpoint)
         if procedure.cooldown is None:
             t += float(travel_s.sum()) + len(angles) * pose_fixed_s
         else:  # the records come on a schedule from the first
             t += float(travel_s[0]) + (len(angles) - 1) * procedure.cooldown.record_every_s + pose_fixed_s
-        table_deg = angles[-1]
         rows.append(SetpointEstimate(setpoint, t_reached - ramp_start, soak_s, t - t_stable, len(angles), outcome,
                                      settled))
     return DurationEstimate(tuple(rows))

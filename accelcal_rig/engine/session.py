@@ -199,7 +199,8 @@ def _create_file(prepared: PreparedCampaign, output: Path, instruments: RigInstr
                "rig_name": rig.model.name, "rig_path": str(rig.path), "dry_run": dry_run, "seed": seed,
                "clock": clock.kind, "samples_per_pose": acquisition.samples_per_pose,
                "fit_mode": procedure.fit.mode, "polynomial_degree": procedure.fit.polynomial_degree,
-               "fit_parameters": procedure.fit.parameters, "fit_out_of_range": procedure.fit.out_of_range},
+               "fit_parameters": procedure.fit.parameters, "fit_out_of_range": procedure.fit.out_of_range,
+               "fit_temperature_model": procedure.fit.temperature_model},
         procedure_yaml=prepared.procedure.text, rig_yaml=rig.text, plan=prepared.plan, duts=duts,
         instruments=_instrument_info(instruments), samples_per_pose=acquisition.samples_per_pose,
         turntable_accuracy_arcsec=rig.model.turntable.accuracy_arcsec,
@@ -236,8 +237,9 @@ def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, instr
 
 
 def _fit_stage(procedure: Procedure, output: Path, calibration: Path) -> FitStage:
-    options = FitOptions(mode=procedure.fit.mode, degree=procedure.fit.polynomial_degree,
-                         free=procedure.fit.parameters, out_of_range=procedure.fit.out_of_range)
+    options = FitOptions(mode=procedure.fit.mode, degree=procedure.fit.polynomial_degree,  # type: ignore[arg-type]
+                         free=procedure.fit.parameters, out_of_range=procedure.fit.out_of_range,
+                         temperature_model=procedure.fit.temperature_model)
 
     def stage(file: h5py.File) -> str:
         _, report = fit_and_save(file, output, calibration, options)

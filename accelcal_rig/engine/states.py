@@ -29,7 +29,7 @@ ACTIVE_STATES = frozenset({State.IDLE, State.PREFLIGHT, State.RAMP, State.SOAK, 
 TRANSITIONS: dict[State, frozenset[State]] = {
     State.IDLE: frozenset({State.PREFLIGHT}),
     State.PREFLIGHT: frozenset({State.RAMP, State.SAFE}),  # SAFE: a resumed run with every pose stored
-    State.RAMP: frozenset({State.SOAK}),
+    State.RAMP: frozenset({State.SOAK, State.MOVE}),  # MOVE: the ramp method, poses while ramping
     State.SOAK: frozenset({State.MOVE, State.RAMP, State.SAFE}),  # RAMP, SAFE: a setpoint skipped
     State.MOVE: frozenset({State.SETTLE}),
     State.SETTLE: frozenset({State.ACQUIRE}),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import h5py
 import numpy as np
@@ -15,10 +15,13 @@ from accelcal_rig.fit.calibration import FORMAT_VERSION as CALIBRATION_VERSION
 from accelcal_rig.fit.calibration import (
     CalibrationFile, PolynomialModel, SensorCalibration, SetpointFit, plain, save_calibration,
 )
+from accelcal_rig.fit.joint import fit_joint
 from accelcal_rig.fit.lm import FitMode, FreeParameters, SfemFit, fit_sfem
 from accelcal_rig.fit.metrics import drift_mg, noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, norm_only_gauge
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
+
+TemperatureModel = Literal["per-setpoint", "joint"]
 from accelcal_rig.store.campaign_file import utc_now
 from accelcal_rig.store.fit_results import write_fit_group
 from accelcal_rig.store.read import DutPoses, measurements_sha256, read_dut_poses
@@ -30,6 +33,7 @@ class FitOptions:
     degree: int = 3
     free: FreeParameters = "all"
     out_of_range: OutOfRange = "clamp"
+    temperature_model: TemperatureModel = "per-setpoint"
 
 
 @dataclass(frozen=True)
@@ -76,6 +80,10 @@ def fit_dut(poses: DutPoses, options: FitOptions) -> DutFitResult:
     sigmas = np.array([f.sigma for f in fits])
     free = fits[0].free
     thermal = fit_thermal(temperatures, estimates, sigmas, free, options.degree)
+    if options.temperature_model == "joint":
+        thermal = fit_joint(thermal, free, pose_temperatures, poses.mean_g, poses.stderr_g,
+                            poses.reference_g if options.mode == "reference" else None, options.mode,
+                            np.radians(poses.reference_accuracy_arcsec / 3600))
     compensated = correct(poses.mean_g, thermal.parameters_at(pose_temperatures, "extrapolate"))
     metrics = _metrics(poses, setpoints, groups, temperatures, fits, thermal, compensated, options)
     calibration = SensorCalibration(

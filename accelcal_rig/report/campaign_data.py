@@ -75,13 +75,16 @@ def read_campaign_data(path: Path) -> CampaignData:
         band_c = float((procedure.get("soak") or {}).get("band_c", SoakCriterion().band_c))
         options = FitOptions(mode=str(attrs.get("fit_mode", "reference")), degree=int(attrs.get("polynomial_degree", 3)),
                              free=str(attrs.get("fit_parameters", "all")),  # type: ignore[arg-type]
-                             out_of_range=str(attrs.get("fit_out_of_range", "clamp")))  # type: ignore[arg-type]
+                             out_of_range=str(attrs.get("fit_out_of_range", "clamp")),  # type: ignore[arg-type]
+                             temperature_model=str(attrs.get("fit_temperature_model", "per-setpoint")))  # type: ignore[arg-type]
         pose_numbers = file["poses/pose_number"][:]
         duts, reasons = {}, []
         for serial in file["duts"]:
             poses = read_dut_poses(file, serial)
             fit = None
-            if len(poses.setpoint_c):
+            if options.mode == "none":
+                reasons.append("the procedure measures only (fit.mode: none)")
+            elif len(poses.setpoint_c):
                 try:
                     fit = fit_dut(poses, options)
                 except (ValueError, np.linalg.LinAlgError) as exc:

@@ -42,7 +42,8 @@ def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[s
     t = 0.0
     for row in estimate.setpoints:
         t += row.total_s
-        outcome = "" if row.soak_outcome == "stable" else f"  {row.soak_outcome.upper()}: the campaign would stop"
+        outcome = {"stable": "", "ramp": "  (poses while ramping)"}.get(
+            row.soak_outcome, f"  {row.soak_outcome.upper()}: the campaign would stop")
         settled = ", ".join(f"{c:.2f}" for c in row.settled_dut_c)
         lines.append(f"{setpoint_label(row.setpoint_c):>8s} {format_duration(row.ramp_s):>8s} "
                      f"{format_duration(row.soak_s):>8s} {format_duration(row.poses_s):>8s} "

@@ -1,0 +1,67 @@
+"""The ramp method: one soak, then poses while the chamber setpoint moves; every pose at its own
+temperature, fitted jointly; refusals for procedures that cannot work."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from accelcal_rig.engine.estimate import estimate_duration
+from accelcal_rig.engine.session import prepare, run_campaign
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.fit.calibration import load_calibration
+from accelcal_rig.sim.truth import truth_for_serial
+from tests.conftest import TINY_PROCEDURE
+
+RAMP = TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c: [20, 25, 30, 35]").replace(
+    "samples_per_pose: 20", "samples_per_pose: 100") + """\
+method: ramp
+ramp: {rate_c_per_min: 0.5, update_s: 20}
+fit: {mode: reference, polynomial_degree: 2, temperature_model: joint}
+"""
+
+
+def test_a_ramp_campaign_measures_while_the_temperature_moves(write, workdir: Path) -> None:
+    prepared = prepare(write("ramp.yaml", RAMP))
+    output = workdir / "ramp.h5"
+    result = run_campaign(prepared, output, dry_run=True, seed=4, overwrite=False, calibration=workdir / "cal.yaml")
+    assert result.summary.state == "done" and result.summary.poses_done == 24
+    estimate = estimate_duration(prepared.procedure.model, prepared.rig.model, prepared.plan)
+    first = estimate.setpoints[0]
+    with h5py.File(output, "r") as f:
+        assert list(f["soaks"]) == ["T20"]  # one soak, at the first setpoint
+        stable_s = float(f["soaks/T20"].attrs["t_stable_s"])
+        # After the soak (whose length the noise decides), the ramp paces the campaign as estimated.
+        assert estimate.total_s - first.ramp_s - first.soak_s == pytest.approx(
+            result.summary.virtual_duration_s - stable_s, rel=0.03)
+        temperature = f["duts/ADX355-A001/temperature_c"][:].mean(axis=1)
+        setpoints = f["poses/setpoint_c"][:]
+        messages = [m.decode() for m in f["events/message"][:]]
+        assert f.attrs["fit_temperature_model"] == "joint"
+    assert any("ramp method: chamber setpoint moving 20 → 35 °C at 0.5 °C/min" in m for m in messages)
+    assert not any("left the" in m for m in messages)
+    assert temperature[-1] - temperature[0] > 10.0  # the DUTs warmed through the campaign
+    later = setpoints == 30.0
+    assert np.ptp(temperature[later]) > 0.3  # within one setpoint's poses the temperature moved
+    # The joint fit follows each pose's temperature: the calibration matches the truth over the range.
+    sensor = load_calibration(workdir / "cal.yaml").sensor("ADX355-A001")
+    temperatures = np.linspace(*sensor.validity_c, 5)
+    bias_error = sensor.parameters_at(temperatures)[:, :3] - truth_for_serial("ADX355-A001").parameters_at(temperatures)[:, :3]
+    assert np.abs(bias_error).max() < 60e-6  # g
+
+
+@pytest.mark.parametrize("change, message", [
+    ("temperature_model: joint", "set fit.temperature_model: joint"),
+    ("setpoints_c: [20, 25, 30, 35]", "all rising or all falling"),
+    ("rate_c_per_min: 0.5", "faster than the chamber"),
+])
+def test_ramp_procedures_that_cannot_work_are_refused(write, change: str, message: str) -> None:
+    replacement = {"temperature_model: joint": "temperature_model: per-setpoint",
+                   "setpoints_c: [20, 25, 30, 35]": "setpoints_c: [20, 30, 25]",
+                   "rate_c_per_min: 0.5": "rate_c_per_min: 5"}[change]
+    with pytest.raises(ConfigError, match=message) as error:
+        prepare(write("ramp.yaml", RAMP.replace(change, replacement)))
+    assert "ramp.yaml:" in str(error.value)
