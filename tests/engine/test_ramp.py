@@ -43,7 +43,7 @@ def test_a_ramp_campaign_measures_while_the_temperature_moves(write, workdir: Pa
         assert f.attrs["fit_temperature_model"] == "joint"
     assert any("ramp method: chamber setpoint moving 20 → 35 °C at 0.5 °C/min" in m for m in messages)
     assert not any("left the" in m for m in messages)
-    assert temperature[-1] - temperature[0] > 10.0  # the DUTs warmed through the campaign
+    assert temperature[-1] - temperature[0] > 5.0  # the DUTs warmed through the campaign (lagging the air)
     later = setpoints == 30.0
     assert np.ptp(temperature[later]) > 0.3  # within one setpoint's poses the temperature moved
     # The joint fit follows each pose's temperature: the calibration matches the truth over the range.
