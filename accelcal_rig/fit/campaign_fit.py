@@ -20,11 +20,11 @@ from accelcal_rig.fit.lm import FitMode, FreeParameters, SfemFit, fit_sfem
 from accelcal_rig.fit.metrics import drift_mg, noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, norm_only_gauge
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
-
-TemperatureModel = Literal["per-setpoint", "joint"]
 from accelcal_rig.store.campaign_file import utc_now
 from accelcal_rig.store.fit_results import write_fit_group
 from accelcal_rig.store.read import DutPoses, measurements_sha256, read_dut_poses
+
+TemperatureModel = Literal["per-setpoint", "joint"]
 
 
 @dataclass(frozen=True)

@@ -87,10 +87,10 @@ def fit_sfem(mean_g: np.ndarray, stderr_g: np.ndarray, reference_g: np.ndarray |
 
         n_residuals = 3 * n_poses
     else:
-        norm_sigma = norm_sigma(mean_g, stderr_g)
+        sigma_norm = norm_sigma(mean_g, stderr_g)
 
         def residuals(theta: np.ndarray) -> np.ndarray:
-            return (np.linalg.norm(correct(mean_g, _full(theta, mask)), axis=1) - 1.0) / norm_sigma
+            return (np.linalg.norm(correct(mean_g, _full(theta, mask)), axis=1) - 1.0) / sigma_norm
 
         n_residuals = n_poses
     if n_residuals < n_free:

@@ -42,7 +42,6 @@ def test_calibration_brings_every_angle_to_its_reference(tilt_campaign: Path, fi
     np.testing.assert_allclose([r["reference_deg"] for r in first],
                                [[0, 0], [15, 0], [30, 0], [0, -15], [0, -30], [15, -15], [30, -30]], atol=0.01)
     for r in rows:
-        before = np.abs(np.subtract(r["before_deg"], r["reference_deg"]))
         after = np.abs(np.subtract(r["after_deg"], r["reference_deg"]))
         assert after.max() < 0.01  # degrees: the table's 3″ and the noise
         np.testing.assert_allclose(r["seoq_percent"], np.abs(np.subtract(r["before_deg"], r["after_deg"])) / 30 * 100)
