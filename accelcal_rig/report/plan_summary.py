@@ -25,9 +25,8 @@ def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[s
         f"soak       at least {soak.min_dwell_min:g} min at setpoint, then each DUT within {soak.band_c:g} °C over "
         f"{soak.window_min:g} min with the chamber within {soak.chamber_tolerance_c:g} °C; polled every "
         f"{soak.poll_s:g} s; deadline {soak.timeout_min:g} min ({soak.on_timeout})",
-        f"poses      {len(plan.poses)} per setpoint ({procedure.schedule.kind}), {len(plan.pose_steps)} in all; "
-        f"{acquisition.samples_per_pose} samples at {acquisition.odr_hz:g} Hz, ±{acquisition.range_g} g, "
-        f"settle {acquisition.settle_s:g} s",
+        _poses_line(prepared),
+        *_method_lines(prepared),
         "fit        none: measured only" if procedure.fit.mode == "none" else
         f"fit        {procedure.fit.mode}, {procedure.fit.parameters} parameters, polynomial degree "
         f"{procedure.fit.polynomial_degree}",
@@ -51,6 +50,31 @@ def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[s
     lines += ["", f"estimated duration {format_duration(estimate.total_s)} (h:mm:ss; from the rig's ramp rate, "
                   "thermal time constants and axis speeds; instrument communication not included)"]
     return lines
+
+
+def _poses_line(prepared: PreparedCampaign) -> str:
+    procedure, plan = prepared.procedure.model, prepared.plan
+    acquisition, cooldown = procedure.acquisition, procedure.cooldown
+    samples = (f"{acquisition.samples_per_pose} samples at {acquisition.odr_hz:g} Hz, ±{acquisition.range_g} g, "
+               f"settle {acquisition.settle_s:g} s")
+    if cooldown is not None:
+        return (f"records    {len(plan.pose_steps)} at pose {cooldown.pose} of the {procedure.schedule.kind} schedule, "
+                f"every {cooldown.record_every_s:g} s for {cooldown.duration_min:g} min; {samples}")
+    return f"poses      {len(plan.poses)} per setpoint ({procedure.schedule.kind}), {len(plan.pose_steps)} in all; {samples}"
+
+
+def _method_lines(prepared: PreparedCampaign) -> list[str]:
+    procedure = prepared.procedure.model
+    if procedure.cooldown is not None:
+        how = ("switched off" if procedure.cooldown.chamber == "power-off"
+               else f"set to {procedure.cooldown.ambient_c:g} °C")
+        return [f"cool-down  after the soak at {procedure.setpoints_c[0]:g} °C the chamber is {how} and the DUTs "
+                "cool while recording"]
+    if procedure.ramp is not None:
+        return [f"method     ramp: soak at {procedure.setpoints_c[0]:g} °C only, then the setpoint moves at "
+                f"{procedure.ramp.rate_c_per_min:g} °C/min to {procedure.setpoints_c[-1]:g} °C, poses taken as it "
+                "goes (each setpoint's poses from half-way to it)"]
+    return []
 
 
 def plan_json(prepared: PreparedCampaign, estimate: DurationEstimate) -> dict[str, Any]:

@@ -65,3 +65,25 @@ def test_ramp_procedures_that_cannot_work_are_refused(write, change: str, messag
     with pytest.raises(ConfigError, match=message) as error:
         prepare(write("ramp.yaml", RAMP.replace(change, replacement)))
     assert "ramp.yaml:" in str(error.value)
+
+
+def test_a_ramp_campaign_that_stopped_resumes_with_a_soak_where_it_stopped(write, workdir: Path) -> None:
+    from accelcal_rig.errors import CampaignAborted
+    from accelcal_rig.store.read import integrity_problems
+
+    path = write("ramp.yaml", RAMP)
+    output = workdir / "ramp.h5"
+    with pytest.raises(CampaignAborted):
+        run_campaign(prepare(path, faults="turntable_stall_after_min=25"), output, dry_run=True, seed=4,
+                     overwrite=False)
+    with h5py.File(output, "r") as f:
+        stored = f["poses/step_key"].shape[0]
+    assert 6 <= stored < 24
+    result = run_campaign(prepare(path), output, dry_run=True, seed=4, overwrite=False, resume=True)
+    assert result.summary.state == "done" and result.summary.poses_done == 24
+    with h5py.File(output, "r") as f:
+        assert integrity_problems(f) == []
+        keys = [k.decode() for k in f["poses/step_key"][:]]
+        soaks = list(f["soaks"])
+    assert len(set(keys)) == 24
+    assert soaks[0] == "T20" and len(soaks) == 2  # the resumed run soaked where it went on, then ramped again
