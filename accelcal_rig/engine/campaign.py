@@ -265,8 +265,16 @@ class CampaignRunner:
         self._setpoint_start_s = self.clock.now()
         self.machine.go(State.RAMP, label)
         pose_steps = [s for s in steps if s.kind == "pose"]
-        if self._ramp_origin is not None:
+        if self._ramp_origin is not None and setpoint_c != self.plan.setpoints_c[-1]:
             self._follow_ramp_to(self._cycle_start_c(setpoint_c))
+        elif self._ramp_origin is not None:
+            # The end of the ramp: hold the last setpoint until the DUTs, lagging the air, have caught up, so
+            # the calibrated range reaches it.
+            self._follow_ramp_to(setpoint_c)
+            self._temperature_moving = False
+            self.machine.go(State.SOAK, label)
+            if not self._soak(setpoint_c, label, self.clock.now(), len(pose_steps)):
+                return
         else:
             t_reached = self._ramp(setpoint_c)
             self.machine.go(State.SOAK, label)
@@ -287,7 +295,7 @@ class CampaignRunner:
     # ----------------------------------------------------------------- the ramp method
     def _start_software_ramp(self, setpoint_c: float) -> None:
         """From the soak at `setpoint_c` on, move the chamber setpoint at the procedure's rate towards the
-        last setpoint; the poses follow it."""
+        last setpoint, where it soaks again; the poses in between follow the ramp."""
         assert self.procedure.ramp is not None
         self._ramp_origin = (self.clock.now(), setpoint_c)
         self._temperature_moving = True

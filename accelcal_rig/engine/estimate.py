@@ -105,13 +105,22 @@ def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> Durat
         path = np.vstack([table_deg, angles])
         travel_s = np.max(np.abs(np.diff(path, axis=0)) / speeds, axis=1)
         table_deg = angles[-1]
+        poses_s = float(travel_s.sum()) + len(angles) * pose_fixed_s
         if ramp_origin is not None:
             assert procedure.ramp is not None
-            start_c = 0.5 * (plan.setpoints_c[index - 1] + setpoint)
+            last = index == len(plan.setpoints_c) - 1
+            start_c = setpoint if last else 0.5 * (plan.setpoints_c[index - 1] + setpoint)
             wait_s = max(ramp_origin[0] + abs(start_c - ramp_origin[1]) / (procedure.ramp.rate_c_per_min / 60.0) - t, 0)
-            poses_s = float(travel_s.sum()) + len(angles) * pose_fixed_s
-            rows.append(SetpointEstimate(setpoint, wait_s, 0.0, poses_s, len(angles), "ramp", ()))
-            t += wait_s + poses_s
+            _follow_software_ramp(thermal, procedure, ramp_origin, setpoint if last else plan.setpoints_c[-1], t,
+                                  t + wait_s + (0.0 if last else poses_s))
+            t += wait_s
+            if not last:
+                rows.append(SetpointEstimate(setpoint, wait_s, 0.0, poses_s, len(angles), "ramp", ()))
+                t += poses_s
+                continue
+            soak_s, outcome, settled = _soak(thermal, procedure, setpoint, t)
+            rows.append(SetpointEstimate(setpoint, wait_s, soak_s, poses_s, len(angles), outcome, settled))
+            t += soak_s + poses_s
             continue
         thermal.set_setpoint(t, setpoint)
         ramp_start = t
@@ -128,12 +137,24 @@ def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> Durat
         if procedure.method == "ramp":
             ramp_origin = (t, setpoint)
         if procedure.cooldown is None:
-            t += float(travel_s.sum()) + len(angles) * pose_fixed_s
+            t += poses_s
         else:  # the records come on a schedule from the first
             t += float(travel_s[0]) + (len(angles) - 1) * procedure.cooldown.record_every_s + pose_fixed_s
         rows.append(SetpointEstimate(setpoint, t_reached - ramp_start, soak_s, t - t_stable, len(angles), outcome,
                                      settled))
     return DurationEstimate(tuple(rows))
+
+
+def _follow_software_ramp(thermal: ThermalModel, procedure: Procedure, origin: tuple[float, float], last_c: float,
+                          from_s: float, to_s: float) -> None:
+    """Move the model's setpoint as the engine's software ramp writes it, every `ramp.update_s`."""
+    assert procedure.ramp is not None
+    rate_c_per_s = procedure.ramp.rate_c_per_min / 60.0
+    t0, start_c = origin
+    for t in np.arange(from_s, to_s + 1e-9, procedure.ramp.update_s):
+        travelled = rate_c_per_s * (t - t0)
+        thermal.set_setpoint(float(t), min(start_c + travelled, last_c) if last_c > start_c
+                             else max(start_c - travelled, last_c))
 
 
 def _soak(thermal: ThermalModel, procedure: Procedure, setpoint_c: float,

@@ -121,8 +121,9 @@ def _summary(data: CampaignData) -> list[str]:
         ["setpoints (°C)", ", ".join(f"{t:g}" for t in s.get("setpoints_c", []))],
         ["started / finished", f"{s.get('started')} / {s.get('finished') or '—'}"],
         ["campaign time", format_duration(float(data.pose_t_s.max())) if len(data.pose_t_s) else "—"],
-        ["fit", f"{data.options.mode}, {data.options.free} parameters, polynomial degree {data.options.degree}, "
-                f"{data.options.out_of_range} outside the calibrated range"],
+        ["fit", "none: the procedure measures only (see rig analyze)" if data.options.mode == "none" else
+         f"{data.options.mode}, {data.options.free} parameters, polynomial degree {data.options.degree} "
+         f"({data.options.temperature_model}), {data.options.out_of_range} outside the calibrated range"],
         ["integrity", s.get("integrity", "?")],
     ]
     out = ["<h2>Campaign</h2>", _table(["", ""], rows, text_columns=2)]
