@@ -7,29 +7,16 @@ from pathlib import Path
 
 import numpy as np
 
-from accelcal_rig.errors import ConfigError
-from accelcal_rig.store.read import DutPoses, open_campaign, read_dut_poses
+from accelcal_rig.store.read import DutPoses, open_campaign, read_dut_poses, rows_at_setpoint
 
 
 def poses_at_setpoint(path: Path, setpoint_c: float | None) -> tuple[float, dict[str, DutPoses], np.ndarray]:
     """(setpoint, each DUT's poses there, their pose numbers); `setpoint_c` None: the file's only one."""
     with open_campaign(path) as file:
-        setpoints = file["poses/setpoint_c"][:]
-        available = list(dict.fromkeys(setpoints.tolist()))
-        if not available:
-            raise ConfigError(f"{path}: no poses stored")
-        if setpoint_c is None:
-            if len(available) > 1:
-                raise ConfigError(f"{path}: poses at {len(available)} setpoints "
-                                  f"({', '.join(f'{s:g}' for s in available)} °C): choose one with --setpoint")
-            setpoint_c = available[0]
-        rows = setpoints == setpoint_c
-        if not rows.any():
-            raise ConfigError(f"{path}: no poses at {setpoint_c:g} °C "
-                              f"(setpoints: {', '.join(f'{s:g}' for s in available)})")
+        setpoint_c, rows = rows_at_setpoint(path, file, setpoint_c)
         numbers = file["poses/pose_number"][:][rows]
         duts = {serial: _select(read_dut_poses(file, serial), rows) for serial in file["duts"]}
-    return float(setpoint_c), duts, numbers
+    return setpoint_c, duts, numbers
 
 
 def _select(poses: DutPoses, rows: np.ndarray) -> DutPoses:

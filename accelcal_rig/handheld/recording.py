@@ -11,7 +11,7 @@ from typing import Literal
 import numpy as np
 
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.store.read import open_campaign
+from accelcal_rig.store.read import open_campaign, rows_at_setpoint
 
 STANDARD_GRAVITY_M_S2 = 9.80665
 Units = Literal["g", "counts", "m/s2"]
@@ -107,18 +107,8 @@ def read_campaign_recording(path: Path, serial: str | None, setpoint_c: float | 
             serial = serials[0]
         if serial not in serials:
             raise ConfigError(f"{path}: no sensor {serial} (the file has {', '.join(serials)})")
-        setpoints = file["poses/setpoint_c"][:]
-        available = list(dict.fromkeys(setpoints.tolist()))
-        if not available:
-            raise ConfigError(f"{path}: no poses stored")
-        if setpoint_c is None:
-            if len(available) > 1:
-                raise ConfigError(f"{path}: poses at {len(available)} setpoints ({', '.join(f'{s:g}' for s in available)}"
-                                  " °C): choose one with --setpoint")
-            setpoint_c = available[0]
-        rows = np.flatnonzero(setpoints == setpoint_c)
-        if not len(rows):
-            raise ConfigError(f"{path}: no poses at {setpoint_c:g} °C (setpoints: {', '.join(f'{s:g}' for s in available)})")
+        setpoint_c, mask = rows_at_setpoint(path, file, setpoint_c)
+        rows = np.flatnonzero(mask)
         dut = file["duts"][serial]
         lsb_g, odr_hz = float(dut.attrs["lsb_g"]), float(dut.attrs["odr_hz"])
         codes = dut["raw_codes"][rows]

@@ -12,7 +12,7 @@ from accelcal_rig.plan.compile import setpoint_label
 
 def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[str]:
     procedure, rig, plan = prepared.procedure.model, prepared.rig.model, prepared.plan
-    soak, acquisition = procedure.soak, procedure.acquisition
+    soak = procedure.soak
     setpoints = plan.setpoints_c
     lines = [
         f"procedure  {procedure.name} ({prepared.procedure.path})",

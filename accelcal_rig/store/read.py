@@ -219,3 +219,21 @@ def measurements_sha256(file: h5py.File) -> str:
         for name in ("raw_codes", "temperature_c", "gravity_reference_g"):
             digest.update(np.ascontiguousarray(file["duts"][serial][name][:]).tobytes())
     return digest.hexdigest()
+
+
+def rows_at_setpoint(path: Path, file: h5py.File, setpoint_c: float | None) -> tuple[float, np.ndarray]:
+    """(setpoint, boolean rows of `poses/` there) for analyses at one temperature; `setpoint_c` None means
+    the file's only setpoint, and is refused when there are several."""
+    setpoints = file["poses/setpoint_c"][:]
+    available = list(dict.fromkeys(setpoints.tolist()))
+    listed = ", ".join(f"{s:g}" for s in available)
+    if not available:
+        raise ConfigError(f"{path}: no poses stored")
+    if setpoint_c is None:
+        if len(available) > 1:
+            raise ConfigError(f"{path}: poses at {len(available)} setpoints ({listed} °C): choose one with --setpoint")
+        setpoint_c = available[0]
+    rows = setpoints == setpoint_c
+    if not rows.any():
+        raise ConfigError(f"{path}: no poses at {setpoint_c:g} °C (setpoints: {listed})")
+    return float(setpoint_c), rows
