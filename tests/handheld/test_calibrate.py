@@ -88,3 +88,29 @@ def test_a_campaign_files_raw_samples_are_a_recording(paper_campaign: Path) -> N
     result = fit_recording(recording, detection, "all", "ADX355-A002")
     assert result.report["rmse_after_mg"] < 1.5 * result.report["noise_floor_mg"]
     assert result.report["temperature_c"] == pytest.approx(20.0, abs=0.5)
+
+
+@pytest.mark.parametrize("argv, expected", [
+    (["--columns", "time_s,ax,ay,accel_z"], "no column accel_z (columns: time_s, ax, ay, az, temp_c)"),
+    (["--columns", "time_s,ax,ay,az,temp_c", "--units", "counts"], "--counts-per-g is needed with --units counts"),
+    (["--columns", "t,x"], "--columns: 't,x': expected time,x,y,z"),
+    (["--columns", "time_s,ax,ay,az", "--window-s", "0"], "--window-s: must be positive"),
+])
+def test_fit_recording_input_errors_are_one_line(tmp_path: Path, capsys, argv: list[str], expected: str) -> None:
+    from accelcal_rig.cli import main
+
+    simulated = handheld_recording("HH-7", 10, 100.0, np.random.default_rng(15))
+    write_csv(simulated, tmp_path / "s.csv")
+    assert main(["fit-recording", str(tmp_path / "s.csv"), "-o", str(tmp_path / "cal.yaml"), *argv]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and expected in err, err
+    assert not (tmp_path / "cal.yaml").exists()
+
+
+def test_a_broken_row_is_named_by_its_line(tmp_path: Path) -> None:
+    from accelcal_rig.errors import ConfigError
+
+    path = tmp_path / "s.csv"
+    path.write_text("t,x,y,z\n" + "".join(f"{i / 100},0,0,1\n" for i in range(20)) + "0.2,0,zero,1\n")
+    with pytest.raises(ConfigError, match=r"s\.csv:22: not a number in columns t, x, y, z"):
+        read_csv_recording(path, CsvLayout.parse_columns("t,x,y,z"))
