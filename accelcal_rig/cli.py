@@ -456,7 +456,7 @@ def _cmd_fit_recording(args: argparse.Namespace) -> int:
             raise ConfigError(f"--{name.replace('_', '-')}: must be positive, not {value:g}")
     if args.recording.suffix in (".h5", ".hdf5"):
         recording = read_campaign_recording(args.recording, args.serial, args.setpoint)
-        serial = args.serial or recording.source.split(" sensor ")[1].split(" at ")[0]
+        serial = recording.serial or args.recording.stem
     else:
         layout = CsvLayout.parse_columns(args.columns, time_unit=args.time_unit, rate_hz=args.rate_hz,
                                          units=args.units, counts_per_g=args.counts_per_g, zero_code=args.zero_code)
@@ -591,7 +591,8 @@ def _analyze_positions(args: argparse.Namespace) -> int:
         _check_figure_path(args.figure)
     setpoint, duts, _ = poses_at_setpoint(args.campaign, args.setpoint)
     with open_campaign(args.campaign) as file:
-        mode = args.mode or str(file.attrs.get("fit_mode", "reference"))
+        recorded = str(file.attrs.get("fit_mode", "reference"))
+        mode = args.mode or ("reference" if recorded == "none" else recorded)  # measure-only: the table's reference
         free = str(file.attrs.get("fit_parameters", "all"))
     rows, floors = [], {}
     for serial, poses in duts.items():
@@ -652,7 +653,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
         return 0
     if not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
-    args.output.write_text(text)
+    args.output.write_text(text, encoding="utf-8")
     print(f"{args.format} of {len(calibration.sensors)} sensors → {args.output}")
     return 0
 

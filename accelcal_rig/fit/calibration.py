@@ -127,8 +127,9 @@ def apply_codes(calibration: SensorCalibration, codes: np.ndarray, temperature_c
 
 
 def save_calibration(calibration: CalibrationFile, path: Path) -> None:
-    text = yaml.safe_dump(calibration.model_dump(mode="json"), sort_keys=False, width=120)
-    path.write_text("# accelcal-rig calibration: Eq. 1 parameters as polynomials of the sensor temperature\n" + text)
+    text = yaml.safe_dump(calibration.model_dump(mode="json"), sort_keys=False, width=120, allow_unicode=True)
+    path.write_text("# accelcal-rig calibration: Eq. 1 parameters as polynomials of the sensor temperature\n" + text,
+                    encoding="utf-8")
 
 
 def load_calibration(path: Path) -> CalibrationFile:

@@ -27,6 +27,7 @@ class Recording:
     lsb_g: float                       # g per count (for codes); 1.0 when given in g
     sha256: str                        # of the source data, for the calibration's provenance
     notes: list[str] = field(default_factory=list)
+    serial: str | None = None          # the sensor, when the source names it (a campaign file's DUT)
 
 
 @dataclass(frozen=True)
@@ -119,4 +120,4 @@ def read_campaign_recording(path: Path, serial: str | None, setpoint_c: float | 
     accel_g = codes.reshape(-1, 3).astype(float) * lsb_g
     digest = hashlib.sha256(np.ascontiguousarray(codes).tobytes()).hexdigest()
     return Recording(f"{path} sensor {serial} at {setpoint_c:g} °C", t, accel_g, np.repeat(pose_temperature, n), lsb_g,
-                     digest)
+                     digest, serial=serial)
