@@ -193,6 +193,7 @@ def _build_parser() -> argparse.ArgumentParser:
                         "rig analyze cooldown cooldown.h5 --calibration campaign.calibration.yaml --figure cool.png")
     cooldown.add_argument("campaign", type=Path, help="campaign file (HDF5) of a cool-down procedure")
     cooldown.add_argument("--calibration", type=Path, required=True, help="calibration file (YAML) of the same DUTs")
+    cooldown.add_argument("--setpoint", type=float, help="the setpoint to analyse (default: the file's only one)")
     cooldown.add_argument("--figure", type=Path, help="write the figure (PNG) here")
     cooldown.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -511,7 +512,7 @@ def _analyze_cooldown(args: argparse.Namespace) -> int:
 
     if args.figure is not None:
         _check_figure_path(args.figure)
-    _, duts, _ = poses_at_setpoint(args.campaign, None)
+    _, duts, _ = poses_at_setpoint(args.campaign, args.setpoint)
     calibration = _calibrations_for(args.calibration, args.campaign, list(duts))
     results = [analyse_cooldown(poses, calibration.sensors[serial]) for serial, poses in duts.items()]
     if args.figure is not None:

@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import logging
 import os
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+from quiet import silence_campaign_log  # bench/quiet.py, beside this script
 
 REPO = Path(__file__).resolve().parent.parent
 PAPER = REPO / "procedures" / "paper-24pos-thermal.yaml"
@@ -58,13 +59,11 @@ def campaign_only(output: Path, seed: int, in_process: bool) -> float:
 def main() -> None:
     import h5py
 
-    from accelcal_rig.engine.events import LOGGER
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3)
     args = parser.parse_args()
-    LOGGER.addHandler(logging.NullHandler())
-    LOGGER.propagate = False
+    silence_campaign_log()
     walls = []
     with tempfile.TemporaryDirectory() as folder:
         output = Path(folder) / "campaign.h5"

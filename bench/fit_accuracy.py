@@ -10,7 +10,6 @@ quoted 1σ; then fit times; then the same campaign with unmodelled effects switc
 from __future__ import annotations
 
 import argparse
-import logging
 import tempfile
 import time
 from collections import defaultdict
@@ -19,8 +18,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 import yaml
+from quiet import silence_campaign_log  # bench/quiet.py, beside this script
 
-from accelcal_rig.engine.events import LOGGER
 from accelcal_rig.engine.session import prepare, run_campaign
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_campaign, fit_dut
 from accelcal_rig.store.read import read_dut_poses
@@ -115,8 +114,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=10)
     args = parser.parse_args()
-    LOGGER.addHandler(logging.NullHandler())  # the campaigns' own progress and warnings are not the figures
-    LOGGER.propagate = False
+    silence_campaign_log()
     with tempfile.TemporaryDirectory() as folder:
         accuracy(args.seeds, Path(folder))
         print("speed")

@@ -7,7 +7,6 @@ clock, what the progress display costs a dry run, and how long `rig plan` and `r
 from __future__ import annotations
 
 import argparse
-import logging
 import statistics
 import subprocess
 import sys
@@ -16,9 +15,10 @@ import time
 from pathlib import Path
 
 import h5py
+from quiet import silence_campaign_log  # bench/quiet.py, beside this script
 
 from accelcal_rig.engine.estimate import estimate_duration
-from accelcal_rig.engine.events import LOGGER, format_duration
+from accelcal_rig.engine.events import format_duration
 from accelcal_rig.engine.session import prepare, run_campaign
 from accelcal_rig.report.live import ProgressLines
 
@@ -75,9 +75,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seeds", type=int, default=5)
     args = parser.parse_args()
-    LOGGER.setLevel(logging.WARNING)
-    LOGGER.propagate = False
-    LOGGER.addHandler(logging.NullHandler())
+    silence_campaign_log()
     with tempfile.TemporaryDirectory() as folder:
         estimate_against_dry_runs(args.seeds, Path(folder))
         progress_cost(3, Path(folder))

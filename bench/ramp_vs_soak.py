@@ -11,17 +11,21 @@ force (mg), and the worst parameter errors of the polynomials against the truth.
 from __future__ import annotations
 
 import argparse
-import logging
 import statistics
 import tempfile
 import warnings
 from pathlib import Path
 
 import numpy as np
+from quiet import silence_campaign_log  # bench/quiet.py, beside this script
 
-from accelcal_rig.engine.events import LOGGER, format_duration
+from accelcal_rig.engine.events import format_duration
 from accelcal_rig.engine.session import prepare, run_campaign
-from accelcal_rig.fit.calibration import CalibrationRangeWarning, apply, load_calibration
+from accelcal_rig.fit.calibration import (
+    CalibrationRangeWarning,
+    apply,
+    load_calibration,
+)
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.plan.schedules import sphere
 from accelcal_rig.sim.truth import truth_for_serial
@@ -53,9 +57,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seeds", type=int, default=3)
     args = parser.parse_args()
-    LOGGER.setLevel(logging.WARNING)
-    LOGGER.propagate = False
-    LOGGER.addHandler(logging.NullHandler())
+    silence_campaign_log()
     results: dict[str, list[dict[str, float]]] = {m: [] for m in METHODS}
     with tempfile.TemporaryDirectory() as folder:
         for seed in range(args.seeds):

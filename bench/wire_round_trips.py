@@ -6,13 +6,13 @@ counted and timed by kind, over one paper campaign. Usage:
 
 from __future__ import annotations
 
-import logging
 import tempfile
 import time
 from collections import defaultdict
 from pathlib import Path
 
-from accelcal_rig.engine.events import LOGGER
+from quiet import silence_campaign_log  # bench/quiet.py, beside this script
+
 from accelcal_rig.engine.session import prepare, run_campaign
 from accelcal_rig.instruments import chamber_modbus, line_port
 
@@ -20,8 +20,7 @@ REPO = Path(__file__).resolve().parent.parent
 
 
 def main() -> None:
-    LOGGER.addHandler(logging.NullHandler())
-    LOGGER.propagate = False
+    silence_campaign_log()
     counts: dict[str, list[float]] = defaultdict(lambda: [0, 0.0])
 
     def timed(key_of, function):

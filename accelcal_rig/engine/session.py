@@ -230,9 +230,11 @@ def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, instr
                                 resume=resume, audience=Audience(progress, estimate, notifier, str(output)))
         summary = runner.run()
     finally:
-        writer.close()
-        if notifier is not None:
-            notifier.close()
+        try:
+            writer.close()
+        finally:
+            if notifier is not None:  # the fault, safe and finish events still go out
+                notifier.close()
     return RunResult(summary, time.perf_counter() - wall_start, output)
 
 

@@ -1,0 +1,14 @@
+"""Shared by the benchmarks: the campaigns' own progress and warnings are not the figures."""
+
+from __future__ import annotations
+
+import logging
+
+from accelcal_rig.engine.events import LOGGER
+
+
+def silence_campaign_log() -> None:
+    """Keep the engine's log off the console (and off the root logger) while a benchmark prints figures."""
+    LOGGER.setLevel(logging.WARNING)
+    LOGGER.propagate = False
+    LOGGER.addHandler(logging.NullHandler())
