@@ -35,6 +35,20 @@ def _command(commands: argparse._SubParsersAction, name: str, summary: str, desc
                                formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
+def _analysis_command(analyses: argparse._SubParsersAction, name: str, summary: str, description: str,
+                      example: str, *, calibration: bool, figure: bool) -> argparse.ArgumentParser:
+    """A `rig analyze` subcommand with the arguments every analysis shares."""
+    command = _command(analyses, name, summary, description, example)
+    command.add_argument("campaign", type=Path, help="campaign file (HDF5)")
+    if calibration:
+        command.add_argument("--calibration", type=Path, required=True, help="calibration file (YAML) of the same DUTs")
+    command.add_argument("--setpoint", type=float, help="the setpoint to analyse (default: the file's only one)")
+    if figure:
+        command.add_argument("--figure", type=Path, help="write the figure (PNG) here")
+    command.add_argument("--json", action="store_true", help="print one JSON object")
+    return command
+
+
 def _build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="rig", description="Run MEMS accelerometer calibration campaigns.")
     parser.add_argument("--version", action="version", version=f"accelcal-rig {__version__}")
@@ -159,43 +173,31 @@ def _build_parser() -> argparse.ArgumentParser:
                        "coefficient during a free cool-down (cooldown).",
                        "rig analyze positions campaign.h5 --figure positions.png")
     analyses = analyze.add_subparsers(dest="analysis", required=True, metavar="ANALYSIS")
-    positions = _command(analyses, "positions", "refit on subsets of 1296 … 12 positions, score on the rest",
-                         "Refit the error model on subsets of the poses of one setpoint, of the sizes of the "
-                         "paper's Table 4 (several random subsets and one evenly spread subset each), and "
-                         "report the RMSE of |g| on the poses each fit did not use (paper Fig. 8). Made for "
-                         "procedures/positions-study.yaml (1296 orientations).",
-                         "rig analyze positions campaign.h5 --figure positions.png")
-    positions.add_argument("campaign", type=Path, help="campaign file (HDF5)")
-    positions.add_argument("--setpoint", type=float, help="the setpoint to analyse (default: the file's only one)")
+    positions = _analysis_command(
+        analyses, "positions", "refit on subsets of 1296 … 12 positions, score on the rest",
+        "Refit the error model on subsets of the poses of one setpoint, of the sizes of the paper's Table 4 "
+        "(several random subsets and one evenly spread subset each), and report the RMSE of |g| on the poses "
+        "each fit did not use (paper Fig. 8). Made for procedures/positions-study.yaml (1296 orientations).",
+        "rig analyze positions campaign.h5 --figure positions.png", calibration=False, figure=True)
     positions.add_argument("--sizes", help="comma-separated subset sizes (default: the paper's 1296,648,…,12)")
     positions.add_argument("--subsets", type=int, default=10, help="random subsets per size (default 10)")
     positions.add_argument("--seed", type=int, default=0, help="seed of the random subsets (default 0)")
     positions.add_argument("--mode", choices=["reference", "norm-only"], help="default: the campaign's fit mode")
-    positions.add_argument("--figure", type=Path, help="write the figure (PNG) here")
-    positions.add_argument("--json", action="store_true", help="print one JSON object")
-
-    tilt = _command(analyses, "tilt", "pitch and roll before and after a calibration, against the reference",
-                    "For every pose of one setpoint and every DUT: the reference pitch and roll (paper Eq. 10) "
-                    "from the orientation the turntable set, those measured raw and after compensation with "
-                    "the calibration, and the SEOQ (|before − after| relative to 30°), as in the paper's "
-                    "Table 5. Made for procedures/tilt-check.yaml.",
-                    "rig analyze tilt tilt.h5 --calibration campaign.calibration.yaml")
-    tilt.add_argument("campaign", type=Path, help="campaign file (HDF5)")
-    tilt.add_argument("--calibration", type=Path, required=True, help="calibration file (YAML) of the same DUTs")
-    tilt.add_argument("--setpoint", type=float, help="the setpoint to analyse (default: the file's only one)")
-    tilt.add_argument("--json", action="store_true", help="print one JSON object")
-
-    cooldown = _command(analyses, "cooldown", "temperature coefficient per axis during a free cool-down",
-                        "For every DUT of a cool-down campaign (procedures/cooldown-60c.yaml): the slope of each "
-                        "axis's output against the DUT's own temperature, in µg/K, before and after compensation "
-                        "with the calibration (paper: 1346 → 37 µg/K), and the output's span; the figure shows "
-                        "the outputs over the cool-down (paper Fig. 11).",
-                        "rig analyze cooldown cooldown.h5 --calibration campaign.calibration.yaml --figure cool.png")
-    cooldown.add_argument("campaign", type=Path, help="campaign file (HDF5) of a cool-down procedure")
-    cooldown.add_argument("--calibration", type=Path, required=True, help="calibration file (YAML) of the same DUTs")
-    cooldown.add_argument("--setpoint", type=float, help="the setpoint to analyse (default: the file's only one)")
-    cooldown.add_argument("--figure", type=Path, help="write the figure (PNG) here")
-    cooldown.add_argument("--json", action="store_true", help="print one JSON object")
+    _analysis_command(
+        analyses, "tilt", "pitch and roll before and after a calibration, against the reference",
+        "For every pose of one setpoint and every DUT: the reference pitch and roll (paper Eq. 10) from the "
+        "orientation the turntable set, those measured raw and after compensation with the calibration, and "
+        "the SEOQ (|before − after| relative to 30°), as in the paper's Table 5. Made for "
+        "procedures/tilt-check.yaml.",
+        "rig analyze tilt tilt.h5 --calibration campaign.calibration.yaml", calibration=True, figure=False)
+    _analysis_command(
+        analyses, "cooldown", "temperature coefficient per axis during a free cool-down",
+        "For every DUT of a cool-down campaign (procedures/cooldown-60c.yaml): the slope of each axis's output "
+        "against the DUT's own temperature, in µg/K, before and after compensation with the calibration "
+        "(paper: 1346 → 37 µg/K), and the output's span; the figure shows the outputs over the cool-down "
+        "(paper Fig. 11).",
+        "rig analyze cooldown cooldown.h5 --calibration campaign.calibration.yaml --figure cool.png",
+        calibration=True, figure=True)
 
     report = _command(commands, "report", "write an HTML report with figures of a campaign",
                       "Write REPORT/index.html and REPORT/figures/*.png: the campaign's summary, |g| per pose "
