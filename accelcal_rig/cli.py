@@ -103,6 +103,14 @@ def _build_parser() -> argparse.ArgumentParser:
     status.add_argument("campaign", type=Path, help="campaign file (HDF5)")
     status.add_argument("--json", action="store_true", help="print one JSON object")
 
+    repair = _command(commands, "repair", "rebuild a campaign file from its journal",
+                      "Bring a campaign's files back in step without losing a record: the campaign file (HDF5) "
+                      "rebuilt from its journal; a journal with damaged stretches compacted to its whole records "
+                      "(the original kept beside it); a campaign file without a journal given one. Refused while "
+                      "a run holds the campaign.",
+                      "rig repair campaign.h5")
+    repair.add_argument("campaign", type=Path, help="campaign file (HDF5)")
+
     check = _command(commands, "check", "contact every instrument of a rig and describe each in one line",
                      "Connect to the chamber, the turntable and every sensor of a rig config, check their "
                      "identities and print what they report. Run it before leaving a campaign overnight.",
@@ -122,7 +130,7 @@ def _build_parser() -> argparse.ArgumentParser:
 
     fit = _command(commands, "fit", "fit the error model of every DUT and write a calibration file",
                    "LM fit of Eq. 1 at each setpoint, polynomials over the sensor temperature (Eq. 8), metrics. "
-                   "Results also replace the campaign file's fit/ group; measured data are never touched.",
+                   "The campaign is only read; the calibration file is replaced whole.",
                    "rig fit campaign.h5 -o calibration.yaml --json")
     fit.add_argument("campaign", type=Path, help="campaign file (HDF5)")
     fit.add_argument("-o", "--output", type=Path, required=True, help="calibration file to write (YAML)")
@@ -227,7 +235,8 @@ def _campaign_logging(output: Path, verbose: bool, quiet: bool, append: bool,
     """Console on stderr at the chosen level (a live status line on a terminal, timestamped lines
     otherwise), the full debug log with progress lines in a file beside the campaign file (appended to by
     a resumed run); yields the progress listener. Everything is detached and closed when the run ends."""
-    from accelcal_rig.report.live import ProgressLines, StatusLine, TerminalHandler, listeners
+    from accelcal_rig.report.live import LogFileHandler, ProgressLines, StatusLine, TerminalHandler, listeners
+    from accelcal_rig.store.paths import log_path
 
     status = StatusLine(sys.stderr, real_clock) if sys.stderr.isatty() and not quiet else None
     console: logging.Handler
@@ -238,8 +247,10 @@ def _campaign_logging(output: Path, verbose: bool, quiet: bool, append: bool,
         console = logging.StreamHandler(sys.stderr)
         console.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s", "%Y-%m-%d %H:%M:%S"))
     console.setLevel(logging.DEBUG if verbose else logging.WARNING if quiet else logging.INFO)
-    log_file = logging.FileHandler(output.with_suffix(output.suffix + ".log"), mode="a" if append else "w",
-                                   encoding="utf-8")
+    try:
+        log_file = LogFileHandler(str(log_path(output)), mode="a" if append else "w")
+    except OSError as exc:
+        raise ConfigError(f"{log_path(output)}: cannot write the campaign's log: {exc.strerror}") from None
     log_file.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s"))
     LOGGER.setLevel(logging.DEBUG)
     propagate, LOGGER.propagate = LOGGER.propagate, False
@@ -273,15 +284,17 @@ class _StopOnFirstSignal:
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from accelcal_rig.engine.session import prepare
+    from accelcal_rig.store.paths import journal_path
 
     prepared = prepare(args.procedure, args.config, args.faults)
-    if args.output.exists() and not (args.overwrite or args.resume):
+    exists = args.output.exists() or journal_path(args.output).exists()
+    if exists and not (args.overwrite or args.resume):
         raise ConfigError(f"{args.output}: campaign file exists; continue it with --resume, or choose another -o "
                           "or pass --overwrite")
     if not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
     return _execute(prepared, args.output, args, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite,
-                    resume=args.resume and args.output.exists())
+                    resume=args.resume and exists)
 
 
 def _cmd_plan(args: argparse.Namespace) -> int:
@@ -300,22 +313,40 @@ def _cmd_plan(args: argparse.Namespace) -> int:
 
 def _cmd_resume(args: argparse.Namespace) -> int:
     from accelcal_rig.engine.session import prepare
-    from accelcal_rig.store.read import read_stored_campaign
+    from accelcal_rig.store.read import load_campaign
 
-    stored = read_stored_campaign(args.campaign)
-    procedure = args.procedure or stored.procedure_path
-    if not procedure.exists():
+    stored = load_campaign(args.campaign)
+    procedure = args.procedure or Path(str(stored.attrs.get("procedure_path", "")))
+    if not procedure.is_file():
         raise ConfigError(f"{args.campaign}: its procedure {procedure} is gone; pass --procedure with the same "
                           "procedure")
     prepared = prepare(procedure, args.config, args.faults)
-    return _execute(prepared, args.campaign, args, dry_run=stored.dry_run, seed=stored.seed, overwrite=False,
-                    resume=True)
+    return _execute(prepared, args.campaign, args, dry_run=bool(stored.attrs.get("dry_run", False)),
+                    seed=int(stored.attrs.get("seed", 0)), overwrite=False, resume=True)
+
+
+def _check_free_space(prepared: PreparedCampaign, output: Path, dry_run: bool, overwrite: bool) -> None:
+    """Refuse to start a campaign the disk cannot hold (with a margin), before anything is touched."""
+    from accelcal_rig.durable import free_bytes
+    from accelcal_rig.store.paths import journal_path
+    from accelcal_rig.store.space import START_MARGIN, megabytes
+
+    estimate = prepared.storage(dry_run)
+    replaced = sum(p.stat().st_size for p in (output, journal_path(output)) if overwrite and p.is_file())
+    free = free_bytes(output.parent) + replaced
+    needed = int(START_MARGIN * estimate.need_bytes)
+    if free < needed:
+        raise ConfigError(f"{output}: {megabytes(free)} free on {output.parent.resolve()}, the campaign needs about "
+                          f"{megabytes(needed)} ({START_MARGIN:g} × its estimated {megabytes(estimate.need_bytes)}): "
+                          "free some space or choose another -o")
 
 
 def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace, *, dry_run: bool, seed: int,
              overwrite: bool, resume: bool) -> int:
-    """Run or resume under the CLI's signal handling and logging; print the summary."""
+    """Run or resume under the CLI's signal handling and logging; print the summary. The campaign is
+    locked before anything of it changes, the log included."""
     from accelcal_rig.engine.session import NothingToResume, run_campaign
+    from accelcal_rig.store.lock import campaign_lock
 
     calibration = args.calibration or output.with_suffix(".calibration.yaml")
     if not calibration.parent.is_dir():
@@ -323,9 +354,12 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
     stop = _StopOnFirstSignal()
     previous = {signum: signal.signal(signum, stop) for signum in (signal.SIGINT, signal.SIGTERM)}
     try:
-        with _campaign_logging(output, args.verbose, args.quiet, append=resume, real_clock=not dry_run) as progress:
-            result = run_campaign(prepared, output, dry_run=dry_run, seed=seed, overwrite=overwrite,
-                                  calibration=calibration, resume=resume, progress=progress)
+        with campaign_lock(output, "rig resume" if resume else "rig run"):
+            if not resume:
+                _check_free_space(prepared, output, dry_run, overwrite)
+            with _campaign_logging(output, args.verbose, args.quiet, append=resume, real_clock=not dry_run) as progress:
+                result = run_campaign(prepared, output, dry_run=dry_run, seed=seed, overwrite=overwrite,
+                                      calibration=calibration, resume=resume, progress=progress)
     except NothingToResume as done:
         print(done)
         return 0
@@ -334,7 +368,7 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
             signal.signal(signum, handler)
     summary = result.summary
     setpoints = summary.setpoints_c
-    size_mb = result.output.stat().st_size / 1e6
+    size_mb = result.output.stat().st_size / 1e6 if result.output.is_file() else 0.0
     print(f"campaign {summary.state}: {prepared.procedure.model.name}")
     print(f"  setpoints  {len(setpoints)} ({min(setpoints):g} … {max(setpoints):g} °C)")
     print(f"  poses      {summary.poses_done} of {summary.poses_total} × {summary.n_duts} DUTs × "
@@ -350,16 +384,22 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
 
 
 def _cmd_status(args: argparse.Namespace) -> int:
-    from accelcal_rig.engine.clock import RealClock
-    from accelcal_rig.store.read import campaign_status, status_json
+    from accelcal_rig.store.read import campaign_status
 
-    sleep = RealClock().sleep  # a running campaign may be mid-flush: retry briefly for a consistent read
+    status = campaign_status(args.campaign)
     if args.json:
-        print(status_json(args.campaign, sleep))
+        print(json.dumps(status))
         return 0
-    status = campaign_status(args.campaign, sleep)
     for key, value in status.items():
         print(f"{key:17s}{value}")
+    return 0
+
+
+def _cmd_repair(args: argparse.Namespace) -> int:
+    from accelcal_rig.store.repair import repair_campaign
+
+    for line in repair_campaign(args.campaign):
+        print(f"{args.campaign}: {line}")
     return 0
 
 
@@ -413,28 +453,35 @@ def _cmd_sim(args: argparse.Namespace) -> int:
 
 
 def _cmd_fit(args: argparse.Namespace) -> int:
-    from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
-    from accelcal_rig.store.read import open_campaign_for_update
+    import numpy as np
 
-    with open_campaign_for_update(args.campaign) as file:
-        attrs = file.attrs
-        options = FitOptions(
-            mode=args.mode or str(attrs.get("fit_mode", "reference")),
-            degree=args.degree if args.degree is not None else int(attrs.get("polynomial_degree", 3)),
-            free=args.parameters or str(attrs.get("fit_parameters", "all")),
-            out_of_range=args.out_of_range or str(attrs.get("fit_out_of_range", "clamp")),
-            temperature_model=args.temperature_model or str(attrs.get("fit_temperature_model", "per-setpoint")),
-        )
-        if options.mode == "none":
-            raise ConfigError(f"{args.campaign}: its procedure asked for no fit (fit.mode: none); choose one with "
-                              "--mode reference or --mode norm-only")
-        state = str(attrs["state"])
-        try:
-            _, report = fit_and_save(file, args.campaign, args.output, options)
-        except ValueError as exc:
-            raise RigError(f"{args.campaign}: fit failed: {exc}") from None
-    if state != "done":
-        print(f"rig: warning: campaign state is {state}: fitted the poses stored so far", file=sys.stderr)
+    from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
+    from accelcal_rig.store.lock import holder
+    from accelcal_rig.store.read import usable_campaign
+
+    running = holder(args.campaign)
+    if running is not None:
+        raise ConfigError(f"{args.campaign}: a campaign is running on it ({running}): fit it once it is done")
+    campaign = usable_campaign(args.campaign)
+    attrs = campaign.attrs
+    options = FitOptions(
+        mode=args.mode or str(attrs.get("fit_mode", "reference")),
+        degree=args.degree if args.degree is not None else int(attrs.get("polynomial_degree", 3)),
+        free=args.parameters or str(attrs.get("fit_parameters", "all")),
+        out_of_range=args.out_of_range or str(attrs.get("fit_out_of_range", "clamp")),
+        temperature_model=args.temperature_model or str(attrs.get("fit_temperature_model", "per-setpoint")),
+    )
+    if options.mode == "none":
+        raise ConfigError(f"{args.campaign}: its procedure asked for no fit (fit.mode: none); choose one with "
+                          "--mode reference or --mode norm-only")
+    if args.output.is_dir():
+        raise ConfigError(f"{args.output}: is a folder; name the calibration file to write")
+    try:
+        _, report = fit_and_save(campaign, args.campaign, args.output, options)
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        raise RigError(f"{args.campaign}: fit failed: {str(exc).splitlines()[0]}") from None
+    if campaign.state != "done":
+        print(f"rig: warning: campaign state is {campaign.state}: fitted the poses stored so far", file=sys.stderr)
     if args.json:
         print(json.dumps(report))
     else:
@@ -582,7 +629,7 @@ def _analyze_positions(args: argparse.Namespace) -> int:
     from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
     from accelcal_rig.analysis.positions import PAPER_SIZES, floor_mg, score_subsets, summarise
     from accelcal_rig.fit.calibration import plain
-    from accelcal_rig.store.read import open_campaign
+    from accelcal_rig.store.read import load_campaign
 
     try:
         sizes = tuple(int(v) for v in args.sizes.split(",")) if args.sizes else PAPER_SIZES
@@ -593,10 +640,10 @@ def _analyze_positions(args: argparse.Namespace) -> int:
     if args.figure is not None:
         _check_figure_path(args.figure)
     setpoint, duts, _ = poses_at_setpoint(args.campaign, args.setpoint)
-    with open_campaign(args.campaign) as file:
-        recorded = str(file.attrs.get("fit_mode", "reference"))
-        mode = args.mode or ("reference" if recorded == "none" else recorded)  # measure-only: the table's reference
-        free = str(file.attrs.get("fit_parameters", "all"))
+    attrs = load_campaign(args.campaign).attrs
+    recorded = str(attrs.get("fit_mode", "reference"))
+    mode = args.mode or ("reference" if recorded == "none" else recorded)  # measure-only: the table's reference
+    free = str(attrs.get("fit_parameters", "all"))
     rows, floors = [], {}
     for serial, poses in duts.items():
         scores = score_subsets(poses, sizes, mode, free, args.subsets, np.random.default_rng(args.seed))  # type: ignore[arg-type]
@@ -697,7 +744,8 @@ def main(argv: list[str] | None = None) -> int:
     # Driver libraries log their own view of a failure; ours is the one line that names the instrument.
     logging.getLogger("pymodbus").addHandler(logging.NullHandler())
     logging.getLogger("pymodbus").propagate = False
-    handler = {"run": _cmd_run, "plan": _cmd_plan, "resume": _cmd_resume, "status": _cmd_status, "fit": _cmd_fit, "check": _cmd_check,
+    handler = {"run": _cmd_run, "plan": _cmd_plan, "resume": _cmd_resume, "status": _cmd_status, "repair": _cmd_repair,
+               "fit": _cmd_fit, "check": _cmd_check,
                "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export,
                "fit-recording": _cmd_fit_recording, "analyze": _cmd_analyze}[args.command]
     try:

@@ -34,3 +34,11 @@ class WaitTimeout(RigError):
 
 class CampaignAborted(RigError):
     """The campaign stopped before its end; the rig was put in its safe state."""
+
+
+class DiskFull(RigError):
+    """No space left where a campaign writes: it stops, everything stored stays readable (exit code 1)."""
+
+
+class InsufficientSpace(RigError):
+    """Free space is below what the rest of a campaign needs, found before it would run out."""

@@ -51,13 +51,38 @@ def paper_campaign(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture(scope="session")
 def fitted_paper_campaign(paper_campaign: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     """A copy of the paper campaign with its fit done: (campaign file, calibration file)."""
-    import h5py
-
     from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save
+    from accelcal_rig.store.read import load_campaign
 
     folder = tmp_path_factory.mktemp("fitted")
     campaign, calibration = folder / "campaign.h5", folder / "campaign.calibration.yaml"
     shutil.copy(paper_campaign, campaign)
-    with h5py.File(campaign, "a") as file:
-        fit_and_save(file, campaign, calibration, FitOptions())
+    fit_and_save(load_campaign(campaign), campaign, calibration, FitOptions())
     return campaign, calibration
+
+
+def kill_mid_pose(campaign: Path, keep_poses: int) -> int:
+    """Leave the campaign's journal as `kill -9` in the middle of storing pose `keep_poses + 1` would: whole
+    up to the record of pose `keep_poses`, then half of the next pose's record. Returns that half's bytes."""
+    from accelcal_rig.store.journal import scan
+    from accelcal_rig.store.paths import journal_path
+
+    journal = journal_path(campaign)
+    data = journal.read_bytes()
+    poses = [r for r in scan(data).records if r.kind == "pose"]
+    kept, cut = poses[keep_poses - 1], poses[keep_poses]
+    torn = data[cut.offset:cut.offset + cut.size // 2]
+    journal.write_bytes(data[:kept.offset + kept.size] + torn)
+    return len(torn)
+
+
+def stored_poses(campaign: Path) -> dict[str, bytes]:
+    """Every stored pose's data as bytes, by step key (to compare before and after)."""
+    from accelcal_rig.store.read import load_campaign
+
+    loaded = load_campaign(campaign)
+    return {p.step_key: b"".join([p.commanded_angles_deg.tobytes(), p.measured_angles_deg.tobytes(),
+                                  repr((p.setpoint_c, p.t_start_s, p.t_end_s, p.chamber_temperature_c)).encode()]
+                                 + [d.raw_codes.tobytes() + d.mean_g.tobytes() + d.stderr_g.tobytes()
+                                    + repr(d.temperature_c).encode() + d.gravity_reference_g.tobytes() for d in p.duts])
+            for p in loaded.poses}

@@ -168,20 +168,24 @@ def test_rig_fit_json_report_and_calibration_file(paper_campaign: Path, tmp_path
     assert loaded.source["campaign"] == str(campaign) and len(loaded.source["measurements_sha256"]) == 64
 
 
-def test_rig_fit_refuses_a_file_a_campaign_still_holds(paper_campaign: Path, tmp_path: Path, capsys) -> None:
+def test_rig_fit_refuses_a_campaign_still_running(paper_campaign: Path, tmp_path: Path, capsys) -> None:
+    import hashlib
+
     campaign = tmp_path / "campaign.h5"
     shutil.copy(paper_campaign, campaign)
-    holder = subprocess.Popen(  # another process with the file open for writing, as a running campaign has
-        [sys.executable, "-c", f"import h5py, time; f = h5py.File({str(campaign)!r}, 'a'); print('open', flush=True); "
-                               "time.sleep(60)"], stdout=subprocess.PIPE, text=True)
+    holder = subprocess.Popen(  # another process holding the campaign, as a running campaign does
+        [sys.executable, "-c", "import sys, time; from pathlib import Path; from accelcal_rig.store.lock import acquire; "
+                               f"acquire(Path({str(campaign)!r}), 'rig run'); print('held', flush=True); time.sleep(60)"],
+        stdout=subprocess.PIPE, text=True)
+    digest = hashlib.sha256(campaign.read_bytes()).hexdigest()
     try:
-        assert holder.stdout.readline().strip() == "open"
-        assert main(["fit", str(campaign), "-o", str(tmp_path / "cal.yaml")]) == 2
+        assert holder.stdout.readline().strip() == "held"
+        err = one_line_error(capsys, ["fit", str(campaign), "-o", str(tmp_path / "cal.yaml")], 2)
     finally:
         holder.kill()
         holder.wait()
-    err = capsys.readouterr().err
-    assert "cannot open for writing (is a campaign still running on it?)" in err and "Traceback" not in err
+    assert f"a campaign is running on it (pid {holder.pid} on " in err
+    assert hashlib.sha256(campaign.read_bytes()).hexdigest() == digest and not (tmp_path / "cal.yaml").exists()
 
 
 def test_rig_fit_on_a_file_without_poses_is_one_line(write, workdir: Path, capsys) -> None:
@@ -226,7 +230,7 @@ def test_kill_9_then_resume_stores_every_pose_exactly_once(tmp_path: Path, kill_
 
     import h5py
 
-    from accelcal_rig.store.read import integrity_problems
+    from accelcal_rig.store.read import load_campaign
 
     beside_python = Path(sys.executable).parent / "rig"
     process = subprocess.Popen([str(beside_python), "run", str(REPO / "procedures" / "quick-6pos.yaml"),
@@ -248,8 +252,8 @@ def test_kill_9_then_resume_stores_every_pose_exactly_once(tmp_path: Path, kill_
     assert "12 of 12 × 4 DUTs" in resumed.stdout
     with h5py.File(tmp_path / "c.h5", "r") as f:
         assert f.attrs["state"] == "done" and f.attrs["runs"] == 2
-        assert integrity_problems(f) == []
         assert f["poses/step_key"].shape[0] == 12
+    assert load_campaign(tmp_path / "c.h5").integrity_problems() == []
     assert "run 2 resumes" in (tmp_path / "c.h5.log").read_text()  # the log goes on, not replaced
     assert "rig resume" not in rig("status", "c.h5", cwd=tmp_path).stdout
 

@@ -7,15 +7,15 @@ from pathlib import Path
 
 import numpy as np
 
-from accelcal_rig.store.read import DutPoses, open_campaign, read_dut_poses, rows_at_setpoint
+from accelcal_rig.store.read import DutPoses, read_dut_poses, rows_at_setpoint, usable_campaign
 
 
 def poses_at_setpoint(path: Path, setpoint_c: float | None) -> tuple[float, dict[str, DutPoses], np.ndarray]:
     """(setpoint, each DUT's poses there, their pose numbers); `setpoint_c` None: the file's only one."""
-    with open_campaign(path) as file:
-        setpoint_c, rows = rows_at_setpoint(path, file, setpoint_c)
-        numbers = file["poses/pose_number"][:][rows]
-        duts = {serial: _select(read_dut_poses(file, serial), rows) for serial in file["duts"]}
+    campaign = usable_campaign(path)
+    setpoint_c, rows = rows_at_setpoint(path, campaign, setpoint_c)
+    numbers = campaign.pose_column("pose_number")[rows]
+    duts = {serial: _select(read_dut_poses(campaign, serial), rows) for serial in campaign.serials}
     return setpoint_c, duts, numbers
 
 

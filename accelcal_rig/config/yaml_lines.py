@@ -1,7 +1,14 @@
-"""YAML loading that remembers the line of every key, so validation errors can say `file:line: key`."""
+"""YAML loading that remembers the line of every key, so validation errors can say `file:line: key`.
+
+A config file is small and written by a person; anything else is refused before it can cost time or
+memory: files over `MAX_FILE_BYTES`, characters YAML does not allow (a null byte), nesting deeper than
+`MAX_DEPTH`, more than `MAX_NODES` values once aliases are expanded (an alias bomb), an alias that
+contains itself, numbers longer than `MAX_NUMBER_CHARS` characters.
+"""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -11,28 +18,129 @@ from accelcal_rig.errors import ConfigError
 
 KeyPath = tuple[str | int, ...]
 
+MAX_FILE_BYTES = 1 << 20
+MAX_DEPTH = 32
+MAX_NODES = 100_000
+MAX_SCALAR_CHARS = 65_536
+MAX_NUMBER_CHARS = 40
+#: Characters YAML 1.1 forbids in a stream (PyYAML's reader would refuse them with a two-line message).
+_NOT_ALLOWED = re.compile("[^\x09\x0a\x0d\x20-\x7e\x85\xa0-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+_NUMBER_TAGS = frozenset({"tag:yaml.org,2002:int", "tag:yaml.org,2002:float"})
 
-def load_yaml_with_lines(path: Path) -> tuple[Any, dict[KeyPath, int], str]:
-    """Parse `path`; return (data, {key path: 1-based line}, raw text).
 
-    Syntax errors and duplicate keys (which PyYAML would silently overwrite) become ConfigError.
-    """
+def _line_of(text: str, index: int) -> int:
+    return text.count("\n", 0, index) + 1
+
+
+def _check_events(text: str, where: str) -> None:
+    """One pass over the event stream (PyYAML's parser is not recursive): syntax, depth, sizes."""
+    depth = count = 0
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: cannot read: {exc}") from None
-    try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-        data = yaml.safe_load(text)
+        for event in yaml.parse(text, Loader=yaml.SafeLoader):
+            count += 1
+            line = event.start_mark.line + 1 if event.start_mark else 1
+            if count > MAX_NODES:
+                raise ConfigError(f"{where}:{line}: more than {MAX_NODES} values: not a config file")
+            if isinstance(event, yaml.CollectionStartEvent):
+                depth += 1
+                if depth > MAX_DEPTH:
+                    raise ConfigError(f"{where}:{line}: nested more than {MAX_DEPTH} levels deep")
+            elif isinstance(event, yaml.CollectionEndEvent):
+                depth -= 1
+            elif isinstance(event, yaml.ScalarEvent) and len(event.value) > MAX_SCALAR_CHARS:
+                raise ConfigError(f"{where}:{line}: a value of {len(event.value)} characters (at most {MAX_SCALAR_CHARS})")
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else 1
         problem = (exc.problem or exc.context or "invalid YAML").strip()
-        raise ConfigError(f"{path}:{line}: syntax: {problem}") from None
+        raise ConfigError(f"{where}:{line}: syntax: {problem}") from None
     except yaml.YAMLError as exc:
-        raise ConfigError(f"{path}:1: syntax: {exc}") from None
+        raise ConfigError(f"{where}:1: syntax: {str(exc).splitlines()[0]}") from None
+
+
+def _check_expansion(root: yaml.Node, where: str) -> None:
+    """Count the values the document holds with its aliases expanded, without expanding them."""
+    sizes: dict[int, tuple[int, int]] = {}  # node id → (values, depth) once counted
+    visiting: set[int] = set()
+
+    def size(node: yaml.Node, depth: int) -> tuple[int, int]:
+        key = id(node)
+        line = node.start_mark.line + 1
+        if key in sizes:
+            if depth + sizes[key][1] > MAX_DEPTH:
+                raise ConfigError(f"{where}:{line}: nested more than {MAX_DEPTH} levels deep (through aliases)")
+            return sizes[key]
+        if key in visiting:
+            raise ConfigError(f"{where}:{line}: an alias that contains itself")
+        if depth > MAX_DEPTH:
+            raise ConfigError(f"{where}:{line}: nested more than {MAX_DEPTH} levels deep (through aliases)")
+        if isinstance(node, yaml.ScalarNode):
+            if node.tag in _NUMBER_TAGS and len(node.value) > MAX_NUMBER_CHARS:
+                raise ConfigError(f"{where}:{line}: a number of {len(node.value)} characters (at most {MAX_NUMBER_CHARS})")
+            return 1, 0
+        visiting.add(key)
+        children = [c for pair in node.value for c in pair] if isinstance(node, yaml.MappingNode) else node.value
+        total, deepest = 1, 0
+        for child in children:
+            values, child_depth = size(child, depth + 1)
+            total, deepest = total + values, max(deepest, child_depth + 1)
+            if total > MAX_NODES:
+                raise ConfigError(f"{where}:{line}: more than {MAX_NODES} values once its aliases are expanded")
+        visiting.discard(key)
+        sizes[key] = (total, deepest)
+        return sizes[key]
+
+    size(root, 0)
+
+
+def parse_yaml_text(text: str, where: str) -> Any:
+    """The data of one YAML document, within the bounds above; ConfigError `where:line: problem`."""
+    return _parse(text, where)[0]
+
+
+def _parse(text: str, where: str) -> tuple[Any, yaml.Node | None]:
+    bad = _NOT_ALLOWED.search(text)
+    if bad:
+        raise ConfigError(f"{where}:{_line_of(text, bad.start())}: syntax: character U+{ord(bad.group()):04X} is "
+                          "not allowed in YAML")
+    _check_events(text, where)
+    loader = yaml.SafeLoader(text)
+    try:
+        root = loader.get_single_node()
+        if root is None:
+            return None, None
+        _check_expansion(root, where)
+        return loader.construct_document(root), root
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        line = mark.line + 1 if mark is not None else 1
+        problem = (exc.problem or exc.context or "invalid YAML").strip()
+        raise ConfigError(f"{where}:{line}: syntax: {problem}") from None
+    except (yaml.YAMLError, ValueError, TypeError, OverflowError) as exc:
+        raise ConfigError(f"{where}:1: syntax: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}") from None
+    finally:
+        loader.dispose()
+
+
+def load_yaml_with_lines(path: Path) -> tuple[Any, dict[KeyPath, int], str]:
+    """Parse `path`; return (data, {key path: 1-based line}, raw text).
+
+    Syntax errors, duplicate keys (which PyYAML would silently overwrite) and files beyond the bounds
+    above become ConfigError.
+    """
+    try:
+        if path.is_dir():
+            raise ConfigError(f"{path}: is a folder, not a YAML file")
+        size = path.stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise ConfigError(f"{path}: {size} bytes: a procedure, rig or calibration file is at most "
+                              f"{MAX_FILE_BYTES} bytes")
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: file not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"{path}: cannot read: {str(exc).splitlines()[0]}") from None
+    data, root = _parse(text, str(path))
     if root is None:
         raise ConfigError(f"{path}:1: file is empty")
     if not isinstance(root, yaml.MappingNode):
@@ -46,7 +154,7 @@ def _collect_lines(path: Path, node: yaml.Node, prefix: KeyPath, lines: dict[Key
     if isinstance(node, yaml.MappingNode):
         seen: set[str] = set()
         for key_node, value_node in node.value:
-            key = str(key_node.value)
+            key = str(key_node.value) if isinstance(key_node, yaml.ScalarNode) else "(complex key)"
             line = key_node.start_mark.line + 1
             if key in seen:
                 dotted = format_key(prefix + (key,))

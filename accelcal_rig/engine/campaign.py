@@ -11,7 +11,6 @@ from dataclasses import dataclass
 from functools import partial
 from itertools import groupby
 
-import h5py
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -35,8 +34,9 @@ from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity, R
 from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable
 from accelcal_rig.plan.compile import Plan, PlanStep, setpoint_label
 from accelcal_rig.store.atomic import signals_deferred
-from accelcal_rig.store.campaign_file import CampaignWriter
+from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.records import DutPoseRecord, PoseRecord, SoakTrace
+from accelcal_rig.store.writer import CampaignWriter
 
 #: A move's deadline is 1.5 × its travel time at the configured speeds plus this margin.
 MOVE_MARGIN_S = 30.0
@@ -51,8 +51,8 @@ class TerminationRequested(BaseException):
     """SIGTERM arrived: stop like Ctrl-C, through the safe state."""
 
 
-#: Runs on the open campaign file once the rig is safe; returns a one-line summary of the calibration.
-FitStage = Callable[[h5py.File], str]
+#: Runs on the stored campaign once the rig is safe; returns a one-line summary of the calibration.
+FitStage = Callable[[Campaign], str]
 
 
 @dataclass(frozen=True)
@@ -185,8 +185,8 @@ class CampaignRunner:
         assert self.fit_stage is not None
         self.machine.go(State.FIT)
         try:
-            summary = self.fit_stage(self.writer.file)
-        except (ValueError, KeyError, OSError, np.linalg.LinAlgError) as exc:
+            summary = self.fit_stage(self.writer.campaign)
+        except (ValueError, KeyError, OSError, np.linalg.LinAlgError, RigError) as exc:
             self.events.error("fit", f"fit failed: {exc}")
             return str(exc), True
         self.events.info("fit", summary)
@@ -263,6 +263,7 @@ class CampaignRunner:
             return
         self._setpoint_index = self.plan.setpoints_c.index(setpoint_c)
         self._setpoint_start_s = self.clock.now()
+        self.writer.check_space(sum(self._poses_left[self._setpoint_index:]))
         self.machine.go(State.RAMP, label)
         pose_steps = [s for s in steps if s.kind == "pose"]
         if self._ramp_origin is not None and setpoint_c != self.plan.setpoints_c[-1]:

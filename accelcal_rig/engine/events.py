@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 
 from accelcal_rig.engine.clock import Clock
-from accelcal_rig.store.campaign_file import CampaignWriter
+from accelcal_rig.store.writer import CampaignWriter
 from accelcal_rig.store.records import Event
 
 LOGGER = logging.getLogger("accelcal_rig")

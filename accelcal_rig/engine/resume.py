@@ -10,16 +10,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
 from pydantic import ValidationError
 
 from accelcal_rig.config.load import LoadedConfig
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.config.yaml_lines import KeyPath
+from accelcal_rig.config.yaml_lines import KeyPath, parse_yaml_text
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.plan.compile import Plan
-from accelcal_rig.store.read import StoredCampaign
+from accelcal_rig.store.content import Campaign
 
 #: Rig keys that say how to reach an instrument (or how to retry it, what faults a simulator injects, whom
 #: to notify), not what it is or how it measures.
@@ -38,20 +37,21 @@ class ResumePoint:
     run: int
 
 
-def check_same_campaign(path: Path, stored: StoredCampaign, procedure: LoadedConfig[Procedure],
+def check_same_campaign(path: Path, stored: Campaign, procedure: LoadedConfig[Procedure],
                         rig: LoadedConfig[RigConfig], plan: Plan, dry_run: bool) -> None:
     """Refuse to resume with a procedure or rig that differs from the campaign's, naming the first key."""
-    if stored.dry_run != dry_run:
-        started = "a dry run" if stored.dry_run else "on the real rig"
+    stored_dry_run = bool(stored.attrs.get("dry_run", False))
+    if stored_dry_run != dry_run:
+        started = "a dry run" if stored_dry_run else "on the real rig"
         raise ConfigError(f"{path}: the campaign was started {started}; resume it the same way "
-                          f"({'with' if stored.dry_run else 'without'} --dry-run)")
+                          f"({'with' if stored_dry_run else 'without'} --dry-run)")
     checks: list[tuple[str, LoadedConfig[Any], str, Any, frozenset[str]]] = [
-        ("procedure", procedure, stored.procedure_yaml, Procedure, PROCEDURE_FILE_KEYS),
-        ("rig", rig, stored.rig_yaml, RigConfig, CONNECTION_KEYS)]
+        ("procedure", procedure, stored.header.procedure_yaml, Procedure, PROCEDURE_FILE_KEYS),
+        ("rig", rig, stored.header.rig_yaml, RigConfig, CONNECTION_KEYS)]
     for kind, new, old_text, model, ignored in checks:
         try:
-            old = model.model_validate(yaml.safe_load(old_text))
-        except (ValidationError, yaml.YAMLError) as exc:
+            old = model.model_validate(parse_yaml_text(old_text, f"{path}: its stored {kind}"))
+        except (ValidationError, ConfigError) as exc:
             raise ConfigError(f"{path}: the campaign's stored {kind} no longer validates: "
                               f"{str(exc).splitlines()[0]}") from None
         difference = first_difference(old.model_dump(mode="json"), new.model.model_dump(mode="json"), ignored)
@@ -59,9 +59,9 @@ def check_same_campaign(path: Path, stored: StoredCampaign, procedure: LoadedCon
             key, before, after = difference
             raise new.error(key, f"is {after!r} but the campaign in {path} was started with {before!r}; "
                                  f"resume with the same {kind} (or start a new campaign)")
-    if plan.fingerprint != stored.plan_fingerprint:
+    if plan.fingerprint != stored.header.plan.fingerprint:
         raise ConfigError(f"{path}: the plan compiled now differs from the campaign's (fingerprint "
-                          f"{plan.fingerprint[:12]} vs {stored.plan_fingerprint[:12]}): start a new campaign")
+                          f"{plan.fingerprint[:12]} vs {stored.header.plan.fingerprint[:12]}): start a new campaign")
 
 
 def first_difference(old: Any, new: Any, ignored: frozenset[str], key: KeyPath = ()) -> tuple[KeyPath, Any, Any] | None:

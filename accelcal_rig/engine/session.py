@@ -8,7 +8,6 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-import h5py
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -32,8 +31,11 @@ from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
 from accelcal_rig.sim.wire_rig import SimulatedRig
-from accelcal_rig.store.campaign_file import CampaignWriter
-from accelcal_rig.store.read import read_stored_campaign
+from accelcal_rig.store.content import Campaign
+from accelcal_rig.store.read import load_campaign
+from accelcal_rig.store.records import StoredPlan
+from accelcal_rig.store.space import StorageEstimate, estimate_storage
+from accelcal_rig.store.writer import CampaignWriter
 
 
 @dataclass(frozen=True)
@@ -43,6 +45,12 @@ class PreparedCampaign:
     procedure: LoadedConfig[Procedure]
     rig: LoadedConfig[RigConfig]
     plan: Plan
+
+    def storage(self, dry_run: bool) -> StorageEstimate:
+        """The disk the campaign will take (a dry run also stores the simulation's truth)."""
+        acquisition = self.procedure.model.acquisition
+        return estimate_storage(len(self.plan.pose_steps), len(self.rig.model.fixture.sensors),
+                                acquisition.samples_per_pose, len(self.plan.axis_names), dry_run)
 
 
 def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str | None = None) -> PreparedCampaign:
@@ -118,28 +126,30 @@ def resume_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, 
                     build_instruments: InstrumentFactory | None = None,
                     progress: ProgressListener | None = None) -> RunResult:
     """Continue the campaign in `output`: the same procedure and rig (refused otherwise, before anything is
-    touched), poses cut back to those stored whole, the rig made safe first if the last run died, then a
-    fresh soak at the first setpoint with poses missing and on from the first pose not stored."""
+    touched), the journal mended and the campaign file rebuilt from it, the rig made safe first if the
+    last run died, then a fresh soak at the first setpoint with poses missing and on from the first pose
+    not stored."""
     wall_start = time.perf_counter()
-    stored = read_stored_campaign(output)
+    stored = load_campaign(output)
     check_same_campaign(output, stored, prepared.procedure, prepared.rig, prepared.plan, dry_run)
-    if stored.state == "done" and stored.poses_stored == stored.poses_planned:
+    if stored.state == "done" and stored.poses_planned == len(stored.poses):
         raise NothingToResume(f"{output}: the campaign is complete: nothing to resume")
-    writer, reopened = CampaignWriter.reopen(output)
+    writer, reopened = CampaignWriter.reopen(output, prepared.storage(dry_run))
     try:
         # Noise of a resumed dry run is new noise (the same sensors, not a replay of the first run).
-        seed = stored.seed + 1000 * (reopened.run - 1)
+        seed = int(stored.attrs.get("seed", 0)) + 1000 * (reopened.run - 1)
         with _connected(prepared, dry_run, seed, build_instruments, reopened.clock_now_s) as (instruments, clock):
             writer.record_instruments(_instrument_info(instruments))
             point = ResumePoint(frozenset(writer.stored_step_keys()), reopened.previous_state in ("created", "running"),
                                 reopened.run)
-            cut = f"; {reopened.rows_cut} rows of a pose written in part removed" if reopened.rows_cut else ""
-            EventLog(clock, writer).info(
-                "resume", f"run {reopened.run} resumes after {reopened.poses_stored} stored poses (the last run "
-                          f"left the file {reopened.previous_state!r}{cut})")
+            events = EventLog(clock, writer)
+            events.info("resume", f"run {reopened.run} resumes after {reopened.poses_stored} stored poses (the last run "
+                                  f"left the file {reopened.previous_state!r})")
+            for repair in reopened.repairs:
+                events.warning("resume", repair)
             return _run(prepared, output, writer, instruments, clock, point, calibration, wall_start, progress)
     finally:
-        writer.close()
+        _close(writer)
 
 
 @contextmanager
@@ -193,26 +203,37 @@ def _create_file(prepared: PreparedCampaign, output: Path, instruments: RigInstr
          "driver": type(s).__name__, "endpoint": s.endpoint}
         for s in instruments.sensors
     ]
-    writer = CampaignWriter.create(
-        output, overwrite=overwrite,
-        attrs={"procedure_name": procedure.name, "procedure_path": str(prepared.procedure.path),
-               "rig_name": rig.model.name, "rig_path": str(rig.path), "dry_run": dry_run, "seed": seed,
-               "clock": clock.kind, "samples_per_pose": acquisition.samples_per_pose,
-               "fit_mode": procedure.fit.mode, "polynomial_degree": procedure.fit.polynomial_degree,
-               "fit_parameters": procedure.fit.parameters, "fit_out_of_range": procedure.fit.out_of_range,
-               "fit_temperature_model": procedure.fit.temperature_model},
-        procedure_yaml=prepared.procedure.text, rig_yaml=rig.text, plan=prepared.plan, duts=duts,
-        instruments=_instrument_info(instruments), samples_per_pose=acquisition.samples_per_pose,
-        turntable_accuracy_arcsec=rig.model.turntable.accuracy_arcsec,
-    )
-    try:
-        if instruments.truth is not None:
-            for sensor in instruments.sensors:
-                writer.write_truth_header(sensor.serial, instruments.truth.describe(sensor.serial, acquisition.odr_hz))
-    except BaseException:
-        writer.close()
-        raise
-    return writer
+    truth = ({s.serial: instruments.truth.describe(s.serial, acquisition.odr_hz) for s in instruments.sensors}
+             if instruments.truth is not None else {})
+    attrs = {"procedure_name": procedure.name, "procedure_path": str(prepared.procedure.path.resolve()),
+             "rig_name": rig.model.name, "rig_path": str(rig.path.resolve()), "dry_run": dry_run, "seed": seed,
+             "clock": clock.kind, "samples_per_pose": acquisition.samples_per_pose,
+             "fit_mode": procedure.fit.mode, "polynomial_degree": procedure.fit.polynomial_degree,
+             "fit_parameters": procedure.fit.parameters, "fit_out_of_range": procedure.fit.out_of_range,
+             "fit_temperature_model": procedure.fit.temperature_model}
+    return CampaignWriter.create(
+        output, {"attrs": attrs, "procedure_yaml": prepared.procedure.text, "rig_yaml": rig.text,
+                 "plan": _stored_plan(prepared.plan), "duts": duts, "instruments": _instrument_info(instruments),
+                 "turntable_accuracy_arcsec": rig.model.turntable.accuracy_arcsec, "truth": truth},
+        overwrite=overwrite, storage=prepared.storage(dry_run))
+
+
+def _stored_plan(plan: Plan) -> StoredPlan:
+    steps, n_axes = plan.steps, len(plan.axis_names)
+    return StoredPlan(
+        step_key=tuple(s.key for s in steps), kind=tuple(s.kind for s in steps),
+        setpoint_c=np.array([s.setpoint_c for s in steps], dtype=float),
+        pose_number=np.array([s.pose.number if s.pose else 0 for s in steps], dtype=np.int64),
+        angles_deg=np.array([s.pose.angles_deg if s.pose else (np.nan,) * n_axes for s in steps], dtype=float).reshape(
+            len(steps), n_axes),
+        gravity_fixture=np.array([s.pose.gravity_fixture if s.pose else (np.nan,) * 3 for s in steps], dtype=float),
+        fingerprint=plan.fingerprint, axis_names=tuple(plan.axis_names))
+
+
+def _close(writer: CampaignWriter) -> None:
+    """Close the campaign; what closing could not do reaches the operator, the run's outcome stands."""
+    for problem in writer.close():
+        LOGGER.error(problem)
 
 
 def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, instruments: RigInstruments,
@@ -231,7 +252,7 @@ def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, instr
         summary = runner.run()
     finally:
         try:
-            writer.close()
+            _close(writer)
         finally:
             if notifier is not None:  # the fault, safe and finish events still go out
                 notifier.close()
@@ -243,8 +264,8 @@ def _fit_stage(procedure: Procedure, output: Path, calibration: Path) -> FitStag
                          free=procedure.fit.parameters, out_of_range=procedure.fit.out_of_range,
                          temperature_model=procedure.fit.temperature_model)
 
-    def stage(file: h5py.File) -> str:
-        _, report = fit_and_save(file, output, calibration, options)
+    def stage(campaign: Campaign) -> str:
+        _, report = fit_and_save(campaign, output, calibration, options)
         return summary_line(report, calibration)
 
     return stage

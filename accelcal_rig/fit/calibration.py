@@ -14,6 +14,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from accelcal_rig.config.load import load_validated
+from accelcal_rig.durable import write_text_atomically
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
 
 FORMAT_NAME = "accelcal-rig calibration"
@@ -127,9 +128,10 @@ def apply_codes(calibration: SensorCalibration, codes: np.ndarray, temperature_c
 
 
 def save_calibration(calibration: CalibrationFile, path: Path) -> None:
+    """Write the calibration file, replacing any file at `path` whole (never a half-written one)."""
     text = yaml.safe_dump(calibration.model_dump(mode="json"), sort_keys=False, width=120, allow_unicode=True)
-    path.write_text("# accelcal-rig calibration: Eq. 1 parameters as polynomials of the sensor temperature\n" + text,
-                    encoding="utf-8")
+    write_text_atomically(path, "# accelcal-rig calibration: Eq. 1 parameters as polynomials of the sensor "
+                                "temperature\n" + text, "the calibration")
 
 
 def load_calibration(path: Path) -> CalibrationFile:

@@ -6,7 +6,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-import h5py
 import numpy as np
 
 from accelcal_rig import __version__
@@ -20,9 +19,9 @@ from accelcal_rig.fit.lm import FitMode, FreeParameters, SfemFit, fit_sfem
 from accelcal_rig.fit.metrics import drift_mg, noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, norm_only_gauge
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
-from accelcal_rig.store.campaign_file import utc_now
-from accelcal_rig.store.fit_results import write_fit_group
+from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.read import DutPoses, measurements_sha256, read_dut_poses
+from accelcal_rig.store.records import utc_now
 
 TemperatureModel = Literal["per-setpoint", "joint"]
 
@@ -151,22 +150,11 @@ def _truth_error(truth: np.ndarray, setpoints: np.ndarray, groups: list[np.ndarr
     return records
 
 
-def fit_campaign(file: h5py.File, options: FitOptions, source: dict[str, str]) -> tuple[CalibrationFile, dict[str, Any]]:
-    """Fit every DUT in an open campaign file, replace its `fit/` group, and return the calibration file
-    and the report `rig fit --json` prints (per serial)."""
-    results = [fit_dut(read_dut_poses(file, serial), options) for serial in file["duts"]]
-    per_dut = {
-        r.serial: {
-            "setpoint_c": r.setpoints_c, "temperature_c": r.temperatures_c,
-            "parameters": np.array([f.parameters for f in r.fits]), "sigma": np.array([f.sigma for f in r.fits]),
-            "chi2_reduced": np.array([f.chi2_reduced for f in r.fits]),
-            "polynomial_coefficients": r.thermal.coefficients, "polynomial_domain_c": r.thermal.domain_c,
-            "compensated_g": r.compensated_g, "metrics": plain(r.metrics),
-        }
-        for r in results
-    }
-    write_fit_group(file, {"mode": options.mode, "polynomial_degree": options.degree, "free": options.free,
-                           "parameter_names": list(PARAMETER_NAMES)}, per_dut)
+def fit_campaign(campaign: Campaign, options: FitOptions,
+                 source: dict[str, str]) -> tuple[CalibrationFile, dict[str, Any]]:
+    """Fit every DUT of a stored campaign; the calibration file and the report `rig fit --json` prints
+    (per serial). Nothing is written: the campaign's measurements are only read."""
+    results = [fit_dut(read_dut_poses(campaign, serial), options) for serial in campaign.serials]
     calibration = CalibrationFile(
         format=CALIBRATION_FORMAT, format_version=CALIBRATION_VERSION, created=utc_now(),
         software_version=__version__, source=source, sensors={r.serial: r.calibration for r in results},
@@ -175,14 +163,14 @@ def fit_campaign(file: h5py.File, options: FitOptions, source: dict[str, str]) -
     return calibration, report
 
 
-def fit_and_save(file: h5py.File, campaign_path: Path, calibration_path: Path,
+def fit_and_save(campaign: Campaign, campaign_path: Path, calibration_path: Path,
                  options: FitOptions) -> tuple[CalibrationFile, dict[str, Any]]:
-    """`fit_campaign`, then the calibration file written to `calibration_path`."""
-    if file["poses/step_key"].shape[0] == 0:
+    """`fit_campaign`, then the calibration file written to `calibration_path` (replaced whole)."""
+    if not campaign.poses:
         raise ValueError(f"{campaign_path}: no poses stored, nothing to fit")
-    source = {"campaign": str(campaign_path), "measurements_sha256": measurements_sha256(file),
-              "procedure": str(file.attrs.get("procedure_name", ""))}
-    calibration, report = fit_campaign(file, options, source)
+    source = {"campaign": str(campaign_path), "measurements_sha256": measurements_sha256(campaign),
+              "procedure": str(campaign.attrs.get("procedure_name", ""))}
+    calibration, report = fit_campaign(campaign, options, source)
     save_calibration(calibration, calibration_path)
     return calibration, report
 

@@ -17,7 +17,7 @@ from accelcal_rig.fit.metrics import noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
 from accelcal_rig.handheld.recording import Recording
 from accelcal_rig.handheld.static_intervals import Detection
-from accelcal_rig.store.campaign_file import utc_now
+from accelcal_rig.store.records import utc_now
 
 #: A half-axis counts as visited when some interval puts at least this much gravity along it.
 VISITED_G = 0.5

@@ -11,7 +11,7 @@ from typing import Literal
 import numpy as np
 
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.store.read import open_campaign, rows_at_setpoint
+from accelcal_rig.store.read import dut_description, rows_at_setpoint, usable_campaign
 
 STANDARD_GRAVITY_M_S2 = 9.80665
 Units = Literal["g", "counts", "m/s2"]
@@ -102,19 +102,19 @@ def read_csv_recording(path: Path, layout: CsvLayout) -> Recording:
 def read_campaign_recording(path: Path, serial: str | None, setpoint_c: float | None) -> Recording:
     """One DUT's raw samples at one setpoint of a campaign file, pose after pose, as one recording (the
     gaps between poses are where the turntable moved)."""
-    with open_campaign(path) as file:
-        serials = list(file["duts"])
-        if serial is None:
-            serial = serials[0]
-        if serial not in serials:
-            raise ConfigError(f"{path}: no sensor {serial} (the file has {', '.join(serials)})")
-        setpoint_c, mask = rows_at_setpoint(path, file, setpoint_c)
-        rows = np.flatnonzero(mask)
-        dut = file["duts"][serial]
-        lsb_g, odr_hz = float(dut.attrs["lsb_g"]), float(dut.attrs["odr_hz"])
-        codes = dut["raw_codes"][rows]
-        pose_temperature = dut["temperature_c"][rows].mean(axis=1)
-        t_start = file["poses/t_start_s"][rows]
+    campaign = usable_campaign(path)
+    serials = campaign.serials
+    if serial is None:
+        serial = serials[0]
+    if serial not in serials:
+        raise ConfigError(f"{path}: no sensor {serial} (the file has {', '.join(serials)})")
+    setpoint_c, mask = rows_at_setpoint(path, campaign, setpoint_c)
+    rows = np.flatnonzero(mask)
+    dut = dut_description(campaign, serial)
+    lsb_g, odr_hz = float(dut["lsb_g"]), float(dut["odr_hz"])
+    codes = campaign.dut_column(serial, "raw_codes")[rows]
+    pose_temperature = campaign.dut_column(serial, "temperature_c")[rows].mean(axis=1)
+    t_start = campaign.pose_column("t_start_s")[rows]
     n = codes.shape[1]
     t = (t_start[:, None] + np.arange(n)[None, :] / odr_hz).ravel()
     accel_g = codes.reshape(-1, 3).astype(float) * lsb_g

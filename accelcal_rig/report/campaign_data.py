@@ -12,11 +12,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from accelcal_rig.config.procedure import SoakCriterion
+from accelcal_rig.config.yaml_lines import parse_yaml_text
 from accelcal_rig.fit.campaign_fit import DutFitResult, FitOptions, fit_dut
-from accelcal_rig.store.read import DutPoses, campaign_status, open_campaign, read_dut_poses
+from accelcal_rig.store.read import DutPoses, campaign_status, load_campaign, read_dut_poses
 
 
 @dataclass(frozen=True)
@@ -63,49 +63,42 @@ class CampaignData:
     no_fit_reason: str                # empty when every DUT was fitted
 
 
-def _text(value: Any) -> str:
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
 def read_campaign_data(path: Path) -> CampaignData:
-    status = campaign_status(path)
-    with open_campaign(path) as file:
-        attrs = file.attrs
-        procedure = yaml.safe_load(_text(file["config/procedure_yaml"][()])) or {}
-        band_c = float((procedure.get("soak") or {}).get("band_c", SoakCriterion().band_c))
-        options = FitOptions(mode=str(attrs.get("fit_mode", "reference")), degree=int(attrs.get("polynomial_degree", 3)),
-                             free=str(attrs.get("fit_parameters", "all")),  # type: ignore[arg-type]
-                             out_of_range=str(attrs.get("fit_out_of_range", "clamp")),  # type: ignore[arg-type]
-                             temperature_model=str(attrs.get("fit_temperature_model", "per-setpoint")))  # type: ignore[arg-type]
-        pose_numbers = file["poses/pose_number"][:]
-        duts, reasons = {}, []
-        for serial in file["duts"]:
-            poses = read_dut_poses(file, serial)
-            fit = None
-            if options.mode == "none":
-                reasons.append("the procedure measures only (fit.mode: none)")
-            elif len(poses.setpoint_c):
-                try:
-                    fit = fit_dut(poses, options)
-                except (ValueError, np.linalg.LinAlgError) as exc:
-                    reasons.append(str(exc))
-            else:
-                reasons.append("no poses stored")
-            duts[serial] = DutReport(poses, pose_numbers, fit, _truth_by_setpoint(poses))
-        soaks = [
-            SoakRecord(label, float(g.attrs["setpoint_c"]), _text(g.attrs["outcome"]), g["t_s"][:], g["chamber_c"][:],
-                       g["dut_c"][:], float(g.attrs["t_reached_s"]), float(g.attrs["t_stable_s"]))
-            for label, g in file.get("soaks", {}).items()
-        ]
-        events_group = file["events"]
-        events = [EventRecord(float(t), _text(w), _text(lv), _text(k), _text(m)) for t, w, lv, k, m in zip(
-            events_group["t_s"][:], events_group["wall_time"][:], events_group["level"][:], events_group["kind"][:],
-            events_group["message"][:])]
-        pose_t_s = file["poses/t_start_s"][:]
-        procedure_path, rig_name = _text(attrs.get("procedure_path", "")), _text(attrs.get("rig_name", ""))
+    campaign = load_campaign(path)
+    status = campaign_status(path, campaign)
+    attrs = campaign.attrs
+    procedure = parse_yaml_text(campaign.header.procedure_yaml, f"{path}: its stored procedure")
+    soak = procedure.get("soak") if isinstance(procedure, dict) else None
+    band_c = float(soak.get("band_c", SoakCriterion().band_c)) if isinstance(soak, dict) else SoakCriterion().band_c
+    options = FitOptions(mode=str(attrs.get("fit_mode", "reference")), degree=int(attrs.get("polynomial_degree", 3)),  # type: ignore[arg-type]
+                         free=str(attrs.get("fit_parameters", "all")),  # type: ignore[arg-type]
+                         out_of_range=str(attrs.get("fit_out_of_range", "clamp")),  # type: ignore[arg-type]
+                         temperature_model=str(attrs.get("fit_temperature_model", "per-setpoint")))  # type: ignore[arg-type]
+    pose_numbers = campaign.pose_column("pose_number")
+    damaged = campaign.unusable_reasons()
+    duts, reasons = {}, []
+    for serial in campaign.serials:
+        poses = read_dut_poses(campaign, serial)
+        fit = None
+        if options.mode == "none":
+            reasons.append("the procedure measures only (fit.mode: none)")
+        elif damaged:
+            reasons.append(f"damaged measurements: {damaged[0]}")
+        elif len(poses.setpoint_c):
+            try:
+                fit = fit_dut(poses, options)
+            except (ValueError, np.linalg.LinAlgError) as exc:
+                reasons.append(str(exc))
+        else:
+            reasons.append("no poses stored")
+        duts[serial] = DutReport(poses, pose_numbers, fit, _truth_by_setpoint(poses))
+    soaks = [SoakRecord(name, s.setpoint_c, s.outcome, s.t_s, s.chamber_c, s.dut_c, s.t_reached_s, s.t_stable_s)
+             for name, s in zip(campaign.soak_names(), campaign.soaks)]
+    events = [EventRecord(e.t_s, e.wall_time, e.level, e.kind, e.message) for e in campaign.events]
     soaks.sort(key=lambda s: s.t_reached_s)
     reason = "; ".join(dict.fromkeys(reasons))
-    return CampaignData(path, status, procedure_path, rig_name, band_c, options, duts, soaks, events, pose_t_s, reason)
+    return CampaignData(path, status, str(attrs.get("procedure_path", "")), str(attrs.get("rig_name", "")), band_c,
+                        options, duts, soaks, events, campaign.pose_column("t_start_s"), reason)
 
 
 def _truth_by_setpoint(poses: DutPoses) -> np.ndarray | None:

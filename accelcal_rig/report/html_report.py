@@ -15,7 +15,7 @@ from accelcal_rig import __version__
 from accelcal_rig.engine.events import format_duration
 from accelcal_rig.report import figures
 from accelcal_rig.report.campaign_data import CampaignData, read_campaign_data
-from accelcal_rig.store.campaign_file import utc_now
+from accelcal_rig.store.records import utc_now
 
 STYLE = """
 body { font-family: sans-serif; margin: 2em auto; max-width: 1200px; color: #222; }

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import shutil
+import sys
 import threading
 import time
 from datetime import datetime, timedelta
@@ -82,6 +83,41 @@ class TerminalHandler(logging.Handler):
             self.status.print_above(self.format(record))
         except Exception:  # noqa: BLE001 - logging's own convention: report, never raise
             self.handleError(record)
+
+
+class LogFileHandler(logging.FileHandler):
+    """The log beside the campaign file. A write that fails (a full disk) stops the log with one warning
+    on the console, instead of a traceback per line; the campaign file's event log keeps going."""
+
+    def __init__(self, filename: str, mode: str) -> None:
+        super().__init__(filename, mode=mode, encoding="utf-8")
+        self.failed = False
+
+    def emit(self, record: logging.LogRecord) -> None:
+        if not self.failed:
+            super().emit(record)
+
+    def handleError(self, record: logging.LogRecord) -> None:  # noqa: N802 - logging's name
+        if self.failed:
+            return
+        self.failed = True
+        error = sys.exc_info()[1]
+        print(f"rig: warning: log file {self.baseFilename}: {error}; no more lines go to it (the campaign's own "
+              "event log is unaffected)", file=sys.stderr)
+
+    def flush(self) -> None:
+        try:
+            super().flush()
+        except OSError as error:
+            if not self.failed:
+                self.failed = True
+                print(f"rig: warning: log file {self.baseFilename}: {error}", file=sys.stderr)
+
+    def close(self) -> None:
+        try:
+            super().close()
+        except OSError:
+            pass  # already reported by flush
 
 
 class ProgressLines:

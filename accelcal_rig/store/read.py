@@ -1,4 +1,10 @@
-"""Read a campaign file without the writer's help: status now, arrays for fitting later."""
+"""Read a campaign without the writer's help, whatever state its files are in: status now, arrays for
+fitting later. Never changes a byte of what it reads.
+
+A campaign is read from its journal when it has one (the durable truth, always up to the last pose
+stored, also while a run is writing it) and from its HDF5 file otherwise. Anything that is not a
+readable campaign is one ConfigError naming the file and what is wrong with it.
+"""
 
 from __future__ import annotations
 
@@ -6,8 +12,6 @@ import hashlib
 import json
 import os
 import socket
-from collections import Counter
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -16,163 +20,146 @@ import h5py
 import numpy as np
 
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.store.campaign_file import FORMAT_NAME
+from accelcal_rig.store import lock
+from accelcal_rig.store.codec import NotACampaignJournal, replay
+from accelcal_rig.store.content import Campaign
+from accelcal_rig.durable import stale_temporaries
+from accelcal_rig.store.hdf5_file import DamagedFile, read_campaign_file
+from accelcal_rig.store.journal import read_journal
+from accelcal_rig.store.paths import journal_path
 
 
-def _open_checked(path: Path, mode: str, cannot_open: str, **options: Any) -> h5py.File:
-    if not path.exists():
-        raise ConfigError(f"{path}: no such campaign file")
-    try:
-        file = h5py.File(path, mode, **options)
-    except OSError as exc:
-        raise ConfigError(f"{path}: {cannot_open} ({exc})") from None
-    if file.attrs.get("format") != FORMAT_NAME:
-        file.close()
-        raise ConfigError(f"{path}: not an accelcal-rig campaign file")
-    return file
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__
 
 
-def open_campaign(path: Path) -> h5py.File:
-    """Open read-only without taking HDF5's file lock, so a running campaign can be inspected."""
-    return _open_checked(path, "r", "not a readable HDF5 file", locking=False)
-
-
-def open_campaign_for_update(path: Path) -> h5py.File:
-    """Open for adding results (the fit); refused while a writer holds the file (a running campaign)."""
-    return _open_checked(path, "a", "cannot open for writing (is a campaign still running on it?)")
-
-
-def _text(value: Any) -> str:
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
-#: Attempts and first wait for a consistent read of a file a running campaign is writing.
-SNAPSHOT_ATTEMPTS = 6
-SNAPSHOT_FIRST_WAIT_S = 0.05
-
-
-def campaign_status(path: Path, sleep: Callable[[float], None] | None = None) -> dict[str, Any]:
-    """The campaign's state and progress, as `rig status` prints it.
-
-    A running campaign may be mid-flush when we read (the file is not opened in SWMR mode), which shows
-    as an HDF5 read error; with `sleep`, the read is retried with doubling waits (about 1.5 s in all).
-    """
-    if not path.exists():
-        raise ConfigError(f"{path}: no such campaign file")
-    for attempt in range(SNAPSHOT_ATTEMPTS if sleep else 1):
+def load_campaign(path: Path) -> Campaign:
+    """The campaign stored as `path` (its journal, else the HDF5 file itself)."""
+    if path.is_dir():
+        raise ConfigError(f"{path}: is a folder, not a campaign file")
+    journal = journal_path(path)
+    fallback_note = ""
+    if journal.is_file():
         try:
-            return _read_status(path)
-        except (ConfigError, OSError, KeyError, ValueError) as exc:
-            last = exc
-            if sleep:
-                sleep(SNAPSHOT_FIRST_WAIT_S * 2**attempt)
-    if isinstance(last, ConfigError):
-        raise last
-    raise ConfigError(f"{path}: no consistent read (a campaign is writing it?): {last}")
+            found = read_journal(journal)
+        except OSError as exc:
+            raise ConfigError(f"{journal}: cannot read: {exc.strerror}") from None
+        try:
+            campaign = replay(found, journal.name)
+            campaign.journal_bytes = found.end
+            return campaign
+        except NotACampaignJournal as exc:
+            if not path.is_file():
+                raise ConfigError(f"{path}: no campaign: {exc}") from None
+            fallback_note = f"{exc}: read from {path.name} instead"
+    if not path.exists():
+        if stale_temporaries(journal) or stale_temporaries(path):
+            raise ConfigError(f"{path}: no campaign: a run stopped before it had created it (nothing was measured); "
+                              "start it again with rig run")
+        raise ConfigError(f"{path}: no such campaign file")
+    campaign = read_hdf5_campaign(path)
+    if fallback_note:
+        campaign.notes.append(fallback_note)
+    return campaign
 
 
-def _read_status(path: Path) -> dict[str, Any]:
-    with open_campaign(path) as file:
-        attrs = file.attrs
-        plan_keys = [_text(k) for k in file["plan/step_key"][:]]
-        plan_kinds = [_text(k) for k in file["plan/kind"][:]]
-        done_keys = {_text(k) for k in file["poses/step_key"][:]}
-        pending = [k for k, kind in zip(plan_keys, plan_kinds) if kind == "pose" and k not in done_keys]
-        setpoints = list(dict.fromkeys(float(v) for v in file["plan/setpoint_c"][:]))  # plan order
-        events = file["events"]
-        last_event = _text(events["message"][-1]) if events["message"].shape[0] else ""
-        state = _text(attrs["state"])
-        return {
-            "file": str(path),
-            "procedure": _text(attrs.get("procedure_name", "")),
-            "state": state,
-            "writer": _writer_liveness(attrs) if state in ("created", "running") else None,
-            "runs": int(attrs.get("runs", 1)),
-            "poses_done": int(file["poses/step_key"].shape[0]),
-            "poses_total": plan_kinds.count("pose"),
-            "next_step": pending[0] if pending else None,
-            "samples_per_pose": int(attrs["samples_per_pose"]),
-            "duts": list(file["duts"].keys()),
-            "setpoints_c": setpoints,
-            "dry_run": bool(attrs.get("dry_run", False)),
-            "started": _text(attrs["started"]),
-            "finished": _text(attrs["finished"]) or None,
-            "abort_reason": _text(attrs["abort_reason"]) or None,
-            "last_event": last_event,
-            "integrity": "; ".join(integrity_problems(file)) or "ok",
-        }
-
-
-@dataclass(frozen=True)
-class StoredCampaign:
-    """What a resume needs to know of a campaign before touching it or the rig."""
-
-    procedure_yaml: str
-    rig_yaml: str
-    plan_fingerprint: str
-    procedure_path: Path
-    dry_run: bool
-    seed: int
-    state: str
-    poses_stored: int
-    poses_planned: int
-
-
-def read_stored_campaign(path: Path) -> StoredCampaign:
-    with open_campaign(path) as file:
-        attrs = file.attrs
-        return StoredCampaign(
-            procedure_yaml=_text(file["config/procedure_yaml"][()]),
-            rig_yaml=_text(file["config/rig_yaml"][()]),
-            plan_fingerprint=_text(file["plan"].attrs["fingerprint"]),
-            procedure_path=Path(_text(attrs["procedure_path"])),
-            dry_run=bool(attrs.get("dry_run", False)),
-            seed=int(attrs.get("seed", 0)),
-            state=_text(attrs["state"]),
-            poses_stored=int(file["poses/step_key"].shape[0]),
-            poses_planned=int(np.count_nonzero(file["plan/kind"][:] == b"pose")),
-        )
-
-
-def _writer_liveness(attrs: h5py.AttributeManager) -> str:
-    """Whether the process writing a `running` file is still there: `alive`, `gone (resume it)`, or
-    `unknown` when it ran on another host."""
-    pid, host = int(attrs.get("writer_pid", 0)), _text(attrs.get("writer_host", ""))
-    if not pid or host != socket.gethostname():
-        return f"unknown (pid {pid} on {host or 'an unknown host'})"
+def read_hdf5_campaign(path: Path) -> Campaign:
+    """The campaign in the HDF5 file alone (no journal consulted)."""
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return f"gone (pid {pid} ended without closing the file: continue with rig resume)"
-    except PermissionError:
-        pass  # exists, owned by someone else
-    return f"alive (pid {pid})"
+        file = h5py.File(path, "r", locking=False)
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f"{path}: not a readable HDF5 file ({_first_line(exc)})") from None
+    try:
+        with file:
+            campaign = read_campaign_file(file)
+    except DamagedFile as exc:
+        raise ConfigError(f"{path}: {str(exc).splitlines()[0]}") from None
+    except (OSError, KeyError, ValueError, TypeError, IndexError, RuntimeError, AttributeError) as exc:
+        raise ConfigError(f"{path}: damaged campaign file ({_first_line(exc)})") from None
+    campaign.source = "file"
+    return campaign
 
 
-def integrity_problems(file: h5py.File) -> list[str]:
-    """What is wrong with a campaign file's poses, one line each (empty when every pose-aligned dataset
-    has one row per stored pose and no pose of the plan is stored twice or is foreign to it)."""
-    problems = []
-    keys = [_text(k) for k in file["poses/step_key"][:]]
-    n = len(keys)
-    aligned = {f"poses/{name}": d for name, d in file["poses"].items()}
-    for group in ("duts", "simulation_truth"):
-        for serial, sub in file.get(group, {}).items():
-            aligned.update({f"{group}/{serial}/{name}": d for name, d in sub.items()
-                            if isinstance(d, h5py.Dataset) and d.maxshape[0] is None})
-    problems += [f"{path}: {d.shape[0]} rows for {n} poses" for path, d in aligned.items() if d.shape[0] != n]
-    duplicates = sorted(k for k, count in Counter(keys).items() if count > 1)
-    if duplicates:
-        problems.append(f"poses stored more than once: {', '.join(duplicates)}")
-    planned = {_text(k) for k, kind in zip(file["plan/step_key"][:], file["plan/kind"][:]) if _text(kind) == "pose"}
-    foreign = sorted(set(keys) - planned)
-    if foreign:
-        problems.append(f"poses not in the plan: {', '.join(foreign)}")
-    return problems
+def file_currency(path: Path, campaign: Campaign, writing: bool) -> str:
+    """Whether the HDF5 file holds what the journal holds (readers outside accelcal-rig see the file)."""
+    if campaign.source == "file":
+        return "the only copy (no journal)"
+    rebuild = "a campaign is writing: it catches up as it goes" if writing else f"rig repair {path} rebuilds it"
+    try:
+        with h5py.File(path, "r", locking=False) as file:
+            same = str(file.attrs.get("campaign_id", "")) == campaign.header.campaign_id
+            held, poses = int(file.attrs.get("journal_bytes", -1)), int(file.attrs.get("poses_done", 0))
+    except FileNotFoundError:
+        return f"missing ({rebuild})"
+    except (OSError, ValueError, TypeError) as exc:
+        return f"unreadable: {_first_line(exc)} ({rebuild})"
+    if not same:
+        return f"holds another campaign ({rebuild})"
+    if held != campaign.journal_bytes:
+        return f"behind the journal: {poses} of {len(campaign.poses)} poses ({rebuild})"
+    return "current"
 
 
-def status_json(path: Path, sleep: Callable[[float], None] | None = None) -> str:
-    return json.dumps(campaign_status(path, sleep))
+def writer_liveness(path: Path, campaign: Campaign) -> tuple[bool, str]:
+    """(alive, description) of the process that writes a `created` or `running` campaign."""
+    holder = lock.holder(path)
+    if holder is not None:
+        return True, f"alive ({holder})"
+    run = campaign.runs[-1] if campaign.runs else None
+    if campaign.source == "file" and run is not None and run.pid and run.host == socket.gethostname():
+        try:  # a file from before the lock: ask the process itself
+            os.kill(run.pid, 0)
+            return True, f"alive (pid {run.pid})"
+        except ProcessLookupError:
+            pass
+        except PermissionError:
+            return True, f"alive (pid {run.pid})"
+    last = f"pid {run.pid} on {run.host}" if run is not None and run.pid else "its last run"
+    return False, f"gone ({last} ended without closing it: continue with rig resume)"
+
+
+def campaign_status(path: Path, campaign: Campaign | None = None) -> dict[str, Any]:
+    """The campaign's state and progress, as `rig status` prints it (`campaign`: read already)."""
+    campaign = campaign if campaign is not None else load_campaign(path)
+    header, state = campaign.header, campaign.state
+    plan = header.plan
+    alive, liveness = writer_liveness(path, campaign) if state in ("created", "running") else (False, None)
+    pending = [k for k in plan.pose_keys if k not in campaign.stored_keys]
+    return {
+        "file": str(path),
+        "procedure": str(campaign.attrs.get("procedure_name", "")),
+        "state": state,
+        "writer": liveness,
+        "runs": campaign.run_count,
+        "poses_done": len(campaign.poses),
+        "poses_total": campaign.poses_planned,
+        "next_step": pending[0] if pending else None,
+        "samples_per_pose": campaign.samples_per_pose,
+        "duts": campaign.serials,
+        "setpoints_c": list(dict.fromkeys(float(v) for v in plan.setpoint_c)),
+        "dry_run": bool(campaign.attrs.get("dry_run", False)),
+        "started": header.created,
+        "finished": campaign.finished or None,
+        "abort_reason": campaign.abort_reason or None,
+        "last_event": campaign.events[-1].message if campaign.events else "",
+        "integrity": "; ".join(campaign.integrity_problems()) or "ok",
+        "campaign_file": file_currency(path, campaign, alive),
+    }
+
+
+def status_json(path: Path) -> str:
+    return json.dumps(campaign_status(path))
+
+
+def usable_campaign(path: Path) -> Campaign:
+    """The campaign, refused in one line when its measurements are damaged (fit and analyses need them)."""
+    campaign = load_campaign(path)
+    problems = campaign.unusable_reasons()
+    if problems:
+        repair = " (rig repair rebuilds it from its journal)" if campaign.source == "journal" else ""
+        raise ConfigError(f"{path}: damaged measurements: {problems[0]}{repair}")
+    return campaign
 
 
 @dataclass(frozen=True)
@@ -180,7 +167,7 @@ class DutPoses:
     """One DUT's stored poses as arrays (row i is pose i of `poses/`)."""
 
     serial: str
-    range_g: int
+    range_g: float
     lsb_g: float
     setpoint_c: np.ndarray            # (N,)
     t_s: np.ndarray                   # (N,) clock time of each pose's first sample
@@ -192,39 +179,42 @@ class DutPoses:
     truth_parameters: np.ndarray | None  # (N, 12) simulation truth, dry runs only
 
 
-def read_dut_poses(file: h5py.File, serial: str) -> DutPoses:
-    dut = file["duts"][serial]
-    truth = file.get(f"simulation_truth/{serial}/parameters")
+def dut_description(campaign: Campaign, serial: str) -> dict[str, Any]:
+    return campaign.header.duts[campaign.serials.index(serial)]
+
+
+def read_dut_poses(campaign: Campaign, serial: str) -> DutPoses:
+    dut = dut_description(campaign, serial)
     return DutPoses(
         serial=serial,
-        range_g=int(dut.attrs["range_g"]),
-        lsb_g=float(dut.attrs["lsb_g"]),
-        setpoint_c=file["poses/setpoint_c"][:],
-        t_s=file["poses/t_start_s"][:],
-        temperature_c=dut["temperature_c"][:].mean(axis=1),
-        mean_g=dut["mean_g"][:],
-        stderr_g=dut["stderr_g"][:],
-        reference_g=dut["gravity_reference_g"][:],
-        reference_accuracy_arcsec=float(file["poses"].attrs.get("turntable_accuracy_arcsec", 0.0)),
-        truth_parameters=truth[:] if truth is not None else None,
+        range_g=float(dut["range_g"]),
+        lsb_g=float(dut["lsb_g"]),
+        setpoint_c=campaign.pose_column("setpoint_c"),
+        t_s=campaign.pose_column("t_start_s"),
+        temperature_c=campaign.dut_column(serial, "temperature_c").mean(axis=1),
+        mean_g=campaign.dut_column(serial, "mean_g"),
+        stderr_g=campaign.dut_column(serial, "stderr_g"),
+        reference_g=campaign.dut_column(serial, "gravity_reference_g"),
+        reference_accuracy_arcsec=float(campaign.header.turntable_accuracy_arcsec),
+        truth_parameters=campaign.truth_column(serial, "parameters"),
     )
 
 
-def measurements_sha256(file: h5py.File) -> str:
-    """Digest of the measured data (pose keys, raw codes, temperatures, references), not of the file:
-    fit results written into the file later leave it unchanged."""
+def measurements_sha256(campaign: Campaign) -> str:
+    """Digest of the measured data (pose keys, raw codes, temperatures, references), not of a file: the
+    same campaign read from its journal or its HDF5 file has the same digest."""
     digest = hashlib.sha256()
-    digest.update(b"".join(k if isinstance(k, bytes) else k.encode() for k in file["poses/step_key"][:]))
-    for serial in sorted(file["duts"]):
+    digest.update(b"".join(p.step_key.encode() for p in campaign.poses))
+    for serial in sorted(campaign.serials):
         for name in ("raw_codes", "temperature_c", "gravity_reference_g"):
-            digest.update(np.ascontiguousarray(file["duts"][serial][name][:]).tobytes())
+            digest.update(np.ascontiguousarray(campaign.dut_column(serial, name)).tobytes())
     return digest.hexdigest()
 
 
-def rows_at_setpoint(path: Path, file: h5py.File, setpoint_c: float | None) -> tuple[float, np.ndarray]:
-    """(setpoint, boolean rows of `poses/` there) for analyses at one temperature; `setpoint_c` None means
-    the file's only setpoint, and is refused when there are several."""
-    setpoints = file["poses/setpoint_c"][:]
+def rows_at_setpoint(path: Path, campaign: Campaign, setpoint_c: float | None) -> tuple[float, np.ndarray]:
+    """(setpoint, boolean rows of the stored poses there) for analyses at one temperature; `setpoint_c`
+    None means the campaign's only setpoint, and is refused when there are several."""
+    setpoints = campaign.pose_column("setpoint_c")
     available = list(dict.fromkeys(setpoints.tolist()))
     listed = ", ".join(f"{s:g}" for s in available)
     if not available:

@@ -1,10 +1,17 @@
-"""What the engine hands the store after each step: plain data, no file handles."""
+"""What the engine hands the store, and what the store keeps: plain data, no file handles."""
 
 from __future__ import annotations
 
+import datetime as dt
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+
+
+def utc_now() -> str:
+    """Wall-clock time as the campaign records it: ISO 8601, UTC, whole seconds."""
+    return dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
 
 
 @dataclass(frozen=True)
@@ -56,3 +63,72 @@ class Event:
     level: str                        # "info" | "warning" | "error"
     kind: str                         # "transition", "soak", "pose", "fault", ...
     message: str
+
+
+@dataclass(frozen=True)
+class StoredEvent:
+    """An event as the campaign keeps it: with the wall-clock time it was logged."""
+
+    t_s: float
+    wall_time: str
+    level: str
+    kind: str
+    message: str
+
+
+@dataclass(frozen=True)
+class StoredPlan:
+    """The compiled plan as the campaign keeps it: one row per step."""
+
+    step_key: tuple[str, ...]
+    kind: tuple[str, ...]             # "soak" | "pose"
+    setpoint_c: np.ndarray            # (S,)
+    pose_number: np.ndarray           # (S,) 1-based, 0 for soaks
+    angles_deg: np.ndarray            # (S, A) commanded angles, NaN for soaks
+    gravity_fixture: np.ndarray       # (S, 3) expected gravity in the fixture frame, NaN for soaks
+    fingerprint: str
+    axis_names: tuple[str, ...]
+
+    @property
+    def pose_keys(self) -> list[str]:
+        return [k for k, kind in zip(self.step_key, self.kind) if kind == "pose"]
+
+
+@dataclass(frozen=True)
+class CampaignHeader:
+    """Everything known of a campaign when it is created, before its first pose."""
+
+    campaign_id: str                  # random, so a file and its journal can be matched
+    created: str                      # wall-clock time (ISO 8601 UTC)
+    software_version: str
+    attrs: dict[str, Any]             # procedure_name, procedure_path, rig_name, rig_path, dry_run, seed, clock,
+                                      # samples_per_pose, fit_mode, …: the file's root attributes
+    procedure_yaml: str
+    rig_yaml: str
+    plan: StoredPlan
+    duts: list[dict[str, Any]]        # per DUT: serial, name, mount_euler_deg, range_g, odr_hz, lsb_g, driver, endpoint
+    instruments: dict[str, dict[str, str]]
+    turntable_accuracy_arcsec: float
+    #: Dry runs: each simulated DUT's hidden model (attributes and `polynomial_coefficients`).
+    truth: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+    @property
+    def serials(self) -> list[str]:
+        return [str(d["serial"]) for d in self.duts]
+
+
+@dataclass(frozen=True)
+class RunStart:
+    """One run of the campaign (1 created it; each resume adds one)."""
+
+    run: int
+    pid: int
+    host: str
+    started: str                      # wall-clock time
+
+
+@dataclass(frozen=True)
+class StateChange:
+    state: str                        # "running" | "done" | "aborted"
+    reason: str                       # why it aborted, empty otherwise
+    wall_time: str

@@ -11,7 +11,7 @@ import pytest
 from accelcal_rig.engine.session import prepare
 from accelcal_rig.errors import CampaignAborted
 from accelcal_rig.sim.wire_rig import SimulatedRig
-from accelcal_rig.store.read import integrity_problems
+from accelcal_rig.store.read import load_campaign
 from tests.conftest import TINY_PROCEDURE
 from tests.engine.test_campaign import events
 
@@ -57,7 +57,7 @@ def test_transient_faults_are_retried_and_every_pose_is_stored_once(write, workd
     assert error is None
     with h5py.File(output, "r") as f:
         assert f.attrs["state"] == "done" and f["poses/step_key"].shape[0] == 6
-        assert integrity_problems(f) == []
+    assert load_campaign(output).integrity_problems() == []
     retries = events(output, "retry")
     assert len(retries) >= 10
     for instrument in ("chamber (modbus-tcp", "turntable (serial", "sensor bridge (serial"):
@@ -73,7 +73,7 @@ def assert_safe_and_recorded(output: Path, rig: SimulatedRig, error: CampaignAbo
     assert all(not bridge.device._measuring for bridge in rig.bridges.values())
     with h5py.File(output, "r") as f:
         assert f.attrs["state"] == "aborted" and reason in f.attrs["abort_reason"]
-        assert integrity_problems(f) == []
+    assert load_campaign(output).integrity_problems() == []
 
 
 @pytest.mark.parametrize(("faults", "reason"), [
@@ -99,7 +99,7 @@ def test_instruments_that_never_answer_are_refused_before_the_campaign_starts(wr
 def test_a_stop_mid_campaign_leaves_the_simulators_safe(write, workdir: Path, monkeypatch, stop, at_pose) -> None:
     """As a signal surfaces (stop_when_safe raises it between two poses): the simulators at the far end of
     the wires last heard the safe setpoint and a STOP, and every sensor is in standby."""
-    from accelcal_rig.store.campaign_file import CampaignWriter
+    from accelcal_rig.store.writer import CampaignWriter
 
     real_append, stored = CampaignWriter.append_pose, []
 

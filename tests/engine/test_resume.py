@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import h5py
@@ -12,6 +13,7 @@ from accelcal_rig.engine.resume import first_difference
 from accelcal_rig.engine.session import NothingToResume, prepare, run_campaign
 from accelcal_rig.errors import CampaignAborted, ConfigError
 from accelcal_rig.sim.devices import build_simulated_rig
+from tests.conftest import kill_mid_pose, stored_poses
 from tests.engine.test_campaign import events
 
 TWO_SETPOINTS = """\
@@ -83,16 +85,18 @@ def test_a_run_that_died_mid_pose_is_cut_back_and_made_safe_first(write, workdir
     procedure, output = write("two.yaml", TWO_SETPOINTS), workdir / "c.h5"
     with pytest.raises(CampaignAborted):
         run(procedure, output, fail_at_pose=5)
-    with h5py.File(output, "a") as f:  # what kill -9 in the middle of the fifth pose leaves
-        f.attrs["state"] = "running"
-        for path in ("poses/step_key", "duts/ADX355-A001/mean_g", "duts/ADX355-A001/raw_codes"):
-            f[path].resize(f[path].shape[0] + 1, axis=0)
+    kill_mid_pose(output, 3)  # what kill -9 in the middle of storing the fourth pose leaves
+    before = stored_poses(output)
+    assert len(before) == 3
     instruments = run(procedure, output, resume=True)
     keys = stored_keys(output)
     assert sorted(keys) == sorted(plan_pose_keys(output)) and len(set(keys)) == 12
+    after = stored_poses(output)
+    assert all(after[key] == data for key, data in before.items())  # stored before the kill: untouched
     messages = events(output)
-    assert any("3 rows of a pose written in part removed" in m for m in messages)
-    resumed = next(i for i, m in enumerate(messages) if "run 2 resumes" in m)
+    assert any(re.fullmatch(r"a record written in part by the run that died \(\d+ bytes\) cut off the journal", m)
+               for m in messages)
+    resumed = next(i for i, m in enumerate(messages) if "run 2 resumes after 3 stored poses" in m)
     safe_first = next(i for i, m in enumerate(messages) if "safe state first" in m)
     preflight = next(i for i, m in enumerate(messages) if "→ preflight" in m and i > resumed)
     assert resumed < safe_first < preflight  # the rig is made safe before anything else is done with it

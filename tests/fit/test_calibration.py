@@ -22,10 +22,9 @@ from accelcal_rig.sim.truth import truth_for_serial
 
 @pytest.fixture(scope="module")
 def calibration(paper_campaign):
-    import h5py
+    from accelcal_rig.store.read import load_campaign
 
-    with h5py.File(paper_campaign, "a") as file:
-        calibration, _ = fit_campaign(file, FitOptions(), {"campaign": str(paper_campaign)})
+    calibration, _ = fit_campaign(load_campaign(paper_campaign), FitOptions(), {"campaign": str(paper_campaign)})
     return calibration
 
 

@@ -2,26 +2,22 @@
 
 from __future__ import annotations
 
-import shutil
+import hashlib
 from pathlib import Path
 
-import h5py
 import numpy as np
 import pytest
 
-from accelcal_rig.fit.campaign_fit import FitOptions, fit_campaign
-from accelcal_rig.store.read import measurements_sha256
+from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, fit_campaign
+from accelcal_rig.store.paths import journal_path
+from accelcal_rig.store.read import load_campaign, measurements_sha256, read_hdf5_campaign
 
 
 @pytest.fixture(scope="module")
-def reports(paper_campaign: Path, tmp_path_factory) -> dict[str, dict]:
-    copy = tmp_path_factory.mktemp("fit") / "campaign.h5"
-    shutil.copy(paper_campaign, copy)
-    out = {}
-    with h5py.File(copy, "a") as file:
-        for mode in ("reference", "norm-only"):
-            out[mode] = fit_campaign(file, FitOptions(mode=mode), {"campaign": "x"})[1]
-    return out
+def reports(paper_campaign: Path) -> dict[str, dict]:
+    campaign = load_campaign(paper_campaign)
+    return {mode: fit_campaign(campaign, FitOptions(mode=mode), {"campaign": "x"})[1]
+            for mode in ("reference", "norm-only")}
 
 
 @pytest.mark.parametrize("mode", ["reference", "norm-only"])
@@ -47,17 +43,22 @@ def test_truth_errors_are_consistent_with_their_sigmas(reports, mode: str) -> No
         assert {"parameter", "setpoint_c", "error", "sigma", "z"} <= set(records[0])
 
 
-def test_refitting_replaces_the_fit_group_and_leaves_measurements_alone(paper_campaign: Path, tmp_path: Path) -> None:
-    copy = tmp_path / "campaign.h5"
-    shutil.copy(paper_campaign, copy)
-    with h5py.File(copy, "a") as file:
-        digest = measurements_sha256(file)
-        raw_before = file["duts/ADX355-A001/raw_codes"][:]
-        fit_campaign(file, FitOptions(mode="reference"), {"campaign": "x"})
-        fit_campaign(file, FitOptions(mode="norm-only", degree=2), {"campaign": "x"})
-        assert file["fit"].attrs["mode"] == "norm-only"
-        assert file["fit"].attrs["polynomial_degree"] == 2
-        assert sorted(file["fit"]) == sorted(file["duts"])
-        assert file["fit/ADX355-A001/polynomial_coefficients"].shape == (12, 3)
-        assert measurements_sha256(file) == digest
-        np.testing.assert_array_equal(file["duts/ADX355-A001/raw_codes"][:], raw_before)
+def test_fitting_writes_only_the_calibration_and_never_the_campaign(paper_campaign: Path, tmp_path: Path) -> None:
+    files = [paper_campaign, journal_path(paper_campaign)]
+    before = [hashlib.sha256(f.read_bytes()).hexdigest() for f in files]
+    calibration = tmp_path / "cal.yaml"
+    fit_and_save(load_campaign(paper_campaign), paper_campaign, calibration, FitOptions(mode="reference"))
+    first = calibration.read_text()
+    fit_and_save(load_campaign(paper_campaign), paper_campaign, calibration, FitOptions(mode="norm-only", degree=2))
+    assert [hashlib.sha256(f.read_bytes()).hexdigest() for f in files] == before
+    assert calibration.read_text() != first and "mode: norm-only" in calibration.read_text()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cal.yaml"]  # replaced whole, nothing left beside it
+
+
+def test_the_journal_and_the_campaign_file_hold_the_same_measurements(paper_campaign: Path) -> None:
+    from_journal, from_file = load_campaign(paper_campaign), read_hdf5_campaign(paper_campaign)
+    assert from_journal.source == "journal" and from_file.source == "file"
+    assert measurements_sha256(from_journal) == measurements_sha256(from_file)
+    for serial in from_journal.serials:
+        for name in ("mean_g", "stderr_g", "temperature_c", "gravity_reference_g"):
+            np.testing.assert_array_equal(from_journal.dut_column(serial, name), from_file.dut_column(serial, name))

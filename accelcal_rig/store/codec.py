@@ -1,0 +1,215 @@
+"""The campaign's records as journal records, and a journal's records replayed into a `Campaign`.
+
+Kinds: `header` (first, once), `run` (each run's start), `instruments` (the drivers a run reached),
+`events`, `pose`, `soak`, `state`. Numbers travel as arrays, so they come back bit for bit.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from accelcal_rig.store.content import Campaign
+from accelcal_rig.store.journal import Record, Scan, encode_record
+from accelcal_rig.store.records import (
+    CampaignHeader, DutPoseRecord, PoseRecord, RunStart, SoakTrace, StateChange, StoredEvent, StoredPlan,
+)
+
+
+class NotACampaignJournal(ValueError):
+    """The journal has no readable header record."""
+
+
+def _plain(value: Any) -> Any:
+    """JSON-able: numpy scalars and arrays become Python numbers and lists."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+# ---------------------------------------------------------------------- encoding
+def encode_header(header: CampaignHeader) -> bytes:
+    plan = header.plan
+    truth_attrs = {s: {k: _plain(v) for k, v in d.items() if k != "polynomial_coefficients"}
+                   for s, d in header.truth.items()}
+    arrays = {"plan_setpoint_c": plan.setpoint_c, "plan_pose_number": plan.pose_number,
+              "plan_angles_deg": plan.angles_deg, "plan_gravity_fixture": plan.gravity_fixture}
+    arrays.update({f"truth_coefficients/{s}": np.asarray(d["polynomial_coefficients"], dtype="f8")
+                   for s, d in header.truth.items()})
+    meta = {"campaign_id": header.campaign_id, "created": header.created, "software_version": header.software_version,
+            "attrs": _plain(header.attrs), "procedure_yaml": header.procedure_yaml, "rig_yaml": header.rig_yaml,
+            "plan": {"step_key": list(plan.step_key), "kind": list(plan.kind), "fingerprint": plan.fingerprint,
+                     "axis_names": list(plan.axis_names)},
+            "duts": _plain(header.duts), "instruments": header.instruments,
+            "turntable_accuracy_arcsec": float(header.turntable_accuracy_arcsec), "truth": truth_attrs}
+    return encode_record("header", meta, arrays)
+
+
+def encode_run(run: RunStart) -> bytes:
+    return encode_record("run", {"run": run.run, "pid": run.pid, "host": run.host, "started": run.started})
+
+
+def encode_instruments(instruments: dict[str, dict[str, str]]) -> bytes:
+    return encode_record("instruments", {"instruments": instruments})
+
+
+def encode_state(change: StateChange) -> bytes:
+    return encode_record("state", {"state": change.state, "reason": change.reason, "wall_time": change.wall_time})
+
+
+def encode_events(events: list[StoredEvent]) -> bytes:
+    rows = [[e.wall_time, e.level, e.kind, e.message] for e in events]
+    return encode_record("events", {"rows": rows}, {"t_s": np.array([e.t_s for e in events], dtype="f8")})
+
+
+def encode_pose(pose: PoseRecord) -> bytes:
+    duts = pose.duts
+    arrays: dict[str, np.ndarray] = {
+        "commanded_angles_deg": np.asarray(pose.commanded_angles_deg, dtype="f8"),
+        "measured_angles_deg": np.asarray(pose.measured_angles_deg, dtype="f8"),
+        "gravity_fixture": np.asarray(pose.gravity_fixture, dtype="f8"),
+        "scalars": np.array([pose.setpoint_c, pose.t_start_s, pose.t_end_s, *pose.chamber_temperature_c], dtype="f8"),
+        "raw_codes": np.stack([np.asarray(d.raw_codes, dtype="i4") for d in duts]),
+        "mean_g": np.stack([np.asarray(d.mean_g, dtype="f8") for d in duts]),
+        "stderr_g": np.stack([np.asarray(d.stderr_g, dtype="f8") for d in duts]),
+        "temperature_c": np.array([d.temperature_c for d in duts], dtype="f8"),
+        "gravity_reference_g": np.stack([np.asarray(d.gravity_reference_g, dtype="f8") for d in duts]),
+        "temperature_in_band": np.array([d.temperature_in_band for d in duts], dtype="?"),
+    }
+    if all(d.truth is not None for d in duts) and duts:
+        arrays["truth_parameters"] = np.stack([np.asarray(d.truth["parameters"], dtype="f8") for d in duts])  # type: ignore[index]
+        arrays["truth_gravity_g"] = np.stack([np.asarray(d.truth["gravity_g"], dtype="f8") for d in duts])  # type: ignore[index]
+        arrays["truth_temperature_c"] = np.array([float(d.truth["temperature_c"]) for d in duts], dtype="f8")  # type: ignore[index]
+    meta = {"step_key": pose.step_key, "pose_number": int(pose.pose_number), "serials": [d.serial for d in duts]}
+    return encode_record("pose", meta, arrays)
+
+
+def encode_soak(soak: SoakTrace) -> bytes:
+    arrays = {"t_s": np.asarray(soak.t_s, dtype="f8"), "chamber_c": np.asarray(soak.chamber_c, dtype="f8"),
+              "dut_c": np.asarray(soak.dut_c, dtype="f8"), "settled_dut_c": np.asarray(soak.settled_dut_c, dtype="f8"),
+              "times_s": np.array([soak.setpoint_c, soak.t_reached_s, soak.t_stable_s], dtype="f8")}
+    return encode_record("soak", {"label": soak.label, "outcome": soak.outcome}, arrays)
+
+
+# ---------------------------------------------------------------------- decoding
+def _header(record: Record) -> CampaignHeader:
+    meta, arrays = record.meta, record.arrays
+    plan_meta = meta["plan"]
+    plan = StoredPlan(tuple(plan_meta["step_key"]), tuple(plan_meta["kind"]), arrays["plan_setpoint_c"],
+                      arrays["plan_pose_number"], arrays["plan_angles_deg"], arrays["plan_gravity_fixture"],
+                      str(plan_meta["fingerprint"]), tuple(plan_meta["axis_names"]))
+    steps = len(plan.step_key)
+    if not (len(plan.kind) == plan.setpoint_c.shape[0] == plan.pose_number.shape[0] == steps
+            and plan.angles_deg.shape == (steps, len(plan.axis_names)) and plan.gravity_fixture.shape == (steps, 3)):
+        raise ValueError("plan columns of different lengths")
+    truth = {s: {**attrs, "polynomial_coefficients": arrays[f"truth_coefficients/{s}"]}
+             for s, attrs in meta.get("truth", {}).items()}
+    duts = [dict(d) for d in meta["duts"]]
+    if not all(isinstance(d.get("serial"), str) for d in duts) or len({d["serial"] for d in duts}) != len(duts):
+        raise ValueError("DUT serials missing or repeated")
+    return CampaignHeader(str(meta["campaign_id"]), str(meta["created"]), str(meta["software_version"]),
+                          dict(meta["attrs"]), str(meta["procedure_yaml"]), str(meta["rig_yaml"]), plan, duts,
+                          dict(meta["instruments"]), float(meta["turntable_accuracy_arcsec"]), truth)
+
+
+def _pose(record: Record, header: CampaignHeader) -> PoseRecord:
+    meta, arrays = record.meta, record.arrays
+    serials = list(meta["serials"])
+    if serials != header.serials:
+        raise ValueError(f"its sensors {serials} are not the campaign's {header.serials}")
+    n_duts, n_axes, n = len(serials), len(header.plan.axis_names), int(header.attrs.get("samples_per_pose", 0))
+    shapes = {"commanded_angles_deg": (n_axes,), "measured_angles_deg": (n_axes,), "gravity_fixture": (3,),
+              "scalars": (5,), "raw_codes": (n_duts, n, 3), "mean_g": (n_duts, 3), "stderr_g": (n_duts, 3),
+              "temperature_c": (n_duts, 2), "gravity_reference_g": (n_duts, 3), "temperature_in_band": (n_duts,)}
+    for name, shape in shapes.items():
+        if arrays[name].shape != shape:
+            raise ValueError(f"{name} has shape {arrays[name].shape}, expected {shape}")
+    truth = "truth_parameters" in arrays
+    setpoint, t_start, t_end, before, after = arrays["scalars"].tolist()
+    duts = [
+        DutPoseRecord(
+            serial=serial, raw_codes=arrays["raw_codes"][i], mean_g=arrays["mean_g"][i], stderr_g=arrays["stderr_g"][i],
+            temperature_c=(float(arrays["temperature_c"][i, 0]), float(arrays["temperature_c"][i, 1])),
+            gravity_reference_g=arrays["gravity_reference_g"][i], temperature_in_band=bool(arrays["temperature_in_band"][i]),
+            truth={"parameters": arrays["truth_parameters"][i], "gravity_g": arrays["truth_gravity_g"][i],
+                   "temperature_c": np.float64(arrays["truth_temperature_c"][i])} if truth else None)
+        for i, serial in enumerate(serials)
+    ]
+    return PoseRecord(str(meta["step_key"]), setpoint, int(meta["pose_number"]), arrays["commanded_angles_deg"],
+                      arrays["measured_angles_deg"], arrays["gravity_fixture"], t_start, t_end, (before, after), duts)
+
+
+def _soak(record: Record, header: CampaignHeader) -> SoakTrace:
+    arrays = record.arrays
+    m, d = arrays["t_s"].shape[0], len(header.duts)
+    if arrays["chamber_c"].shape != (m,) or arrays["dut_c"].shape not in ((m, d), (0,)) or arrays["times_s"].shape != (3,):
+        raise ValueError("soak columns of different lengths")
+    setpoint, reached, stable = arrays["times_s"].tolist()
+    return SoakTrace(str(record.meta["label"]), setpoint, str(record.meta["outcome"]), arrays["t_s"],
+                     arrays["chamber_c"], arrays["dut_c"].reshape(m, d), reached, stable, arrays["settled_dut_c"])
+
+
+def replay(found: Scan, source: str) -> Campaign:
+    """The campaign a journal's records make; what could not be used is said in `notes`.
+
+    `source` names the journal in those notes. NotACampaignJournal when there is no header to start from.
+    """
+    records = found.records
+    first = next((r for r in records if r.kind == "header"), None)
+    if first is None:
+        raise NotACampaignJournal(f"{source}: no campaign header record")
+    try:
+        campaign = Campaign(_header(first))
+    except (KeyError, ValueError, TypeError) as exc:
+        raise NotACampaignJournal(f"{source}: its header record is not readable ({exc})") from None
+    if found.damaged:
+        skipped = sum(length for _, length in found.damaged)
+        campaign.notes.append(f"{source}: {len(found.damaged)} damaged stretches ({skipped} bytes, first at byte "
+                              f"{found.damaged[0][0]}) skipped; what they held is measured again on resume")
+    if first is not records[0]:
+        campaign.notes.append(f"{source}: {records.index(first)} records before the header ignored")
+    for record in records[records.index(first) + 1:]:
+        try:
+            _apply(campaign, record, source)
+        except (KeyError, ValueError, TypeError, IndexError) as exc:
+            campaign.notes.append(f"{source}: {record.kind} record at byte {record.offset} not usable ({exc})")
+    return campaign
+
+
+def _apply(campaign: Campaign, record: Record, source: str) -> None:
+    meta = record.meta
+    if record.kind == "pose":
+        campaign.add_pose(_pose(record, campaign.header), f"{source} byte {record.offset}")
+    elif record.kind == "events":
+        times = record.arrays["t_s"]
+        rows = meta["rows"]
+        if len(rows) != times.shape[0]:
+            raise ValueError("event columns of different lengths")
+        campaign.events.extend(StoredEvent(float(t), str(w), str(lv), str(k), str(m))
+                               for t, (w, lv, k, m) in zip(times.tolist(), rows))
+    elif record.kind == "soak":
+        campaign.soaks.append(_soak(record, campaign.header))
+    elif record.kind == "state":
+        state = str(meta["state"])
+        campaign.state = state
+        if state == "running":  # a run starts afresh: the last run's ending no longer applies
+            campaign.abort_reason, campaign.finished = "", ""
+        else:
+            campaign.finished = str(meta["wall_time"])
+        if meta.get("reason"):
+            campaign.abort_reason = str(meta["reason"])
+    elif record.kind == "run":
+        campaign.runs.append(RunStart(int(meta["run"]), int(meta["pid"]), str(meta["host"]), str(meta["started"])))
+    elif record.kind == "instruments":
+        campaign.instruments.update({str(k): dict(v) for k, v in meta["instruments"].items()})
+    elif record.kind == "header":
+        raise ValueError("a second header")
+    else:
+        raise ValueError(f"unknown kind {record.kind!r}")

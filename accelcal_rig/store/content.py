@@ -1,0 +1,191 @@
+"""A stored campaign as plain data: what its journal (or its HDF5 file) holds, with the views readers use.
+
+The journal and the HDF5 file are two ways of writing the same `Campaign`; every command reads one of
+them into this, so what a reader sees does not depend on which file it came from.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections import Counter
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from accelcal_rig.store.records import CampaignHeader, PoseRecord, RunStart, SoakTrace, StoredEvent
+
+POSE_FIELDS = ("step_key", "setpoint_c", "pose_number", "commanded_angles_deg", "measured_angles_deg",
+               "gravity_fixture", "t_start_s", "t_end_s", "chamber_temperature_c")
+DUT_FIELDS = ("raw_codes", "mean_g", "stderr_g", "temperature_c", "gravity_reference_g", "temperature_in_band")
+TRUTH_FIELDS = ("parameters", "gravity_g", "temperature_c")
+
+
+@dataclass
+class Campaign:
+    header: CampaignHeader
+    runs: list[RunStart] = field(default_factory=list)
+    instruments: dict[str, dict[str, str]] = field(default_factory=dict)
+    poses: list[PoseRecord] = field(default_factory=list)
+    soaks: list[SoakTrace] = field(default_factory=list)
+    events: list[StoredEvent] = field(default_factory=list)
+    state: str = "created"
+    abort_reason: str = ""
+    finished: str = ""
+    #: What reading it found wrong that leaves the measurements usable (a pose stored twice, damaged
+    #: journal records skipped, …), one line each.
+    notes: list[str] = field(default_factory=list)
+    #: What makes the stored measurements untrustworthy until repaired (a damaged column), one line each.
+    damage: list[str] = field(default_factory=list)
+    #: Where it was read from: "journal" or "file" (the HDF5 file alone); and how many bytes of the
+    #: journal it holds.
+    source: str = "journal"
+    journal_bytes: int = 0
+    _columns: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
+    _stored: set[str] = field(default_factory=set, repr=False)
+
+    def __post_init__(self) -> None:
+        self._stored = {p.step_key for p in self.poses}
+        if not self.instruments:  # later runs may reach them another way: `instruments` records update these
+            self.instruments = {name: dict(info) for name, info in self.header.instruments.items()}
+
+    # ------------------------------------------------------------------ building it
+    def add_pose(self, pose: PoseRecord, where: str) -> bool:
+        """Keep `pose` unless its step is stored already (then say so, naming `where` it came from)."""
+        if pose.step_key in self.stored_keys:
+            self.notes.append(f"pose {pose.step_key} stored more than once ({where}): the first is kept")
+            return False
+        self.poses.append(pose)
+        self._stored.add(pose.step_key)
+        self._columns.clear()
+        return True
+
+    @property
+    def stored_keys(self) -> set[str]:
+        return self._stored
+
+    # ------------------------------------------------------------------ views
+    @property
+    def serials(self) -> list[str]:
+        return self.header.serials
+
+    @property
+    def attrs(self) -> dict[str, Any]:
+        return self.header.attrs
+
+    @property
+    def poses_planned(self) -> int:
+        return self.header.plan.kind.count("pose")
+
+    @property
+    def run_count(self) -> int:
+        return max(len(self.runs), 1)
+
+    def pose_column(self, name: str) -> np.ndarray:
+        """One field of every stored pose, stacked: (N, …)."""
+        key = f"poses/{name}"
+        if key not in self._columns:
+            values = [getattr(p, name) for p in self.poses]
+            if name == "step_key":
+                self._columns[key] = np.array(values, dtype=object)
+            else:
+                self._columns[key] = _stack(values, _POSE_TAILS[name](self), _POSE_DTYPES.get(name, "f8"))
+        return self._columns[key]
+
+    def dut_column(self, serial: str, name: str) -> np.ndarray:
+        key = f"duts/{serial}/{name}"
+        if key not in self._columns:
+            index = self.serials.index(serial)
+            values = [getattr(p.duts[index], name) for p in self.poses]
+            tail = {"raw_codes": (self.samples_per_pose, 3), "temperature_c": (2,), "temperature_in_band": ()}.get(name, (3,))
+            dtype = {"raw_codes": "i4", "temperature_in_band": "?"}.get(name, "f8")
+            self._columns[key] = _stack(values, tail, dtype)
+        return self._columns[key]
+
+    def truth_column(self, serial: str, name: str) -> np.ndarray | None:
+        """Simulation truth of one field over the poses (dry runs), None when the campaign has none."""
+        if serial not in self.header.truth:
+            return None
+        key = f"truth/{serial}/{name}"
+        if key not in self._columns:
+            index = self.serials.index(serial)
+            values = [p.duts[index].truth[name] if p.duts[index].truth else np.nan for p in self.poses]
+            self._columns[key] = _stack(values, {"parameters": (12,), "gravity_g": (3,)}.get(name, ()), "f8")
+        return self._columns[key]
+
+    @property
+    def samples_per_pose(self) -> int:
+        return int(self.attrs.get("samples_per_pose", 0))
+
+    def soak_names(self) -> list[str]:
+        """Each soak's name in the file: its label, then `T-40#2`, `T-40#3`, … for later soaks there."""
+        names, seen = [], Counter[str]()
+        for soak in self.soaks:
+            seen[soak.label] += 1
+            names.append(soak.label if seen[soak.label] == 1 else f"{soak.label}#{seen[soak.label]}")
+        return names
+
+    def last_clock_s(self) -> float:
+        """The latest campaign-clock time anything in the campaign carries."""
+        times = [e.t_s for e in self.events[-1:]] + [p.t_end_s for p in self.poses[-1:]]
+        times += [float(s.t_s[-1]) for s in self.soaks if len(s.t_s)]
+        return float(max(times, default=0.0))
+
+    def clock_now_s(self) -> float:
+        """Where a resumed run's clock starts: the latest time in the campaign, plus the wall time since
+        its last event when the clock is real."""
+        last = self.last_clock_s()
+        if self.attrs.get("clock") != "real" or not self.events:
+            return last
+        try:
+            wall = dt.datetime.fromisoformat(self.events[-1].wall_time)
+        except ValueError:
+            return last
+        return last + max(0.0, (dt.datetime.now(dt.timezone.utc) - wall).total_seconds())
+
+    def unusable_reasons(self) -> list[str]:
+        """Why the measurements cannot be fitted or analysed as they are (empty when they can)."""
+        return list(self.damage) + [
+            f"duts/{serial}: implausible values (zeros or non-finite) in {len(rows)} poses, first "
+            f"{self.poses[rows[0]].step_key}" for serial in self.serials if (rows := _implausible_rows(self, serial))]
+
+    def integrity_problems(self) -> list[str]:
+        """What is wrong with the stored poses, one line each (empty for a sound campaign)."""
+        problems = self.unusable_reasons() + list(self.notes)
+        foreign = sorted(self.stored_keys - set(self.header.plan.pose_keys))
+        if foreign:
+            problems.append(f"poses not in the plan: {', '.join(foreign[:5])}{' …' if len(foreign) > 5 else ''}")
+        return problems
+
+
+def _implausible_rows(campaign: Campaign, serial: str) -> list[int]:
+    """Rows no real measurement produces: a reference gravity that is not a unit vector, a block of
+    codes all zero, or a non-finite mean or temperature."""
+    if not campaign.poses:
+        return []
+    reference = campaign.dut_column(serial, "gravity_reference_g")
+    codes = campaign.dut_column(serial, "raw_codes")
+    mean = campaign.dut_column(serial, "mean_g")
+    temperature = campaign.dut_column(serial, "temperature_c")
+    with np.errstate(invalid="ignore"):
+        bad = (np.abs(np.linalg.norm(reference, axis=1) - 1.0) > 1e-6) | ~np.any(codes != 0, axis=(1, 2))
+    bad |= ~np.all(np.isfinite(mean), axis=1) | ~np.all(np.isfinite(temperature), axis=1)
+    return np.flatnonzero(bad).tolist()
+
+
+def _stack(values: list[Any], tail: tuple[int, ...], dtype: str) -> np.ndarray:
+    if not values:
+        return np.zeros((0, *tail), dtype=dtype)
+    return np.asarray(np.stack([np.asarray(v, dtype=dtype) for v in values]), dtype=dtype)
+
+
+def _axes(campaign: Campaign) -> tuple[int, ...]:
+    return (len(campaign.header.plan.axis_names),)
+
+
+_POSE_TAILS = {
+    "setpoint_c": lambda c: (), "pose_number": lambda c: (), "t_start_s": lambda c: (), "t_end_s": lambda c: (),
+    "commanded_angles_deg": _axes, "measured_angles_deg": _axes, "gravity_fixture": lambda c: (3,),
+    "chamber_temperature_c": lambda c: (2,),
+}
+_POSE_DTYPES = {"pose_number": "i4"}

@@ -1,0 +1,242 @@
+"""The campaign journal: an append-only, checksummed, fsync'd log of records, the durable truth of a campaign.
+
+A record on disk is `ACJ1 | payload length (u32) | CRC-32 of the payload (u32) | payload`, little-endian;
+the payload is a JSON head (`kind`, `meta`, and the name, dtype and shape of each array) followed by
+the arrays' raw bytes, so numbers come back bit for bit. Bytes once acknowledged are never written again:
+the writer only appends, at the end of the last whole record, into space it has allocated ahead
+(zeros), keeping a reserve so the records that stop a campaign still fit when the disk is full.
+
+Reading tolerates anything: a record cut short by a kill (the tail), zeroed or flipped bytes (a
+stretch that fails its checksum, skipped to the next record that passes), a foreign file (no records).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import struct
+import zlib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from accelcal_rig.durable import disk_errors, fsync_directory, is_disk_full, temporary_beside, write_all
+from accelcal_rig.errors import DiskFull
+
+MAGIC = b"ACJ1"
+_HEAD = struct.Struct("<4sII")
+_META_LENGTH = struct.Struct("<I")
+#: Allocation grows by this much at a time (fewer allocations, a full disk found early).
+ALLOCATION_CHUNK_BYTES = 1 << 20
+#: Array element types a record may hold (anything else marks the record as damaged).
+_DTYPE_KINDS = frozenset("fiub")
+_sync = getattr(os, "fdatasync", os.fsync)
+
+
+def encode_record(kind: str, meta: dict[str, Any], arrays: dict[str, np.ndarray] | None = None) -> bytes:
+    arrays = {name: np.ascontiguousarray(value) for name, value in (arrays or {}).items()}
+    head = {"kind": kind, "meta": meta, "arrays": [[n, a.dtype.str, list(a.shape)] for n, a in arrays.items()]}
+    head_bytes = json.dumps(head, separators=(",", ":"), ensure_ascii=False).encode("utf-8")
+    payload = b"".join([_META_LENGTH.pack(len(head_bytes)), head_bytes, *(a.tobytes() for a in arrays.values())])
+    return _HEAD.pack(MAGIC, len(payload), zlib.crc32(payload)) + payload
+
+
+@dataclass(frozen=True)
+class Record:
+    offset: int                        # where it starts in the journal
+    size: int                          # its bytes on disk, framing included
+    kind: str
+    meta: dict[str, Any]
+    arrays: dict[str, np.ndarray]
+
+
+def _decode_payload(offset: int, payload: bytes) -> Record:
+    """The record in `payload` (whose checksum passed); ValueError if it is not one of ours."""
+    (head_length,) = _META_LENGTH.unpack_from(payload)
+    head = json.loads(payload[_META_LENGTH.size:_META_LENGTH.size + head_length].decode("utf-8"))
+    if not isinstance(head, dict) or not isinstance(head.get("kind"), str) or not isinstance(head.get("meta"), dict):
+        raise ValueError("not a record head")
+    position, arrays = _META_LENGTH.size + head_length, {}
+    for name, dtype_text, shape in head.get("arrays", []):
+        dtype = np.dtype(dtype_text)
+        if dtype.kind not in _DTYPE_KINDS or not all(isinstance(s, int) and s >= 0 for s in shape):
+            raise ValueError(f"array {name}: unexpected type")
+        size = dtype.itemsize * int(np.prod(shape, dtype=np.int64))
+        if position + size > len(payload):
+            raise ValueError(f"array {name} runs past the record")
+        arrays[str(name)] = np.frombuffer(payload, dtype, int(np.prod(shape, dtype=np.int64)), position).reshape(shape).copy()
+        position += size
+    if position != len(payload):
+        raise ValueError("bytes left over after the arrays")
+    return Record(offset, _HEAD.size + len(payload), head["kind"], head["meta"], arrays)
+
+
+def _record_at(data: bytes | memoryview, offset: int) -> Record | None:
+    """The whole, checksummed record starting at `offset`, or None."""
+    if offset + _HEAD.size > len(data):
+        return None
+    magic, length, crc = _HEAD.unpack_from(data, offset)
+    start, end = offset + _HEAD.size, offset + _HEAD.size + length
+    if magic != MAGIC or end > len(data) or length < _META_LENGTH.size:
+        return None
+    payload = bytes(data[start:end])
+    if zlib.crc32(payload) != crc:
+        return None
+    try:
+        return _decode_payload(offset, payload)
+    except (ValueError, TypeError, UnicodeDecodeError, struct.error, OverflowError):
+        return None
+
+
+def _next_record(data: bytes, start: int) -> Record | None:
+    """The first whole record at or after `start` (where reading picks up again after damage)."""
+    position = data.find(MAGIC, start)
+    while position != -1:
+        record = _record_at(data, position)
+        if record is not None:
+            return record
+        position = data.find(MAGIC, position + 1)
+    return None
+
+
+@dataclass
+class Scan:
+    """What a journal holds: its whole records in order, and what was wrong with the rest."""
+
+    records: list[Record] = field(default_factory=list)
+    end: int = 0                                         # just after the last whole record
+    damaged: list[tuple[int, int]] = field(default_factory=list)  # (offset, bytes) skipped between records
+    tail_bytes: int = 0                                  # non-zero bytes after `end`: a record written in part
+
+    @property
+    def clean(self) -> bool:
+        return not self.damaged and not self.tail_bytes
+
+
+def scan(data: bytes) -> Scan:
+    result = Scan()
+    position = 0
+    while position < len(data):
+        record = _record_at(data, position)
+        if record is None:
+            following = _next_record(data, position + 1)
+            if following is None:
+                break
+            result.damaged.append((position, following.offset - position))
+            record = following
+        result.records.append(record)
+        position = result.end = record.offset + record.size
+    result.tail_bytes = len(data[result.end:].rstrip(b"\0"))
+    return result
+
+
+def read_journal(path: Path) -> Scan:
+    """Every whole record of the journal at `path` (read-only; OSError if it cannot be read)."""
+    return scan(path.read_bytes())
+
+
+class JournalWriter:
+    """Appends records to one journal, each fsync'd before `append` returns.
+
+    Space is allocated ahead of the records in chunks; `reserve_bytes` of it are kept back. When the
+    disk is full and no more can be allocated, records still go into the reserve and
+    `space_exhausted` turns true: the campaign stops, and the records that say so still fit.
+    """
+
+    def __init__(self, path: Path, fd: int, end: int, reserve_bytes: int) -> None:
+        self.path = path
+        self._fd = fd
+        self.end = end
+        self.reserve_bytes = reserve_bytes
+        self.allocated = os.fstat(fd).st_size
+        self.space_exhausted = False
+
+    @classmethod
+    def create(cls, path: Path, first_record: bytes, reserve_bytes: int) -> JournalWriter:
+        """A new journal holding `first_record`, in place of any journal at `path` (replaced whole, by
+        rename, once the new one is on disk: a kill meanwhile leaves the old one or none)."""
+        temporary = temporary_beside(path)
+        with disk_errors(path, "the campaign journal"):
+            fd = os.open(temporary, os.O_RDWR | os.O_CREAT | os.O_TRUNC, 0o666)
+            try:
+                write_all(fd, first_record, 0)
+                _allocate(fd, 0, len(first_record) + reserve_bytes + ALLOCATION_CHUNK_BYTES)
+                os.fsync(fd)
+                os.replace(temporary, path)
+            except BaseException:
+                os.close(fd)
+                temporary.unlink(missing_ok=True)
+                raise
+            fsync_directory(path.parent)
+        return cls(path, fd, len(first_record), reserve_bytes)
+
+    @classmethod
+    def reopen(cls, path: Path, reserve_bytes: int) -> tuple[JournalWriter, Scan]:
+        """Open an existing journal to append to it; a record a killed process left half-written is cut
+        off (it was never acknowledged), and the scan of what is there is returned."""
+        with disk_errors(path, "the campaign journal"):
+            fd = os.open(path, os.O_RDWR)
+            try:
+                found = scan(os.pread(fd, os.fstat(fd).st_size, 0))
+                if found.tail_bytes:
+                    os.ftruncate(fd, found.end)
+                    os.fsync(fd)
+            except BaseException:
+                os.close(fd)
+                raise
+        writer = cls(path, fd, found.end, reserve_bytes)
+        try:
+            writer._ensure_room(0)
+        except DiskFull:
+            writer.space_exhausted = True
+        return writer, found
+
+    def _ensure_room(self, length: int) -> None:
+        """Allocate so that `length` more bytes and the reserve fit; DiskFull if the disk has no room."""
+        needed = self.end + length + self.reserve_bytes
+        if needed <= self.allocated:
+            return
+        try:
+            _allocate(self._fd, self.allocated, needed + ALLOCATION_CHUNK_BYTES - self.allocated)
+        except OSError as exc:
+            self.allocated = os.fstat(self._fd).st_size
+            if is_disk_full(exc):
+                raise DiskFull(f"no space left on {self.path.parent.resolve()} (the campaign journal "
+                               f"{self.path.name} could not grow)") from None
+            raise
+        self.allocated = os.fstat(self._fd).st_size
+
+    def append(self, record: bytes) -> None:
+        """Write `record` after the last one and fsync; DiskFull when not even the reserve holds it."""
+        try:
+            self._ensure_room(len(record))
+        except DiskFull:
+            self.space_exhausted = True
+            if self.end + len(record) > self.allocated:
+                raise
+        with disk_errors(self.path, "the campaign journal"):
+            write_all(self._fd, record, self.end)
+            _sync(self._fd)
+        self.end += len(record)
+
+    def close(self) -> None:
+        """Give back the space allocated ahead (zeros after the last record), then close."""
+        if self._fd >= 0:
+            try:
+                os.ftruncate(self._fd, self.end)
+            except OSError:
+                pass  # the zeros stay: readers take them for the end
+            os.close(self._fd)
+            self._fd = -1
+
+
+def _allocate(fd: int, offset: int, length: int) -> None:
+    """Reserve disk blocks for [offset, offset + length) (zeros), where the file system can."""
+    try:
+        os.posix_fallocate(fd, offset, length)
+    except OSError as exc:
+        if is_disk_full(exc):
+            raise
+        write_all(fd, bytes(length), offset)  # no fallocate here: write the zeros

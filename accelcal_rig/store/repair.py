@@ -1,0 +1,105 @@
+"""Bring a campaign's journal and file back in step, losing nothing (`rig repair`, and every resume).
+
+A journal with damaged stretches is compacted into a new one holding its whole records byte for byte,
+the damaged original kept beside it. A campaign file with no journal (written before the journal
+existed, or copied alone) gets one made from it; so does a campaign whose journal has lost its header,
+that journal kept beside it. The campaign file is then rebuilt from the journal.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import os
+import shutil
+from pathlib import Path
+
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.store import lock
+from accelcal_rig.store.codec import (
+    NotACampaignJournal, encode_events, encode_header, encode_instruments, encode_pose, encode_run, encode_soak,
+    encode_state, replay,
+)
+from accelcal_rig.store.content import Campaign
+from accelcal_rig.durable import disk_errors, fsync_directory, write_atomically
+from accelcal_rig.store.hdf5_file import campaign_image
+from accelcal_rig.store.journal import JournalWriter, scan
+from accelcal_rig.store.paths import journal_path
+from accelcal_rig.store.read import read_hdf5_campaign
+from accelcal_rig.store.records import StateChange
+
+
+def journal_bytes_of(campaign: Campaign) -> bytes:
+    """Journal records holding `campaign` (to give a campaign file that has none its journal)."""
+    records = [encode_header(campaign.header), *(encode_run(r) for r in campaign.runs),
+               encode_instruments(campaign.instruments), *(encode_soak(s) for s in campaign.soaks),
+               *(encode_pose(p) for p in campaign.poses)]
+    if campaign.events:
+        records.append(encode_events(campaign.events))
+    if campaign.state != "created":
+        records.append(encode_state(StateChange(campaign.state, campaign.abort_reason, campaign.finished)))
+    return b"".join(records)
+
+
+def _keep_copy(journal: Path) -> Path:
+    """A second name for the journal as it is now (`….journal.damaged-20261201T081500`): a hard link,
+    so the original survives the journal being replaced, whatever happens in between."""
+    stamp = dt.datetime.now(dt.timezone.utc).strftime("%Y%m%dT%H%M%S")
+    kept = journal.with_name(f"{journal.name}.damaged-{stamp}")
+    with disk_errors(kept, "a copy of the damaged journal"):
+        try:
+            os.link(journal, kept)
+        except OSError:
+            shutil.copy2(journal, kept)
+        fsync_directory(journal.parent)
+    return kept
+
+
+def _from_campaign_file(path: Path, why: str) -> Campaign:
+    if not path.is_file():
+        raise ConfigError(f"{path}: {why}, and there is no campaign file to make one from")
+    campaign = read_hdf5_campaign(path)
+    if campaign.damage:
+        raise ConfigError(f"{path}: {campaign.damage[0]}; {why}: nothing to repair it from, nothing was changed")
+    return campaign
+
+
+def mend_journal(path: Path) -> list[str]:
+    """Make the campaign's journal whole and readable (the caller holds the campaign's lock); what was
+    done, one line each. A record cut short at the end is left for the journal's writer to cut."""
+    journal = journal_path(path)
+    if not journal.is_file():
+        campaign = _from_campaign_file(path, "it has no journal")
+        write_atomically(journal, journal_bytes_of(campaign), "the campaign journal")
+        return [f"{path.name} had no journal: {journal.name} made from its {len(campaign.poses)} poses"]
+    with disk_errors(journal, "the campaign journal"):
+        data = journal.read_bytes()
+    found = scan(data)
+    try:
+        replay(found, journal.name)
+    except NotACampaignJournal as exc:
+        campaign = _from_campaign_file(path, str(exc))
+        kept = _keep_copy(journal)
+        write_atomically(journal, journal_bytes_of(campaign), "the campaign journal")
+        return [f"{exc}: kept as {kept.name}, {journal.name} made again from {path.name} ({len(campaign.poses)} poses)"]
+    if not found.damaged:
+        return []
+    kept = _keep_copy(journal)
+    write_atomically(journal, b"".join(data[r.offset:r.offset + r.size] for r in found.records), "the campaign journal")
+    skipped = sum(length for _, length in found.damaged)
+    return [f"{journal.name}: {len(found.damaged)} damaged stretches ({skipped} bytes) left out, every whole record "
+            f"kept; the original kept as {kept.name}"]
+
+
+def repair_campaign(path: Path) -> list[str]:
+    """Repair the campaign at `path`: what was done, one line each. Refused while a run holds it."""
+    with lock.campaign_lock(path, "rig repair"):
+        done = mend_journal(path)
+        journal, found = JournalWriter.reopen(journal_path(path), 0)
+        journal.close()
+        if found.tail_bytes:
+            done.append(f"a record written in part by a run that died ({found.tail_bytes} bytes) cut off the journal")
+        campaign = replay(found, journal_path(path).name)
+        write_atomically(path, campaign_image(campaign, found.end), "the campaign file")
+        done.append(f"{path.name} rebuilt from its journal: {len(campaign.poses)} of {campaign.poses_planned} poses, "
+                    f"{len(campaign.soaks)} soaks, {campaign.run_count} runs, state {campaign.state}")
+        return done + campaign.notes
