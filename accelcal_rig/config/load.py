@@ -8,7 +8,7 @@ from typing import Generic, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
-from accelcal_rig.config.procedure import Procedure
+from accelcal_rig.config.procedure import MAX_POLLS, Procedure
 from accelcal_rig.config.rig import FaultInjection, RigConfig
 from accelcal_rig.config.yaml_lines import KeyPath, format_key, load_yaml_with_lines, locate
 from accelcal_rig.errors import ConfigError
@@ -76,6 +76,11 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
     safe = procedure.model.safe_setpoint_c
     if safe is not None and not chamber.min_setpoint_c <= safe <= chamber.max_setpoint_c:
         raise procedure.error(("safe_setpoint_c",), f"{safe:g} °C is outside the chamber limits of {rig.path}")
+    polls = worst_case_polls(procedure.model, rig.model)
+    if polls > MAX_POLLS:
+        raise procedure.error(("soak",), f"its ramp and soak deadlines allow {polls:.0f} temperature polls at "
+                                         f"poll_s {procedure.model.soak.poll_s:g} s with the chamber of {rig.path} "
+                                         f"(at most {MAX_POLLS}): poll less often or shorten the deadlines")
     ramp = procedure.model.ramp
     if ramp is not None and ramp.rate_c_per_min > chamber.ramp_rate_c_per_min:
         raise procedure.error(("ramp", "rate_c_per_min"), f"{ramp.rate_c_per_min:g} °C/min is faster than the chamber "
@@ -99,6 +104,19 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
                         ("schedule", "angles_deg", pose),
                         f"axis {axis.name} angle {angle:g}° is outside its limits {axis.min_deg:g}…{axis.max_deg:g}°",
                     )
+
+
+def worst_case_polls(procedure: Procedure, rig: RigConfig) -> float:
+    """Temperature polls the campaign makes if every ramp and soak runs to its deadline (the plan's duration
+    estimate plays them, so this bounds its work)."""
+    soak = procedure.soak
+    previous = rig.simulation.ambient_c
+    polls = 0.0
+    for setpoint in procedure.setpoints_c:
+        ramp_s = soak.ramp_timeout_factor * abs(setpoint - previous) / (rig.chamber.ramp_rate_c_per_min / 60.0)
+        polls += (ramp_s + soak.ramp_timeout_margin_min * 60.0 + soak.timeout_min * 60.0) / soak.poll_s
+        previous = setpoint
+    return polls
 
 
 def with_faults(rig: LoadedConfig[RigConfig], spec: str | None) -> LoadedConfig[RigConfig]:

@@ -2,39 +2,48 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, Field, field_validator, model_validator
 
+from accelcal_rig.config.bounds import STRICT, AngleDeg, TemperatureC, TemperatureSpanC
 from accelcal_rig.instruments.adxl355 import OUTPUT_DATA_RATES_HZ
+
+#: Most temperature polls a campaign's ramp and soak deadlines allow (`rig plan` plays them all).
+MAX_POLLS = 200_000
+#: Most poses a plan may hold (setpoints × schedule, or a cool-down's records).
+MAX_PLAN_POSES = 50_000
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = STRICT
 
 
 class SoakCriterion(_Strict):
     """When the DUTs count as thermally stable at a setpoint (every wait has a deadline: `timeout_min`)."""
 
-    min_dwell_min: float = Field(30.0, ge=0, description="least time at setpoint before stability counts")
-    window_min: float = Field(10.0, gt=0, description="trailing window over which stability is judged")
-    band_c: float = Field(0.3, gt=0, description="max−min of each DUT's own temperature over the window")
-    chamber_tolerance_c: float = Field(1.0, gt=0, description="chamber air within this of the setpoint")
-    poll_s: float = Field(10.0, gt=0, le=600, description="temperature polling interval")
-    timeout_min: float = Field(240.0, gt=0, description="soak deadline, counted from reaching the setpoint")
+    min_dwell_min: float = Field(30.0, ge=0, le=2880, description="least time at setpoint before stability counts")
+    window_min: float = Field(10.0, gt=0, le=1440, description="trailing window over which stability is judged")
+    band_c: TemperatureSpanC = Field(0.3, description="max−min of each DUT's own temperature over the window")
+    chamber_tolerance_c: TemperatureSpanC = Field(1.0, description="chamber air within this of the setpoint")
+    poll_s: float = Field(10.0, ge=1, le=600, description="temperature polling interval")
+    timeout_min: float = Field(240.0, gt=0, le=2880, description="soak deadline, counted from reaching the setpoint")
     on_timeout: Literal["abort", "skip", "proceed"] = Field(
         "abort", description="a soak not stable by its deadline: abort the campaign, skip the setpoint "
                              "(recorded; a resume tries it again), or measure its poses anyway with a warning")
     ramp_timeout_factor: float = Field(
-        2.0, ge=1, description="ramp deadline = factor × |Δ| / rig ramp rate + ramp_timeout_margin_min"
+        2.0, ge=1, le=10, description="ramp deadline = factor × |Δ| / rig ramp rate + ramp_timeout_margin_min"
     )
-    ramp_timeout_margin_min: float = Field(15.0, ge=0)
+    ramp_timeout_margin_min: float = Field(15.0, ge=0, le=1440)
 
     @model_validator(mode="after")
     def _fits_in_timeout(self) -> SoakCriterion:
         if max(self.min_dwell_min, self.window_min) > self.timeout_min:
             raise ValueError("timeout_min must be at least min_dwell_min and window_min")
+        if self.timeout_min * 60.0 / self.poll_s > MAX_POLLS:
+            raise ValueError(f"timeout_min / poll_s: a soak would be polled {self.timeout_min * 60 / self.poll_s:.0f} "
+                             f"times (at most {MAX_POLLS}): poll less often or shorten the timeout")
         return self
 
 
@@ -42,19 +51,25 @@ class Paper24Schedule(_Strict):
     """Table 1 of the paper: eight 45° steps about each of the sensor's z, y and x axes."""
 
     kind: Literal["paper-24"]
+    size: ClassVar[int] = 24
 
 
 class SixPositionSchedule(_Strict):
     """The classic six positions: each sensor axis up, then down."""
 
     kind: Literal["six-position"]
+    size: ClassVar[int] = 6
 
 
 class SphereSchedule(_Strict):
     """`count` gravity directions spread evenly over the sphere (Fibonacci lattice)."""
 
     kind: Literal["sphere"]
-    count: int = Field(ge=6, le=20000)
+    count: int = Field(ge=6, le=MAX_PLAN_POSES)
+
+    @property
+    def size(self) -> int:
+        return self.count
 
 
 class TiltSchedule(_Strict):
@@ -62,7 +77,11 @@ class TiltSchedule(_Strict):
     y axis up, roll tilts the x axis down; (0, 0) is level with z up."""
 
     kind: Literal["tilt"]
-    pitch_roll_deg: list[tuple[float, float]] = Field(min_length=1)
+    pitch_roll_deg: list[tuple[float, float]] = Field(min_length=1, max_length=MAX_PLAN_POSES)
+
+    @property
+    def size(self) -> int:
+        return len(self.pitch_roll_deg)
 
     @field_validator("pitch_roll_deg")
     @classmethod
@@ -76,7 +95,12 @@ class ExplicitSchedule(_Strict):
     """Turntable axis angles given pose by pose, in degrees, in the rig's axis order."""
 
     kind: Literal["explicit"]
-    angles_deg: list[list[float]] = Field(min_length=1)
+    angles_deg: list[Annotated[list[AngleDeg], Field(min_length=1, max_length=6)]] = Field(
+        min_length=1, max_length=MAX_PLAN_POSES)
+
+    @property
+    def size(self) -> int:
+        return len(self.angles_deg)
 
 
 Schedule = Annotated[
@@ -88,7 +112,7 @@ Schedule = Annotated[
 class Acquisition(_Strict):
     """How each pose is measured."""
 
-    samples_per_pose: int = Field(200, ge=2, le=1_000_000)
+    samples_per_pose: int = Field(200, ge=2, le=100_000)
     range_g: Literal[2, 4, 8] = 2
     odr_hz: float = Field(125.0, description="ADXL355 output data rate, one of its ODR_LPF settings")
     settle_s: float = Field(5.0, ge=0, le=3600, description="wait after the turntable is in position")
@@ -130,11 +154,11 @@ class Cooldown(_Strict):
     """Free cool-down validation (paper §4.3, Fig. 11): after the soak at the procedure's one setpoint,
     hold one pose, let the chamber go (switched off, or set to ambient) and record while the DUTs cool."""
 
-    pose: int = Field(1, ge=1, description="pose number of the schedule to hold")
+    pose: int = Field(1, ge=1, le=MAX_PLAN_POSES, description="pose number of the schedule to hold")
     chamber: Literal["power-off", "ambient"] = Field(
         "power-off", description="power-off: the chamber switched off (its power event); ambient: its set point "
                                  "to ambient_c")
-    ambient_c: float = Field(23.0, description="set point for chamber: ambient")
+    ambient_c: TemperatureC = Field(23.0, description="set point for chamber: ambient")
     record_every_s: float = Field(60.0, gt=0, le=3600, description="one block of samples this often")
     duration_min: float = Field(240.0, gt=0, le=7 * 24 * 60, description="how long to record")
 
@@ -144,21 +168,21 @@ class RampMethod(_Strict):
     both methods). After a soak at the first setpoint the chamber setpoint moves at `rate_c_per_min`
     towards the last; each setpoint's poses start once the ramp is half-way from the previous setpoint."""
 
-    rate_c_per_min: float = Field(gt=0, le=10, description="the software ramp of the chamber setpoint")
-    update_s: float = Field(30.0, gt=0, le=600, description="how often the chamber setpoint is moved on")
+    rate_c_per_min: float = Field(ge=0.01, le=10, description="the software ramp of the chamber setpoint")
+    update_s: float = Field(30.0, ge=1, le=600, description="how often the chamber setpoint is moved on")
 
 
 class Procedure(_Strict):
     """A whole campaign. Setpoints run in the order given."""
 
-    name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_.-]+$")
-    description: str = ""
-    rig: str = Field(min_length=1, description="rig config path, relative to this file")
-    setpoints_c: list[float] = Field(min_length=1, max_length=1000)
+    name: str = Field(min_length=1, max_length=128, pattern=r"^[A-Za-z0-9_.-]+$")
+    description: str = Field("", max_length=10_000)
+    rig: str = Field(min_length=1, max_length=4096, description="rig config path, relative to this file")
+    setpoints_c: list[TemperatureC] = Field(min_length=1, max_length=200)
     soak: SoakCriterion = SoakCriterion()
     schedule: Schedule
     acquisition: Acquisition = Acquisition()
-    safe_setpoint_c: float | None = Field(None, description="overrides the rig's chamber.safe_setpoint_c")
+    safe_setpoint_c: TemperatureC | None = Field(None, description="overrides the rig's chamber.safe_setpoint_c")
     fit: FitOptions = FitOptions()
     cooldown: Cooldown | None = Field(None, description="record a free cool-down instead of the schedule's poses")
     method: Literal["soak", "ramp"] = Field("soak", description="soak at every setpoint, or measure while ramping")
@@ -192,7 +216,21 @@ class Procedure(_Strict):
             if self.cooldown.record_every_s < block_s:
                 raise ValueError(f"cooldown.record_every_s must be at least one record's {block_s:g} s (settle "
                                  "and samples)")
+            if self.cooldown.duration_min * 60.0 / self.cooldown.record_every_s >= MAX_PLAN_POSES:
+                raise ValueError(f"cooldown.duration_min / record_every_s: more than {MAX_PLAN_POSES} records")
         return self
+
+    @model_validator(mode="after")
+    def _plan_size(self) -> Procedure:
+        poses = len(self.setpoints_c) * self.schedule_size()
+        if self.cooldown is None and poses > MAX_PLAN_POSES:
+            raise ValueError(f"{len(self.setpoints_c)} setpoints × {self.schedule_size()} poses = {poses} poses: a "
+                             f"campaign holds at most {MAX_PLAN_POSES}")
+        return self
+
+    def schedule_size(self) -> int:
+        """Poses of the schedule at one setpoint."""
+        return self.schedule.size
 
     @field_validator("setpoints_c", mode="before")
     @classmethod
@@ -208,11 +246,13 @@ class Procedure(_Strict):
             start, stop, step = (float(value[k]) for k in ("from_c", "to_c", "step_c"))
         except (TypeError, ValueError):
             raise ValueError("from_c, to_c and step_c must be numbers") from None
+        if not all(np.isfinite([start, stop, step])) or max(abs(start), abs(stop)) > 1000:
+            raise ValueError("from_c, to_c and step_c must be finite temperatures")
         if step == 0 or (stop - start) / step < 0:
             raise ValueError("step_c must be non-zero and lead from from_c to to_c")
         count = int(np.floor((stop - start) / step + 1e-9)) + 1
-        if count > 1000:
-            raise ValueError("a setpoint range may hold at most 1000 setpoints")
+        if count > 200:
+            raise ValueError("a setpoint range may hold at most 200 setpoints")
         return [round(start + i * step, 9) for i in range(count)]
 
     @field_validator("setpoints_c")

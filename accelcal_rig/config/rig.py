@@ -3,35 +3,40 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
 
+from accelcal_rig.config.bounds import STRICT, AngleDeg, Baudrate, TemperatureC, TimeoutS
 from accelcal_rig.instruments.chamber_registers import ChamberRegisterMap, register_map
 from accelcal_rig.instruments.turntable_protocol import TurntableProtocol, turntable_protocol
 
+#: A year of campaign time, in minutes: the furthest a simulated fault may be scheduled.
+_YEAR_MIN = 365 * 24 * 60.0
+
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = STRICT
 
 
 class ChamberConfig(_Strict):
     """Thermal chamber: how to reach its controller, its register map, limits and dynamics."""
 
     driver: Literal["modbus-tcp", "modbus-rtu"] = "modbus-tcp"
-    endpoint: str | None = Field(None, description="modbus-tcp: host:port; modbus-rtu: serial device or URL")
+    endpoint: str | None = Field(None, max_length=1024, description="modbus-tcp: host:port; modbus-rtu: serial "
+                                 "device or URL")
     device_id: int = Field(1, ge=0, le=247)
     profile: Literal["watlow-f4", "watlow-f4t"] = "watlow-f4t"
     registers: dict[str, Any] = Field({}, description="fields of the profile's register map to override")
-    timeout_s: float = Field(1.0, gt=0, le=60)
-    baudrate: int = Field(9600, gt=0)
+    timeout_s: TimeoutS = 1.0
+    baudrate: Baudrate = 9600
     parity: Literal["N", "E", "O"] = "N"
     stopbits: Literal[1, 2] = 1
-    min_setpoint_c: float = -55.0
-    max_setpoint_c: float = 100.0
-    safe_setpoint_c: float = 23.0
-    ramp_rate_c_per_min: float = Field(3.0, gt=0, le=50)
+    min_setpoint_c: TemperatureC = -55.0
+    max_setpoint_c: TemperatureC = 100.0
+    safe_setpoint_c: TemperatureC = 23.0
+    ramp_rate_c_per_min: float = Field(3.0, ge=0.1, le=50)
 
     def register_map(self) -> ChamberRegisterMap:
         return register_map(self.profile, self.registers)
@@ -51,12 +56,13 @@ class ChamberConfig(_Strict):
 class TurntableAxis(_Strict):
     """One rotary axis of the kinematic chain, its direction given in its parent's frame at zero angles."""
 
-    name: str = Field(min_length=1, pattern=r"^[A-Za-z0-9_.-]+$")
-    axis: tuple[float, float, float]
-    min_deg: float = -180.0
-    max_deg: float = 180.0
+    name: str = Field(min_length=1, max_length=32, pattern=r"^[A-Za-z0-9_.-]+$")
+    axis: tuple[Annotated[float, Field(ge=-1e6, le=1e6)], Annotated[float, Field(ge=-1e6, le=1e6)],
+                Annotated[float, Field(ge=-1e6, le=1e6)]]
+    min_deg: AngleDeg = -180.0
+    max_deg: AngleDeg = 180.0
     continuous: bool = Field(False, description="endless axis: angles wrap into [min_deg, max_deg)")
-    speed_deg_s: float = Field(10.0, gt=0, le=1000)
+    speed_deg_s: float = Field(10.0, ge=0.01, le=1000)
 
     @field_validator("axis")
     @classmethod
@@ -79,13 +85,14 @@ class TurntableConfig(_Strict):
     """A chain of rotary axes, outermost first; the fixture sits on the innermost axis."""
 
     driver: Literal["serial"] = "serial"
-    endpoint: str | None = Field(None, description="serial device or pyserial URL (socket://host:port, …)")
-    baudrate: int = Field(9600, gt=0)
+    endpoint: str | None = Field(None, max_length=1024, description="serial device or pyserial URL "
+                                 "(socket://host:port, …)")
+    baudrate: Baudrate = 9600
     protocol: Literal["accelcal-line"] = "accelcal-line"
     protocol_overrides: dict[str, Any] = Field({}, description="fields of the line protocol to override")
-    timeout_s: float = Field(2.0, gt=0, le=60)
+    timeout_s: TimeoutS = 2.0
     axes: list[TurntableAxis] = Field(min_length=1, max_length=6)
-    position_tolerance_deg: float = Field(0.01, gt=0, le=5)
+    position_tolerance_deg: float = Field(0.01, ge=1e-6, le=5)
     accuracy_arcsec: float = Field(3.0, ge=0, le=3600, description="angular position accuracy of each axis "
                                    "(spec sheet, ±): the fit's reference-mode uncertainty, the simulated table's error")
 
@@ -112,11 +119,12 @@ class SensorConfig(_Strict):
     serial: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.-]+$")
     name: str = Field("", max_length=64)
     driver: Literal["serial-bridge", "spidev"] = "serial-bridge"
-    endpoint: str | None = Field(None, description="serial-bridge: device or URL; spidev: bus.chip_select")
-    baudrate: int = Field(921600, gt=0)
-    spi_speed_hz: int = Field(5_000_000, gt=0, le=10_000_000)
-    timeout_s: float = Field(1.0, gt=0, le=60)
-    mount_euler_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    endpoint: str | None = Field(None, max_length=1024, description="serial-bridge: device or URL; spidev: "
+                                 "bus.chip_select")
+    baudrate: Baudrate = 921600
+    spi_speed_hz: int = Field(5_000_000, ge=1000, le=10_000_000)
+    timeout_s: TimeoutS = 1.0
+    mount_euler_deg: tuple[AngleDeg, AngleDeg, AngleDeg] = (0.0, 0.0, 0.0)
 
 
 def _first_error_as_value_error(key: str, build: Callable[[], object]) -> None:
@@ -154,28 +162,29 @@ class FaultInjection(_Strict):
 
     rate: float = Field(0.0, ge=0, le=1, description="share of replies hit by a transient fault")
     kinds: list[Literal["drop", "delay", "corrupt", "disconnect", "busy"]] = ["drop", "delay", "corrupt", "disconnect"]
-    delay_s: float = Field(0.05, ge=0, description="wall-clock delay of a delayed reply")
-    disconnect_s: float = Field(2.0, ge=0, description="campaign time a disconnected line stays dead")
-    seed: int = 0
-    chamber_stall_after_min: float | None = Field(None, ge=0, description="the chamber stops following its setpoint")
-    turntable_stall_after_min: float | None = Field(None, ge=0, description="the turntable stops moving")
-    sensor_wrong_id: str | None = Field(None, description="serial of a DUT whose part ID reads wrong")
-    sensor_stuck: str | None = Field(None, description="serial of a DUT whose samples freeze")
-    sensor_stuck_after_min: float = Field(0.0, ge=0, description="when that DUT's samples freeze")
+    delay_s: float = Field(0.05, ge=0, le=10, description="wall-clock delay of a delayed reply")
+    disconnect_s: float = Field(2.0, ge=0, le=3600, description="campaign time a disconnected line stays dead")
+    seed: int = Field(0, ge=0, le=2**32 - 1)
+    chamber_stall_after_min: float | None = Field(None, ge=0, le=_YEAR_MIN,
+                                                  description="the chamber stops following its setpoint")
+    turntable_stall_after_min: float | None = Field(None, ge=0, le=_YEAR_MIN, description="the turntable stops moving")
+    sensor_wrong_id: str | None = Field(None, max_length=64, description="serial of a DUT whose part ID reads wrong")
+    sensor_stuck: str | None = Field(None, max_length=64, description="serial of a DUT whose samples freeze")
+    sensor_stuck_after_min: float = Field(0.0, ge=0, le=_YEAR_MIN, description="when that DUT's samples freeze")
 
 
 class SimulationConfig(_Strict):
     """Physics of the virtual lab used by `--dry-run` (DESIGN §3)."""
 
-    ambient_c: float = 23.0
-    chamber_time_constant_min: float = Field(3.0, gt=0)
-    chamber_noise_c: float = Field(0.05, ge=0)
-    fixture_time_constant_min: float = Field(10.0, gt=0)
-    free_cooling_time_constant_min: float = Field(45.0, gt=0, description="chamber switched off: its air "
-                                                  "relaxes to ambient with this time constant")
-    self_heating_c: float = Field(0.2, ge=0)
-    noise_density_ug_per_rthz: float = Field(25.0, ge=0)
-    turntable_settle_s: float = Field(0.5, ge=0)
+    ambient_c: TemperatureC = 23.0
+    chamber_time_constant_min: float = Field(3.0, ge=0.01, le=1440)
+    chamber_noise_c: float = Field(0.05, ge=0, le=10)
+    fixture_time_constant_min: float = Field(10.0, ge=0.01, le=1440)
+    free_cooling_time_constant_min: float = Field(45.0, ge=0.01, le=10080, description="chamber switched off: its "
+                                                  "air relaxes to ambient with this time constant")
+    self_heating_c: float = Field(0.2, ge=0, le=20)
+    noise_density_ug_per_rthz: float = Field(25.0, ge=0, le=100_000)
+    turntable_settle_s: float = Field(0.5, ge=0, le=600)
     faults: FaultInjection = FaultInjection()
 
 
@@ -183,8 +192,8 @@ class RetryPolicy(_Strict):
     """Transient communication failures (no reply, garbled reply, a port gone) are retried this way."""
 
     attempts: int = Field(5, ge=1, le=20, description="tries in all, the first included")
-    first_backoff_s: float = Field(0.5, ge=0, description="wait before the second try; doubles each time")
-    max_backoff_s: float = Field(8.0, ge=0, description="longest wait between tries")
+    first_backoff_s: float = Field(0.5, ge=0, le=600, description="wait before the second try; doubles each time")
+    max_backoff_s: float = Field(8.0, ge=0, le=3600, description="longest wait between tries")
 
 
 NotifyEvent = Literal["start", "soak", "fault", "safe", "finish"]
@@ -193,16 +202,18 @@ NotifyEvent = Literal["start", "soak", "fault", "safe", "finish"]
 class NotifyConfig(_Strict):
     """Who hears about an unattended run: a webhook (JSON POST) and/or a local command (JSON on stdin)."""
 
-    webhook_url: str | None = Field(None, pattern=r"^https?://", description="http(s) URL to POST each event to")
-    command: list[str] = Field([], description="program and arguments to run for each event")
+    webhook_url: str | None = Field(None, max_length=2048, pattern=r"^https?://",
+                                    description="http(s) URL to POST each event to")
+    command: list[Annotated[str, Field(max_length=4096)]] = Field([], max_length=64,
+                                                                  description="program and arguments to run for each event")
     events: list[NotifyEvent] = Field(["start", "soak", "fault", "safe", "finish"],
                                       description="which events to send")
     timeout_s: float = Field(10.0, gt=0, le=120, description="longest one delivery may take")
 
 
 class RigConfig(_Strict):
-    name: str = Field(min_length=1)
-    description: str = ""
+    name: str = Field(min_length=1, max_length=128)
+    description: str = Field("", max_length=10_000)
     chamber: ChamberConfig
     turntable: TurntableConfig
     fixture: FixtureConfig

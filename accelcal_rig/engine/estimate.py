@@ -23,7 +23,7 @@ import numpy as np
 
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.engine.soak import SoakDetector
+from accelcal_rig.engine.soak import first_stable_poll, settled_at
 from accelcal_rig.engine.waits import MOVE_POLL_S
 from accelcal_rig.instruments.adxl355 import raw_from_temperature_c, temperature_c_from_raw
 from accelcal_rig.plan.compile import Plan
@@ -164,20 +164,17 @@ def _soak(thermal: ThermalModel, procedure: Procedure, setpoint_c: float,
     n_polls = int(math.ceil(soak.timeout_min * 60.0 / soak.poll_s)) + 1
     t = np.minimum(t_reached_s + soak.poll_s * np.arange(n_polls), t_reached_s + soak.timeout_min * 60.0)
     ahead = copy.deepcopy(thermal)  # looks ahead to the deadline; the campaign's model stays at t_reached
-    air_and_dut = np.array([[ahead.air_c(ti), *(ahead.dut_c(ti, i) for i in range(len(ahead.dut_tau_s)))]
-                            for ti in t])  # the model only advances: every query at one time before the next
-    air, dut = air_and_dut[:, 0], air_and_dut[:, 1:]
+    air, dut = np.empty(n_polls), np.empty((n_polls, len(thermal.dut_tau_s)))
+    for k, ti in enumerate(t.tolist()):  # the model only advances: every query at one time before the next
+        air[k], dut[k] = ahead.air_c(ti), ahead.duts_c(ti)
     rng = np.random.default_rng(0)
     outcomes = []
     for _ in range(SOAK_DRAWS):
         read = temperature_c_from_raw(raw_from_temperature_c(dut + rng.normal(0.0, TEMPERATURE_READ_NOISE_C, dut.shape)))
-        detector = SoakDetector(soak, setpoint_c, t_reached_s)
-        for k in range(n_polls):
-            detector.add(float(t[k]), float(air[k]), read[k])
-            if detector.is_stable():
-                outcomes.append((float(t[k] - t_reached_s), "stable", detector.settled_dut_c()))
-                break
+        stable = first_stable_poll(soak, setpoint_c, t_reached_s, t, air, read)
+        if stable is not None:
+            outcomes.append((float(t[stable] - t_reached_s), "stable", settled_at(soak, t, read, stable)))
         else:
-            outcomes.append((float(t[-1] - t_reached_s), "timeout", detector.settled_dut_c()))
+            outcomes.append((float(t[-1] - t_reached_s), "timeout", settled_at(soak, t, read, n_polls - 1)))
     soak_s, outcome, settled = sorted(outcomes, key=lambda o: o[0])[SOAK_DRAWS // 2]
     return soak_s, outcome, tuple(round(float(c), 3) for c in settled)

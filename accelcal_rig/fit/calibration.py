@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, Field, field_validator
 
+from accelcal_rig.config.bounds import STRICT, TemperatureC
 from accelcal_rig.config.load import load_validated
 from accelcal_rig.durable import write_text_atomically
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
@@ -26,15 +27,21 @@ class CalibrationRangeWarning(UserWarning):
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = STRICT
+
+
+def _ordered(value: tuple[float, float]) -> tuple[float, float]:
+    if not value[0] < value[1]:
+        raise ValueError(f"a temperature range from low to high, not {value[0]:g}…{value[1]:g}")
+    return value
 
 
 class PolynomialModel(_Strict):
     """Each parameter's coefficients in x = (T − mid(domain)) / half-width(domain), increasing powers."""
 
-    domain_c: tuple[float, float]
-    degree: int = Field(ge=0)
-    coefficients: dict[str, list[float]]
+    domain_c: tuple[TemperatureC, TemperatureC]
+    degree: int = Field(ge=0, le=6)
+    coefficients: dict[str, Annotated[list[Annotated[float, Field(ge=-1e6, le=1e6)]], Field(min_length=1, max_length=7)]]
 
     @field_validator("coefficients")
     @classmethod
@@ -42,6 +49,8 @@ class PolynomialModel(_Strict):
         if set(value) != set(PARAMETER_NAMES):
             raise ValueError(f"coefficients needed for exactly {', '.join(PARAMETER_NAMES)}")
         return value
+
+    _domain = field_validator("domain_c")(_ordered)
 
     def matrix(self) -> np.ndarray:
         width = max(len(c) for c in self.coefficients.values())
@@ -58,12 +67,12 @@ class SetpointFit(_Strict):
 
 
 class SensorCalibration(_Strict):
-    serial: str
+    serial: str = Field(min_length=1, max_length=128)
     mode: Literal["reference", "norm-only"]
-    free_parameters: list[str]
-    range_g: float = Field(gt=0, description="measuring range, ± g (2, 4 or 8 for an ADXL355)")
-    lsb_g: float = Field(gt=0, description="g per code, for compensating raw codes")
-    validity_c: tuple[float, float]
+    free_parameters: list[str] = Field(max_length=12)
+    range_g: float = Field(gt=0, le=1000, description="measuring range, ± g (2, 4 or 8 for an ADXL355)")
+    lsb_g: float = Field(gt=0, le=1, description="g per code, for compensating raw codes")
+    validity_c: tuple[TemperatureC, TemperatureC]
     out_of_range: Literal["clamp", "extrapolate"] = "clamp"
     polynomial: PolynomialModel
     setpoints: list[SetpointFit]
@@ -94,7 +103,7 @@ class CalibrationFile(_Strict):
     created: str
     software_version: str
     source: dict[str, str]
-    sensors: dict[str, SensorCalibration] = Field(min_length=1)
+    sensors: dict[str, SensorCalibration] = Field(min_length=1, max_length=1024)
 
     @field_validator("format")
     @classmethod

@@ -5,7 +5,7 @@ Addresses are zero-based Modbus PDU addresses (what goes on the wire), not "4xxx
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -17,7 +17,7 @@ class ChamberRegisterMap(BaseModel):
     read from `decimals_register`). `float32`: IEEE-754 in two registers, `word_order` of the two words.
     """
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
     encoding: Literal["scaled-int16", "float32"]
     word_order: Literal["little", "big"] = "little"
@@ -26,14 +26,14 @@ class ChamberRegisterMap(BaseModel):
     decimals: int = Field(1, ge=0, le=3, description="scaled-int16: implied decimal places expected")
     decimals_register: int | None = Field(None, ge=0, le=65535, description="checked against `decimals`")
     units_register: int | None = Field(None, ge=0, le=65535)
-    units_celsius: int = Field(1, description="value of `units_register` that means °C")
+    units_celsius: int = Field(1, ge=0, le=65535, description="value of `units_register` that means °C")
     identity_register: int | None = Field(None, ge=0, le=65535)
-    identity_value: int | None = None
+    identity_value: int | None = Field(None, ge=0, le=65535)
     power_register: int | None = Field(None, ge=0, le=65535, description="event output that runs the chamber")
-    power_on: int = 1
-    power_off: int = 0
+    power_on: int = Field(1, ge=0, le=65535)
+    power_off: int = Field(0, ge=0, le=65535)
     alarm_register: int | None = Field(None, ge=0, le=65535)
-    alarm_inactive: list[int] = [0]
+    alarm_inactive: list[Annotated[int, Field(ge=0, le=65535)]] = Field([0], max_length=64)
 
 
 #: Watlow F4 (TestEquity, Thermotron, Cincinnati Sub-Zero): signed 16-bit, decimals from register 606,

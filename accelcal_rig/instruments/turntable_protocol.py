@@ -14,12 +14,17 @@ import string
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 
+#: What a template may name: the request's axis (1-based) and angle, and the values replies carry.
+_TEMPLATE_FIELDS = frozenset({"axis", "angle", "identity", "busy", "fault"})
+
+
 class Command(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
-    send: str = Field(min_length=1)
-    reply: str = Field(min_length=1, description="regular expression a good reply matches in full")
-    answer: str = Field(min_length=1, description="what a controller answers (template), for simulators")
+    send: str = Field(min_length=1, max_length=256)
+    reply: str = Field(min_length=1, max_length=256, description="regular expression a good reply matches in full")
+    answer: str = Field(min_length=1, max_length=256, description="what a controller answers (template), for "
+                        "simulators")
 
     @field_validator("reply")
     @classmethod
@@ -28,6 +33,23 @@ class Command(BaseModel):
             re.compile(value)
         except re.error as exc:
             raise ValueError(f"not a regular expression: {exc}") from None
+        return value
+
+    @field_validator("send", "answer")
+    @classmethod
+    def _template(cls, value: str) -> str:
+        """A template must format: `{axis}` and `{angle:.5f}` style fields, nothing a request cannot fill."""
+        try:
+            fields = [f for _, f, _, _ in string.Formatter().parse(value) if f is not None]
+        except ValueError as exc:
+            raise ValueError(f"not a template: {exc}") from None
+        unknown = sorted(set(fields) - _TEMPLATE_FIELDS)
+        if unknown:
+            raise ValueError(f"template fields {', '.join(unknown)} unknown (known: {', '.join(sorted(_TEMPLATE_FIELDS))})")
+        try:
+            value.format(axis=1, angle=0.0, identity="x", busy=0, fault=0)
+        except (ValueError, TypeError, IndexError) as exc:
+            raise ValueError(f"template does not format: {exc}") from None
         return value
 
     def request_pattern(self) -> re.Pattern[str]:
@@ -43,9 +65,9 @@ class Command(BaseModel):
 class TurntableProtocol(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
-    write_terminator: str = "\n"
-    read_terminator: str = "\n"
-    error_pattern: str = "^ERR"
+    write_terminator: str = Field("\n", min_length=1, max_length=4)
+    read_terminator: str = Field("\n", min_length=1, max_length=4)
+    error_pattern: str = Field("^ERR", max_length=256)
     identify: Command
     move: Command
     position: Command
@@ -53,8 +75,17 @@ class TurntableProtocol(BaseModel):
     stop: Command
     home: Command
     fault: Command
-    busy_values: list[str] = ["1"]
-    fault_ok: list[str] = ["0"]
+    busy_values: list[str] = Field(["1"], max_length=16)
+
+    @field_validator("error_pattern")
+    @classmethod
+    def _error_compiles(cls, value: str) -> str:
+        try:
+            re.compile(value)
+        except re.error as exc:
+            raise ValueError(f"not a regular expression: {exc}") from None
+        return value
+    fault_ok: list[str] = Field(["0"], max_length=16)
 
 
 #: The built-in profile: a plain SCPI-like line protocol, one command per line, one reply per command.

@@ -149,7 +149,7 @@ def _pose(record: Record, header: CampaignHeader) -> PoseRecord:
 def _soak(record: Record, header: CampaignHeader) -> SoakTrace:
     arrays = record.arrays
     m, d = arrays["t_s"].shape[0], len(header.duts)
-    if arrays["chamber_c"].shape != (m,) or arrays["dut_c"].shape not in ((m, d), (0,)) or arrays["times_s"].shape != (3,):
+    if arrays["chamber_c"].shape != (m,) or arrays["dut_c"].size != m * d or arrays["times_s"].shape != (3,):
         raise ValueError("soak columns of different lengths")
     setpoint, reached, stable = arrays["times_s"].tolist()
     return SoakTrace(str(record.meta["label"]), setpoint, str(record.meta["outcome"]), arrays["t_s"],

@@ -41,3 +41,19 @@ def test_query_granularity_does_not_change_the_answer() -> None:
     for t in np.arange(0.0, 2000.0, 1.0):
         fine.dut_c(t, 0)
     assert abs(coarse.dut_c(2000.0, 0) - fine.dut_c(2000.0, 0)) < 0.01
+
+
+def test_advancing_is_bounded_whatever_the_gaps() -> None:
+    """Setpoints a hair from the reference, and queries a hair apart, each cost one sub-step at most."""
+    from accelcal_rig.sim import thermal
+
+    m = model()
+    steps = []
+    real_step = m._step
+    m._step = lambda step_s, arrives: (steps.append(step_s), real_step(step_s, arrives))  # type: ignore[method-assign]
+    for k in range(1, 200):
+        m.set_setpoint(k * 1e-3, 23.0 + (-1) ** k * 1e-13)
+        m.air_c(k * 1e-3 + 1e-12)
+    assert len(steps) <= 2 * 2 * 200
+    m.air_c(1e6)
+    assert len(steps) <= 2 * 2 * 200 + 1e6 / thermal.MAX_STEP_S + 2
