@@ -24,6 +24,8 @@ if TYPE_CHECKING:
     from accelcal_rig.engine.session import PreparedCampaign
 
 EXIT_INTERRUPTED = 130
+#: A failure the program did not foresee (a bug): one line, and this code.
+EXIT_INTERNAL = 70
 FAULTS_HELP = ("fault injection into the simulators, e.g. rate=0.05,kinds=drop+corrupt or "
                "chamber_stall_after_min=60 (keys of simulation.faults)")
 
@@ -286,6 +288,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from accelcal_rig.engine.session import prepare
     from accelcal_rig.store.paths import journal_path
 
+    if args.output.is_dir():
+        raise ConfigError(f"{args.output}: is a folder; name the campaign file to write")
     prepared = prepare(args.procedure, args.config, args.faults)
     exists = args.output.exists() or journal_path(args.output).exists()
     if exists and not (args.overwrite or args.resume):
@@ -463,6 +467,8 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     if running is not None:
         raise ConfigError(f"{args.campaign}: a campaign is running on it ({running}): fit it once it is done")
     campaign = usable_campaign(args.campaign)
+    for note in campaign.notes:
+        print(f"rig: warning: {args.campaign}: {note}", file=sys.stderr)
     attrs = campaign.attrs
     options = FitOptions(
         mode=args.mode or str(attrs.get("fit_mode", "reference")),
@@ -760,3 +766,10 @@ def main(argv: list[str] | None = None) -> int:
     except (KeyboardInterrupt, TerminationRequested):
         print("rig: interrupted before the campaign started; nothing was moved", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except Exception as exc:  # noqa: BLE001 - a bug still reaches the operator as one line, not a traceback
+        if os.environ.get("RIG_TRACEBACK") or isinstance(exc, BrokenPipeError):
+            raise
+        detail = str(exc).strip().splitlines()
+        print(f"rig: internal error: {type(exc).__name__}{': ' + detail[0] if detail else ''} (a bug in accelcal-rig; "
+              "please report it with the command; RIG_TRACEBACK=1 shows where)", file=sys.stderr)
+        return EXIT_INTERNAL

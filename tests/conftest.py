@@ -64,6 +64,8 @@ def fitted_paper_campaign(paper_campaign: Path, tmp_path_factory: pytest.TempPat
 def kill_mid_pose(campaign: Path, keep_poses: int) -> int:
     """Leave the campaign's journal as `kill -9` in the middle of storing pose `keep_poses + 1` would: whole
     up to the record of pose `keep_poses`, then half of the next pose's record. Returns that half's bytes."""
+    from accelcal_rig.store.codec import replay
+    from accelcal_rig.store.hdf5_file import campaign_image
     from accelcal_rig.store.journal import scan
     from accelcal_rig.store.paths import journal_path
 
@@ -71,8 +73,11 @@ def kill_mid_pose(campaign: Path, keep_poses: int) -> int:
     data = journal.read_bytes()
     poses = [r for r in scan(data).records if r.kind == "pose"]
     kept, cut = poses[keep_poses - 1], poses[keep_poses]
+    whole = data[:kept.offset + kept.size]
     torn = data[cut.offset:cut.offset + cut.size // 2]
-    journal.write_bytes(data[:kept.offset + kept.size] + torn)
+    journal.write_bytes(whole + torn)
+    # The campaign file is never ahead of its journal: leave it as it was built from the last whole record.
+    campaign.write_bytes(campaign_image(replay(scan(whole), journal.name), len(whole)))
     return len(torn)
 
 

@@ -13,7 +13,9 @@ from accelcal_rig.instruments.adxl355 import OUTPUT_DATA_RATES_HZ
 #: Most temperature polls a campaign's ramp and soak deadlines allow (`rig plan` plays them all).
 MAX_POLLS = 200_000
 #: Most poses a plan may hold (setpoints × schedule, or a cool-down's records).
-MAX_PLAN_POSES = 50_000
+MAX_PLAN_POSES = 20_000
+#: Most orientations a schedule may list (each is solved for the turntable's angles when the plan compiles).
+MAX_SCHEDULE_POSES = 2_000
 
 
 class _Strict(BaseModel):
@@ -65,7 +67,7 @@ class SphereSchedule(_Strict):
     """`count` gravity directions spread evenly over the sphere (Fibonacci lattice)."""
 
     kind: Literal["sphere"]
-    count: int = Field(ge=6, le=MAX_PLAN_POSES)
+    count: int = Field(ge=6, le=MAX_SCHEDULE_POSES)
 
     @property
     def size(self) -> int:
@@ -77,7 +79,7 @@ class TiltSchedule(_Strict):
     y axis up, roll tilts the x axis down; (0, 0) is level with z up."""
 
     kind: Literal["tilt"]
-    pitch_roll_deg: list[tuple[float, float]] = Field(min_length=1, max_length=MAX_PLAN_POSES)
+    pitch_roll_deg: list[tuple[float, float]] = Field(min_length=1, max_length=MAX_SCHEDULE_POSES)
 
     @property
     def size(self) -> int:
@@ -96,7 +98,7 @@ class ExplicitSchedule(_Strict):
 
     kind: Literal["explicit"]
     angles_deg: list[Annotated[list[AngleDeg], Field(min_length=1, max_length=6)]] = Field(
-        min_length=1, max_length=MAX_PLAN_POSES)
+        min_length=1, max_length=MAX_SCHEDULE_POSES)
 
     @property
     def size(self) -> int:
@@ -154,7 +156,7 @@ class Cooldown(_Strict):
     """Free cool-down validation (paper §4.3, Fig. 11): after the soak at the procedure's one setpoint,
     hold one pose, let the chamber go (switched off, or set to ambient) and record while the DUTs cool."""
 
-    pose: int = Field(1, ge=1, le=MAX_PLAN_POSES, description="pose number of the schedule to hold")
+    pose: int = Field(1, ge=1, le=MAX_SCHEDULE_POSES, description="pose number of the schedule to hold")
     chamber: Literal["power-off", "ambient"] = Field(
         "power-off", description="power-off: the chamber switched off (its power event); ambient: its set point "
                                  "to ambient_c")
@@ -177,7 +179,8 @@ class Procedure(_Strict):
 
     name: str = Field(min_length=1, max_length=128, pattern=r"^[A-Za-z0-9_.-]+$")
     description: str = Field("", max_length=10_000)
-    rig: str = Field(min_length=1, max_length=4096, description="rig config path, relative to this file")
+    rig: str = Field(min_length=1, max_length=4096, pattern=r"^[^\x00]+$",
+                     description="rig config path, relative to this file")
     setpoints_c: list[TemperatureC] = Field(min_length=1, max_length=200)
     soak: SoakCriterion = SoakCriterion()
     schedule: Schedule

@@ -138,7 +138,10 @@ def load_yaml_with_lines(path: Path) -> tuple[Any, dict[KeyPath, int], str]:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ConfigError(f"{path}: file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except UnicodeDecodeError as exc:
+        line = path.read_bytes()[:exc.start].count(b"\n") + 1
+        raise ConfigError(f"{path}:{line}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x})") from None
+    except (OSError, ValueError) as exc:
         raise ConfigError(f"{path}: cannot read: {str(exc).splitlines()[0]}") from None
     data, root = _parse(text, str(path))
     if root is None:

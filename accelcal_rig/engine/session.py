@@ -32,8 +32,11 @@ from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
 from accelcal_rig.sim.wire_rig import SimulatedRig
 from accelcal_rig.store.content import Campaign
-from accelcal_rig.store.read import load_campaign
+from accelcal_rig.store.lock import campaign_lock
+from accelcal_rig.store.paths import journal_path
+from accelcal_rig.store.read import file_currency, load_campaign
 from accelcal_rig.store.records import StoredPlan
+from accelcal_rig.store.repair import repair_campaign
 from accelcal_rig.store.space import StorageEstimate, estimate_storage
 from accelcal_rig.store.writer import CampaignWriter
 
@@ -110,7 +113,7 @@ def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, see
     snapshot at every transition, temperature poll and pose; the rig config's `notify` is sent events.
     """
     wall_start = time.perf_counter()
-    if resume and output.exists():
+    if resume and (output.exists() or journal_path(output).exists()):
         return resume_campaign(prepared, output, dry_run=dry_run, calibration=calibration,
                                build_instruments=build_instruments, progress=progress)
     with _connected(prepared, dry_run, seed, build_instruments) as (instruments, clock):
@@ -133,7 +136,8 @@ def resume_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, 
     stored = load_campaign(output)
     check_same_campaign(output, stored, prepared.procedure, prepared.rig, prepared.plan, dry_run)
     if stored.state == "done" and stored.poses_planned == len(stored.poses):
-        raise NothingToResume(f"{output}: the campaign is complete: nothing to resume")
+        raise NothingToResume("; ".join([f"{output}: the campaign is complete: nothing to resume",
+                                         *_finish_complete(prepared, output, stored, calibration)]))
     writer, reopened = CampaignWriter.reopen(output, prepared.storage(dry_run))
     try:
         # Noise of a resumed dry run is new noise (the same sensors, not a replay of the first run).
@@ -150,6 +154,20 @@ def resume_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, 
             return _run(prepared, output, writer, instruments, clock, point, calibration, wall_start, progress)
     finally:
         _close(writer)
+
+
+def _finish_complete(prepared: PreparedCampaign, output: Path, stored: Campaign, calibration: Path | None) -> list[str]:
+    """What a complete campaign may still lack after a full disk or a kill at its very end: a campaign
+    file as current as its journal, its calibration file. Done now; what was done, one line each."""
+    done = []
+    with campaign_lock(output, "rig resume"):
+        if file_currency(output, stored, writing=False) != "current":
+            repair_campaign(output)
+            done.append(f"{output.name} brought up to date from its journal")
+        if calibration is not None and not calibration.exists() and prepared.procedure.model.fit.mode != "none":
+            procedure = prepared.procedure.model
+            done.append(_fit_stage(procedure, output, calibration)(load_campaign(output)))
+    return done
 
 
 @contextmanager

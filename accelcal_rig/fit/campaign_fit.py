@@ -20,7 +20,8 @@ from accelcal_rig.fit.metrics import drift_mg, noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, norm_only_gauge
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
 from accelcal_rig.store.content import Campaign
-from accelcal_rig.store.read import DutPoses, measurements_sha256, read_dut_poses
+from accelcal_rig.store.content import measurements_sha256
+from accelcal_rig.store.read import DutPoses, read_dut_poses
 from accelcal_rig.store.records import utc_now
 
 TemperatureModel = Literal["per-setpoint", "joint"]

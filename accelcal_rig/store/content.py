@@ -7,6 +7,7 @@ them into this, so what a reader sees does not depend on which file it came from
 from __future__ import annotations
 
 import datetime as dt
+import hashlib
 from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
@@ -156,6 +157,17 @@ class Campaign:
         if foreign:
             problems.append(f"poses not in the plan: {', '.join(foreign[:5])}{' …' if len(foreign) > 5 else ''}")
         return problems
+
+
+def measurements_sha256(campaign: Campaign) -> str:
+    """Digest of the measured data (pose keys, raw codes, temperatures, references), not of a file: the
+    same campaign read from its journal or its HDF5 file has the same digest."""
+    digest = hashlib.sha256()
+    digest.update(b"".join(p.step_key.encode() for p in campaign.poses))
+    for serial in sorted(campaign.serials):
+        for name in ("raw_codes", "temperature_c", "gravity_reference_g"):
+            digest.update(np.ascontiguousarray(campaign.dut_column(serial, name)).tobytes())
+    return digest.hexdigest()
 
 
 def _implausible_rows(campaign: Campaign, serial: str) -> list[int]:

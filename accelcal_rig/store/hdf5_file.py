@@ -17,7 +17,7 @@ from typing import Any
 import h5py
 import numpy as np
 
-from accelcal_rig.store.content import POSE_FIELDS, Campaign
+from accelcal_rig.store.content import POSE_FIELDS, Campaign, measurements_sha256
 from accelcal_rig.store.records import (
     CampaignHeader, DutPoseRecord, PoseRecord, RunStart, SoakTrace, StoredEvent, StoredPlan,
 )
@@ -35,6 +35,8 @@ _UNITS = {"setpoint_c": "degC", "commanded_angles_deg": "deg", "measured_angles_
           "chamber_c": "degC", "dut_c": "degC", "settled_dut_c": "degC", "gravity_g": "g"}
 #: Names of the in-memory files images are built in (HDF5 wants one; nothing is written under it).
 _image_names = itertools.count()
+#: Most runs (1 + resumes) a file may claim before it is taken for damaged.
+_MAX_RUNS = 10_000
 #: Largest plan and sample count a file may claim before it is taken for damaged.
 _MAX_ROWS = 10_000_000
 
@@ -66,7 +68,7 @@ def root_attrs(campaign: Campaign, journal_bytes: int) -> dict[str, Any]:
             "campaign_id": campaign.header.campaign_id, "state": campaign.state, "started": campaign.header.created,
             "finished": campaign.finished, "abort_reason": campaign.abort_reason, "runs": campaign.run_count,
             "writer_pid": last_run.pid, "writer_host": last_run.host, "poses_done": len(campaign.poses),
-            "journal_bytes": journal_bytes, **campaign.attrs}
+            "journal_bytes": journal_bytes, "measurements_sha256": measurements_sha256(campaign), **campaign.attrs}
 
 
 def campaign_image(campaign: Campaign, journal_bytes: int) -> bytes:
@@ -238,6 +240,12 @@ def read_campaign_file(file: h5py.File) -> Campaign:
     campaign.abort_reason = _text(attrs.get("abort_reason", ""))
     campaign.finished = _text(attrs.get("finished", ""))
     runs = int(attrs.get("runs", 1))
+    if not 1 <= runs <= _MAX_RUNS:
+        raise DamagedFile(f"attribute runs is {runs}")
+    recorded = _text(attrs.get("measurements_sha256", ""))
+    if recorded and longest == whole and recorded != measurements_sha256(campaign):
+        campaign.damage.append("its measurements do not match the digest written with them (changed or damaged "
+                               "since accelcal-rig wrote the file)")
     campaign.runs = [RunStart(k, 0, "", "") for k in range(1, runs)] + [
         RunStart(runs, int(attrs.get("writer_pid", 0)), _text(attrs.get("writer_host", "")), "")]
     return campaign

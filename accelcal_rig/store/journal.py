@@ -13,6 +13,7 @@ stretch that fails its checksum, skipped to the next record that passes), a fore
 from __future__ import annotations
 
 import json
+import math
 import os
 import struct
 import zlib
@@ -61,43 +62,78 @@ def _decode_payload(offset: int, payload: bytes) -> Record:
     position, arrays = _META_LENGTH.size + head_length, {}
     for name, dtype_text, shape in head.get("arrays", []):
         dtype = np.dtype(dtype_text)
-        if dtype.kind not in _DTYPE_KINDS or not all(isinstance(s, int) and s >= 0 for s in shape):
+        if dtype.kind not in _DTYPE_KINDS or len(shape) > 4 or not all(isinstance(s, int) and s >= 0 for s in shape):
             raise ValueError(f"array {name}: unexpected type")
-        size = dtype.itemsize * int(np.prod(shape, dtype=np.int64))
+        count = math.prod(shape)
+        size = dtype.itemsize * count
         if position + size > len(payload):
             raise ValueError(f"array {name} runs past the record")
-        arrays[str(name)] = np.frombuffer(payload, dtype, int(np.prod(shape, dtype=np.int64)), position).reshape(shape).copy()
+        arrays[str(name)] = np.frombuffer(payload, dtype, count, position).reshape(shape).copy()
         position += size
     if position != len(payload):
         raise ValueError("bytes left over after the arrays")
     return Record(offset, _HEAD.size + len(payload), head["kind"], head["meta"], arrays)
 
 
-def _record_at(data: bytes | memoryview, offset: int) -> Record | None:
+#: The largest record a journal may hold (a pose of 64 DUTs × 100 000 samples is 77 MB): a length field
+#: claiming more is damage, never a reason to read gigabytes.
+MAX_RECORD_BYTES = 256 << 20
+#: How much of the journal is searched at a time for the next record after damage.
+_SEARCH_CHUNK_BYTES = 1 << 20
+#: How far past the last record `Scan.tail_bytes` looks for what a killed write left.
+_TAIL_LOOK_BYTES = 16 << 20
+
+
+class _Bytes:
+    """Random access to a journal's bytes: an open file (read as needed) or bytes in memory."""
+
+    def __init__(self, data: bytes | None = None, fd: int | None = None) -> None:
+        self._data, self._fd = data, fd
+        self.size = len(data) if data is not None else os.fstat(fd).st_size  # type: ignore[arg-type]
+
+    def read(self, offset: int, length: int) -> bytes:
+        length = max(0, min(length, self.size - offset))
+        if self._data is not None:
+            return self._data[offset:offset + length]
+        return os.pread(self._fd, length, offset)  # type: ignore[arg-type]
+
+    def find(self, start: int) -> int:
+        """The next offset of MAGIC at or after `start`, or -1."""
+        while start < self.size:
+            chunk = self.read(start, _SEARCH_CHUNK_BYTES + len(MAGIC) - 1)
+            found = chunk.find(MAGIC)
+            if found != -1:
+                return start + found
+            start += _SEARCH_CHUNK_BYTES
+        return -1
+
+
+def _record_at(source: _Bytes, offset: int) -> Record | None:
     """The whole, checksummed record starting at `offset`, or None."""
-    if offset + _HEAD.size > len(data):
+    head = source.read(offset, _HEAD.size)
+    if len(head) < _HEAD.size:
         return None
-    magic, length, crc = _HEAD.unpack_from(data, offset)
-    start, end = offset + _HEAD.size, offset + _HEAD.size + length
-    if magic != MAGIC or end > len(data) or length < _META_LENGTH.size:
+    magic, length, crc = _HEAD.unpack(head)
+    if magic != MAGIC or length > MAX_RECORD_BYTES or offset + _HEAD.size + length > source.size or \
+            length < _META_LENGTH.size:
         return None
-    payload = bytes(data[start:end])
+    payload = source.read(offset + _HEAD.size, length)
     if zlib.crc32(payload) != crc:
         return None
     try:
         return _decode_payload(offset, payload)
-    except (ValueError, TypeError, UnicodeDecodeError, struct.error, OverflowError):
+    except (ValueError, TypeError, UnicodeDecodeError, struct.error, OverflowError, MemoryError):
         return None
 
 
-def _next_record(data: bytes, start: int) -> Record | None:
+def _next_record(source: _Bytes, start: int) -> Record | None:
     """The first whole record at or after `start` (where reading picks up again after damage)."""
-    position = data.find(MAGIC, start)
+    position = source.find(start)
     while position != -1:
-        record = _record_at(data, position)
+        record = _record_at(source, position)
         if record is not None:
             return record
-        position = data.find(MAGIC, position + 1)
+        position = source.find(position + 1)
     return None
 
 
@@ -108,33 +144,43 @@ class Scan:
     records: list[Record] = field(default_factory=list)
     end: int = 0                                         # just after the last whole record
     damaged: list[tuple[int, int]] = field(default_factory=list)  # (offset, bytes) skipped between records
-    tail_bytes: int = 0                                  # non-zero bytes after `end`: a record written in part
+    tail_bytes: int = 0                                  # non-zero bytes soon after `end`: a record written in part
 
     @property
     def clean(self) -> bool:
         return not self.damaged and not self.tail_bytes
 
 
-def scan(data: bytes) -> Scan:
+def _scan(source: _Bytes) -> Scan:
     result = Scan()
     position = 0
-    while position < len(data):
-        record = _record_at(data, position)
+    while position < source.size:
+        record = _record_at(source, position)
         if record is None:
-            following = _next_record(data, position + 1)
+            following = _next_record(source, position + 1)
             if following is None:
                 break
             result.damaged.append((position, following.offset - position))
             record = following
         result.records.append(record)
         position = result.end = record.offset + record.size
-    result.tail_bytes = len(data[result.end:].rstrip(b"\0"))
+    result.tail_bytes = len(source.read(result.end, _TAIL_LOOK_BYTES).rstrip(b"\0"))
     return result
 
 
+def scan(data: bytes) -> Scan:
+    """Every whole record in `data` (a journal's bytes)."""
+    return _scan(_Bytes(data=data))
+
+
 def read_journal(path: Path) -> Scan:
-    """Every whole record of the journal at `path` (read-only; OSError if it cannot be read)."""
-    return scan(path.read_bytes())
+    """Every whole record of the journal at `path`, read record by record (memory bounded by its records,
+    whatever the file's size); OSError if it cannot be read."""
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        return _scan(_Bytes(fd=fd))
+    finally:
+        os.close(fd)
 
 
 class JournalWriter:
@@ -179,8 +225,8 @@ class JournalWriter:
         with disk_errors(path, "the campaign journal"):
             fd = os.open(path, os.O_RDWR)
             try:
-                found = scan(os.pread(fd, os.fstat(fd).st_size, 0))
-                if found.tail_bytes:
+                found = _scan(_Bytes(fd=fd))
+                if os.fstat(fd).st_size > found.end:  # a record written in part, or zeros allocated ahead
                     os.ftruncate(fd, found.end)
                     os.fsync(fd)
             except BaseException:

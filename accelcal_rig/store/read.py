@@ -8,7 +8,6 @@ readable campaign is one ConfigError naming the file and what is wrong with it.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import socket
@@ -38,6 +37,8 @@ def load_campaign(path: Path) -> Campaign:
     """The campaign stored as `path` (its journal, else the HDF5 file itself)."""
     if path.is_dir():
         raise ConfigError(f"{path}: is a folder, not a campaign file")
+    if path.exists() and not path.is_file():
+        raise ConfigError(f"{path}: not a regular file")
     journal = journal_path(path)
     fallback_note = ""
     if journal.is_file():
@@ -47,12 +48,13 @@ def load_campaign(path: Path) -> Campaign:
             raise ConfigError(f"{journal}: cannot read: {exc.strerror}") from None
         try:
             campaign = replay(found, journal.name)
-            campaign.journal_bytes = found.end
-            return campaign
         except NotACampaignJournal as exc:
             if not path.is_file():
                 raise ConfigError(f"{path}: no campaign: {exc}") from None
             fallback_note = f"{exc}: read from {path.name} instead"
+        else:
+            campaign.journal_bytes = found.end
+            return _unless_the_file_holds_more(path, campaign)
     if not path.exists():
         if stale_temporaries(journal) or stale_temporaries(path):
             raise ConfigError(f"{path}: no campaign: a run stopped before it had created it (nothing was measured); "
@@ -64,8 +66,44 @@ def load_campaign(path: Path) -> Campaign:
     return campaign
 
 
+def file_identity(path: Path) -> tuple[str, int] | None:
+    """(campaign id, poses) the HDF5 file says it holds, from its attributes alone; None when it cannot
+    say (missing, unreadable, or written before campaigns had ids)."""
+    try:
+        with h5py.File(path, "r", locking=False) as file:
+            identity = str(file.attrs.get("campaign_id", ""))
+            return (identity, int(file.attrs.get("poses_done", 0))) if identity else None
+    except (OSError, ValueError, TypeError, KeyError):
+        return None
+
+
+def _unless_the_file_holds_more(path: Path, campaign: Campaign) -> Campaign:
+    """The journal's campaign, unless the HDF5 file beside it is another campaign (refused) or holds poses
+    the journal has lost (then the file is read, and the notes say so)."""
+    identity = file_identity(path) if path.is_file() else None
+    if identity is None:
+        return campaign
+    campaign_id, poses = identity
+    if campaign_id != campaign.header.campaign_id:
+        raise ConfigError(f"{path}: it and its journal hold different campaigns ({campaign_id[:12]} and "
+                          f"{campaign.header.campaign_id[:12]}): move the one that does not belong away")
+    if poses <= len(campaign.poses):
+        return campaign
+    try:
+        from_file = read_hdf5_campaign(path)
+    except ConfigError:
+        return campaign
+    if from_file.damage or len(from_file.poses) <= len(campaign.poses):
+        return campaign
+    from_file.notes.append(f"{journal_path(path).name} holds {len(campaign.poses)} poses, {path.name} "
+                           f"{len(from_file.poses)}: read from {path.name} (rig repair gives the journal what it lost)")
+    return from_file
+
+
 def read_hdf5_campaign(path: Path) -> Campaign:
     """The campaign in the HDF5 file alone (no journal consulted)."""
+    if not path.is_file():
+        raise ConfigError(f"{path}: not a regular file")
     try:
         file = h5py.File(path, "r", locking=False)
     except (OSError, ValueError) as exc:
@@ -198,17 +236,6 @@ def read_dut_poses(campaign: Campaign, serial: str) -> DutPoses:
         reference_accuracy_arcsec=float(campaign.header.turntable_accuracy_arcsec),
         truth_parameters=campaign.truth_column(serial, "parameters"),
     )
-
-
-def measurements_sha256(campaign: Campaign) -> str:
-    """Digest of the measured data (pose keys, raw codes, temperatures, references), not of a file: the
-    same campaign read from its journal or its HDF5 file has the same digest."""
-    digest = hashlib.sha256()
-    digest.update(b"".join(p.step_key.encode() for p in campaign.poses))
-    for serial in sorted(campaign.serials):
-        for name in ("raw_codes", "temperature_c", "gravity_reference_g"):
-            digest.update(np.ascontiguousarray(campaign.dut_column(serial, name)).tobytes())
-    return digest.hexdigest()
 
 
 def rows_at_setpoint(path: Path, campaign: Campaign, setpoint_c: float | None) -> tuple[float, np.ndarray]:

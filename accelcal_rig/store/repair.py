@@ -22,9 +22,9 @@ from accelcal_rig.store.codec import (
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.durable import disk_errors, fsync_directory, write_atomically
 from accelcal_rig.store.hdf5_file import campaign_image
-from accelcal_rig.store.journal import JournalWriter, scan
+from accelcal_rig.store.journal import JournalWriter, read_journal
 from accelcal_rig.store.paths import journal_path
-from accelcal_rig.store.read import read_hdf5_campaign
+from accelcal_rig.store.read import file_identity, read_hdf5_campaign
 from accelcal_rig.store.records import StateChange
 
 
@@ -72,19 +72,34 @@ def mend_journal(path: Path) -> list[str]:
         write_atomically(journal, journal_bytes_of(campaign), "the campaign journal")
         return [f"{path.name} had no journal: {journal.name} made from its {len(campaign.poses)} poses"]
     with disk_errors(journal, "the campaign journal"):
-        data = journal.read_bytes()
-    found = scan(data)
+        found = read_journal(journal)
     try:
-        replay(found, journal.name)
+        held = replay(found, journal.name)
     except NotACampaignJournal as exc:
         campaign = _from_campaign_file(path, str(exc))
         kept = _keep_copy(journal)
         write_atomically(journal, journal_bytes_of(campaign), "the campaign journal")
         return [f"{exc}: kept as {kept.name}, {journal.name} made again from {path.name} ({len(campaign.poses)} poses)"]
+    identity = file_identity(path) if path.is_file() else None
+    if identity is not None and identity[0] != held.header.campaign_id:
+        raise ConfigError(f"{path}: it and its journal hold different campaigns ({identity[0][:12]} and "
+                          f"{held.header.campaign_id[:12]}): move the one that does not belong away; nothing was changed")
+    if identity is not None and identity[1] > len(held.poses):
+        try:
+            from_file = read_hdf5_campaign(path)
+        except ConfigError:  # damaged too: what the journal holds is what is left
+            from_file = held
+        if from_file is not held and not from_file.damage and held.stored_keys <= from_file.stored_keys:
+            kept = _keep_copy(journal)
+            write_atomically(journal, journal_bytes_of(from_file), "the campaign journal")
+            return [f"{journal.name} had lost poses {path.name} holds: made again from {path.name} "
+                    f"({len(from_file.poses)} poses), the old one kept as {kept.name}"]
     if not found.damaged:
         return []
+    with disk_errors(journal, "the campaign journal"), journal.open("rb") as original:
+        whole = b"".join(os.pread(original.fileno(), r.size, r.offset) for r in found.records)
     kept = _keep_copy(journal)
-    write_atomically(journal, b"".join(data[r.offset:r.offset + r.size] for r in found.records), "the campaign journal")
+    write_atomically(journal, whole, "the campaign journal")
     skipped = sum(length for _, length in found.damaged)
     return [f"{journal.name}: {len(found.damaged)} damaged stretches ({skipped} bytes) left out, every whole record "
             f"kept; the original kept as {kept.name}"]

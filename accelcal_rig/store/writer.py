@@ -86,6 +86,9 @@ class CampaignWriter:
                 raise ConfigError(f"{path}: campaign file exists; choose another -o or pass --overwrite")
             for stale in stale_temporaries(path) + stale_temporaries(journal):
                 stale.unlink(missing_ok=True)
+            # Replaced: the old campaign file goes first, so a kill from here on leaves one campaign (the
+            # old journal alone, or the new one), never the new journal beside the old campaign's file.
+            path.unlink(missing_ok=True)
             header = CampaignHeader(campaign_id=uuid.uuid4().hex, created=utc_now(), software_version=__version__,
                                     **header_fields)
             campaign = Campaign(header)

@@ -10,7 +10,8 @@ import pytest
 
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, fit_campaign
 from accelcal_rig.store.paths import journal_path
-from accelcal_rig.store.read import load_campaign, measurements_sha256, read_hdf5_campaign
+from accelcal_rig.store.content import measurements_sha256
+from accelcal_rig.store.read import load_campaign, read_hdf5_campaign
 
 
 @pytest.fixture(scope="module")
