@@ -5,13 +5,14 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import math
 import os
 import signal
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NoReturn
 
 from accelcal_rig import __version__
 from accelcal_rig.engine.campaign import TerminationRequested
@@ -30,6 +31,30 @@ FAULTS_HELP = ("fault injection into the simulators, e.g. rate=0.05,kinds=drop+c
                "chamber_stall_after_min=60 (keys of simulation.faults)")
 
 
+class _Parser(argparse.ArgumentParser):
+    """Command-line mistakes are one line too (argparse would print its usage above them)."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def _number(low: float, high: float, unit: str = "", integer: bool = False) -> Callable[[str], float]:
+    """An argparse type: a finite number within [low, high]."""
+    def parse(text: str) -> float:
+        try:
+            value = int(text) if integer else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a{'' if integer else ' finite'} number") from None
+        if not (math.isfinite(value) and low <= value <= high):
+            raise argparse.ArgumentTypeError(f"{text} is outside {low:g} … {high:g}{' ' + unit if unit else ''}")
+        return value
+    return parse
+
+
+_TEMPERATURE = _number(-100.0, 300.0, "°C")
+_SEED = _number(0, 2**32 - 1, integer=True)
+
+
 def _command(commands: argparse._SubParsersAction, name: str, summary: str, description: str,
              example: str) -> argparse.ArgumentParser:
     """A subcommand whose --help ends with an example."""
@@ -44,7 +69,7 @@ def _analysis_command(analyses: argparse._SubParsersAction, name: str, summary: 
     command.add_argument("campaign", type=Path, help="campaign file (HDF5)")
     if calibration:
         command.add_argument("--calibration", type=Path, required=True, help="calibration file (YAML) of the same DUTs")
-    command.add_argument("--setpoint", type=float, help="the setpoint to analyse (default: the file's only one)")
+    command.add_argument("--setpoint", type=_TEMPERATURE, help="the setpoint to analyse (default: the file's only one)")
     if figure:
         command.add_argument("--figure", type=Path, help="write the figure (PNG) here")
     command.add_argument("--json", action="store_true", help="print one JSON object")
@@ -52,7 +77,7 @@ def _analysis_command(analyses: argparse._SubParsersAction, name: str, summary: 
 
 
 def _build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="rig", description="Run MEMS accelerometer calibration campaigns.")
+    parser = _Parser(prog="rig", description="Run MEMS accelerometer calibration campaigns.")
     parser.add_argument("--version", action="version", version=f"accelcal-rig {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -64,7 +89,7 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("-o", "--output", type=Path, required=True, help="campaign file to create (HDF5)")
     run.add_argument("--config", type=Path, help="rig config YAML (overrides the procedure's `rig`)")
     run.add_argument("--dry-run", action="store_true", help="simulated rig in virtual time")
-    run.add_argument("--seed", type=int, default=0, help="seed of the simulated noise (default 0)")
+    run.add_argument("--seed", type=_SEED, default=0, help="seed of the simulated noise (default 0)")
     run.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
     run.add_argument("--overwrite", action="store_true", help="replace an existing campaign file")
     run.add_argument("--resume", action="store_true",
@@ -127,7 +152,7 @@ def _build_parser() -> argparse.ArgumentParser:
                    "stdout is one JSON object with the endpoints. Ctrl-C stops it.",
                    "rig sim configs/sim.yaml")
     sim.add_argument("rig", type=Path, help="rig config YAML")
-    sim.add_argument("--seed", type=int, default=0, help="seed of the simulated noise (default 0)")
+    sim.add_argument("--seed", type=_SEED, default=0, help="seed of the simulated noise (default 0)")
     sim.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
 
     fit = _command(commands, "fit", "fit the error model of every DUT and write a calibration file",
@@ -158,23 +183,27 @@ def _build_parser() -> argparse.ArgumentParser:
     recording.add_argument("--columns", default="time,x,y,z", metavar="TIME,X,Y,Z[,TEMPERATURE]",
                            help="CSV column names, in this order (default: time,x,y,z)")
     recording.add_argument("--time-unit", choices=["s", "ms", "samples"], default="s", help="of the time column")
-    recording.add_argument("--rate-hz", type=float, help="sample rate, when the time column counts samples")
+    recording.add_argument("--rate-hz", type=_number(1e-3, 1e7, "Hz"), help="sample rate, when the time column counts "
+                                                                              "samples")
     recording.add_argument("--units", choices=["g", "counts", "m/s2"], default="g", help="of x, y, z (default g)")
-    recording.add_argument("--counts-per-g", type=float, help="with --units counts (ADXL355 at ±2 g: 256000)")
-    recording.add_argument("--zero-code", type=float, default=0.0,
+    recording.add_argument("--counts-per-g", type=_number(1e-6, 1e12), help="with --units counts (ADXL355 at ±2 g: "
+                                                                          "256000)")
+    recording.add_argument("--zero-code", type=_number(-1e12, 1e12), default=0.0,
                            help="code of 0 g: 0 for signed codes (default), 32768 for a 16-bit offset-binary ADC")
     recording.add_argument("--serial", help="sensor name in the calibration (default: the file's name; campaign "
                                             "files: the first DUT)")
-    recording.add_argument("--setpoint", type=float, help="campaign files: the setpoint whose poses to use")
+    recording.add_argument("--setpoint", type=_TEMPERATURE, help="campaign files: the setpoint whose poses to use")
     recording.add_argument("--parameters", choices=["all", "bias-scale"], default="all",
                            help="all: bias, scale, non-orthogonality (9); bias-scale: 6 (default all)")
-    recording.add_argument("--temperature-c", type=float, help="the recording's temperature, if it has none")
-    recording.add_argument("--window-s", type=float, default=0.5, help="variance window (default 0.5 s)")
-    recording.add_argument("--init-s", type=float, default=2.0,
+    recording.add_argument("--temperature-c", type=_TEMPERATURE, help="the recording's temperature, if it has none")
+    recording.add_argument("--window-s", type=_number(1e-3, 3600, "s"), default=0.5, help="variance window (default "
+                                                                                          "0.5 s)")
+    recording.add_argument("--init-s", type=_number(1e-3, 3600, "s"), default=2.0,
                            help="initial still period that sets the threshold (default 2 s)")
-    recording.add_argument("--threshold-factor", type=float, default=10.0,
+    recording.add_argument("--threshold-factor", type=_number(1.0, 1e6), default=10.0,
                            help="threshold = this × the initial period's variance (default 10)")
-    recording.add_argument("--min-interval-s", type=float, default=1.0, help="shortest static interval (default 1 s)")
+    recording.add_argument("--min-interval-s", type=_number(1e-3, 3600, "s"), default=1.0,
+                           help="shortest static interval (default 1 s)")
     recording.add_argument("--json", action="store_true", help="print the intervals and results as one JSON object")
 
     analyze = _command(commands, "analyze", "the paper's other experiments on a campaign file: positions, tilt, cooldown",
@@ -190,8 +219,8 @@ def _build_parser() -> argparse.ArgumentParser:
         "each fit did not use (paper Fig. 8). Made for procedures/positions-study.yaml (1296 orientations).",
         "rig analyze positions campaign.h5 --figure positions.png", calibration=False, figure=True)
     positions.add_argument("--sizes", help="comma-separated subset sizes (default: the paper's 1296,648,…,12)")
-    positions.add_argument("--subsets", type=int, default=10, help="random subsets per size (default 10)")
-    positions.add_argument("--seed", type=int, default=0, help="seed of the random subsets (default 0)")
+    positions.add_argument("--subsets", type=_number(1, 1000, integer=True), default=10, help="random subsets per size (default 10)")
+    positions.add_argument("--seed", type=_SEED, default=0, help="seed of the random subsets (default 0)")
     positions.add_argument("--mode", choices=["reference", "norm-only"], help="default: the campaign's fit mode")
     _analysis_command(
         analyses, "tilt", "pitch and roll before and after a calibration, against the reference",
@@ -745,6 +774,11 @@ def run_program() -> None:
     raise SystemExit(code)
 
 
+def _one_line(error: BaseException) -> str:
+    """An error's message as one line, whatever text from a file it quotes."""
+    return " ".join(str(error).splitlines())
+
+
 def main(argv: list[str] | None = None) -> int:
     args = _build_parser().parse_args(argv)
     # Driver libraries log their own view of a failure; ours is the one line that names the instrument.
@@ -757,11 +791,11 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return handler(args)
     except CampaignAborted as exc:
-        print(f"rig: campaign aborted, rig in safe state: {exc}", file=sys.stderr)
+        print(f"rig: campaign aborted, rig in safe state: {_one_line(exc)}", file=sys.stderr)
         interrupted = isinstance(exc.__cause__, (KeyboardInterrupt, TerminationRequested))
         return EXIT_INTERRUPTED if interrupted else exc.exit_code
     except RigError as exc:
-        print(f"rig: error: {exc}", file=sys.stderr)
+        print(f"rig: error: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
     except (KeyboardInterrupt, TerminationRequested):
         print("rig: interrupted before the campaign started; nothing was moved", file=sys.stderr)

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import csv
 import hashlib
+import io
+import math
+from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
@@ -14,6 +17,11 @@ from accelcal_rig.errors import ConfigError
 from accelcal_rig.store.read import dut_description, rows_at_setpoint, usable_campaign
 
 STANDARD_GRAVITY_M_S2 = 9.80665
+#: The largest number a recording's CSV may hold, and the largest reading (in g, once scaled) and
+#: temperature range taken for a recording of an accelerometer turned by hand.
+MAX_VALUE = 1e15
+MAX_ACCEL_G = 1000.0
+MIN_TEMPERATURE_C, MAX_TEMPERATURE_C = -100.0, 300.0
 Units = Literal["g", "counts", "m/s2"]
 TimeUnit = Literal["s", "ms", "samples"]
 
@@ -63,25 +71,33 @@ def read_csv_recording(path: Path, layout: CsvLayout) -> Recording:
         raw = path.read_bytes()
     except OSError as exc:
         raise ConfigError(f"{path}: cannot read ({exc.strerror})") from None
-    reader = csv.reader(raw.decode("utf-8", errors="replace").splitlines())
-    header = next(reader, None)
-    if header is None:
-        raise ConfigError(f"{path}: empty file")
-    header = [h.strip() for h in header]
-    wanted = [layout.time, layout.x, layout.y, layout.z] + ([layout.temperature] if layout.temperature else [])
-    missing = [c for c in wanted if c not in header]
-    if missing:
-        raise ConfigError(f"{path}: no column {', '.join(missing)} (columns: {', '.join(header)}); map them with "
-                          "--columns time,x,y,z[,temperature]")
-    index = [header.index(c) for c in wanted]
-    values = []
-    for line, row in enumerate(reader, start=2):
-        if not row:
-            continue
-        try:
-            values.append([float(row[i]) for i in index])
-        except (ValueError, IndexError):
-            raise ConfigError(f"{path}:{line}: not a number in columns {', '.join(wanted)}") from None
+    reader = csv.reader(io.StringIO(raw.decode("utf-8-sig", errors="replace"), newline=""))
+    try:
+        header = next(reader, None)
+        if header is None:
+            raise ConfigError(f"{path}: empty file")
+        header = [h.strip() for h in header]
+        wanted = [layout.time, layout.x, layout.y, layout.z] + ([layout.temperature] if layout.temperature else [])
+        missing = [c for c in wanted if c not in header]
+        if missing:
+            columns = repr(", ".join(header))[1:-1]
+            raise ConfigError(f"{path}: no column {', '.join(missing)} (columns: {columns[:120]}"
+                              f"{'…' if len(columns) > 120 else ''}); map them with --columns time,x,y,z[,temperature]")
+        index = [header.index(c) for c in wanted]
+        values = array("d")
+        for row in reader:
+            if not row:
+                continue
+            try:
+                numbers = [float(row[i]) for i in index]
+            except (ValueError, IndexError):
+                raise ConfigError(f"{path}:{reader.line_num}: not a number in columns {', '.join(wanted)}") from None
+            if not all(math.isfinite(v) and abs(v) <= MAX_VALUE for v in numbers):
+                raise ConfigError(f"{path}:{reader.line_num}: not a finite number of at most {MAX_VALUE:g} in "
+                                  f"columns {', '.join(wanted)}")
+            values.extend(numbers)
+    except csv.Error as exc:
+        raise ConfigError(f"{path}:{reader.line_num}: not a CSV row: {exc}") from None
     data = np.array(values, dtype=float).reshape(-1, len(wanted))
     if len(data) < 10:
         raise ConfigError(f"{path}: {len(data)} rows: too short to be a calibration recording")
@@ -95,7 +111,14 @@ def read_csv_recording(path: Path, layout: CsvLayout) -> Recording:
         raise ConfigError(f"{path}: column {layout.time} repeats a time: one row per sample expected")
     lsb_g = {"g": 1.0, "m/s2": 1.0 / STANDARD_GRAVITY_M_S2, "counts": 1.0 / (layout.counts_per_g or 1.0)}[layout.units]
     accel_g = (data[:, 1:4] - (layout.zero_code if layout.units == "counts" else 0.0)) * lsb_g
+    largest = float(np.abs(accel_g).max())
+    if largest > MAX_ACCEL_G:
+        raise ConfigError(f"{path}: readings up to {largest:.3g} g once scaled: not an accelerometer at rest and "
+                          "turned by hand; check --units, --counts-per-g and --zero-code")
     temperature = data[:, 4] if layout.temperature else None
+    if temperature is not None and not np.all((MIN_TEMPERATURE_C <= temperature) & (temperature <= MAX_TEMPERATURE_C)):
+        raise ConfigError(f"{path}: column {layout.temperature}: temperatures outside {MIN_TEMPERATURE_C:g} … "
+                          f"{MAX_TEMPERATURE_C:g} °C")
     return Recording(str(path), t, accel_g, temperature, lsb_g, hashlib.sha256(raw).hexdigest(), notes)
 
 
