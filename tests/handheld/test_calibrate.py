@@ -94,14 +94,19 @@ def test_a_campaign_files_raw_samples_are_a_recording(paper_campaign: Path) -> N
     (["--columns", "time_s,ax,ay,accel_z"], "no column accel_z (columns: time_s, ax, ay, az, temp_c)"),
     (["--columns", "time_s,ax,ay,az,temp_c", "--units", "counts"], "--counts-per-g is needed with --units counts"),
     (["--columns", "t,x"], "--columns: 't,x': expected time,x,y,z"),
-    (["--columns", "time_s,ax,ay,az", "--window-s", "0"], "--window-s: must be positive"),
+    (["--columns", "time_s,ax,ay,az", "--window-s", "0"], "--window-s: 0 is outside 0.001 … 3600 s"),
+    (["--columns", "time_s,ax,ay,az", "--init-s", "nan"], "--init-s: nan is outside 0.001 … 3600 s"),
 ])
 def test_fit_recording_input_errors_are_one_line(tmp_path: Path, capsys, argv: list[str], expected: str) -> None:
     from accelcal_rig.cli import main
 
     simulated = handheld_recording("HH-7", 10, 100.0, np.random.default_rng(15))
     write_csv(simulated, tmp_path / "s.csv")
-    assert main(["fit-recording", str(tmp_path / "s.csv"), "-o", str(tmp_path / "cal.yaml"), *argv]) == 2
+    try:
+        code = main(["fit-recording", str(tmp_path / "s.csv"), "-o", str(tmp_path / "cal.yaml"), *argv])
+    except SystemExit as exit_:  # command-line mistakes are argparse's to refuse
+        code = exit_.code
+    assert code == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and expected in err, err
     assert not (tmp_path / "cal.yaml").exists()
