@@ -410,9 +410,12 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
           f"{result.wall_s:.1f} s wall")
     print(f"  output     {result.output} ({size_mb:.1f} MB)")
     if summary.fit_failed:
-        print(f"rig: campaign done but the fit failed: {summary.fit}", file=sys.stderr)
+        print(f"rig: campaign done but the fit failed: {_one_line(Exception(summary.fit))}", file=sys.stderr)
         return 1
     print(f"  fit        {summary.fit or 'none (the procedure measures only: fit.mode none)'}")
+    if result.problems:
+        print(f"rig: error: campaign done, but {result.problems[0]}", file=sys.stderr)
+        return 1
     return 0
 
 

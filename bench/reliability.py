@@ -1,30 +1,39 @@
 """Reliability trials of unattended campaigns, as processes, the way a lab runs them. Usage:
 
-    python bench/reliability.py crash --trials 50     # kill -9 the paper dry run at a random moment, resume
-    python bench/reliability.py signals --trials 20   # SIGINT / SIGTERM at a random moment
-    python bench/reliability.py faults --trials 3     # injected faults, transient and persistent
+    python bench/reliability.py syscalls --points 220   # kill -9 at chosen write system calls of rig run, fit, resume
+    python bench/reliability.py crash --trials 50       # kill -9 at a random moment of the paper dry run
+    python bench/reliability.py diskfull                # the disk fills up at 12 sizes of free space (needs root)
+    python bench/reliability.py concurrent --trials 8   # --overwrite, resume, fit, repair against a running campaign
+    python bench/reliability.py signals --trials 20     # SIGINT / SIGTERM at a random moment
+    python bench/reliability.py faults --trials 2       # injected instrument faults, transient and persistent
 
-Crash trials: `rig run procedures/paper-24pos-thermal.yaml --dry-run` is killed with SIGKILL at a moment
-drawn uniformly over an uninterrupted run's wall time; the file must open with h5py as the kill left
-it; `rig resume` must finish the campaign with every pose of the plan stored exactly once and a fit as
-good as an uninterrupted run's (|g| RMSE after calibration within 1.2 × the noise floor, the figure the
-accuracy benchmark holds every fit to). Signal trials: the run must exit 130 with the file `aborted`, the
-poses stored whole, and the simulators' last chamber setpoint the safe one, each sensor in standby and
-the turntable stopped, as the file's event log records. Fault trials: with 1 %, 5 % and 20 % of all
-replies spoiled (dropped, late, corrupted, a line dead for 2 s of campaign time) the campaign must complete with every
-pose stored once; with a persistent fault (chamber or turntable stall at a random time, a wrong part ID,
-a DUT whose data freeze at a random time) it must end `aborted` with the safe state recorded. Fault
-trials use a copy of the simulated rig with 0.05 s wire timeouts and 10 tries per request (a lab with a
-link this bad would configure the same), so that a dropped reply costs 0.05 s of wall time.
+Every trial runs `rig run procedures/paper-24pos-thermal.yaml --dry-run` (11 setpoints × 24 poses × 4 DUTs)
+and judges what is left the way a careful lab would:
+
+- After a kill: `rig status` answers; the poses stored at the kill (read from what is on disk) are noted;
+  `rig resume` (or `rig run --resume` when the kill came before the campaign existed) must exit 0 with
+  every pose of the plan stored once, the campaign file as current as its journal, a calibration whose
+  |g| RMSE is within 1.2 × the noise floor, and every pose stored before the kill byte for byte the same.
+  `syscalls` kills at chosen write system calls (`pwrite64`, `fdatasync`, `fsync`, `rename`, spread evenly
+  over an uninterrupted run's calls, fit stage included) with strace's syscall injection; it also kills
+  `rig fit` at each of its writes (the campaign must be unchanged, the calibration absent or whole) and
+  `rig resume` at writes spread over a resume.
+- A full disk: a small tmpfs, filled by another file as soon as the campaign exists, leaving a chosen
+  amount free. The run must exit 1 with "no space left on …", the safe state recorded, every stored pose
+  readable; once the filler is removed `rig resume` must complete as above.
+- Concurrent commands against a running campaign must be refused with one line naming its process, and
+  change nothing: the running campaign's journal records, log and final result are as if alone.
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
 import random
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -32,204 +41,482 @@ import tempfile
 import time
 from pathlib import Path
 
-import h5py
-
-from accelcal_rig.store.read import integrity_problems
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.fit.calibration import load_calibration
+from accelcal_rig.store.journal import read_journal
+from accelcal_rig.store.paths import journal_path, log_path
+from accelcal_rig.store.read import file_currency, load_campaign
 
 REPO = Path(__file__).resolve().parent.parent
 PAPER = REPO / "procedures" / "paper-24pos-thermal.yaml"
 RIG = str(Path(sys.executable).parent / "rig")
+WRITE_CALLS = ("pwrite64", "fdatasync", "fsync", "rename")
 
 
-def fit_metrics(campaign: Path) -> dict[str, tuple[float, float]]:
-    """Per DUT: (rmse_after_mg, noise_floor_mg) from the file's fit/ group."""
-    with h5py.File(campaign, "r") as f:
-        metrics = {serial: json.loads(f[f"fit/{serial}/metrics_json"][()]) for serial in f["duts"]}
-    return {serial: (m["rmse_after_mg"], m["noise_floor_mg"]) for serial, m in metrics.items()}
-
-
-def uninterrupted(folder: Path) -> tuple[float, dict[str, tuple[float, float]]]:
-    output = folder / "reference.h5"
-    start = time.perf_counter()
-    subprocess.run([RIG, "run", str(PAPER), "--dry-run", "-o", str(output), "-q"], check=True,
-                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    return time.perf_counter() - start, fit_metrics(output)
-
-
-def crash_trial(folder: Path, kill_at_s: float) -> tuple[bool, str, dict[str, float]]:
-    output = folder / "crash.h5"
-    for stale in (output, output.with_suffix(".h5.log"), output.with_suffix(".calibration.yaml")):
-        stale.unlink(missing_ok=True)
-    process = subprocess.Popen([RIG, "run", str(PAPER), "--dry-run", "-o", str(output), "-q"],
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    time.sleep(kill_at_s)
-    process.send_signal(signal.SIGKILL)
-    process.wait()
-    figures: dict[str, float] = {}
-    if not output.exists():
-        return True, "killed before the file existed (nothing to resume: a new run starts over)", figures
+# ---------------------------------------------------------------------- judging a campaign
+def stored_poses(campaign: Path) -> dict[str, bytes]:
+    """Every stored pose, by step key, as the bytes of all its numbers (empty when there is no campaign)."""
     try:
-        with h5py.File(output, "r") as f:
-            figures["stored_at_kill"] = f["poses/step_key"].shape[0]
-            figures["rows_ragged_at_kill"] = float(bool(integrity_problems(f)))
-            state = str(f.attrs["state"])
-    except OSError as exc:
-        return False, f"unreadable after the kill: {exc}", figures
-    if state == "done":
-        return True, "killed after the campaign was complete", figures
+        loaded = load_campaign(campaign)
+    except ConfigError:
+        return {}
+    return {p.step_key: b"".join([p.commanded_angles_deg.tobytes(), p.measured_angles_deg.tobytes(),
+                                  repr((p.setpoint_c, p.pose_number, p.t_start_s, p.t_end_s,
+                                        p.chamber_temperature_c)).encode()]
+                                 + [d.raw_codes.tobytes() + d.mean_g.tobytes() + d.stderr_g.tobytes() +
+                                    d.gravity_reference_g.tobytes() + repr((d.temperature_c, d.temperature_in_band)).encode()
+                                    for d in p.duts])
+            for p in loaded.poses}
+
+
+def judge_complete(campaign: Path, before: dict[str, bytes]) -> tuple[bool, str]:
+    """Whether the campaign is complete, consistent and kept every pose of `before` unchanged."""
+    try:
+        loaded = load_campaign(campaign)
+    except ConfigError as exc:
+        return False, f"unreadable: {exc}"
+    problems = loaded.integrity_problems()
+    after = stored_poses(campaign)
+    changed = [k for k, v in before.items() if after.get(k) != v]
+    currency = file_currency(campaign, loaded, writing=False)
+    calibration = campaign.with_suffix(".calibration.yaml")
+    try:
+        metrics = load_calibration(calibration).sensors
+        worst = max(s.metrics["rmse_after_mg"] / s.metrics["noise_floor_mg"] for s in metrics.values())
+    except (ConfigError, KeyError, ZeroDivisionError) as exc:
+        return False, f"calibration: {exc}"
+    ok = (loaded.state == "done" and len(loaded.poses) == loaded.poses_planned and not problems and not changed
+          and currency == "current" and worst <= 1.2)
+    return ok, (f"{len(loaded.poses)}/{loaded.poses_planned} poses, {len(before)} kept"
+                f"{' CHANGED ' + ', '.join(changed[:3]) if changed else ''}, file {currency}, rmse/floor {worst:.2f}"
+                f"{'; ' + '; '.join(problems) if problems else ''}")
+
+
+def digests(*paths: Path) -> list[str]:
+    return [hashlib.sha256(p.read_bytes()).hexdigest() if p.is_file() else "-" for p in paths]
+
+
+def rig(*args: str, timeout: float = 600) -> subprocess.CompletedProcess:
+    return subprocess.run([RIG, *args], capture_output=True, text=True, timeout=timeout)
+
+
+def one_line(result: subprocess.CompletedProcess) -> bool:
+    lines = [line for line in result.stderr.strip().splitlines() if not line.startswith("rig: warning")]
+    return "Traceback" not in result.stderr and (result.returncode == 0 or len(lines) == 1)
+
+
+def clean(campaign: Path) -> None:
+    for path in campaign.parent.glob(campaign.name + "*"):
+        path.unlink()
+    campaign.with_suffix(".calibration.yaml").unlink(missing_ok=True)
+
+
+def finish_after_kill(campaign: Path, procedure: Path = PAPER) -> tuple[bool, str, dict[str, float]]:
+    """After a kill: status answers, resume completes, what was stored is unchanged."""
+    figures: dict[str, float] = {}
+    status = rig("status", str(campaign), "--json")
+    if not one_line(status):
+        return False, f"status: {status.stderr.strip()[-200:]}", figures
+    before = stored_poses(campaign)
+    figures["stored_at_kill"] = len(before)
     start = time.perf_counter()
-    resumed = subprocess.run([RIG, "resume", str(output), "-q"], capture_output=True, text=True)
+    if status.returncode == 0:
+        resumed = rig("resume", str(campaign), "-q")
+    else:  # killed before the campaign existed: start it again
+        resumed = rig("run", str(procedure), "--dry-run", "-o", str(campaign), "--resume", "-q")
     figures["resume_wall_s"] = time.perf_counter() - start
     if resumed.returncode != 0:
-        return False, f"resume exit {resumed.returncode}: {resumed.stderr.strip()[-200:]}", figures
-    with h5py.File(output, "r") as f:
-        problems = integrity_problems(f)
-        stored, planned = f["poses/step_key"].shape[0], int((f["plan/kind"][:] == b"pose").sum())
-        events = [(float(t), m.decode()) for t, m in zip(f["events/t_s"][:], f["events/message"][:])]
-    if problems or stored != planned:
-        return False, f"{stored}/{planned} poses; {'; '.join(problems)}", figures
-    figures.update(resume_cost(events))
-    worst = max(rmse / floor for rmse, floor in fit_metrics(output).values())
-    figures["rmse_over_floor"] = worst
-    if worst > 1.2:
-        return False, f"fit after resume: rmse_after / noise floor {worst:.2f} > 1.2", figures
-    return True, f"{int(figures['stored_at_kill'])} poses at the kill, resumed to {stored}", figures
+        return False, f"resume exit {resumed.returncode}: {resumed.stderr.strip()[-300:]}", figures
+    ok, note = judge_complete(campaign, before)
+    return ok, note, figures
 
 
-def resume_cost(events: list[tuple[float, str]]) -> dict[str, float]:
-    """Campaign-clock seconds the resumed run spent before its first ramp, in its ramp and soak, and
-    between the end of that soak and the first pose stored."""
-    index = next(i for i, (_, m) in enumerate(events) if "resumes after" in m)
-    t_resume, after = events[index][0], events[index:]
-    ramps = [t for t, m in after if "→ ramp" in m]
-    if not ramps:
-        return {}  # every pose was stored when the kill came: the resume only made safe and fitted
-    t_ramp = ramps[0]
-    t_soak_end = next(t for t, m in after if m.startswith("soak → move"))
-    t_first_pose = next(t for t, m in after if re.fullmatch(r"\S+/pose\d+ stored", m))
-    return {"before_ramp_s": t_ramp - t_resume, "ramp_and_soak_s": t_soak_end - t_ramp,
-            "first_pose_after_soak_s": t_first_pose - t_soak_end}
+# ---------------------------------------------------------------------- kill -9 at chosen write calls
+def count_write_calls(argv: list[str]) -> dict[str, int]:
+    """How many of each write call an uninterrupted command makes."""
+    with tempfile.NamedTemporaryFile("r", suffix=".strace") as counts:
+        subprocess.run(["strace", "-f", "--seccomp-bpf", "-c", "-o", counts.name, "-e",
+                        f"trace={','.join(WRITE_CALLS)}", *argv], capture_output=True, check=True)
+        table = counts.read()
+    return {name: int(m.group(1)) for name in WRITE_CALLS
+            if (m := re.search(rf"^\s*[\d.]+\s+[\d.]+\s+\d+\s+(\d+)\s+(?:\d+\s+)?{name}$", table, re.M))}
 
 
-def signal_trial(folder: Path, send_at_s: float, signum: int) -> tuple[bool, str]:
-    output = folder / "signal.h5"
-    for stale in (output, output.with_suffix(".h5.log")):
-        stale.unlink(missing_ok=True)
-    process = subprocess.Popen([RIG, "run", str(PAPER), "--dry-run", "-o", str(output), "-q"],
-                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    time.sleep(send_at_s)
-    process.send_signal(signum)
-    _, err = process.communicate()
-    if not output.exists():
-        ok = process.returncode == 130 and len(err.strip().splitlines()) == 1 and "interrupted" in err
-        return ok, f"before the file existed: exit {process.returncode} {err.strip()[-80:]}"
-    with h5py.File(output, "r") as f:
-        state = str(f.attrs["state"])
-        problems = integrity_problems(f)
-        safe = [m.decode() for m, k in zip(f["events/message"][:], f["events/kind"][:]) if k == b"safe"]
-    if state == "done":
-        return process.returncode == 0, "the signal came after the campaign was complete"
-    chamber_safe = any("to 23 °C" in m for m in safe[-6:])
-    standby = sum("standby" in m for m in safe[-6:]) == 4
-    stopped = any("turntable" in m and "stop" in m for m in safe[-6:])
-    ok = process.returncode == 130 and state == "aborted" and not problems and chamber_safe and standby and stopped
-    return ok, f"exit {process.returncode}, state {state}, safe: chamber {chamber_safe} turntable {stopped} " \
-               f"sensors {standby}{'; ' + '; '.join(problems) if problems else ''}"
+def killed_at(argv: list[str], call: str, when: int) -> subprocess.CompletedProcess:
+    """Run `argv` and kill it (SIGKILL, as strace delivers it) when it enters its `when`-th `call`."""
+    return subprocess.run(["strace", "-f", "--seccomp-bpf", "-o", "/dev/null", "-e", f"trace={call}", "-e",
+                           f"inject={call}:signal=SIGKILL:when={when}", *argv], capture_output=True, text=True,
+                          timeout=600)
+
+
+def spread(counts: dict[str, int], points: int) -> list[tuple[str, int]]:
+    """`points` (call, index) pairs spread evenly over all the calls, in the order of `WRITE_CALLS`."""
+    every = [(name, k) for name in WRITE_CALLS for k in range(1, counts.get(name, 0) + 1)]
+    if points >= len(every):
+        return every
+    return [every[round(i * (len(every) - 1) / (points - 1))] for i in range(points)]
+
+
+def syscall_trials(folder: Path, points: int, resume_points: int) -> tuple[int, int]:
+    if shutil.which("strace") is None:
+        sys.exit("syscalls: needs strace (apt-get install strace)")
+    campaign = folder / "crash.h5"
+    run = [RIG, "run", str(PAPER), "--dry-run", "-o", str(campaign), "-q"]
+    clean(campaign)
+    counts = count_write_calls(run)
+    print(f"uninterrupted rig run: {counts} write calls", flush=True)
+    passed = total = 0
+    for call, when in spread(counts, points):
+        clean(campaign)
+        killed = killed_at(run, call, when)
+        ok, note, figures = finish_after_kill(campaign)
+        ok = ok and killed.returncode != 0
+        passed, total = passed + ok, total + 1
+        print(f"run    {call:9s} #{when:4d}: {'pass' if ok else 'FAIL'}  {int(figures.get('stored_at_kill', 0)):3d} "
+              f"stored at the kill; {note}", flush=True)
+    # rig fit on a finished campaign, killed at each of its writes
+    clean(campaign)
+    subprocess.run(run, check=True, capture_output=True)
+    calibration = folder / "refit.yaml"
+    fit = [RIG, "fit", str(campaign), "-o", str(calibration)]
+    counts = count_write_calls(fit)
+    print(f"uninterrupted rig fit: {counts} write calls", flush=True)
+    files = [campaign, journal_path(campaign)]
+    for call, when in spread(counts, 10_000):
+        calibration.unlink(missing_ok=True)
+        before = digests(*files)
+        killed_at(fit, call, when)
+        whole = not calibration.exists() or _loads(calibration)
+        again = rig("fit", str(campaign), "-o", str(calibration))
+        ok = digests(*files) == before and whole and again.returncode == 0 and _loads(calibration)
+        passed, total = passed + ok, total + 1
+        print(f"fit    {call:9s} #{when:4d}: {'pass' if ok else 'FAIL'}  campaign unchanged "
+              f"{digests(*files) == before}, calibration after the kill absent or whole {whole}", flush=True)
+    # rig resume of a campaign stopped after its first setpoint, killed at writes spread over the resume
+    stopped = folder / "stopped.h5"
+    clean(stopped)
+    _stop_after_first_setpoint(stopped)
+    kept = folder / "kept"
+    shutil.rmtree(kept, ignore_errors=True)
+    kept.mkdir()
+    for path in stopped.parent.glob(stopped.name + "*"):
+        shutil.copy(path, kept / path.name)
+    resume = [RIG, "resume", str(stopped), "-q"]
+    counts = count_write_calls(resume)
+    print(f"uninterrupted rig resume: {counts} write calls", flush=True)
+    for call, when in spread(counts, resume_points):
+        clean(stopped)
+        for path in kept.iterdir():
+            shutil.copy(path, stopped.parent / path.name)
+        before = stored_poses(stopped)
+        killed_at(resume, call, when)
+        at_kill = stored_poses(stopped)
+        kept_ok = all(at_kill.get(k) == v for k, v in before.items())
+        ok, note, _ = finish_after_kill(stopped)
+        ok = ok and kept_ok and judge_complete(stopped, before)[0]
+        passed, total = passed + ok, total + 1
+        print(f"resume {call:9s} #{when:4d}: {'pass' if ok else 'FAIL'}  {len(at_kill)} stored at the kill; {note}",
+              flush=True)
+    return passed, total
+
+
+def _loads(calibration: Path) -> bool:
+    try:
+        load_calibration(calibration)
+        return True
+    except ConfigError:
+        return False
+
+
+def _stop_after_first_setpoint(campaign: Path) -> None:
+    """A campaign interrupted (SIGTERM) once its first setpoint's poses are stored."""
+    process = subprocess.Popen([RIG, "run", str(PAPER), "--dry-run", "-o", str(campaign), "-q"],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and "T-40: 24 poses stored" not in _text(log_path(campaign)):
+        time.sleep(0.01)
+    process.send_signal(signal.SIGTERM)
+    process.wait()
+
+
+def _text(path: Path) -> str:
+    try:
+        return path.read_text(errors="replace")
+    except OSError:
+        return ""
+
+
+# ---------------------------------------------------------------------- kill -9 at a random moment
+def crash_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, int]:
+    campaign = folder / "crash.h5"
+    clean(campaign)
+    start = time.perf_counter()
+    subprocess.run([RIG, "run", str(PAPER), "--dry-run", "-o", str(campaign), "-q"], check=True, capture_output=True)
+    wall_s = time.perf_counter() - start
+    print(f"uninterrupted run: {wall_s:.1f} s wall", flush=True)
+    passed = 0
+    costs = []
+    for trial in range(trials):
+        clean(campaign)
+        at = rng.uniform(0.2, wall_s)
+        process = subprocess.Popen([RIG, "run", str(PAPER), "--dry-run", "-o", str(campaign), "-q"],
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        time.sleep(at)
+        process.send_signal(signal.SIGKILL)
+        process.wait()
+        ok, note, figures = finish_after_kill(campaign)
+        passed += ok
+        costs.append(figures.get("resume_wall_s", 0.0))
+        print(f"trial {trial:3d} at {at:5.2f} s: {'pass' if ok else 'FAIL'}  {int(figures.get('stored_at_kill', 0)):3d} "
+              f"stored at the kill; {note}", flush=True)
+    print(f"resume wall time: mean {sum(costs) / len(costs):.1f} s")
+    return passed, trials
+
+
+# ---------------------------------------------------------------------- a full disk
+#: When the disk fills up (poses stored by then) and how much is left free then (bytes): from before the
+#: first pose to the fit, with nothing left (the next write fails) or a little (a later one does, or the
+#: check before a setpoint stops the campaign first).
+FULL_AT = [(0, 0), (0, 512 << 10), (1, 0), (30, 0), (30, 2 << 20), (100, 0), (100, 64 << 10), (150, 1 << 20),
+           (200, 0), (240, 256 << 10), (263, 0), (264, 0), (264, 3 << 20)]
+
+
+def diskfull_trials(folder: Path) -> tuple[int, int]:
+    if os.geteuid() != 0:
+        sys.exit("diskfull: needs root, to mount a small tmpfs that can really fill up")
+    passed = total = 0
+    for after_poses, free in FULL_AT:
+        mount = folder / f"disk-{after_poses}-{free}"
+        mount.mkdir()
+        subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64m", "tmpfs", str(mount)], check=True)
+        try:
+            ok, note = _diskfull_trial(mount, after_poses, free)
+        finally:
+            subprocess.run(["umount", "-l", str(mount)], check=True)
+        passed, total = passed + ok, total + 1
+        print(f"full after {after_poses:3d} poses, {free / 2**20:4.2f} MiB left: {'pass' if ok else 'FAIL'}  {note}",
+              flush=True)
+    return passed, total
+
+
+def _fill(ballast: Path, leave: int) -> None:
+    """Grow `ballast` until only about `leave` bytes are free on its file system (the campaign writes meanwhile)."""
+    fd = os.open(ballast, os.O_WRONLY | os.O_CREAT)
+    size, chunk = 0, 8 << 20
+    try:
+        while True:
+            stats = os.statvfs(ballast.parent)
+            more = min(stats.f_bavail * stats.f_frsize - leave, chunk)
+            if more <= 0:
+                return
+            try:
+                os.posix_fallocate(fd, size, more)
+                size += more
+            except OSError:
+                if chunk <= 4096:
+                    return
+                chunk //= 2
+    finally:
+        os.close(fd)
+
+
+def _diskfull_trial(mount: Path, after_poses: int, free: int) -> tuple[bool, str]:
+    campaign = mount / "c.h5"
+    process = subprocess.Popen([RIG, "run", str(PAPER), "--dry-run", "-o", str(campaign), "-q"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    ballast = mount / "ballast"
+    try:
+        while process.poll() is None and not journal_path(campaign).exists():
+            time.sleep(0.002)
+        while process.poll() is None and _poses_stored(campaign) < after_poses:
+            time.sleep(0.005)
+        filled_at = _poses_stored(campaign)
+        _fill(ballast, free)
+        out, err = process.communicate(timeout=600)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    loaded = load_campaign(campaign)
+    where = f"filled at {filled_at} poses; {len(loaded.poses)}/{loaded.poses_planned} stored, state {loaded.state}"
+    status = rig("status", str(campaign), "--json")
+    safe = [e.message for e in loaded.events[-12:] if e.kind == "safe"]
+    recorded = (any("to 23 °C" in m for m in safe) and any("turntable" in m and "stop" in m for m in safe)
+                and sum("standby" in m for m in safe) == 4)
+    last = err.strip().splitlines()[-1] if err.strip() else ""
+    space = "no space left on" in last or "not enough space left on" in last
+    if process.returncode == 0:
+        said = True  # what was left was enough
+    elif loaded.state == "done":  # measured whole; the fit or the last campaign file failed for space
+        said = process.returncode == 1 and space
+    else:
+        said = process.returncode == 1 and space and loaded.state == "aborted" and recorded
+    noise = "Traceback" in err or "Logging error" in err or "internal error" in err
+    before = stored_poses(campaign)
+    ballast.unlink()
+    resumed = rig("resume", str(campaign), "-q")
+    ok_after, note = judge_complete(campaign, before)
+    ok = said and not noise and status.returncode == 0 and resumed.returncode == 0 and ok_after
+    return ok, (f"exit {process.returncode}, {where}; said {last[-100:]!r}; safe state recorded {recorded}; "
+                f"resumed: {note}")
+
+
+def _poses_stored(campaign: Path) -> int:
+    try:
+        return sum(r.kind == "pose" for r in read_journal(journal_path(campaign)).records)
+    except OSError:
+        return 0
+
+
+# ---------------------------------------------------------------------- concurrent commands
+def concurrent_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, int]:
+    campaign = folder / "running.h5"
+    others = [["run", str(PAPER), "--dry-run", "-o", str(campaign), "--overwrite", "-q"],
+              ["run", str(PAPER), "--dry-run", "-o", str(campaign), "--resume", "-q"],
+              ["resume", str(campaign), "-q"], ["fit", str(campaign), "-o", str(folder / "other.yaml")],
+              ["repair", str(campaign)]]
+    passed = total = 0
+    for trial in range(trials):
+        clean(campaign)
+        process = subprocess.Popen([RIG, "run", str(PAPER), "--dry-run", "-o", str(campaign), "-q"],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        while not journal_path(campaign).exists():
+            time.sleep(0.005)
+        time.sleep(rng.uniform(0.0, 2.5))
+        refusals = []
+        for argv in others:
+            records = [(r.offset, r.size) for r in read_journal(journal_path(campaign)).records]
+            journal_before = _prefix(journal_path(campaign), records)
+            log_before = log_path(campaign).read_bytes()
+            if process.poll() is not None:
+                break
+            other = rig(*argv)
+            refused = (other.returncode == 2 and one_line(other) and f"pid {process.pid} on " in other.stderr)
+            unchanged = (_prefix(journal_path(campaign), records) == journal_before
+                         and log_path(campaign).read_bytes().startswith(log_before))
+            refusals.append((argv[0] + (" " + argv[-2] if argv[0] == "run" else ""), refused and unchanged,
+                             other.stderr.strip()[-120:]))
+        out, _ = process.communicate(timeout=600)
+        ok_first, note = judge_complete(campaign, {})
+        for name, ok, said in refusals:
+            ok = ok and process.returncode == 0 and ok_first
+            passed, total = passed + ok, total + 1
+            print(f"trial {trial}: {name:16s} {'pass' if ok else 'FAIL'}  {said}", flush=True)
+        print(f"trial {trial}: the running campaign: exit {process.returncode}; {note}", flush=True)
+    return passed, total
+
+
+def _prefix(journal: Path, records: list[tuple[int, int]]) -> bytes:
+    data = journal.read_bytes()
+    return b"".join(data[offset:offset + size] for offset, size in records)
+
+
+# ---------------------------------------------------------------------- signals and faults
+def signal_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, int]:
+    campaign = folder / "signal.h5"
+    clean(campaign)
+    start = time.perf_counter()
+    subprocess.run([RIG, "run", str(PAPER), "--dry-run", "-o", str(campaign), "-q"], check=True, capture_output=True)
+    wall_s = time.perf_counter() - start
+    passed = 0
+    for trial in range(trials):
+        clean(campaign)
+        at, signum = rng.uniform(0.2, wall_s), rng.choice([signal.SIGINT, signal.SIGTERM])
+        process = subprocess.Popen([RIG, "run", str(PAPER), "--dry-run", "-o", str(campaign), "-q"],
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        time.sleep(at)
+        process.send_signal(signum)
+        _, err = process.communicate()
+        try:
+            loaded = load_campaign(campaign)
+        except ConfigError:
+            ok = process.returncode == 130 and len(err.strip().splitlines()) == 1 and "interrupted" in err
+            passed += ok
+            print(f"trial {trial:3d} at {at:5.2f} s: {'pass' if ok else 'FAIL'}  before the campaign existed: exit "
+                  f"{process.returncode} {err.strip()[-80:]}", flush=True)
+            continue
+        if loaded.state == "done":
+            ok = process.returncode == 0
+            note = "the signal came after the campaign was complete"
+        else:
+            safe = [e.message for e in loaded.events[-8:] if e.kind == "safe"]
+            recorded = (any("to 23 °C" in m for m in safe) and any("turntable" in m and "stop" in m for m in safe)
+                        and sum("standby" in m for m in safe) == 4)
+            ok = process.returncode == 130 and loaded.state == "aborted" and recorded and not loaded.integrity_problems()
+            note = f"exit {process.returncode}, {loaded.state}, {len(loaded.poses)} poses, safe state recorded {recorded}"
+        passed += ok
+        print(f"trial {trial:3d} at {at:5.2f} s ({signal.Signals(signum).name}): {'pass' if ok else 'FAIL'}  {note}",
+              flush=True)
+    return passed, trials
 
 
 def lossy_rig(folder: Path) -> Path:
     """The paper procedure on a copy of the simulated rig with short timeouts and more retries."""
-    rig = (REPO / "configs" / "sim.yaml").read_text()
+    rig_text = (REPO / "configs" / "sim.yaml").read_text()
     for section in ("chamber:\n", "turntable:\n"):
-        rig = rig.replace(section, section + "  timeout_s: 0.05\n", 1)
+        rig_text = rig_text.replace(section, section + "  timeout_s: 0.05\n", 1)
     for n in range(1, 5):
-        rig = rig.replace(f"name: dut{n}", f"name: dut{n}, timeout_s: 0.05", 1)
-    (folder / "sim.yaml").write_text(rig + "retry: {attempts: 10}\n")
+        rig_text = rig_text.replace(f"name: dut{n}", f"name: dut{n}, timeout_s: 0.05", 1)
+    (folder / "sim.yaml").write_text(rig_text + "retry: {attempts: 10}\n")
     procedure = folder / "paper.yaml"
     procedure.write_text(PAPER.read_text().replace("rig: ../configs/sim.yaml", "rig: sim.yaml"))
     return procedure
 
 
-def fault_trial(procedure: Path, faults: str, persistent: bool) -> tuple[bool, str, float]:
-    output = procedure.parent / "faults.h5"
-    for stale in (output, output.with_suffix(".h5.log")):
-        stale.unlink(missing_ok=True)
-    start = time.perf_counter()
-    run = subprocess.run([RIG, "run", str(procedure), "--dry-run", "-o", str(output), "-q", "--faults", faults],
-                         capture_output=True, text=True)
-    wall = time.perf_counter() - start
-    with h5py.File(output, "r") as f:
-        state, problems = str(f.attrs["state"]), integrity_problems(f)
-        stored, planned = f["poses/step_key"].shape[0], int((f["plan/kind"][:] == b"pose").sum())
-        kinds = [k.decode() for k in f["events/kind"][:]]
-        messages = [m.decode() for m in f["events/message"][:]]
-        reason = str(f.attrs["abort_reason"])
-    retries = kinds.count("retry")
-    if persistent:
-        safe = messages[-8:]
-        recorded = (any("to 23 °C" in m for m in safe) and any("turntable" in m and "stop" in m for m in safe)
-                    and sum("standby" in m for m in safe) == 4)
-        ok = run.returncode != 0 and state == "aborted" and recorded and not problems
-        return ok, f"aborted after {stored} poses ({reason[:90]}); safe state recorded: {recorded}", wall
-    ok = run.returncode == 0 and state == "done" and stored == planned and not problems
-    return ok, f"{state}, {stored}/{planned} poses, {retries} retries logged{'; ' + run.stderr[-120:] if not ok else ''}", wall
-
-
 def fault_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, int]:
     procedure = lossy_rig(folder)
+    campaign = folder / "faults.h5"
     passed = total = 0
-    for rate in (0.01, 0.05, 0.2):
-        for trial in range(trials):
-            ok, note, wall = fault_trial(procedure, f"rate={rate},seed={trial}", persistent=False)
-            passed, total = passed + ok, total + 1
-            print(f"transient {rate:4.0%} seed {trial}: {'pass' if ok else 'FAIL'} in {wall:5.1f} s  {note}", flush=True)
-    for trial in range(trials):
+    cases = [(f"rate={rate},seed={trial}", False) for rate in (0.01, 0.05, 0.2) for trial in range(trials)]
+    for _ in range(trials):
         minutes = rng.uniform(0, 600)
-        for faults in (f"chamber_stall_after_min={minutes:.0f}", f"turntable_stall_after_min={minutes:.0f}",
-                       "sensor_wrong_id=ADX355-A002", f"sensor_stuck=ADX355-A003,sensor_stuck_after_min={minutes:.0f}"):
-            ok, note, wall = fault_trial(procedure, faults, persistent=True)
-            passed, total = passed + ok, total + 1
-            print(f"persistent {faults}: {'pass' if ok else 'FAIL'} in {wall:5.1f} s  {note}", flush=True)
+        cases += [(f"chamber_stall_after_min={minutes:.0f}", True), (f"turntable_stall_after_min={minutes:.0f}", True),
+                  ("sensor_wrong_id=ADX355-A002", True), (f"sensor_stuck=ADX355-A003,sensor_stuck_after_min={minutes:.0f}", True)]
+    for faults, persistent in cases:
+        clean(campaign)
+        start = time.perf_counter()
+        run = rig("run", str(procedure), "--dry-run", "-o", str(campaign), "-q", "--faults", faults)
+        wall = time.perf_counter() - start
+        loaded = load_campaign(campaign)
+        retries = sum(e.kind == "retry" for e in loaded.events)
+        if persistent:
+            safe = [e.message for e in loaded.events[-8:]]
+            recorded = (any("to 23 °C" in m for m in safe) and any("turntable" in m and "stop" in m for m in safe)
+                        and sum("standby" in m for m in safe) == 4)
+            ok = run.returncode != 0 and loaded.state == "aborted" and recorded and not loaded.integrity_problems()
+            note = f"aborted after {len(loaded.poses)} poses ({loaded.abort_reason[:80]}); safe state recorded {recorded}"
+        else:
+            ok = run.returncode == 0 and judge_complete(campaign, {})[0]
+            note = f"{loaded.state}, {len(loaded.poses)}/{loaded.poses_planned} poses, {retries} retries logged"
+        passed, total = passed + ok, total + 1
+        print(f"{faults:48s} {'pass' if ok else 'FAIL'} in {wall:6.1f} s  {note}", flush=True)
     return passed, total
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("kind", choices=["crash", "signals", "faults"])
-    parser.add_argument("--trials", type=int, default=50)
+    parser.add_argument("kind", choices=["syscalls", "crash", "diskfull", "concurrent", "signals", "faults"])
+    parser.add_argument("--trials", type=int, default=20)
+    parser.add_argument("--points", type=int, default=220, help="syscalls: kill points over rig run")
+    parser.add_argument("--resume-points", type=int, default=40, help="syscalls: kill points over rig resume")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--json", action="store_true", help="end with one JSON line of the totals")
     args = parser.parse_args()
     rng = random.Random(args.seed)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        if args.kind == "faults":
-            passed, total = fault_trials(folder, args.trials, rng)
-            print(f"faults: {passed}/{total} trials passed")
-            sys.exit(0 if passed == total else 1)
-        wall_s, reference = uninterrupted(folder)
-        worst_reference = max(rmse / floor for rmse, floor in reference.values())
-        print(f"uninterrupted run: {wall_s:.1f} s wall, rmse_after / noise floor worst {worst_reference:.2f}")
-        passed, costs = 0, []
-        for trial in range(args.trials):
-            at = rng.uniform(0.2, wall_s)
-            if args.kind == "crash":
-                ok, note, figures = crash_trial(folder, at)
-                if "before_ramp_s" in figures:
-                    costs.append(figures)
-            else:
-                ok, note = signal_trial(folder, at, rng.choice([signal.SIGINT, signal.SIGTERM]))
-            passed += ok
-            print(f"trial {trial:3d} at {at:5.2f} s: {'pass' if ok else 'FAIL'}  {note}", flush=True)
-        print(f"{args.kind}: {passed}/{args.trials} trials passed")
-        if costs:
-            mean = lambda key: sum(c[key] for c in costs) / len(costs)  # noqa: E731
-            print(f"resume, mean of {len(costs)}: {mean('resume_wall_s'):.1f} s wall for the resume command; "
-                  f"campaign clock: {mean('before_ramp_s'):.1f} s before the first ramp, "
-                  f"{mean('ramp_and_soak_s') / 60:.1f} min ramp and re-soak, "
-                  f"{mean('first_pose_after_soak_s'):.1f} s from the soak to the first pose stored; "
-                  f"worst rmse_after / noise floor {max(c['rmse_over_floor'] for c in costs):.2f}; "
-                  f"a pose cut mid-write in {sum(c['rows_ragged_at_kill'] for c in costs):.0f} trials")
-    sys.exit(0 if passed == args.trials else 1)
+        passed, total = {
+            "syscalls": lambda: syscall_trials(folder, args.points, args.resume_points),
+            "crash": lambda: crash_trials(folder, args.trials, rng),
+            "diskfull": lambda: diskfull_trials(folder),
+            "concurrent": lambda: concurrent_trials(folder, args.trials, rng),
+            "signals": lambda: signal_trials(folder, args.trials, rng),
+            "faults": lambda: fault_trials(folder, args.trials, rng),
+        }[args.kind]()
+    print(f"{args.kind}: {passed}/{total} trials passed")
+    if args.json:
+        print(json.dumps({"trials": args.kind, "passed": passed, "total": total}))
+    sys.exit(0 if passed == total else 1)
 
 
 if __name__ == "__main__":

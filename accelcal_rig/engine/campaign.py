@@ -125,8 +125,8 @@ class CampaignRunner:
 
     # ----------------------------------------------------------------- top level
     def run(self) -> CampaignSummary:
-        self.writer.set_state("running")
         try:
+            self.writer.set_state("running")
             self.events.info("plan", f"{len(self.plan.setpoints_c)} setpoints × {len(self.plan.poses)} poses = "
                                      f"{len(self.plan.pose_steps)} poses, {len(self.sensors)} DUTs, "
                                      f"{self.procedure.acquisition.samples_per_pose} samples per pose")

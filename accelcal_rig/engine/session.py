@@ -94,6 +94,8 @@ class RunResult:
     summary: CampaignSummary
     wall_s: float
     output: Path
+    #: What closing the campaign could not do (the campaign file left behind its journal), one line each.
+    problems: tuple[str, ...] = ()
 
 
 #: Connects the rig on the campaign's clock: (rig config, procedure, clock, seed) → instruments.
@@ -248,10 +250,12 @@ def _stored_plan(plan: Plan) -> StoredPlan:
         fingerprint=plan.fingerprint, axis_names=tuple(plan.axis_names))
 
 
-def _close(writer: CampaignWriter) -> None:
-    """Close the campaign; what closing could not do reaches the operator, the run's outcome stands."""
-    for problem in writer.close():
+def _close(writer: CampaignWriter) -> tuple[str, ...]:
+    """Close the campaign; what closing could not do is logged and returned, the run's outcome stands."""
+    problems = tuple(writer.close())
+    for problem in problems:
         LOGGER.error(problem)
+    return problems
 
 
 def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, instruments: RigInstruments,
@@ -260,6 +264,7 @@ def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, instr
     procedure, rig = prepared.procedure.model, prepared.rig.model
     notify = rig.notify
     notifier = Notifier(notify) if notify.webhook_url or notify.command else None
+    problems: tuple[str, ...] = ()
     try:
         events = EventLog(clock, writer)
         estimate = estimate_duration(procedure, rig, prepared.plan) if progress or notifier else None
@@ -270,11 +275,11 @@ def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, instr
         summary = runner.run()
     finally:
         try:
-            _close(writer)
+            problems = _close(writer)
         finally:
             if notifier is not None:  # the fault, safe and finish events still go out
                 notifier.close()
-    return RunResult(summary, time.perf_counter() - wall_start, output)
+    return RunResult(summary, time.perf_counter() - wall_start, output, problems)
 
 
 def _fit_stage(procedure: Procedure, output: Path, calibration: Path) -> FitStage:

@@ -69,8 +69,10 @@ class CampaignWriter:
         self._file_written_at = float("-inf")
         self._file_cost_s = 0.0
         self._file_behind = True
-        #: After a full disk: only the journal's reserve is written, the file stays as it is.
-        self._stopping = False
+        #: Why the disk counts as full (None while it is not): the campaign file then stays as it is and
+        #: only the journal's reserve is written.
+        self._full: str | None = None
+        self._stop_raised = False
         self._closed = False
 
     # ------------------------------------------------------------------ opening
@@ -155,28 +157,32 @@ class CampaignWriter:
         self._file_behind = True
 
     def _stop_if_full(self, what: str) -> None:
-        """Once the journal is into its reserve: stop the campaign (what was written stays stored)."""
-        if self._journal.space_exhausted and not self._stopping:
-            self._stopping = True
-            raise DiskFull(f"no space left on {self.path.parent.resolve()}: {what} stored in the journal's reserve; "
-                           "stopping while there is room to record it")
+        """Once the disk is full (the journal into its reserve, or the campaign file could not be
+        written): stop the measurements, once. What was written stays stored; the records of the stop
+        still fit in the reserve."""
+        if self._full is None and self._journal.space_exhausted:
+            self._full = f"no space left on {self.path.parent.resolve()} (the campaign journal is into its reserve)"
+        if self._full is not None and not self._stop_raised:
+            self._stop_raised = True
+            raise DiskFull(f"{self._full}: {what} stored; measuring stops while there is room to record it")
 
     def append_pose(self, pose: PoseRecord) -> None:
         """Store one pose for every DUT: when this returns it is on disk (fsync'd), whole or not at all.
-        Signals wait until the pose is written."""
+        Signals wait until the pose is written. DiskFull (after storing it) once the disk is full."""
         with signals_deferred():
             self._append(encode_pose(pose))
             self._campaign.add_pose(pose, "this run")
-            self._stop_if_full(f"pose {pose.step_key}")
             if time.monotonic() - self._file_written_at >= max(FILE_INTERVAL_S, FILE_COST_FACTOR * self._file_cost_s):
                 self._write_file()
+            self._stop_if_full(f"pose {pose.step_key}")
 
     def write_soak(self, soak: SoakTrace) -> None:
+        """Store a soak's trace; DiskFull (after storing it) once the disk is full."""
         with signals_deferred():
             self._append(encode_soak(soak))
             self._campaign.soaks.append(soak)
-            self._stop_if_full(f"the soak {soak.label}")
             self._write_file()
+            self._stop_if_full(f"the soak {soak.label}")
 
     def record_instruments(self, instruments: dict[str, dict[str, str]]) -> None:
         """The drivers and endpoints of this run (a resumed run may reach an instrument another way)."""
@@ -189,6 +195,7 @@ class CampaignWriter:
         self._pending.append(StoredEvent(event.t_s, utc_now(), event.level, event.kind, event.message))
 
     def set_state(self, state: str, *, reason: str = "", finished: bool = False) -> None:
+        """Record a state change (a full disk does not stop this: the journal keeps its reserve for it)."""
         with signals_deferred():
             change = StateChange(state, reason, utc_now() if finished else "")
             self._append(encode_state(change))
@@ -209,22 +216,24 @@ class CampaignWriter:
                 self._append(b"")
 
     def _write_file(self) -> None:
-        """Rebuild the campaign file from what is stored and swap it in (not once the disk is full)."""
-        if self._stopping:
+        """Rebuild the campaign file from what is stored and swap it in. On a full disk the file stays at
+        its last version (the journal holds everything) and measuring stops at the next pose or soak."""
+        if self._full is not None:
             return
         started = time.monotonic()
         try:
             write_atomically(self.path, campaign_image(self._campaign, self._journal.end), "the campaign file")
-        except DiskFull:
-            self._stopping = True
-            raise
+        except DiskFull as exc:
+            self._full = str(exc)
+            return
         self._file_written_at = time.monotonic()
         self._file_cost_s = self._file_written_at - started
         self._file_behind = False
 
     def check_space(self, poses_left: int) -> None:
-        """InsufficientSpace when the rest of the campaign would not fit on the disk (checked at every
-        setpoint, so a campaign stops between setpoints rather than in the middle of one)."""
+        """Before a setpoint: DiskFull if the disk has filled up already, InsufficientSpace when the rest of
+        the campaign would not fit (so a campaign stops between setpoints rather than in one)."""
+        self._stop_if_full("everything so far")
         if self._storage is None or not poses_left:
             return
         needed, free = self._storage.remaining_bytes(poses_left), free_bytes(self.path.parent)
@@ -247,12 +256,12 @@ class CampaignWriter:
         try:
             if self._file_behind:
                 self._write_file()
-        except (DiskFull, ConfigError, OSError) as exc:
+        except (ConfigError, OSError) as exc:
             problems.append(f"{self.path} not brought up to date ({exc}); the journal holds everything: "
                             f"rig repair {self.path} once that is mended")
-        if self._stopping and self._file_behind:
-            problems.append(f"{self.path} is behind its journal (the disk filled up); rig resume or rig repair "
-                            "brings it up to date once space is freed")
+        if self._full is not None and self._file_behind:
+            problems.append(f"{self.path} is behind its journal ({self._full}); rig resume or rig repair brings it "
+                            "up to date once space is freed")
         self._journal.close()
         lock.release(self.path)
         return problems
