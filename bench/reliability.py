@@ -135,7 +135,7 @@ def finish_after_kill(campaign: Path, procedure: Path = PAPER) -> tuple[bool, st
 def count_write_calls(argv: list[str]) -> dict[str, int]:
     """How many of each write call an uninterrupted command makes."""
     with tempfile.NamedTemporaryFile("r", suffix=".strace") as counts:
-        subprocess.run(["strace", "-f", "--seccomp-bpf", "-c", "-o", counts.name, "-e",
+        subprocess.run(["strace", "-f", "-c", "-o", counts.name, "-e",
                         f"trace={','.join(WRITE_CALLS)}", *argv], capture_output=True, check=True)
         table = counts.read()
     return {name: int(m.group(1)) for name in WRITE_CALLS
@@ -144,7 +144,7 @@ def count_write_calls(argv: list[str]) -> dict[str, int]:
 
 def killed_at(argv: list[str], call: str, when: int) -> subprocess.CompletedProcess:
     """Run `argv` and kill it (SIGKILL, as strace delivers it) when it enters its `when`-th `call`."""
-    return subprocess.run(["strace", "-f", "--seccomp-bpf", "-o", "/dev/null", "-e", f"trace={call}", "-e",
+    return subprocess.run(["strace", "-f", "-o", "/dev/null", "-e", f"trace={call}", "-e",
                            f"inject={call}:signal=SIGKILL:when={when}", *argv], capture_output=True, text=True,
                           timeout=600)
 
@@ -277,8 +277,8 @@ def crash_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, in
 #: When the disk fills up (poses stored by then) and how much is left free then (bytes): from before the
 #: first pose to the fit, with nothing left (the next write fails) or a little (a later one does, or the
 #: check before a setpoint stops the campaign first).
-FULL_AT = [(0, 0), (0, 512 << 10), (1, 0), (30, 0), (30, 2 << 20), (100, 0), (100, 64 << 10), (150, 1 << 20),
-           (200, 0), (240, 256 << 10), (263, 0), (264, 0), (264, 3 << 20)]
+FULL_AT = [(0, 0), (0, 512 << 10), (1, 0), (30, 2 << 20), (75, 0), (100, 0), (100, 64 << 10), (150, 1 << 20),
+           (170, 0), (200, 0), (240, 256 << 10), (263, 0), (264, 0), (264, 3 << 20)]
 
 
 def diskfull_trials(folder: Path) -> tuple[int, int]:

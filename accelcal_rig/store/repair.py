@@ -20,7 +20,7 @@ from accelcal_rig.store.codec import (
     encode_state, replay,
 )
 from accelcal_rig.store.content import Campaign
-from accelcal_rig.durable import disk_errors, fsync_directory, write_atomically
+from accelcal_rig.durable import disk_errors, fsync_directory, stale_temporaries, write_atomically
 from accelcal_rig.store.hdf5_file import campaign_image
 from accelcal_rig.store.journal import JournalWriter, read_journal
 from accelcal_rig.store.paths import journal_path
@@ -108,6 +108,8 @@ def mend_journal(path: Path) -> list[str]:
 def repair_campaign(path: Path) -> list[str]:
     """Repair the campaign at `path`: what was done, one line each. Refused while a run holds it."""
     with lock.campaign_lock(path, "rig repair"):
+        for stale in stale_temporaries(path) + stale_temporaries(journal_path(path)):
+            stale.unlink(missing_ok=True)  # what a killed run left half-built
         done = mend_journal(path)
         journal, found = JournalWriter.reopen(journal_path(path), 0)
         journal.close()

@@ -112,6 +112,8 @@ class CampaignWriter:
         a campaign file without a journal gets one, and the campaign file is rebuilt."""
         lock.acquire(path, "rig resume")
         try:
+            for stale in stale_temporaries(path) + stale_temporaries(journal_path(path)):
+                stale.unlink(missing_ok=True)  # what a killed run left half-built
             with signals_deferred():
                 writer, repairs = cls._open_journal(path, storage)
                 campaign = writer._campaign
