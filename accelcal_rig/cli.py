@@ -729,6 +729,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
+    from accelcal_rig.durable import write_text_atomically
     from accelcal_rig.export.c_header import to_c_header
     from accelcal_rig.export.tables import to_csv, to_json
     from accelcal_rig.fit.calibration import load_calibration
@@ -740,7 +741,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
         return 0
     if not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
-    args.output.write_text(text, encoding="utf-8")
+    write_text_atomically(args.output, text, f"the {args.format} export")
     print(f"{args.format} of {len(calibration.sensors)} sensors → {args.output}")
     return 0
 

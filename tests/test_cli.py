@@ -364,3 +364,60 @@ def test_on_a_terminal_a_live_status_line_shows_progress(tmp_path: Path) -> None
     assert re.search(r"\r\x1b\[K\[\d:\d\d:\d\d\] T15: stable after", text)  # messages above the line
     assert "progress: " not in text  # the status line replaces the progress lines on a terminal
     assert text.endswith("\r\x1b[K")  # cleared at the end, the summary follows on stdout
+
+
+def test_commands_against_a_running_campaign_are_refused_and_change_nothing(tmp_path: Path, capsys) -> None:
+    """What a lab types at the wrong file while a campaign runs: --overwrite, --resume, resume, repair, fit."""
+    import time
+
+    from accelcal_rig.store.journal import read_journal
+    from accelcal_rig.store.paths import journal_path, log_path
+
+    procedure, campaign = tmp_path / "long.yaml", tmp_path / "c.h5"
+    procedure.write_text(TINY_PROCEDURE.replace("rig: sim.yaml", f"rig: {REPO / 'configs' / 'sim.yaml'}")
+                         .replace("[30]", "{from_c: -40, to_c: 59, step_c: 1}"))  # a run of some seconds
+    beside_python = Path(sys.executable).parent / "rig"
+    process = subprocess.Popen([str(beside_python), "run", str(procedure), "--dry-run", "-o", str(campaign), "-q"],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60
+        while not journal_path(campaign).exists() and time.monotonic() < deadline:
+            time.sleep(0.005)
+        for argv in (["run", str(procedure), "--dry-run", "-o", str(campaign), "--overwrite"],
+                     ["run", str(procedure), "--dry-run", "-o", str(campaign), "--resume"],
+                     ["resume", str(campaign)], ["repair", str(campaign)],
+                     ["fit", str(campaign), "-o", str(tmp_path / "other.yaml")]):
+            assert process.poll() is None, "the campaign ended before the commands were tried"
+            records = [(r.offset, r.size) for r in read_journal(journal_path(campaign)).records]
+            stored = journal_path(campaign).read_bytes()
+            log = log_path(campaign).read_bytes()
+            err = one_line_error(capsys, argv, 2)
+            assert f"pid {process.pid} on " in err, (argv, err)
+            now = journal_path(campaign).read_bytes()
+            assert all(now[o:o + n] == stored[o:o + n] for o, n in records), argv   # only ever appended to
+            assert log_path(campaign).read_bytes().startswith(log), argv           # the log not cut
+    finally:
+        assert process.wait(timeout=120) == 0
+    from accelcal_rig.store.read import campaign_status
+
+    status = campaign_status(campaign)
+    assert (status["state"], status["poses_done"], status["campaign_file"]) == ("done", 600, "current")
+    assert not (tmp_path / "other.yaml").exists()
+
+
+def test_resume_finds_the_procedure_from_any_folder(tmp_path: Path) -> None:
+    """The campaign stores its procedure's path absolute: resumed from another folder, it is found."""
+    (tmp_path / "configs").mkdir()
+    shutil.copy(REPO / "configs" / "sim.yaml", tmp_path / "configs" / "sim.yaml")
+    (tmp_path / "procedures").mkdir()
+    shutil.copy(REPO / "procedures" / "quick-6pos.yaml", tmp_path / "procedures" / "quick.yaml")
+    run = rig("run", "procedures/quick.yaml", "--dry-run", "-o", "c.h5", "-q", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    import h5py
+
+    with h5py.File(tmp_path / "c.h5", "r") as f:
+        assert f.attrs["procedure_path"] == str(tmp_path / "procedures" / "quick.yaml")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    resumed = rig("resume", str(tmp_path / "c.h5"), cwd=elsewhere)
+    assert resumed.returncode == 0 and "the campaign is complete: nothing to resume" in resumed.stdout, resumed.stderr

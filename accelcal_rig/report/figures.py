@@ -6,11 +6,14 @@ Each function writes one PNG and returns its path.
 
 from __future__ import annotations
 
+import io
+
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from accelcal_rig.durable import write_atomically
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, distort, norm_only_gauge
 from accelcal_rig.report.campaign_data import CampaignData
@@ -41,8 +44,11 @@ def pyplot():  # noqa: ANN201 - matplotlib's module
 
 
 def save(figure: Figure, path: Path) -> Path:
-    figure.savefig(path, dpi=DPI, bbox_inches="tight")
+    """Write the figure as PNG, replacing any file at `path` whole."""
+    image = io.BytesIO()
+    figure.savefig(image, format="png", dpi=DPI, bbox_inches="tight")
     pyplot().close(figure)
+    write_atomically(path, image.getvalue(), "a figure")
     return path
 
 

@@ -12,7 +12,9 @@ from pathlib import Path
 import numpy as np
 
 from accelcal_rig import __version__
+from accelcal_rig.durable import write_text_atomically
 from accelcal_rig.engine.events import format_duration
+from accelcal_rig.errors import ConfigError
 from accelcal_rig.report import figures
 from accelcal_rig.report.campaign_data import CampaignData, read_campaign_data
 from accelcal_rig.store.records import utc_now
@@ -64,14 +66,17 @@ def write_report(campaign: Path, output: Path) -> Path:
     """Write `output/index.html` and `output/figures/*.png` for a campaign file; return the HTML path."""
     data = read_campaign_data(campaign)
     folder = output / "figures"
-    folder.mkdir(parents=True, exist_ok=True)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"{folder}: cannot make the report's folder: {exc.strerror}") from None
     figures.norm_deviation(data, folder / FIGURES["norm_deviation"])
     figures.ellipsoid(data, folder / FIGURES["ellipsoid"])
     figures.parameters(data, folder / FIGURES["parameters"])
     figures.drift(data, folder / FIGURES["drift"])
     figures.soak_traces(data, data.soak_band_c, folder / FIGURES["soaks"])
     page = output / "index.html"
-    page.write_text(_page(data), encoding="utf-8")
+    write_text_atomically(page, _page(data), "the report")
     return page
 
 

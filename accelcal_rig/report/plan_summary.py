@@ -8,6 +8,7 @@ from accelcal_rig.engine.estimate import DurationEstimate
 from accelcal_rig.engine.events import format_duration
 from accelcal_rig.engine.session import PreparedCampaign
 from accelcal_rig.plan.compile import setpoint_label
+from accelcal_rig.store.space import START_MARGIN, megabytes
 
 
 def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[str]:
@@ -30,6 +31,7 @@ def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[s
         "fit        none: measured only" if procedure.fit.mode == "none" else
         f"fit        {procedure.fit.mode}, {procedure.fit.parameters} parameters, polynomial degree "
         f"{procedure.fit.polynomial_degree}",
+        _storage_line(prepared),
         "",
         "pose  " + " ".join(f"{name + ' °':>9s}" for name in plan.axis_names) + "   gravity in the fixture frame (g)",
     ]
@@ -50,6 +52,13 @@ def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[s
     lines += ["", f"estimated duration {format_duration(estimate.total_s)} (h:mm:ss; from the rig's ramp rate, "
                   "thermal time constants and axis speeds; instrument communication not included)"]
     return lines
+
+
+def _storage_line(prepared: PreparedCampaign) -> str:
+    storage = prepared.storage(dry_run=False)
+    return (f"storage    about {megabytes(storage.journal_bytes)} journal + {megabytes(storage.file_bytes)} campaign "
+            f"file; rig run starts with {megabytes(int(START_MARGIN * storage.need_bytes))} free ({START_MARGIN:g} × "
+            f"the {megabytes(storage.need_bytes)} it needs at most, log and calibration included)")
 
 
 def _poses_line(prepared: PreparedCampaign) -> str:
@@ -79,6 +88,7 @@ def _method_lines(prepared: PreparedCampaign) -> list[str]:
 
 def plan_json(prepared: PreparedCampaign, estimate: DurationEstimate) -> dict[str, Any]:
     procedure, plan = prepared.procedure.model, prepared.plan
+    storage = prepared.storage(dry_run=False)
     return {
         "procedure": procedure.name, "procedure_path": str(prepared.procedure.path),
         "rig": prepared.rig.model.name, "rig_path": str(prepared.rig.path),
@@ -88,6 +98,8 @@ def plan_json(prepared: PreparedCampaign, estimate: DurationEstimate) -> dict[st
         "poses": [{"number": p.number, "angles_deg": list(p.angles_deg), "gravity_fixture": list(p.gravity_fixture)}
                   for p in plan.poses],
         "poses_total": len(plan.pose_steps),
+        "storage": {"journal_bytes": storage.journal_bytes, "file_bytes": storage.file_bytes,
+                    "need_bytes": storage.need_bytes, "start_free_bytes": int(START_MARGIN * storage.need_bytes)},
         "estimate": {
             "total_s": estimate.total_s,
             "setpoints": [{"setpoint_c": r.setpoint_c, "ramp_s": r.ramp_s, "soak_s": r.soak_s, "poses_s": r.poses_s,

@@ -1,5 +1,5 @@
 """How much disk a campaign needs, known before it starts: a pose's journal record is encoded for real,
-the campaign file's size follows from the data it holds."""
+the rest follows from what the files hold per pose and per event."""
 
 from __future__ import annotations
 
@@ -8,17 +8,24 @@ from dataclasses import dataclass
 import numpy as np
 
 from accelcal_rig.store.codec import encode_pose
+from accelcal_rig.store.hdf5_file import TEXT_BYTES
 from accelcal_rig.store.records import DutPoseRecord, PoseRecord
 
 #: `rig run` starts only with this many times the estimated need free.
 START_MARGIN = 1.5
 #: Bytes the journal keeps back for the records that stop a campaign on a full disk (at least).
 MIN_RESERVE_BYTES = 256 * 1024
-#: A campaign file's fixed part (configs, plan, groups, checksums), and per stored event (journal and log).
+#: Events a pose brings (its transitions, its line, the odd warning), and what one costs in the journal
+#: (JSON), the campaign file (fixed-length text columns) and the log (a line).
+_EVENTS_PER_POSE = 6
+_EVENT_JOURNAL_BYTES = 100
+_EVENT_FILE_BYTES = 8 + sum(TEXT_BYTES[name] for name in ("wall_time", "level", "kind", "message"))
+_EVENT_LOG_BYTES = 140
+#: A campaign file's fixed part (configs, plan, groups, checksums) and a journal's (its header).
 _FILE_FIXED_BYTES = 256 * 1024
-_EVENT_BYTES = 160
-_EVENTS_PER_POSE = 4
-_CALIBRATION_BYTES = 64 * 1024
+_JOURNAL_FIXED_BYTES = 64 * 1024
+#: A calibration file: its fixed part, and per DUT.
+_CALIBRATION_BYTES = (32 * 1024, 24 * 1024)
 
 
 def pose_record_bytes(n_duts: int, samples_per_pose: int, n_axes: int, with_truth: bool) -> int:
@@ -43,6 +50,7 @@ class StorageEstimate:
     journal_bytes: int
     file_bytes: int        # the campaign file (HDF5) when complete
     other_bytes: int       # log, calibration, the journal's reserve
+    calibration_bytes: int
 
     @property
     def need_bytes(self) -> int:
@@ -52,18 +60,19 @@ class StorageEstimate:
 
     def remaining_bytes(self, poses_left: int) -> int:
         """What the rest of a campaign with `poses_left` poses to go still needs beyond what is stored: its
-        journal records, events and log lines, a new campaign file beside the old, the calibration."""
-        return poses_left * (self.pose_bytes + 2 * _EVENTS_PER_POSE * _EVENT_BYTES) + self.file_bytes + \
-            _CALIBRATION_BYTES
+        journal records and log lines, a new campaign file beside the old, the calibration."""
+        per_pose = self.pose_bytes + _EVENTS_PER_POSE * (_EVENT_JOURNAL_BYTES + _EVENT_LOG_BYTES)
+        return poses_left * per_pose + self.file_bytes + self.calibration_bytes
 
 
 def estimate_storage(poses: int, n_duts: int, samples_per_pose: int, n_axes: int, with_truth: bool) -> StorageEstimate:
     pose_bytes = pose_record_bytes(n_duts, samples_per_pose, n_axes, with_truth)
-    events_bytes = poses * _EVENTS_PER_POSE * _EVENT_BYTES
-    journal = 64 * 1024 + poses * pose_bytes + events_bytes
-    file = _FILE_FIXED_BYTES + int(1.05 * poses * pose_bytes) + events_bytes
-    other = events_bytes + _CALIBRATION_BYTES + reserve_bytes(pose_bytes)
-    return StorageEstimate(poses, pose_bytes, journal, file, other)
+    events = poses * _EVENTS_PER_POSE
+    journal = _JOURNAL_FIXED_BYTES + poses * pose_bytes + events * _EVENT_JOURNAL_BYTES
+    file = _FILE_FIXED_BYTES + int(1.05 * poses * pose_bytes) + events * _EVENT_FILE_BYTES
+    calibration = _CALIBRATION_BYTES[0] + n_duts * _CALIBRATION_BYTES[1]
+    other = events * _EVENT_LOG_BYTES + calibration + reserve_bytes(pose_bytes)
+    return StorageEstimate(poses, pose_bytes, journal, file, other, calibration)
 
 
 def megabytes(n_bytes: int) -> str:

@@ -34,10 +34,10 @@ from accelcal_rig.durable import free_bytes, stale_temporaries, write_atomically
 from accelcal_rig.store.hdf5_file import campaign_image
 from accelcal_rig.store.journal import JournalWriter
 from accelcal_rig.store.paths import journal_path
-from accelcal_rig.store.repair import mend_journal
 from accelcal_rig.store.records import (
     CampaignHeader, Event, PoseRecord, RunStart, SoakTrace, StateChange, StoredEvent, utc_now,
 )
+from accelcal_rig.store.repair import mend_journal
 from accelcal_rig.store.space import StorageEstimate, megabytes, reserve_bytes
 
 #: Least wall time between two rebuilds of the campaign file while poses come in.

@@ -33,3 +33,13 @@ def test_every_procedure_and_rig_key_is_documented() -> None:
     doc = (REPO / "docs" / "procedures.md").read_text()
     missing = sorted(k for k in keys(Procedure) | keys(RigConfig) if f"`{k}`" not in doc)
     assert not missing, f"undocumented keys: {missing}"
+
+
+def test_every_numeric_key_has_its_range_in_the_docs() -> None:
+    from tests.config.bounds import numeric_keys, shown
+
+    doc = (REPO / "docs" / "procedures.md").read_text()
+    ranges = doc[doc.index("### Ranges"):doc.index("## Procedure")]
+    missing = [f"`{key}` {shown(limits)}" for model in (Procedure, RigConfig) for key, _, limits in numeric_keys(model)
+               if shown(limits) and f"`{key}` {shown(limits)}" not in " ".join(ranges.split())]
+    assert not missing, f"ranges missing or wrong in docs/procedures.md: {missing}"
