@@ -7,8 +7,11 @@ never a mixture. A full disk is one error type naming the folder, whatever wrote
 
 from __future__ import annotations
 
+import datetime as dt
 import errno
+import itertools
 import os
+import stat
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -28,9 +31,33 @@ def temporary_beside(path: Path) -> Path:
     return path.with_name(f"{path.name}.tmp-{os.getpid()}")
 
 
+def unused_name(path: Path, why: str) -> Path:
+    """`<path>.<why>-20261201T081500` (with `-2`, `-3`, … if taken): where a copy set aside is kept."""
+    stamp = dt.datetime.now(dt.timezone.utc).strftime("%Y%m%dT%H%M%S")
+    for count in itertools.count(1):
+        candidate = path.with_name(f"{path.name}.{why}-{stamp}{'' if count == 1 else f'-{count}'}")
+        if not os.path.lexists(candidate):
+            return candidate
+    raise AssertionError("unreachable")
+
+
 def stale_temporaries(path: Path) -> list[Path]:
     """Versions of `path` that a killed process left half-built."""
     return sorted(path.parent.glob(f"{path.name}.tmp-*"))
+
+
+def clear_stale_temporaries(*paths: Path) -> None:
+    """Remove what killed processes left half-built beside `paths` (the caller holds the campaign)."""
+    for path in paths:
+        for stale in stale_temporaries(path):
+            with disk_errors(stale, "a file left half-built"):
+                stale.unlink(missing_ok=True)
+
+
+def remove(path: Path, what: str) -> None:
+    """Remove `path` if it is there; an error is one line naming it."""
+    with disk_errors(path, what):
+        path.unlink(missing_ok=True)
 
 
 @contextmanager
@@ -82,6 +109,37 @@ def write_atomically(path: Path, data: bytes, what: str) -> None:
 
 def write_text_atomically(path: Path, text: str, what: str) -> None:
     write_atomically(path, text.encode("utf-8"), what)
+
+
+def read_regular_file(path: Path, limit: int, what: str) -> bytes:
+    """The bytes of a regular file of at most `limit` bytes (a device, a pipe or a folder is refused
+    without waiting on it, a larger file without reading it); ConfigError naming `path`."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: file not found") from None
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f"{path}: cannot read: {str(exc).splitlines()[0]}") from None
+    try:
+        info = os.fstat(fd)
+        if stat.S_ISDIR(info.st_mode):
+            raise ConfigError(f"{path}: is a folder, not a file")
+        if not stat.S_ISREG(info.st_mode):
+            raise ConfigError(f"{path}: not a regular file")
+        chunks, size = [], 0
+        while size <= limit:
+            chunk = os.read(fd, min(1 << 20, limit + 1 - size))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+        if size > limit:
+            raise ConfigError(f"{path}: more than {limit} bytes: {what} is at most {limit} bytes")
+        return b"".join(chunks)
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    finally:
+        os.close(fd)
 
 
 def free_bytes(folder: Path) -> int:

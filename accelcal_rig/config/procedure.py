@@ -251,8 +251,8 @@ class Procedure(_Strict):
             raise ValueError("from_c, to_c and step_c must be numbers") from None
         if not all(np.isfinite([start, stop, step])) or max(abs(start), abs(stop)) > 1000:
             raise ValueError("from_c, to_c and step_c must be finite temperatures")
-        if step == 0 or (stop - start) / step < 0:
-            raise ValueError("step_c must be non-zero and lead from from_c to to_c")
+        if abs(step) < 1e-3 or (stop - start) / step < 0:
+            raise ValueError("step_c must be at least 0.001 °C and lead from from_c to to_c")
         count = int(np.floor((stop - start) / step + 1e-9)) + 1
         if count > 200:
             raise ValueError("a setpoint range may hold at most 200 setpoints")

@@ -14,6 +14,7 @@ from typing import Any
 
 import yaml
 
+from accelcal_rig.durable import read_regular_file
 from accelcal_rig.errors import ConfigError
 
 KeyPath = tuple[str | int, ...]
@@ -128,21 +129,12 @@ def load_yaml_with_lines(path: Path) -> tuple[Any, dict[KeyPath, int], str]:
     Syntax errors, duplicate keys (which PyYAML would silently overwrite) and files beyond the bounds
     above become ConfigError.
     """
+    raw = read_regular_file(path, MAX_FILE_BYTES, "a procedure, rig or calibration file")
     try:
-        if path.is_dir():
-            raise ConfigError(f"{path}: is a folder, not a YAML file")
-        size = path.stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise ConfigError(f"{path}: {size} bytes: a procedure, rig or calibration file is at most "
-                              f"{MAX_FILE_BYTES} bytes")
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: file not found") from None
+        text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
-        line = path.read_bytes()[:exc.start].count(b"\n") + 1
-        raise ConfigError(f"{path}:{line}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x})") from None
-    except (OSError, ValueError) as exc:
-        raise ConfigError(f"{path}: cannot read: {str(exc).splitlines()[0]}") from None
+        line = raw[:exc.start].count(b"\n") + 1
+        raise ConfigError(f"{path}:{line}: not UTF-8 text (byte 0x{raw[exc.start]:02x})") from None
     data, root = _parse(text, str(path))
     if root is None:
         raise ConfigError(f"{path}:1: file is empty")

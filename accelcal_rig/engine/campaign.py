@@ -410,7 +410,7 @@ class CampaignRunner:
             t, chamber, dut = detector.trace()
             self._settled_dut_c = detector.settled_dut_c() if len(t) else np.full(len(self.sensors), np.nan)
             self.writer.write_soak(SoakTrace(label, setpoint_c, outcome, t, chamber, dut, t_reached, t_stable,
-                                             self._settled_dut_c))
+                                             self._settled_dut_c, tuple(s.serial for s in self.sensors)))
         if outcome == "timeout":
             if criterion.on_timeout == "skip":
                 self.events.warning("soak", f"{timed_out}; setpoint skipped, its {n_poses} poses not measured "

@@ -14,6 +14,10 @@ from scipy.ndimage import maximum_filter1d, minimum_filter1d
 
 from accelcal_rig.config.procedure import SoakCriterion
 
+#: Window lengths (in polls) judged with running filters; rarer ones (the poll cut short at a deadline)
+#: one by one. Evenly spaced polls give one or two lengths, rounding the window to whole polls.
+_FILTERED_LENGTHS = 4
+
 
 class SoakDetector:
     """Collects temperature polls from the moment the chamber reached its setpoint and judges stability."""
@@ -89,14 +93,18 @@ def first_stable_poll(criterion: SoakCriterion, setpoint_c: float, t_reached_s: 
     candidate &= outside[index + 1] - outside[start] == 0
     if not candidate.any():
         return None
-    usual = int(np.bincount(length[candidate]).argmax())
-    # A running filter of size w centred at c covers [c − w//2, c − w//2 + w − 1]: the window ending at k
-    # is centred at k − w + 1 + w//2.
-    centre = np.clip(index - usual + 1 + usual // 2, 0, n - 1)
-    span = (maximum_filter1d(dut_c, usual, axis=0, mode="nearest") -
-            minimum_filter1d(dut_c, usual, axis=0, mode="nearest"))[centre]
-    settled = np.all(span <= criterion.band_c, axis=1) & candidate & (length == usual)
-    for k in np.flatnonzero(candidate & (length != usual)):  # windows of another length, judged directly
+    settled = np.zeros(n, dtype=bool)
+    values, counts = np.unique(length[candidate], return_counts=True)
+    lengths = values[np.argsort(-counts, kind="stable")]  # the most common first
+    for width in lengths[:_FILTERED_LENGTHS]:  # each window length its own running filter
+        rows = candidate & (length == width)
+        # A running filter of size w centred at c covers [c − w//2, c − w//2 + w − 1]: the window ending at
+        # k is centred at k − w + 1 + w//2.
+        centre = np.clip(index[rows] - width + 1 + width // 2, 0, n - 1)
+        span = (maximum_filter1d(dut_c, int(width), axis=0, mode="nearest") -
+                minimum_filter1d(dut_c, int(width), axis=0, mode="nearest"))[centre]
+        settled[rows] = np.all(span <= criterion.band_c, axis=1)
+    for k in np.flatnonzero(candidate & np.isin(length, lengths[_FILTERED_LENGTHS:])):  # rare lengths, directly
         window = dut_c[start[k]:k + 1]
         settled[k] = bool(np.all(window.max(axis=0) - window.min(axis=0) <= criterion.band_c))
     found = np.flatnonzero(settled)

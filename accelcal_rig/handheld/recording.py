@@ -13,6 +13,7 @@ from typing import Literal
 
 import numpy as np
 
+from accelcal_rig.durable import read_regular_file
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.store.read import dut_description, rows_at_setpoint, usable_campaign
 
@@ -20,6 +21,8 @@ STANDARD_GRAVITY_M_S2 = 9.80665
 #: The largest number a recording's CSV may hold, and the largest reading (in g, once scaled) and
 #: temperature range taken for a recording of an accelerometer turned by hand.
 MAX_VALUE = 1e15
+#: The largest CSV recording read (a day at 1 kHz is about 3 GB: split it; an hour at 100 Hz is 20 MB).
+MAX_CSV_BYTES = 512 << 20
 MAX_ACCEL_G = 1000.0
 MIN_TEMPERATURE_C, MAX_TEMPERATURE_C = -100.0, 300.0
 Units = Literal["g", "counts", "m/s2"]
@@ -67,10 +70,7 @@ def read_csv_recording(path: Path, layout: CsvLayout) -> Recording:
         raise ConfigError("--counts-per-g is needed with --units counts (ADXL355: 256000 at ±2 g)")
     if layout.time_unit == "samples" and not layout.rate_hz:
         raise ConfigError("--rate-hz is needed when the time column counts samples")
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise ConfigError(f"{path}: cannot read ({exc.strerror})") from None
+    raw = read_regular_file(path, MAX_CSV_BYTES, "a recording")
     reader = csv.reader(io.StringIO(raw.decode("utf-8-sig", errors="replace"), newline=""))
     try:
         header = next(reader, None)

@@ -21,6 +21,11 @@ class NotACampaignJournal(ValueError):
     """The journal has no readable header record."""
 
 
+#: What a record that checksums but holds the wrong things (crafted, or from another program) raises
+#: when it is taken apart: the record is noted as unusable and left out.
+_UNUSABLE = (KeyError, ValueError, TypeError, IndexError, AttributeError, OverflowError, RecursionError)
+
+
 def _plain(value: Any) -> Any:
     """JSON-able: numpy scalars and arrays become Python numbers and lists."""
     if isinstance(value, dict):
@@ -91,11 +96,12 @@ def encode_pose(pose: PoseRecord) -> bytes:
     return encode_record("pose", meta, arrays)
 
 
-def encode_soak(soak: SoakTrace) -> bytes:
+def encode_soak(soak: SoakTrace, serials: list[str]) -> bytes:
+    """`serials`: whose temperatures the columns of `soak.dut_c` are, in order."""
     arrays = {"t_s": np.asarray(soak.t_s, dtype="f8"), "chamber_c": np.asarray(soak.chamber_c, dtype="f8"),
               "dut_c": np.asarray(soak.dut_c, dtype="f8"), "settled_dut_c": np.asarray(soak.settled_dut_c, dtype="f8"),
               "times_s": np.array([soak.setpoint_c, soak.t_reached_s, soak.t_stable_s], dtype="f8")}
-    return encode_record("soak", {"label": soak.label, "outcome": soak.outcome}, arrays)
+    return encode_record("soak", {"label": soak.label, "outcome": soak.outcome, "serials": serials}, arrays)
 
 
 # ---------------------------------------------------------------------- decoding
@@ -121,8 +127,8 @@ def _header(record: Record) -> CampaignHeader:
 
 def _pose(record: Record, header: CampaignHeader) -> PoseRecord:
     meta, arrays = record.meta, record.arrays
-    serials = list(meta["serials"])
-    if serials != header.serials:
+    serials = [str(s) for s in meta["serials"]]  # the order they were measured in; the campaign matches by serial
+    if sorted(serials) != sorted(header.serials) or len(set(serials)) != len(serials):
         raise ValueError(f"its sensors {serials} are not the campaign's {header.serials}")
     n_duts, n_axes, n = len(serials), len(header.plan.axis_names), int(header.attrs.get("samples_per_pose", 0))
     shapes = {"commanded_angles_deg": (n_axes,), "measured_angles_deg": (n_axes,), "gravity_fixture": (3,),
@@ -152,8 +158,13 @@ def _soak(record: Record, header: CampaignHeader) -> SoakTrace:
     if arrays["chamber_c"].shape != (m,) or arrays["dut_c"].size != m * d or arrays["times_s"].shape != (3,):
         raise ValueError("soak columns of different lengths")
     setpoint, reached, stable = arrays["times_s"].tolist()
+    columns = [str(s) for s in record.meta.get("serials", header.serials)]
+    if sorted(columns) != sorted(header.serials) or arrays["settled_dut_c"].shape != (d,):
+        raise ValueError(f"its sensors {columns} are not the campaign's {header.serials}")
+    order = [columns.index(serial) for serial in header.serials]  # the campaign's order
     return SoakTrace(str(record.meta["label"]), setpoint, str(record.meta["outcome"]), arrays["t_s"],
-                     arrays["chamber_c"], arrays["dut_c"].reshape(m, d), reached, stable, arrays["settled_dut_c"])
+                     arrays["chamber_c"], arrays["dut_c"].reshape(m, d)[:, order], reached, stable,
+                     arrays["settled_dut_c"][order])
 
 
 def replay(found: Scan, source: str) -> Campaign:
@@ -167,7 +178,7 @@ def replay(found: Scan, source: str) -> Campaign:
         raise NotACampaignJournal(f"{source}: no campaign header record")
     try:
         campaign = Campaign(_header(first))
-    except (KeyError, ValueError, TypeError) as exc:
+    except _UNUSABLE as exc:
         raise NotACampaignJournal(f"{source}: its header record is not readable ({exc})") from None
     if found.damaged:
         skipped = sum(length for _, length in found.damaged)
@@ -178,7 +189,7 @@ def replay(found: Scan, source: str) -> Campaign:
     for record in records[records.index(first) + 1:]:
         try:
             _apply(campaign, record, source)
-        except (KeyError, ValueError, TypeError, IndexError) as exc:
+        except _UNUSABLE as exc:
             campaign.notes.append(f"{source}: {record.kind} record at byte {record.offset} not usable ({exc})")
     return campaign
 
@@ -195,13 +206,15 @@ def _apply(campaign: Campaign, record: Record, source: str) -> None:
         campaign.events.extend(StoredEvent(float(t), str(w), str(lv), str(k), str(m))
                                for t, (w, lv, k, m) in zip(times.tolist(), rows))
     elif record.kind == "soak":
-        campaign.soaks.append(_soak(record, campaign.header))
+        campaign.add_soak(_soak(record, campaign.header))
     elif record.kind == "state":
         state = str(meta["state"])
+        if state not in ("running", "done", "aborted", "created"):
+            raise ValueError(f"unknown state {state!r}")
         campaign.state = state
         if state == "running":  # a run starts afresh: the last run's ending no longer applies
             campaign.abort_reason, campaign.finished = "", ""
-        else:
+        if meta.get("wall_time"):
             campaign.finished = str(meta["wall_time"])
         if meta.get("reason"):
             campaign.abort_reason = str(meta["reason"])

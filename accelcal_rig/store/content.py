@@ -9,7 +9,7 @@ from __future__ import annotations
 import datetime as dt
 import hashlib
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -52,7 +52,14 @@ class Campaign:
 
     # ------------------------------------------------------------------ building it
     def add_pose(self, pose: PoseRecord, where: str) -> bool:
-        """Keep `pose` unless its step is stored already (then say so, naming `where` it came from)."""
+        """Keep `pose` unless its step is stored already (then say so, naming `where` it came from). Its
+        DUTs are matched to the campaign's by serial, whatever order they came in; ValueError when they
+        are not the campaign's."""
+        if [d.serial for d in pose.duts] != self.serials:
+            by_serial = {d.serial: d for d in pose.duts}
+            if sorted(by_serial) != sorted(self.serials) or len(by_serial) != len(pose.duts):
+                raise ValueError(f"its sensors {sorted(by_serial)} are not the campaign's {self.serials}")
+            pose = replace(pose, duts=[by_serial[serial] for serial in self.serials])
         if pose.step_key in self.stored_keys:
             self.notes.append(f"pose {pose.step_key} stored more than once ({where}): the first is kept")
             return False
@@ -60,6 +67,16 @@ class Campaign:
         self._stored.add(pose.step_key)
         self._columns.clear()
         return True
+
+    def add_soak(self, soak: SoakTrace) -> None:
+        """Keep a soak trace, its DUT columns put in the campaign's order."""
+        if soak.serials and list(soak.serials) != self.serials:
+            if sorted(soak.serials) != sorted(self.serials):
+                raise ValueError(f"its sensors {list(soak.serials)} are not the campaign's {self.serials}")
+            order = [soak.serials.index(serial) for serial in self.serials]
+            dut_c = soak.dut_c[:, order] if soak.dut_c.size else soak.dut_c
+            soak = replace(soak, dut_c=dut_c, settled_dut_c=soak.settled_dut_c[order], serials=tuple(self.serials))
+        self.soaks.append(soak)
 
     @property
     def stored_keys(self) -> set[str]:
@@ -157,6 +174,34 @@ class Campaign:
         if foreign:
             problems.append(f"poses not in the plan: {', '.join(foreign[:5])}{' …' if len(foreign) > 5 else ''}")
         return problems
+
+
+def take_what_the_file_kept(campaign: Campaign, from_file: Campaign, journal_name: str, file_name: str) -> str:
+    """Add to a journal's `campaign` what its campaign file `from_file` (the same campaign, read whole)
+    still holds and the journal has lost: poses it lacks, and — when the file was built from more of the
+    journal than is left — the soaks, events and state past the journal's end. What was added, or ""."""
+    poses = [p for p in from_file.poses if p.step_key not in campaign.stored_keys]
+    for pose in poses:
+        campaign.add_pose(pose, file_name)
+    ahead = from_file.journal_bytes > campaign.journal_bytes
+    soaks = events = 0
+    if ahead:
+        known = {(s.label, s.t_reached_s) for s in campaign.soaks}
+        for soak in from_file.soaks:
+            if (soak.label, soak.t_reached_s) not in known:
+                campaign.add_soak(soak)
+                soaks += 1
+        last = campaign.events[-1].t_s if campaign.events else float("-inf")
+        later = [e for e in from_file.events if e.t_s > last]
+        campaign.events.extend(later)
+        events = len(later)
+        campaign.state, campaign.abort_reason, campaign.finished = from_file.state, from_file.abort_reason, from_file.finished
+    if not (poses or soaks or events):
+        return ""
+    added = f"{len(poses)} poses, {soaks} soaks and {events} events"
+    campaign.notes.append(f"{journal_name} had lost what {file_name} holds: {added} taken from {file_name} (rig repair "
+                          "gives them back to the journal)")
+    return added
 
 
 def measurements_sha256(campaign: Campaign) -> str:

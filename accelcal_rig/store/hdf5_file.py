@@ -17,6 +17,8 @@ from typing import Any
 import h5py
 import numpy as np
 
+from accelcal_rig.config.yaml_lines import parse_yaml_text
+from accelcal_rig.errors import ConfigError
 from accelcal_rig.store.content import POSE_FIELDS, Campaign, measurements_sha256
 from accelcal_rig.store.records import (
     CampaignHeader, DutPoseRecord, PoseRecord, RunStart, SoakTrace, StoredEvent, StoredPlan,
@@ -35,6 +37,8 @@ _UNITS = {"setpoint_c": "degC", "commanded_angles_deg": "deg", "measured_angles_
           "chamber_c": "degC", "dut_c": "degC", "settled_dut_c": "degC", "gravity_g": "g"}
 #: Names of the in-memory files images are built in (HDF5 wants one; nothing is written under it).
 _image_names = itertools.count()
+#: What a dataset may claim beyond twice the bytes stored for it (small datasets, headers).
+_SLACK_BYTES = 1 << 20
 #: Most runs (1 + resumes) a file may claim before it is taken for damaged.
 _MAX_RUNS = 10_000
 #: Largest plan and sample count a file may claim before it is taken for damaged.
@@ -85,7 +89,7 @@ def campaign_image(campaign: Campaign, journal_bytes: int) -> bytes:
         for name in POSE_FIELDS:
             column = campaign.pose_column(name)
             _dataset(poses, name, _fixed_text("step_key", list(column)) if name == "step_key" else column)
-        duts = file.create_group("duts")
+        duts = file.create_group("duts", track_order=True)
         for dut in header.duts:
             group = duts.create_group(dut["serial"])
             group.attrs.update(dut)
@@ -146,6 +150,14 @@ class _Reader:
             raise DamagedFile(f"{path}: missing or not a {'group' if kind is h5py.Group else 'dataset'}")
         return node
 
+    def _stored(self, path: str, dataset: h5py.Dataset) -> None:
+        """Refuse a dataset that claims far more data than the file holds for it (unwritten chunks, or
+        a damaged shape): reading it would conjure gigabytes of fill values."""
+        claimed = int(np.prod(dataset.shape, dtype=np.float64) * dataset.dtype.itemsize) if dataset.shape else 0
+        held = dataset.id.get_storage_size()
+        if claimed > 2 * held + _SLACK_BYTES:
+            raise DamagedFile(f"{path}: claims {claimed} bytes, the file holds {held} for it")
+
     def array(self, path: str, tail: tuple[int, ...], kinds: str, rows: int | None = None) -> np.ndarray:
         dataset = self.node(path, h5py.Dataset)
         shape, dtype = dataset.shape, dataset.dtype
@@ -154,12 +166,14 @@ class _Reader:
                               f"kind {kinds}")
         if shape[0] > _MAX_ROWS or (rows is not None and shape[0] < rows):
             raise DamagedFile(f"{path}: {shape[0]} rows{f' for {rows} poses' if rows is not None else ''}")
+        self._stored(path, dataset)
         return dataset[: shape[0] if rows is None else rows]
 
     def matrix(self, path: str) -> np.ndarray:
         dataset = self.node(path, h5py.Dataset)
         if dataset.ndim != 2 or dataset.dtype.kind != "f" or dataset.size > _MAX_ROWS:
             raise DamagedFile(f"{path}: shape {dataset.shape} of {dataset.dtype}, expected a matrix of numbers")
+        self._stored(path, dataset)
         return dataset[()]
 
     def text(self, path: str) -> str:
@@ -246,6 +260,7 @@ def read_campaign_file(file: h5py.File) -> Campaign:
     if recorded and longest == whole and recorded != measurements_sha256(campaign):
         campaign.damage.append("its measurements do not match the digest written with them (changed or damaged "
                                "since accelcal-rig wrote the file)")
+    campaign.journal_bytes = int(attrs.get("journal_bytes", 0))
     campaign.runs = [RunStart(k, 0, "", "") for k in range(1, runs)] + [
         RunStart(runs, int(attrs.get("writer_pid", 0)), _text(attrs.get("writer_host", "")), "")]
     return campaign
@@ -281,8 +296,11 @@ def _read_header(reader: _Reader) -> CampaignHeader:
     samples = attrs.get("samples_per_pose")
     if not isinstance(samples, int) or not 0 < samples <= _MAX_ROWS:
         raise DamagedFile(f"attribute samples_per_pose is {samples!r}")
+    rig_yaml = reader.text("config/rig_yaml")
     duts = []
-    for serial, group in reader.node("duts", h5py.Group).items():
+    groups = reader.node("duts", h5py.Group)
+    for serial in _campaign_order(rig_yaml, list(groups)):
+        group = groups[serial]
         if not isinstance(group, h5py.Group):
             raise DamagedFile(f"duts/{serial}: not a group")
         duts.append({"serial": serial, **{k: _plain_attr(v) for k, v in group.attrs.items() if k != "serial"}})
@@ -298,9 +316,20 @@ def _read_header(reader: _Reader) -> CampaignHeader:
     return CampaignHeader(
         campaign_id=_text(file.attrs.get("campaign_id", "")), created=_text(file.attrs.get("started", "")),
         software_version=_text(file.attrs.get("software_version", "")), attrs=attrs,
-        procedure_yaml=reader.text("config/procedure_yaml"), rig_yaml=reader.text("config/rig_yaml"), plan=plan,
+        procedure_yaml=reader.text("config/procedure_yaml"), rig_yaml=rig_yaml, plan=plan,
         duts=duts, instruments={}, turntable_accuracy_arcsec=float(poses_group.attrs.get("turntable_accuracy_arcsec", 0.0)),
         truth=truth)
+
+
+def _campaign_order(rig_yaml: str, serials: list[str]) -> list[str]:
+    """The DUTs in the campaign's order: the rig config's fixture order, in which every run measured them
+    and the soak traces' columns are (the file's groups may list them in another)."""
+    try:
+        sensors = parse_yaml_text(rig_yaml, "the stored rig config")["fixture"]["sensors"]
+        order = [str(sensor["serial"]) for sensor in sensors]
+    except (ConfigError, KeyError, TypeError, IndexError):
+        return sorted(serials)
+    return order if sorted(order) == sorted(serials) else sorted(serials)
 
 
 def _read_soaks(reader: _Reader, n_duts: int, notes: list[str]) -> list[SoakTrace]:

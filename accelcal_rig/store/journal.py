@@ -17,14 +17,17 @@ import math
 import os
 import struct
 import zlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from accelcal_rig.durable import disk_errors, fsync_directory, is_disk_full, temporary_beside, write_all
-from accelcal_rig.errors import DiskFull
+from accelcal_rig.durable import (
+    disk_errors, fsync_directory, is_disk_full, temporary_beside, unused_name, write_all, write_atomically,
+)
+from accelcal_rig.errors import ConfigError, DiskFull
 
 MAGIC = b"ACJ1"
 _HEAD = struct.Struct("<4sII")
@@ -90,6 +93,9 @@ class _Bytes:
     def __init__(self, data: bytes | None = None, fd: int | None = None) -> None:
         self._data, self._fd = data, fd
         self.size = len(data) if data is not None else os.fstat(fd).st_size  # type: ignore[arg-type]
+        #: Bytes that may still be summed looking for records: twice the journal, so that searching a
+        #: damaged journal cannot cost more than reading a sound one a few times.
+        self.budget = 2 * self.size + MAX_RECORD_BYTES
 
     def read(self, offset: int, length: int) -> bytes:
         length = max(0, min(length, self.size - offset))
@@ -108,21 +114,30 @@ class _Bytes:
         return -1
 
 
+#: How every record's JSON head begins (after its length): checked before a payload is read and summed.
+_HEAD_START = b'{"kind":'
+
+
 def _record_at(source: _Bytes, offset: int) -> Record | None:
     """The whole, checksummed record starting at `offset`, or None."""
-    head = source.read(offset, _HEAD.size)
-    if len(head) < _HEAD.size:
+    head = source.read(offset, _HEAD.size + _META_LENGTH.size + len(_HEAD_START))
+    if len(head) < len(_HEAD_START) + _HEAD.size + _META_LENGTH.size:
         return None
-    magic, length, crc = _HEAD.unpack(head)
+    magic, length, crc = _HEAD.unpack_from(head)
+    (head_length,) = _META_LENGTH.unpack_from(head, _HEAD.size)
     if magic != MAGIC or length > MAX_RECORD_BYTES or offset + _HEAD.size + length > source.size or \
-            length < _META_LENGTH.size:
+            not len(_HEAD_START) <= head_length <= length - _META_LENGTH.size or \
+            head[_HEAD.size + _META_LENGTH.size:] != _HEAD_START:
         return None
+    source.budget -= length
+    if source.budget < 0:
+        return None  # searching damage has cost more than reading the journal twice over: the rest is lost
     payload = source.read(offset + _HEAD.size, length)
     if zlib.crc32(payload) != crc:
         return None
     try:
         return _decode_payload(offset, payload)
-    except (ValueError, TypeError, UnicodeDecodeError, struct.error, OverflowError, MemoryError):
+    except (ValueError, TypeError, UnicodeDecodeError, struct.error, OverflowError, MemoryError, RecursionError):
         return None
 
 
@@ -198,18 +213,24 @@ class JournalWriter:
         self.reserve_bytes = reserve_bytes
         self.allocated = os.fstat(fd).st_size
         self.space_exhausted = False
+        #: Where `reopen` kept what it cut off after the last whole record (None: nothing but zeros).
+        self.tail_kept: Path | None = None
 
     @classmethod
-    def create(cls, path: Path, first_record: bytes, reserve_bytes: int) -> JournalWriter:
+    def create(cls, path: Path, first_record: bytes, reserve_bytes: int,
+               before_replace: Callable[[], None] | None = None) -> JournalWriter:
         """A new journal holding `first_record`, in place of any journal at `path` (replaced whole, by
-        rename, once the new one is on disk: a kill meanwhile leaves the old one or none)."""
+        rename, once the new one is on disk: a kill meanwhile leaves the old one or none). `before_replace`
+        runs once the new one is on disk, just before it replaces the old (nothing has changed before)."""
         temporary = temporary_beside(path)
         with disk_errors(path, "the campaign journal"):
             fd = os.open(temporary, os.O_RDWR | os.O_CREAT | os.O_TRUNC, 0o666)
             try:
                 write_all(fd, first_record, 0)
-                _allocate(fd, 0, len(first_record) + reserve_bytes + ALLOCATION_CHUNK_BYTES)
+                _allocate(fd, len(first_record), reserve_bytes + ALLOCATION_CHUNK_BYTES)
                 os.fsync(fd)
+                if before_replace is not None:
+                    before_replace()
                 os.replace(temporary, path)
             except BaseException:
                 os.close(fd)
@@ -220,19 +241,28 @@ class JournalWriter:
 
     @classmethod
     def reopen(cls, path: Path, reserve_bytes: int) -> tuple[JournalWriter, Scan]:
-        """Open an existing journal to append to it; a record a killed process left half-written is cut
-        off (it was never acknowledged), and the scan of what is there is returned."""
+        """Open an existing journal to append to it, and the scan of what is there. What follows the last
+        whole record is cut off — a record a killed process left half-written, or a last record that was
+        damaged — and kept beside the journal (`….journal.tail-<time>`, in `tail_kept`) unless it is only
+        the zeros allocated ahead."""
+        tail_kept = None
         with disk_errors(path, "the campaign journal"):
             fd = os.open(path, os.O_RDWR)
             try:
                 found = _scan(_Bytes(fd=fd))
-                if os.fstat(fd).st_size > found.end:  # a record written in part, or zeros allocated ahead
+                if found.tail_bytes:
+                    tail_kept = unused_name(path, "tail")
+                    # A record may end in zero bytes: keep a little past the last non-zero one.
+                    length = min(found.tail_bytes + 4096, MAX_RECORD_BYTES + _HEAD.size)
+                    write_atomically(tail_kept, os.pread(fd, length, found.end), "the end of the journal cut off")
+                if os.fstat(fd).st_size > found.end:
                     os.ftruncate(fd, found.end)
                     os.fsync(fd)
             except BaseException:
                 os.close(fd)
                 raise
         writer = cls(path, fd, found.end, reserve_bytes)
+        writer.tail_kept = tail_kept
         try:
             writer._ensure_room(0)
         except DiskFull:
@@ -251,7 +281,7 @@ class JournalWriter:
             if is_disk_full(exc):
                 raise DiskFull(f"no space left on {self.path.parent.resolve()} (the campaign journal "
                                f"{self.path.name} could not grow)") from None
-            raise
+            raise ConfigError(f"{self.path}: the campaign journal could not grow: {exc.strerror or exc}") from None
         self.allocated = os.fstat(self._fd).st_size
 
     def append(self, record: bytes) -> None:
@@ -279,10 +309,13 @@ class JournalWriter:
 
 
 def _allocate(fd: int, offset: int, length: int) -> None:
-    """Reserve disk blocks for [offset, offset + length) (zeros), where the file system can."""
+    """Reserve disk blocks up to `offset + length` (zeros past the end of the file), where the file system
+    can; where it cannot, write the zeros — past the file's end only, never over a record."""
     try:
         os.posix_fallocate(fd, offset, length)
     except OSError as exc:
         if is_disk_full(exc):
             raise
-        write_all(fd, bytes(length), offset)  # no fallocate here: write the zeros
+        end = os.fstat(fd).st_size
+        if offset + length > end:
+            write_all(fd, bytes(offset + length - end), end)

@@ -14,6 +14,7 @@ import fcntl
 import json
 import os
 import socket
+import stat
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -57,9 +58,12 @@ def acquire(campaign: Path, command: str) -> None:
         _held[key][1] += 1
         return
     try:
-        fd = os.open(key, os.O_RDWR | os.O_CREAT, 0o666)
+        fd = os.open(key, os.O_RDWR | os.O_CREAT | os.O_NONBLOCK, 0o666)
     except OSError as exc:
         raise ConfigError(f"{campaign}: cannot take its lock {key.name}: {exc.strerror}") from None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise ConfigError(f"{campaign}: its lock {key.name} is not a regular file")
     deadline = time.monotonic() + ACQUIRE_PATIENCE_S
     while True:
         try:
@@ -73,8 +77,13 @@ def acquire(campaign: Path, command: str) -> None:
             time.sleep(_RETRY_S)
     info = {"pid": os.getpid(), "host": socket.gethostname(), "command": command,
             "since": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")}
-    os.ftruncate(fd, 0)
-    os.pwrite(fd, json.dumps(info).encode(), 0)
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, json.dumps(info).encode(), 0)
+    except OSError as exc:  # a full disk, say: the lock is held all the same, only who holds it is unsaid
+        if exc.errno not in (errno.ENOSPC, errno.EDQUOT):
+            os.close(fd)
+            raise ConfigError(f"{campaign}: cannot write its lock {key.name}: {exc.strerror}") from None
     _held[key] = [fd, 1]
 
 
@@ -86,8 +95,11 @@ def release(campaign: Path) -> None:
     entry[1] -= 1
     if entry[1] == 0:
         del _held[key]
-        os.ftruncate(entry[0], 0)  # nobody holds it now: say so
-        os.close(entry[0])         # closing drops the flock
+        try:
+            os.ftruncate(entry[0], 0)  # nobody holds it now: say so
+        except OSError:
+            pass  # the kernel drops the lock with the descriptor all the same
+        os.close(entry[0])             # closing drops the flock
 
 
 def holds(campaign: Path) -> bool:
@@ -101,10 +113,12 @@ def holder(campaign: Path) -> str | None:
     if holds(campaign):
         return f"this process (pid {os.getpid()})"
     try:
-        fd = os.open(lock_path(campaign), os.O_RDONLY)
+        fd = os.open(lock_path(campaign), os.O_RDONLY | os.O_NONBLOCK)
     except OSError:
         return None
     try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
         try:
             fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
         except OSError:

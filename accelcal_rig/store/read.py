@@ -21,7 +21,7 @@ import numpy as np
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.store import lock
 from accelcal_rig.store.codec import NotACampaignJournal, replay
-from accelcal_rig.store.content import Campaign
+from accelcal_rig.store.content import Campaign, take_what_the_file_kept
 from accelcal_rig.durable import stale_temporaries
 from accelcal_rig.store.hdf5_file import DamagedFile, read_campaign_file
 from accelcal_rig.store.journal import read_journal
@@ -66,38 +66,48 @@ def load_campaign(path: Path) -> Campaign:
     return campaign
 
 
-def file_identity(path: Path) -> tuple[str, int] | None:
-    """(campaign id, poses) the HDF5 file says it holds, from its attributes alone; None when it cannot
-    say (missing, unreadable, or written before campaigns had ids)."""
+def file_identity(path: Path) -> tuple[str, int, int] | None:
+    """(campaign id, poses, journal bytes) the HDF5 file says it holds, from its attributes alone; None when
+    it cannot say (missing, unreadable, or written before campaigns had ids)."""
     try:
         with h5py.File(path, "r", locking=False) as file:
             identity = str(file.attrs.get("campaign_id", ""))
-            return (identity, int(file.attrs.get("poses_done", 0))) if identity else None
-    except (OSError, ValueError, TypeError, KeyError):
+            if not identity:
+                return None
+            return identity, int(file.attrs.get("poses_done", 0)), int(file.attrs.get("journal_bytes", 0))
+    except (OSError, ValueError, TypeError, KeyError, OverflowError):
         return None
 
 
-def _unless_the_file_holds_more(path: Path, campaign: Campaign) -> Campaign:
-    """The journal's campaign, unless the HDF5 file beside it is another campaign (refused) or holds poses
-    the journal has lost (then the file is read, and the notes say so)."""
+def check_same_campaign_files(path: Path, campaign: Campaign) -> tuple[str, int, int] | None:
+    """The campaign file's identity; ConfigError when it and the journal are different campaigns."""
     identity = file_identity(path) if path.is_file() else None
-    if identity is None:
-        return campaign
-    campaign_id, poses = identity
-    if campaign_id != campaign.header.campaign_id:
-        raise ConfigError(f"{path}: it and its journal hold different campaigns ({campaign_id[:12]} and "
-                          f"{campaign.header.campaign_id[:12]}): move the one that does not belong away")
-    if poses <= len(campaign.poses):
-        return campaign
+    if identity is not None and identity[0] != campaign.header.campaign_id:
+        raise ConfigError(f"{path}: it and its journal hold different campaigns ({identity[0][:12]} and "
+                          f"{campaign.header.campaign_id[:12]}): move the one that does not belong away; nothing "
+                          "was changed")
+    return identity
+
+
+def file_kept_more(path: Path, campaign: Campaign) -> Campaign | None:
+    """The campaign file read whole when it holds what the journal has lost (poses it lacks, or more of
+    the journal than is left), else None."""
+    identity = check_same_campaign_files(path, campaign)
+    if identity is None or (identity[1] <= len(campaign.poses) and identity[2] <= campaign.journal_bytes):
+        return None
     try:
         from_file = read_hdf5_campaign(path)
     except ConfigError:
-        return campaign
-    if from_file.damage or len(from_file.poses) <= len(campaign.poses):
-        return campaign
-    from_file.notes.append(f"{journal_path(path).name} holds {len(campaign.poses)} poses, {path.name} "
-                           f"{len(from_file.poses)}: read from {path.name} (rig repair gives the journal what it lost)")
-    return from_file
+        return None
+    return None if from_file.damage else from_file
+
+
+def _unless_the_file_holds_more(path: Path, campaign: Campaign) -> Campaign:
+    """The journal's campaign, with what its campaign file still holds and the journal lost added."""
+    from_file = file_kept_more(path, campaign)
+    if from_file is not None:
+        take_what_the_file_kept(campaign, from_file, journal_path(path).name, path.name)
+    return campaign
 
 
 def read_hdf5_campaign(path: Path) -> Campaign:
@@ -134,6 +144,8 @@ def file_currency(path: Path, campaign: Campaign, writing: bool) -> str:
         return f"unreadable: {_first_line(exc)} ({rebuild})"
     if not same:
         return f"holds another campaign ({rebuild})"
+    if held > campaign.journal_bytes:
+        return f"ahead of its journal, which lost records ({rebuild})"
     if held != campaign.journal_bytes:
         return f"behind the journal: {poses} of {len(campaign.poses)} poses ({rebuild})"
     return "current"

@@ -55,6 +55,7 @@ class SoakTrace:
     t_reached_s: float                # chamber air within tolerance of the setpoint
     t_stable_s: float                 # NaN unless stable
     settled_dut_c: np.ndarray         # (n_dut,) mean over the final window
+    serials: tuple[str, ...] = ()     # whose temperatures the columns of dut_c are (empty: the campaign's order)
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,6 @@ that journal kept beside it. The campaign file is then rebuilt from the journal.
 
 from __future__ import annotations
 
-import datetime as dt
 import os
 import shutil
 from pathlib import Path
@@ -19,19 +18,19 @@ from accelcal_rig.store.codec import (
     NotACampaignJournal, encode_events, encode_header, encode_instruments, encode_pose, encode_run, encode_soak,
     encode_state, replay,
 )
-from accelcal_rig.store.content import Campaign
-from accelcal_rig.durable import disk_errors, fsync_directory, stale_temporaries, write_atomically
+from accelcal_rig.store.content import Campaign, take_what_the_file_kept
+from accelcal_rig.durable import clear_stale_temporaries, disk_errors, fsync_directory, unused_name, write_atomically
 from accelcal_rig.store.hdf5_file import campaign_image
 from accelcal_rig.store.journal import JournalWriter, read_journal
 from accelcal_rig.store.paths import journal_path
-from accelcal_rig.store.read import file_identity, read_hdf5_campaign
+from accelcal_rig.store.read import file_kept_more, read_hdf5_campaign
 from accelcal_rig.store.records import StateChange
 
 
 def journal_bytes_of(campaign: Campaign) -> bytes:
     """Journal records holding `campaign` (to give a campaign file that has none its journal)."""
     records = [encode_header(campaign.header), *(encode_run(r) for r in campaign.runs),
-               encode_instruments(campaign.instruments), *(encode_soak(s) for s in campaign.soaks),
+               encode_instruments(campaign.instruments), *(encode_soak(s, campaign.serials) for s in campaign.soaks),
                *(encode_pose(p) for p in campaign.poses)]
     if campaign.events:
         records.append(encode_events(campaign.events))
@@ -41,13 +40,15 @@ def journal_bytes_of(campaign: Campaign) -> bytes:
 
 
 def _keep_copy(journal: Path) -> Path:
-    """A second name for the journal as it is now (`….journal.damaged-20261201T081500`): a hard link,
-    so the original survives the journal being replaced, whatever happens in between."""
-    stamp = dt.datetime.now(dt.timezone.utc).strftime("%Y%m%dT%H%M%S")
-    kept = journal.with_name(f"{journal.name}.damaged-{stamp}")
+    """A second name for the journal as it is now (`….journal.damaged-20261201T081500`, a new name every
+    time): a hard link, so the original survives the journal being replaced, whatever happens in between;
+    a copy where the file system has no hard links."""
+    kept = unused_name(journal, "damaged")
     with disk_errors(kept, "a copy of the damaged journal"):
         try:
             os.link(journal, kept)
+        except FileExistsError:
+            raise
         except OSError:
             shutil.copy2(journal, kept)
         fsync_directory(journal.parent)
@@ -80,20 +81,14 @@ def mend_journal(path: Path) -> list[str]:
         kept = _keep_copy(journal)
         write_atomically(journal, journal_bytes_of(campaign), "the campaign journal")
         return [f"{exc}: kept as {kept.name}, {journal.name} made again from {path.name} ({len(campaign.poses)} poses)"]
-    identity = file_identity(path) if path.is_file() else None
-    if identity is not None and identity[0] != held.header.campaign_id:
-        raise ConfigError(f"{path}: it and its journal hold different campaigns ({identity[0][:12]} and "
-                          f"{held.header.campaign_id[:12]}): move the one that does not belong away; nothing was changed")
-    if identity is not None and identity[1] > len(held.poses):
-        try:
-            from_file = read_hdf5_campaign(path)
-        except ConfigError:  # damaged too: what the journal holds is what is left
-            from_file = held
-        if from_file is not held and not from_file.damage and held.stored_keys <= from_file.stored_keys:
-            kept = _keep_copy(journal)
-            write_atomically(journal, journal_bytes_of(from_file), "the campaign journal")
-            return [f"{journal.name} had lost poses {path.name} holds: made again from {path.name} "
-                    f"({len(from_file.poses)} poses), the old one kept as {kept.name}"]
+    held.journal_bytes = found.end
+    from_file = file_kept_more(path, held)
+    added = take_what_the_file_kept(held, from_file, journal.name, path.name) if from_file is not None else ""
+    if added:
+        kept = _keep_copy(journal)
+        write_atomically(journal, journal_bytes_of(held), "the campaign journal")
+        return [f"{journal.name} had lost what {path.name} holds ({added}): made again with them, the old one kept as "
+                f"{kept.name}"]
     if not found.damaged:
         return []
     with disk_errors(journal, "the campaign journal"), journal.open("rb") as original:
@@ -108,13 +103,13 @@ def mend_journal(path: Path) -> list[str]:
 def repair_campaign(path: Path) -> list[str]:
     """Repair the campaign at `path`: what was done, one line each. Refused while a run holds it."""
     with lock.campaign_lock(path, "rig repair"):
-        for stale in stale_temporaries(path) + stale_temporaries(journal_path(path)):
-            stale.unlink(missing_ok=True)  # what a killed run left half-built
+        clear_stale_temporaries(path, journal_path(path))  # what a killed run left half-built
         done = mend_journal(path)
         journal, found = JournalWriter.reopen(journal_path(path), 0)
         journal.close()
-        if found.tail_bytes:
-            done.append(f"a record written in part by a run that died ({found.tail_bytes} bytes) cut off the journal")
+        if journal.tail_kept is not None:
+            done.append(f"{found.tail_bytes} bytes after the journal's last whole record (a record a run that died was "
+                        f"writing, or a damaged one) cut off, kept as {journal.tail_kept.name}")
         campaign = replay(found, journal_path(path).name)
         write_atomically(path, campaign_image(campaign, found.end), "the campaign file")
         done.append(f"{path.name} rebuilt from its journal: {len(campaign.poses)} of {campaign.poses_planned} poses, "

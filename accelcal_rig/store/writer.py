@@ -30,7 +30,7 @@ from accelcal_rig.store.codec import (
     encode_events, encode_header, encode_instruments, encode_pose, encode_run, encode_soak, encode_state, replay,
 )
 from accelcal_rig.store.content import Campaign
-from accelcal_rig.durable import free_bytes, stale_temporaries, write_atomically
+from accelcal_rig.durable import clear_stale_temporaries, free_bytes, remove, write_atomically
 from accelcal_rig.store.hdf5_file import campaign_image
 from accelcal_rig.store.journal import JournalWriter
 from accelcal_rig.store.paths import journal_path
@@ -69,9 +69,9 @@ class CampaignWriter:
         self._file_written_at = float("-inf")
         self._file_cost_s = 0.0
         self._file_behind = True
-        #: Why the disk counts as full (None while it is not): the campaign file then stays as it is and
-        #: only the journal's reserve is written.
-        self._full: str | None = None
+        #: Why the disk cannot take more (full, or failing; None while it can): the campaign file then stays
+        #: as it is and measuring stops, the records that say so going into the journal's reserve.
+        self._write_failed: str | None = None
         self._stop_raised = False
         self._closed = False
 
@@ -86,11 +86,7 @@ class CampaignWriter:
             journal = journal_path(path)
             if (path.exists() or journal.exists()) and not overwrite:
                 raise ConfigError(f"{path}: campaign file exists; choose another -o or pass --overwrite")
-            for stale in stale_temporaries(path) + stale_temporaries(journal):
-                stale.unlink(missing_ok=True)
-            # Replaced: the old campaign file goes first, so a kill from here on leaves one campaign (the
-            # old journal alone, or the new one), never the new journal beside the old campaign's file.
-            path.unlink(missing_ok=True)
+            clear_stale_temporaries(path, journal)
             header = CampaignHeader(campaign_id=uuid.uuid4().hex, created=utc_now(), software_version=__version__,
                                     **header_fields)
             campaign = Campaign(header)
@@ -98,8 +94,11 @@ class CampaignWriter:
             campaign.runs.append(run)
             reserve = reserve_bytes(storage.pose_bytes if storage else 0)
             with signals_deferred():
-                writer = cls(path, JournalWriter.create(journal, encode_header(header) + encode_run(run), reserve),
-                             campaign, storage)
+                # Replacing a campaign: its campaign file goes once the new journal is on disk and before it
+                # replaces the old one, so a kill leaves the old campaign (its journal alone) or the new.
+                journal_writer = JournalWriter.create(journal, encode_header(header) + encode_run(run), reserve,
+                                                      before_replace=lambda: remove(path, "the campaign file replaced"))
+                writer = cls(path, journal_writer, campaign, storage)
                 writer._write_file()
             return writer
         except BaseException:
@@ -112,8 +111,7 @@ class CampaignWriter:
         a campaign file without a journal gets one, and the campaign file is rebuilt."""
         lock.acquire(path, "rig resume")
         try:
-            for stale in stale_temporaries(path) + stale_temporaries(journal_path(path)):
-                stale.unlink(missing_ok=True)  # what a killed run left half-built
+            clear_stale_temporaries(path, journal_path(path))  # what a killed run left half-built
             with signals_deferred():
                 writer, repairs = cls._open_journal(path, storage)
                 campaign = writer._campaign
@@ -135,8 +133,9 @@ class CampaignWriter:
         journal_writer, found = JournalWriter.reopen(journal_path(path), reserve_bytes(storage.pose_bytes if storage else 0))
         campaign = replay(found, journal_path(path).name)
         campaign.journal_bytes = found.end
-        if found.tail_bytes:
-            repairs.append(f"a record written in part by the run that died ({found.tail_bytes} bytes) cut off the journal")
+        if journal_writer.tail_kept is not None:
+            repairs.append(f"{found.tail_bytes} bytes after the journal's last whole record (a record the run that died "
+                           f"was writing, or a damaged one) cut off, kept as {journal_writer.tail_kept.name}")
         return cls(path, journal_writer, campaign, storage), repairs + campaign.notes
 
     # ------------------------------------------------------------------ what the run reads back
@@ -159,14 +158,15 @@ class CampaignWriter:
         self._file_behind = True
 
     def _stop_if_full(self, what: str) -> None:
-        """Once the disk is full (the journal into its reserve, or the campaign file could not be
-        written): stop the measurements, once. What was written stays stored; the records of the stop
+        """Once the disk is full or failing (the journal into its reserve, or the campaign file could not
+        be written): stop the measurements, once. What was written stays stored; the records of the stop
         still fit in the reserve."""
-        if self._full is None and self._journal.space_exhausted:
-            self._full = f"no space left on {self.path.parent.resolve()} (the campaign journal is into its reserve)"
-        if self._full is not None and not self._stop_raised:
+        if self._write_failed is None and self._journal.space_exhausted:
+            self._write_failed = (f"no space left on {self.path.parent.resolve()} (the campaign journal is into its "
+                                  "reserve)")
+        if self._write_failed is not None and not self._stop_raised:
             self._stop_raised = True
-            raise DiskFull(f"{self._full}: {what} stored; measuring stops while there is room to record it")
+            raise DiskFull(f"{self._write_failed}: {what} stored; measuring stops while there is room to record it")
 
     def append_pose(self, pose: PoseRecord) -> None:
         """Store one pose for every DUT: when this returns it is on disk (fsync'd), whole or not at all.
@@ -181,8 +181,8 @@ class CampaignWriter:
     def write_soak(self, soak: SoakTrace) -> None:
         """Store a soak's trace; DiskFull (after storing it) once the disk is full."""
         with signals_deferred():
-            self._append(encode_soak(soak))
-            self._campaign.soaks.append(soak)
+            self._append(encode_soak(soak, list(soak.serials) or self._campaign.serials))
+            self._campaign.add_soak(soak)
             self._write_file()
             self._stop_if_full(f"the soak {soak.label}")
 
@@ -220,13 +220,13 @@ class CampaignWriter:
     def _write_file(self) -> None:
         """Rebuild the campaign file from what is stored and swap it in. On a full disk the file stays at
         its last version (the journal holds everything) and measuring stops at the next pose or soak."""
-        if self._full is not None:
+        if self._write_failed is not None:
             return
         started = time.monotonic()
         try:
             write_atomically(self.path, campaign_image(self._campaign, self._journal.end), "the campaign file")
-        except DiskFull as exc:
-            self._full = str(exc)
+        except (DiskFull, ConfigError) as exc:  # a full or failing disk: measuring stops at the next pose
+            self._write_failed = str(exc)
             return
         self._file_written_at = time.monotonic()
         self._file_cost_s = self._file_written_at - started
@@ -261,8 +261,8 @@ class CampaignWriter:
         except (ConfigError, OSError) as exc:
             problems.append(f"{self.path} not brought up to date ({exc}); the journal holds everything: "
                             f"rig repair {self.path} once that is mended")
-        if self._full is not None and self._file_behind:
-            problems.append(f"{self.path} is behind its journal ({self._full}); rig resume or rig repair brings it "
+        if self._write_failed is not None and self._file_behind:
+            problems.append(f"{self.path} is behind its journal ({self._write_failed}); rig resume or rig repair brings it "
                             "up to date once space is freed")
         self._journal.close()
         lock.release(self.path)

@@ -94,7 +94,8 @@ def test_a_run_that_died_mid_pose_is_cut_back_and_made_safe_first(write, workdir
     after = stored_poses(output)
     assert all(after[key] == data for key, data in before.items())  # stored before the kill: untouched
     messages = events(output)
-    assert any(re.fullmatch(r"a record written in part by the run that died \(\d+ bytes\) cut off the journal", m)
+    assert any(re.fullmatch(r"\d+ bytes after the journal's last whole record \(a record the run that died was "
+                            r"writing, or a damaged one\) cut off, kept as c\.h5\.journal\.tail-\d{8}T\d{6}", m)
                for m in messages)
     resumed = next(i for i, m in enumerate(messages) if "run 2 resumes after 3 stored poses" in m)
     safe_first = next(i for i, m in enumerate(messages) if "safe state first" in m)

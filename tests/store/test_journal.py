@@ -106,3 +106,33 @@ def test_a_full_disk_leaves_the_reserve_for_the_records_that_stop_the_campaign(t
         writer.append(encoded[1])                 # the reserve is used up: refused, nothing written
     writer.close()
     assert len(read_journal(path).records) == 2
+
+
+def test_without_fallocate_the_zeros_go_past_the_records_only(tmp_path: Path, monkeypatch) -> None:
+    """A file system without posix_fallocate: the space ahead is written as zeros after the records."""
+    def unsupported(fd: int, offset: int, length: int) -> None:
+        raise OSError(errno.EOPNOTSUPP, "Operation not supported")
+
+    monkeypatch.setattr(journal.os, "posix_fallocate", unsupported)
+    path = tmp_path / "c.journal"
+    encoded = records(3)
+    writer = JournalWriter.create(path, encoded[0], reserve_bytes=4096)
+    writer.append(encoded[1])
+    writer.append(encoded[2])
+    assert writer.allocated >= writer.end + 4096
+    writer.close()
+    found = read_journal(path)
+    assert found.clean and [r.meta["step_key"] for r in found.records] == ["T20/pose00", "T20/pose01", "T20/pose02"]
+
+
+def test_what_follows_the_last_whole_record_is_kept_when_cut_off(tmp_path: Path) -> None:
+    path = tmp_path / "c.journal"
+    encoded = records(3)
+    damaged = bytearray(encoded[2])
+    damaged[40] ^= 0x01  # a whole last record with one bit flipped: not a kill's half record, still not readable
+    path.write_bytes(encoded[0] + encoded[1] + bytes(damaged))
+    writer, found = JournalWriter.reopen(path, reserve_bytes=0)
+    writer.close()
+    assert len(found.records) == 2 and writer.tail_kept is not None
+    assert writer.tail_kept.read_bytes() == bytes(damaged) and path.read_bytes() == encoded[0] + encoded[1]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.journal", writer.tail_kept.name]

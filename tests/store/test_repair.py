@@ -114,3 +114,67 @@ def test_a_pose_stored_twice_is_reported_and_kept_once(campaign: Path) -> None:
     with h5py.File(campaign, "r") as f:
         keys = [k.decode() for k in f["poses/step_key"][:]]
     assert sorted(keys) == sorted(set(keys)) and len(keys) == 6
+
+
+def test_a_lone_campaign_file_keeps_each_dut_its_own_data_when_it_gets_a_journal(write, workdir: Path) -> None:
+    """DUTs listed in the rig config out of alphabetical order (the campaign file's groups are read in
+    the campaign's order, not the alphabet's), aborted, the journal lost, resumed."""
+    from accelcal_rig.errors import CampaignAborted
+    from accelcal_rig.fit.sfem import distort
+    from accelcal_rig.sim.truth import truth_for_serial
+    from tests.engine.test_resume import TWO_SETPOINTS, run
+
+    rig = (workdir / "sim.yaml").read_text()
+    lines = [line for line in rig.splitlines() if "{serial: ADX355-A00" in line]
+    write("sim.yaml", rig.replace("\n".join(lines), "\n".join(reversed(lines))))
+    procedure, output = write("two.yaml", TWO_SETPOINTS), workdir / "c.h5"
+    with pytest.raises(CampaignAborted):
+        run(procedure, output, fail_at_pose=6)
+    def by_serial(path: Path) -> dict[tuple[str, str], bytes]:
+        return {(p.step_key, d.serial): d.mean_g.tobytes() + d.raw_codes.tobytes()
+                for p in load_campaign(path).poses for d in p.duts}
+    before = by_serial(output)
+    journal_path(output).unlink()
+    run(procedure, output, resume=True)
+    after = by_serial(output)
+    assert len(after) == 12 * 4 and all(after[key] == data for key, data in before.items())
+    campaign = load_campaign(output)
+    assert campaign.source == "journal" and campaign.notes == []
+    for serial in campaign.serials:  # every DUT's data are its own: its simulated truth (fixed by its serial)
+        true = truth_for_serial(serial).parameters_at(campaign.truth_column(serial, "temperature_c"))
+        np.testing.assert_allclose(campaign.truth_column(serial, "parameters"), true, atol=1e-9)
+        expected = distort(campaign.truth_column(serial, "gravity_g"), true)
+        error = np.abs(campaign.dut_column(serial, "mean_g") - expected) / campaign.dut_column(serial, "stderr_g")
+        assert error.max() < 6, serial
+    with h5py.File(output, "r") as f:
+        soak = f["soaks/T20"]
+        settled = dict(zip(list(f["duts"]), soak["settled_dut_c"][:]))
+    for serial in campaign.serials:  # the soak columns follow the DUTs too
+        assert abs(settled[serial] - campaign.dut_column(serial, "temperature_c")[0].mean()) < 0.5
+
+
+def test_poses_only_the_campaign_file_still_holds_go_back_into_the_journal(campaign: Path) -> None:
+    """The file one pose behind its journal, and two of the journal's pose records damaged: between them
+    every pose is still there, and reading, then repairing, keeps all six."""
+    from accelcal_rig.store.codec import replay
+    from accelcal_rig.store.hdf5_file import campaign_image
+    from accelcal_rig.store.journal import scan
+
+    original = stored_poses(campaign)
+    journal = journal_path(campaign)
+    data = journal.read_bytes()
+    poses = [r for r in scan(data).records if r.kind == "pose"]
+    upto_fifth = data[:poses[4].offset + poses[4].size]
+    campaign.write_bytes(campaign_image(replay(scan(upto_fifth), journal.name), len(upto_fifth)))  # one pose behind
+    damaged = bytearray(data)
+    for record in poses[1:3]:
+        damaged[record.offset + 200] ^= 0xFF
+    journal.write_bytes(bytes(damaged))
+    status = campaign_status(campaign)
+    assert status["poses_done"] == 6 and "2 poses, 0 soaks and 0 events taken from c.h5" in status["integrity"]
+    assert stored_poses(campaign) == original
+    done = repair_campaign(campaign)
+    assert "c.h5.journal had lost what c.h5 holds (2 poses, 0 soaks and 0 events)" in done[0]
+    assert read_journal(journal).clean and len([r for r in read_journal(journal).records if r.kind == "pose"]) == 6
+    assert stored_poses(campaign) == original and campaign_status(campaign)["integrity"] == "ok"
+    assert measurements_sha256(read_hdf5_campaign(campaign)) == measurements_sha256(load_campaign(campaign))
