@@ -43,6 +43,7 @@ from pathlib import Path
 
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import load_calibration
+from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.journal import read_journal
 from accelcal_rig.store.paths import journal_path, log_path
 from accelcal_rig.store.read import file_currency, load_campaign
@@ -90,6 +91,13 @@ def judge_complete(campaign: Path, before: dict[str, bytes]) -> tuple[bool, str]
     return ok, (f"{len(loaded.poses)}/{loaded.poses_planned} poses, {len(before)} kept"
                 f"{' CHANGED ' + ', '.join(changed[:3]) if changed else ''}, file {currency}, rmse/floor {worst:.2f}"
                 f"{'; ' + '; '.join(problems) if problems else ''}")
+
+
+def safe_state_recorded(loaded: Campaign) -> bool:
+    """The last safe-state actions in the event log: the chamber to 23 °C, the table stopped, 4 sensors in standby."""
+    safe = [e.message for e in loaded.events[-12:] if e.kind == "safe"]
+    return (any("to 23 °C" in m for m in safe) and any("turntable" in m and "stop" in m for m in safe)
+            and sum("standby" in m for m in safe) == 4)
 
 
 def digests(*paths: Path) -> list[str]:
@@ -340,9 +348,7 @@ def _diskfull_trial(mount: Path, after_poses: int, free: int) -> tuple[bool, str
     loaded = load_campaign(campaign)
     where = f"filled at {filled_at} poses; {len(loaded.poses)}/{loaded.poses_planned} stored, state {loaded.state}"
     status = rig("status", str(campaign), "--json")
-    safe = [e.message for e in loaded.events[-12:] if e.kind == "safe"]
-    recorded = (any("to 23 °C" in m for m in safe) and any("turntable" in m and "stop" in m for m in safe)
-                and sum("standby" in m for m in safe) == 4)
+    recorded = safe_state_recorded(loaded)
     last = err.strip().splitlines()[-1] if err.strip() else ""
     space = "no space left on" in last or "not enough space left on" in last
     if process.returncode == 0:
@@ -439,9 +445,7 @@ def signal_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, i
             ok = process.returncode == 0
             note = "the signal came after the campaign was complete"
         else:
-            safe = [e.message for e in loaded.events[-8:] if e.kind == "safe"]
-            recorded = (any("to 23 °C" in m for m in safe) and any("turntable" in m and "stop" in m for m in safe)
-                        and sum("standby" in m for m in safe) == 4)
+            recorded = safe_state_recorded(loaded)
             ok = process.returncode == 130 and loaded.state == "aborted" and recorded and not loaded.integrity_problems()
             note = f"exit {process.returncode}, {loaded.state}, {len(loaded.poses)} poses, safe state recorded {recorded}"
         passed += ok
@@ -468,9 +472,7 @@ def fault_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, in
         loaded = load_campaign(campaign)
         retries = sum(e.kind == "retry" for e in loaded.events)
         if persistent:
-            safe = [e.message for e in loaded.events[-8:]]
-            recorded = (any("to 23 °C" in m for m in safe) and any("turntable" in m and "stop" in m for m in safe)
-                        and sum("standby" in m for m in safe) == 4)
+            recorded = safe_state_recorded(loaded)
             ok = run.returncode != 0 and loaded.state == "aborted" and recorded and not loaded.integrity_problems()
             note = f"aborted after {len(loaded.poses)} poses ({loaded.abort_reason[:80]}); safe state recorded {recorded}"
         else:

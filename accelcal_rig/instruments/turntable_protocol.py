@@ -14,6 +14,14 @@ import string
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 
+def _regular_expression(value: str) -> str:
+    try:
+        re.compile(value)
+    except re.error as exc:
+        raise ValueError(f"not a regular expression: {exc}") from None
+    return value
+
+
 #: What a template may name: the request's axis (1-based) and angle, and the values replies carry.
 _TEMPLATE_FIELDS = frozenset({"axis", "angle", "identity", "busy", "fault"})
 
@@ -26,14 +34,7 @@ class Command(BaseModel):
     answer: str = Field(min_length=1, max_length=256, description="what a controller answers (template), for "
                         "simulators")
 
-    @field_validator("reply")
-    @classmethod
-    def _compiles(cls, value: str) -> str:
-        try:
-            re.compile(value)
-        except re.error as exc:
-            raise ValueError(f"not a regular expression: {exc}") from None
-        return value
+    _compiles = field_validator("reply")(classmethod(lambda cls, value: _regular_expression(value)))
 
     @field_validator("send", "answer")
     @classmethod
@@ -76,16 +77,9 @@ class TurntableProtocol(BaseModel):
     home: Command
     fault: Command
     busy_values: list[str] = Field(["1"], max_length=16)
-
-    @field_validator("error_pattern")
-    @classmethod
-    def _error_compiles(cls, value: str) -> str:
-        try:
-            re.compile(value)
-        except re.error as exc:
-            raise ValueError(f"not a regular expression: {exc}") from None
-        return value
     fault_ok: list[str] = Field(["0"], max_length=16)
+
+    _compiles = field_validator("error_pattern")(classmethod(lambda cls, value: _regular_expression(value)))
 
 
 #: The built-in profile: a plain SCPI-like line protocol, one command per line, one reply per command.

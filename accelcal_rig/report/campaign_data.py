@@ -17,6 +17,7 @@ from accelcal_rig.config.procedure import SoakCriterion
 from accelcal_rig.config.yaml_lines import parse_yaml_text
 from accelcal_rig.fit.campaign_fit import DutFitResult, FitOptions, fit_dut
 from accelcal_rig.store.read import DutPoses, campaign_status, load_campaign, read_dut_poses
+from accelcal_rig.store.records import StoredEvent
 
 
 @dataclass(frozen=True)
@@ -29,15 +30,6 @@ class SoakRecord:
     dut_c: np.ndarray         # (m, D)
     t_reached_s: float
     t_stable_s: float
-
-
-@dataclass(frozen=True)
-class EventRecord:
-    t_s: float
-    wall_time: str
-    level: str
-    kind: str
-    message: str
 
 
 @dataclass(frozen=True)
@@ -58,7 +50,7 @@ class CampaignData:
     options: FitOptions
     duts: dict[str, DutReport]
     soaks: list[SoakRecord]
-    events: list[EventRecord]
+    events: list[StoredEvent]
     pose_t_s: np.ndarray              # (N,) first sample of each pose
     no_fit_reason: str                # empty when every DUT was fitted
 
@@ -94,7 +86,7 @@ def read_campaign_data(path: Path) -> CampaignData:
         duts[serial] = DutReport(poses, pose_numbers, fit, _truth_by_setpoint(poses))
     soaks = [SoakRecord(name, s.setpoint_c, s.outcome, s.t_s, s.chamber_c, s.dut_c, s.t_reached_s, s.t_stable_s)
              for name, s in zip(campaign.soak_names(), campaign.soaks)]
-    events = [EventRecord(e.t_s, e.wall_time, e.level, e.kind, e.message) for e in campaign.events]
+    events = list(campaign.events)
     soaks.sort(key=lambda s: s.t_reached_s)
     reason = "; ".join(dict.fromkeys(reasons))
     return CampaignData(path, status, str(attrs.get("procedure_path", "")), str(attrs.get("rig_name", "")), band_c,

@@ -6,14 +6,13 @@ Kinds: `header` (first, once), `run` (each run's start), `instruments` (the driv
 
 from __future__ import annotations
 
-from typing import Any
 
 import numpy as np
 
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.journal import Record, Scan, encode_record
 from accelcal_rig.store.records import (
-    CampaignHeader, DutPoseRecord, PoseRecord, RunStart, SoakTrace, StateChange, StoredEvent, StoredPlan,
+    CampaignHeader, DutPoseRecord, PoseRecord, RunStart, SoakTrace, StateChange, StoredEvent, StoredPlan, plain_value,
 )
 
 
@@ -26,33 +25,20 @@ class NotACampaignJournal(ValueError):
 _UNUSABLE = (KeyError, ValueError, TypeError, IndexError, AttributeError, OverflowError, RecursionError)
 
 
-def _plain(value: Any) -> Any:
-    """JSON-able: numpy scalars and arrays become Python numbers and lists."""
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
-
-
 # ---------------------------------------------------------------------- encoding
 def encode_header(header: CampaignHeader) -> bytes:
     plan = header.plan
-    truth_attrs = {s: {k: _plain(v) for k, v in d.items() if k != "polynomial_coefficients"}
+    truth_attrs = {s: {k: plain_value(v) for k, v in d.items() if k != "polynomial_coefficients"}
                    for s, d in header.truth.items()}
     arrays = {"plan_setpoint_c": plan.setpoint_c, "plan_pose_number": plan.pose_number,
               "plan_angles_deg": plan.angles_deg, "plan_gravity_fixture": plan.gravity_fixture}
     arrays.update({f"truth_coefficients/{s}": np.asarray(d["polynomial_coefficients"], dtype="f8")
                    for s, d in header.truth.items()})
     meta = {"campaign_id": header.campaign_id, "created": header.created, "software_version": header.software_version,
-            "attrs": _plain(header.attrs), "procedure_yaml": header.procedure_yaml, "rig_yaml": header.rig_yaml,
+            "attrs": plain_value(header.attrs), "procedure_yaml": header.procedure_yaml, "rig_yaml": header.rig_yaml,
             "plan": {"step_key": list(plan.step_key), "kind": list(plan.kind), "fingerprint": plan.fingerprint,
                      "axis_names": list(plan.axis_names)},
-            "duts": _plain(header.duts), "instruments": header.instruments,
+            "duts": plain_value(header.duts), "instruments": header.instruments,
             "turntable_accuracy_arcsec": float(header.turntable_accuracy_arcsec), "truth": truth_attrs}
     return encode_record("header", meta, arrays)
 

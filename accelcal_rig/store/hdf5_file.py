@@ -21,7 +21,7 @@ from accelcal_rig.config.yaml_lines import parse_yaml_text
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.store.content import POSE_FIELDS, Campaign, measurements_sha256
 from accelcal_rig.store.records import (
-    CampaignHeader, DutPoseRecord, PoseRecord, RunStart, SoakTrace, StoredEvent, StoredPlan,
+    CampaignHeader, DutPoseRecord, PoseRecord, RunStart, SoakTrace, StoredEvent, StoredPlan, plain_value,
 )
 
 FORMAT_NAME = "accelcal-rig campaign"
@@ -271,16 +271,6 @@ _HEADER_ATTRS = ("procedure_name", "procedure_path", "rig_name", "rig_path", "dr
                  "fit_temperature_model")
 
 
-def _plain_attr(value: Any) -> Any:
-    if isinstance(value, bytes):
-        return value.decode(errors="replace")
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    return value
-
-
 def _read_header(reader: _Reader) -> CampaignHeader:
     file = reader.file
     plan_group = reader.node("plan", h5py.Group)
@@ -292,7 +282,7 @@ def _read_header(reader: _Reader) -> CampaignHeader:
         reader.array("plan/setpoint_c", (), "f", steps), reader.array("plan/pose_number", (), "iu", steps),
         reader.array("plan/angles_deg", (len(axis_names),), "f", steps), reader.array("plan/gravity_fixture", (3,), "f", steps),
         reader.attr(plan_group, "fingerprint", _text), axis_names)
-    attrs = {name: _plain_attr(file.attrs[name]) for name in _HEADER_ATTRS if name in file.attrs}
+    attrs = {name: plain_value(file.attrs[name]) for name in _HEADER_ATTRS if name in file.attrs}
     samples = attrs.get("samples_per_pose")
     if not isinstance(samples, int) or not 0 < samples <= _MAX_ROWS:
         raise DamagedFile(f"attribute samples_per_pose is {samples!r}")
@@ -303,14 +293,14 @@ def _read_header(reader: _Reader) -> CampaignHeader:
         group = groups[serial]
         if not isinstance(group, h5py.Group):
             raise DamagedFile(f"duts/{serial}: not a group")
-        duts.append({"serial": serial, **{k: _plain_attr(v) for k, v in group.attrs.items() if k != "serial"}})
+        duts.append({"serial": serial, **{k: plain_value(v) for k, v in group.attrs.items() if k != "serial"}})
         for name in ("range_g", "lsb_g", "odr_hz"):
             reader.attr(group, name, float)
     truth = {}
     if "simulation_truth" in file:
         for serial, group in reader.node("simulation_truth", h5py.Group).items():
             if serial in {d["serial"] for d in duts} and isinstance(group, h5py.Group):
-                truth[serial] = {**{k: _plain_attr(v) for k, v in group.attrs.items()},
+                truth[serial] = {**{k: plain_value(v) for k, v in group.attrs.items()},
                                  "polynomial_coefficients": reader.matrix(f"simulation_truth/{serial}/polynomial_coefficients")}
     poses_group = reader.node("poses", h5py.Group)
     return CampaignHeader(

@@ -18,11 +18,11 @@ from typing import Any
 import h5py
 import numpy as np
 
+from accelcal_rig.durable import stale_temporaries
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.store import lock
 from accelcal_rig.store.codec import NotACampaignJournal, replay
 from accelcal_rig.store.content import Campaign, take_what_the_file_kept
-from accelcal_rig.durable import stale_temporaries
 from accelcal_rig.store.hdf5_file import DamagedFile, read_campaign_file
 from accelcal_rig.store.journal import read_journal
 from accelcal_rig.store.paths import journal_path

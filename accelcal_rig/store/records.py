@@ -9,6 +9,21 @@ from typing import Any
 import numpy as np
 
 
+def plain_value(value: Any) -> Any:
+    """JSON-able: numpy scalars and arrays become Python numbers and lists, bytes text."""
+    if isinstance(value, dict):
+        return {str(k): plain_value(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [plain_value(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, bytes):
+        return value.decode(errors="replace")
+    return value
+
+
 def utc_now() -> str:
     """Wall-clock time as the campaign records it: ISO 8601, UTC, whole seconds."""
     return dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")

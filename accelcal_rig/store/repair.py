@@ -12,6 +12,7 @@ import os
 import shutil
 from pathlib import Path
 
+from accelcal_rig.durable import clear_stale_temporaries, disk_errors, fsync_directory, unused_name, write_atomically
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.store import lock
 from accelcal_rig.store.codec import (
@@ -19,7 +20,6 @@ from accelcal_rig.store.codec import (
     encode_state, replay,
 )
 from accelcal_rig.store.content import Campaign, take_what_the_file_kept
-from accelcal_rig.durable import clear_stale_temporaries, disk_errors, fsync_directory, unused_name, write_atomically
 from accelcal_rig.store.hdf5_file import campaign_image
 from accelcal_rig.store.journal import JournalWriter, read_journal
 from accelcal_rig.store.paths import journal_path

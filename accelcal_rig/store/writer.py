@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from accelcal_rig import __version__
+from accelcal_rig.durable import clear_stale_temporaries, free_bytes, remove, write_atomically
 from accelcal_rig.errors import ConfigError, DiskFull, InsufficientSpace
 from accelcal_rig.store import lock
 from accelcal_rig.store.atomic import signals_deferred
@@ -30,7 +31,6 @@ from accelcal_rig.store.codec import (
     encode_events, encode_header, encode_instruments, encode_pose, encode_run, encode_soak, encode_state, replay,
 )
 from accelcal_rig.store.content import Campaign
-from accelcal_rig.durable import clear_stale_temporaries, free_bytes, remove, write_atomically
 from accelcal_rig.store.hdf5_file import campaign_image
 from accelcal_rig.store.journal import JournalWriter
 from accelcal_rig.store.paths import journal_path
