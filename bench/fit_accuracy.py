@@ -15,14 +15,13 @@ import time
 from collections import defaultdict
 from pathlib import Path
 
-import h5py
 import numpy as np
 import yaml
 from quiet import silence_campaign_log  # bench/quiet.py, beside this script
 
 from accelcal_rig.engine.session import prepare, run_campaign
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_campaign, fit_dut
-from accelcal_rig.store.read import read_dut_poses
+from accelcal_rig.store.read import load_campaign, read_dut_poses
 
 REPO = Path(__file__).resolve().parent.parent
 PAPER = REPO / "procedures" / "paper-24pos-thermal.yaml"
@@ -42,17 +41,17 @@ def accuracy(seeds: int, folder: Path) -> None:
     sigmas: dict[tuple, list[float]] = defaultdict(list)
     for seed in range(seeds):
         path = dry_run(PAPER, folder, seed)
-        with h5py.File(path, "a") as file:
-            for mode in MODES:
-                _, report = fit_campaign(file, FitOptions(mode=mode), {"campaign": str(path)})
-                for serial, r in report.items():
-                    ratios[mode].append(r["rmse_after_mg"] / r["noise_floor_mg"])
-                    drifts[mode].append(max(r["drift_after_mg"]))
-                    for record in r["truth_error"]:
-                        key = (mode, serial, record["parameter"], record["setpoint_c"])
-                        errors[key].append(record["error"])
-                        sigmas[key].append(record["sigma"])
-                        z_scores[mode].append(record["z"])
+        campaign = load_campaign(path)
+        for mode in MODES:
+            _, report = fit_campaign(campaign, FitOptions(mode=mode), {"campaign": str(path)})
+            for serial, r in report.items():
+                ratios[mode].append(r["rmse_after_mg"] / r["noise_floor_mg"])
+                drifts[mode].append(max(r["drift_after_mg"]))
+                for record in r["truth_error"]:
+                    key = (mode, serial, record["parameter"], record["setpoint_c"])
+                    errors[key].append(record["error"])
+                    sigmas[key].append(record["sigma"])
+                    z_scores[mode].append(record["z"])
     print(f"accuracy over {seeds} dry runs of the paper campaign × 4 DUTs (11 setpoints × 24 poses, 125 Hz, 200 samples)")
     for mode in MODES:
         z = np.array(z_scores[mode])
@@ -79,18 +78,17 @@ def accuracy(seeds: int, folder: Path) -> None:
 
 def speed(folder: Path) -> None:
     path = dry_run(PAPER, folder, 0)
-    with h5py.File(path, "a") as file:
-        for mode in MODES:
-            poses = read_dut_poses(file, "ADX355-A001")
-            start = time.perf_counter()
-            for _ in range(5):
-                fit_dut(poses, FitOptions(mode=mode))
-            one = (time.perf_counter() - start) / 5
-            start = time.perf_counter()
-            fit_campaign(file, FitOptions(mode=mode), {"campaign": str(path)})
-            four = time.perf_counter() - start
-            print(f"  {mode:9s} fit time: one sensor {one * 1e3:.0f} ms (11 LM fits + 12 polynomials + metrics), "
-                  f"4-sensor file {four * 1e3:.0f} ms (incl. reading and writing the fit group)")
+    for mode in MODES:
+        poses = read_dut_poses(load_campaign(path), "ADX355-A001")
+        start = time.perf_counter()
+        for _ in range(5):
+            fit_dut(poses, FitOptions(mode=mode))
+        one = (time.perf_counter() - start) / 5
+        start = time.perf_counter()
+        fit_campaign(load_campaign(path), FitOptions(mode=mode), {"campaign": str(path)})
+        four = time.perf_counter() - start
+        print(f"  {mode:9s} fit time: one sensor {one * 1e3:.0f} ms (11 LM fits + 12 polynomials + metrics), "
+              f"4-sensor campaign {four * 1e3:.0f} ms (incl. reading it from its journal)")
 
 
 def with_effects(folder: Path, hysteresis_mg: float, nonlinearity_mg_per_g2: float) -> None:
@@ -100,14 +98,13 @@ def with_effects(folder: Path, hysteresis_mg: float, nonlinearity_mg_per_g2: flo
     path = folder / "effects.yaml"
     path.write_text(yaml.safe_dump(procedure))
     campaign = dry_run(path, folder, 0)
-    with h5py.File(campaign, "a") as file:
-        for mode in MODES:
-            _, report = fit_campaign(file, FitOptions(mode=mode), {"campaign": str(campaign)})
-            ratio = max(r["rmse_after_mg"] / r["noise_floor_mg"] for r in report.values())
-            drift = max(max(r["drift_after_mg"]) for r in report.values())
-            worst = max(abs(t["z"]) for r in report.values() for t in r["truth_error"])
-            print(f"  hysteresis {hysteresis_mg:g} mg, non-linearity {nonlinearity_mg_per_g2:g} mg/g², {mode:9s}: "
-                  f"rmse_after / floor max {ratio:.1f}, drift after max {drift * 1e3:.0f} µg, max |z| {worst:.0f}")
+    for mode in MODES:
+        _, report = fit_campaign(load_campaign(campaign), FitOptions(mode=mode), {"campaign": str(campaign)})
+        ratio = max(r["rmse_after_mg"] / r["noise_floor_mg"] for r in report.values())
+        drift = max(max(r["drift_after_mg"]) for r in report.values())
+        worst = max(abs(t["z"]) for r in report.values() for t in r["truth_error"])
+        print(f"  hysteresis {hysteresis_mg:g} mg, non-linearity {nonlinearity_mg_per_g2:g} mg/g², {mode:9s}: "
+              f"rmse_after / floor max {ratio:.1f}, drift after max {drift * 1e3:.0f} µg, max |z| {worst:.0f}")
 
 
 def main() -> None:
