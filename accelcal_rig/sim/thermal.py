@@ -95,6 +95,6 @@ class ThermalModel:
         new_dut_c = _lag(self._dut_c, target_start, target_end, step_s, self.dut_tau_s)
         change = new_dut_c - self._dut_c
         self.approach_sign = np.where(np.abs(change) > _DIRECTION_THRESHOLD_C, np.sign(change), self.approach_sign)
-        self._dut_c = new_dut_c
+        self._dut_c = np.asarray(new_dut_c)
         self._reference_c = reference_end
         self._air_c = air_end

@@ -131,7 +131,7 @@ def _pose(record: Record, header: CampaignHeader) -> PoseRecord:
             temperature_c=(float(arrays["temperature_c"][i, 0]), float(arrays["temperature_c"][i, 1])),
             gravity_reference_g=arrays["gravity_reference_g"][i], temperature_in_band=bool(arrays["temperature_in_band"][i]),
             truth={"parameters": arrays["truth_parameters"][i], "gravity_g": arrays["truth_gravity_g"][i],
-                   "temperature_c": np.float64(arrays["truth_temperature_c"][i])} if truth else None)
+                   "temperature_c": np.asarray(arrays["truth_temperature_c"][i])} if truth else None)
         for i, serial in enumerate(serials)
     ]
     return PoseRecord(str(meta["step_key"]), setpoint, int(meta["pose_number"]), arrays["commanded_angles_deg"],

@@ -127,7 +127,8 @@ class Campaign:
         key = f"truth/{serial}/{name}"
         if key not in self._columns:
             index = self.serials.index(serial)
-            values = [p.duts[index].truth[name] if p.duts[index].truth else np.nan for p in self.poses]
+            truths = [p.duts[index].truth for p in self.poses]
+            values = [truth[name] if truth is not None else np.nan for truth in truths]
             self._columns[key] = _stack(values, {"parameters": (12,), "gravity_g": (3,)}.get(name, ()), "f8")
         return self._columns[key]
 

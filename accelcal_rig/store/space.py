@@ -30,7 +30,7 @@ _CALIBRATION_BYTES = (32 * 1024, 24 * 1024)
 
 def pose_record_bytes(n_duts: int, samples_per_pose: int, n_axes: int, with_truth: bool) -> int:
     """The journal bytes of one pose, encoded as the writer encodes it."""
-    truth = {"parameters": np.zeros(12), "gravity_g": np.zeros(3), "temperature_c": np.float64(0.0)}
+    truth = {"parameters": np.zeros(12), "gravity_g": np.zeros(3), "temperature_c": np.asarray(0.0)}
     duts = [DutPoseRecord(f"DUT-{k:04d}", np.zeros((samples_per_pose, 3), dtype="i4"), np.zeros(3), np.zeros(3),
                           (0.0, 0.0), np.zeros(3), True, truth if with_truth else None) for k in range(n_duts)]
     pose = PoseRecord("T-100/pose0001", -100.0, 1, np.zeros(n_axes), np.zeros(n_axes), np.zeros(3), 0.0, 0.0,
