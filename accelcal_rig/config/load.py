@@ -60,7 +60,10 @@ def resolve_rig_path(procedure: LoadedConfig[Procedure], override: Path | None) 
     """The rig config to use: `--config` if given, else the procedure's `rig`, relative to the procedure."""
     if override is not None:
         return override
-    return (procedure.path.parent / procedure.model.rig).resolve()
+    path = (procedure.path.parent / procedure.model.rig).resolve()
+    if not path.is_file():
+        raise procedure.error(("rig",), f"{path}: no such rig config (it is relative to the procedure's folder)")
+    return path
 
 
 def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedConfig[RigConfig]) -> None:

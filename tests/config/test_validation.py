@@ -67,7 +67,7 @@ def test_unreachable_schedule_is_a_config_error(write, workdir: Path) -> None:
 
 def test_missing_rig_file_is_named(write) -> None:
     path = write("tiny.yaml", TINY_PROCEDURE.replace("rig: sim.yaml", "rig: nowhere.yaml"))
-    with pytest.raises(ConfigError, match=r"nowhere.yaml: file not found"):
+    with pytest.raises(ConfigError, match=r"tiny.yaml:2: rig: .*nowhere.yaml: no such rig config"):
         prepare(path)
 
 
