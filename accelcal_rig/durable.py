@@ -42,8 +42,9 @@ def unused_name(path: Path, why: str) -> Path:
 
 
 def stale_temporaries(path: Path) -> list[Path]:
-    """Versions of `path` that a killed process left half-built."""
-    return sorted(path.parent.glob(f"{path.name}.tmp-*"))
+    """Versions of `path`, and of copies set aside beside it, that a killed process left half-built."""
+    return sorted(p for pattern in (f"{path.name}.tmp-*", f"{path.name}.tail-*.tmp-*")
+                  for p in path.parent.glob(pattern))
 
 
 def clear_stale_temporaries(*paths: Path) -> None:
@@ -115,16 +116,18 @@ def read_regular_file(path: Path, limit: int, what: str) -> bytes:
     """The bytes of a regular file of at most `limit` bytes (a device, a pipe or a folder is refused
     without waiting on it, a larger file without reading it); ConfigError naming `path`."""
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+        info = os.stat(path)
+        if stat.S_ISDIR(info.st_mode):
+            raise ConfigError(f"{path}: is a folder, not a file")
+        if not stat.S_ISREG(info.st_mode):
+            raise ConfigError(f"{path}: not a regular file")
+        fd = os.open(path, os.O_RDONLY)
     except FileNotFoundError:
         raise ConfigError(f"{path}: file not found") from None
     except (OSError, ValueError) as exc:
         raise ConfigError(f"{path}: cannot read: {str(exc).splitlines()[0]}") from None
     try:
-        info = os.fstat(fd)
-        if stat.S_ISDIR(info.st_mode):
-            raise ConfigError(f"{path}: is a folder, not a file")
-        if not stat.S_ISREG(info.st_mode):
+        if not stat.S_ISREG(os.fstat(fd).st_mode):  # replaced by something else meanwhile
             raise ConfigError(f"{path}: not a regular file")
         chunks, size = [], 0
         while size <= limit:

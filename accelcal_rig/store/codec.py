@@ -101,14 +101,28 @@ def _header(record: Record) -> CampaignHeader:
     if not (len(plan.kind) == plan.setpoint_c.shape[0] == plan.pose_number.shape[0] == steps
             and plan.angles_deg.shape == (steps, len(plan.axis_names)) and plan.gravity_fixture.shape == (steps, 3)):
         raise ValueError("plan columns of different lengths")
-    truth = {s: {**attrs, "polynomial_coefficients": arrays[f"truth_coefficients/{s}"]}
+    truth = {s: {**_attributes(attrs), "polynomial_coefficients": arrays[f"truth_coefficients/{s}"]}
              for s, attrs in meta.get("truth", {}).items()}
-    duts = [dict(d) for d in meta["duts"]]
+    duts = [_attributes(d) for d in meta["duts"]]
     if not all(isinstance(d.get("serial"), str) for d in duts) or len({d["serial"] for d in duts}) != len(duts):
         raise ValueError("DUT serials missing or repeated")
+    if not set(truth) <= {d["serial"] for d in duts} or not all(isinstance(n, str) for n in plan.axis_names):
+        raise ValueError("truth of sensors not in the campaign, or axis names that are not text")
     return CampaignHeader(str(meta["campaign_id"]), str(meta["created"]), str(meta["software_version"]),
                           dict(meta["attrs"]), str(meta["procedure_yaml"]), str(meta["rig_yaml"]), plan, duts,
                           dict(meta["instruments"]), float(meta["turntable_accuracy_arcsec"]), truth)
+
+
+def _attributes(value: object) -> dict[str, object]:
+    """A dict of attributes as the campaign file can hold them: text, numbers, flags, lists of numbers."""
+    if not isinstance(value, dict):
+        raise ValueError("attributes that are not a mapping")
+    for key, item in value.items():
+        plain = isinstance(item, (str, bool, int, float)) or (
+            isinstance(item, list) and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in item))
+        if not plain or (isinstance(item, int) and not -2**63 <= item < 2**63):
+            raise ValueError(f"attribute {key!r} of another kind")
+    return dict(value)
 
 
 def _pose(record: Record, header: CampaignHeader) -> PoseRecord:
@@ -134,6 +148,8 @@ def _pose(record: Record, header: CampaignHeader) -> PoseRecord:
                    "temperature_c": np.asarray(arrays["truth_temperature_c"][i])} if truth else None)
         for i, serial in enumerate(serials)
     ]
+    if not isinstance(meta["pose_number"], int) or not 0 <= meta["pose_number"] < 2**31:
+        raise ValueError(f"pose number {meta['pose_number']!r}")
     return PoseRecord(str(meta["step_key"]), setpoint, int(meta["pose_number"]), arrays["commanded_angles_deg"],
                       arrays["measured_angles_deg"], arrays["gravity_fixture"], t_start, t_end, (before, after), duts)
 
@@ -205,9 +221,12 @@ def _apply(campaign: Campaign, record: Record, source: str) -> None:
         if meta.get("reason"):
             campaign.abort_reason = str(meta["reason"])
     elif record.kind == "run":
-        campaign.runs.append(RunStart(int(meta["run"]), int(meta["pid"]), str(meta["host"]), str(meta["started"])))
+        if not all(isinstance(meta[k], int) and 0 <= meta[k] < 2**31 for k in ("run", "pid")):
+            raise ValueError("run or pid not a small whole number")
+        campaign.runs.append(RunStart(meta["run"], meta["pid"], str(meta["host"]), str(meta["started"])))
     elif record.kind == "instruments":
-        campaign.instruments.update({str(k): dict(v) for k, v in meta["instruments"].items()})
+        campaign.instruments.update({str(k): {str(a): str(b) for a, b in _attributes(v).items()}
+                                     for k, v in meta["instruments"].items()})
     elif record.kind == "header":
         raise ValueError("a second header")
     else:

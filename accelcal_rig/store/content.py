@@ -177,32 +177,21 @@ class Campaign:
         return problems
 
 
-def take_what_the_file_kept(campaign: Campaign, from_file: Campaign, journal_name: str, file_name: str) -> str:
-    """Add to a journal's `campaign` what its campaign file `from_file` (the same campaign, read whole)
-    still holds and the journal has lost: poses it lacks, and — when the file was built from more of the
-    journal than is left — the soaks, events and state past the journal's end. What was added, or ""."""
+def take_what_the_file_kept(campaign: Campaign, from_file: Campaign, journal_name: str, file_name: str) -> int:
+    """Add to a journal's `campaign` the poses its campaign file `from_file` (the same campaign, read
+    whole) still holds and the journal has lost, in measurement order; how many. Only measurements are
+    taken back: the journal's own records (state, soaks, events) stay what they are, a lost one is what
+    a resume treats as a run that died."""
     poses = [p for p in from_file.poses if p.step_key not in campaign.stored_keys]
+    if not poses:
+        return 0
     for pose in poses:
         campaign.add_pose(pose, file_name)
-    ahead = from_file.journal_bytes > campaign.journal_bytes
-    soaks = events = 0
-    if ahead:
-        known = {(s.label, s.t_reached_s) for s in campaign.soaks}
-        for soak in from_file.soaks:
-            if (soak.label, soak.t_reached_s) not in known:
-                campaign.add_soak(soak)
-                soaks += 1
-        last = campaign.events[-1].t_s if campaign.events else float("-inf")
-        later = [e for e in from_file.events if e.t_s > last]
-        campaign.events.extend(later)
-        events = len(later)
-        campaign.state, campaign.abort_reason, campaign.finished = from_file.state, from_file.abort_reason, from_file.finished
-    if not (poses or soaks or events):
-        return ""
-    added = f"{len(poses)} poses, {soaks} soaks and {events} events"
-    campaign.notes.append(f"{journal_name} had lost what {file_name} holds: {added} taken from {file_name} (rig repair "
-                          "gives them back to the journal)")
-    return added
+    campaign.poses.sort(key=lambda p: p.t_start_s)
+    campaign._columns.clear()
+    campaign.notes.append(f"{journal_name} had lost {len(poses)} poses {file_name} still holds: taken from "
+                          f"{file_name} (rig repair gives them back to the journal)")
+    return len(poses)
 
 
 def measurements_sha256(campaign: Campaign) -> str:

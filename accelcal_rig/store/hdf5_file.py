@@ -76,7 +76,17 @@ def root_attrs(campaign: Campaign, journal_bytes: int) -> dict[str, Any]:
 
 
 def campaign_image(campaign: Campaign, journal_bytes: int) -> bytes:
-    """The whole campaign file as bytes. `journal_bytes`: how much of the journal it holds."""
+    """The whole campaign file as bytes. `journal_bytes`: how much of the journal it holds. DamagedFile
+    when what the campaign holds cannot be written as HDF5 (a journal whose records checksum but hold
+    values of the wrong kind: crafted, or from another program)."""
+    try:
+        return _image(campaign, journal_bytes)
+    except (ValueError, TypeError, OverflowError, KeyError) as exc:
+        raise DamagedFile(f"cannot be written as a campaign file: {str(exc).splitlines()[0] if str(exc) else exc}") \
+            from None
+
+
+def _image(campaign: Campaign, journal_bytes: int) -> bytes:
     with h5py.File(f"campaign-image-{next(_image_names)}", "w", driver="core", backing_store=False) as file:
         file.attrs.update(root_attrs(campaign, journal_bytes))
         header = campaign.header

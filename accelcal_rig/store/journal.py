@@ -160,6 +160,7 @@ class Scan:
     end: int = 0                                         # just after the last whole record
     damaged: list[tuple[int, int]] = field(default_factory=list)  # (offset, bytes) skipped between records
     tail_bytes: int = 0                                  # non-zero bytes soon after `end`: a record written in part
+    searched_out: bool = False                           # the search after damage ran out of budget
 
     @property
     def clean(self) -> bool:
@@ -180,7 +181,19 @@ def _scan(source: _Bytes) -> Scan:
         result.records.append(record)
         position = result.end = record.offset + record.size
     result.tail_bytes = len(source.read(result.end, _TAIL_LOOK_BYTES).rstrip(b"\0"))
+    result.searched_out = source.budget < 0
     return result
+
+
+def _tail_length(fd: int, found: Scan) -> int:
+    """How much after the last whole record to keep when it is cut off: what a record header there claims
+    (a damaged last record may end in zeros), else up to its last non-zero byte, never past the file."""
+    size = os.fstat(fd).st_size - found.end
+    head = os.pread(fd, _HEAD.size, found.end)
+    claimed = 0
+    if len(head) == _HEAD.size and head[:4] == MAGIC:
+        claimed = _HEAD.size + min(_HEAD.unpack(head)[1], MAX_RECORD_BYTES)
+    return min(size, max(claimed, found.tail_bytes))
 
 
 def scan(data: bytes) -> Scan:
@@ -250,11 +263,13 @@ class JournalWriter:
             fd = os.open(path, os.O_RDWR)
             try:
                 found = _scan(_Bytes(fd=fd))
+                if found.searched_out:
+                    raise ConfigError(f"{path}: damaged beyond what reading may search through (a record in it "
+                                      "could not be found); nothing was changed")
                 if found.tail_bytes:
                     tail_kept = unused_name(path, "tail")
-                    # A record may end in zero bytes: keep a little past the last non-zero one.
-                    length = min(found.tail_bytes + 4096, MAX_RECORD_BYTES + _HEAD.size)
-                    write_atomically(tail_kept, os.pread(fd, length, found.end), "the end of the journal cut off")
+                    write_atomically(tail_kept, os.pread(fd, _tail_length(fd, found), found.end),
+                                     "the end of the journal cut off")
                 if os.fstat(fd).st_size > found.end:
                     os.ftruncate(fd, found.end)
                     os.fsync(fd)
@@ -265,7 +280,7 @@ class JournalWriter:
         writer.tail_kept = tail_kept
         try:
             writer._ensure_room(0)
-        except DiskFull:
+        except (DiskFull, ConfigError):
             writer.space_exhausted = True
         return writer, found
 
@@ -288,7 +303,7 @@ class JournalWriter:
         """Write `record` after the last one and fsync; DiskFull when not even the reserve holds it."""
         try:
             self._ensure_room(len(record))
-        except DiskFull:
+        except (DiskFull, ConfigError):  # full, over a quota or a size limit, failing: the reserve is for this
             self.space_exhausted = True
             if self.end + len(record) > self.allocated:
                 raise

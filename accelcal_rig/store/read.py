@@ -42,6 +42,7 @@ def load_campaign(path: Path) -> Campaign:
     journal = journal_path(path)
     fallback_note = ""
     if journal.is_file():
+        identity = file_identity(path)  # before the journal: see file_kept_more
         try:
             found = read_journal(journal)
         except OSError as exc:
@@ -54,7 +55,13 @@ def load_campaign(path: Path) -> Campaign:
             fallback_note = f"{exc}: read from {path.name} instead"
         else:
             campaign.journal_bytes = found.end
-            return _unless_the_file_holds_more(path, campaign)
+            if found.tail_bytes and lock.holder(path) is None:  # while a run writes, its next record is on its way
+                campaign.notes.append(f"{journal.name}: {found.tail_bytes} bytes after its last whole record (a record "
+                                      "a run that died was writing, or a damaged one): resume or repair sets them aside")
+            from_file = file_kept_more(path, identity, campaign)
+            if from_file is not None:
+                take_what_the_file_kept(campaign, from_file, journal.name, path.name)
+            return campaign
     if not path.exists():
         if stale_temporaries(journal) or stale_temporaries(path):
             raise ConfigError(f"{path}: no campaign: a run stopped before it had created it (nothing was measured); "
@@ -66,48 +73,51 @@ def load_campaign(path: Path) -> Campaign:
     return campaign
 
 
-def file_identity(path: Path) -> tuple[str, int, int] | None:
-    """(campaign id, poses, journal bytes) the HDF5 file says it holds, from its attributes alone; None when
-    it cannot say (missing, unreadable, or written before campaigns had ids)."""
+@dataclass(frozen=True)
+class FileIdentity:
+    """What an HDF5 campaign file says of itself, read cheaply (attributes and pose keys only)."""
+
+    campaign_id: str
+    step_keys: frozenset[str]
+    journal_bytes: int
+
+
+def file_identity(path: Path) -> FileIdentity | None:
+    """None when the file cannot say (missing, unreadable, or written before campaigns had ids)."""
     try:
+        if not path.is_file():
+            return None
         with h5py.File(path, "r", locking=False) as file:
             identity = str(file.attrs.get("campaign_id", ""))
-            if not identity:
+            keys = file.get("poses/step_key")
+            if not identity or not isinstance(keys, h5py.Dataset) or keys.ndim != 1 or keys.shape[0] > 10**6:
                 return None
-            return identity, int(file.attrs.get("poses_done", 0)), int(file.attrs.get("journal_bytes", 0))
+            return FileIdentity(identity, frozenset(k.decode(errors="replace") if isinstance(k, bytes) else str(k)
+                                                    for k in keys[()]), int(file.attrs.get("journal_bytes", 0)))
     except (OSError, ValueError, TypeError, KeyError, OverflowError):
         return None
 
 
-def check_same_campaign_files(path: Path, campaign: Campaign) -> tuple[str, int, int] | None:
-    """The campaign file's identity; ConfigError when it and the journal are different campaigns."""
-    identity = file_identity(path) if path.is_file() else None
-    if identity is not None and identity[0] != campaign.header.campaign_id:
-        raise ConfigError(f"{path}: it and its journal hold different campaigns ({identity[0][:12]} and "
+def check_same_campaign_files(path: Path, identity: FileIdentity | None, campaign: Campaign) -> None:
+    """ConfigError when the campaign file and the journal are different campaigns."""
+    if identity is not None and identity.campaign_id != campaign.header.campaign_id:
+        raise ConfigError(f"{path}: it and its journal hold different campaigns ({identity.campaign_id[:12]} and "
                           f"{campaign.header.campaign_id[:12]}): move the one that does not belong away; nothing "
                           "was changed")
-    return identity
 
 
-def file_kept_more(path: Path, campaign: Campaign) -> Campaign | None:
-    """The campaign file read whole when it holds what the journal has lost (poses it lacks, or more of
-    the journal than is left), else None."""
-    identity = check_same_campaign_files(path, campaign)
-    if identity is None or (identity[1] <= len(campaign.poses) and identity[2] <= campaign.journal_bytes):
+def file_kept_more(path: Path, identity: FileIdentity | None, campaign: Campaign) -> Campaign | None:
+    """The campaign file read whole when it holds poses the journal has lost, else None. `identity` must
+    be read before the journal: the journal only grows, so a pose the file had then and the journal
+    lacks now is lost, not merely newer."""
+    check_same_campaign_files(path, identity, campaign)
+    if identity is None or identity.step_keys <= campaign.stored_keys:
         return None
     try:
         from_file = read_hdf5_campaign(path)
     except ConfigError:
         return None
     return None if from_file.damage else from_file
-
-
-def _unless_the_file_holds_more(path: Path, campaign: Campaign) -> Campaign:
-    """The journal's campaign, with what its campaign file still holds and the journal lost added."""
-    from_file = file_kept_more(path, campaign)
-    if from_file is not None:
-        take_what_the_file_kept(campaign, from_file, journal_path(path).name, path.name)
-    return campaign
 
 
 def read_hdf5_campaign(path: Path) -> Campaign:
@@ -134,20 +144,17 @@ def file_currency(path: Path, campaign: Campaign, writing: bool) -> str:
     if campaign.source == "file":
         return "the only copy (no journal)"
     rebuild = "a campaign is writing: it catches up as it goes" if writing else f"rig repair {path} rebuilds it"
-    try:
-        with h5py.File(path, "r", locking=False) as file:
-            same = str(file.attrs.get("campaign_id", "")) == campaign.header.campaign_id
-            held, poses = int(file.attrs.get("journal_bytes", -1)), int(file.attrs.get("poses_done", 0))
-    except FileNotFoundError:
+    if not path.exists():
         return f"missing ({rebuild})"
-    except (OSError, ValueError, TypeError) as exc:
-        return f"unreadable: {_first_line(exc)} ({rebuild})"
-    if not same:
+    identity = file_identity(path)
+    if identity is None:
+        return f"unreadable or not a campaign file of this version ({rebuild})"
+    if identity.campaign_id != campaign.header.campaign_id:
         return f"holds another campaign ({rebuild})"
-    if held > campaign.journal_bytes:
-        return f"ahead of its journal, which lost records ({rebuild})"
-    if held != campaign.journal_bytes:
-        return f"behind the journal: {poses} of {len(campaign.poses)} poses ({rebuild})"
+    if not identity.step_keys <= {p.step_key for p in campaign.poses}:
+        return f"holds poses its journal lost ({rebuild})"
+    if identity.journal_bytes != campaign.journal_bytes or len(identity.step_keys) != len(campaign.poses):
+        return f"behind the journal: {len(identity.step_keys)} of {len(campaign.poses)} poses ({rebuild})"
     return "current"
 
 

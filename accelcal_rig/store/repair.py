@@ -20,10 +20,10 @@ from accelcal_rig.store.codec import (
     encode_state, replay,
 )
 from accelcal_rig.store.content import Campaign, take_what_the_file_kept
-from accelcal_rig.store.hdf5_file import campaign_image
+from accelcal_rig.store.hdf5_file import DamagedFile, campaign_image
 from accelcal_rig.store.journal import JournalWriter, read_journal
 from accelcal_rig.store.paths import journal_path
-from accelcal_rig.store.read import file_kept_more, read_hdf5_campaign
+from accelcal_rig.store.read import file_identity, file_kept_more, read_hdf5_campaign
 from accelcal_rig.store.records import StateChange
 
 
@@ -72,6 +72,7 @@ def mend_journal(path: Path) -> list[str]:
         campaign = _from_campaign_file(path, "it has no journal")
         write_atomically(journal, journal_bytes_of(campaign), "the campaign journal")
         return [f"{path.name} had no journal: {journal.name} made from its {len(campaign.poses)} poses"]
+    identity = file_identity(path)  # before the journal: see file_kept_more
     with disk_errors(journal, "the campaign journal"):
         found = read_journal(journal)
     try:
@@ -82,13 +83,13 @@ def mend_journal(path: Path) -> list[str]:
         write_atomically(journal, journal_bytes_of(campaign), "the campaign journal")
         return [f"{exc}: kept as {kept.name}, {journal.name} made again from {path.name} ({len(campaign.poses)} poses)"]
     held.journal_bytes = found.end
-    from_file = file_kept_more(path, held)
-    added = take_what_the_file_kept(held, from_file, journal.name, path.name) if from_file is not None else ""
+    from_file = file_kept_more(path, identity, held)
+    added = take_what_the_file_kept(held, from_file, journal.name, path.name) if from_file is not None else 0
     if added:
         kept = _keep_copy(journal)
         write_atomically(journal, journal_bytes_of(held), "the campaign journal")
-        return [f"{journal.name} had lost what {path.name} holds ({added}): made again with them, the old one kept as "
-                f"{kept.name}"]
+        return [f"{journal.name} had lost {added} poses {path.name} still holds: made again with them, the old one "
+                f"kept as {kept.name}"]
     if not found.damaged:
         return []
     with disk_errors(journal, "the campaign journal"), journal.open("rb") as original:
@@ -111,7 +112,11 @@ def repair_campaign(path: Path) -> list[str]:
             done.append(f"{found.tail_bytes} bytes after the journal's last whole record (a record a run that died was "
                         f"writing, or a damaged one) cut off, kept as {journal.tail_kept.name}")
         campaign = replay(found, journal_path(path).name)
-        write_atomically(path, campaign_image(campaign, found.end), "the campaign file")
+        try:
+            image = campaign_image(campaign, found.end)
+        except DamagedFile as exc:
+            raise ConfigError(f"{journal_path(path)}: its campaign {exc}") from None
+        write_atomically(path, image, "the campaign file")
         done.append(f"{path.name} rebuilt from its journal: {len(campaign.poses)} of {campaign.poses_planned} poses, "
                     f"{len(campaign.soaks)} soaks, {campaign.run_count} runs, state {campaign.state}")
         return done + campaign.notes

@@ -31,7 +31,7 @@ from accelcal_rig.store.codec import (
     encode_events, encode_header, encode_instruments, encode_pose, encode_run, encode_soak, encode_state, replay,
 )
 from accelcal_rig.store.content import Campaign
-from accelcal_rig.store.hdf5_file import campaign_image
+from accelcal_rig.store.hdf5_file import DamagedFile, campaign_image
 from accelcal_rig.store.journal import JournalWriter
 from accelcal_rig.store.paths import journal_path
 from accelcal_rig.store.records import (
@@ -228,6 +228,9 @@ class CampaignWriter:
         except (DiskFull, ConfigError) as exc:  # a full or failing disk: measuring stops at the next pose
             self._write_failed = str(exc)
             return
+        except DamagedFile as exc:
+            self._write_failed = f"{self.path}: {exc}"
+            return
         self._file_written_at = time.monotonic()
         self._file_cost_s = self._file_written_at - started
         self._file_behind = False
@@ -263,7 +266,7 @@ class CampaignWriter:
                             f"rig repair {self.path} once that is mended")
         if self._write_failed is not None and self._file_behind:
             problems.append(f"{self.path} is behind its journal ({self._write_failed}); rig resume or rig repair brings it "
-                            "up to date once space is freed")
+                            "up to date once that is mended")
         self._journal.close()
         lock.release(self.path)
         return problems

@@ -154,8 +154,8 @@ def test_a_lone_campaign_file_keeps_each_dut_its_own_data_when_it_gets_a_journal
 
 
 def test_poses_only_the_campaign_file_still_holds_go_back_into_the_journal(campaign: Path) -> None:
-    """The file one pose behind its journal, and two of the journal's pose records damaged: between them
-    every pose is still there, and reading, then repairing, keeps all six."""
+    """The file one pose behind its journal, and one of the journal's pose records damaged: each holds five
+    poses, between them all six are still there, and reading, then repairing, keeps all six."""
     from accelcal_rig.store.codec import replay
     from accelcal_rig.store.hdf5_file import campaign_image
     from accelcal_rig.store.journal import scan
@@ -167,14 +167,31 @@ def test_poses_only_the_campaign_file_still_holds_go_back_into_the_journal(campa
     upto_fifth = data[:poses[4].offset + poses[4].size]
     campaign.write_bytes(campaign_image(replay(scan(upto_fifth), journal.name), len(upto_fifth)))  # one pose behind
     damaged = bytearray(data)
-    for record in poses[1:3]:
-        damaged[record.offset + 200] ^= 0xFF
+    damaged[poses[1].offset + 200] ^= 0xFF
     journal.write_bytes(bytes(damaged))
     status = campaign_status(campaign)
-    assert status["poses_done"] == 6 and "2 poses, 0 soaks and 0 events taken from c.h5" in status["integrity"]
+    assert status["poses_done"] == 6 and "c.h5.journal had lost 1 poses c.h5 still holds" in status["integrity"]
+    assert status["campaign_file"].startswith("behind the journal: 5 of 6 poses")
     assert stored_poses(campaign) == original
     done = repair_campaign(campaign)
-    assert "c.h5.journal had lost what c.h5 holds (2 poses, 0 soaks and 0 events)" in done[0]
+    assert "c.h5.journal had lost 1 poses c.h5 still holds: made again with them" in done[0]
     assert read_journal(journal).clean and len([r for r in read_journal(journal).records if r.kind == "pose"]) == 6
     assert stored_poses(campaign) == original and campaign_status(campaign)["integrity"] == "ok"
     assert measurements_sha256(read_hdf5_campaign(campaign)) == measurements_sha256(load_campaign(campaign))
+
+
+def test_a_damaged_last_record_is_noted_set_aside_and_the_campaign_finished_again(campaign: Path, write) -> None:
+    journal = journal_path(campaign)
+    last = read_journal(journal).records[-1]
+    assert last.kind == "state" and last.meta["state"] == "done"
+    data = bytearray(journal.read_bytes())
+    data[last.offset + 20] ^= 0x01
+    journal.write_bytes(bytes(data))
+    status = campaign_status(campaign)
+    assert status["state"] == "running" and "bytes after its last whole record" in status["integrity"]
+    run_campaign(prepare(write("tiny.yaml", TINY_PROCEDURE)), campaign, dry_run=True, seed=3, overwrite=False,
+                 resume=True)
+    status = campaign_status(campaign)
+    assert (status["state"], status["poses_done"], status["integrity"]) == ("done", 6, "ok")
+    kept = next(campaign.parent.glob("c.h5.journal.tail-*"))
+    assert kept.read_bytes() == bytes(data[last.offset:])
