@@ -497,7 +497,7 @@ def _cmd_fit(args: argparse.Namespace) -> int:
 
     running = holder(args.campaign)
     if running is not None:
-        raise ConfigError(f"{args.campaign}: a campaign is running on it ({running}): fit it once it is done")
+        raise ConfigError(f"{args.campaign}: a campaign is running on it, {running}: fit it once it is done")
     campaign = usable_campaign(args.campaign)
     for note in campaign.notes:
         print(f"rig: warning: {args.campaign}: {note}", file=sys.stderr)

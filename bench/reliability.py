@@ -2,7 +2,7 @@
 
     python bench/reliability.py syscalls --points 220   # kill -9 at chosen write system calls of rig run, fit, resume
     python bench/reliability.py crash --trials 50       # kill -9 at a random moment of the paper dry run
-    python bench/reliability.py diskfull                # the disk fills up at 12 sizes of free space (needs root)
+    python bench/reliability.py diskfull                # the disk fills up at 14 moments and sizes (needs root)
     python bench/reliability.py concurrent --trials 8   # --overwrite, resume, fit, repair against a running campaign
     python bench/reliability.py signals --trials 20     # SIGINT / SIGTERM at a random moment
     python bench/reliability.py faults --trials 2       # injected instrument faults, transient and persistent

@@ -184,7 +184,7 @@ def test_rig_fit_refuses_a_campaign_still_running(paper_campaign: Path, tmp_path
     finally:
         holder.kill()
         holder.wait()
-    assert f"a campaign is running on it (pid {holder.pid} on " in err
+    assert f"a campaign is running on it, pid {holder.pid} on " in err
     assert hashlib.sha256(campaign.read_bytes()).hexdigest() == digest and not (tmp_path / "cal.yaml").exists()
 
 
