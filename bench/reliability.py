@@ -255,12 +255,17 @@ def _text(path: Path) -> str:
 
 
 # ---------------------------------------------------------------------- kill -9 at a random moment
-def crash_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, int]:
-    campaign = folder / "crash.h5"
+def uninterrupted_wall_s(campaign: Path) -> float:
+    """The wall time of one whole paper dry run to `campaign`: the span the random moments are drawn from."""
     clean(campaign)
     start = time.perf_counter()
     subprocess.run([RIG, "run", str(PAPER), "--dry-run", "-o", str(campaign), "-q"], check=True, capture_output=True)
-    wall_s = time.perf_counter() - start
+    return time.perf_counter() - start
+
+
+def crash_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, int]:
+    campaign = folder / "crash.h5"
+    wall_s = uninterrupted_wall_s(campaign)
     print(f"uninterrupted run: {wall_s:.1f} s wall", flush=True)
     passed = 0
     costs = []
@@ -434,10 +439,7 @@ def _prefix(journal: Path, records: list[tuple[int, int]]) -> bytes:
 # ---------------------------------------------------------------------- signals and faults
 def signal_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, int]:
     campaign = folder / "signal.h5"
-    clean(campaign)
-    start = time.perf_counter()
-    subprocess.run([RIG, "run", str(PAPER), "--dry-run", "-o", str(campaign), "-q"], check=True, capture_output=True)
-    wall_s = time.perf_counter() - start
+    wall_s = uninterrupted_wall_s(campaign)
     passed = 0
     for trial in range(trials):
         clean(campaign)

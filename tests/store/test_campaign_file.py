@@ -9,19 +9,10 @@ from pathlib import Path
 
 import h5py
 import numpy as np
-import pytest
 
-from accelcal_rig.engine.session import prepare, run_campaign
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.store.read import campaign_status
-from tests.conftest import REPO, TINY_PROCEDURE
-
-
-@pytest.fixture
-def campaign(write, workdir: Path) -> Path:
-    output = workdir / "campaign.h5"
-    run_campaign(prepare(write("tiny.yaml", TINY_PROCEDURE)), output, dry_run=True, seed=3, overwrite=False)
-    return output
+from tests.conftest import REPO
 
 
 def test_layout_shapes_and_units(campaign: Path) -> None:

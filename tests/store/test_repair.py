@@ -21,13 +21,6 @@ from accelcal_rig.store.repair import repair_campaign
 from tests.conftest import TINY_PROCEDURE, stored_poses
 
 
-@pytest.fixture
-def campaign(write, workdir: Path) -> Path:
-    output = workdir / "c.h5"
-    run_campaign(prepare(write("tiny.yaml", TINY_PROCEDURE)), output, dry_run=True, seed=3, overwrite=False)
-    return output
-
-
 def digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
