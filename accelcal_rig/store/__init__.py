@@ -1,1 +1,1 @@
-"""The campaign file: one self-describing HDF5 file per campaign, written pose by pose."""
+"""The campaign store: an append-only journal per campaign is the durable truth; the HDF5 file is rebuilt from it."""
