@@ -36,6 +36,8 @@ from tests.fuzz.campaigns import CALIBRATION, CAMPAIGN, JOURNAL, damaged_case, m
 from tests.fuzz.configs import config_case, mutate  # noqa: E402
 from tests.fuzz.recordings import clean_recording, recording_case  # noqa: E402
 
+from quiet import silence_campaign_log  # noqa: E402  bench/quiet.py, beside this script
+
 RIG = str(Path(sys.executable).parent / "rig")
 LIMIT_S = 10.0
 LIMIT_BYTES = 1 << 30
@@ -196,6 +198,7 @@ def main() -> None:
     args = parser.parse_args()
     cases = args.cases or {"configs": 600, "campaigns": 132, "recordings": 300, "exports": 150}[args.inputs]
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+    silence_campaign_log()  # the source campaigns' soak warnings are not what is judged
     with tempfile.TemporaryDirectory() as tmp:
         failures = {"configs": configs, "campaigns": campaigns, "recordings": recordings,
                     "exports": exports}[args.inputs](Path(tmp), cases)
