@@ -20,7 +20,3 @@ AngleDeg = Annotated[float, Field(ge=-3600.0, le=3600.0)]
 TimeoutS = Annotated[float, Field(ge=0.001, le=60.0)]
 #: A serial line's speed, baud.
 Baudrate = Annotated[int, Field(ge=50, le=20_000_000)]
-#: A Modbus register address or 16-bit register value.
-Register = Annotated[int, Field(ge=0, le=65535)]
-#: A minute count up to a week.
-MinutesUpToWeek = Annotated[float, Field(ge=0.0, le=7 * 24 * 60)]

@@ -102,7 +102,7 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
                     f"{len(angles)} angles given, the turntable of {rig.path} has {len(axes)} axes",
                 )
             for axis, angle in zip(axes, angles):
-                if not axis.continuous and not axis.min_deg <= angle <= axis.max_deg:
+                if not axis.allows(angle):
                     raise procedure.error(
                         ("schedule", "angles_deg", pose),
                         f"axis {axis.name} angle {angle:g}° is outside its limits {axis.min_deg:g}…{axis.max_deg:g}°",

@@ -80,6 +80,10 @@ class TurntableAxis(_Strict):
             raise ValueError("a continuous axis wraps over exactly 360°: set max_deg = min_deg + 360")
         return self
 
+    def allows(self, angle_deg: float) -> bool:
+        """The one axis-limit rule: a continuous axis goes anywhere, any other stays within its limits."""
+        return self.continuous or self.min_deg <= angle_deg <= self.max_deg
+
 
 class TurntableConfig(_Strict):
     """A chain of rotary axes, outermost first; the fixture sits on the innermost axis."""
@@ -174,7 +178,7 @@ class FaultInjection(_Strict):
 
 
 class SimulationConfig(_Strict):
-    """Physics of the virtual lab used by `--dry-run` (DESIGN §3)."""
+    """Physics of the virtual lab used by `--dry-run` (docs/procedures.md, "The simulated rig")."""
 
     ambient_c: TemperatureC = 23.0
     chamber_time_constant_min: float = Field(3.0, ge=0.01, le=1440)

@@ -515,16 +515,10 @@ def _checked_identity(sensor: Accelerometer) -> DeviceIdentity:
     """The sensor's identity registers; anything but an ADXL355's may be a glitch on the line (retried),
     and is a fault when it persists."""
     identity = sensor.identify()
-    expected = (adxl355.DEVID_AD, adxl355.DEVID_MST, adxl355.PARTID)
-    found = (identity.devid_ad, identity.devid_mst, identity.partid)
-    if found != expected:
-        raise TransientInstrumentError(
-            f"sensor {sensor.serial} ({sensor.endpoint}): identity {_hex(found)} is not an ADXL355 ({_hex(expected)})")
+    wrong = adxl355.wrong_identity((identity.devid_ad, identity.devid_mst, identity.partid))
+    if wrong:
+        raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): {wrong}")
     return identity
-
-
-def _hex(values: tuple[int, ...]) -> str:
-    return "/".join(f"{v:02X}" for v in values)
 
 
 def _one_line_reason(exc: BaseException) -> str:

@@ -17,13 +17,11 @@ def check_lines(instruments: RigInstruments) -> Iterator[str]:
     angles = " ".join(f"{a:.3f}" for a in turntable.read_angles_deg())
     yield (f"turntable  {turntable.endpoint}: {turntable.identify()}, angles {angles}°, "
            f"{'in position' if turntable.in_position() else 'moving'}")
-    expected = (adxl355.DEVID_AD, adxl355.DEVID_MST, adxl355.PARTID)
     for sensor in instruments.sensors:
         identity = sensor.identify()
-        found = (identity.devid_ad, identity.devid_mst, identity.partid)
-        if found != expected:
-            raise InstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): identity "
-                                  f"{'/'.join(f'{v:02X}' for v in found)} is not an ADXL355 (AD/1D/ED)")
+        wrong = adxl355.wrong_identity((identity.devid_ad, identity.devid_mst, identity.partid))
+        if wrong:
+            raise InstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): {wrong}")
         range_g, odr_hz = sensor.read_settings()
         yield (f"sensor {sensor.serial}  {sensor.endpoint}: ADXL355 rev {identity.revid}, ±{range_g} g, "
                f"{odr_hz:g} Hz, {sensor.read_temperature_c():.1f} °C")

@@ -32,6 +32,11 @@ def lsb_g(range_g: int) -> float:
     return 1.0 / RANGE_LSB_PER_G[range_g]
 
 
+def raw_temperature(temp2: int, temp1: int) -> int:
+    """TEMP2 (low nibble: bits 11..8) and TEMP1 (bits 7..0) → the 12-bit raw temperature."""
+    return ((temp2 & 0x0F) << 8) | temp1
+
+
 def temperature_c_from_raw(raw: np.ndarray | int) -> np.ndarray | float:
     """12-bit TEMP2:TEMP1 reading → °C (datasheet: 1885 LSB at 25 °C, −9.05 LSB/°C)."""
     return TEMPERATURE_REFERENCE_C + (np.asarray(raw, dtype=float) - TEMPERATURE_INTERCEPT_LSB) / (
@@ -58,13 +63,14 @@ REG_DEVID_AD = 0x00
 REG_STATUS = 0x04
 REG_FIFO_ENTRIES = 0x05
 REG_TEMP2 = 0x06
-REG_XDATA3 = 0x08
 REG_FIFO_DATA = 0x11
 REG_FILTER = 0x28
 REG_FIFO_SAMPLES = 0x29
 REG_RANGE = 0x2C
 REG_POWER_CTL = 0x2D
 REG_RESET = 0x2F
+
+IDENTITY = (DEVID_AD, DEVID_MST, PARTID)
 
 RESET_CODE = 0x52
 STATUS_NVM_BUSY = 0x10
@@ -76,6 +82,17 @@ FIFO_CAPACITY_ENTRIES = 96  # one entry is one axis: 32 xyz samples
 
 _ENTRY_X_MARKER = 0x01
 _ENTRY_EMPTY = 0x02
+
+
+def wrong_identity(found: tuple[int, int, int]) -> str | None:
+    """Why identification registers (DEVID_AD, DEVID_MST, PARTID) are not an ADXL355's; None when they are."""
+    if tuple(found) == IDENTITY:
+        return None
+    return f"identity {_hex(found)} is not an ADXL355 ({_hex(IDENTITY)})"
+
+
+def _hex(values: tuple[int, ...]) -> str:
+    return "/".join(f"{v:02X}" for v in values)
 
 
 def odr_code(odr_hz: float) -> int:

@@ -91,7 +91,7 @@ class Adxl355:
 
     def read_temperature_c(self) -> float:
         high, low = self._bus.read(adxl355.REG_TEMP2, 2)
-        return float(adxl355.temperature_c_from_raw(((high & 0x0F) << 8) | low))
+        return float(adxl355.temperature_c_from_raw(adxl355.raw_temperature(high, low)))
 
     def acquire(self, n_samples: int) -> SampleBlock:
         """`n_samples` consecutive samples, captured by the bridge if it can, else drained from the FIFO."""
@@ -196,7 +196,7 @@ class Adxl355:
     def _status_and_temperature(self) -> tuple[int, float]:
         """STATUS, FIFO_ENTRIES, TEMP2 and TEMP1 are neighbours: one burst, one round trip."""
         status, _, high, low = self._bus.read(adxl355.REG_STATUS, 4)
-        return status, float(adxl355.temperature_c_from_raw(((high & 0x0F) << 8) | low))
+        return status, float(adxl355.temperature_c_from_raw(adxl355.raw_temperature(high, low)))
 
     def _status(self) -> int:
         return self._bus.read(adxl355.REG_STATUS, 1)[0]

@@ -26,6 +26,7 @@ from collections.abc import Callable
 from typing import Protocol
 
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.line_port import LinePort
 
 BRIDGE_GREETING = "ADXL355-BRIDGE"
@@ -149,7 +150,7 @@ def _raw_temperature(hex_digits: str) -> int | None:
         high, low = bytes.fromhex(hex_digits)
     except ValueError:
         return None
-    return ((high & 0x0F) << 8) | low
+    return adxl355.raw_temperature(high, low)
 
 
 def _capture_capacity(greeting: str) -> int:

@@ -50,7 +50,7 @@ class LimitedTurntable:
         if angles.shape != (len(self._axes),):
             raise InstrumentError(f"turntable ({self.endpoint}): {angles.size} angles for {len(self._axes)} axes")
         for axis, angle in zip(self._axes, angles):
-            if not axis.continuous and not axis.min_deg <= angle <= axis.max_deg:
+            if not axis.allows(angle):
                 raise InstrumentError(
                     f"turntable ({self.endpoint}): axis {axis.name} to {angle:g}° refused, "
                     f"limits are {axis.min_deg:g}…{axis.max_deg:g}°"

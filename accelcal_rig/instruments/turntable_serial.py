@@ -51,9 +51,6 @@ class SerialTurntable:
     def stop(self) -> None:
         self._ask(self.protocol.stop)
 
-    def home(self) -> None:
-        self._ask(self.protocol.home)
-
     def close(self) -> None:
         self._line.close()
 

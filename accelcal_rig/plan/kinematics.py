@@ -14,8 +14,6 @@ from scipy.spatial.transform import Rotation
 
 from accelcal_rig.config.rig import TurntableAxis
 
-WORLD_UP = np.array([0.0, 0.0, 1.0])
-
 #: Largest gravity-direction error (rad) accepted from the inverse kinematics: 0.002″.
 _IK_TOLERANCE_RAD = 1e-8
 
@@ -60,13 +58,6 @@ class TurntableKinematics:
             if axis.continuous:
                 wrapped[..., k] = (wrapped[..., k] - axis.min_deg) % 360.0 + axis.min_deg
         return wrapped
-
-    def within_limits(self, angles_deg: np.ndarray) -> bool:
-        angles = np.asarray(angles_deg, dtype=float)
-        return all(
-            axis.continuous or axis.min_deg - 1e-9 <= angles[..., k].min() and angles[..., k].max() <= axis.max_deg + 1e-9
-            for k, axis in enumerate(self.axes)
-        )
 
     def solve(self, gravity_fixture: np.ndarray, near_deg: np.ndarray) -> np.ndarray:
         """Angles that put gravity along `gravity_fixture`, preferring the solution nearest `near_deg`.

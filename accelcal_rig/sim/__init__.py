@@ -1,1 +1,1 @@
-"""The virtual lab: physics of the simulated rig (DESIGN §3) and simulated instruments on one clock."""
+"""The virtual lab: physics of the simulated rig (docs/procedures.md, "The simulated rig") and simulated instruments on one clock."""

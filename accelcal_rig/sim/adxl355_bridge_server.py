@@ -16,7 +16,6 @@ from accelcal_rig.sim.pty_line_server import PtyLineServer
 
 _READ_ONLY_BELOW = 0x1E
 _FIFO_REGISTERS = frozenset({adxl355.REG_STATUS, adxl355.REG_FIFO_ENTRIES, adxl355.REG_FIFO_DATA})  # ID, status, data and FIFO registers
-_FIFO_CAPACITY_BYTES = 3 * adxl355.FIFO_CAPACITY_ENTRIES
 _SAMPLES_IN_FIFO = adxl355.FIFO_CAPACITY_ENTRIES // 3
 #: Samples the simulated bridge's capture buffer holds (9 bytes each: 36 kB, a small microcontroller's RAM).
 CAPTURE_CAPACITY_SAMPLES = 4096

@@ -43,7 +43,6 @@ class SimulatedChamberServer:
         self.host, self.port = host, port
         #: The last set point written over the wire, for tests that check the safe state.
         self.last_setpoint_c: float | None = None
-        self._shown_setpoint_c: float | None = None  # what a stalled controller shows it was given
 
     @property
     def endpoint(self) -> str:

@@ -18,8 +18,6 @@ from accelcal_rig.store.records import CampaignHeader, PoseRecord, RunStart, Soa
 
 POSE_FIELDS = ("step_key", "setpoint_c", "pose_number", "commanded_angles_deg", "measured_angles_deg",
                "gravity_fixture", "t_start_s", "t_end_s", "chamber_temperature_c")
-DUT_FIELDS = ("raw_codes", "mean_g", "stderr_g", "temperature_c", "gravity_reference_g", "temperature_in_band")
-TRUTH_FIELDS = ("parameters", "gravity_g", "temperature_c")
 
 
 @dataclass

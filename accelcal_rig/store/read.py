@@ -8,7 +8,6 @@ readable campaign is one ConfigError naming the file and what is wrong with it.
 
 from __future__ import annotations
 
-import json
 import os
 import socket
 from dataclasses import dataclass
@@ -203,10 +202,6 @@ def campaign_status(path: Path, campaign: Campaign | None = None) -> dict[str, A
         "integrity": "; ".join(campaign.integrity_problems()) or "ok",
         "campaign_file": file_currency(path, campaign, alive),
     }
-
-
-def status_json(path: Path) -> str:
-    return json.dumps(campaign_status(path))
 
 
 def usable_campaign(path: Path) -> Campaign:
