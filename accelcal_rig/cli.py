@@ -15,10 +15,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
 from accelcal_rig import __version__
+from accelcal_rig.core.formatting import format_duration
+from accelcal_rig.core.signals import stop_when_safe
 from accelcal_rig.engine.campaign import TerminationRequested
-from accelcal_rig.engine.events import LOGGER, format_duration
+from accelcal_rig.engine.events import LOGGER
 from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
-from accelcal_rig.store.atomic import stop_when_safe
 
 if TYPE_CHECKING:
     from accelcal_rig.engine.progress import ProgressListener
@@ -441,8 +442,8 @@ def _cmd_repair(args: argparse.Namespace) -> int:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from accelcal_rig.config.load import load_rig, with_faults
+    from accelcal_rig.core.clock import RealClock
     from accelcal_rig.engine.check import check_lines
-    from accelcal_rig.engine.clock import RealClock
     from accelcal_rig.instruments.connect import configured_endpoints, connect_rig
     from accelcal_rig.sim.wire_rig import SimulatedRig
 
@@ -468,7 +469,7 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     import threading
 
     from accelcal_rig.config.load import load_rig, with_faults
-    from accelcal_rig.engine.clock import RealClock
+    from accelcal_rig.core.clock import RealClock
     from accelcal_rig.sim.wire_rig import SimulatedRig
 
     rig = with_faults(load_rig(args.rig), args.faults)

@@ -12,7 +12,7 @@ import time
 from pathlib import Path
 
 from accelcal_rig.config.load import load_rig
-from accelcal_rig.engine.clock import VirtualClock
+from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.instruments.adxl355_driver import Adxl355
 from accelcal_rig.instruments.adxl355_transport import SerialBridge
 from accelcal_rig.sim.adxl355_bridge_server import SimulatedBridgeServer

@@ -32,11 +32,11 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
+from quiet import silence_campaign_log  # noqa: E402  bench/quiet.py, beside this script
+
 from tests.fuzz.campaigns import CALIBRATION, CAMPAIGN, JOURNAL, damaged_case, make_source  # noqa: E402
 from tests.fuzz.configs import config_case, mutate  # noqa: E402
 from tests.fuzz.recordings import clean_recording, recording_case  # noqa: E402
-
-from quiet import silence_campaign_log  # noqa: E402  bench/quiet.py, beside this script
 
 RIG = str(Path(sys.executable).parent / "rig")
 LIMIT_S = 10.0

@@ -9,16 +9,13 @@ from __future__ import annotations
 from collections.abc import Sequence
 from functools import partial
 
-from accelcal_rig.engine.clock import Clock
 import numpy as np
 
-from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.core.clock import Clock
+from accelcal_rig.errors import TransientInstrumentError
 from accelcal_rig.instruments import adxl355
-from accelcal_rig.instruments.adxl355_transport import CaptureOverflow
-from accelcal_rig.instruments.interfaces import Accelerometer, BlockCapturing, SampleBlock
-
-#: Attempts at a gap-free block before lost samples are reported as a fault.
-OVERFLOW_ATTEMPTS = 3
+from accelcal_rig.instruments.capture import capture_together
+from accelcal_rig.instruments.interfaces import Accelerometer, SampleBlock
 
 
 def acquire_together(sensors: Sequence[Accelerometer], n_samples: int, clock: Clock,
@@ -45,32 +42,3 @@ def check_block(sensor: Accelerometer, block: SampleBlock, range_g: int) -> None
     if np.any(codes >= adxl355.CODE_MAX) or np.any(codes <= adxl355.CODE_MIN):
         raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): saturated at ±{range_g} g "
                                        "(a code at the end of the ADC range)")
-
-
-def capture_together(sensors: Sequence[BlockCapturing], n_samples: int, clock: Clock) -> list[SampleBlock]:
-    """Start every capture, then fetch in rounds until all are complete. A capture that lost samples is
-    started again (that sensor only), OVERFLOW_ATTEMPTS times at most."""
-    blocks: dict[int, SampleBlock] = {}
-    pending = list(range(len(sensors)))
-    for _ in range(OVERFLOW_ATTEMPTS):
-        for index in pending:
-            sensors[index].begin_capture(n_samples)
-        capturing, overflowed = list(pending), []
-        while capturing:
-            clock.sleep(min(sensors[index].capture_wait_s() for index in capturing))
-            for index in list(capturing):
-                try:
-                    complete = sensors[index].fetch_capture()
-                except CaptureOverflow:
-                    capturing.remove(index)
-                    overflowed.append(index)
-                    continue
-                if complete:
-                    capturing.remove(index)
-                    blocks[index] = sensors[index].end_capture()
-        pending = overflowed
-        if not pending:
-            return [blocks[index] for index in range(len(sensors))]
-    lost = sensors[pending[0]]
-    raise InstrumentError(f"sensor {lost.serial} ({lost.endpoint}): FIFO overflowed in {OVERFLOW_ATTEMPTS} "
-                          "attempts: the bridge's capture lost samples")

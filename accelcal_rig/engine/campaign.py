@@ -16,10 +16,13 @@ from scipy.spatial.transform import Rotation
 
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.core.clock import Clock
+from accelcal_rig.core.formatting import format_duration
+from accelcal_rig.core.signals import signals_deferred
+from accelcal_rig.core.waits import MOVE_POLL_S, wait_until
 from accelcal_rig.engine.acquisition import acquire_together
-from accelcal_rig.engine.clock import Clock
 from accelcal_rig.engine.estimate import DurationEstimate
-from accelcal_rig.engine.events import LOGGER, EventLog, format_duration
+from accelcal_rig.engine.events import LOGGER, EventLog
 from accelcal_rig.engine.notify import Notification, Notifier
 from accelcal_rig.engine.progress import COOLDOWN_PHASES, PHASES, Progress, ProgressListener
 from accelcal_rig.engine.resume import ResumePoint
@@ -27,13 +30,11 @@ from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.engine.safe_state import apply_safe_state
 from accelcal_rig.engine.soak import SoakDetector
 from accelcal_rig.engine.states import ACTIVE_STATES, State, StateMachine
-from accelcal_rig.engine.waits import MOVE_POLL_S, wait_until
 from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, TransientInstrumentError, WaitTimeout
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity, RigInstruments, SampleBlock
 from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable
 from accelcal_rig.plan.compile import Plan, PlanStep, setpoint_label
-from accelcal_rig.store.atomic import signals_deferred
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.records import DutPoseRecord, PoseRecord, SoakTrace
 from accelcal_rig.store.writer import CampaignWriter

@@ -23,12 +23,11 @@ import numpy as np
 
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel, dut_time_constant_s
+from accelcal_rig.core.waits import MOVE_POLL_S
 from accelcal_rig.engine.soak import first_stable_poll, settled_at
-from accelcal_rig.engine.waits import MOVE_POLL_S
 from accelcal_rig.instruments.adxl355 import raw_from_temperature_c, temperature_c_from_raw
 from accelcal_rig.plan.compile import Plan
-from accelcal_rig.sim.lab import TEMPERATURE_READ_NOISE_C, dut_time_constant_s
-from accelcal_rig.sim.thermal import ThermalModel
 
 #: Draws of the temperature reading noise over which the soak duration is a median.
 SOAK_DRAWS = 9

@@ -4,18 +4,13 @@ from __future__ import annotations
 
 import logging
 
-from accelcal_rig.engine.clock import Clock
-from accelcal_rig.store.writer import CampaignWriter
+from accelcal_rig.core.clock import Clock
+from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.store.records import Event
+from accelcal_rig.store.writer import CampaignWriter
 
 LOGGER = logging.getLogger("accelcal_rig")
 _LEVELS = {"debug": logging.DEBUG, "info": logging.INFO, "warning": logging.WARNING, "error": logging.ERROR}
-
-
-def format_duration(seconds: float) -> str:
-    """`50412.3` → `14:00:12` (hours may exceed 24)."""
-    whole = int(round(seconds))
-    return f"{whole // 3600:d}:{whole % 3600 // 60:02d}:{whole % 60:02d}"
 
 
 class EventLog:

@@ -5,9 +5,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from accelcal_rig.engine.events import format_duration
+from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.plan.compile import setpoint_label
-
 
 #: Engine states as an operator names the phase they belong to.
 PHASES = {"move": "poses", "settle": "poses", "acquire": "poses", "store": "poses"}

@@ -10,7 +10,7 @@ from collections.abc import Callable
 from typing import TypeVar
 
 from accelcal_rig.config.rig import RetryPolicy
-from accelcal_rig.engine.clock import Clock
+from accelcal_rig.core.clock import Clock
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.retrying import Retrying

@@ -12,12 +12,17 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from accelcal_rig.config.load import (
-    LoadedConfig, check_procedure_against_rig, load_procedure, load_rig, resolve_rig_path, with_faults,
+    LoadedConfig,
+    check_procedure_against_rig,
+    load_procedure,
+    load_rig,
+    resolve_rig_path,
+    with_faults,
 )
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.core.clock import Clock, RealClock, VirtualClock
 from accelcal_rig.engine.campaign import Audience, CampaignRunner, CampaignSummary, FitStage
-from accelcal_rig.engine.clock import Clock, RealClock, VirtualClock
 from accelcal_rig.engine.estimate import estimate_duration
 from accelcal_rig.engine.events import LOGGER, EventLog
 from accelcal_rig.engine.notify import Notifier

@@ -12,15 +12,19 @@ from accelcal_rig import __version__
 from accelcal_rig.fit.calibration import FORMAT_NAME as CALIBRATION_FORMAT
 from accelcal_rig.fit.calibration import FORMAT_VERSION as CALIBRATION_VERSION
 from accelcal_rig.fit.calibration import (
-    CalibrationFile, PolynomialModel, SensorCalibration, SetpointFit, plain, save_calibration,
+    CalibrationFile,
+    PolynomialModel,
+    SensorCalibration,
+    SetpointFit,
+    plain,
+    save_calibration,
 )
 from accelcal_rig.fit.joint import fit_joint
 from accelcal_rig.fit.lm import FitMode, FreeParameters, SfemFit, fit_sfem
 from accelcal_rig.fit.metrics import drift_mg, noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, norm_only_gauge
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
-from accelcal_rig.store.content import Campaign
-from accelcal_rig.store.content import measurements_sha256
+from accelcal_rig.store.content import Campaign, measurements_sha256
 from accelcal_rig.store.read import DutPoses, read_dut_poses
 from accelcal_rig.store.records import utc_now
 

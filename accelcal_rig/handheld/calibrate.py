@@ -10,8 +10,15 @@ import numpy as np
 
 from accelcal_rig import __version__
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.fit.calibration import FORMAT_NAME, FORMAT_VERSION, CalibrationFile, PolynomialModel, \
-    SensorCalibration, SetpointFit, plain
+from accelcal_rig.fit.calibration import (
+    FORMAT_NAME,
+    FORMAT_VERSION,
+    CalibrationFile,
+    PolynomialModel,
+    SensorCalibration,
+    SetpointFit,
+    plain,
+)
 from accelcal_rig.fit.lm import DegenerateDesign, FreeParameters, SfemFit, fit_sfem
 from accelcal_rig.fit.metrics import noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct

@@ -8,12 +8,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from accelcal_rig.engine.acquisition import OVERFLOW_ATTEMPTS, capture_together
-from accelcal_rig.engine.clock import Clock
-from accelcal_rig.engine.waits import wait_until
+from accelcal_rig.core.clock import Clock
+from accelcal_rig.core.waits import wait_until
 from accelcal_rig.errors import InstrumentError, WaitTimeout
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import BlockCapture, RegisterTransport
+from accelcal_rig.instruments.capture import OVERFLOW_ATTEMPTS, capture_together
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
 from accelcal_rig.instruments.retrying import RetryCall, Retrying
 

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 from accelcal_rig.config.load import LoadedConfig
 from accelcal_rig.config.rig import ChamberConfig, RigConfig, SensorConfig
-from accelcal_rig.engine.clock import Clock
+from accelcal_rig.core.clock import Clock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.instruments.adxl355_driver import Adxl355
 from accelcal_rig.instruments.adxl355_transport import RegisterTransport, SerialBridge, SpidevBus

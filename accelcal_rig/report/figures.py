@@ -7,7 +7,6 @@ Each function writes one PNG and returns its path.
 from __future__ import annotations
 
 import io
-
 from pathlib import Path
 from typing import TYPE_CHECKING
 

@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from accelcal_rig import __version__
+from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.durable import write_text_atomically
-from accelcal_rig.engine.events import format_duration
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.report import figures
 from accelcal_rig.report.campaign_data import CampaignData, read_campaign_data

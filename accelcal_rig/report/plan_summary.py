@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.engine.estimate import DurationEstimate
-from accelcal_rig.engine.events import format_duration
 from accelcal_rig.engine.session import PreparedCampaign
 from accelcal_rig.plan.compile import setpoint_label
 from accelcal_rig.store.space import START_MARGIN, megabytes

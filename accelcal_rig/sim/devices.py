@@ -11,7 +11,7 @@ import numpy as np
 
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.engine.clock import Clock
+from accelcal_rig.core.clock import Clock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.fit.sfem import PARAMETER_NAMES
 from accelcal_rig.instruments import adxl355

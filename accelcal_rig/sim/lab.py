@@ -11,22 +11,13 @@ from scipy.spatial.transform import Rotation
 
 from accelcal_rig.config.procedure import SimulatedEffects
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.engine.clock import Clock
+from accelcal_rig.core.clock import Clock
+from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel, dut_time_constant_s
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.instruments.adxl355 import quantise_g, raw_from_temperature_c, temperature_c_from_raw
 from accelcal_rig.plan.kinematics import TurntableKinematics
-from accelcal_rig.sim.thermal import ThermalModel
 from accelcal_rig.sim.truth import DutTruth, truth_for_serial
 from accelcal_rig.sim.turntable_motion import TurntableMotion
-
-#: Noise of the DUT temperature reading before its 12-bit quantisation (dithers the 0.11 °C LSB).
-TEMPERATURE_READ_NOISE_C = 0.05
-
-
-def dut_time_constant_s(serial: str, fixture_tau_s: float) -> float:
-    """Fixtures are never quite uniform: each DUT lags the air by its own ±10 % of the nominal constant."""
-    spread = int.from_bytes(hashlib.sha256(f"tau:{serial}".encode()).digest()[:4], "little") / 2**32
-    return fixture_tau_s * (0.9 + 0.2 * spread)
 
 
 class SimulatedDut:

@@ -11,6 +11,7 @@ from collections.abc import Callable
 
 from accelcal_rig.sim.faults import ReplyFaults
 
+
 class PtyLineServer:
     """Reads requests ending in `terminator` from the pty and writes back `handle(request) + terminator`."""
 

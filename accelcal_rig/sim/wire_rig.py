@@ -12,7 +12,7 @@ from typing import Any
 
 from accelcal_rig.config.procedure import SimulatedEffects
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.engine.clock import Clock
+from accelcal_rig.core.clock import Clock
 from accelcal_rig.instruments.connect import Endpoints
 from accelcal_rig.sim.adxl355_bridge_server import SimulatedBridgeServer
 from accelcal_rig.sim.chamber_server import SimulatedChamberServer

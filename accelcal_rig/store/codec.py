@@ -6,13 +6,20 @@ Kinds: `header` (first, once), `run` (each run's start), `instruments` (the driv
 
 from __future__ import annotations
 
-
 import numpy as np
 
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.journal import Record, Scan, encode_record
 from accelcal_rig.store.records import (
-    CampaignHeader, DutPoseRecord, PoseRecord, RunStart, SoakTrace, StateChange, StoredEvent, StoredPlan, plain_value,
+    CampaignHeader,
+    DutPoseRecord,
+    PoseRecord,
+    RunStart,
+    SoakTrace,
+    StateChange,
+    StoredEvent,
+    StoredPlan,
+    plain_value,
 )
 
 

@@ -21,7 +21,14 @@ from accelcal_rig.config.yaml_lines import parse_yaml_text
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.store.content import POSE_FIELDS, Campaign, measurements_sha256
 from accelcal_rig.store.records import (
-    CampaignHeader, DutPoseRecord, PoseRecord, RunStart, SoakTrace, StoredEvent, StoredPlan, plain_value,
+    CampaignHeader,
+    DutPoseRecord,
+    PoseRecord,
+    RunStart,
+    SoakTrace,
+    StoredEvent,
+    StoredPlan,
+    plain_value,
 )
 
 FORMAT_NAME = "accelcal-rig campaign"

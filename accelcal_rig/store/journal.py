@@ -25,7 +25,13 @@ from typing import Any
 import numpy as np
 
 from accelcal_rig.durable import (
-    disk_errors, fsync_directory, is_disk_full, temporary_beside, unused_name, write_all, write_atomically,
+    disk_errors,
+    fsync_directory,
+    is_disk_full,
+    temporary_beside,
+    unused_name,
+    write_all,
+    write_atomically,
 )
 from accelcal_rig.errors import ConfigError, DiskFull
 

@@ -16,8 +16,15 @@ from accelcal_rig.durable import clear_stale_temporaries, disk_errors, fsync_dir
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.store import lock
 from accelcal_rig.store.codec import (
-    NotACampaignJournal, encode_events, encode_header, encode_instruments, encode_pose, encode_run, encode_soak,
-    encode_state, replay,
+    NotACampaignJournal,
+    encode_events,
+    encode_header,
+    encode_instruments,
+    encode_pose,
+    encode_run,
+    encode_soak,
+    encode_state,
+    replay,
 )
 from accelcal_rig.store.content import Campaign, take_what_the_file_kept
 from accelcal_rig.store.hdf5_file import DamagedFile, campaign_image

@@ -23,19 +23,33 @@ from pathlib import Path
 from typing import Any
 
 from accelcal_rig import __version__
+from accelcal_rig.core.signals import signals_deferred
 from accelcal_rig.durable import clear_stale_temporaries, free_bytes, remove, write_atomically
 from accelcal_rig.errors import ConfigError, DiskFull, InsufficientSpace
 from accelcal_rig.store import lock
-from accelcal_rig.store.atomic import signals_deferred
 from accelcal_rig.store.codec import (
-    encode_events, encode_header, encode_instruments, encode_pose, encode_run, encode_soak, encode_state, replay,
+    encode_events,
+    encode_header,
+    encode_instruments,
+    encode_pose,
+    encode_run,
+    encode_soak,
+    encode_state,
+    replay,
 )
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.hdf5_file import DamagedFile, campaign_image
 from accelcal_rig.store.journal import JournalWriter
 from accelcal_rig.store.paths import journal_path
 from accelcal_rig.store.records import (
-    CampaignHeader, Event, PoseRecord, RunStart, SoakTrace, StateChange, StoredEvent, utc_now,
+    CampaignHeader,
+    Event,
+    PoseRecord,
+    RunStart,
+    SoakTrace,
+    StateChange,
+    StoredEvent,
+    utc_now,
 )
 from accelcal_rig.store.repair import mend_journal
 from accelcal_rig.store.space import StorageEstimate, megabytes, reserve_bytes

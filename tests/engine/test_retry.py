@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from accelcal_rig.config.rig import RetryPolicy
-from accelcal_rig.engine.clock import VirtualClock
+from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 

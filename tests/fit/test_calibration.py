@@ -10,9 +10,7 @@ import pytest
 import yaml
 
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.fit.calibration import (
-    CalibrationRangeWarning, apply, apply_codes, load_calibration, save_calibration,
-)
+from accelcal_rig.fit.calibration import CalibrationRangeWarning, apply, apply_codes, load_calibration, save_calibration
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_campaign
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.instruments import adxl355

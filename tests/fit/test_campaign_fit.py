@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, fit_campaign
-from accelcal_rig.store.paths import journal_path
 from accelcal_rig.store.content import measurements_sha256
+from accelcal_rig.store.paths import journal_path
 from accelcal_rig.store.read import load_campaign, read_hdf5_campaign
 
 

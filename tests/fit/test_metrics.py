@@ -1,7 +1,11 @@
 import numpy as np
 
 from accelcal_rig.fit.metrics import (
-    drift_mg, noise_floor_mg, norm_rmse_mg, temperature_coefficient_ug_per_k, tilt_angles_deg,
+    drift_mg,
+    noise_floor_mg,
+    norm_rmse_mg,
+    temperature_coefficient_ug_per_k,
+    tilt_angles_deg,
 )
 
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from accelcal_rig.config.load import load_rig
-from accelcal_rig.engine.clock import VirtualClock
+from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.instruments import adxl355

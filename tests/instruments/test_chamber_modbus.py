@@ -10,7 +10,7 @@ from pyModbusTCP.client import ModbusClient as IndependentModbusClient
 
 from accelcal_rig.config.load import load_rig
 from accelcal_rig.config.rig import ChamberConfig
-from accelcal_rig.engine.clock import VirtualClock
+from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.instruments.chamber_modbus import ModbusChamber
 from accelcal_rig.instruments.chamber_registers import register_map

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from accelcal_rig.config.load import load_rig
-from accelcal_rig.engine.clock import VirtualClock
+from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.instruments.limits import LimitedTurntable
 from accelcal_rig.instruments.turntable_protocol import ACCELCAL_LINE, turntable_protocol

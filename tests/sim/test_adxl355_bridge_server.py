@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from accelcal_rig.config.load import load_rig
-from accelcal_rig.engine.clock import VirtualClock
+from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.sim.adxl355_bridge_server import CAPTURE_CAPACITY_SAMPLES, SimulatedAdxl355
 from accelcal_rig.sim.lab import VirtualLab

@@ -1,6 +1,6 @@
 import numpy as np
 
-from accelcal_rig.sim.thermal import ThermalModel
+from accelcal_rig.core.thermal import ThermalModel
 
 
 def model(**overrides) -> ThermalModel:
@@ -45,7 +45,7 @@ def test_query_granularity_does_not_change_the_answer() -> None:
 
 def test_advancing_is_bounded_whatever_the_gaps() -> None:
     """Setpoints a hair from the reference, and queries a hair apart, each cost one sub-step at most."""
-    from accelcal_rig.sim import thermal
+    from accelcal_rig.core import thermal
 
     m = model()
     steps = []

@@ -1,6 +1,6 @@
 import pytest
 
-from accelcal_rig.store.atomic import signals_deferred, stop_when_safe
+from accelcal_rig.core.signals import signals_deferred, stop_when_safe
 
 
 def test_stop_outside_a_critical_section_is_immediate() -> None:

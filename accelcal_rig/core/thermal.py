@@ -8,6 +8,7 @@ where the ramp arrives (it then sits exactly on its target).
 
 from __future__ import annotations
 
+import hashlib
 import math
 
 import numpy as np
@@ -15,6 +16,16 @@ import numpy as np
 MAX_STEP_S = 10.0
 #: A sub-step's change larger than this sets a DUT's direction of approach.
 _DIRECTION_THRESHOLD_C = 1e-4
+
+
+#: Noise of the DUT temperature reading before its 12-bit quantisation (dithers the 0.11 °C LSB).
+TEMPERATURE_READ_NOISE_C = 0.05
+
+
+def dut_time_constant_s(serial: str, fixture_tau_s: float) -> float:
+    """Fixtures are never quite uniform: each DUT lags the air by its own ±10 % of the nominal constant."""
+    spread = int.from_bytes(hashlib.sha256(f"tau:{serial}".encode()).digest()[:4], "little") / 2**32
+    return fixture_tau_s * (0.9 + 0.2 * spread)
 
 
 def _lag(state: np.ndarray | float, input_start: float, input_end: float, step_s: float,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from accelcal_rig.engine.clock import Clock
+from accelcal_rig.core.clock import Clock
 from accelcal_rig.errors import WaitTimeout
 
 #: Turntable position polling interval, from the time a move could first have arrived (its travel at the

@@ -1,7 +1,7 @@
 import pytest
 
-from accelcal_rig.engine.clock import VirtualClock
-from accelcal_rig.engine.waits import wait_until
+from accelcal_rig.core.clock import VirtualClock
+from accelcal_rig.core.waits import wait_until
 from accelcal_rig.errors import WaitTimeout
 
 
@@ -64,7 +64,7 @@ def test_a_failing_task_is_raised_after_every_task_has_ended() -> None:
 def test_an_interrupt_before_the_tasks_start_leaves_no_thread_waiting(monkeypatch) -> None:
     import threading
 
-    from accelcal_rig.engine import clock as clock_module
+    from accelcal_rig.core import clock as clock_module
 
     class InterruptedInCaller(threading.Barrier):
         def wait(self, timeout=None):
