@@ -12,6 +12,7 @@ from accelcal_rig.config.procedure import MAX_POLLS, Procedure
 from accelcal_rig.config.rig import FaultInjection, RigConfig
 from accelcal_rig.config.yaml_lines import KeyPath, format_key, load_yaml_with_lines, locate
 from accelcal_rig.errors import ConfigError
+from accelcal_rig.parts.registry import part
 
 ModelT = TypeVar("ModelT", bound=BaseModel)
 
@@ -67,8 +68,16 @@ def resolve_rig_path(procedure: LoadedConfig[Procedure], override: Path | None) 
 
 
 def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedConfig[RigConfig]) -> None:
-    """Cross-file checks that neither file can make alone: setpoints and angles inside the rig's limits."""
+    """Cross-file checks that neither file can make alone: setpoints and angles inside the rig's limits, the
+    range and data rate among those of every DUT's part."""
     chamber = rig.model.chamber
+    acquisition = procedure.model.acquisition
+    for sensor in rig.model.fixture.sensors:
+        dut_part = part(sensor.part)
+        for key, problem in (("range_g", dut_part.range_problem(acquisition.range_g)),
+                             ("odr_hz", dut_part.rate_problem(acquisition.odr_hz))):
+            if problem:
+                raise procedure.error(("acquisition", key), f"{problem}: sensor {sensor.serial} of {rig.path}")
     for index, setpoint in enumerate(procedure.model.setpoints_c):
         if not chamber.min_setpoint_c <= setpoint <= chamber.max_setpoint_c:
             raise procedure.error(

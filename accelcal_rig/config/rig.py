@@ -11,6 +11,7 @@ from pydantic import BaseModel, Field, ValidationError, field_validator, model_v
 from accelcal_rig.config.bounds import STRICT, AngleDeg, Baudrate, TemperatureC, TimeoutS
 from accelcal_rig.instruments.chamber_registers import ChamberRegisterMap, register_map
 from accelcal_rig.instruments.turntable_protocol import TurntableProtocol, turntable_protocol
+from accelcal_rig.parts.registry import DEFAULT_PART, part
 
 #: A year of campaign time, in minutes: the furthest a simulated fault may be scheduled.
 _YEAR_MIN = 365 * 24 * 60.0
@@ -122,6 +123,7 @@ class SensorConfig(_Strict):
 
     serial: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.-]+$")
     name: str = Field("", max_length=64)
+    part: str = Field(DEFAULT_PART, max_length=64, description="the sensor part (accelcal_rig.parts), e.g. adxl357")
     driver: Literal["serial-bridge", "spidev"] = "serial-bridge"
     endpoint: str | None = Field(None, max_length=1024, description="serial-bridge: device or URL; spidev: "
                                  "bus.chip_select")
@@ -129,6 +131,15 @@ class SensorConfig(_Strict):
     spi_speed_hz: int = Field(5_000_000, ge=1000, le=10_000_000)
     timeout_s: TimeoutS = 1.0
     mount_euler_deg: tuple[AngleDeg, AngleDeg, AngleDeg] = (0.0, 0.0, 0.0)
+
+    @field_validator("part")
+    @classmethod
+    def _known_part(cls, value: str) -> str:
+        try:
+            part(value)
+        except KeyError as exc:
+            raise ValueError(exc.args[0]) from None
+        return value
 
 
 def _first_error_as_value_error(key: str, build: Callable[[], object]) -> None:
@@ -187,7 +198,8 @@ class SimulationConfig(_Strict):
     free_cooling_time_constant_min: float = Field(45.0, ge=0.01, le=10080, description="chamber switched off: its "
                                                   "air relaxes to ambient with this time constant")
     self_heating_c: float = Field(0.2, ge=0, le=20)
-    noise_density_ug_per_rthz: float = Field(25.0, ge=0, le=100_000)
+    noise_density_ug_per_rthz: float | None = Field(None, ge=0, le=100_000, description="every DUT's noise "
+                                                    "density; unset: each part's own (its data sheet's)")
     turntable_settle_s: float = Field(0.5, ge=0, le=600)
     faults: FaultInjection = FaultInjection()
 

@@ -13,7 +13,6 @@ import numpy as np
 
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.errors import TransientInstrumentError
-from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.capture import capture_together
 from accelcal_rig.instruments.interfaces import Accelerometer, SampleBlock
 
@@ -39,6 +38,6 @@ def check_block(sensor: Accelerometer, block: SampleBlock, range_g: int) -> None
     if frozen:
         raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): data stuck: every one of "
                                        f"{len(codes)} samples of axis {','.join(frozen)} reads the same code")
-    if np.any(codes >= adxl355.CODE_MAX) or np.any(codes <= adxl355.CODE_MIN):
+    if np.any(codes >= sensor.part.code_max) or np.any(codes <= sensor.part.code_min):
         raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): saturated at ±{range_g} g "
                                        "(a code at the end of the ADC range)")

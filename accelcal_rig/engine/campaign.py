@@ -31,7 +31,6 @@ from accelcal_rig.engine.safe_state import apply_safe_state
 from accelcal_rig.engine.soak import SoakDetector
 from accelcal_rig.engine.states import ACTIVE_STATES, State, StateMachine
 from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, TransientInstrumentError, WaitTimeout
-from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity, RigInstruments, SampleBlock
 from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable
 from accelcal_rig.plan.compile import Plan, PlanStep, setpoint_label
@@ -252,7 +251,7 @@ class CampaignRunner:
             sensor.standby()
             sensor.configure(acquisition.range_g, acquisition.odr_hz)
             sensor.start_measurement()
-            self.events.info("preflight", f"sensor {sensor.serial}: ADXL355 rev {identity.revid}, "
+            self.events.info("preflight", f"sensor {sensor.serial}: {sensor.part.label} rev {identity.revid}, "
                                           f"±{acquisition.range_g} g, {acquisition.odr_hz:g} Hz")
 
     # ----------------------------------------------------------------- one setpoint
@@ -487,7 +486,7 @@ class CampaignRunner:
 
     def _dut_record(self, index: int, block: SampleBlock, gravity_fixture: np.ndarray) -> DutPoseRecord:
         sensor = self.sensors[index]
-        lsb = adxl355.lsb_g(self.procedure.acquisition.range_g)
+        lsb = sensor.part.lsb_g(self.procedure.acquisition.range_g)
         codes = block.codes_xyz
         n = codes.shape[0]
         mean_g = codes.mean(axis=0) * lsb
@@ -513,10 +512,10 @@ def _angle_difference(a_deg: np.ndarray, b_deg: np.ndarray) -> np.ndarray:
 
 
 def _checked_identity(sensor: Accelerometer) -> DeviceIdentity:
-    """The sensor's identity registers; anything but an ADXL355's may be a glitch on the line (retried),
+    """The sensor's identity registers; anything but its part's may be a glitch on the line (retried),
     and is a fault when it persists."""
     identity = sensor.identify()
-    wrong = adxl355.wrong_identity((identity.devid_ad, identity.devid_mst, identity.partid))
+    wrong = sensor.part.wrong_identity((identity.devid_ad, identity.devid_mst, identity.partid))
     if wrong:
         raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): {wrong}")
     return identity

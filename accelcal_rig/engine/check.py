@@ -5,7 +5,6 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 from accelcal_rig.errors import InstrumentError
-from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.interfaces import RigInstruments
 
 
@@ -19,9 +18,9 @@ def check_lines(instruments: RigInstruments) -> Iterator[str]:
            f"{'in position' if turntable.in_position() else 'moving'}")
     for sensor in instruments.sensors:
         identity = sensor.identify()
-        wrong = adxl355.wrong_identity((identity.devid_ad, identity.devid_mst, identity.partid))
+        wrong = sensor.part.wrong_identity((identity.devid_ad, identity.devid_mst, identity.partid))
         if wrong:
             raise InstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): {wrong}")
         range_g, odr_hz = sensor.read_settings()
-        yield (f"sensor {sensor.serial}  {sensor.endpoint}: ADXL355 rev {identity.revid}, ±{range_g} g, "
+        yield (f"sensor {sensor.serial}  {sensor.endpoint}: {sensor.part.label} rev {identity.revid}, ±{range_g} g, "
                f"{odr_hz:g} Hz, {sensor.read_temperature_c():.1f} °C")

@@ -3,7 +3,7 @@
 The chamber ramps at the rig's ramp rate and its air lags with `simulation.chamber_time_constant_min`;
 each DUT lags the air with `simulation.fixture_time_constant_min` (the same thermal model a dry run uses,
 so set those two to a real rig's measured values). The ramp and soak are polled exactly as the engine
-polls them, through the same soak detector, fed with what an ADXL355 reads (0.11 °C steps, with noise):
+polls them, through the same soak detector, fed with what each DUT's part reads (an ADXL355: 0.11 °C steps, with noise):
 the soak is the median over `SOAK_DRAWS` draws of that noise, since the band is a few steps wide and the
 noise moves the moment it is met by minutes. Each pose costs its turntable travel at the axes' speeds, the
 table's settling (`simulation.turntable_settle_s`) and half a position poll, the procedure's settle time
@@ -26,7 +26,8 @@ from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel, dut_time_constant_s
 from accelcal_rig.core.waits import MOVE_POLL_S
 from accelcal_rig.engine.soak import first_stable_poll, settled_at
-from accelcal_rig.instruments.adxl355 import raw_from_temperature_c, temperature_c_from_raw
+from accelcal_rig.parts.part import TemperatureFormat
+from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.compile import Plan
 
 #: Draws of the temperature reading noise over which the soak duration is a median.
@@ -90,6 +91,7 @@ def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> Durat
         dut_tau_s=[dut_time_constant_s(s.serial, sim.fixture_time_constant_min * 60.0) for s in rig.fixture.sensors],
         self_heating_c=sim.self_heating_c,
     )
+    readers = [part(s.part).temperature for s in rig.fixture.sensors]
     speeds = np.array([a.speed_deg_s for a in rig.turntable.axes])
     # The table reports in position its settling time after arriving; the engine's position polls find
     # that moment half a polling interval late on average.
@@ -117,7 +119,7 @@ def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> Durat
                 rows.append(SetpointEstimate(setpoint, wait_s, 0.0, poses_s, len(angles), "ramp", ()))
                 t += poses_s
                 continue
-            soak_s, outcome, settled = _soak(thermal, procedure, setpoint, t)
+            soak_s, outcome, settled = _soak(thermal, procedure, setpoint, t, readers)
             rows.append(SetpointEstimate(setpoint, wait_s, soak_s, poses_s, len(angles), outcome, settled))
             t += soak_s + poses_s
             continue
@@ -131,7 +133,7 @@ def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> Durat
         if abs(thermal.air_c(t) - setpoint) > soak.chamber_tolerance_c:
             rows.append(SetpointEstimate(setpoint, t - ramp_start, 0.0, 0.0, len(angles), "ramp timeout", ()))
             break  # the engine would abort here
-        soak_s, outcome, settled = _soak(thermal, procedure, setpoint, t_reached)
+        soak_s, outcome, settled = _soak(thermal, procedure, setpoint, t_reached, readers)
         t_stable = t = t_reached + soak_s
         if procedure.method == "ramp":
             ramp_origin = (t, setpoint)
@@ -156,8 +158,8 @@ def _follow_software_ramp(thermal: ThermalModel, procedure: Procedure, origin: t
                              else max(start_c - travelled, last_c))
 
 
-def _soak(thermal: ThermalModel, procedure: Procedure, setpoint_c: float,
-          t_reached_s: float) -> tuple[float, str, tuple[float, ...]]:
+def _soak(thermal: ThermalModel, procedure: Procedure, setpoint_c: float, t_reached_s: float,
+          readers: list[TemperatureFormat]) -> tuple[float, str, tuple[float, ...]]:
     """(soak duration s, outcome, settled DUT temperatures °C): the median over noise draws of the soak."""
     soak = procedure.soak
     n_polls = int(math.ceil(soak.timeout_min * 60.0 / soak.poll_s)) + 1
@@ -169,7 +171,7 @@ def _soak(thermal: ThermalModel, procedure: Procedure, setpoint_c: float,
     rng = np.random.default_rng(0)
     outcomes = []
     for _ in range(SOAK_DRAWS):
-        read = temperature_c_from_raw(raw_from_temperature_c(dut + rng.normal(0.0, TEMPERATURE_READ_NOISE_C, dut.shape)))
+        read = _as_read(dut + rng.normal(0.0, TEMPERATURE_READ_NOISE_C, dut.shape), readers)
         stable = first_stable_poll(soak, setpoint_c, t_reached_s, t, air, read)
         if stable is not None:
             outcomes.append((float(t[stable] - t_reached_s), "stable", settled_at(soak, t, read, stable)))
@@ -177,3 +179,11 @@ def _soak(thermal: ThermalModel, procedure: Procedure, setpoint_c: float,
             outcomes.append((float(t[-1] - t_reached_s), "timeout", settled_at(soak, t, read, n_polls - 1)))
     soak_s, outcome, settled = sorted(outcomes, key=lambda o: o[0])[SOAK_DRAWS // 2]
     return soak_s, outcome, tuple(round(float(c), 3) for c in settled)
+
+
+def _as_read(dut_c: np.ndarray, readers: list[TemperatureFormat]) -> np.ndarray:
+    """Temperatures (polls × DUTs) as each DUT's temperature sensor reports them (its code, converted)."""
+    read = np.empty_like(dut_c)
+    for column, reader in enumerate(readers):
+        read[:, column] = reader.celsius(reader.raw(dut_c[:, column]))
+    return read

@@ -30,7 +30,6 @@ from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.resume import ResumePoint, check_same_campaign
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
-from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.connect import configured_endpoints, connect_rig
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, compile_plan
@@ -224,7 +223,8 @@ def _create_file(prepared: PreparedCampaign, output: Path, instruments: RigInstr
     mounts = {s.serial: s for s in rig.model.fixture.sensors}
     duts = [
         {"serial": s.serial, "name": mounts[s.serial].name, "mount_euler_deg": list(mounts[s.serial].mount_euler_deg),
-         "range_g": acquisition.range_g, "odr_hz": acquisition.odr_hz, "lsb_g": adxl355.lsb_g(acquisition.range_g),
+         "part": s.part.name, "range_g": acquisition.range_g, "odr_hz": acquisition.odr_hz,
+         "lsb_g": s.part.lsb_g(acquisition.range_g),
          "driver": type(s).__name__, "endpoint": s.endpoint}
         for s in instruments.sensors
     ]

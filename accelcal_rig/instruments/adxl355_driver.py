@@ -1,6 +1,6 @@
-"""ADXL355 at register level over any RegisterTransport: bring-up, configuration, temperature, and
-gap-free blocks of samples (decoded with numpy, not per sample) — captured by the bridge where it can,
-else drained from the FIFO by the host."""
+"""An ADXL355 (or a register-compatible ADXL357/ADXL359, by its part table) at register level over any
+RegisterTransport: bring-up, configuration, temperature, and gap-free blocks of samples (decoded with
+numpy, not per sample) — captured by the bridge where it can, else drained from the FIFO by the host."""
 
 from __future__ import annotations
 
@@ -16,6 +16,8 @@ from accelcal_rig.instruments.adxl355_transport import BlockCapture, RegisterTra
 from accelcal_rig.instruments.capture import OVERFLOW_ATTEMPTS, capture_together
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
 from accelcal_rig.instruments.retrying import RetryCall, Retrying
+from accelcal_rig.parts.adxl35x import ADXL355
+from accelcal_rig.parts.part import AccelerometerPart
 
 #: Samples to let accumulate between FIFO bursts: under its 32, so a burst is never late.
 DRAIN_EVERY_SAMPLES = 30
@@ -35,7 +37,9 @@ class _Capture:
 
 
 class Adxl355:
-    def __init__(self, transport: RegisterTransport, serial: str, clock: Clock) -> None:
+    def __init__(self, transport: RegisterTransport, serial: str, clock: Clock,
+                 part: AccelerometerPart = ADXL355) -> None:
+        self.part = part
         self._bus = transport
         self._fifo_bus = transport  # FIFO bursts are never retried alone: a lost reply took samples with it
         self.serial = serial
@@ -67,10 +71,10 @@ class Adxl355:
         """Range and filter, written explicitly; the part takes them only in standby."""
         if not self._bus.read(adxl355.REG_POWER_CTL, 1)[0] & adxl355.POWER_CTL_STANDBY:
             raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): range and filter can only change in standby")
-        self._bus.write(adxl355.REG_RANGE, adxl355.RANGE_CODES[range_g])
-        self._bus.write(adxl355.REG_FILTER, adxl355.odr_code(odr_hz))
+        self._bus.write(adxl355.REG_RANGE, self.part.range_codes[range_g])
+        self._bus.write(adxl355.REG_FILTER, self.part.odr_code(odr_hz))
         readback = self._bus.read(adxl355.REG_FILTER, 1)[0], self._bus.read(adxl355.REG_RANGE, 1)[0] & 0x03
-        if readback != (adxl355.odr_code(odr_hz), adxl355.RANGE_CODES[range_g]):
+        if readback != (self.part.odr_code(odr_hz), self.part.range_codes[range_g]):
             raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): range/filter did not read back")
         self._odr_hz = odr_hz
 
@@ -84,14 +88,14 @@ class Adxl355:
         """(range in g, output data rate in Hz) as the part is configured now."""
         filter_code = self._bus.read(adxl355.REG_FILTER, 1)[0] & 0x0F
         range_code = self._bus.read(adxl355.REG_RANGE, 1)[0] & 0x03
-        ranges = {code: g for g, code in adxl355.RANGE_CODES.items()}
-        if range_code not in ranges or filter_code >= len(adxl355.OUTPUT_DATA_RATES_HZ):
+        ranges = {code: g for g, code in self.part.range_codes.items()}
+        if range_code not in ranges or filter_code >= len(self.part.output_data_rates_hz):
             raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): RANGE/FILTER read back invalid codes")
-        return ranges[range_code], adxl355.OUTPUT_DATA_RATES_HZ[filter_code]
+        return ranges[range_code], self.part.output_data_rates_hz[filter_code]
 
     def read_temperature_c(self) -> float:
         high, low = self._bus.read(adxl355.REG_TEMP2, 2)
-        return float(adxl355.temperature_c_from_raw(adxl355.raw_temperature(high, low)))
+        return float(self.part.temperature.celsius(adxl355.raw_temperature(high, low)))
 
     def acquire(self, n_samples: int) -> SampleBlock:
         """`n_samples` consecutive samples, captured by the bridge if it can, else drained from the FIFO."""
@@ -121,7 +125,7 @@ class Adxl355:
     def begin_capture(self, n_samples: int) -> None:
         """The bridge starts capturing the next `n_samples` (and says the temperature then)."""
         capture: BlockCapture = self._bus  # type: ignore[assignment]
-        temperature_before = float(adxl355.temperature_c_from_raw(capture.start_capture(n_samples)))
+        temperature_before = float(self.part.temperature.celsius(capture.start_capture(n_samples)))
         self._capture = _Capture(n_samples, self._clock.now(), temperature_before)
 
     def capture_wait_s(self) -> float:
@@ -140,7 +144,7 @@ class Adxl355:
         capture.blocks.append(codes)
         capture.have += len(codes)
         if temperature_raw is not None:
-            capture.temperature_after_c = float(adxl355.temperature_c_from_raw(temperature_raw))
+            capture.temperature_after_c = float(self.part.temperature.celsius(temperature_raw))
         done = capture.have >= capture.n_samples
         if not done and self._clock.now() > capture.t_start_s + 2.0 * capture.n_samples / self._odr_hz + 1.0:
             raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {capture.have} of {capture.n_samples} "
@@ -196,7 +200,7 @@ class Adxl355:
     def _status_and_temperature(self) -> tuple[int, float]:
         """STATUS, FIFO_ENTRIES, TEMP2 and TEMP1 are neighbours: one burst, one round trip."""
         status, _, high, low = self._bus.read(adxl355.REG_STATUS, 4)
-        return status, float(adxl355.temperature_c_from_raw(adxl355.raw_temperature(high, low)))
+        return status, float(self.part.temperature.celsius(adxl355.raw_temperature(high, low)))
 
     def _status(self) -> int:
         return self._bus.read(adxl355.REG_STATUS, 1)[0]

@@ -13,6 +13,7 @@ from accelcal_rig.instruments.adxl355_transport import RegisterTransport, Serial
 from accelcal_rig.instruments.chamber_modbus import ModbusChamber
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.instruments.turntable_serial import SerialTurntable
+from accelcal_rig.parts.registry import part
 
 
 @dataclass(frozen=True)
@@ -52,7 +53,7 @@ def connect_rig(rig: RigConfig, endpoints: Endpoints, clock: Clock) -> RigInstru
                                            rig.turntable.timeout_s))
         for sensor in rig.fixture.sensors:
             transport = _transport(sensor, endpoints.sensors[sensor.serial], rig.retry.attempts, clock)
-            opened.append(Adxl355(transport, sensor.serial, clock))
+            opened.append(Adxl355(transport, sensor.serial, clock, part(sensor.part)))
     except BaseException:
         for device in opened:
             device.close()

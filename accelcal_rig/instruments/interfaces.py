@@ -7,10 +7,12 @@ from typing import Protocol
 
 import numpy as np
 
+from accelcal_rig.parts.part import AccelerometerPart
+
 
 @dataclass(frozen=True)
 class DeviceIdentity:
-    """ADXL355 identification registers (DEVID_AD, DEVID_MST, PARTID, REVID)."""
+    """Identification registers (DEVID_AD, DEVID_MST, PARTID, REVID)."""
 
     devid_ad: int
     devid_mst: int
@@ -60,10 +62,11 @@ class Turntable(Protocol):
 
 
 class Accelerometer(Protocol):
-    """One ADXL355 DUT."""
+    """One DUT: a digital accelerometer whose facts (ranges, codes, identity) its `part` gives."""
 
     serial: str
     endpoint: str
+    part: AccelerometerPart
 
     @property
     def capture_capacity_samples(self) -> int:

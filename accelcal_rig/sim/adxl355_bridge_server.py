@@ -22,20 +22,22 @@ CAPTURE_CAPACITY_SAMPLES = 4096
 
 
 class SimulatedAdxl355:
-    """One DUT's ADXL355 at register level."""
+    """One DUT's ADXL355 (or ADXL357, ADXL359: the lab's part for it) at register level."""
 
     def __init__(self, lab: VirtualLab, index: int, wrong_part_id: bool = False,
                  stuck_after_s: float | None = None) -> None:
         self._lab = lab
         self._index = index
-        self._part_id = 0xE9 if wrong_part_id else adxl355.PARTID  # 0xE9: an ADXL359 fitted by mistake
+        self._part = lab.duts[index].part
+        # The wrong part fitted by mistake: an ADXL359 (PARTID 0xE9) where another part belongs, else an ADXL355.
+        self._part_id = (0xED if self._part.identity[2] == 0xE9 else 0xE9) if wrong_part_id else self._part.identity[2]
         self._stuck_after_s = stuck_after_s
         self._stuck_codes: np.ndarray | None = None
         self.reset()
 
     def reset(self) -> None:
         self._regs = bytearray(0x30)
-        self._regs[0:4] = bytes([adxl355.DEVID_AD, adxl355.DEVID_MST, self._part_id, 0x01])
+        self._regs[0:4] = bytes([*self._part.identity[:2], self._part_id, 0x01])
         self._regs[adxl355.REG_RANGE] = 0x81
         self._regs[adxl355.REG_POWER_CTL] = adxl355.POWER_CTL_STANDBY
         self._regs[adxl355.REG_FIFO_SAMPLES] = 0x60
@@ -53,11 +55,11 @@ class SimulatedAdxl355:
 
     @property
     def _odr_hz(self) -> float:
-        return adxl355.OUTPUT_DATA_RATES_HZ[self._regs[adxl355.REG_FILTER] & 0x0F]
+        return self._part.output_data_rates_hz[self._regs[adxl355.REG_FILTER] & 0x0F]
 
     @property
     def _range_g(self) -> int:
-        return {code: g for g, code in adxl355.RANGE_CODES.items()}[self._regs[adxl355.REG_RANGE] & 0x03]
+        return {code: g for g, code in self._part.range_codes.items()}[self._regs[adxl355.REG_RANGE] & 0x03]
 
     def read(self, address: int, count: int) -> bytes:
         if not _FIFO_REGISTERS.isdisjoint(range(address, address + count)):
@@ -148,7 +150,7 @@ class SimulatedAdxl355:
         return codes
 
     def _temperature_raw(self) -> int:
-        return int(adxl355.raw_from_temperature_c(self._lab.dut_reading_c(self._index)))
+        return self._lab.dut_reading_raw(self._index)
 
     def _samples_in_fifo(self) -> int:
         return len(self._fifo) // 9 + self._fifo_pending

@@ -14,7 +14,6 @@ from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.fit.sfem import PARAMETER_NAMES
-from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.interfaces import DeviceIdentity, RigInstruments, SampleBlock
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.truth import HALF_RANGE_C, T_REF_C
@@ -76,7 +75,8 @@ class SimulatedTurntable:
 
 
 class SimulatedAccelerometer:
-    """An ADXL355 whose samples come from its hidden truth, the table's true angles and white noise."""
+    """A DUT (of its rig config's part) whose samples come from its hidden truth, the table's true angles and
+    white noise."""
 
     endpoint = ENDPOINT
     capture_capacity_samples = 0  # read one thread per DUT, as a host draining FIFOs would
@@ -85,16 +85,17 @@ class SimulatedAccelerometer:
         self._lab = lab
         self._index = index
         self.serial = lab.duts[index].serial
-        self._range_g = 2
+        self.part = lab.duts[index].part
+        self._range_g = self.part.ranges_g[0]
         self._odr_hz = 125.0
         self._measuring = False
 
     def identify(self) -> DeviceIdentity:
-        return DeviceIdentity(adxl355.DEVID_AD, adxl355.DEVID_MST, adxl355.PARTID, 1)
+        return DeviceIdentity(*self.part.identity, 1)
 
     def reset(self) -> None:
         self._measuring = False
-        self._range_g, self._odr_hz = 2, 4000.0  # the part's reset state
+        self._range_g, self._odr_hz = self.part.ranges_g[0], self.part.output_data_rates_hz[0]  # the reset state
 
     def configure(self, range_g: int, odr_hz: float) -> None:
         if self._measuring:
@@ -115,7 +116,7 @@ class SimulatedAccelerometer:
         return self._lab.dut_reading_c(self._index)
 
     def noise_g(self) -> float:
-        return self._lab.noise_g(self._odr_hz)
+        return self._lab.noise_g(self._index, self._odr_hz)
 
     def acquire(self, n_samples: int) -> SampleBlock:
         if not self._measuring:
@@ -147,7 +148,7 @@ class SimulationTruth:
             "t_ref_c": T_REF_C,
             "half_range_c": HALF_RANGE_C,
             "fixture_time_constant_s": dut.tau_s,
-            "noise_g_per_sample": self._lab.noise_g(odr_hz),
+            "noise_g_per_sample": self._lab.noise_g(self._index[serial], odr_hz),
         }
 
     def block_truth(self, serial: str, block: SampleBlock) -> dict[str, np.ndarray]:

@@ -14,17 +14,20 @@ from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel, dut_time_constant_s
 from accelcal_rig.fit.sfem import distort
-from accelcal_rig.instruments.adxl355 import quantise_g, raw_from_temperature_c, temperature_c_from_raw
+from accelcal_rig.parts.part import AccelerometerPart
+from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.sim.truth import DutTruth, truth_for_serial
 from accelcal_rig.sim.turntable_motion import TurntableMotion
 
 
 class SimulatedDut:
-    """A DUT's place on the fixture, its hidden truth and its own thermal time constant."""
+    """A DUT's part, its place on the fixture, its hidden truth and its own thermal time constant."""
 
-    def __init__(self, serial: str, mount_euler_deg: tuple[float, float, float], fixture_tau_s: float) -> None:
+    def __init__(self, serial: str, mount_euler_deg: tuple[float, float, float], fixture_tau_s: float,
+                 dut_part: AccelerometerPart) -> None:
         self.serial = serial
+        self.part = dut_part
         self.truth: DutTruth = truth_for_serial(serial)
         #: Fixture frame → DUT frame.
         self.fixture_to_dut = Rotation.from_euler("xyz", mount_euler_deg, degrees=True).inv().as_matrix()
@@ -48,12 +51,14 @@ class VirtualLab:
         # One stream per DUT: sensors read concurrently draw their noise in their own order only.
         self.dut_rngs = [np.random.default_rng([seed, index]) for index in range(len(rig.fixture.sensors))]
         self.chamber_noise_c = sim.chamber_noise_c
-        self.noise_density_g_per_rthz = sim.noise_density_ug_per_rthz * 1e-6
         self.kinematics = TurntableKinematics(rig.turntable.axes)
         self.duts = [
-            SimulatedDut(s.serial, s.mount_euler_deg, sim.fixture_time_constant_min * 60.0)
+            SimulatedDut(s.serial, s.mount_euler_deg, sim.fixture_time_constant_min * 60.0, part(s.part))
             for s in rig.fixture.sensors
         ]
+        #: Each DUT's noise density: the rig config's, or its part's.
+        self.noise_density_g_per_rthz = [1e-6 * (d.part.noise_density_ug_per_rthz if sim.noise_density_ug_per_rthz
+                                                 is None else sim.noise_density_ug_per_rthz) for d in self.duts]
         self.thermal = ThermalModel(
             ambient_c=sim.ambient_c,
             ramp_rate_c_per_s=rig.chamber.ramp_rate_c_per_min / 60.0,
@@ -79,9 +84,13 @@ class VirtualLab:
         return self.thermal.dut_c(self.clock.now(), index)
 
     def dut_reading_c(self, index: int) -> float:
-        """What the ADXL355 temperature sensor reports: 12-bit code, datasheet conversion."""
+        """What the DUT's temperature sensor reports, in °C: its code, converted as its data sheet says."""
+        return float(self.duts[index].part.temperature.celsius(self.dut_reading_raw(index)))
+
+    def dut_reading_raw(self, index: int) -> int:
+        """The DUT's temperature sensor's code now (true temperature, read noise, the part's format)."""
         noisy = self.dut_true_c(index) + float(self.dut_rngs[index].normal(0.0, TEMPERATURE_READ_NOISE_C))
-        return float(temperature_c_from_raw(raw_from_temperature_c(noisy)))
+        return int(self.duts[index].part.temperature.raw(noisy))
 
     def unmodelled_g(self, index: int, gravity_g: np.ndarray) -> np.ndarray:
         """What the DUT adds beyond Eq. 1 (zero unless the procedure switches effects on), in g."""
@@ -90,9 +99,10 @@ class VirtualLab:
         nonlinearity = 1e-3 * self.effects.nonlinearity_mg_per_g2 * dut.nonlinearity_signs * gravity_g**2
         return hysteresis + nonlinearity
 
-    def noise_g(self, odr_hz: float) -> float:
-        """Per-sample white noise: density × √(equivalent noise bandwidth of the ODR/4 low-pass, ×π/2)."""
-        return self.noise_density_g_per_rthz * float(np.sqrt(np.pi / 2 * odr_hz / 4))
+    def noise_g(self, index: int, odr_hz: float) -> float:
+        """DUT `index`'s per-sample white noise: density × √(equivalent noise bandwidth of the ODR/4 low-pass,
+        ×π/2)."""
+        return self.noise_density_g_per_rthz[index] * float(np.sqrt(np.pi / 2 * odr_hz / 4))
 
     def dut_samples(self, index: int, t_start_s: float, n_samples: int, odr_hz: float, range_g: int) -> np.ndarray:
         """`n_samples` codes (n, 3) of DUT `index` from `t_start_s` on, at the DUT's state now (temperature
@@ -101,10 +111,10 @@ class VirtualLab:
         temperature = self.dut_true_c(index)
         params = dut.truth.parameters_at(temperature)
         gravity = self.gravity_in_dut(index)
-        noise = self.dut_rngs[index].normal(0.0, self.noise_g(odr_hz), (n_samples, 3))
+        noise = self.dut_rngs[index].normal(0.0, self.noise_g(index, odr_hz), (n_samples, 3))
         raw_g = distort(gravity, params) + self.unmodelled_g(index, gravity) + noise
         dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, params, gravity, temperature))
-        return quantise_g(raw_g, range_g)
+        return dut.part.quantise_g(raw_g, range_g)
 
     def truth_between(self, index: int, t_start_s: float, t_end_s: float) -> dict[str, np.ndarray]:
         """The truth behind the samples of [t_start_s, t_end_s], averaged over the chunks that made them."""

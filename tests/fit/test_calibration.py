@@ -13,7 +13,7 @@ from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import CalibrationRangeWarning, apply, apply_codes, load_calibration, save_calibration
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_campaign
 from accelcal_rig.fit.sfem import distort
-from accelcal_rig.instruments import adxl355
+from accelcal_rig.parts.adxl35x import ADXL355
 from accelcal_rig.plan import schedules
 from accelcal_rig.sim.truth import truth_for_serial
 
@@ -46,7 +46,7 @@ def test_apply_undoes_the_simulated_sensor_at_any_temperature(calibration) -> No
     # reference mode recovers the full vector, not only its norm; the fit's noise is ~10 µg
     assert np.abs(compensated - directions).max() < 1e-4
     np.testing.assert_allclose(np.linalg.norm(compensated, axis=1), 1.0, atol=5e-5)
-    codes = adxl355.quantise_g(raw, 2)
+    codes = ADXL355.quantise_g(raw, 2)
     np.testing.assert_allclose(apply_codes(calibration.sensor(serial), codes, temperatures), compensated, atol=1e-5)
 
 

@@ -11,9 +11,9 @@ from accelcal_rig.config.load import load_rig
 from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.fit.sfem import distort
-from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_driver import Adxl355
 from accelcal_rig.instruments.adxl355_transport import SerialBridge, SpidevBus
+from accelcal_rig.parts.adxl35x import ADXL355
 from accelcal_rig.sim.adxl355_bridge_server import SimulatedBridgeServer
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
@@ -76,8 +76,8 @@ def test_blocks_are_gap_free_and_match_the_truth(sensor) -> None:
     assert block.t_end_s - block.t_start_s == pytest.approx(999 / 125)
     truth = lab.truth_between(1, block.t_start_s, block.t_end_s)
     expected = distort(truth["gravity_g"], truth["parameters"])
-    measured = block.codes_xyz * adxl355.lsb_g(2)
-    noise = lab.noise_g(125.0)
+    measured = block.codes_xyz * ADXL355.lsb_g(2)
+    noise = lab.noise_g(0, 125.0)
     np.testing.assert_allclose(measured.mean(axis=0), expected, atol=5 * noise / np.sqrt(1000))
     # gap-free white noise: no step between drains, lag-1 correlation ≈ 0
     centred = measured - measured.mean(axis=0)

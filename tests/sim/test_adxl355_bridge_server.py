@@ -8,6 +8,7 @@ import pytest
 from accelcal_rig.config.load import load_rig
 from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.instruments import adxl355
+from accelcal_rig.parts.adxl35x import ADXL355
 from accelcal_rig.sim.adxl355_bridge_server import CAPTURE_CAPACITY_SAMPLES, SimulatedAdxl355
 from accelcal_rig.sim.lab import VirtualLab
 from tests.conftest import SIM_RIG
@@ -20,7 +21,7 @@ def part():
     clock = VirtualClock()
     lab = VirtualLab(load_rig(SIM_RIG).model, clock, 5)
     device = SimulatedAdxl355(lab, 0)
-    device.write(adxl355.REG_FILTER, adxl355.odr_code(ODR_HZ))
+    device.write(adxl355.REG_FILTER, ADXL355.odr_code(ODR_HZ))
     device.write(adxl355.REG_POWER_CTL, 0x00)  # measure
     return device, clock
 
@@ -66,9 +67,9 @@ def test_a_capture_delivers_consecutive_samples_in_pieces(part) -> None:
     assert not_yet is None and end_raw is not None  # the end temperature comes with the completing piece
     true_c = device._lab.dut_true_c(0)
     for raw in (start_raw, end_raw):
-        assert float(adxl355.temperature_c_from_raw(raw)) == pytest.approx(true_c, abs=0.3)
+        assert float(ADXL355.temperature.celsius(raw)) == pytest.approx(true_c, abs=0.3)
     codes, _ = adxl355.decode_fifo(first + second)
-    assert codes.shape == (200, 3) and np.abs(codes).max() < adxl355.CODE_MAX
+    assert codes.shape == (200, 3) and np.abs(codes).max() < ADXL355.code_max
     log = [entry for entry in device._lab.duts[0].truth_log if entry[0] >= 50 / ODR_HZ]
     assert [entry[2] for entry in log] == [120, 80]
     assert log[1][0] == pytest.approx(log[0][1])  # the second piece starts where the first ended

@@ -5,7 +5,7 @@ from accelcal_rig.config.load import load_procedure, load_rig
 from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.fit.sfem import distort
-from accelcal_rig.instruments import adxl355
+from accelcal_rig.parts.adxl35x import ADXL355
 from accelcal_rig.sim.devices import build_simulated_rig
 from tests.conftest import REPO, SIM_RIG
 
@@ -26,7 +26,7 @@ def test_block_mean_matches_the_truth_within_the_noise(rig) -> None:
     assert block.codes_xyz.shape == (2000, 3) and block.codes_xyz.dtype == np.int32
     truth = instruments.truth.block_truth(sensor.serial, block)
     expected = distort(truth["gravity_g"], truth["parameters"])
-    lsb = adxl355.lsb_g(2)
+    lsb = ADXL355.lsb_g(2)
     measured = block.codes_xyz * lsb
     noise = sensor.noise_g()
     np.testing.assert_allclose(measured.mean(axis=0), expected, atol=5 * noise / np.sqrt(2000))

@@ -1,0 +1,33 @@
+"""Parts by name: the built-in ones, and any a third-party package registers under the entry-point group
+`accelcal_rig.parts` (an entry point's object is an `AccelerometerPart`)."""
+
+from __future__ import annotations
+
+from functools import cache
+from importlib.metadata import entry_points
+
+from accelcal_rig.parts.adxl35x import ADXL355, ADXL357, ADXL359
+from accelcal_rig.parts.part import AccelerometerPart
+
+ENTRY_POINT_GROUP = "accelcal_rig.parts"
+DEFAULT_PART = "adxl355"
+_BUILT_IN = {part.name: part for part in (ADXL355, ADXL357, ADXL359)}
+
+
+@cache
+def known_parts() -> dict[str, AccelerometerPart]:
+    """Every part by name; a built-in name cannot be taken over by a plug-in."""
+    parts = {}
+    for entry in entry_points(group=ENTRY_POINT_GROUP):
+        part = entry.load()
+        if isinstance(part, AccelerometerPart) and part.name == entry.name:
+            parts[entry.name] = part
+    return {**parts, **_BUILT_IN}
+
+
+def part(name: str) -> AccelerometerPart:
+    """The part called `name`; KeyError names the ones known."""
+    parts = known_parts()
+    if name not in parts:
+        raise KeyError(f"unknown part {name!r} (known: {', '.join(sorted(parts))})")
+    return parts[name]
