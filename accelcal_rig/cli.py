@@ -379,7 +379,8 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
              overwrite: bool, resume: bool) -> int:
     """Run or resume under the CLI's signal handling and logging; print the summary. The campaign is
     locked before anything of it changes, the log included."""
-    from accelcal_rig.engine.session import NothingToResume, run_campaign
+    from accelcal_rig.assembly import run_campaign
+    from accelcal_rig.engine.session import NothingToResume
     from accelcal_rig.store.lock import campaign_lock
 
     calibration = args.calibration or output.with_suffix(".calibration.yaml")
@@ -441,26 +442,14 @@ def _cmd_repair(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
+    from accelcal_rig.assembly import connected
     from accelcal_rig.config.load import load_rig, with_faults
-    from accelcal_rig.core.clock import RealClock
     from accelcal_rig.engine.check import check_lines
-    from accelcal_rig.instruments.connect import configured_endpoints, connect_rig
-    from accelcal_rig.sim.wire_rig import SimulatedRig
 
     rig = with_faults(load_rig(args.rig), args.faults)
-    clock = RealClock()
-    simulated = SimulatedRig(rig.model, clock, 0) if args.dry_run else None
-    endpoints = simulated.start() if simulated else configured_endpoints(rig)
-    try:
-        instruments = connect_rig(rig.model, endpoints, clock)
-        try:
-            for line in check_lines(instruments):
-                print(line, flush=True)
-        finally:
-            instruments.close()
-    finally:
-        if simulated:
-            simulated.stop()
+    with connected(rig, dry_run=args.dry_run) as instruments:
+        for line in check_lines(instruments):
+            print(line, flush=True)
     print(f"rig {rig.model.name}: every instrument answered as configured")
     return 0
 
@@ -468,21 +457,19 @@ def _cmd_check(args: argparse.Namespace) -> int:
 def _cmd_sim(args: argparse.Namespace) -> int:
     import threading
 
+    from accelcal_rig.assembly import served_rig
     from accelcal_rig.config.load import load_rig, with_faults
     from accelcal_rig.core.clock import RealClock
-    from accelcal_rig.sim.wire_rig import SimulatedRig
 
     rig = with_faults(load_rig(args.rig), args.faults)
-    simulated = SimulatedRig(rig.model, RealClock(), args.seed)
-    simulated.start()
     stop = threading.Event()
     previous = {signum: signal.signal(signum, lambda *_: stop.set()) for signum in (signal.SIGINT, signal.SIGTERM)}
     try:
-        print(json.dumps(simulated.describe()), flush=True)
-        while not stop.wait(0.5):
-            pass
+        with served_rig(rig.model, RealClock(), args.seed) as simulated:
+            print(json.dumps(simulated.describe()), flush=True)
+            while not stop.wait(0.5):
+                pass
     finally:
-        simulated.stop()
         for signum, handler in previous.items():
             signal.signal(signum, handler)
     print("rig sim: stopped", file=sys.stderr)

@@ -45,14 +45,17 @@ def cli_run(output: Path, seed: int) -> tuple[float, float, dict]:
 
 
 def campaign_only(output: Path, seed: int, in_process: bool) -> float:
-    from accelcal_rig.engine.session import prepare, run_campaign
-    from accelcal_rig.sim.devices import build_simulated_rig
+    from accelcal_rig.assembly import in_process_simulation, run_campaign
+    from accelcal_rig.engine import session
 
-    prepared = prepare(PAPER)
+    prepared = session.prepare(PAPER)
     start = time.perf_counter()
-    run_campaign(prepared, output, dry_run=True, seed=seed, overwrite=True,
-                 calibration=output.with_suffix(".calibration.yaml"),
-                 build_instruments=build_simulated_rig if in_process else None)
+    calibration = output.with_suffix(".calibration.yaml")
+    if in_process:
+        session.run_campaign(prepared, output, in_process_simulation(prepared), seed=seed, overwrite=True,
+                             calibration=calibration)
+    else:
+        run_campaign(prepared, output, dry_run=True, seed=seed, overwrite=True, calibration=calibration)
     return time.perf_counter() - start
 
 

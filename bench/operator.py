@@ -17,9 +17,10 @@ from pathlib import Path
 import h5py
 from quiet import silence_campaign_log  # bench/quiet.py, beside this script
 
+from accelcal_rig.assembly import run_campaign
 from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.engine.estimate import estimate_duration
-from accelcal_rig.engine.session import prepare, run_campaign
+from accelcal_rig.engine.session import prepare
 from accelcal_rig.report.live import ProgressLines
 
 REPO = Path(__file__).resolve().parent.parent

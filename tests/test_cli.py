@@ -189,7 +189,8 @@ def test_rig_fit_refuses_a_campaign_still_running(paper_campaign: Path, tmp_path
 
 
 def test_rig_fit_on_a_file_without_poses_is_one_line(write, workdir: Path, capsys) -> None:
-    from accelcal_rig.engine.session import prepare, run_campaign
+    from accelcal_rig.assembly import run_campaign
+    from accelcal_rig.engine.session import prepare
     from accelcal_rig.errors import CampaignAborted
 
     campaign = workdir / "empty.h5"
@@ -209,13 +210,13 @@ def test_rig_fit_on_a_file_without_poses_is_one_line(write, workdir: Path, capsy
 
 
 def test_a_signal_before_the_campaign_starts_is_one_line_and_leaves_no_file(write, capsys, monkeypatch) -> None:
-    from accelcal_rig.engine import session
+    from accelcal_rig import assembly
     from accelcal_rig.engine.campaign import TerminationRequested
 
     def terminated(*_):
         raise TerminationRequested()
 
-    monkeypatch.setattr(session, "connect_rig", terminated)  # SIGTERM while connecting to the instruments
+    monkeypatch.setattr(assembly, "connect_rig", terminated)  # SIGTERM while connecting to the instruments
     path = write("tiny.yaml", TINY_PROCEDURE)
     err = one_line_error(capsys, ["run", str(path), "--dry-run", "-o", str(path.with_suffix(".h5"))], 130)
     assert "interrupted before the campaign started" in err

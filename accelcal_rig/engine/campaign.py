@@ -21,18 +21,17 @@ from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.core.signals import signals_deferred
 from accelcal_rig.core.waits import MOVE_POLL_S, wait_until
 from accelcal_rig.engine.acquisition import acquire_together
+from accelcal_rig.engine.connection import GuardedRig
 from accelcal_rig.engine.estimate import DurationEstimate
 from accelcal_rig.engine.events import LOGGER, EventLog
 from accelcal_rig.engine.notify import Notification, Notifier
 from accelcal_rig.engine.progress import COOLDOWN_PHASES, PHASES, Progress, ProgressListener
 from accelcal_rig.engine.resume import ResumePoint
-from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.engine.safe_state import apply_safe_state
 from accelcal_rig.engine.soak import SoakDetector
 from accelcal_rig.engine.states import ACTIVE_STATES, State, StateMachine
 from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, TransientInstrumentError, WaitTimeout
-from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity, RigInstruments, SampleBlock
-from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable
+from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity, SampleBlock
 from accelcal_rig.plan.compile import Plan, PlanStep, setpoint_label
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.records import DutPoseRecord, PoseRecord, SoakTrace
@@ -79,17 +78,15 @@ class CampaignSummary:
 
 
 class CampaignRunner:
-    def __init__(self, procedure: Procedure, rig: RigConfig, plan: Plan, instruments: RigInstruments,
+    def __init__(self, procedure: Procedure, rig: RigConfig, plan: Plan, guarded: GuardedRig,
                  writer: CampaignWriter, clock: Clock, events: EventLog, fit_stage: FitStage | None = None,
                  resume: ResumePoint | None = None, audience: Audience = Audience()) -> None:
         self.procedure = procedure
         self.rig = rig
         self.plan = plan
-        # Transient failures are retried below the safety limits, so a retried write is checked too.
-        self.retrier = Retrier(rig.retry, clock, events)
-        self.chamber = LimitedChamber(self.retrier.retried(instruments.chamber), rig.chamber)
-        self.turntable = LimitedTurntable(self.retrier.retried(instruments.turntable), rig.turntable)
-        self.sensors = [self.retrier.retried(s) for s in instruments.sensors]
+        self.retrier = guarded.retrier
+        instruments = guarded.instruments
+        self.chamber, self.turntable, self.sensors = instruments.chamber, instruments.turntable, instruments.sensors
         self.truth = instruments.truth
         self.writer = writer
         self.clock = clock

@@ -1,10 +1,9 @@
-"""From files to a finished campaign: validate, compile, connect, create the file, run."""
+"""From files to a finished campaign: validate, compile, connect (through the rig connector given), create
+the file, run."""
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -21,8 +20,8 @@ from accelcal_rig.config.load import (
 )
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.core.clock import Clock, RealClock, VirtualClock
 from accelcal_rig.engine.campaign import Audience, CampaignRunner, CampaignSummary, FitStage
+from accelcal_rig.engine.connection import ConnectedRig, RigConnector
 from accelcal_rig.engine.estimate import estimate_duration
 from accelcal_rig.engine.events import LOGGER, EventLog
 from accelcal_rig.engine.notify import Notifier
@@ -30,11 +29,9 @@ from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.resume import ResumePoint, check_same_campaign
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
-from accelcal_rig.instruments.connect import configured_endpoints, connect_rig
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
-from accelcal_rig.sim.wire_rig import SimulatedRig
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.lock import campaign_lock
 from accelcal_rig.store.paths import journal_path
@@ -102,44 +99,38 @@ class RunResult:
     problems: tuple[str, ...] = ()
 
 
-#: Connects the rig on the campaign's clock: (rig config, procedure, clock, seed) → instruments.
-InstrumentFactory = Callable[[RigConfig, Procedure, Clock, int], RigInstruments]
+def run_campaign(prepared: PreparedCampaign, output: Path, connect: RigConnector, *, seed: int, overwrite: bool,
+                 calibration: Path | None = None, resume: bool = False,
+                 progress: ProgressListener | None = None) -> RunResult:
+    """Run the whole campaign into `output` on the rig `connect` connects. Raises CampaignAborted after
+    reaching the safe state.
 
-
-def run_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, seed: int, overwrite: bool,
-                 calibration: Path | None = None, build_instruments: InstrumentFactory | None = None,
-                 resume: bool = False, progress: ProgressListener | None = None) -> RunResult:
-    """Run the whole campaign into `output`. Raises CampaignAborted after reaching the safe state.
-
-    The instruments: with `build_instruments`, whatever it builds (a test double); with `dry_run`, the
-    real drivers talking to wire-level simulators of this rig on a virtual clock; otherwise the real
-    drivers at the rig config's endpoints, in real time. With `calibration`, the fit stage runs once the
-    rig is safe and writes the calibration file there. With `resume` and an existing `output`, the
-    campaign in it continues (see resume_campaign); without one, a new campaign starts. `progress` gets a
-    snapshot at every transition, temperature poll and pose; the rig config's `notify` is sent events.
+    With `calibration`, the fit stage runs once the rig is safe and writes the calibration file there.
+    With `resume` and an existing `output`, the campaign in it continues (see resume_campaign); without
+    one, a new campaign starts. `progress` gets a snapshot at every transition, temperature poll and pose;
+    the rig config's `notify` is sent events.
     """
     wall_start = time.perf_counter()
     if resume and (output.exists() or journal_path(output).exists()):
-        return resume_campaign(prepared, output, dry_run=dry_run, calibration=calibration,
-                               build_instruments=build_instruments, progress=progress)
-    with _connected(prepared, dry_run, seed, build_instruments) as (instruments, clock):
-        writer = _create_file(prepared, output, instruments, clock, dry_run=dry_run, seed=seed, overwrite=overwrite)
-        return _run(prepared, output, writer, instruments, clock, None, calibration, wall_start, progress)
+        return resume_campaign(prepared, output, connect, calibration=calibration, progress=progress)
+    with connect(seed) as rig:
+        writer = _create_file(prepared, output, rig, dry_run=connect.dry_run, seed=seed, overwrite=overwrite)
+        return _run(prepared, output, writer, rig, None, calibration, wall_start, progress)
 
 
 class NothingToResume(Exception):
     """The campaign in the file is complete."""
 
 
-def resume_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, calibration: Path | None = None,
-                    build_instruments: InstrumentFactory | None = None,
-                    progress: ProgressListener | None = None) -> RunResult:
+def resume_campaign(prepared: PreparedCampaign, output: Path, connect: RigConnector, *,
+                    calibration: Path | None = None, progress: ProgressListener | None = None) -> RunResult:
     """Continue the campaign in `output`: the same procedure and rig (refused otherwise, before anything is
     touched), the journal mended and the campaign file rebuilt from it, the rig made safe first if the
     last run died, then a fresh soak at the first setpoint with poses missing and on from the first pose
     not stored."""
     wall_start = time.perf_counter()
     stored = load_campaign(output)
+    dry_run = connect.dry_run
     check_same_campaign(output, stored, prepared.procedure, prepared.rig, prepared.plan, dry_run)
     if stored.state == "done" and stored.poses_planned == len(stored.poses):
         raise NothingToResume("; ".join([f"{output}: the campaign is complete: nothing to resume",
@@ -148,16 +139,16 @@ def resume_campaign(prepared: PreparedCampaign, output: Path, *, dry_run: bool, 
     try:
         # Noise of a resumed dry run is new noise (the same sensors, not a replay of the first run).
         seed = int(stored.attrs.get("seed", 0)) + 1000 * (reopened.run - 1)
-        with _connected(prepared, dry_run, seed, build_instruments, reopened.clock_now_s) as (instruments, clock):
-            writer.record_instruments(_instrument_info(instruments))
+        with connect(seed, reopened.clock_now_s) as rig:
+            writer.record_instruments(_instrument_info(rig.instruments))
             point = ResumePoint(frozenset(writer.stored_step_keys()), reopened.previous_state in ("created", "running"),
                                 reopened.run)
-            events = EventLog(clock, writer)
+            events = EventLog(rig.clock, writer)
             events.info("resume", f"run {reopened.run} resumes after {reopened.poses_stored} stored poses (the last run "
                                   f"left the file {reopened.previous_state!r})")
             for repair in reopened.repairs:
                 events.warning("resume", repair)
-            return _run(prepared, output, writer, instruments, clock, point, calibration, wall_start, progress)
+            return _run(prepared, output, writer, rig, point, calibration, wall_start, progress)
     finally:
         _close(writer)
 
@@ -176,38 +167,6 @@ def _finish_complete(prepared: PreparedCampaign, output: Path, stored: Campaign,
     return done
 
 
-@contextmanager
-def _connected(prepared: PreparedCampaign, dry_run: bool, seed: int, build_instruments: InstrumentFactory | None,
-               clock_start_s: float = 0.0) -> Iterator[tuple[RigInstruments, Clock]]:
-    rig, procedure = prepared.rig, prepared.procedure.model
-    stop_simulators: list[Callable[[], None]] = []
-    clock: Clock
-    if build_instruments is not None:
-        clock = VirtualClock(clock_start_s)
-        instruments = build_instruments(rig.model, procedure, clock, seed)
-    elif dry_run:
-        clock = VirtualClock(clock_start_s)
-        simulated = SimulatedRig(rig.model, clock, seed, procedure.simulation)
-        endpoints = simulated.start()
-        stop_simulators.append(simulated.stop)
-        try:
-            instruments = connect_rig(rig.model, endpoints, clock)
-        except BaseException:
-            simulated.stop()
-            raise
-        instruments.truth = simulated.truth
-    else:
-        clock = RealClock(clock_start_s)
-        instruments = connect_rig(rig.model, configured_endpoints(rig), clock)
-    try:
-        yield instruments, clock
-    finally:
-        for failure in instruments.close():
-            LOGGER.error(failure)
-        for stop in stop_simulators:
-            stop()
-
-
 def _instrument_info(instruments: RigInstruments) -> dict[str, dict[str, str]]:
     return {
         "chamber": {"driver": type(instruments.chamber).__name__, "endpoint": instruments.chamber.endpoint},
@@ -215,9 +174,9 @@ def _instrument_info(instruments: RigInstruments) -> dict[str, dict[str, str]]:
     }
 
 
-def _create_file(prepared: PreparedCampaign, output: Path, instruments: RigInstruments, clock: Clock, *,
+def _create_file(prepared: PreparedCampaign, output: Path, connected: ConnectedRig, *,
                  dry_run: bool, seed: int, overwrite: bool) -> CampaignWriter:
-    rig = prepared.rig
+    rig, instruments, clock = prepared.rig, connected.instruments, connected.clock
     procedure = prepared.procedure.model
     acquisition = procedure.acquisition
     mounts = {s.serial: s for s in rig.model.fixture.sensors}
@@ -263,17 +222,18 @@ def _close(writer: CampaignWriter) -> tuple[str, ...]:
     return problems
 
 
-def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, instruments: RigInstruments,
-         clock: Clock, resume: ResumePoint | None, calibration: Path | None, wall_start: float,
+def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, rig_connected: ConnectedRig,
+         resume: ResumePoint | None, calibration: Path | None, wall_start: float,
          progress: ProgressListener | None) -> RunResult:
     procedure, rig = prepared.procedure.model, prepared.rig.model
     notify = rig.notify
     notifier = Notifier(notify) if notify.webhook_url or notify.command else None
     problems: tuple[str, ...] = ()
     try:
+        clock = rig_connected.clock
         events = EventLog(clock, writer)
         estimate = estimate_duration(procedure, rig, prepared.plan) if progress or notifier else None
-        runner = CampaignRunner(procedure, rig, prepared.plan, instruments, writer, clock, events,
+        runner = CampaignRunner(procedure, rig, prepared.plan, rig_connected.guarded(events), writer, clock, events,
                                 fit_stage=_fit_stage(procedure, output, calibration)
                                 if calibration and procedure.fit.mode != "none" else None,
                                 resume=resume, audience=Audience(progress, estimate, notifier, str(output)))

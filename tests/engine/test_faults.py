@@ -8,7 +8,8 @@ from pathlib import Path
 import h5py
 import pytest
 
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.assembly import WiredRig
+from accelcal_rig.engine.session import prepare, run_campaign
 from accelcal_rig.errors import CampaignAborted
 from accelcal_rig.sim.wire_rig import SimulatedRig
 from accelcal_rig.store.read import load_campaign
@@ -30,26 +31,16 @@ def fast_rig(workdir: Path) -> None:
 
 def run_wired(write, workdir: Path, faults: str) -> tuple[Path, SimulatedRig, CampaignAborted | None]:
     """A dry run through the wires with `faults`; returns the simulated rig to inspect its last commands."""
-    from accelcal_rig.engine import session
-
     fast_rig(workdir)
     prepared = prepare(write("tiny.yaml", TINY_PROCEDURE), faults=faults)
-    kept: dict[str, SimulatedRig] = {}
-    real = session.SimulatedRig
-
-    def keep(*args, **kwargs):
-        kept["rig"] = real(*args, **kwargs)
-        return kept["rig"]
-
+    wired = WiredRig(prepared.rig, prepared.procedure.model.simulation, dry_run=True)
     output, error = workdir / "run.h5", None
-    session.SimulatedRig = keep
     try:
-        session.run_campaign(prepared, output, dry_run=True, seed=2, overwrite=False)
+        run_campaign(prepared, output, wired, seed=2, overwrite=False)
     except CampaignAborted as exc:
         error = exc
-    finally:
-        session.SimulatedRig = real
-    return output, kept["rig"], error
+    assert wired.served is not None
+    return output, wired.served, error
 
 
 def test_transient_faults_are_retried_and_every_pose_is_stored_once(write, workdir: Path) -> None:

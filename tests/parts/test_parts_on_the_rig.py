@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 import yaml
 
+from accelcal_rig.assembly import run_campaign
 from accelcal_rig.engine.campaign import CampaignAborted
-from accelcal_rig.engine.session import prepare, run_campaign
+from accelcal_rig.engine.session import prepare
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.adxl35x import ADXL357, ADXL359
 from accelcal_rig.store.read import load_campaign

@@ -10,8 +10,9 @@ from pathlib import Path
 
 import pytest
 
+from accelcal_rig.assembly import run_campaign
 from accelcal_rig.cli import main
-from accelcal_rig.engine.session import prepare, run_campaign
+from accelcal_rig.engine.session import prepare
 from accelcal_rig.errors import CampaignAborted
 from accelcal_rig.report.html_report import FIGURES, write_report
 from tests.conftest import TINY_PROCEDURE

@@ -6,7 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from accelcal_rig.engine.session import prepare, run_campaign
+from accelcal_rig.assembly import run_campaign
+from accelcal_rig.engine.session import prepare
 from tests.conftest import TINY_PROCEDURE
 
 
