@@ -64,17 +64,17 @@ class WiredRig:
     @contextmanager
     def __call__(self, seed: int, clock_start_s: float = 0.0) -> Iterator[AssembledRig]:
         if not self.dry_run:
-            clock = RealClock(clock_start_s)
-            with _closing(AssembledRig(self.rig.model, connect_rig(self.rig.model, configured_endpoints(self.rig),
-                                                                   clock), clock)) as rig:
+            real_time = RealClock(clock_start_s)
+            instruments = connect_rig(self.rig.model, configured_endpoints(self.rig), real_time)
+            with _closing(AssembledRig(self.rig.model, instruments, real_time)) as rig:
                 yield rig
             return
-        clock = VirtualClock(clock_start_s)
-        with served_rig(self.rig.model, clock, seed, self.effects) as simulated:
+        virtual = VirtualClock(clock_start_s)
+        with served_rig(self.rig.model, virtual, seed, self.effects) as simulated:
             self.served = simulated
-            instruments = connect_rig(self.rig.model, simulated.endpoints, clock)
+            instruments = connect_rig(self.rig.model, simulated.endpoints, virtual)
             instruments.truth = simulated.truth
-            with _closing(AssembledRig(self.rig.model, instruments, clock)) as rig:
+            with _closing(AssembledRig(self.rig.model, instruments, virtual)) as rig:
                 yield rig
 
 

@@ -479,7 +479,8 @@ def _cmd_sim(args: argparse.Namespace) -> int:
 def _cmd_fit(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
+    from accelcal_rig.fit.campaign_fit import fit_and_save, summary_line
+    from accelcal_rig.fit.recorded_options import recorded_options
     from accelcal_rig.store.lock import holder
     from accelcal_rig.store.read import usable_campaign
 
@@ -489,15 +490,10 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     campaign = usable_campaign(args.campaign)
     for note in campaign.notes:
         print(f"rig: warning: {args.campaign}: {note}", file=sys.stderr)
-    attrs = campaign.attrs
-    options = FitOptions(
-        mode=args.mode or str(attrs.get("fit_mode", "reference")),
-        degree=args.degree if args.degree is not None else int(attrs.get("polynomial_degree", 3)),
-        free=args.parameters or str(attrs.get("fit_parameters", "all")),
-        out_of_range=args.out_of_range or str(attrs.get("fit_out_of_range", "clamp")),
-        temperature_model=args.temperature_model or str(attrs.get("fit_temperature_model", "per-setpoint")),
-    )
-    if options.mode == "none":
+    options = recorded_options(campaign.attrs, str(args.campaign), mode=args.mode, degree=args.degree,
+                               free=args.parameters, out_of_range=args.out_of_range,
+                               temperature_model=args.temperature_model)
+    if options is None:
         raise ConfigError(f"{args.campaign}: its procedure asked for no fit (fit.mode: none); choose one with "
                           "--mode reference or --mode norm-only")
     if args.output.is_dir():
@@ -654,6 +650,7 @@ def _analyze_positions(args: argparse.Namespace) -> int:
     from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
     from accelcal_rig.analysis.positions import PAPER_SIZES, floor_mg, score_subsets, summarise
     from accelcal_rig.fit.calibration import plain
+    from accelcal_rig.fit.recorded_options import NO_FIT, recorded_options, requested_mode
     from accelcal_rig.store.read import load_campaign
 
     try:
@@ -666,9 +663,11 @@ def _analyze_positions(args: argparse.Namespace) -> int:
         _check_figure_path(args.figure)
     setpoint, duts, _ = poses_at_setpoint(args.campaign, args.setpoint)
     attrs = load_campaign(args.campaign).attrs
-    recorded = str(attrs.get("fit_mode", "reference"))
-    mode = args.mode or ("reference" if recorded == "none" else recorded)  # measure-only: the table's reference
-    free = str(attrs.get("fit_parameters", "all"))
+    recorded = requested_mode(attrs)
+    mode = args.mode or ("reference" if recorded == NO_FIT else recorded)  # measure-only: the table's reference
+    options = recorded_options(attrs, str(args.campaign), mode=mode)
+    assert options is not None
+    free = options.free
     rows, floors = [], {}
     for serial, poses in duts.items():
         scores = score_subsets(poses, sizes, mode, free, args.subsets, np.random.default_rng(args.seed))  # type: ignore[arg-type]

@@ -33,7 +33,7 @@ def temporary_beside(path: Path) -> Path:
 
 def unused_name(path: Path, why: str) -> Path:
     """`<path>.<why>-20261201T081500` (with `-2`, `-3`, … if taken): where a copy set aside is kept."""
-    stamp = dt.datetime.now(dt.timezone.utc).strftime("%Y%m%dT%H%M%S")
+    stamp = dt.datetime.now(dt.UTC).strftime("%Y%m%dT%H%M%S")
     for count in itertools.count(1):
         candidate = path.with_name(f"{path.name}.{why}-{stamp}{'' if count == 1 else f'-{count}'}")
         if not os.path.lexists(candidate):

@@ -94,7 +94,7 @@ def report(kind: str, results: list[tuple[str, Outcome, str]]) -> int:
     walls = sorted(o.wall_s for _, o, _ in results)
     rss = max(o.max_rss_bytes for _, o, _ in results)
     codes = {c: sum(o.code == c for _, o, _ in results) for c in sorted({o.code for _, o, _ in results}, key=str)}
-    for what, o, why in failed:
+    for what, _, why in failed:
         print(f"FAIL {what}: {why}", flush=True)
     print(f"{kind}: {len(results) - len(failed)}/{len(results)} runs passed; exit codes {codes}; wall median "
           f"{walls[len(walls) // 2]:.2f} s, max {walls[-1]:.2f} s; peak memory {rss / 2**20:.0f} MB")

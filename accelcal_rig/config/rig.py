@@ -9,9 +9,9 @@ import numpy as np
 from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
 
 from accelcal_rig.config.bounds import STRICT, AngleDeg, Baudrate, TemperatureC, TimeoutS
-from accelcal_rig.instruments.chamber_registers import ChamberRegisterMap, register_map
-from accelcal_rig.instruments.turntable_protocol import TurntableProtocol, turntable_protocol
 from accelcal_rig.parts.registry import DEFAULT_PART, part
+from accelcal_rig.protocols.chamber_registers import ChamberRegisterMap, register_map
+from accelcal_rig.protocols.turntable_line import TurntableProtocol, turntable_protocol
 
 #: A year of campaign time, in minutes: the furthest a simulated fault may be scheduled.
 _YEAR_MIN = 365 * 24 * 60.0

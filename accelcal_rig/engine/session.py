@@ -27,8 +27,9 @@ from accelcal_rig.engine.events import LOGGER, EventLog
 from accelcal_rig.engine.notify import Notifier
 from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.resume import ResumePoint, check_same_campaign
-from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save, summary_line
+from accelcal_rig.fit.campaign_fit import fit_and_save, summary_line
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
+from accelcal_rig.fit.recorded_options import options_attrs, recorded_options
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
@@ -192,9 +193,7 @@ def _create_file(prepared: PreparedCampaign, output: Path, connected: ConnectedR
     attrs = {"procedure_name": procedure.name, "procedure_path": str(prepared.procedure.path.resolve()),
              "rig_name": rig.model.name, "rig_path": str(rig.path.resolve()), "dry_run": dry_run, "seed": seed,
              "clock": clock.kind, "samples_per_pose": acquisition.samples_per_pose,
-             "fit_mode": procedure.fit.mode, "polynomial_degree": procedure.fit.polynomial_degree,
-             "fit_parameters": procedure.fit.parameters, "fit_out_of_range": procedure.fit.out_of_range,
-             "fit_temperature_model": procedure.fit.temperature_model}
+             **_fit_attrs(procedure)}
     return CampaignWriter.create(
         output, {"attrs": attrs, "procedure_yaml": prepared.procedure.text, "rig_yaml": rig.text,
                  "plan": _stored_plan(prepared.plan), "duts": duts, "instruments": _instrument_info(instruments),
@@ -247,10 +246,14 @@ def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, rig_c
     return RunResult(summary, time.perf_counter() - wall_start, output, problems)
 
 
+def _fit_attrs(procedure: Procedure) -> dict[str, object]:
+    fit = procedure.fit
+    return options_attrs(fit.mode, fit.polynomial_degree, fit.parameters, fit.out_of_range, fit.temperature_model)
+
+
 def _fit_stage(procedure: Procedure, output: Path, calibration: Path) -> FitStage:
-    options = FitOptions(mode=procedure.fit.mode, degree=procedure.fit.polynomial_degree,  # type: ignore[arg-type]
-                         free=procedure.fit.parameters, out_of_range=procedure.fit.out_of_range,
-                         temperature_model=procedure.fit.temperature_model)
+    options = recorded_options(_fit_attrs(procedure), f"{output}: its procedure's fit")
+    assert options is not None, "a procedure without a fit has no fit stage"
 
     def stage(campaign: Campaign) -> str:
         _, report = fit_and_save(campaign, output, calibration, options)

@@ -26,7 +26,7 @@ class ThermalModel:
     degree: int
     warnings: list[str] = field(default_factory=list)
 
-    def scaled(self, temperature_c: np.ndarray) -> np.ndarray:
+    def scaled(self, temperature_c: np.ndarray | float) -> np.ndarray:
         low, high = self.domain_c
         return (np.asarray(temperature_c, dtype=float) - 0.5 * (low + high)) / (0.5 * (high - low))
 

@@ -62,7 +62,7 @@ class CsvLayout:
         names = [n.strip() for n in spec.split(",")]
         if len(names) not in (4, 5) or not all(names):
             raise ConfigError(f"--columns: {spec!r}: expected time,x,y,z or time,x,y,z,temperature column names")
-        return cls(*names[:4], names[4] if len(names) == 5 else None, **options)  # type: ignore[arg-type]
+        return cls(*names[:4], names[4] if len(names) == 5 else None, **options)  # type: ignore[arg-type, call-arg]
 
 
 def read_csv_recording(path: Path, layout: CsvLayout) -> Recording:

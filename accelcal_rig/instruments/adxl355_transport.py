@@ -23,7 +23,7 @@ firmware can.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Protocol
+from typing import Any, Protocol
 
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments import adxl355
@@ -168,8 +168,8 @@ class SpidevBus:
 
     capture_capacity_samples = 0
 
-    def __init__(self, device: object, endpoint: str) -> None:
-        self._device = device
+    def __init__(self, device: Any, endpoint: str) -> None:
+        self._device = device  # a spidev.SpiDev (untyped)
         self.endpoint = endpoint
 
     @classmethod

@@ -16,8 +16,8 @@ from pymodbus.client.base import ModbusBaseSyncClient
 from pymodbus.exceptions import ModbusException
 
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
-from accelcal_rig.instruments.chamber_registers import ChamberRegisterMap
 from accelcal_rig.instruments.retrying import RetryCall
+from accelcal_rig.protocols.chamber_registers import ChamberRegisterMap
 
 #: Readings outside this are not a chamber's air: the map or word order must be wrong.
 PLAUSIBLE_C = (-100.0, 300.0)
@@ -115,10 +115,10 @@ class ModbusChamber:
         m = self.registers
         if m.encoding == "float32":
             words = self._read(address, 2)
-            return float(self._client.convert_from_registers(words, self._client.DATATYPE.FLOAT32,
-                                                             word_order=m.word_order))
+            return _number(self._client.convert_from_registers(words, self._client.DATATYPE.FLOAT32,
+                                                               word_order=m.word_order))
         raw = self._client.convert_from_registers(self._read(address, 1), self._client.DATATYPE.INT16)
-        return float(raw) / 10**m.decimals
+        return _number(raw) / 10**m.decimals
 
     def _encode(self, temperature_c: float) -> list[int]:
         m = self.registers
@@ -172,3 +172,10 @@ class ModbusChamber:
 
     def _error(self, message: str) -> InstrumentError:
         return InstrumentError(f"chamber ({self.endpoint}): {message}")
+
+
+def _number(value: object) -> float:
+    """A single register value as pymodbus converts it (typed as any of its conversions' results)."""
+    if not isinstance(value, int | float):
+        raise TypeError(f"expected one number from the register conversion, got {value!r}")
+    return float(value)

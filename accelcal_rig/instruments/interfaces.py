@@ -107,9 +107,9 @@ class RigInstruments:
     def close(self) -> list[str]:
         """Release every connection, each in its own guard; return the failures, one line each."""
         failures = []
-        for name, device in [("chamber", self.chamber), ("turntable", self.turntable)] + [
-            (f"sensor {s.serial}", s) for s in self.sensors
-        ]:
+        devices: list[tuple[str, Chamber | Turntable | Accelerometer]] = [
+            ("chamber", self.chamber), ("turntable", self.turntable), *((f"sensor {s.serial}", s) for s in self.sensors)]
+        for name, device in devices:
             try:
                 device.close()
             except Exception as exc:  # noqa: BLE001 - one stuck port must not keep the others open

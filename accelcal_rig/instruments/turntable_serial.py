@@ -9,7 +9,7 @@ import numpy as np
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.line_port import LinePort
 from accelcal_rig.instruments.retrying import RetryCall
-from accelcal_rig.instruments.turntable_protocol import Command, TurntableProtocol
+from accelcal_rig.protocols.turntable_line import Command, TurntableProtocol
 
 
 class SerialTurntable:

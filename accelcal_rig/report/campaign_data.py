@@ -16,6 +16,7 @@ import numpy as np
 from accelcal_rig.config.procedure import SoakCriterion
 from accelcal_rig.config.yaml_lines import parse_yaml_text
 from accelcal_rig.fit.campaign_fit import DutFitResult, FitOptions, fit_dut
+from accelcal_rig.fit.recorded_options import recorded_options
 from accelcal_rig.store.read import DutPoses, campaign_status, load_campaign, read_dut_poses
 from accelcal_rig.store.records import StoredEvent
 
@@ -47,7 +48,7 @@ class CampaignData:
     procedure_path: str
     rig_name: str
     soak_band_c: float                # the procedure's soak band
-    options: FitOptions
+    options: FitOptions | None       # None: the procedure measures only (fit.mode: none)
     duts: dict[str, DutReport]
     soaks: list[SoakRecord]
     events: list[StoredEvent]
@@ -62,17 +63,14 @@ def read_campaign_data(path: Path) -> CampaignData:
     procedure = parse_yaml_text(campaign.header.procedure_yaml, f"{path}: its stored procedure")
     soak = procedure.get("soak") if isinstance(procedure, dict) else None
     band_c = float(soak.get("band_c", SoakCriterion().band_c)) if isinstance(soak, dict) else SoakCriterion().band_c
-    options = FitOptions(mode=str(attrs.get("fit_mode", "reference")), degree=int(attrs.get("polynomial_degree", 3)),  # type: ignore[arg-type]
-                         free=str(attrs.get("fit_parameters", "all")),  # type: ignore[arg-type]
-                         out_of_range=str(attrs.get("fit_out_of_range", "clamp")),  # type: ignore[arg-type]
-                         temperature_model=str(attrs.get("fit_temperature_model", "per-setpoint")))  # type: ignore[arg-type]
+    options = recorded_options(attrs, str(path))
     pose_numbers = campaign.pose_column("pose_number")
     damaged = campaign.unusable_reasons()
     duts, reasons = {}, []
     for serial in campaign.serials:
         poses = read_dut_poses(campaign, serial)
         fit = None
-        if options.mode == "none":
+        if options is None:
             reasons.append("the procedure measures only (fit.mode: none)")
         elif damaged:
             reasons.append(f"damaged measurements: {damaged[0]}")

@@ -114,7 +114,7 @@ def ellipsoid(data: CampaignData, path: Path) -> Path:
     rows = max((len(fitted) + 1) // 2, 1)
     figure = plt.figure(figsize=(16, 4.2 * rows), constrained_layout=True)
     sphere = _sphere_grid()
-    with_reference = data.options.mode == "reference"
+    with_reference = data.options is not None and data.options.mode == "reference"
     for index, serial in enumerate(fitted):
         dut = data.duts[serial]
         assert dut.fit is not None
@@ -160,7 +160,7 @@ def parameters(data: CampaignData, path: Path) -> Path:
         curve = fit.thermal.parameters_at(dense, "extrapolate")
         middle = fit.thermal.parameters_at(0.5 * sum(fit.thermal.domain_c), "extrapolate")
         truth = dut.truth_by_setpoint
-        if truth is not None and data.options.mode == "norm-only":
+        if truth is not None and data.options is not None and data.options.mode == "norm-only":
             truth = norm_only_gauge(truth)
         for k, name in enumerate(PARAMETER_NAMES):
             axis = axes[k // 3, k % 3]
@@ -179,7 +179,7 @@ def parameters(data: CampaignData, path: Path) -> Path:
     if any(d.fit for d in data.duts.values()):
         axes[0, 0].legend(fontsize=7)
     figure.suptitle(f"Change of each error parameter over temperature from its mid-range value, with the "
-                    f"degree-{data.options.degree} polynomials (paper Fig. 10)")
+                    f"degree-{data.options.degree if data.options else '?'} polynomials (paper Fig. 10)")
     return save(figure, path)
 
 

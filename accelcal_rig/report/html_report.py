@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import html
 from collections import Counter
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +16,7 @@ from accelcal_rig import __version__
 from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.durable import write_text_atomically
 from accelcal_rig.errors import ConfigError
+from accelcal_rig.fit.campaign_fit import FitOptions
 from accelcal_rig.report import figures
 from accelcal_rig.report.campaign_data import CampaignData, read_campaign_data
 from accelcal_rig.store.records import utc_now
@@ -43,7 +45,7 @@ def _e(value: object) -> str:
     return html.escape(str(value))
 
 
-def _table(header: list[str], rows: list[list[object]], text_columns: int = 1,
+def _table(header: list[str], rows: Sequence[Sequence[object]], text_columns: int = 1,
            row_classes: list[str] | None = None) -> str:
     def cell(tag: str, index: int, value: object) -> str:
         css = ' class="text"' if index < text_columns else ""
@@ -126,9 +128,7 @@ def _summary(data: CampaignData) -> list[str]:
         ["setpoints (°C)", ", ".join(f"{t:g}" for t in s.get("setpoints_c", []))],
         ["started / finished", f"{s.get('started')} / {s.get('finished') or '—'}"],
         ["campaign time", format_duration(float(data.pose_t_s.max())) if len(data.pose_t_s) else "—"],
-        ["fit", "none: the procedure measures only (see rig analyze)" if data.options.mode == "none" else
-         f"{data.options.mode}, {data.options.free} parameters, polynomial degree {data.options.degree} "
-         f"({data.options.temperature_model}), {data.options.out_of_range} outside the calibrated range"],
+        ["fit", _fit_description(data.options)],
         ["integrity", s.get("integrity", "?")],
     ]
     out = ["<h2>Campaign</h2>", _table(["", ""], rows, text_columns=2)]
@@ -216,3 +216,10 @@ def _event_table(data: CampaignData) -> str:
     return (f"<p class='note'>{_e(summary)} events; debug events (transitions, each pose) are in the file and "
             "its log, not shown here.</p>" + _table(["campaign time", "wall time", "level", "kind", "message"], rows,
                                                     text_columns=5, row_classes=classes))
+
+
+def _fit_description(options: FitOptions | None) -> str:
+    if options is None:
+        return "none: the procedure measures only (see rig analyze)"
+    return (f"{options.mode}, {options.free} parameters, polynomial degree {options.degree} "
+            f"({options.temperature_model}), {options.out_of_range} outside the calibrated range")

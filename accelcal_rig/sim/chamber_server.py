@@ -15,7 +15,7 @@ from pymodbus.constants import ExcCodes
 from pymodbus.server import ModbusTcpServer
 from pymodbus.simulator import DataType, SimData, SimDevice
 
-from accelcal_rig.instruments.chamber_registers import ChamberRegisterMap
+from accelcal_rig.protocols.chamber_registers import ChamberRegisterMap
 from accelcal_rig.sim.faults import ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 
@@ -87,7 +87,7 @@ class SimulatedChamberServer:
         device = SimDevice(id=self._device_id, simdata=self._blocks(), action=self._action)
         self._server = ModbusTcpServer(device, address=self._address)
         await self._server.serve_forever(background=True)
-        self.host, self.port = self._server.transport.sockets[0].getsockname()[:2]
+        self.host, self.port = self._server.transport.sockets[0].getsockname()[:2]  # type: ignore[attr-defined]
 
     def _blocks(self) -> list[SimData]:
         m = self._map

@@ -123,7 +123,7 @@ class VirtualLab:
             raise ValueError(f"no samples of {self.duts[index].serial} between {t_start_s:g} and {t_end_s:g} s")
         weights = np.array([c[2] for c in chunks], dtype=float)
         mean = lambda k: np.average(np.array([c[k] for c in chunks]), axis=0, weights=weights)  # noqa: E731
-        return {"parameters": mean(3), "gravity_g": mean(4), "temperature_c": np.float64(mean(5))}
+        return {"parameters": mean(3), "gravity_g": mean(4), "temperature_c": np.asarray(mean(5), dtype=float)}
 
     def gravity_in_dut(self, index: int) -> np.ndarray:
         """True specific-force direction (+1 g up) in DUT `index`'s frame at the table's actual angles."""

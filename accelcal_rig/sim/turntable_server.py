@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from accelcal_rig.instruments.turntable_protocol import TurntableProtocol
+import numpy as np
+
+from accelcal_rig.protocols.turntable_line import TurntableProtocol
 from accelcal_rig.sim.faults import ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
@@ -56,12 +58,12 @@ class SimulatedTurntableServer:
             if axis is not None and not 0 <= axis < n_axes:
                 raise ValueError(f"no axis {axis + 1}")
             stalled = self._stall_after_s is not None and now >= self._stall_after_s
-            if name == "move" and not stalled:  # a stalled table says OK and stays where it is
+            if name == "move" and not stalled and axis is not None:  # a stalled table says OK, stays put
                 motion.command_axis(now, axis, float(fields["angle"]))
             elif name == "stop":
                 motion.stop(now)
             elif name == "home":
-                motion.command(now, [0.0] * n_axes)
+                motion.command(now, np.zeros(n_axes))
             values = {
                 "identity": self._identity,
                 "angle": float(motion.position_deg(now)[axis]) if axis is not None else 0.0,

@@ -48,11 +48,13 @@ class SimulatedRig:
                 stuck_after_s=after_s(faults.sensor_stuck_after_min) if s.serial == faults.sensor_stuck else None)
             for i, s in enumerate(rig.fixture.sensors)
         }
-        self._started: list = []
+        self._started: list[SimulatedChamberServer | SimulatedTurntableServer | SimulatedBridgeServer] = []
 
     def start(self) -> Endpoints:
         try:
-            for server in (self.chamber, self.turntable, *self.bridges.values()):
+            servers: list[SimulatedChamberServer | SimulatedTurntableServer | SimulatedBridgeServer] = [
+                self.chamber, self.turntable, *self.bridges.values()]
+            for server in servers:
                 server.start()
                 self._started.append(server)
         except BaseException:

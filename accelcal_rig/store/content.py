@@ -158,7 +158,7 @@ class Campaign:
             wall = dt.datetime.fromisoformat(self.events[-1].wall_time)
         except ValueError:
             return last
-        return last + max(0.0, (dt.datetime.now(dt.timezone.utc) - wall).total_seconds())
+        return last + max(0.0, (dt.datetime.now(dt.UTC) - wall).total_seconds())
 
     def unusable_reasons(self) -> list[str]:
         """Why the measurements cannot be fitted or analysed as they are (empty when they can)."""

@@ -76,7 +76,7 @@ def acquire(campaign: Path, command: str) -> None:
                 raise CampaignBusy(f"{campaign}: in use by {holder}; nothing was changed") from None
             time.sleep(_RETRY_S)
     info = {"pid": os.getpid(), "host": socket.gethostname(), "command": command,
-            "since": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")}
+            "since": dt.datetime.now(dt.UTC).isoformat(timespec="seconds")}
     try:
         os.ftruncate(fd, 0)
         os.pwrite(fd, json.dumps(info).encode(), 0)

@@ -26,7 +26,7 @@ def plain_value(value: Any) -> Any:
 
 def utc_now() -> str:
     """Wall-clock time as the campaign records it: ISO 8601, UTC, whole seconds."""
-    return dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
+    return dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
 
 
 @dataclass(frozen=True)

@@ -13,8 +13,8 @@ from accelcal_rig.config.rig import ChamberConfig
 from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.instruments.chamber_modbus import ModbusChamber
-from accelcal_rig.instruments.chamber_registers import register_map
 from accelcal_rig.instruments.limits import LimitedChamber
+from accelcal_rig.protocols.chamber_registers import register_map
 from accelcal_rig.sim.chamber_server import SimulatedChamberServer
 from accelcal_rig.sim.lab import VirtualLab
 from tests.conftest import SIM_RIG

@@ -14,8 +14,8 @@ from accelcal_rig.config.load import load_rig
 from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.instruments.limits import LimitedTurntable
-from accelcal_rig.instruments.turntable_protocol import ACCELCAL_LINE, turntable_protocol
 from accelcal_rig.instruments.turntable_serial import SerialTurntable
+from accelcal_rig.protocols.turntable_line import ACCELCAL_LINE, turntable_protocol
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 from accelcal_rig.sim.turntable_server import SimulatedTurntableServer
