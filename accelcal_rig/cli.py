@@ -23,7 +23,7 @@ from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
 
 if TYPE_CHECKING:
     from accelcal_rig.engine.progress import ProgressListener
-    from accelcal_rig.engine.session import PreparedCampaign
+    from accelcal_rig.engine.session import PreparedCampaign, RunResult
 
 EXIT_INTERRUPTED = 130
 #: A failure the program did not foresee (a bug): one line, and this code.
@@ -401,6 +401,15 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+    try:
+        return _print_summary(prepared, result, dry_run)
+    except (KeyboardInterrupt, TerminationRequested):
+        print(f"rig: interrupted after the campaign ended ({result.summary.state}); {result.output} holds all of it",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
+
+
+def _print_summary(prepared: PreparedCampaign, result: RunResult, dry_run: bool) -> int:
     summary = result.summary
     setpoints = summary.setpoints_c
     size_mb = result.output.stat().st_size / 1e6 if result.output.is_file() else 0.0

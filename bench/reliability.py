@@ -94,8 +94,14 @@ def judge_complete(campaign: Path, before: dict[str, bytes], rmse_limit: float =
 
 
 def safe_state_recorded(loaded: Campaign) -> bool:
-    """The last safe-state actions in the event log: the chamber to 23 °C, the table stopped, 4 sensors in standby."""
-    safe = [e.message for e in loaded.events[-12:] if e.kind == "safe"]
+    """The last safe state in the event log (its actions are recorded one after another) set the chamber to
+    23 °C, stopped the table and put 4 sensors in standby."""
+    kinds = [e.kind for e in loaded.events]
+    end = len(kinds) - kinds[::-1].index("safe") if "safe" in kinds else 0
+    start = end
+    while start > 0 and kinds[start - 1] == "safe":
+        start -= 1
+    safe = [e.message for e in loaded.events[start:end]]
     return (any("to 23 °C" in m for m in safe) and any("turntable" in m and "stop" in m for m in safe)
             and sum("standby" in m for m in safe) == 4)
 

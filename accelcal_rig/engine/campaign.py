@@ -27,7 +27,7 @@ from accelcal_rig.engine.events import LOGGER, EventLog
 from accelcal_rig.engine.notify import Notification, Notifier
 from accelcal_rig.engine.progress import COOLDOWN_PHASES, PHASES, Progress, ProgressListener
 from accelcal_rig.engine.resume import ResumePoint
-from accelcal_rig.engine.safe_state import apply_safe_state
+from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
 from accelcal_rig.engine.soak import SoakDetector
 from accelcal_rig.engine.states import ACTIVE_STATES, State, StateMachine
 from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, TransientInstrumentError, WaitTimeout
@@ -101,8 +101,7 @@ class CampaignRunner:
         self._settled_dut_c = np.zeros(len(self.sensors))
         #: The table's angles as last read within this setpoint's poses (None: read before moving).
         self._table_angles_deg: np.ndarray | None = None
-        safe = procedure.safe_setpoint_c
-        self.safe_setpoint_c = rig.chamber.safe_setpoint_c if safe is None else safe
+        self.safe_setpoint_c = safe_setpoint_c(procedure, rig)
         self.audience = audience
         #: What the progress display shows: where in the plan, and the last temperatures read.
         self._setpoint_index = -1
@@ -149,7 +148,7 @@ class CampaignRunner:
             self._notify("finish", f"campaign done; fit failed: {fit}" if fit_failed else f"campaign done; {fit}")
             return self._summary("done", fit, fit_failed)
         except BaseException as exc:  # noqa: BLE001 - every exit path goes through the safe state
-            reason = _one_line_reason(exc)
+            reason = one_line_reason(exc)
             self._abort(reason)
             raise CampaignAborted(reason) from exc
 
@@ -518,7 +517,7 @@ def _checked_identity(sensor: Accelerometer) -> DeviceIdentity:
     return identity
 
 
-def _one_line_reason(exc: BaseException) -> str:
+def one_line_reason(exc: BaseException) -> str:
     if isinstance(exc, KeyboardInterrupt):
         return "interrupted by operator (Ctrl-C)"
     if isinstance(exc, TerminationRequested):

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from accelcal_rig.config.procedure import Procedure
+from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.instruments.interfaces import Accelerometer, Chamber, Turntable
 
@@ -32,3 +34,8 @@ def apply_safe_state(chamber: Chamber, turntable: Turntable, sensors: list[Accel
             all_ok = False
             events.error("safe", f"safe state FAILED: {description}: {type(exc).__name__}: {exc}")
     return all_ok
+
+
+def safe_setpoint_c(procedure: Procedure, rig: RigConfig) -> float:
+    """Where the chamber goes when the campaign ends or stops: the procedure's choice, else the rig's."""
+    return rig.chamber.safe_setpoint_c if procedure.safe_setpoint_c is None else procedure.safe_setpoint_c

@@ -4,8 +4,10 @@ the file, run."""
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NoReturn
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -20,13 +22,23 @@ from accelcal_rig.config.load import (
 )
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.engine.campaign import Audience, CampaignRunner, CampaignSummary, FitStage
+from accelcal_rig.core.signals import signals_deferred
+from accelcal_rig.engine.campaign import (
+    Audience,
+    CampaignRunner,
+    CampaignSummary,
+    FitStage,
+    TerminationRequested,
+    one_line_reason,
+)
 from accelcal_rig.engine.connection import ConnectedRig, RigConnector
 from accelcal_rig.engine.estimate import estimate_duration
 from accelcal_rig.engine.events import LOGGER, EventLog
 from accelcal_rig.engine.notify import Notifier
 from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.resume import ResumePoint, check_same_campaign
+from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
+from accelcal_rig.errors import CampaignAborted
 from accelcal_rig.fit.campaign_fit import fit_and_save, summary_line
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
 from accelcal_rig.fit.recorded_options import options_attrs, recorded_options
@@ -115,8 +127,10 @@ def run_campaign(prepared: PreparedCampaign, output: Path, connect: RigConnector
     if resume and (output.exists() or journal_path(output).exists()):
         return resume_campaign(prepared, output, connect, calibration=calibration, progress=progress)
     with connect(seed) as rig:
-        writer = _create_file(prepared, output, rig, dry_run=connect.dry_run, seed=seed, overwrite=overwrite)
-        return _run(prepared, output, writer, rig, None, calibration, wall_start, progress)
+        def create() -> CampaignWriter:
+            return _create_file(prepared, output, rig, dry_run=connect.dry_run, seed=seed, overwrite=overwrite)
+
+        return _run(prepared, output, create, rig, None, calibration, wall_start, progress)
 
 
 class NothingToResume(Exception):
@@ -149,7 +163,7 @@ def resume_campaign(prepared: PreparedCampaign, output: Path, connect: RigConnec
                                   f"left the file {reopened.previous_state!r})")
             for repair in reopened.repairs:
                 events.warning("resume", repair)
-            return _run(prepared, output, writer, rig, point, calibration, wall_start, progress)
+            return _run(prepared, output, lambda: writer, rig, point, calibration, wall_start, progress)
     finally:
         _close(writer)
 
@@ -221,14 +235,20 @@ def _close(writer: CampaignWriter) -> tuple[str, ...]:
     return problems
 
 
-def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, rig_connected: ConnectedRig,
-         resume: ResumePoint | None, calibration: Path | None, wall_start: float,
+def _run(prepared: PreparedCampaign, output: Path, open_writer: Callable[[], CampaignWriter],
+         rig_connected: ConnectedRig, resume: ResumePoint | None, calibration: Path | None, wall_start: float,
          progress: ProgressListener | None) -> RunResult:
+    """The campaign from its file's opening to its closing. A stop requested while the file is opened waits
+    until `writer` holds it, so any stop before the runner begins is recorded (_stopped_before_start)."""
     procedure, rig = prepared.procedure.model, prepared.rig.model
     notify = rig.notify
-    notifier = Notifier(notify) if notify.webhook_url or notify.command else None
+    notifier: Notifier | None = None
+    writer: CampaignWriter | None = None
     problems: tuple[str, ...] = ()
     try:
+        with signals_deferred():
+            writer = open_writer()
+        notifier = Notifier(notify) if notify.webhook_url or notify.command else None
         clock = rig_connected.clock
         events = EventLog(clock, writer)
         estimate = estimate_duration(procedure, rig, prepared.plan) if progress or notifier else None
@@ -237,13 +257,32 @@ def _run(prepared: PreparedCampaign, output: Path, writer: CampaignWriter, rig_c
                                 if calibration and procedure.fit.mode != "none" else None,
                                 resume=resume, audience=Audience(progress, estimate, notifier, str(output)))
         summary = runner.run()
+    except (KeyboardInterrupt, TerminationRequested) as exc:
+        if writer is not None and writer.campaign.state == "created":
+            _stopped_before_start(writer, rig_connected, procedure, rig, exc)
+        raise
     finally:
         try:
-            problems = _close(writer)
+            if writer is not None:
+                problems = _close(writer)
         finally:
             if notifier is not None:  # the fault, safe and finish events still go out
                 notifier.close()
     return RunResult(summary, time.perf_counter() - wall_start, output, problems)
+
+
+def _stopped_before_start(writer: CampaignWriter, connected: ConnectedRig, procedure: Procedure, rig: RigConfig,
+                          exc: BaseException) -> NoReturn:
+    """A stop between the campaign's creation and its first step: nothing has moved yet, but the rig still
+    goes to its safe state and the file says why the campaign ended, as after any other abort."""
+    reason = one_line_reason(exc)
+    with signals_deferred():
+        events = EventLog(connected.clock, writer)
+        events.error("fault", f"campaign aborted before its first step: {reason}")
+        raw = connected.instruments
+        apply_safe_state(raw.chamber, raw.turntable, raw.sensors, safe_setpoint_c(procedure, rig), events)
+        writer.set_state("aborted", reason=reason, finished=True)
+    raise CampaignAborted(reason) from exc
 
 
 def _fit_attrs(procedure: Procedure) -> dict[str, object]:
