@@ -16,9 +16,10 @@ from accelcal_rig.config.load import LoadedConfig
 from accelcal_rig.config.procedure import Procedure, SimulatedEffects
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock, RealClock, VirtualClock
+from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.engine import session
 from accelcal_rig.engine.connection import GuardedRig, RigConnector
-from accelcal_rig.engine.events import LOGGER, EventLog
+from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.engine.session import PreparedCampaign, RunResult

@@ -16,9 +16,8 @@ from typing import TYPE_CHECKING, NoReturn
 
 from accelcal_rig import __version__
 from accelcal_rig.core.formatting import format_duration
-from accelcal_rig.core.signals import stop_when_safe
-from accelcal_rig.engine.campaign import TerminationRequested
-from accelcal_rig.engine.events import LOGGER
+from accelcal_rig.core.logger import LOGGER
+from accelcal_rig.core.signals import TerminationRequested, stop_when_safe
 from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
 
 if TYPE_CHECKING:

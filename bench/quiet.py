@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 
-from accelcal_rig.engine.events import LOGGER
+from accelcal_rig.core.logger import LOGGER
 
 
 def silence_campaign_log() -> None:

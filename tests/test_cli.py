@@ -211,7 +211,7 @@ def test_rig_fit_on_a_file_without_poses_is_one_line(write, workdir: Path, capsy
 
 def test_a_signal_before_the_campaign_starts_is_one_line_and_leaves_no_file(write, capsys, monkeypatch) -> None:
     from accelcal_rig import assembly
-    from accelcal_rig.engine.campaign import TerminationRequested
+    from accelcal_rig.core.signals import TerminationRequested
 
     def terminated(*_):
         raise TerminationRequested()

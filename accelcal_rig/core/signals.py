@@ -10,6 +10,11 @@ from __future__ import annotations
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+
+class TerminationRequested(BaseException):
+    """SIGTERM arrived: stop like Ctrl-C, through the safe state."""
+
+
 _depth = 0
 _pending: BaseException | None = None
 

@@ -18,12 +18,13 @@ from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.formatting import format_duration
-from accelcal_rig.core.signals import signals_deferred
+from accelcal_rig.core.logger import LOGGER
+from accelcal_rig.core.signals import TerminationRequested, signals_deferred
 from accelcal_rig.core.waits import MOVE_POLL_S, wait_until
 from accelcal_rig.engine.acquisition import acquire_together
 from accelcal_rig.engine.connection import GuardedRig
 from accelcal_rig.engine.estimate import DurationEstimate
-from accelcal_rig.engine.events import LOGGER, EventLog
+from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.notify import Notification, Notifier
 from accelcal_rig.engine.progress import COOLDOWN_PHASES, PHASES, Progress, ProgressListener
 from accelcal_rig.engine.resume import ResumePoint
@@ -44,10 +45,6 @@ MOVE_MARGIN_S = 30.0
 #: States in which the campaign still has measuring ahead of it (the time left is estimated).
 _MEASURING_STATES = frozenset({State.IDLE, State.PREFLIGHT, State.RAMP, State.SOAK, State.MOVE, State.SETTLE,
                                State.ACQUIRE, State.STORE, State.COOL})
-
-
-class TerminationRequested(BaseException):
-    """SIGTERM arrived: stop like Ctrl-C, through the safe state."""
 
 
 #: Runs on the stored campaign once the rig is safe; returns a one-line summary of the calibration.

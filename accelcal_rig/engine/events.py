@@ -6,10 +6,10 @@ import logging
 
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.formatting import format_duration
+from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.store.records import Event
 from accelcal_rig.store.writer import CampaignWriter
 
-LOGGER = logging.getLogger("accelcal_rig")
 _LEVELS = {"debug": logging.DEBUG, "info": logging.INFO, "warning": logging.WARNING, "error": logging.ERROR}
 
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from accelcal_rig.config.rig import NotifyConfig
-from accelcal_rig.engine.events import LOGGER
+from accelcal_rig.core.logger import LOGGER
 
 NOTIFICATION_FORMAT = "accelcal-rig notification"
 

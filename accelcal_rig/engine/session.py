@@ -22,18 +22,12 @@ from accelcal_rig.config.load import (
 )
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.core.signals import signals_deferred
-from accelcal_rig.engine.campaign import (
-    Audience,
-    CampaignRunner,
-    CampaignSummary,
-    FitStage,
-    TerminationRequested,
-    one_line_reason,
-)
+from accelcal_rig.core.logger import LOGGER
+from accelcal_rig.core.signals import TerminationRequested, signals_deferred
+from accelcal_rig.engine.campaign import Audience, CampaignRunner, CampaignSummary, FitStage, one_line_reason
 from accelcal_rig.engine.connection import ConnectedRig, RigConnector
 from accelcal_rig.engine.estimate import estimate_duration
-from accelcal_rig.engine.events import LOGGER, EventLog
+from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.notify import Notifier
 from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.resume import ResumePoint, check_same_campaign

@@ -16,7 +16,7 @@ import time
 from datetime import datetime, timedelta
 from typing import TextIO
 
-from accelcal_rig.engine.events import LOGGER
+from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.engine.progress import Progress, ProgressListener
 
 REDRAW_S = 0.2

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from accelcal_rig.assembly import AssembledRig, InProcessRig
-from accelcal_rig.engine.campaign import TerminationRequested
+from accelcal_rig.core.signals import TerminationRequested
 from accelcal_rig.engine.connection import GuardedRig
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.session import prepare, run_campaign

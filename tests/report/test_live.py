@@ -7,7 +7,7 @@ import logging
 
 import pytest
 
-from accelcal_rig.engine.events import LOGGER
+from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.engine.progress import Progress
 from accelcal_rig.report import live
 from accelcal_rig.report.live import ProgressLines, StatusLine, TerminalHandler
