@@ -10,6 +10,7 @@ from pydantic import BaseModel, Field, ValidationError, field_validator, model_v
 
 from accelcal_rig.config.bounds import STRICT, AngleDeg, Baudrate, TemperatureC, TimeoutS
 from accelcal_rig.parts.registry import DEFAULT_PART, part
+from accelcal_rig.plugins import Kind, driver_problem
 from accelcal_rig.protocols.chamber_registers import ChamberRegisterMap, register_map
 from accelcal_rig.protocols.turntable_line import TurntableProtocol, turntable_protocol
 
@@ -21,10 +22,23 @@ class _Strict(BaseModel):
     model_config = STRICT
 
 
+def _known_driver(kind: Kind) -> classmethod:
+    """A validator of a `driver:` name against the registered drivers of `kind`."""
+    def check(cls: type, value: str) -> str:
+        problem = driver_problem(kind, value)
+        if problem:
+            raise ValueError(problem)
+        return value
+    return field_validator("driver")(classmethod(check))  # type: ignore[return-value]
+
+
 class ChamberConfig(_Strict):
     """Thermal chamber: how to reach its controller, its register map, limits and dynamics."""
 
-    driver: Literal["modbus-tcp", "modbus-rtu"] = "modbus-tcp"
+    driver: str = Field("modbus-tcp", max_length=64, description="a chamber driver (accelcal_rig.plugins)")
+    _driver = _known_driver("chamber")
+    #: Settings of a plug-in driver, which validates them itself.
+    options: dict[str, Any] = Field({}, description="settings a plug-in chamber driver reads")
     endpoint: str | None = Field(None, max_length=1024, description="modbus-tcp: host:port; modbus-rtu: serial "
                                  "device or URL")
     device_id: int = Field(1, ge=0, le=247)
@@ -89,7 +103,8 @@ class TurntableAxis(_Strict):
 class TurntableConfig(_Strict):
     """A chain of rotary axes, outermost first; the fixture sits on the innermost axis."""
 
-    driver: Literal["serial"] = "serial"
+    driver: str = Field("serial", max_length=64, description="a turntable driver (accelcal_rig.plugins)")
+    _driver = _known_driver("turntable")
     endpoint: str | None = Field(None, max_length=1024, description="serial device or pyserial URL "
                                  "(socket://host:port, …)")
     baudrate: Baudrate = 9600
@@ -124,7 +139,8 @@ class SensorConfig(_Strict):
     serial: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.-]+$")
     name: str = Field("", max_length=64)
     part: str = Field(DEFAULT_PART, max_length=64, description="the sensor part (accelcal_rig.parts), e.g. adxl357")
-    driver: Literal["serial-bridge", "spidev"] = "serial-bridge"
+    driver: str = Field("serial-bridge", max_length=64, description="a sensor driver (accelcal_rig.plugins)")
+    _driver = _known_driver("sensor")
     endpoint: str | None = Field(None, max_length=1024, description="serial-bridge: device or URL; spidev: "
                                  "bus.chip_select")
     baudrate: Baudrate = 921600

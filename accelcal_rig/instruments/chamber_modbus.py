@@ -15,7 +15,9 @@ from pymodbus.client import ModbusSerialClient, ModbusTcpClient
 from pymodbus.client.base import ModbusBaseSyncClient
 from pymodbus.exceptions import ModbusException
 
+from accelcal_rig.config.rig import ChamberConfig
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.instruments.definitions import ChamberDriver
 from accelcal_rig.instruments.retrying import RetryCall
 from accelcal_rig.protocols.chamber_registers import ChamberRegisterMap
 
@@ -179,3 +181,22 @@ def _number(value: object) -> float:
     if not isinstance(value, int | float):
         raise TypeError(f"expected one number from the register conversion, got {value!r}")
     return float(value)
+
+
+def _open_tcp(config: ChamberConfig, endpoint: str) -> ModbusChamber:
+    host, _, port = endpoint.rpartition(":")
+    if not host or not port.isdigit():
+        raise InstrumentError(f"chamber (modbus-tcp {endpoint}): endpoint is not host:port")
+    return ModbusChamber.tcp(host, int(port), config.register_map(), config.device_id, config.timeout_s)
+
+
+def _open_rtu(config: ChamberConfig, endpoint: str) -> ModbusChamber:
+    return ModbusChamber.rtu(endpoint, config.register_map(), config.device_id, config.baudrate, config.parity,
+                             config.stopbits, config.timeout_s)
+
+
+MODBUS_TCP = ChamberDriver("modbus-tcp", _open_tcp, simulator="accelcal_rig.sim.chamber_server:serve_modbus",
+                           protocol="accelcal_rig.protocols.chamber_registers")
+#: Simulated on Modbus TCP: the same register map and requests, another framing.
+MODBUS_RTU = ChamberDriver("modbus-rtu", _open_rtu, simulator="accelcal_rig.sim.chamber_server:serve_modbus",
+                           protocol="accelcal_rig.protocols.chamber_registers", simulated_by="modbus-tcp")

@@ -6,7 +6,9 @@ import re
 
 import numpy as np
 
+from accelcal_rig.config.rig import TurntableConfig
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.instruments.definitions import TurntableDriver
 from accelcal_rig.instruments.line_port import LinePort
 from accelcal_rig.instruments.retrying import RetryCall
 from accelcal_rig.protocols.turntable_line import Command, TurntableProtocol
@@ -74,3 +76,11 @@ class SerialTurntable:
         if match is None:
             raise TransientInstrumentError(f"turntable ({self.endpoint}): {request!r}: unexpected reply {reply!r}")
         return {k: v for k, v in match.groupdict().items() if v is not None}
+
+
+def _open(config: TurntableConfig, endpoint: str) -> SerialTurntable:
+    return SerialTurntable.open(endpoint, config.line_protocol(), len(config.axes), config.baudrate, config.timeout_s)
+
+
+SERIAL = TurntableDriver("serial", _open, simulator="accelcal_rig.sim.turntable_server:serve_line",
+                         protocol="accelcal_rig.protocols.turntable_line")

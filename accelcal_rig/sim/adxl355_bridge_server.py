@@ -8,9 +8,10 @@ import math
 
 import numpy as np
 
+from accelcal_rig.config.rig import SensorConfig
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import BRIDGE_GREETING
-from accelcal_rig.sim.faults import ReplyFaults
+from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 
@@ -182,7 +183,7 @@ class SimulatedBridgeServer:
         self._version = protocol_version
         self.device = SimulatedAdxl355(lab, index, wrong_part_id, stuck_after_s)
         self._server = PtyLineServer(self._handle, b"\n", f"simulated-bridge-{lab.duts[index].serial}", faults)
-        self.path = self._server.path
+        self.path = self.endpoint = self._server.path
 
     def start(self) -> SimulatedBridgeServer:
         self._server.start()
@@ -212,3 +213,12 @@ class SimulatedBridgeServer:
         except ValueError as exc:
             return f"!{exc}"
         return f"!unknown request {request!r}"
+
+
+def serve_bridge(lab: VirtualLab, config: SensorConfig, faults: InstrumentFaults) -> SimulatedBridgeServer:
+    """The sensor drivers' simulator: a version 2 bridge in front of the DUT's simulated part."""
+    settings = faults.settings
+    index = [d.serial for d in lab.duts].index(config.serial)
+    return SimulatedBridgeServer(lab, index, faults=faults.replies, wrong_part_id=config.serial == settings.sensor_wrong_id,
+                                 stuck_after_s=faults.after_s(settings.sensor_stuck_after_min)
+                                 if config.serial == settings.sensor_stuck else None)

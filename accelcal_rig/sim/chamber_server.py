@@ -15,8 +15,9 @@ from pymodbus.constants import ExcCodes
 from pymodbus.server import ModbusTcpServer
 from pymodbus.simulator import DataType, SimData, SimDevice
 
+from accelcal_rig.config.rig import ChamberConfig
 from accelcal_rig.protocols.chamber_registers import ChamberRegisterMap
-from accelcal_rig.sim.faults import ReplyFaults
+from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 
 _STARTUP_TIMEOUT_S = 10.0
@@ -169,3 +170,9 @@ class SimulatedChamberServer:
             high, low = (words[1], words[0]) if m.word_order == "little" else (words[0], words[1])
             return struct.unpack(">f", struct.pack(">HH", high, low))[0]
         return struct.unpack(">h", struct.pack(">H", words[0]))[0] / 10**m.decimals
+
+
+def serve_modbus(lab: VirtualLab, config: ChamberConfig, faults: InstrumentFaults) -> SimulatedChamberServer:
+    """The Modbus chamber drivers' simulator: the config's register map on Modbus TCP (RTU too)."""
+    return SimulatedChamberServer(lab, config.register_map(), config.device_id, faults=faults.replies,
+                                  stall_after_s=faults.after_s(faults.settings.chamber_stall_after_min))

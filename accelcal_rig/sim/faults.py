@@ -10,6 +10,7 @@ from __future__ import annotations
 import hashlib
 import threading
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -54,3 +55,16 @@ class ReplyFaults:
             position = int(self._rng.integers(max(1, len(reply) - 1)))
             junk = _JUNK[int(self._rng.integers(len(_JUNK)))]
         return reply[:position] + bytes([junk]) + reply[position + 1:]
+
+
+@dataclass(frozen=True)
+class InstrumentFaults:
+    """What one simulated instrument is told to get wrong: its replies' transient faults (None: none) and
+    the rig's persistent ones, with the time they start in seconds of campaign time."""
+
+    replies: ReplyFaults | None
+    settings: FaultInjection
+
+    @staticmethod
+    def after_s(minutes: float | None) -> float | None:
+        return None if minutes is None else minutes * 60.0

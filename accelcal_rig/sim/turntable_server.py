@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from accelcal_rig.config.rig import TurntableConfig
 from accelcal_rig.protocols.turntable_line import TurntableProtocol
-from accelcal_rig.sim.faults import ReplyFaults
+from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 
@@ -26,7 +27,7 @@ class SimulatedTurntableServer:
         if protocol.write_terminator != protocol.read_terminator:
             raise ValueError("the simulated turntable needs one terminator for both directions")
         self._server = PtyLineServer(self._handle, protocol.write_terminator.encode(), "simulated-turntable", faults)
-        self.path = self._server.path
+        self.path = self.endpoint = self._server.path
         #: Fault code the controller reports (fault injection sets it).
         self.fault = self._protocol.fault_ok[0]
 
@@ -71,3 +72,9 @@ class SimulatedTurntableServer:
                 "fault": self.fault,
             }
         return template.format(**values)
+
+
+def serve_line(lab: VirtualLab, config: TurntableConfig, faults: InstrumentFaults) -> SimulatedTurntableServer:
+    """The serial turntable driver's simulator: a controller speaking the config's line protocol."""
+    return SimulatedTurntableServer(lab, config.line_protocol(), faults=faults.replies,
+                                    stall_after_s=faults.after_s(faults.settings.turntable_stall_after_min))

@@ -1,25 +1,34 @@
-"""The whole simulated rig as real endpoints: the chamber on Modbus TCP (127.0.0.1), the turntable and
-each sensor bridge on a pseudo-terminal, all backed by one virtual lab on one clock.
+"""The whole simulated rig as real endpoints, each instrument served by the simulator its driver names
+(accelcal_rig.plugins): built in, the chamber on Modbus TCP (127.0.0.1), the turntable and each sensor
+bridge on a pseudo-terminal, all backed by one virtual lab on one clock.
 
 A dry run connects the real drivers to these; `rig sim` leaves them up for any Modbus master or serial
-terminal. A chamber configured for Modbus RTU is served over Modbus TCP: the same register map and
-requests, another framing.
+terminal. A driver whose simulator speaks another framing says which driver talks to it (`simulated_by`:
+a chamber configured for Modbus RTU is served over Modbus TCP, the same register map and requests).
 """
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Protocol
 
 from accelcal_rig.config.procedure import SimulatedEffects
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.instruments.connect import Endpoints
-from accelcal_rig.sim.adxl355_bridge_server import SimulatedBridgeServer
-from accelcal_rig.sim.chamber_server import SimulatedChamberServer
+from accelcal_rig.plugins import Kind, load_driver, load_object
 from accelcal_rig.sim.devices import SimulationTruth
-from accelcal_rig.sim.faults import ReplyFaults
+from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
-from accelcal_rig.sim.turntable_server import SimulatedTurntableServer
+
+
+class ServedInstrument(Protocol):
+    """What a driver's simulator factory returns: a server at an endpoint its driver can open."""
+
+    @property
+    def endpoint(self) -> str: ...
+
+    def start(self) -> Any: ...
+    def stop(self) -> None: ...
 
 
 class SimulatedRig:
@@ -28,33 +37,26 @@ class SimulatedRig:
         self.rig = rig
         self.lab = VirtualLab(rig, clock, seed, effects)
         self.truth = SimulationTruth(self.lab)
-        faults = rig.simulation.faults
+        settings = rig.simulation.faults
 
-        def reply_faults(name: str) -> ReplyFaults | None:
-            return ReplyFaults(faults, name, clock.now) if faults.rate > 0 else None
+        def served(kind: Kind, driver: str, config: Any, name: str) -> tuple[ServedInstrument, str]:
+            """(the instrument's simulator, the driver that talks to it)."""
+            definition = load_driver(kind, driver)
+            factory = load_object(definition.simulator, f"the simulator of {kind} driver {driver!r}")
+            replies = ReplyFaults(settings, name, clock.now) if settings.rate > 0 else None
+            return factory(self.lab, config, InstrumentFaults(replies, settings)), definition.simulated_by or driver
 
-        def after_s(minutes: float | None) -> float | None:
-            return None if minutes is None else minutes * 60.0
-
-        self.chamber = SimulatedChamberServer(self.lab, rig.chamber.register_map(), rig.chamber.device_id,
-                                              faults=reply_faults("chamber"),
-                                              stall_after_s=after_s(faults.chamber_stall_after_min))
-        self.turntable = SimulatedTurntableServer(self.lab, rig.turntable.line_protocol(),
-                                                  faults=reply_faults("turntable"),
-                                                  stall_after_s=after_s(faults.turntable_stall_after_min))
-        self.bridges = {
-            s.serial: SimulatedBridgeServer(
-                self.lab, i, faults=reply_faults(s.serial), wrong_part_id=s.serial == faults.sensor_wrong_id,
-                stuck_after_s=after_s(faults.sensor_stuck_after_min) if s.serial == faults.sensor_stuck else None)
-            for i, s in enumerate(rig.fixture.sensors)
-        }
-        self._started: list[SimulatedChamberServer | SimulatedTurntableServer | SimulatedBridgeServer] = []
+        self.chamber, chamber_driver = served("chamber", rig.chamber.driver, rig.chamber, "chamber")
+        self.turntable, turntable_driver = served("turntable", rig.turntable.driver, rig.turntable, "turntable")
+        bridges = {s.serial: served("sensor", s.driver, s, s.serial) for s in rig.fixture.sensors}
+        self.bridges = {serial: server for serial, (server, _) in bridges.items()}
+        self._drivers = {"chamber": chamber_driver, "turntable": turntable_driver,
+                         **{serial: driver for serial, (_, driver) in bridges.items()}}
+        self._started: list[ServedInstrument] = []
 
     def start(self) -> Endpoints:
         try:
-            servers: list[SimulatedChamberServer | SimulatedTurntableServer | SimulatedBridgeServer] = [
-                self.chamber, self.turntable, *self.bridges.values()]
-            for server in servers:
+            for server in [self.chamber, self.turntable, *self.bridges.values()]:
                 server.start()
                 self._started.append(server)
         except BaseException:
@@ -68,15 +70,19 @@ class SimulatedRig:
 
     @property
     def endpoints(self) -> Endpoints:
-        return Endpoints(self.chamber.endpoint, self.turntable.path,
-                         {serial: bridge.path for serial, bridge in self.bridges.items()}, chamber_over_tcp=True)
+        return Endpoints(self.chamber.endpoint, self.turntable.endpoint,
+                         {serial: bridge.endpoint for serial, bridge in self.bridges.items()}, dict(self._drivers))
 
     def describe(self) -> dict[str, Any]:
         """The endpoints as `rig sim` prints them."""
+        chamber: dict[str, Any] = {"protocol": self._drivers["chamber"], "endpoint": self.chamber.endpoint}
+        if self._drivers["chamber"] == "modbus-tcp":
+            host, _, port = self.chamber.endpoint.rpartition(":")
+            chamber |= {"host": host, "port": int(port), "device_id": self.rig.chamber.device_id,
+                        "profile": self.rig.chamber.profile}
         return {
-            "chamber": {"protocol": "modbus-tcp", "host": self.chamber.host, "port": self.chamber.port,
-                        "device_id": self.rig.chamber.device_id, "profile": self.rig.chamber.profile},
-            "turntable": {"protocol": self.rig.turntable.protocol, "device": self.turntable.path},
-            "sensors": {serial: {"protocol": "adxl355-bridge", "device": bridge.path}
+            "chamber": chamber,
+            "turntable": {"protocol": self.rig.turntable.protocol, "device": self.turntable.endpoint},
+            "sensors": {serial: {"protocol": "adxl355-bridge", "device": bridge.endpoint}
                         for serial, bridge in self.bridges.items()},
         }
