@@ -251,38 +251,18 @@ def _cmd_sim(args: argparse.Namespace) -> int:
 
 
 def _cmd_fit(args: argparse.Namespace) -> int:
-    import numpy as np
+    from accelcal_rig.fit.campaign_file import fit_campaign_file
+    from accelcal_rig.fit.campaign_fit import summary_line
 
-    from accelcal_rig.fit.campaign_fit import fit_and_save, summary_line
-    from accelcal_rig.fit.recorded_options import recorded_options
-    from accelcal_rig.store.lock import holder
-    from accelcal_rig.store.read import usable_campaign
-
-    running = holder(args.campaign)
-    if running is not None:
-        raise ConfigError(f"{args.campaign}: a campaign is running on it, {running}: fit it once it is done")
-    campaign = usable_campaign(args.campaign)
-    for note in campaign.notes:
-        print(f"rig: warning: {args.campaign}: {note}", file=sys.stderr)
-    options = recorded_options(campaign.attrs, str(args.campaign), mode=args.mode, degree=args.degree,
-                               free=args.parameters, out_of_range=args.out_of_range,
-                               temperature_model=args.temperature_model)
-    if options is None:
-        raise ConfigError(f"{args.campaign}: its procedure asked for no fit (fit.mode: none); choose one with "
-                          "--mode reference or --mode norm-only")
-    if args.output.is_dir():
-        raise ConfigError(f"{args.output}: is a folder; name the calibration file to write")
-    try:
-        _, report = fit_and_save(campaign, args.campaign, args.output, options)
-    except (ValueError, np.linalg.LinAlgError) as exc:
-        raise RigError(f"{args.campaign}: fit failed: {str(exc).splitlines()[0]}") from None
-    if campaign.state != "done":
-        print(f"rig: warning: campaign state is {campaign.state}: fitted the poses stored so far", file=sys.stderr)
+    outcome = fit_campaign_file(args.campaign, args.output, mode=args.mode, degree=args.degree, free=args.parameters,
+                                out_of_range=args.out_of_range, temperature_model=args.temperature_model)
+    for warning in outcome.warnings:
+        print(f"rig: warning: {warning}", file=sys.stderr)
     if args.json:
-        print(json.dumps(report))
+        print(json.dumps(outcome.report))
     else:
-        _print_fit_table(report)
-        print(summary_line(report, args.output))
+        _print_fit_table(outcome.report)
+        print(summary_line(outcome.report, args.output))
     return 0
 
 

@@ -1,0 +1,49 @@
+"""`rig fit` on a campaign file: the fit's adapter from a file on disk to a calibration file beside it.
+
+Everything the command refuses is refused here in one line: a campaign a run holds (fit it once it is
+done), damaged measurements, a procedure that asked for no fit and no mode given, a folder as output.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from accelcal_rig.errors import ConfigError, RigError
+from accelcal_rig.fit.campaign_fit import fit_and_save
+from accelcal_rig.fit.recorded_options import recorded_options
+from accelcal_rig.store.lock import holder
+from accelcal_rig.store.read import usable_campaign
+
+
+@dataclass(frozen=True)
+class FitOutcome:
+    report: dict[str, Any]    #: per sensor serial, as `rig fit --json` prints it
+    warnings: list[str]       #: for the operator, one line each
+
+
+def fit_campaign_file(path: Path, output: Path, **overrides: Any) -> FitOutcome:
+    """The campaign at `path` fitted with the options it records (any `overrides` not None instead: mode,
+    degree, free, out_of_range, temperature_model), its calibration written to `output`; the campaign is
+    only read."""
+    running = holder(path)
+    if running is not None:
+        raise ConfigError(f"{path}: a campaign is running on it, {running}: fit it once it is done")
+    campaign = usable_campaign(path)
+    warnings = [f"{path}: {note}" for note in campaign.notes]
+    options = recorded_options(campaign.attrs, str(path), **overrides)
+    if options is None:
+        raise ConfigError(f"{path}: its procedure asked for no fit (fit.mode: none); choose one with "
+                          "--mode reference or --mode norm-only")
+    if output.is_dir():
+        raise ConfigError(f"{output}: is a folder; name the calibration file to write")
+    try:
+        _, report = fit_and_save(campaign, path, output, options)
+    except (ValueError, np.linalg.LinAlgError) as exc:
+        raise RigError(f"{path}: fit failed: {str(exc).splitlines()[0]}") from None
+    if campaign.state != "done":
+        warnings.append(f"campaign state is {campaign.state}: fitted the poses stored so far")
+    return FitOutcome(report, warnings)
