@@ -48,6 +48,14 @@ def _command(commands: argparse._SubParsersAction, name: str, summary: str, desc
                                formatter_class=argparse.RawDescriptionHelpFormatter)
 
 
+def _campaign_output_options(command: argparse.ArgumentParser) -> None:
+    """What `rig run` and `rig resume` share: where the fit writes, and how much the console says."""
+    command.add_argument("--calibration", type=Path,
+                         help="calibration file the final fit writes (default: beside the campaign, .calibration.yaml)")
+    command.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
+    command.add_argument("-q", "--quiet", action="store_true", help="print only warnings and the summary")
+
+
 def _analysis_command(analyses: argparse._SubParsersAction, name: str, summary: str, description: str,
                       example: str, *, calibration: bool, figure: bool) -> argparse.ArgumentParser:
     """A `rig analyze` subcommand with the arguments every analysis shares."""
@@ -81,10 +89,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--resume", action="store_true",
                      help="continue the campaign in the output file if it exists (after a crash, a fault or "
                           "Ctrl-C), else start it")
-    run.add_argument("--calibration", type=Path,
-                     help="calibration file the final fit writes (default: beside the campaign, .calibration.yaml)")
-    run.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
-    run.add_argument("-q", "--quiet", action="store_true", help="print only warnings and the summary")
+    _campaign_output_options(run)
 
     plan = _command(commands, "plan", "validate a procedure, show its schedule and estimate its duration",
                     "Validate the procedure and its rig config, compile the plan and print it: setpoints, soak "
@@ -105,10 +110,7 @@ def build_parser() -> argparse.ArgumentParser:
     resume.add_argument("--procedure", type=Path, help="procedure YAML (default: the path stored in the file)")
     resume.add_argument("--config", type=Path, help="rig config YAML (overrides the procedure's `rig`)")
     resume.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
-    resume.add_argument("--calibration", type=Path,
-                        help="calibration file the final fit writes (default: beside the campaign, .calibration.yaml)")
-    resume.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
-    resume.add_argument("-q", "--quiet", action="store_true", help="print only warnings and the summary")
+    _campaign_output_options(resume)
 
     status = _command(commands, "status", "show a campaign file's state and progress",
                       "Show a campaign's state and progress (works on finished, aborted and running files).",
