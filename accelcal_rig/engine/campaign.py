@@ -22,11 +22,9 @@ from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.core.signals import TerminationRequested, signals_deferred
 from accelcal_rig.core.waits import MOVE_POLL_S, wait_until
 from accelcal_rig.engine.acquisition import acquire_together
+from accelcal_rig.engine.audience import Audience, Reporter
 from accelcal_rig.engine.connection import GuardedRig
-from accelcal_rig.engine.estimate import DurationEstimate
 from accelcal_rig.engine.events import EventLog
-from accelcal_rig.engine.notify import Notification, Notifier
-from accelcal_rig.engine.progress import COOLDOWN_PHASES, PHASES, Progress, ProgressListener
 from accelcal_rig.engine.resume import ResumePoint
 from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
 from accelcal_rig.engine.soak import SoakDetector
@@ -43,23 +41,9 @@ MOVE_MARGIN_S = 30.0
 
 
 #: States in which the campaign still has measuring ahead of it (the time left is estimated).
-_MEASURING_STATES = frozenset({State.IDLE, State.PREFLIGHT, State.RAMP, State.SOAK, State.MOVE, State.SETTLE,
-                               State.ACQUIRE, State.STORE, State.COOL})
-
 
 #: Runs on the stored campaign once the rig is safe; returns a one-line summary of the calibration.
 FitStage = Callable[[Campaign], str]
-
-
-@dataclass(frozen=True)
-class Audience:
-    """Who follows the run besides the file and the log: a progress listener (the estimate gives it the
-    time left) and a notifier. Neither can stop the campaign: their failures are logged."""
-
-    progress: ProgressListener | None = None
-    estimate: DurationEstimate | None = None
-    notifier: Notifier | None = None
-    campaign: str = ""
 
 
 @dataclass(frozen=True)
@@ -92,24 +76,16 @@ class CampaignRunner:
         self.machine = StateMachine(self._record_transition)
         self.resume = resume
         self._stored_keys = resume.done_keys if resume is not None else frozenset()
-        self.poses_done = len(self._stored_keys)
         self._mounts = {s.serial: Rotation.from_euler("xyz", s.mount_euler_deg, degrees=True)
                         for s in rig.fixture.sensors}
         self._settled_dut_c = np.zeros(len(self.sensors))
         #: The table's angles as last read within this setpoint's poses (None: read before moving).
         self._table_angles_deg: np.ndarray | None = None
         self.safe_setpoint_c = safe_setpoint_c(procedure, rig)
-        self.audience = audience
-        #: What the progress display shows: where in the plan, and the last temperatures read.
-        self._setpoint_index = -1
-        self._setpoint_start_s = 0.0
-        self._phase = ("idle", 0.0)  # (phase, clock time it began)
-        self._chamber_c: float | None = None
-        self._dut_c: tuple[float, ...] = ()
-        self._poses_left = [sum(1 for s in plan.pose_steps if s.setpoint_c == setpoint and s.key not in self._stored_keys)
-                            for setpoint in plan.setpoints_c]
-        self._progress_failed = False
-        self._phases = PHASES if procedure.cooldown is None else COOLDOWN_PHASES
+        stored = self._stored_keys
+        self.report = Reporter(audience, plan, procedure.name, clock, procedure.cooldown is not None,
+                               [sum(1 for s in plan.pose_steps if s.setpoint_c == setpoint and s.key not in stored)
+                                for setpoint in plan.setpoints_c], len(stored))
         #: True while the DUT temperatures move on purpose (cool-down, ramp): no band warnings then.
         self._temperature_moving = False
         #: The ramp method's software ramp once running: (clock time, setpoint °C) it started from.
@@ -123,10 +99,10 @@ class CampaignRunner:
             self.events.info("plan", f"{len(self.plan.setpoints_c)} setpoints × {len(self.plan.poses)} poses = "
                                      f"{len(self.plan.pose_steps)} poses, {len(self.sensors)} DUTs, "
                                      f"{self.procedure.acquisition.samples_per_pose} samples per pose")
-            run = f" (run {self.resume.run}, resuming after {self.poses_done} stored poses)" if self.resume else ""
-            self._notify("start", f"campaign started{run}: {len(self.plan.pose_steps) - self.poses_done} poses to "
-                                  f"measure" + (f", about {format_duration(self._remaining_s() or 0.0)}"
-                                                if self.audience.estimate else ""))
+            run = f" (run {self.resume.run}, resuming after {self.report.poses_done} stored poses)" if self.resume else ""
+            self.report.notify("start", f"campaign started{run}: {len(self.plan.pose_steps) - self.report.poses_done} poses to "
+                                  f"measure" + (f", about {format_duration(self.report.remaining_s(self.machine.state) or 0.0)}"
+                                                if self.report.audience.estimate else ""))
             if self.resume is not None and self.resume.unclean:
                 self.events.warning("resume", "the last run ended without closing the file (its process died): "
                                               "safe state first")
@@ -137,12 +113,12 @@ class CampaignRunner:
                 self._run_setpoint(setpoint, [s for s in steps if s.key not in self._stored_keys])
             self.machine.go(State.SAFE, "campaign complete")
             safe = apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
-            self._notify("safe", "every pose measured; rig in its safe state" if safe else
+            self.report.notify("safe", "every pose measured; rig in its safe state" if safe else
                                  "every pose measured; safe state INCOMPLETE: see the event log")
             fit, fit_failed = self._fit() if self.fit_stage is not None else ("", False)
             self.machine.go(State.DONE)
             self.writer.set_state("done", finished=True)
-            self._notify("finish", f"campaign done; fit failed: {fit}" if fit_failed else f"campaign done; {fit}")
+            self.report.notify("finish", f"campaign done; fit failed: {fit}" if fit_failed else f"campaign done; {fit}")
             return self._summary("done", fit, fit_failed)
         except BaseException as exc:  # noqa: BLE001 - every exit path goes through the safe state
             reason = one_line_reason(exc)
@@ -162,9 +138,9 @@ class CampaignRunner:
             self.machine.go(State.ABORTING, reason)
             self.machine.go(State.SAFE, "abort")
         self.events.error("fault", f"campaign aborted: {reason}")
-        self._notify("fault", f"campaign aborted: {reason}")
+        self.report.notify("fault", f"campaign aborted: {reason}")
         safe = apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
-        self._notify("safe", f"rig in its safe state; {self.poses_done} of {len(self.plan.pose_steps)} poses stored"
+        self.report.notify("safe", f"rig in its safe state; {self.report.poses_done} of {len(self.plan.pose_steps)} poses stored"
                      if safe else "safe state INCOMPLETE: check the rig; see the event log")
         if self.machine.state is State.SAFE:
             self.machine.go(State.ABORTED)
@@ -186,51 +162,14 @@ class CampaignRunner:
         return summary, False
 
     def _summary(self, state: str, fit: str = "", fit_failed: bool = False) -> CampaignSummary:
-        return CampaignSummary(state, self.plan.setpoints_c, self.poses_done, len(self.plan.pose_steps),
+        return CampaignSummary(state, self.plan.setpoints_c, self.report.poses_done, len(self.plan.pose_steps),
                                len(self.sensors), self.clock.now(), fit, fit_failed)
 
     def _record_transition(self, previous: State, target: State, reason: str) -> None:
         suffix = f" ({reason})" if reason else ""
         self.events.debug("transition", f"{previous} → {target}{suffix}")
-        if self._phases.get(str(target), str(target)) != self._phases.get(str(previous), str(previous)):
-            self._publish()  # within a pose the snapshot after storing it says all
-
-    # ----------------------------------------------------------------- audience
-    def _remaining_s(self) -> float | None:
-        """The estimate of the time left, while there is measuring left to do."""
-        estimate, state = self.audience.estimate, self.machine.state
-        if estimate is None or state not in _MEASURING_STATES:
-            return None
-        in_poses = self._phases.get(str(state)) in ("poses", "cool")
-        return estimate.remaining_s(self._poses_left, max(self._setpoint_index, 0),
-                                    self.clock.now() - self._setpoint_start_s if self._setpoint_index >= 0 else 0.0,
-                                    in_poses)
-
-    def _publish(self) -> None:
-        """Hand the progress listener a snapshot; a listener that fails is reported once and ignored."""
-        if self.audience.progress is None or self._progress_failed:
-            return
-        now = self.clock.now()
-        phase = self._phases.get(str(self.machine.state), str(self.machine.state))
-        if phase != self._phase[0]:
-            self._phase = (phase, now)
-        index = self._setpoint_index
-        active = 0 <= index and self.machine.state in _MEASURING_STATES
-        try:
-            self.audience.progress(Progress(
-                state=str(self.machine.state), phase=phase, setpoint_c=self.plan.setpoints_c[index] if active else None,
-                setpoint_number=index + 1, setpoints_total=len(self.plan.setpoints_c),
-                phase_elapsed_s=now - self._phase[1], chamber_c=self._chamber_c, dut_c=self._dut_c,
-                poses_done=self.poses_done, poses_total=len(self.plan.pose_steps), clock_s=now,
-                remaining_s=self._remaining_s()))
-        except Exception as exc:  # noqa: BLE001 - a display must never stop a campaign
-            self._progress_failed = True
-            LOGGER.error("progress display failed, no more progress shown: %s", exc)
-
-    def _notify(self, event: str, message: str) -> None:
-        if self.audience.notifier is not None:
-            self.audience.notifier.send(Notification(event, message, self.audience.campaign, self.procedure.name,
-                                                     self.clock.now(), self.poses_done, len(self.plan.pose_steps)))
+        if self.report.phase_of(target) != self.report.phase_of(previous):
+            self.report.publish(self.machine.state)  # within a pose the snapshot after storing it says all
 
     # ----------------------------------------------------------------- preflight
     def _preflight(self) -> None:
@@ -254,9 +193,8 @@ class CampaignRunner:
         if not any(s.kind == "pose" for s in steps):
             self.events.info("setpoint", f"{label}: every pose already stored")
             return
-        self._setpoint_index = self.plan.setpoints_c.index(setpoint_c)
-        self._setpoint_start_s = self.clock.now()
-        self.writer.check_space(sum(self._poses_left[self._setpoint_index:]))
+        self.report.begin_setpoint(setpoint_c)
+        self.writer.check_space(sum(self.report.poses_left[self.report.setpoint_index:]))
         self.machine.go(State.RAMP, label)
         pose_steps = [s for s in steps if s.kind == "pose"]
         if self._ramp_origin is not None and setpoint_c != self.plan.setpoints_c[-1]:
@@ -284,7 +222,7 @@ class CampaignRunner:
                 self._advance_software_ramp()
                 self._measure_pose(step)
         total = len(self.plan.pose_steps)
-        self.events.info("setpoint", f"{label}: {len(pose_steps)} poses stored ({self.poses_done}/{total} in all)")
+        self.events.info("setpoint", f"{label}: {len(pose_steps)} poses stored ({self.report.poses_done}/{total} in all)")
 
     # ----------------------------------------------------------------- the ramp method
     def _start_software_ramp(self, setpoint_c: float) -> None:
@@ -328,7 +266,7 @@ class CampaignRunner:
         while self.clock.now() < arrival_s:
             self._advance_software_ramp()
             self._chamber_temperature_c()  # the alarm, and what the progress display shows
-            self._publish()
+            self.report.publish(self.machine.state)
             self.clock.sleep(min(self.procedure.ramp.update_s, arrival_s - self.clock.now()))
         self._advance_software_ramp()
 
@@ -367,7 +305,7 @@ class CampaignRunner:
         self.events.info("ramp", f"ramp {start_c:.1f} → {setpoint_c:g} °C (deadline {format_duration(timeout_s)})")
         def reached() -> bool:
             within = abs(self._chamber_temperature_c() - setpoint_c) <= soak.chamber_tolerance_c
-            self._publish()
+            self.report.publish(self.machine.state)
             return within
 
         t_reached = wait_until(
@@ -385,8 +323,8 @@ class CampaignRunner:
         def poll() -> bool:
             dut_c = np.array([s.read_temperature_c() for s in self.sensors])
             detector.add(self.clock.now(), self._chamber_temperature_c(), dut_c)
-            self._dut_c = tuple(dut_c.tolist())
-            self._publish()
+            self.report.dut_c = tuple(dut_c.tolist())
+            self.report.publish(self.machine.state)
             return detector.is_stable()
 
         outcome, t_stable = "fault", float("nan")  # what the file says if anything but the deadline stops it
@@ -408,25 +346,25 @@ class CampaignRunner:
             if criterion.on_timeout == "skip":
                 self.events.warning("soak", f"{timed_out}; setpoint skipped, its {n_poses} poses not measured "
                                             "(soak.on_timeout: skip)")
-                self._notify("soak", f"{timed_out}; setpoint skipped (soak.on_timeout: skip)")
-                self._poses_left[self._setpoint_index] = 0
+                self.report.notify("soak", f"{timed_out}; setpoint skipped (soak.on_timeout: skip)")
+                self.report.poses_left[self.report.setpoint_index] = 0
                 return False
             self.events.warning("soak", f"{timed_out}; measuring its poses anyway (soak.on_timeout: proceed)")
-            self._notify("soak", f"{timed_out}; measuring its poses anyway (soak.on_timeout: proceed)")
+            self.report.notify("soak", f"{timed_out}; measuring its poses anyway (soak.on_timeout: proceed)")
             return True
         spans = detector.dut_spans_c()
         message = (f"{label}: stable after {format_duration(t_stable - t_reached)} at DUT "
                    f"{np.round(self._settled_dut_c, 2).tolist()} °C (spans ≤ {spans.max():.2f} °C)")
         self.events.info("soak", message)
-        self._notify("soak", message)
+        self.report.notify("soak", message)
         return True
 
     def _chamber_temperature_c(self) -> float:
         """Chamber air temperature; an active controller alarm is a fault, never a reading to wait out."""
         if self.chamber.alarm_active():
             raise InstrumentError(f"chamber ({self.chamber.endpoint}): controller alarm active")
-        self._chamber_c = self.chamber.read_temperature_c()
-        return self._chamber_c
+        self.report.chamber_c = self.chamber.read_temperature_c()
+        return self.report.chamber_c
 
     # ----------------------------------------------------------------- one pose
     def _measure_pose(self, step: PlanStep) -> None:
@@ -453,12 +391,12 @@ class CampaignRunner:
             duts=[self._dut_record(i, block, gravity_fixture) for i, block in enumerate(blocks)],
         )
         self.writer.append_pose(record)
-        self.poses_done += 1
-        self._poses_left[self._setpoint_index] -= 1
-        self._chamber_c = chamber_after
-        self._dut_c = tuple(float(np.mean(b.temperature_c)) for b in blocks)
+        self.report.poses_done += 1
+        self.report.poses_left[self.report.setpoint_index] -= 1
+        self.report.chamber_c = chamber_after
+        self.report.dut_c = tuple(float(np.mean(b.temperature_c)) for b in blocks)
         self.events.debug("pose", f"{step.key} stored")
-        self._publish()
+        self.report.publish(self.machine.state)
 
     def _move(self, commanded: np.ndarray) -> None:
         current = self.turntable.read_angles_deg() if self._table_angles_deg is None else self._table_angles_deg

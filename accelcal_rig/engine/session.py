@@ -24,7 +24,8 @@ from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.core.signals import TerminationRequested, signals_deferred
-from accelcal_rig.engine.campaign import Audience, CampaignRunner, CampaignSummary, FitStage, one_line_reason
+from accelcal_rig.engine.audience import Audience
+from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitStage, one_line_reason
 from accelcal_rig.engine.connection import ConnectedRig, RigConnector
 from accelcal_rig.engine.estimate import estimate_duration
 from accelcal_rig.engine.events import EventLog
