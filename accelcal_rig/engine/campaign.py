@@ -27,13 +27,13 @@ from accelcal_rig.engine.connection import GuardedRig
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.resume import ResumePoint
 from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
-from accelcal_rig.engine.soak import SoakDetector
 from accelcal_rig.engine.states import ACTIVE_STATES, State, StateMachine
-from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, TransientInstrumentError, WaitTimeout
+from accelcal_rig.engine.thermal_steps import ThermalSteps
+from accelcal_rig.errors import CampaignAborted, RigError, TransientInstrumentError
 from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity, SampleBlock
 from accelcal_rig.plan.compile import Plan, PlanStep, setpoint_label
 from accelcal_rig.store.content import Campaign
-from accelcal_rig.store.records import DutPoseRecord, PoseRecord, SoakTrace
+from accelcal_rig.store.records import DutPoseRecord, PoseRecord
 from accelcal_rig.store.writer import CampaignWriter
 
 #: A move's deadline is 1.5 × its travel time at the configured speeds plus this margin.
@@ -78,7 +78,6 @@ class CampaignRunner:
         self._stored_keys = resume.done_keys if resume is not None else frozenset()
         self._mounts = {s.serial: Rotation.from_euler("xyz", s.mount_euler_deg, degrees=True)
                         for s in rig.fixture.sensors}
-        self._settled_dut_c = np.zeros(len(self.sensors))
         #: The table's angles as last read within this setpoint's poses (None: read before moving).
         self._table_angles_deg: np.ndarray | None = None
         self.safe_setpoint_c = safe_setpoint_c(procedure, rig)
@@ -86,11 +85,8 @@ class CampaignRunner:
         self.report = Reporter(audience, plan, procedure.name, clock, procedure.cooldown is not None,
                                [sum(1 for s in plan.pose_steps if s.setpoint_c == setpoint and s.key not in stored)
                                 for setpoint in plan.setpoints_c], len(stored))
-        #: True while the DUT temperatures move on purpose (cool-down, ramp): no band warnings then.
-        self._temperature_moving = False
-        #: The ramp method's software ramp once running: (clock time, setpoint °C) it started from.
-        self._ramp_origin: tuple[float, float] | None = None
-        self._ramp_written_s = float("-inf")
+        self.thermal = ThermalSteps(procedure, rig, plan, self.chamber, self.sensors, clock, events, writer,
+                                    self.machine, self.report)
 
     # ----------------------------------------------------------------- top level
     def run(self) -> CampaignSummary:
@@ -197,174 +193,32 @@ class CampaignRunner:
         self.writer.check_space(sum(self.report.poses_left[self.report.setpoint_index:]))
         self.machine.go(State.RAMP, label)
         pose_steps = [s for s in steps if s.kind == "pose"]
-        if self._ramp_origin is not None and setpoint_c != self.plan.setpoints_c[-1]:
-            self._follow_ramp_to(self._cycle_start_c(setpoint_c))
-        elif self._ramp_origin is not None:
+        if self.thermal.ramping and setpoint_c != self.plan.setpoints_c[-1]:
+            self.thermal.follow_ramp_to(self.thermal.cycle_start_c(setpoint_c))
+        elif self.thermal.ramping:
             # The end of the ramp: hold the last setpoint until the DUTs, lagging the air, have caught up, so
             # the calibrated range reaches it.
-            self._follow_ramp_to(setpoint_c)
-            self._temperature_moving = False
+            self.thermal.follow_ramp_to(setpoint_c)
+            self.thermal.temperature_moving = False
             self.machine.go(State.SOAK, label)
-            if not self._soak(setpoint_c, label, self.clock.now(), len(pose_steps)):
+            if not self.thermal.soak(setpoint_c, label, self.clock.now(), len(pose_steps)):
                 return
         else:
-            t_reached = self._ramp(setpoint_c)
+            t_reached = self.thermal.ramp(setpoint_c)
             self.machine.go(State.SOAK, label)
-            if not self._soak(setpoint_c, label, t_reached, len(pose_steps)):
+            if not self.thermal.soak(setpoint_c, label, t_reached, len(pose_steps)):
                 return
             self._table_angles_deg = None  # hours of soak: ask the table where it is
             if self.procedure.method == "ramp":
-                self._start_software_ramp(setpoint_c)
+                self.thermal.start_software_ramp(setpoint_c)
         if self.procedure.cooldown is not None:
-            self._cool_down(pose_steps)
+            self.thermal.cool_down(pose_steps, self._measure_pose)
         else:
             for step in pose_steps:
-                self._advance_software_ramp()
+                self.thermal.advance_software_ramp()
                 self._measure_pose(step)
         total = len(self.plan.pose_steps)
         self.events.info("setpoint", f"{label}: {len(pose_steps)} poses stored ({self.report.poses_done}/{total} in all)")
-
-    # ----------------------------------------------------------------- the ramp method
-    def _start_software_ramp(self, setpoint_c: float) -> None:
-        """From the soak at `setpoint_c` on, move the chamber setpoint at the procedure's rate towards the
-        last setpoint, where it soaks again; the poses in between follow the ramp."""
-        assert self.procedure.ramp is not None
-        self._ramp_origin = (self.clock.now(), setpoint_c)
-        self._temperature_moving = True
-        last = self.plan.setpoints_c[-1]
-        self.events.info("ramp", f"ramp method: chamber setpoint moving {setpoint_c:g} → {last:g} °C at "
-                                 f"{self.procedure.ramp.rate_c_per_min:g} °C/min, poses taken as it goes")
-
-    def _ramp_setpoint_c(self, t_s: float) -> float:
-        """Where the software ramp is at clock time `t_s`, stopping at the last setpoint."""
-        assert self._ramp_origin is not None and self.procedure.ramp is not None
-        t0, start_c = self._ramp_origin
-        last = self.plan.setpoints_c[-1]
-        travelled = self.procedure.ramp.rate_c_per_min / 60.0 * (t_s - t0)
-        return float(min(start_c + travelled, last) if last > start_c else max(start_c - travelled, last))
-
-    def _cycle_start_c(self, setpoint_c: float) -> float:
-        """A setpoint's poses begin half-way from the previous setpoint."""
-        index = self.plan.setpoints_c.index(setpoint_c)
-        return 0.5 * (self.plan.setpoints_c[index - 1] + setpoint_c) if index else setpoint_c
-
-    def _advance_software_ramp(self) -> None:
-        """Write the ramp's current setpoint, at most every `ramp.update_s`."""
-        if self._ramp_origin is None:
-            return
-        assert self.procedure.ramp is not None
-        now = self.clock.now()
-        if now - self._ramp_written_s >= self.procedure.ramp.update_s:
-            self.chamber.write_setpoint_c(round(self._ramp_setpoint_c(now), 3))
-            self._ramp_written_s = now
-
-    def _follow_ramp_to(self, target_c: float) -> None:
-        """Keep the software ramp moving until it reaches `target_c` (at once if it already has)."""
-        assert self._ramp_origin is not None and self.procedure.ramp is not None
-        t0, start_c = self._ramp_origin
-        arrival_s = t0 + abs(target_c - start_c) / (self.procedure.ramp.rate_c_per_min / 60.0)
-        while self.clock.now() < arrival_s:
-            self._advance_software_ramp()
-            self._chamber_temperature_c()  # the alarm, and what the progress display shows
-            self.report.publish(self.machine.state)
-            self.clock.sleep(min(self.procedure.ramp.update_s, arrival_s - self.clock.now()))
-        self._advance_software_ramp()
-
-    def _cool_down(self, steps: list[PlanStep]) -> None:
-        """Hold the pose, record once at the setpoint, let the chamber go, record on schedule while the DUTs
-        cool. A resumed cool-down records its missing blocks on a fresh schedule after a fresh soak."""
-        cooldown = self.procedure.cooldown
-        assert cooldown is not None
-        released_s = self.clock.now()
-        self._temperature_moving = True
-        for index, step in enumerate(steps):
-            if index:  # every record_every_s from the moment the chamber was let go
-                self.machine.go(State.COOL, step.key)
-                self.clock.sleep(max(released_s + index * cooldown.record_every_s - self.clock.now(), 0.0))
-            self._measure_pose(step)
-            if index == 0:
-                released_s = self.clock.now()
-                if cooldown.chamber == "power-off":
-                    self.chamber.set_power(False)
-                    self.events.info("cooldown", "chamber switched off: the DUTs cool freely; recording every "
-                                                 f"{cooldown.record_every_s:g} s for {cooldown.duration_min:g} min")
-                else:
-                    self.chamber.write_setpoint_c(cooldown.ambient_c)
-                    self.events.info("cooldown", f"chamber set to ambient {cooldown.ambient_c:g} °C; recording every "
-                                                 f"{cooldown.record_every_s:g} s for {cooldown.duration_min:g} min")
-        self._temperature_moving = False
-
-    def _ramp(self, setpoint_c: float) -> float:
-        soak = self.procedure.soak
-        if self.procedure.cooldown is not None and self.procedure.cooldown.chamber == "power-off":
-            self.chamber.set_power(True)  # a cool-down switches it off; a resumed one needs it on again
-        start_c = self._chamber_temperature_c()
-        self.chamber.write_setpoint_c(setpoint_c)
-        ramp_s = abs(setpoint_c - start_c) / (self.rig.chamber.ramp_rate_c_per_min / 60.0)
-        timeout_s = soak.ramp_timeout_factor * ramp_s + soak.ramp_timeout_margin_min * 60.0
-        self.events.info("ramp", f"ramp {start_c:.1f} → {setpoint_c:g} °C (deadline {format_duration(timeout_s)})")
-        def reached() -> bool:
-            within = abs(self._chamber_temperature_c() - setpoint_c) <= soak.chamber_tolerance_c
-            self.report.publish(self.machine.state)
-            return within
-
-        t_reached = wait_until(
-            self.clock, reached,
-            timeout_s=timeout_s, poll_s=soak.poll_s,
-            what=f"chamber ({self.chamber.endpoint}) reaching {setpoint_c:g} °C",
-        )
-        return t_reached
-
-    def _soak(self, setpoint_c: float, label: str, t_reached: float, n_poses: int) -> bool:
-        """Wait for thermal stability; False when the setpoint is to be skipped (`soak.on_timeout: skip`)."""
-        criterion = self.procedure.soak
-        detector = SoakDetector(criterion, setpoint_c, t_reached)
-
-        def poll() -> bool:
-            dut_c = np.array([s.read_temperature_c() for s in self.sensors])
-            detector.add(self.clock.now(), self._chamber_temperature_c(), dut_c)
-            self.report.dut_c = tuple(dut_c.tolist())
-            self.report.publish(self.machine.state)
-            return detector.is_stable()
-
-        outcome, t_stable = "fault", float("nan")  # what the file says if anything but the deadline stops it
-        try:
-            t_stable = wait_until(self.clock, poll, timeout_s=criterion.timeout_min * 60.0, poll_s=criterion.poll_s,
-                                  what=f"{label}: DUT temperatures stable within {criterion.band_c:g} °C")
-            outcome = "stable"
-        except WaitTimeout as exc:
-            outcome = "timeout"
-            if criterion.on_timeout == "abort":
-                raise
-            timed_out = exc
-        finally:
-            t, chamber, dut = detector.trace()
-            self._settled_dut_c = detector.settled_dut_c() if len(t) else np.full(len(self.sensors), np.nan)
-            self.writer.write_soak(SoakTrace(label, setpoint_c, outcome, t, chamber, dut, t_reached, t_stable,
-                                             self._settled_dut_c, tuple(s.serial for s in self.sensors)))
-        if outcome == "timeout":
-            if criterion.on_timeout == "skip":
-                self.events.warning("soak", f"{timed_out}; setpoint skipped, its {n_poses} poses not measured "
-                                            "(soak.on_timeout: skip)")
-                self.report.notify("soak", f"{timed_out}; setpoint skipped (soak.on_timeout: skip)")
-                self.report.poses_left[self.report.setpoint_index] = 0
-                return False
-            self.events.warning("soak", f"{timed_out}; measuring its poses anyway (soak.on_timeout: proceed)")
-            self.report.notify("soak", f"{timed_out}; measuring its poses anyway (soak.on_timeout: proceed)")
-            return True
-        spans = detector.dut_spans_c()
-        message = (f"{label}: stable after {format_duration(t_stable - t_reached)} at DUT "
-                   f"{np.round(self._settled_dut_c, 2).tolist()} °C (spans ≤ {spans.max():.2f} °C)")
-        self.events.info("soak", message)
-        self.report.notify("soak", message)
-        return True
-
-    def _chamber_temperature_c(self) -> float:
-        """Chamber air temperature; an active controller alarm is a fault, never a reading to wait out."""
-        if self.chamber.alarm_active():
-            raise InstrumentError(f"chamber ({self.chamber.endpoint}): controller alarm active")
-        self.report.chamber_c = self.chamber.read_temperature_c()
-        return self.report.chamber_c
 
     # ----------------------------------------------------------------- one pose
     def _measure_pose(self, step: PlanStep) -> None:
@@ -380,7 +234,7 @@ class CampaignRunner:
         n = self.procedure.acquisition.samples_per_pose
         blocks = self.retrier.call(partial(acquire_together, self.sensors, n, self.clock,
                                            self.procedure.acquisition.range_g))
-        chamber_after = self._chamber_temperature_c()
+        chamber_after = self.thermal.read_chamber_c()
         self.machine.go(State.STORE, step.key)
         gravity_fixture = np.array(step.pose.gravity_fixture)
         record = PoseRecord(
@@ -423,11 +277,11 @@ class CampaignRunner:
         mean_g = codes.mean(axis=0) * lsb
         stderr_g = codes.std(axis=0, ddof=1) * lsb / np.sqrt(n)
         band = self.procedure.soak.band_c
-        in_band = bool(np.all(np.abs(np.array(block.temperature_c) - self._settled_dut_c[index]) <= band))
-        if not in_band and not self._temperature_moving:
+        in_band = bool(np.all(np.abs(np.array(block.temperature_c) - self.thermal.settled_dut_c[index]) <= band))
+        if not in_band and not self.thermal.temperature_moving:
             before, after = block.temperature_c
             self.events.warning("pose", f"sensor {sensor.serial}: temperature {before:.2f}/{after:.2f} °C left the "
-                                        f"±{band:g} °C band around {self._settled_dut_c[index]:.2f} °C")
+                                        f"±{band:g} °C band around {self.thermal.settled_dut_c[index]:.2f} °C")
         return DutPoseRecord(
             serial=sensor.serial, raw_codes=codes, mean_g=mean_g, stderr_g=stderr_g,
             temperature_c=block.temperature_c,
