@@ -55,5 +55,5 @@ def load_object(reference: str, what: str) -> Any:
     module, _, attribute = reference.partition(":")
     try:
         return getattr(importlib.import_module(module), attribute)
-    except (ImportError, AttributeError) as exc:
+    except Exception as exc:  # noqa: BLE001 - a broken plug-in is one line naming it, not a traceback
         raise ConfigError(f"{what}: cannot load {reference}: {exc}") from None

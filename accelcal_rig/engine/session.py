@@ -23,7 +23,7 @@ from accelcal_rig.config.load import (
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.logger import LOGGER
-from accelcal_rig.core.signals import TerminationRequested, signals_deferred
+from accelcal_rig.core.signals import signals_deferred
 from accelcal_rig.engine.audience import Audience
 from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitStage, one_line_reason
 from accelcal_rig.engine.connection import ConnectedRig, RigConnector
@@ -252,7 +252,9 @@ def _run(prepared: PreparedCampaign, output: Path, open_writer: Callable[[], Cam
                                 if calibration and procedure.fit.mode != "none" else None,
                                 resume=resume, audience=Audience(progress, estimate, notifier, str(output)))
         summary = runner.run()
-    except (KeyboardInterrupt, TerminationRequested) as exc:
+    except CampaignAborted:
+        raise  # the runner reached the safe state and recorded it
+    except BaseException as exc:  # noqa: BLE001 - a stop or failure before the first step still ends safe
         if writer is not None and writer.campaign.state == "created":
             _stopped_before_start(writer, rig_connected, procedure, rig, exc)
         raise
@@ -268,15 +270,21 @@ def _run(prepared: PreparedCampaign, output: Path, open_writer: Callable[[], Cam
 
 def _stopped_before_start(writer: CampaignWriter, connected: ConnectedRig, procedure: Procedure, rig: RigConfig,
                           exc: BaseException) -> NoReturn:
-    """A stop between the campaign's creation and its first step: nothing has moved yet, but the rig still
-    goes to its safe state and the file says why the campaign ended, as after any other abort."""
+    """A stop or a failure between the campaign's creation and its first step: nothing has moved yet, but the
+    rig still goes to its safe state and the file says why the campaign ended, as after any other abort."""
     reason = one_line_reason(exc)
     with signals_deferred():
         events = EventLog(connected.clock, writer)
-        events.error("fault", f"campaign aborted before its first step: {reason}")
+        try:
+            events.error("fault", f"campaign aborted before its first step: {reason}")
+        except Exception as failed:  # noqa: BLE001 - the safe state comes first, whatever the file does
+            LOGGER.error("could not record the abort in the campaign file: %s", failed)
         raw = connected.instruments
         apply_safe_state(raw.chamber, raw.turntable, raw.sensors, safe_setpoint_c(procedure, rig), events)
-        writer.set_state("aborted", reason=reason, finished=True)
+        try:
+            writer.set_state("aborted", reason=reason, finished=True)
+        except Exception as failed:  # noqa: BLE001 - the reason still reaches the operator through the exception
+            LOGGER.error("could not record the abort in the campaign file: %s", failed)
     raise CampaignAborted(reason) from exc
 
 

@@ -42,5 +42,6 @@ ADXL359 = AccelerometerPart(
     range_codes=dict(zip((10, 20, 40), _RANGE_CODES)),
     output_data_rates_hz=OUTPUT_DATA_RATES_HZ, code_bits=20,
     temperature=TemperatureFormat(bits=12, intercept_lsb=1852.0, slope_lsb_per_c=-9.05),
-    noise_density_ug_per_rthz=80.0, source="ADXL359 data sheet Rev. 0",
+    # Noise density: the ADXL357's figure, not yet checked against the ADXL359 data sheet (docs/instruments.md).
+    noise_density_ug_per_rthz=80.0, source="ADXL359 data sheet Rev. 0 (identity, ranges); no-OS driver (scale)",
 )

@@ -6,6 +6,7 @@ from __future__ import annotations
 from functools import cache
 from importlib.metadata import entry_points
 
+from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.adxl35x import ADXL355, ADXL357, ADXL359
 from accelcal_rig.parts.part import AccelerometerPart
 
@@ -19,9 +20,14 @@ def known_parts() -> dict[str, AccelerometerPart]:
     """Every part by name; a built-in name cannot be taken over by a plug-in."""
     parts = {}
     for entry in entry_points(group=ENTRY_POINT_GROUP):
-        part = entry.load()
-        if isinstance(part, AccelerometerPart) and part.name == entry.name:
-            parts[entry.name] = part
+        try:
+            part = entry.load()
+        except Exception as exc:  # noqa: BLE001 - a broken plug-in is one line naming it, not a traceback
+            raise ConfigError(f"part plug-in {entry.name!r} ({entry.value}): cannot load: {exc}") from None
+        if not (isinstance(part, AccelerometerPart) and part.name == entry.name):
+            raise ConfigError(f"part plug-in {entry.name!r} ({entry.value}): not an AccelerometerPart named "
+                              f"{entry.name!r}")
+        parts[entry.name] = part
     return {**parts, **_BUILT_IN}
 
 

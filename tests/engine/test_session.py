@@ -1,4 +1,4 @@
-"""The session around the runner: a stop that comes between the campaign file's creation and the runner's
+"""The session around the runner: a stop or a failure that comes between the campaign file's creation and the runner's
 first step still ends in the safe state, recorded in the file."""
 
 from __future__ import annotations
@@ -46,7 +46,8 @@ class StopsBeforeTheFirstStep:
 
 
 @pytest.mark.parametrize(("stop", "reason"), [(KeyboardInterrupt(), "interrupted by operator (Ctrl-C)"),
-                                               (TerminationRequested(), "terminated by signal (SIGTERM)")])
+                                               (TerminationRequested(), "terminated by signal (SIGTERM)"),
+                                               (RuntimeError("wrapping failed"), "RuntimeError: wrapping failed")])
 def test_a_stop_before_the_first_step_ends_safe_and_recorded(write, workdir: Path, stop, reason) -> None:
     prepared = prepare(write("tiny.yaml", TINY_PROCEDURE))
     output = workdir / "run.h5"
