@@ -1,6 +1,10 @@
-"""The runner: a campaign's lifecycle and the order of its plan — preflight, each setpoint's thermal steps
-(engine/thermal_steps.py) and poses (engine/pose_steps.py), the safe state, the fit — while its audience
-is told (engine/audience.py).
+"""The runner: a campaign's lifecycle — preflight, the plan's steps in order, the safe state, the fit —
+while its audience is told (engine/audience.py).
+
+The runner does not know what a step does: it hands each to the handler for its type (thermal steps in
+engine/thermal_steps.py, poses in engine/pose_steps.py, a cool-down's records in engine/cooldown_steps.py).
+It knows where a resumed run begins (the steps not stored yet, a setpoint's restart entry) and that a
+skipped soak skips the rest of its setpoint.
 
 Every wait has a deadline; any fault or signal leads through ABORTING to the safe state, is written to
 the campaign file's event log, and is raised again as CampaignAborted with a one-line reason.
@@ -8,10 +12,10 @@ the campaign file's event log, and is raised again as CampaignAborted with a one
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import partial
-from itertools import groupby
+from typing import Any
 
 import numpy as np
 
@@ -23,15 +27,27 @@ from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.core.signals import TerminationRequested, signals_deferred
 from accelcal_rig.engine.audience import Audience, Reporter
 from accelcal_rig.engine.connection import GuardedRig
+from accelcal_rig.engine.cooldown_steps import CooldownSteps
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.pose_steps import PoseSteps
 from accelcal_rig.engine.resume import ResumePoint
 from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
 from accelcal_rig.engine.states import ACTIVE_STATES, State, StateMachine
-from accelcal_rig.engine.thermal_steps import ThermalSteps
+from accelcal_rig.engine.thermal_steps import SetpointSkipped, ThermalSteps
 from accelcal_rig.errors import CampaignAborted, RigError, TransientInstrumentError
 from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity
-from accelcal_rig.plan.compile import Plan, PlanStep, setpoint_label
+from accelcal_rig.plan.compile import Plan, setpoint_label
+from accelcal_rig.plan.steps import (
+    AdvanceRamp,
+    CooldownRecord,
+    Measurement,
+    MeasurePose,
+    Ramp,
+    RampSegment,
+    Soak,
+    StartSoftwareRamp,
+    Step,
+)
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.writer import CampaignWriter
 
@@ -77,6 +93,13 @@ class CampaignRunner:
         self.thermal = ThermalSteps(procedure, rig, plan, self.chamber, self.sensors, clock, events, writer,
                                     self.machine, self.report)
         self.poses = PoseSteps(procedure, rig, guarded, clock, events, writer, self.machine, self.report, self.thermal)
+        cooldown = CooldownSteps(procedure, self.chamber, clock, events, self.machine, self.thermal, self.poses)
+        #: What each type of step is done by.
+        self.handlers: Mapping[type, Callable[[Any], None]] = {
+            Ramp: self.thermal.ramp, Soak: self.thermal.soak, StartSoftwareRamp: self.thermal.start_software_ramp,
+            RampSegment: self.thermal.follow_software_ramp, AdvanceRamp: self.thermal.advance_software_ramp,
+            MeasurePose: self.poses.measure, CooldownRecord: cooldown.record,
+        }
 
     # ----------------------------------------------------------------- top level
     def run(self) -> CampaignSummary:
@@ -95,8 +118,7 @@ class CampaignRunner:
                 apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
             self.machine.go(State.PREFLIGHT)
             self._preflight()
-            for setpoint, steps in groupby(self.plan.steps, key=lambda s: s.setpoint_c):
-                self._run_setpoint(setpoint, [s for s in steps if s.key not in self._stored_keys])
+            self._run_stages()
             self.machine.go(State.SAFE, "campaign complete")
             safe = apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
             self.report.notify("safe", "every pose measured; rig in its safe state" if safe else
@@ -172,43 +194,36 @@ class CampaignRunner:
             self.events.info("preflight", f"sensor {sensor.serial}: {sensor.part.label} rev {identity.revid}, "
                                           f"±{acquisition.range_g} g, {acquisition.odr_hz:g} Hz")
 
-    # ----------------------------------------------------------------- one setpoint
-    def _run_setpoint(self, setpoint_c: float, steps: list[PlanStep]) -> None:
-        """Ramp, soak and measure the poses in `steps` (those not stored yet); nothing if none are left."""
-        label = setpoint_label(setpoint_c)
-        if not any(s.kind == "pose" for s in steps):
-            self.events.info("setpoint", f"{label}: every pose already stored")
-            return
-        self.report.begin_setpoint(setpoint_c)
-        self.writer.check_space(sum(self.report.poses_left[self.report.setpoint_index:]))
-        self.machine.go(State.RAMP, label)
-        pose_steps = [s for s in steps if s.kind == "pose"]
-        if self.thermal.ramping and setpoint_c != self.plan.setpoints_c[-1]:
-            self.thermal.follow_ramp_to(self.thermal.cycle_start_c(setpoint_c))
-        elif self.thermal.ramping:
-            # The end of the ramp: hold the last setpoint until the DUTs, lagging the air, have caught up, so
-            # the calibrated range reaches it.
-            self.thermal.follow_ramp_to(setpoint_c)
-            self.thermal.temperature_moving = False
-            self.machine.go(State.SOAK, label)
-            if not self.thermal.soak(setpoint_c, label, self.clock.now(), len(pose_steps)):
-                return
-        else:
-            t_reached = self.thermal.ramp(setpoint_c)
-            self.machine.go(State.SOAK, label)
-            if not self.thermal.soak(setpoint_c, label, t_reached, len(pose_steps)):
-                return
-            self.poses.forget_table_position()  # hours of soak: ask the table where it is
-            if self.procedure.method == "ramp":
-                self.thermal.start_software_ramp(setpoint_c)
-        if self.procedure.cooldown is not None:
-            self.thermal.cool_down(pose_steps, self.poses.measure)
-        else:
-            for step in pose_steps:
-                self.thermal.advance_software_ramp()
-                self.poses.measure(step)
-        total = len(self.plan.pose_steps)
-        self.events.info("setpoint", f"{label}: {len(pose_steps)} poses stored ({self.report.poses_done}/{total} in all)")
+    # ----------------------------------------------------------------- the plan
+    def _run_stages(self) -> None:
+        """Each setpoint's steps not stored yet. A run begins at its first setpoint with something left to
+        measure through that setpoint's restart entry, and so does the setpoint after a skipped soak."""
+        restarting = True
+        for stage in self.plan.stages:
+            label = setpoint_label(stage.setpoint_c)
+            body = [s for s in stage.body if not (isinstance(s, Measurement) and s.key in self._stored_keys)]
+            if not any(isinstance(s, Measurement) for s in body):
+                self.events.info("setpoint", f"{label}: every pose already stored")
+                continue
+            self.report.begin_setpoint(stage.setpoint_c)
+            self.writer.check_space(sum(self.report.poses_left[self.report.setpoint_index:]))
+            try:
+                for step in (*(stage.restart_entry if restarting else stage.entry), *body):
+                    self._execute(step)
+            except SetpointSkipped:
+                restarting = True
+                continue
+            restarting = False
+            stored = sum(isinstance(s, Measurement) for s in body)
+            self.events.info("setpoint", f"{label}: {stored} poses stored "
+                                         f"({self.report.poses_done}/{len(self.plan.pose_steps)} in all)")
+
+    def _execute(self, step: Step) -> None:
+        handler = self.handlers.get(type(step))
+        if handler is None:
+            raise TypeError(f"no handler for a plan step of type {type(step).__name__}")
+        handler(step)
+
 
 def _checked_identity(sensor: Accelerometer) -> DeviceIdentity:
     """The sensor's identity registers; anything but its part's may be a glitch on the line (retried),

@@ -20,7 +20,7 @@ from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.states import State, StateMachine
 from accelcal_rig.engine.thermal_steps import ThermalSteps
 from accelcal_rig.instruments.interfaces import SampleBlock
-from accelcal_rig.plan.compile import PlanStep
+from accelcal_rig.plan.steps import Measurement
 from accelcal_rig.store.records import DutPoseRecord, PoseRecord
 from accelcal_rig.store.writer import CampaignWriter
 
@@ -40,16 +40,15 @@ class PoseSteps:
         self.thermal = thermal
         self._mounts = {s.serial: Rotation.from_euler("xyz", s.mount_euler_deg, degrees=True)
                         for s in rig.fixture.sensors}
-        #: The table's angles as last read within this setpoint's poses (None: read before moving).
+        #: The table's angles as last read, and the setpoint they were read at: the first move at each
+        #: setpoint reads them afresh (hours of soak: the table may have been moved, or have drifted).
         self._table_angles_deg: np.ndarray | None = None
+        self._table_setpoint_c: float | None = None
 
-    def forget_table_position(self) -> None:
-        """Read the table's angles before the next move (it may have been moved, or have drifted)."""
-        self._table_angles_deg = None
-
-    def measure(self, step: PlanStep) -> None:
+    def measure(self, step: Measurement) -> None:
         """Move, settle, acquire every DUT at once, store the pose."""
-        assert step.pose is not None
+        if step.setpoint_c != self._table_setpoint_c:
+            self._table_angles_deg, self._table_setpoint_c = None, step.setpoint_c
         commanded = np.array(step.pose.angles_deg)
         self.machine.go(State.MOVE, step.key)
         self._move(commanded)

@@ -40,6 +40,7 @@ from accelcal_rig.fit.recorded_options import options_attrs, recorded_options
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
+from accelcal_rig.plan.steps import Measurement
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.lock import campaign_lock
 from accelcal_rig.store.paths import journal_path
@@ -211,14 +212,15 @@ def _create_file(prepared: PreparedCampaign, output: Path, connected: ConnectedR
 
 
 def _stored_plan(plan: Plan) -> StoredPlan:
-    steps, n_axes = plan.steps, len(plan.axis_names)
+    records, n_axes = plan.records, len(plan.axis_names)
+    poses = [s.pose if isinstance(s, Measurement) else None for s in records]
     return StoredPlan(
-        step_key=tuple(s.key for s in steps), kind=tuple(s.kind for s in steps),
-        setpoint_c=np.array([s.setpoint_c for s in steps], dtype=float),
-        pose_number=np.array([s.pose.number if s.pose else 0 for s in steps], dtype=np.int64),
-        angles_deg=np.array([s.pose.angles_deg if s.pose else (np.nan,) * n_axes for s in steps], dtype=float).reshape(
-            len(steps), n_axes),
-        gravity_fixture=np.array([s.pose.gravity_fixture if s.pose else (np.nan,) * 3 for s in steps], dtype=float),
+        step_key=tuple(s.key for s in records), kind=tuple(s.stored_kind for s in records),
+        setpoint_c=np.array([s.setpoint_c for s in records], dtype=float),
+        pose_number=np.array([p.number if p else 0 for p in poses], dtype=np.int64),
+        angles_deg=np.array([p.angles_deg if p else (np.nan,) * n_axes for p in poses], dtype=float).reshape(
+            len(records), n_axes),
+        gravity_fixture=np.array([p.gravity_fixture if p else (np.nan,) * 3 for p in poses], dtype=float),
         fingerprint=plan.fingerprint, axis_names=tuple(plan.axis_names))
 
 

@@ -1,10 +1,8 @@
-"""The chamber's part of a campaign: ramping to a setpoint, soaking until the DUTs are stable, the ramp
-method's software ramp, a free cool-down — and what they leave for the poses (the settled DUT temperatures,
-whether the temperatures move on purpose)."""
+"""The chamber's steps of a plan: ramping to a setpoint, soaking until the DUTs are stable, the ramp method's
+software ramp — and what they leave for the poses (the settled DUT temperatures, whether the temperatures
+move on purpose)."""
 
 from __future__ import annotations
-
-from collections.abc import Callable
 
 import numpy as np
 
@@ -19,9 +17,14 @@ from accelcal_rig.engine.soak import SoakDetector
 from accelcal_rig.engine.states import State, StateMachine
 from accelcal_rig.errors import InstrumentError, WaitTimeout
 from accelcal_rig.instruments.interfaces import Accelerometer, Chamber
-from accelcal_rig.plan.compile import Plan, PlanStep
+from accelcal_rig.plan.compile import Plan, setpoint_label
+from accelcal_rig.plan.steps import AdvanceRamp, Ramp, RampSegment, Soak, StartSoftwareRamp
 from accelcal_rig.store.records import SoakTrace
 from accelcal_rig.store.writer import CampaignWriter
+
+
+class SetpointSkipped(Exception):
+    """A soak ran out of time and the procedure says to skip its setpoint (`soak.on_timeout: skip`)."""
 
 
 class ThermalSteps:
@@ -38,20 +41,17 @@ class ThermalSteps:
         #: The ramp method's software ramp once running: (clock time, setpoint °C) it started from.
         self._ramp_origin: tuple[float, float] | None = None
         self._ramp_written_s = float("-inf")
+        #: When the chamber air (or the software ramp) last reached its setpoint: where a soak's deadline starts.
+        self._reached_s = 0.0
 
-    @property
-    def ramping(self) -> bool:
-        """The ramp method's software ramp is running."""
-        return self._ramp_origin is not None
-
-    def start_software_ramp(self, setpoint_c: float) -> None:
-        """From the soak at `setpoint_c` on, move the chamber setpoint at the procedure's rate towards the
-        last setpoint, where it soaks again; the poses in between follow the ramp."""
+    def start_software_ramp(self, step: StartSoftwareRamp) -> None:
+        """From the soak at the step's setpoint on, move the chamber setpoint at the procedure's rate towards
+        the last setpoint, where it soaks again; the poses in between follow the ramp."""
         assert self.procedure.ramp is not None
-        self._ramp_origin = (self.clock.now(), setpoint_c)
+        self._ramp_origin = (self.clock.now(), step.setpoint_c)
         self.temperature_moving = True
         last = self.plan.setpoints_c[-1]
-        self.events.info("ramp", f"ramp method: chamber setpoint moving {setpoint_c:g} → {last:g} °C at "
+        self.events.info("ramp", f"ramp method: chamber setpoint moving {step.setpoint_c:g} → {last:g} °C at "
                                  f"{self.procedure.ramp.rate_c_per_min:g} °C/min, poses taken as it goes")
 
     def _ramp_setpoint_c(self, t_s: float) -> float:
@@ -62,13 +62,12 @@ class ThermalSteps:
         travelled = self.procedure.ramp.rate_c_per_min / 60.0 * (t_s - t0)
         return float(min(start_c + travelled, last) if last > start_c else max(start_c - travelled, last))
 
-    def cycle_start_c(self, setpoint_c: float) -> float:
-        """A setpoint's poses begin half-way from the previous setpoint."""
-        index = self.plan.setpoints_c.index(setpoint_c)
-        return 0.5 * (self.plan.setpoints_c[index - 1] + setpoint_c) if index else setpoint_c
+    def advance_software_ramp(self, step: AdvanceRamp) -> None:
+        """Between poses on the ramp: write its current setpoint."""
+        self._write_ramp_setpoint()
 
-    def advance_software_ramp(self) -> None:
-        """Write the ramp's current setpoint, at most every `ramp.update_s`."""
+    def _write_ramp_setpoint(self) -> None:
+        """Write the software ramp's current setpoint, at most every `ramp.update_s`."""
         if self._ramp_origin is None:
             return
         assert self.procedure.ramp is not None
@@ -77,44 +76,24 @@ class ThermalSteps:
             self.chamber.write_setpoint_c(round(self._ramp_setpoint_c(now), 3))
             self._ramp_written_s = now
 
-    def follow_ramp_to(self, target_c: float) -> None:
-        """Keep the software ramp moving until it reaches `target_c` (at once if it already has)."""
+    def follow_software_ramp(self, step: RampSegment) -> None:
+        """Keep the software ramp moving until it reaches `step.until_c` (at once if it already has)."""
         assert self._ramp_origin is not None and self.procedure.ramp is not None
+        self.machine.go(State.RAMP, setpoint_label(step.setpoint_c))
         t0, start_c = self._ramp_origin
-        arrival_s = t0 + abs(target_c - start_c) / (self.procedure.ramp.rate_c_per_min / 60.0)
+        arrival_s = t0 + abs(step.until_c - start_c) / (self.procedure.ramp.rate_c_per_min / 60.0)
         while self.clock.now() < arrival_s:
-            self.advance_software_ramp()
+            self._write_ramp_setpoint()
             self.read_chamber_c()  # the alarm, and what the progress display shows
             self.report.publish(self.machine.state)
             self.clock.sleep(min(self.procedure.ramp.update_s, arrival_s - self.clock.now()))
-        self.advance_software_ramp()
+        self._write_ramp_setpoint()
+        self._reached_s = self.clock.now()
 
-    def cool_down(self, steps: list[PlanStep], measure: Callable[[PlanStep], None]) -> None:
-        """Hold the pose, record once at the setpoint, let the chamber go, record on schedule while the DUTs
-        cool. A resumed cool-down records its missing blocks on a fresh schedule after a fresh soak."""
-        cooldown = self.procedure.cooldown
-        assert cooldown is not None
-        released_s = self.clock.now()
-        self.temperature_moving = True
-        for index, step in enumerate(steps):
-            if index:  # every record_every_s from the moment the chamber was let go
-                self.machine.go(State.COOL, step.key)
-                self.clock.sleep(max(released_s + index * cooldown.record_every_s - self.clock.now(), 0.0))
-            measure(step)
-            if index == 0:
-                released_s = self.clock.now()
-                if cooldown.chamber == "power-off":
-                    self.chamber.set_power(False)
-                    self.events.info("cooldown", "chamber switched off: the DUTs cool freely; recording every "
-                                                 f"{cooldown.record_every_s:g} s for {cooldown.duration_min:g} min")
-                else:
-                    self.chamber.write_setpoint_c(cooldown.ambient_c)
-                    self.events.info("cooldown", f"chamber set to ambient {cooldown.ambient_c:g} °C; recording every "
-                                                 f"{cooldown.record_every_s:g} s for {cooldown.duration_min:g} min")
-        self.temperature_moving = False
-
-    def ramp(self, setpoint_c: float) -> float:
-        soak = self.procedure.soak
+    def ramp(self, step: Ramp) -> None:
+        """Set the chamber to the setpoint and wait, within a deadline, for its air to reach it."""
+        setpoint_c, soak = step.setpoint_c, self.procedure.soak
+        self.machine.go(State.RAMP, setpoint_label(setpoint_c))
         if self.procedure.cooldown is not None and self.procedure.cooldown.chamber == "power-off":
             self.chamber.set_power(True)  # a cool-down switches it off; a resumed one needs it on again
         start_c = self.read_chamber_c()
@@ -127,15 +106,20 @@ class ThermalSteps:
             self.report.publish(self.machine.state)
             return within
 
-        t_reached = wait_until(
+        self._reached_s = wait_until(
             self.clock, reached,
             timeout_s=timeout_s, poll_s=soak.poll_s,
             what=f"chamber ({self.chamber.endpoint}) reaching {setpoint_c:g} °C",
         )
-        return t_reached
 
-    def soak(self, setpoint_c: float, label: str, t_reached: float, n_poses: int) -> bool:
-        """Wait for thermal stability; False when the setpoint is to be skipped (`soak.on_timeout: skip`)."""
+    def soak(self, step: Soak) -> None:
+        """Wait for thermal stability, from when the chamber (or the software ramp) reached the setpoint.
+
+        Raises SetpointSkipped when the deadline passes and the procedure says `soak.on_timeout: skip`.
+        """
+        setpoint_c, label, t_reached = step.setpoint_c, setpoint_label(step.setpoint_c), self._reached_s
+        self.machine.go(State.SOAK, label)
+        self.temperature_moving = False  # a soak holds the temperature
         criterion = self.procedure.soak
         detector = SoakDetector(criterion, setpoint_c, t_reached)
 
@@ -163,20 +147,20 @@ class ThermalSteps:
                                              self.settled_dut_c, tuple(s.serial for s in self.sensors)))
         if outcome == "timeout":
             if criterion.on_timeout == "skip":
+                n_poses = self.report.poses_left[self.report.setpoint_index]
                 self.events.warning("soak", f"{timed_out}; setpoint skipped, its {n_poses} poses not measured "
                                             "(soak.on_timeout: skip)")
                 self.report.notify("soak", f"{timed_out}; setpoint skipped (soak.on_timeout: skip)")
                 self.report.poses_left[self.report.setpoint_index] = 0
-                return False
+                raise SetpointSkipped(label)
             self.events.warning("soak", f"{timed_out}; measuring its poses anyway (soak.on_timeout: proceed)")
             self.report.notify("soak", f"{timed_out}; measuring its poses anyway (soak.on_timeout: proceed)")
-            return True
+            return
         spans = detector.dut_spans_c()
         message = (f"{label}: stable after {format_duration(t_stable - t_reached)} at DUT "
                    f"{np.round(self.settled_dut_c, 2).tolist()} °C (spans ≤ {spans.max():.2f} °C)")
         self.events.info("soak", message)
         self.report.notify("soak", message)
-        return True
 
     def read_chamber_c(self) -> float:
         """Chamber air temperature; an active controller alarm is a fault, never a reading to wait out."""

@@ -9,7 +9,6 @@ from __future__ import annotations
 import hashlib
 import json
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 
@@ -17,42 +16,49 @@ from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.plan import schedules
 from accelcal_rig.plan.kinematics import TurntableKinematics
-
-
-@dataclass(frozen=True)
-class Pose:
-    """One turntable position: `number` is 1-based like the paper's Table 1."""
-
-    number: int
-    angles_deg: tuple[float, ...]
-    gravity_fixture: tuple[float, float, float]
-
-
-@dataclass(frozen=True)
-class PlanStep:
-    key: str
-    kind: Literal["soak", "pose"]
-    setpoint_c: float
-    pose: Pose | None = None
+from accelcal_rig.plan.steps import (
+    AdvanceRamp,
+    CooldownRecord,
+    Measurement,
+    MeasurePose,
+    Pose,
+    Ramp,
+    RampSegment,
+    Record,
+    Soak,
+    Stage,
+    StartSoftwareRamp,
+    Step,
+)
 
 
 @dataclass(frozen=True)
 class Plan:
     setpoints_c: tuple[float, ...]
     poses: tuple[Pose, ...]
-    steps: tuple[PlanStep, ...]
+    stages: tuple[Stage, ...]
     axis_names: tuple[str, ...]
 
     @property
-    def pose_steps(self) -> tuple[PlanStep, ...]:
-        return tuple(s for s in self.steps if s.kind == "pose")
+    def steps(self) -> tuple[Step, ...]:
+        """The program of a run that starts at the beginning."""
+        return tuple(step for stage in self.stages for step in (*stage.entry, *stage.body))
+
+    @property
+    def records(self) -> tuple[Record, ...]:
+        """Every record the campaign may store, in plan order: what its file lists as the plan."""
+        return tuple(record for stage in self.stages for record in stage.records)
+
+    @property
+    def pose_steps(self) -> tuple[Measurement, ...]:
+        return tuple(s for s in self.records if isinstance(s, Measurement))
 
     @property
     def fingerprint(self) -> str:
-        """SHA-256 over every step's key, setpoint and angles: equal plans, equal fingerprints."""
+        """SHA-256 over every record's key, setpoint and angles: equal plans, equal fingerprints."""
         rows = [
-            [s.key, s.setpoint_c, [round(a, 9) for a in s.pose.angles_deg] if s.pose else None]
-            for s in self.steps
+            [s.key, s.setpoint_c, [round(a, 9) for a in s.pose.angles_deg] if isinstance(s, Measurement) else None]
+            for s in self.records
         ]
         return hashlib.sha256(json.dumps(rows).encode()).hexdigest()
 
@@ -106,8 +112,8 @@ def cooldown_records(procedure: Procedure) -> int:
 
 
 def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
-    """Setpoints in procedure order; at each, one soak step then every pose of the schedule. A cool-down
-    procedure: its one soak, then its records (`T60/cool0001`, …), all at the pose it holds."""
+    """Setpoints in procedure order; at each, the steps that bring the rig there, then every pose of the
+    schedule. A cool-down procedure: one setpoint, then its records (`T60/cool0001`, …) at the pose it holds."""
     poses = compile_poses(procedure, rig)
     names = tuple(a.name for a in rig.turntable.axes)
     if procedure.cooldown is not None:
@@ -116,13 +122,41 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
         held = poses[procedure.cooldown.pose - 1]
         setpoint = procedure.setpoints_c[0]
         label = setpoint_label(setpoint)
-        records = [PlanStep(f"{label}/cool{k:04d}", "pose", setpoint, held)
-                   for k in range(1, cooldown_records(procedure) + 1)]
-        return Plan((setpoint,), (held,), (PlanStep(f"{label}/soak", "soak", setpoint), *records), names)
+        soaked = _ramp_and_soak(setpoint)
+        records = tuple(CooldownRecord(f"{label}/cool{k:04d}", setpoint, held, k)
+                        for k in range(1, cooldown_records(procedure) + 1))
+        return Plan((setpoint,), (held,), (Stage(setpoint, soaked, records, soaked),), names)
     width = max(2, len(str(len(poses))))
-    steps: list[PlanStep] = []
-    for setpoint in procedure.setpoints_c:
+    setpoints = tuple(procedure.setpoints_c)
+    stages = []
+    entry: tuple[Step, ...]
+    restart: tuple[Step, ...]
+    for index, setpoint in enumerate(setpoints):
         label = setpoint_label(setpoint)
-        steps.append(PlanStep(f"{label}/soak", "soak", setpoint))
-        steps.extend(PlanStep(f"{label}/pose{p.number:0{width}d}", "pose", setpoint, p) for p in poses)
-    return Plan(tuple(procedure.setpoints_c), poses, tuple(steps), names)
+        measure = [MeasurePose(f"{label}/pose{p.number:0{width}d}", setpoint, p) for p in poses]
+        if procedure.method == "ramp":
+            entry, restart = _ramp_method_entries(setpoints, index)
+            body: tuple[Step, ...] = tuple(step for m in measure for step in (AdvanceRamp(setpoint), m))
+        else:
+            entry = restart = _ramp_and_soak(setpoint)
+            body = tuple(measure)
+        stages.append(Stage(setpoint, entry, body, restart))
+    return Plan(setpoints, poses, tuple(stages), names)
+
+
+def _ramp_and_soak(setpoint_c: float) -> tuple[Ramp, Soak]:
+    return Ramp(setpoint_c), Soak(f"{setpoint_label(setpoint_c)}/soak", setpoint_c)
+
+
+def _ramp_method_entries(setpoints_c: tuple[float, ...], index: int) -> tuple[tuple[Step, ...], tuple[Step, ...]]:
+    """(entry, restart entry) of the ramp method's `index`-th setpoint. The first soaks and starts the software
+    ramp; each later one's poses begin half-way from the previous setpoint, on the ramp; the last holds its
+    setpoint until the DUTs, lagging the air, have caught up, so the calibrated range reaches it."""
+    setpoint = setpoints_c[index]
+    ramp, soak = _ramp_and_soak(setpoint)
+    start = (ramp, soak, StartSoftwareRamp(setpoint))
+    if index == 0:
+        return start, start
+    if index == len(setpoints_c) - 1:
+        return (RampSegment(setpoint, setpoint), soak), (ramp, soak)
+    return (RampSegment(setpoint, 0.5 * (setpoints_c[index - 1] + setpoint)),), start

@@ -89,3 +89,17 @@ def test_a_ramp_campaign_that_stopped_resumes_with_a_soak_where_it_stopped(write
     assert len(set(keys)) == 24
     # The resumed run soaked where it went on, ramped again, and soaked at the end of the ramp.
     assert soaks[0] == "T20" and soaks[-1] == "T35" and len(soaks) == 3
+
+
+def test_after_a_skipped_first_soak_the_next_setpoint_soaks_and_starts_the_ramp_itself(write, workdir: Path) -> None:
+    from tests.engine.test_resume import never_stable_at_20, run_with
+
+    text = RAMP.replace("timeout_min: 120", "timeout_min: 30, on_timeout: skip")
+    output = workdir / "ramp.h5"
+    run_with(write("ramp.yaml", text), output, never_stable_at_20)
+    with h5py.File(output, "r") as f:
+        assert f.attrs["state"] == "done"
+        assert {name: f[f"soaks/{name}"].attrs["outcome"] for name in f["soaks"]} == {
+            "T20": "timeout", "T25": "stable", "T35": "stable"}
+        setpoints = f["poses/setpoint_c"][:]
+    assert sorted(set(setpoints)) == [25.0, 30.0, 35.0] and len(setpoints) == 18

@@ -2,18 +2,49 @@ import numpy as np
 
 from accelcal_rig.engine.session import prepare
 from accelcal_rig.plan.kinematics import TurntableKinematics
+from accelcal_rig.plan.steps import (
+    AdvanceRamp, CooldownRecord, MeasurePose, Ramp, RampSegment, Soak, StartSoftwareRamp,
+)
 from tests.conftest import REPO
 
 
-def test_paper_plan_has_a_soak_then_24_poses_at_each_of_11_setpoints() -> None:
-    prepared = prepare(REPO / "procedures" / "paper-24pos-thermal.yaml")
-    plan = prepared.plan
-    assert len(plan.steps) == 11 * 25
+def test_paper_plan_ramps_and_soaks_then_measures_24_poses_at_each_of_11_setpoints() -> None:
+    plan = prepare(REPO / "procedures" / "paper-24pos-thermal.yaml").plan
+    assert [s.setpoint_c for s in plan.stages] == list(range(-40, 61, 10))
+    for stage in plan.stages:
+        assert stage.entry == stage.restart_entry == (Ramp(stage.setpoint_c), Soak(f"T{stage.setpoint_c:g}/soak",
+                                                                                    stage.setpoint_c))
+        assert [type(s) for s in stage.body] == [MeasurePose] * 24
+    assert len(plan.steps) == 11 * 26
     assert len(plan.pose_steps) == 264
-    assert plan.steps[0].key == "T-40/soak"
-    assert plan.steps[1].key == "T-40/pose01"
-    assert plan.steps[-1].key == "T60/pose24"
-    assert len({s.key for s in plan.steps}) == len(plan.steps)  # keys are unique
+    keys = [s.key for s in plan.records]
+    assert keys[:2] == ["T-40/soak", "T-40/pose01"] and keys[-1] == "T60/pose24" and len(keys) == 11 * 25
+    assert len(set(keys)) == len(keys)  # keys are unique
+
+
+def test_ramp_plan_soaks_at_the_ends_and_measures_on_the_software_ramp_in_between() -> None:
+    plan = prepare(REPO / "procedures" / "paper-24pos-ramp.yaml").plan
+    first, second, last = plan.stages[0], plan.stages[1], plan.stages[-1]
+    setpoints = plan.setpoints_c
+    assert first.entry == first.restart_entry == (Ramp(setpoints[0]), Soak(f"T{setpoints[0]:g}/soak", setpoints[0]),
+                                                  StartSoftwareRamp(setpoints[0]))
+    # Later setpoints ride on the ramp; their poses begin half-way from the previous setpoint.
+    assert second.entry == (RampSegment(setpoints[1], 0.5 * (setpoints[0] + setpoints[1])),)
+    assert [type(s) for s in second.restart_entry] == [Ramp, Soak, StartSoftwareRamp]
+    assert last.entry == (RampSegment(setpoints[-1], setpoints[-1]), Soak(f"T{setpoints[-1]:g}/soak", setpoints[-1]))
+    assert [type(s) for s in last.restart_entry] == [Ramp, Soak]
+    assert [type(s) for s in second.body] == [AdvanceRamp, MeasurePose] * len(plan.poses)
+    # The stored plan still lists a soak and the poses for every setpoint (a resumed run may soak at any).
+    assert [s.key for s in second.records][:2] == [f"T{setpoints[1]:g}/soak", f"T{setpoints[1]:g}/pose01"]
+
+
+def test_cooldown_plan_soaks_once_then_numbers_its_records_at_the_held_pose() -> None:
+    plan = prepare(REPO / "procedures" / "cooldown-60c.yaml").plan
+    (stage,) = plan.stages
+    assert [type(s) for s in stage.entry] == [Ramp, Soak]
+    assert all(isinstance(s, CooldownRecord) and s.pose == plan.poses[0] for s in stage.body)
+    assert [s.number for s in stage.body] == list(range(1, len(stage.body) + 1))
+    assert stage.body[0].key.endswith("/cool0001")
 
 
 def test_plan_angles_reproduce_the_schedule_directions() -> None:

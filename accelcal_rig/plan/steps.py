@@ -1,0 +1,105 @@
+"""The steps a plan is made of: what the rig does, in the order it does it.
+
+Each step is plain data. The engine has one handler per step type and runs a plan by dispatching on it, so
+a new kind of step is a new type here and a handler there; the runner itself does not change.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+
+@dataclass(frozen=True)
+class Pose:
+    """One turntable position: `number` is 1-based like the paper's Table 1."""
+
+    number: int
+    angles_deg: tuple[float, ...]
+    gravity_fixture: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Ramp:
+    """Set the chamber to the setpoint and wait for its air to reach it."""
+
+    setpoint_c: float
+
+
+@dataclass(frozen=True)
+class Soak:
+    """Wait until every DUT's temperature is stable at the setpoint; stores the soak trace under `key`."""
+
+    key: str
+    setpoint_c: float
+    stored_kind: ClassVar[str] = "soak"
+
+
+@dataclass(frozen=True)
+class StartSoftwareRamp:
+    """The ramp method: from here on the chamber setpoint moves at the procedure's rate to the last setpoint."""
+
+    setpoint_c: float
+
+
+@dataclass(frozen=True)
+class RampSegment:
+    """Keep the software ramp moving until it has reached `until_c`."""
+
+    setpoint_c: float
+    until_c: float
+
+
+@dataclass(frozen=True)
+class AdvanceRamp:
+    """Write the software ramp's current setpoint (at most every `ramp.update_s`): between poses taken on it."""
+
+    setpoint_c: float
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """A block of samples from every DUT at `pose`, stored under `key`."""
+
+    key: str
+    setpoint_c: float
+    pose: Pose
+    stored_kind: ClassVar[str] = "pose"
+
+
+@dataclass(frozen=True)
+class MeasurePose(Measurement):
+    """Move to the pose, settle, acquire, store."""
+
+
+@dataclass(frozen=True)
+class CooldownRecord(Measurement):
+    """A cool-down's `number`-th record at the pose it holds: the first at the setpoint, after which the chamber
+    is let go, then one every `cooldown.record_every_s`."""
+
+    number: int
+
+
+Step = Ramp | Soak | StartSoftwareRamp | RampSegment | AdvanceRamp | MeasurePose | CooldownRecord
+#: The steps that store a record in the campaign (what its stored plan lists).
+Record = Soak | Measurement
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One setpoint's steps: `entry` brings the rig there, `body` measures.
+
+    `restart_entry` replaces `entry` when a run begins at this setpoint (a resumed run, or the one after a
+    skipped soak): the ramp method's later setpoints ride on a software ramp that such a run has not started.
+    """
+
+    setpoint_c: float
+    entry: tuple[Step, ...]
+    body: tuple[Step, ...]
+    restart_entry: tuple[Step, ...]
+
+    @property
+    def records(self) -> tuple[Record, ...]:
+        """Every record this setpoint may store: its soak (whichever entry soaks), then its measurements."""
+        soaks = [s for s in (*self.entry, *self.restart_entry) if isinstance(s, Soak)]
+        return (*soaks[:1], *(s for s in self.body if isinstance(s, Measurement)))
