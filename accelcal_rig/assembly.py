@@ -20,9 +20,10 @@ from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.engine import session
 from accelcal_rig.engine.connection import GuardedRig, RigConnector
 from accelcal_rig.engine.events import EventLog
+from accelcal_rig.engine.preparation import PreparedCampaign
 from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.retry import Retrier
-from accelcal_rig.engine.session import PreparedCampaign, RunResult
+from accelcal_rig.engine.session import RunResult
 from accelcal_rig.instruments.connect import Endpoints, configured_endpoints, connect_rig
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable

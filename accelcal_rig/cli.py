@@ -20,8 +20,9 @@ from accelcal_rig.core.signals import TerminationRequested, stop_when_safe
 from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
 
 if TYPE_CHECKING:
+    from accelcal_rig.engine.preparation import PreparedCampaign
     from accelcal_rig.engine.progress import ProgressListener
-    from accelcal_rig.engine.session import PreparedCampaign, RunResult
+    from accelcal_rig.engine.session import RunResult
 
 EXIT_INTERRUPTED = 130
 #: A failure the program did not foresee (a bug): one line, and this code.
@@ -80,7 +81,7 @@ class _StopOnFirstSignal:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from accelcal_rig.engine.session import prepare
+    from accelcal_rig.engine.preparation import prepare
     from accelcal_rig.store.paths import journal_path
 
     if args.output.is_dir():
@@ -98,7 +99,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 def _cmd_plan(args: argparse.Namespace) -> int:
     from accelcal_rig.engine.estimate import estimate_duration
-    from accelcal_rig.engine.session import prepare
+    from accelcal_rig.engine.preparation import prepare
     from accelcal_rig.report.plan_summary import plan_json, plan_lines
 
     prepared = prepare(args.procedure, args.config)
@@ -111,7 +112,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
 
 
 def _cmd_resume(args: argparse.Namespace) -> int:
-    from accelcal_rig.engine.session import prepare
+    from accelcal_rig.engine.preparation import prepare
     from accelcal_rig.store.read import load_campaign
 
     stored = load_campaign(args.campaign)

@@ -20,7 +20,7 @@ import yaml
 from quiet import silence_campaign_log  # bench/quiet.py, beside this script
 
 from accelcal_rig.assembly import run_campaign
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_campaign, fit_dut
 from accelcal_rig.store.read import load_campaign, read_dut_poses
 

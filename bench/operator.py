@@ -20,7 +20,7 @@ from quiet import silence_campaign_log  # bench/quiet.py, beside this script
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.engine.estimate import estimate_duration
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.report.live import ProgressLines
 
 REPO = Path(__file__).resolve().parent.parent

@@ -21,7 +21,7 @@ from quiet import silence_campaign_log  # bench/quiet.py, beside this script
 
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.core.formatting import format_duration
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.fit.calibration import CalibrationRangeWarning, apply, load_calibration
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.plan.schedules import sphere

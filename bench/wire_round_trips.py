@@ -14,7 +14,7 @@ from pathlib import Path
 from quiet import silence_campaign_log  # bench/quiet.py, beside this script
 
 from accelcal_rig.assembly import run_campaign
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.instruments import chamber_modbus, line_port
 
 REPO = Path(__file__).resolve().parent.parent

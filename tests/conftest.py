@@ -41,7 +41,7 @@ def write(workdir: Path):
 def paper_campaign(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """One dry run of the paper campaign (11 × 24 poses, 4 DUTs), shared by the tests that only read it."""
     from accelcal_rig.assembly import run_campaign
-    from accelcal_rig.engine.session import prepare
+    from accelcal_rig.engine.preparation import prepare
 
     output = tmp_path_factory.mktemp("paper") / "campaign.h5"
     run_campaign(prepare(REPO / "procedures" / "paper-24pos-thermal.yaml"), output, dry_run=True, seed=0,

@@ -190,7 +190,7 @@ def test_rig_fit_refuses_a_campaign_still_running(paper_campaign: Path, tmp_path
 
 def test_rig_fit_on_a_file_without_poses_is_one_line(write, workdir: Path, capsys) -> None:
     from accelcal_rig.assembly import run_campaign
-    from accelcal_rig.engine.session import prepare
+    from accelcal_rig.engine.preparation import prepare
     from accelcal_rig.errors import CampaignAborted
 
     campaign = workdir / "empty.h5"

@@ -1,5 +1,5 @@
-"""From files to a finished campaign: validate, compile, connect (through the rig connector given), create
-the file, run."""
+"""From a prepared campaign to a finished one: connect (through the rig connector given), create or reopen
+the file, run, close — a resumed campaign only with the procedure and rig it began with."""
 
 from __future__ import annotations
 
@@ -9,94 +9,30 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import NoReturn
 
-import numpy as np
-from scipy.spatial.transform import Rotation
-
-from accelcal_rig.config.load import (
-    LoadedConfig,
-    check_procedure_against_rig,
-    load_procedure,
-    load_rig,
-    resolve_rig_path,
-    with_faults,
-)
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.core.signals import signals_deferred
 from accelcal_rig.engine.audience import Audience
 from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitStage, one_line_reason
+from accelcal_rig.engine.campaign_header import create_campaign_file, fit_attrs, instrument_info
 from accelcal_rig.engine.connection import ConnectedRig, RigConnector
 from accelcal_rig.engine.estimate import estimate_duration
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.notify import Notifier
+from accelcal_rig.engine.preparation import PreparedCampaign
 from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.resume import ResumePoint, check_same_campaign
 from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
 from accelcal_rig.errors import CampaignAborted
 from accelcal_rig.fit.campaign_fit import fit_and_save, summary_line
-from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
-from accelcal_rig.fit.recorded_options import options_attrs, recorded_options
-from accelcal_rig.instruments.interfaces import RigInstruments
-from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, compile_plan
-from accelcal_rig.plan.kinematics import UnreachablePose
-from accelcal_rig.plan.steps import Measurement
+from accelcal_rig.fit.recorded_options import recorded_options
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.lock import campaign_lock
 from accelcal_rig.store.paths import journal_path
 from accelcal_rig.store.read import file_currency, load_campaign
-from accelcal_rig.store.records import StoredPlan
 from accelcal_rig.store.repair import repair_campaign
-from accelcal_rig.store.space import StorageEstimate, estimate_storage
 from accelcal_rig.store.writer import CampaignWriter
-
-
-@dataclass(frozen=True)
-class PreparedCampaign:
-    """Both files validated against each other and the plan compiled: nothing has moved yet."""
-
-    procedure: LoadedConfig[Procedure]
-    rig: LoadedConfig[RigConfig]
-    plan: Plan
-
-    def storage(self, dry_run: bool) -> StorageEstimate:
-        """The disk the campaign will take (a dry run also stores the simulation's truth)."""
-        acquisition = self.procedure.model.acquisition
-        return estimate_storage(len(self.plan.pose_steps), len(self.rig.model.fixture.sensors),
-                                acquisition.samples_per_pose, len(self.plan.axis_names), dry_run)
-
-
-def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str | None = None) -> PreparedCampaign:
-    """`faults`: fault injection for the simulators, `key=value,…` (see with_faults)."""
-    procedure = load_procedure(procedure_path)
-    rig = with_faults(load_rig(resolve_rig_path(procedure, rig_override)), faults)
-    check_procedure_against_rig(procedure, rig)
-    try:
-        plan = compile_plan(procedure.model, rig.model)
-    except UnreachablePose as exc:
-        raise procedure.error(("schedule",), f"{exc} of {rig.path}") from None
-    except CooldownPoseMissing as exc:
-        raise procedure.error(("cooldown", "pose"), str(exc)) from None
-    _check_design_identifies_fit(procedure, rig.model, plan)
-    return PreparedCampaign(procedure, rig, plan)
-
-
-def _check_design_identifies_fit(procedure: LoadedConfig[Procedure], rig: RigConfig, plan: Plan) -> None:
-    """Refuse, before a long campaign, a schedule that cannot determine the fit it asks for.
-
-    A perfect sensor's readings at the planned poses, as each DUT's mount sees them, go through the same
-    fit; a design the fit would refuse afterwards is refused now.
-    """
-    fit = procedure.model.fit
-    if fit.mode == "none":
-        return
-    gravity_fixture = np.array([p.gravity_fixture for p in plan.poses])
-    for sensor in rig.fixture.sensors:
-        gravity = Rotation.from_euler("xyz", sensor.mount_euler_deg, degrees=True).inv().apply(gravity_fixture)
-        try:
-            fit_sfem(gravity, np.full_like(gravity, 1e-5), gravity, fit.mode, fit.parameters)
-        except DegenerateDesign as exc:
-            raise procedure.error(("fit", "mode"), f"{exc} (sensor {sensor.serial}, {fit.parameters} parameters)") from None
 
 
 @dataclass(frozen=True)
@@ -124,7 +60,7 @@ def run_campaign(prepared: PreparedCampaign, output: Path, connect: RigConnector
         return resume_campaign(prepared, output, connect, calibration=calibration, progress=progress)
     with connect(seed) as rig:
         def create() -> CampaignWriter:
-            return _create_file(prepared, output, rig, dry_run=connect.dry_run, seed=seed, overwrite=overwrite)
+            return create_campaign_file(prepared, output, rig, dry_run=connect.dry_run, seed=seed, overwrite=overwrite)
 
         return _run(prepared, output, create, rig, None, calibration, wall_start, progress)
 
@@ -151,7 +87,7 @@ def resume_campaign(prepared: PreparedCampaign, output: Path, connect: RigConnec
         # Noise of a resumed dry run is new noise (the same sensors, not a replay of the first run).
         seed = int(stored.attrs.get("seed", 0)) + 1000 * (reopened.run - 1)
         with connect(seed, reopened.clock_now_s) as rig:
-            writer.record_instruments(_instrument_info(rig.instruments))
+            writer.record_instruments(instrument_info(rig.instruments))
             point = ResumePoint(frozenset(writer.stored_step_keys()), reopened.previous_state in ("created", "running"),
                                 reopened.run)
             events = EventLog(rig.clock, writer)
@@ -176,52 +112,6 @@ def _finish_complete(prepared: PreparedCampaign, output: Path, stored: Campaign,
             procedure = prepared.procedure.model
             done.append(_fit_stage(procedure, output, calibration)(load_campaign(output)))
     return done
-
-
-def _instrument_info(instruments: RigInstruments) -> dict[str, dict[str, str]]:
-    return {
-        "chamber": {"driver": type(instruments.chamber).__name__, "endpoint": instruments.chamber.endpoint},
-        "turntable": {"driver": type(instruments.turntable).__name__, "endpoint": instruments.turntable.endpoint},
-    }
-
-
-def _create_file(prepared: PreparedCampaign, output: Path, connected: ConnectedRig, *,
-                 dry_run: bool, seed: int, overwrite: bool) -> CampaignWriter:
-    rig, instruments, clock = prepared.rig, connected.instruments, connected.clock
-    procedure = prepared.procedure.model
-    acquisition = procedure.acquisition
-    mounts = {s.serial: s for s in rig.model.fixture.sensors}
-    duts = [
-        {"serial": s.serial, "name": mounts[s.serial].name, "mount_euler_deg": list(mounts[s.serial].mount_euler_deg),
-         "part": s.part.name, "range_g": acquisition.range_g, "odr_hz": acquisition.odr_hz,
-         "lsb_g": s.part.lsb_g(acquisition.range_g),
-         "driver": type(s).__name__, "endpoint": s.endpoint}
-        for s in instruments.sensors
-    ]
-    truth = ({s.serial: instruments.truth.describe(s.serial, acquisition.odr_hz) for s in instruments.sensors}
-             if instruments.truth is not None else {})
-    attrs = {"procedure_name": procedure.name, "procedure_path": str(prepared.procedure.path.resolve()),
-             "rig_name": rig.model.name, "rig_path": str(rig.path.resolve()), "dry_run": dry_run, "seed": seed,
-             "clock": clock.kind, "samples_per_pose": acquisition.samples_per_pose,
-             **_fit_attrs(procedure)}
-    return CampaignWriter.create(
-        output, {"attrs": attrs, "procedure_yaml": prepared.procedure.text, "rig_yaml": rig.text,
-                 "plan": _stored_plan(prepared.plan), "duts": duts, "instruments": _instrument_info(instruments),
-                 "turntable_accuracy_arcsec": rig.model.turntable.accuracy_arcsec, "truth": truth},
-        overwrite=overwrite, storage=prepared.storage(dry_run))
-
-
-def _stored_plan(plan: Plan) -> StoredPlan:
-    records, n_axes = plan.records, len(plan.axis_names)
-    poses = [s.pose if isinstance(s, Measurement) else None for s in records]
-    return StoredPlan(
-        step_key=tuple(s.key for s in records), kind=tuple(s.stored_kind for s in records),
-        setpoint_c=np.array([s.setpoint_c for s in records], dtype=float),
-        pose_number=np.array([p.number if p else 0 for p in poses], dtype=np.int64),
-        angles_deg=np.array([p.angles_deg if p else (np.nan,) * n_axes for p in poses], dtype=float).reshape(
-            len(records), n_axes),
-        gravity_fixture=np.array([p.gravity_fixture if p else (np.nan,) * 3 for p in poses], dtype=float),
-        fingerprint=plan.fingerprint, axis_names=tuple(plan.axis_names))
 
 
 def _close(writer: CampaignWriter) -> tuple[str, ...]:
@@ -290,13 +180,8 @@ def _stopped_before_start(writer: CampaignWriter, connected: ConnectedRig, proce
     raise CampaignAborted(reason) from exc
 
 
-def _fit_attrs(procedure: Procedure) -> dict[str, object]:
-    fit = procedure.fit
-    return options_attrs(fit.mode, fit.polynomial_degree, fit.parameters, fit.out_of_range, fit.temperature_model)
-
-
 def _fit_stage(procedure: Procedure, output: Path, calibration: Path) -> FitStage:
-    options = recorded_options(_fit_attrs(procedure), f"{output}: its procedure's fit")
+    options = recorded_options(fit_attrs(procedure), f"{output}: its procedure's fit")
     assert options is not None, "a procedure without a fit has no fit stage"
 
     def stage(campaign: Campaign) -> str:

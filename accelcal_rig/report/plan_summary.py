@@ -6,7 +6,7 @@ from typing import Any
 
 from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.engine.estimate import DurationEstimate
-from accelcal_rig.engine.session import PreparedCampaign
+from accelcal_rig.engine.preparation import PreparedCampaign
 from accelcal_rig.plan.compile import setpoint_label
 from accelcal_rig.store.space import START_MARGIN, megabytes
 

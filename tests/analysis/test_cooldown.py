@@ -13,7 +13,7 @@ import pytest
 
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.cli import main
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.errors import ConfigError
 from tests.conftest import REPO
 from tests.report.test_html_report import png_size

@@ -12,7 +12,7 @@ import pytest
 from accelcal_rig.analysis.positions import structured_subset
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.cli import main
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.plan.schedules import sphere
 from tests.conftest import TINY_PROCEDURE
 from tests.report.test_html_report import png_size

@@ -13,7 +13,7 @@ import pytest
 from accelcal_rig.analysis.tilt import pitch_roll_deg
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.cli import main
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.plan.schedules import tilt
 from tests.conftest import REPO
 

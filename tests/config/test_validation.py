@@ -5,7 +5,7 @@ from pathlib import Path
 import pytest
 
 from accelcal_rig.config.load import load_procedure, load_rig
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.errors import ConfigError
 from tests.conftest import REPO, TINY_PROCEDURE
 

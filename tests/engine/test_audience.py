@@ -6,7 +6,7 @@ import logging
 
 from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.engine.audience import Audience, Reporter
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.engine.states import State
 from tests.conftest import TINY_PROCEDURE
 

@@ -8,7 +8,7 @@ import h5py
 import numpy as np
 
 from accelcal_rig.assembly import run_campaign
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.errors import CampaignAborted
 from accelcal_rig.instruments.interfaces import DeviceIdentity
 from accelcal_rig.sim.devices import build_simulated_rig

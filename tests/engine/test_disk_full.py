@@ -11,7 +11,8 @@ import pytest
 
 from accelcal_rig import durable
 from accelcal_rig.assembly import run_campaign
-from accelcal_rig.engine.session import NothingToResume, prepare
+from accelcal_rig.engine.preparation import prepare
+from accelcal_rig.engine.session import NothingToResume
 from accelcal_rig.errors import CampaignAborted, DiskFull
 from accelcal_rig.store import journal, writer
 from accelcal_rig.store.read import campaign_status, load_campaign

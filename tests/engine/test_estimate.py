@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from accelcal_rig.engine.estimate import estimate_duration
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from tests.conftest import REPO, TINY_PROCEDURE
 
 

@@ -9,7 +9,8 @@ import h5py
 import pytest
 
 from accelcal_rig.assembly import WiredRig
-from accelcal_rig.engine.session import prepare, run_campaign
+from accelcal_rig.engine.preparation import prepare
+from accelcal_rig.engine.session import run_campaign
 from accelcal_rig.errors import CampaignAborted
 from accelcal_rig.sim.wire_rig import SimulatedRig
 from accelcal_rig.store.read import load_campaign

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from accelcal_rig.assembly import run_campaign
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.errors import CampaignAborted
 from tests.conftest import TINY_PROCEDURE
 

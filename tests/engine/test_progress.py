@@ -6,8 +6,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from accelcal_rig.assembly import run_campaign
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.engine.progress import Progress
-from accelcal_rig.engine.session import prepare
 from tests.conftest import TINY_PROCEDURE
 
 

@@ -11,7 +11,7 @@ import pytest
 
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.engine.estimate import estimate_duration
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import load_calibration
 from accelcal_rig.sim.truth import truth_for_serial

@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 from accelcal_rig.assembly import run_campaign
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.engine.resume import first_difference
-from accelcal_rig.engine.session import NothingToResume, prepare
+from accelcal_rig.engine.session import NothingToResume
 from accelcal_rig.errors import CampaignAborted, ConfigError
 from accelcal_rig.sim.devices import build_simulated_rig
 from tests.conftest import kill_mid_pose, stored_poses

@@ -15,7 +15,8 @@ from accelcal_rig.assembly import AssembledRig, InProcessRig
 from accelcal_rig.core.signals import TerminationRequested
 from accelcal_rig.engine.connection import GuardedRig
 from accelcal_rig.engine.events import EventLog
-from accelcal_rig.engine.session import prepare, run_campaign
+from accelcal_rig.engine.preparation import prepare
+from accelcal_rig.engine.session import run_campaign
 from accelcal_rig.errors import CampaignAborted
 from accelcal_rig.sim.devices import build_simulated_rig
 from accelcal_rig.store.read import load_campaign

@@ -40,7 +40,7 @@ acquisition: {samples_per_pose: 20, range_g: 2, odr_hz: 125, settle_s: 1}
 def make_source(folder: Path, rig_config: Path) -> Path:
     """A finished dry-run campaign in `folder` (and a second one, `other/`, for swapped journals)."""
     from accelcal_rig.assembly import run_campaign
-    from accelcal_rig.engine.session import prepare
+    from accelcal_rig.engine.preparation import prepare
 
     folder.mkdir(parents=True, exist_ok=True)
     shutil.copy(rig_config, folder / "sim.yaml")

@@ -11,7 +11,7 @@ import yaml
 
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.engine.campaign import CampaignAborted
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.adxl35x import ADXL357, ADXL359
 from accelcal_rig.store.read import load_campaign

@@ -1,10 +1,8 @@
 import numpy as np
 
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.plan.kinematics import TurntableKinematics
-from accelcal_rig.plan.steps import (
-    AdvanceRamp, CooldownRecord, MeasurePose, Ramp, RampSegment, Soak, StartSoftwareRamp,
-)
+from accelcal_rig.plan.steps import AdvanceRamp, CooldownRecord, MeasurePose, Ramp, RampSegment, Soak, StartSoftwareRamp
 from tests.conftest import REPO
 
 

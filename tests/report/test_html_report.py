@@ -12,7 +12,7 @@ import pytest
 
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.cli import main
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.errors import CampaignAborted
 from accelcal_rig.report.html_report import FIGURES, write_report
 from tests.conftest import TINY_PROCEDURE

@@ -12,7 +12,7 @@ import pytest
 
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.cli import main
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.store.content import measurements_sha256
 from accelcal_rig.store.journal import read_journal

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from accelcal_rig.engine.session import prepare
+from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.store.paths import journal_path
 from tests.conftest import REPO
 

@@ -1,0 +1,70 @@
+"""What a new campaign file records about itself before the first step: the procedure and rig as written,
+the plan, the DUTs and their parts, the instruments, the fit options, and in a dry run the simulation's
+truth."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from accelcal_rig.config.procedure import Procedure
+from accelcal_rig.engine.connection import ConnectedRig
+from accelcal_rig.engine.preparation import PreparedCampaign
+from accelcal_rig.fit.recorded_options import options_attrs
+from accelcal_rig.instruments.interfaces import RigInstruments
+from accelcal_rig.plan.compile import Plan
+from accelcal_rig.plan.steps import Measurement
+from accelcal_rig.store.records import StoredPlan
+from accelcal_rig.store.writer import CampaignWriter
+
+
+def instrument_info(instruments: RigInstruments) -> dict[str, dict[str, str]]:
+    return {
+        "chamber": {"driver": type(instruments.chamber).__name__, "endpoint": instruments.chamber.endpoint},
+        "turntable": {"driver": type(instruments.turntable).__name__, "endpoint": instruments.turntable.endpoint},
+    }
+
+
+def create_campaign_file(prepared: PreparedCampaign, output: Path, connected: ConnectedRig, *,
+                 dry_run: bool, seed: int, overwrite: bool) -> CampaignWriter:
+    rig, instruments, clock = prepared.rig, connected.instruments, connected.clock
+    procedure = prepared.procedure.model
+    acquisition = procedure.acquisition
+    mounts = {s.serial: s for s in rig.model.fixture.sensors}
+    duts = [
+        {"serial": s.serial, "name": mounts[s.serial].name, "mount_euler_deg": list(mounts[s.serial].mount_euler_deg),
+         "part": s.part.name, "range_g": acquisition.range_g, "odr_hz": acquisition.odr_hz,
+         "lsb_g": s.part.lsb_g(acquisition.range_g),
+         "driver": type(s).__name__, "endpoint": s.endpoint}
+        for s in instruments.sensors
+    ]
+    truth = ({s.serial: instruments.truth.describe(s.serial, acquisition.odr_hz) for s in instruments.sensors}
+             if instruments.truth is not None else {})
+    attrs = {"procedure_name": procedure.name, "procedure_path": str(prepared.procedure.path.resolve()),
+             "rig_name": rig.model.name, "rig_path": str(rig.path.resolve()), "dry_run": dry_run, "seed": seed,
+             "clock": clock.kind, "samples_per_pose": acquisition.samples_per_pose,
+             **fit_attrs(procedure)}
+    return CampaignWriter.create(
+        output, {"attrs": attrs, "procedure_yaml": prepared.procedure.text, "rig_yaml": rig.text,
+                 "plan": stored_plan(prepared.plan), "duts": duts, "instruments": instrument_info(instruments),
+                 "turntable_accuracy_arcsec": rig.model.turntable.accuracy_arcsec, "truth": truth},
+        overwrite=overwrite, storage=prepared.storage(dry_run))
+
+
+def stored_plan(plan: Plan) -> StoredPlan:
+    records, n_axes = plan.records, len(plan.axis_names)
+    poses = [s.pose if isinstance(s, Measurement) else None for s in records]
+    return StoredPlan(
+        step_key=tuple(s.key for s in records), kind=tuple(s.stored_kind for s in records),
+        setpoint_c=np.array([s.setpoint_c for s in records], dtype=float),
+        pose_number=np.array([p.number if p else 0 for p in poses], dtype=np.int64),
+        angles_deg=np.array([p.angles_deg if p else (np.nan,) * n_axes for p in poses], dtype=float).reshape(
+            len(records), n_axes),
+        gravity_fixture=np.array([p.gravity_fixture if p else (np.nan,) * 3 for p in poses], dtype=float),
+        fingerprint=plan.fingerprint, axis_names=tuple(plan.axis_names))
+
+
+def fit_attrs(procedure: Procedure) -> dict[str, object]:
+    fit = procedure.fit
+    return options_attrs(fit.mode, fit.polynomial_degree, fit.parameters, fit.out_of_range, fit.temperature_model)

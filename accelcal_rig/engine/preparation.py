@@ -1,0 +1,73 @@
+"""A campaign before anything moves: both files loaded and checked against each other, the plan compiled,
+and a schedule that cannot determine the fit it asks for refused."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from accelcal_rig.config.load import (
+    LoadedConfig,
+    check_procedure_against_rig,
+    load_procedure,
+    load_rig,
+    resolve_rig_path,
+    with_faults,
+)
+from accelcal_rig.config.procedure import Procedure
+from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
+from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, compile_plan
+from accelcal_rig.plan.kinematics import UnreachablePose
+from accelcal_rig.store.space import StorageEstimate, estimate_storage
+
+
+@dataclass(frozen=True)
+class PreparedCampaign:
+    """Both files validated against each other and the plan compiled: nothing has moved yet."""
+
+    procedure: LoadedConfig[Procedure]
+    rig: LoadedConfig[RigConfig]
+    plan: Plan
+
+    def storage(self, dry_run: bool) -> StorageEstimate:
+        """The disk the campaign will take (a dry run also stores the simulation's truth)."""
+        acquisition = self.procedure.model.acquisition
+        return estimate_storage(len(self.plan.pose_steps), len(self.rig.model.fixture.sensors),
+                                acquisition.samples_per_pose, len(self.plan.axis_names), dry_run)
+
+
+def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str | None = None) -> PreparedCampaign:
+    """`faults`: fault injection for the simulators, `key=value,…` (see with_faults)."""
+    procedure = load_procedure(procedure_path)
+    rig = with_faults(load_rig(resolve_rig_path(procedure, rig_override)), faults)
+    check_procedure_against_rig(procedure, rig)
+    try:
+        plan = compile_plan(procedure.model, rig.model)
+    except UnreachablePose as exc:
+        raise procedure.error(("schedule",), f"{exc} of {rig.path}") from None
+    except CooldownPoseMissing as exc:
+        raise procedure.error(("cooldown", "pose"), str(exc)) from None
+    _check_design_identifies_fit(procedure, rig.model, plan)
+    return PreparedCampaign(procedure, rig, plan)
+
+
+def _check_design_identifies_fit(procedure: LoadedConfig[Procedure], rig: RigConfig, plan: Plan) -> None:
+    """Refuse, before a long campaign, a schedule that cannot determine the fit it asks for.
+
+    A perfect sensor's readings at the planned poses, as each DUT's mount sees them, go through the same
+    fit; a design the fit would refuse afterwards is refused now.
+    """
+    fit = procedure.model.fit
+    if fit.mode == "none":
+        return
+    gravity_fixture = np.array([p.gravity_fixture for p in plan.poses])
+    for sensor in rig.fixture.sensors:
+        gravity = Rotation.from_euler("xyz", sensor.mount_euler_deg, degrees=True).inv().apply(gravity_fixture)
+        try:
+            fit_sfem(gravity, np.full_like(gravity, 1e-5), gravity, fit.mode, fit.parameters)
+        except DegenerateDesign as exc:
+            raise procedure.error(("fit", "mode"), f"{exc} (sensor {sensor.serial}, {fit.parameters} parameters)") from None
