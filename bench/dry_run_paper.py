@@ -47,8 +47,9 @@ def cli_run(output: Path, seed: int) -> tuple[float, float, dict]:
 def campaign_only(output: Path, seed: int, in_process: bool) -> float:
     from accelcal_rig.assembly import in_process_simulation, run_campaign
     from accelcal_rig.engine import session
+    from accelcal_rig.engine.preparation import prepare
 
-    prepared = session.prepare(PAPER)
+    prepared = prepare(PAPER)
     start = time.perf_counter()
     calibration = output.with_suffix(".calibration.yaml")
     if in_process:
