@@ -27,6 +27,8 @@ if TYPE_CHECKING:
 EXIT_INTERRUPTED = 130
 #: A failure the program did not foresee (a bug): one line, and this code.
 EXIT_INTERNAL = 70
+#: `--fail-on-reject`: the campaign and the fit went through, and at least one DUT failed its limits.
+EXIT_REJECTED = 3
 @contextmanager
 def _campaign_logging(output: Path, verbose: bool, quiet: bool, append: bool,
                       real_clock: bool) -> Iterator[ProgressListener]:
@@ -168,14 +170,14 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
         for signum, handler in previous.items():
             signal.signal(signum, handler)
     try:
-        return _print_summary(prepared, result, dry_run)
+        return _print_summary(prepared, result, dry_run, args.fail_on_reject)
     except (KeyboardInterrupt, TerminationRequested):
         print(f"rig: interrupted after the campaign ended ({result.summary.state}); {result.output} holds all of it",
               file=sys.stderr)
         return EXIT_INTERRUPTED
 
 
-def _print_summary(prepared: PreparedCampaign, result: RunResult, dry_run: bool) -> int:
+def _print_summary(prepared: PreparedCampaign, result: RunResult, dry_run: bool, fail_on_reject: bool) -> int:
     summary = result.summary
     setpoints = summary.setpoints_c
     size_mb = result.output.stat().st_size / 1e6 if result.output.is_file() else 0.0
@@ -190,21 +192,37 @@ def _print_summary(prepared: PreparedCampaign, result: RunResult, dry_run: bool)
         print(f"rig: campaign done but the fit failed: {_one_line(Exception(summary.fit))}", file=sys.stderr)
         return 1
     print(f"  fit        {summary.fit or 'none (the procedure measures only: fit.mode none)'}")
+    for warning in summary.fit_warnings:
+        print(f"  warning    {warning}")
+    for serial, (verdict, reasons) in summary.verdicts.items():
+        print(f"  verdict    {serial} {verdict}" + (f": {'; '.join(reasons)}" if verdict == "FAIL" else ""))
     if result.problems:
         print(f"rig: error: campaign done, but {result.problems[0]}", file=sys.stderr)
         return 1
+    return _rejected_exit(summary.rejected, fail_on_reject)
+
+
+def _rejected_exit(rejected: list[str], fail_on_reject: bool) -> int:
+    if rejected and fail_on_reject:
+        print(f"rig: {len(rejected)} DUT(s) failed their acceptance limits: {', '.join(rejected)}", file=sys.stderr)
+        return EXIT_REJECTED
     return 0
 
 
 def _cmd_status(args: argparse.Namespace) -> int:
+    from accelcal_rig.fit.campaign_file import calibration_verdicts
     from accelcal_rig.store.read import campaign_status
 
-    status = campaign_status(args.campaign)
+    status = {**campaign_status(args.campaign), **calibration_verdicts(args.campaign, args.calibration)}
     if args.json:
         print(json.dumps(status))
         return 0
+    verdicts = status.pop("verdicts")
     for key, value in status.items():
         print(f"{key:17s}{value}")
+    for serial, judged in (verdicts or {}).items():
+        reasons = f": {'; '.join(judged['reasons'])}" if judged["verdict"] == "FAIL" else ""
+        print(f"{'verdict':17s}{serial} {judged['verdict'] or 'not judged'}{reasons}")
     return 0
 
 
@@ -264,7 +282,8 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     else:
         _print_fit_table(outcome.report)
         print(summary_line(outcome.report, args.output))
-    return 0
+    rejected = [serial for serial, r in outcome.report.items() if r["verdict"] == "FAIL"]
+    return _rejected_exit(rejected, args.fail_on_reject)
 
 
 def _cmd_fit_recording(args: argparse.Namespace) -> int:
@@ -350,13 +369,18 @@ def _cmd_export(args: argparse.Namespace) -> int:
 
 
 def _print_fit_table(report: dict) -> None:
-    print(f"{'sensor':14s} {'before mg':>10s} {'after mg':>9s} {'floor mg':>9s} {'drift before mg':>22s} "
-          f"{'drift after mg':>22s}")
+    """In-sample figures (the poses fitted) beside verification figures (poses the fit never saw)."""
+    print(f"{'':14s} {'raw':>8s} {'in-sample (the fitted poses)':^36s}  {'verification (never fitted)':^33s}".rstrip())
+    print(f"{'sensor':14s} {'|g| mg':>8s} {'floor':>7s} {'expected':>8s} {'|g| mg':>7s} {'drift mg':>10s}  "
+          f"{'|g| mg':>7s} {'axis mg':>7s} {'tilt °':>7s} {'drift mg':>9s}  verdict")
     for serial, r in report.items():
-        drift_before = " ".join(f"{v:6.2f}" for v in r["drift_before_mg"])
-        drift_after = " ".join(f"{v:6.3f}" for v in r["drift_after_mg"])
-        print(f"{serial:14s} {r['rmse_before_mg']:10.3f} {r['rmse_after_mg']:9.4f} {r['noise_floor_mg']:9.4f} "
-              f"{drift_before:>22s} {drift_after:>22s}")
+        v = r.get("verification")
+        verification = (f"{v['rmse_mg']:7.4f} {v['max_axis_error_mg']:7.4f} {v['max_tilt_error_deg']:7.4f} "
+                        f"{max(v['drift_mg']):9.4f}" if v else f"{'none':>7s} {'':7s} {'':7s} {'':9s}")
+        print(f"{serial:14s} {r['rmse_before_mg']:8.3f} {r['noise_floor_mg']:7.4f} {r['expected_fit_rmse_mg']:8.4f} "
+              f"{r['rmse_after_mg']:7.4f} {max(r['drift_after_mg']):10.4f}  {verification}  {r['verdict']}")
+        for reason in r["verdict_reasons"] if r["verdict"] == "FAIL" else ():
+            print(f"  fails: {reason}")
         for warning in r["warnings"]:
             print(f"  warning: {warning}")
 

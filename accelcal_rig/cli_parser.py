@@ -54,6 +54,12 @@ def _campaign_output_options(command: argparse.ArgumentParser) -> None:
                          help="calibration file the final fit writes (default: beside the campaign, .calibration.yaml)")
     command.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
     command.add_argument("-q", "--quiet", action="store_true", help="print only warnings and the summary")
+    _fail_on_reject(command)
+
+
+def _fail_on_reject(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--fail-on-reject", action="store_true",
+                         help="exit with status 3 when any DUT fails the procedure's acceptance limits")
 
 
 def _analysis_command(analyses: argparse._SubParsersAction, name: str, summary: str, description: str,
@@ -117,6 +123,8 @@ def build_parser() -> argparse.ArgumentParser:
                       "rig status campaign.h5 --json")
     status.add_argument("campaign", type=Path, help="campaign file (HDF5)")
     status.add_argument("--json", action="store_true", help="print one JSON object")
+    status.add_argument("--calibration", type=Path, help="its calibration file, for the verdicts (default: beside "
+                                                         "the campaign, .calibration.yaml)")
 
     repair = _command(commands, "repair", "rebuild a campaign file from its journal",
                       "Bring a campaign's files back in step without losing a record: the campaign file (HDF5) "
@@ -157,6 +165,7 @@ def build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--temperature-model", choices=["per-setpoint", "joint"],
                      help="default: the procedure's fit.temperature_model")
     fit.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
+    _fail_on_reject(fit)
     recording = _command(
         commands, "fit-recording", "calibrate from a continuous recording of a sensor turned by hand (no turntable)",
         "Find the static intervals of a continuous recording (windowed variance against a threshold set from "

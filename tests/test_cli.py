@@ -297,6 +297,18 @@ def test_rig_plan_prints_every_pose_and_an_estimate_without_touching_instruments
         s["ramp_s"] + s["soak_s"] + s["poses_s"] for s in report["estimate"]["setpoints"]))
 
 
+def test_rig_plan_shows_verification_limits_and_warns_of_too_few_setpoints(write, capsys) -> None:
+    text = TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c: [20, 40]") + (
+        "fit: {polynomial_degree: 2}\nverify: {schedule: {kind: sphere, count: 8}, setpoints_c: [30]}\n"
+        "acceptance: {max_drift_mg: 0.2}\n")
+    assert main(["plan", str(write("tiny.yaml", text))]) == 0
+    out = capsys.readouterr().out
+    assert "verify     8 poses (sphere, listed as v1…) at every calibration setpoint and at 30 °C: 24 in all" in out
+    assert "accept     max_drift_mg 0.2; a partial campaign fails" in out
+    assert "warning    2 calibration setpoints cannot fix a degree-2 polynomial: the fit will use degree 1" in out
+    assert len([line for line in out.splitlines() if re.match(r"^\s+v[1-8]\s+-?\d", line)]) == 8
+
+
 @pytest.mark.parametrize("change, where", [
     ("schedule: {kind: six-position}", "syntax"),                          # broken YAML
     ("soak: {", "syntax"),

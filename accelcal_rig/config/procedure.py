@@ -2,19 +2,19 @@
 
 from __future__ import annotations
 
-from typing import Annotated, ClassVar, Literal
+from typing import Literal
 
 import numpy as np
 from pydantic import BaseModel, Field, field_validator, model_validator
 
-from accelcal_rig.config.bounds import STRICT, AngleDeg, TemperatureC, TemperatureSpanC
+from accelcal_rig.config.acceptance import Acceptance, Verification
+from accelcal_rig.config.bounds import STRICT, TemperatureC, TemperatureSpanC
+from accelcal_rig.config.schedule import MAX_SCHEDULE_POSES, Schedule
 
 #: Most temperature polls a campaign's ramp and soak deadlines allow (`rig plan` plays them all).
 MAX_POLLS = 200_000
 #: Most poses a plan may hold (setpoints × schedule, or a cool-down's records).
 MAX_PLAN_POSES = 20_000
-#: Most orientations a schedule may list (each is solved for the turntable's angles when the plan compiles).
-MAX_SCHEDULE_POSES = 2_000
 
 
 class _Strict(BaseModel):
@@ -46,68 +46,6 @@ class SoakCriterion(_Strict):
             raise ValueError(f"timeout_min / poll_s: a soak would be polled {self.timeout_min * 60 / self.poll_s:.0f} "
                              f"times (at most {MAX_POLLS}): poll less often or shorten the timeout")
         return self
-
-
-class Paper24Schedule(_Strict):
-    """Table 1 of the paper: eight 45° steps about each of the sensor's z, y and x axes."""
-
-    kind: Literal["paper-24"]
-    size: ClassVar[int] = 24
-
-
-class SixPositionSchedule(_Strict):
-    """The classic six positions: each sensor axis up, then down."""
-
-    kind: Literal["six-position"]
-    size: ClassVar[int] = 6
-
-
-class SphereSchedule(_Strict):
-    """`count` gravity directions spread evenly over the sphere (Fibonacci lattice)."""
-
-    kind: Literal["sphere"]
-    count: int = Field(ge=6, le=MAX_SCHEDULE_POSES)
-
-    @property
-    def size(self) -> int:
-        return self.count
-
-
-class TiltSchedule(_Strict):
-    """Poses given as pitch and roll of the fixture (paper Eq. 10, Table 5), in degrees: pitch tilts the
-    y axis up, roll tilts the x axis down; (0, 0) is level with z up."""
-
-    kind: Literal["tilt"]
-    pitch_roll_deg: list[tuple[float, float]] = Field(min_length=1, max_length=MAX_SCHEDULE_POSES)
-
-    @property
-    def size(self) -> int:
-        return len(self.pitch_roll_deg)
-
-    @field_validator("pitch_roll_deg")
-    @classmethod
-    def _within_quarter_turn(cls, value: list[tuple[float, float]]) -> list[tuple[float, float]]:
-        if any(not -90.0 <= p <= 90.0 or not -180.0 <= r <= 180.0 for p, r in value):
-            raise ValueError("pitch must lie within ±90° and roll within ±180°")
-        return value
-
-
-class ExplicitSchedule(_Strict):
-    """Turntable axis angles given pose by pose, in degrees, in the rig's axis order."""
-
-    kind: Literal["explicit"]
-    angles_deg: list[Annotated[list[AngleDeg], Field(min_length=1, max_length=6)]] = Field(
-        min_length=1, max_length=MAX_SCHEDULE_POSES)
-
-    @property
-    def size(self) -> int:
-        return len(self.angles_deg)
-
-
-Schedule = Annotated[
-    Paper24Schedule | SixPositionSchedule | SphereSchedule | TiltSchedule | ExplicitSchedule,
-    Field(discriminator="kind")
-]
 
 
 class Acquisition(_Strict):
@@ -182,6 +120,8 @@ class Procedure(_Strict):
     method: Literal["soak", "ramp"] = Field("soak", description="soak at every setpoint, or measure while ramping")
     ramp: RampMethod | None = None
     simulation: SimulatedEffects = SimulatedEffects()
+    verify: Verification | None = Field(None, description="verification poses the fit never sees")
+    acceptance: Acceptance = Acceptance()
 
     @model_validator(mode="after")
     def _ramp_fits(self) -> Procedure:
@@ -215,16 +155,56 @@ class Procedure(_Strict):
         return self
 
     @model_validator(mode="after")
+    def _verification_fits(self) -> Procedure:
+        verify = self.verify
+        if verify is None:
+            needed = self.acceptance.verification_limits()
+            if needed:
+                raise ValueError(f"acceptance.{needed[0]} is judged on verification poses: add a verify: section")
+            return self
+        if self.cooldown is not None:
+            raise ValueError("a cool-down procedure has no verification poses (verify)")
+        if verify.setpoints_c and self.method == "ramp":
+            raise ValueError("verify.setpoints_c: the ramp passes every temperature; verify at_setpoints instead")
+        low, high = min(self.setpoints_c), max(self.setpoints_c)
+        for setpoint in verify.setpoints_c:
+            if setpoint in self.setpoints_c:
+                raise ValueError(f"verify.setpoints_c: {setpoint:g} °C is a calibration setpoint (verify there "
+                                 "with at_setpoints)")
+            if not low < setpoint < high:
+                raise ValueError(f"verify.setpoints_c: {setpoint:g} °C is outside the calibrated range "
+                                 f"{low:g} … {high:g} °C")
+        return self
+
+    @model_validator(mode="after")
+    def _parameters_judged_inside(self) -> Procedure:
+        limits = self.acceptance.parameters
+        low, high = min(self.setpoints_c), max(self.setpoints_c)
+        if limits is not None and not low <= limits.at_c <= high:
+            raise ValueError(f"acceptance.parameters.at_c: {limits.at_c:g} °C is outside the calibrated range "
+                             f"{low:g} … {high:g} °C")
+        return self
+
+    @model_validator(mode="after")
     def _plan_size(self) -> Procedure:
-        poses = len(self.setpoints_c) * self.schedule_size()
+        poses = len(self.setpoints_c) * self.schedule_size() + self.verification_poses()
         if self.cooldown is None and poses > MAX_PLAN_POSES:
-            raise ValueError(f"{len(self.setpoints_c)} setpoints × {self.schedule_size()} poses = {poses} poses: a "
-                             f"campaign holds at most {MAX_PLAN_POSES}")
+            raise ValueError(f"{len(self.setpoints_c)} setpoints × {self.schedule_size()} poses and "
+                             f"{self.verification_poses()} verification poses = {poses} poses: a campaign holds "
+                             f"at most {MAX_PLAN_POSES}")
         return self
 
     def schedule_size(self) -> int:
         """Poses of the schedule at one setpoint."""
         return self.schedule.size
+
+    def verification_poses(self) -> int:
+        """Verification poses of the whole campaign."""
+        verify = self.verify
+        if verify is None:
+            return 0
+        setpoints = len(verify.setpoints_c) + (len(self.setpoints_c) if verify.at_setpoints else 0)
+        return setpoints * verify.schedule.size
 
     @field_validator("setpoints_c", mode="before")
     @classmethod

@@ -13,7 +13,7 @@ the campaign file's event log, and is raised again as CampaignAborted with a one
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Any
 
@@ -47,12 +47,23 @@ from accelcal_rig.plan.steps import (
     Soak,
     StartSoftwareRamp,
     Step,
+    VerifyPose,
 )
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.writer import CampaignWriter
 
-#: Runs on the stored campaign once the rig is safe; returns a one-line summary of the calibration.
-FitStage = Callable[[Campaign], str]
+
+@dataclass(frozen=True)
+class FitOutcome:
+    """What the fit stage says: a one-line summary, each DUT's verdict and reasons, the fit's warnings."""
+
+    summary: str
+    verdicts: dict[str, tuple[str, tuple[str, ...]]] = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
+
+
+#: Runs on the stored campaign once the rig is safe.
+FitStage = Callable[[Campaign], FitOutcome]
 
 
 @dataclass(frozen=True)
@@ -65,6 +76,13 @@ class CampaignSummary:
     virtual_duration_s: float
     fit: str = ""                 # the fit stage's summary, or why it failed
     fit_failed: bool = False
+    verdicts: dict[str, tuple[str, tuple[str, ...]]] = field(default_factory=dict)  # serial → (PASS|FAIL, reasons)
+    fit_warnings: tuple[str, ...] = ()
+
+    @property
+    def rejected(self) -> list[str]:
+        """The DUTs whose calibration failed its acceptance limits."""
+        return [serial for serial, (verdict, _) in self.verdicts.items() if verdict == "FAIL"]
 
 
 class CampaignRunner:
@@ -82,6 +100,7 @@ class CampaignRunner:
         self.clock = clock
         self.events = events
         self.fit_stage = fit_stage
+        self._fit_error = ""
         self.machine = StateMachine(self._record_transition)
         self.resume = resume
         self._stored_keys = resume.done_keys if resume is not None else frozenset()
@@ -98,7 +117,7 @@ class CampaignRunner:
         self.handlers: Mapping[type, Callable[[Any], None]] = {
             Ramp: self.thermal.ramp, Soak: self.thermal.soak, StartSoftwareRamp: self.thermal.start_software_ramp,
             RampSegment: self.thermal.follow_software_ramp, AdvanceRamp: self.thermal.advance_software_ramp,
-            MeasurePose: self.poses.measure, CooldownRecord: cooldown.record,
+            MeasurePose: self.poses.measure, VerifyPose: self.poses.measure, CooldownRecord: cooldown.record,
         }
 
     # ----------------------------------------------------------------- top level
@@ -123,11 +142,15 @@ class CampaignRunner:
             safe = apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
             self.report.notify("safe", "every pose measured; rig in its safe state" if safe else
                                  "every pose measured; safe state INCOMPLETE: see the event log")
-            fit, fit_failed = self._fit() if self.fit_stage is not None else ("", False)
+            fit = self._fit() if self.fit_stage is not None else FitOutcome("")
+            failed = fit is None
+            outcome = fit or FitOutcome(self._fit_error)
             self.machine.go(State.DONE)
             self.writer.set_state("done", finished=True)
-            self.report.notify("finish", f"campaign done; fit failed: {fit}" if fit_failed else f"campaign done; {fit}")
-            return self._summary("done", fit, fit_failed)
+            self.report.notify("finish", f"campaign done; fit failed: {outcome.summary}" if failed
+                               else f"campaign done; {outcome.summary}")
+            return replace(self._summary("done", outcome.summary, failed), verdicts=outcome.verdicts,
+                           fit_warnings=outcome.warnings)
         except BaseException as exc:  # noqa: BLE001 - every exit path goes through the safe state
             reason = one_line_reason(exc)
             self._abort(reason)
@@ -157,17 +180,24 @@ class CampaignRunner:
         except Exception as exc:  # noqa: BLE001 - the reason still reaches the operator through the exception
             LOGGER.error("could not record the abort in the campaign file: %s", exc)
 
-    def _fit(self) -> tuple[str, bool]:
-        """The measurements are complete and the rig is safe: a fit that fails is reported, not an abort."""
+    def _fit(self) -> FitOutcome | None:
+        """The measurements are complete and the rig is safe: a fit that fails is reported (None, the reason
+        in `_fit_error`), not an abort. The fit's warnings and every DUT's verdict go to the event log."""
         assert self.fit_stage is not None
         self.machine.go(State.FIT)
         try:
-            summary = self.fit_stage(self.writer.campaign)
+            outcome = self.fit_stage(self.writer.campaign)
         except (ValueError, KeyError, OSError, np.linalg.LinAlgError, RigError) as exc:
             self.events.error("fit", f"fit failed: {exc}")
-            return str(exc), True
-        self.events.info("fit", summary)
-        return summary, False
+            self._fit_error = str(exc)
+            return None
+        self.events.info("fit", outcome.summary)
+        for warning in outcome.warnings:
+            self.events.warning("fit", warning)
+        for serial, (verdict, reasons) in outcome.verdicts.items():
+            log = self.events.info if verdict == "PASS" else self.events.warning
+            log("verdict", f"{serial}: {verdict}: {'; '.join(reasons)}")
+        return outcome
 
     def _summary(self, state: str, fit: str = "", fit_failed: bool = False) -> CampaignSummary:
         return CampaignSummary(state, self.plan.setpoints_c, self.report.poses_done, len(self.plan.pose_steps),

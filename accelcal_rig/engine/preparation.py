@@ -20,7 +20,7 @@ from accelcal_rig.config.load import (
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
-from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, compile_plan
+from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, VerificationSeenByFit, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
 from accelcal_rig.store.space import StorageEstimate, estimate_storage
 
@@ -51,6 +51,8 @@ def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str 
         raise procedure.error(("schedule",), f"{exc} of {rig.path}") from None
     except CooldownPoseMissing as exc:
         raise procedure.error(("cooldown", "pose"), str(exc)) from None
+    except VerificationSeenByFit as exc:
+        raise procedure.error(("verify", "schedule"), str(exc)) from None
     _check_design_identifies_fit(procedure, rig.model, plan)
     return PreparedCampaign(procedure, rig, plan)
 

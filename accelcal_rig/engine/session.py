@@ -14,7 +14,7 @@ from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.core.signals import signals_deferred
 from accelcal_rig.engine.audience import Audience
-from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitStage, one_line_reason
+from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitOutcome, FitStage, one_line_reason
 from accelcal_rig.engine.campaign_header import create_campaign_file, fit_attrs, instrument_info
 from accelcal_rig.engine.connection import ConnectedRig, RigConnector
 from accelcal_rig.engine.estimate import estimate_duration
@@ -110,7 +110,7 @@ def _finish_complete(prepared: PreparedCampaign, output: Path, stored: Campaign,
             done.append(f"{output.name} brought up to date from its journal")
         if calibration is not None and not calibration.exists() and prepared.procedure.model.fit.mode != "none":
             procedure = prepared.procedure.model
-            done.append(_fit_stage(procedure, output, calibration)(load_campaign(output)))
+            done.append(_fit_stage(procedure, output, calibration)(load_campaign(output)).summary)
     return done
 
 
@@ -184,8 +184,10 @@ def _fit_stage(procedure: Procedure, output: Path, calibration: Path) -> FitStag
     options = recorded_options(fit_attrs(procedure), f"{output}: its procedure's fit")
     assert options is not None, "a procedure without a fit has no fit stage"
 
-    def stage(campaign: Campaign) -> str:
+    def stage(campaign: Campaign) -> FitOutcome:
         _, report = fit_and_save(campaign, output, calibration, options)
-        return summary_line(report, calibration)
+        return FitOutcome(summary_line(report, calibration),
+                          {serial: (r["verdict"], tuple(r["verdict_reasons"])) for serial, r in report.items()},
+                          tuple(f"sensor {serial}: {w}" for serial, r in report.items() for w in r["warnings"]))
 
     return stage

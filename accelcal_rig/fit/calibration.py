@@ -78,6 +78,8 @@ class SensorCalibration(_Strict):
     setpoints: list[SetpointFit]
     metrics: dict[str, Any] = {}
     warnings: list[str] = []
+    verdict: Literal["PASS", "FAIL"] | None = Field(None, description="against the procedure's acceptance limits")
+    verdict_reasons: list[str] = []
 
     def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:
         """Eq. 1 parameters (..., 12) at each temperature, as the file's `out_of_range` says outside it."""

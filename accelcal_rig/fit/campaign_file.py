@@ -13,10 +13,12 @@ from typing import Any
 import numpy as np
 
 from accelcal_rig.errors import ConfigError, RigError
+from accelcal_rig.fit.calibration import load_calibration
 from accelcal_rig.fit.campaign_fit import fit_and_save
 from accelcal_rig.fit.recorded_options import recorded_options
+from accelcal_rig.store.content import measurements_sha256
 from accelcal_rig.store.lock import holder
-from accelcal_rig.store.read import usable_campaign
+from accelcal_rig.store.read import load_campaign, usable_campaign
 
 
 @dataclass(frozen=True)
@@ -47,3 +49,24 @@ def fit_campaign_file(path: Path, output: Path, **overrides: Any) -> FitOutcome:
     if campaign.state != "done":
         warnings.append(f"campaign state is {campaign.state}: fitted the poses stored so far")
     return FitOutcome(report, warnings)
+
+
+def calibration_verdicts(campaign_path: Path, calibration_path: Path | None = None) -> dict[str, Any]:
+    """What `rig status` says of a campaign's calibration: the file (default beside the campaign), whether it
+    was fitted to the measurements the campaign holds now, and each DUT's verdict with its reasons."""
+    path = calibration_path or campaign_path.with_suffix(".calibration.yaml")
+    if not path.is_file():
+        return {"calibration": None, "verdicts": None}
+    try:
+        calibration = load_calibration(path)
+    except ConfigError as exc:
+        return {"calibration": f"{path}: unreadable: {str(exc).splitlines()[0]}", "verdicts": None}
+    fitted = calibration.source.get("measurements_sha256")
+    current = fitted == measurements_sha256(load_campaign(campaign_path))
+    partial = calibration.source.get("partial")
+    return {
+        "calibration": f"{path}" + ("" if current else " (fitted to other measurements than the campaign's now: "
+                                                       "fit again)") + (f"; {partial}" if partial else ""),
+        "verdicts": {serial: {"verdict": s.verdict, "reasons": s.verdict_reasons}
+                     for serial, s in calibration.sensors.items()},
+    }

@@ -9,6 +9,7 @@ from typing import Any, Literal
 import numpy as np
 
 from accelcal_rig import __version__
+from accelcal_rig.fit.acceptance import judge, recorded_acceptance
 from accelcal_rig.fit.calibration import FORMAT_NAME as CALIBRATION_FORMAT
 from accelcal_rig.fit.calibration import FORMAT_VERSION as CALIBRATION_VERSION
 from accelcal_rig.fit.calibration import (
@@ -19,11 +20,13 @@ from accelcal_rig.fit.calibration import (
     plain,
     save_calibration,
 )
+from accelcal_rig.fit.expected import expected_norm_rmse_mg, expected_reference_rmse_mg, thermal_jacobian
 from accelcal_rig.fit.joint import fit_joint
-from accelcal_rig.fit.lm import FitMode, FreeParameters, SfemFit, fit_sfem
+from accelcal_rig.fit.lm import FitMode, FreeParameters, SfemFit, fit_sfem, norm_sigma
 from accelcal_rig.fit.metrics import drift_mg, noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, norm_only_gauge
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
+from accelcal_rig.fit.verification import pose_figures
 from accelcal_rig.store.content import Campaign, measurements_sha256
 from accelcal_rig.store.read import DutPoses, read_dut_poses
 from accelcal_rig.store.records import utc_now
@@ -67,7 +70,11 @@ def smoothed_temperatures(poses: DutPoses, groups: list[np.ndarray]) -> np.ndarr
     return smoothed
 
 
-def fit_dut(poses: DutPoses, options: FitOptions) -> DutFitResult:
+def fit_dut(stored: DutPoses, options: FitOptions) -> DutFitResult:
+    """Fit the calibration poses; judge the result on them (in-sample) and on the verification poses."""
+    poses = stored.subset(~stored.verification)
+    if not len(poses.setpoint_c):
+        raise ValueError(f"sensor {stored.serial}: no calibration poses stored, nothing to fit")
     setpoints = np.array(list(dict.fromkeys(poses.setpoint_c.tolist())))
     groups = [np.flatnonzero(poses.setpoint_c == s) for s in setpoints]
     pose_temperatures = smoothed_temperatures(poses, groups)
@@ -90,6 +97,14 @@ def fit_dut(poses: DutPoses, options: FitOptions) -> DutFitResult:
                             np.radians(poses.reference_accuracy_arcsec / 3600))
     compensated = correct(poses.mean_g, thermal.parameters_at(pose_temperatures, "extrapolate"))
     metrics = _metrics(poses, setpoints, groups, temperatures, fits, thermal, compensated, options)
+    metrics["expected_fit_rmse_mg"] = _expected_rmse_mg(poses, groups, fits, thermal, pose_temperatures, options)
+    for row, group, fit in zip(metrics["rmse_by_setpoint"], groups, fits):
+        row["expected_mg"] = _expected_rmse_mg(poses, [group], [fit], None, pose_temperatures, options)
+    align = options.mode == "norm-only"
+    metrics["in_sample"] = pose_figures(compensated, poses.reference_g, poses.stderr_g, poses.setpoint_c,
+                                        pose_temperatures, align)
+    if stored.verification.any():
+        metrics["verification"] = _verification(stored.subset(stored.verification), thermal, options)
     calibration = SensorCalibration(
         serial=poses.serial, mode=options.mode,
         free_parameters=[n for n, f in zip(PARAMETER_NAMES, free) if f],
@@ -108,6 +123,33 @@ def fit_dut(poses: DutPoses, options: FitOptions) -> DutFitResult:
         warnings=thermal.warnings,
     )
     return DutFitResult(poses.serial, setpoints, temperatures, fits, thermal, compensated, metrics, calibration)
+
+
+def _expected_rmse_mg(poses: DutPoses, groups: list[np.ndarray], fits: list[SfemFit], thermal: ThermalModel | None,
+                      pose_temperatures: np.ndarray, options: FitOptions) -> float:
+    """The in-sample |g| RMSE the fit is expected to reach: of the thermal model's coefficients over every
+    pose, or (`thermal` None) of one setpoint's parameters."""
+    rows = np.concatenate(groups)
+    if thermal is None:
+        jacobian = fits[0].jacobian
+    else:
+        n_powers = min(thermal.degree, len(groups) - 1) + 1
+        powers = [np.vander(thermal.scaled(pose_temperatures[g]), n_powers, increasing=True) for g in groups]
+        jacobian = thermal_jacobian([f.jacobian for f in fits], powers, 3 if options.mode == "reference" else 1)
+    if options.mode == "reference":
+        return expected_reference_rmse_mg(jacobian, poses.reference_g[rows], poses.stderr_g[rows],
+                                          np.radians(poses.reference_accuracy_arcsec / 3600))
+    return expected_norm_rmse_mg(jacobian, norm_sigma(poses.mean_g[rows], poses.stderr_g[rows]))
+
+
+def _verification(checks: DutPoses, thermal: ThermalModel, options: FitOptions) -> dict[str, Any]:
+    """The figures on poses the fit never saw, compensated as `apply` would (the calibration's out-of-range
+    rule), each at its own smoothed temperature."""
+    groups = [np.flatnonzero(checks.setpoint_c == s) for s in dict.fromkeys(checks.setpoint_c.tolist())]
+    temperatures = smoothed_temperatures(checks, groups)
+    compensated = correct(checks.mean_g, thermal.parameters_at(temperatures, options.out_of_range))
+    return pose_figures(compensated, checks.reference_g, checks.stderr_g, checks.setpoint_c, temperatures,
+                        options.mode == "norm-only")
 
 
 def _metrics(poses: DutPoses, setpoints: np.ndarray, groups: list[np.ndarray], temperatures: np.ndarray,
@@ -160,12 +202,28 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     """Fit every DUT of a stored campaign; the calibration file and the report `rig fit --json` prints
     (per serial). Nothing is written: the campaign's measurements are only read."""
     results = [fit_dut(read_dut_poses(campaign, serial), options) for serial in campaign.serials]
+    limits = recorded_acceptance(campaign.header.procedure_yaml, source.get("campaign", "the campaign"))
+    partial = partial_campaign(campaign)
+    judged = {r.serial: judge(r.metrics, r.thermal, options.mode, limits, partial) for r in results}
+    sensors = {r.serial: r.calibration.model_copy(update={"verdict": judged[r.serial].verdict,
+                                                          "verdict_reasons": judged[r.serial].reasons})
+               for r in results}
     calibration = CalibrationFile(
         format=CALIBRATION_FORMAT, format_version=CALIBRATION_VERSION, created=utc_now(),
-        software_version=__version__, source=source, sensors={r.serial: r.calibration for r in results},
+        software_version=__version__, source={**source, **({"partial": partial} if partial else {})}, sensors=sensors,
     )
-    report = {r.serial: {**plain(r.metrics), "warnings": r.thermal.warnings} for r in results}
+    report = {r.serial: {**plain(r.metrics), "warnings": r.thermal.warnings, "verdict": judged[r.serial].verdict,
+                         "verdict_reasons": judged[r.serial].reasons} for r in results}
     return calibration, report
+
+
+def partial_campaign(campaign: Campaign) -> str:
+    """How a campaign fell short of its plan, or "" when every planned pose is stored (and it was not
+    aborted: a run's own fit stage sees its campaign still running)."""
+    stored, planned = len(campaign.poses), campaign.poses_planned
+    if stored >= planned and campaign.state != "aborted":
+        return ""
+    return f"partial campaign: {stored} of {planned} poses stored (state {campaign.state})"
 
 
 def fit_and_save(campaign: Campaign, campaign_path: Path, calibration_path: Path,
@@ -181,10 +239,22 @@ def fit_and_save(campaign: Campaign, campaign_path: Path, calibration_path: Path
 
 
 def summary_line(report: dict[str, Any], calibration_path: Path) -> str:
-    """`calibration → cal.yaml: |g| RMSE 14.3 → 0.013 mg (floor 0.012) for 4 DUTs` style."""
+    """`calibration → cal.yaml: verification |g| RMSE 0.013 mg (noise floor 0.012), …; 4 PASS` style: the
+    held-out figures when there are verification poses, else the in-sample ones, said so."""
     before = max(r["rmse_before_mg"] for r in report.values())
-    after = max(r["rmse_after_mg"] for r in report.values())
     floor = max(r["noise_floor_mg"] for r in report.values())
-    drift = max(max(r["drift_after_mg"]) for r in report.values())
-    return (f"calibration → {calibration_path}: |g| RMSE {before:.2f} → {after:.4f} mg (noise floor {floor:.4f} mg), "
-            f"offset drift after ≤ {drift:.4f} mg, {len(report)} DUTs (worst of each)")
+    verified = all("verification" in r for r in report.values())
+    if verified:
+        after = max(r["verification"]["rmse_mg"] for r in report.values())
+        drift = max(max(r["verification"]["drift_mg"]) for r in report.values())
+        figures = (f"|g| RMSE {before:.2f} → {after:.4f} mg on verification poses (noise floor {floor:.4f} mg), "
+                   f"residual drift ≤ {drift:.4f} mg")
+    else:
+        after = max(r["rmse_after_mg"] for r in report.values())
+        drift = max(max(r["drift_after_mg"]) for r in report.values())
+        figures = (f"|g| RMSE {before:.2f} → {after:.4f} mg in-sample, no verification poses (noise floor "
+                   f"{floor:.4f} mg), offset drift after ≤ {drift:.4f} mg")
+    failed = [serial for serial, r in report.items() if r.get("verdict") == "FAIL"]
+    verdicts = (f"{len(report) - len(failed)} PASS, {len(failed)} FAIL ({', '.join(failed)})" if failed
+                else f"{len(report)} PASS")
+    return f"calibration → {calibration_path}: {figures}, {len(report)} DUTs (worst of each); {verdicts}"

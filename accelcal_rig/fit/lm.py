@@ -55,7 +55,7 @@ class SfemFit:
     residuals: np.ndarray         # weighted residuals at the solution
     n_poses: int
     mode: FitMode
-
+    jacobian: np.ndarray          # of the weighted residuals in the free parameters, at the solution
 
 def norm_sigma(mean_g: np.ndarray, stderr_g: np.ndarray) -> np.ndarray:
     """Standard error of |U| per pose: each axis's error projected on the measured direction."""
@@ -107,7 +107,7 @@ def fit_sfem(mean_g: np.ndarray, stderr_g: np.ndarray, reference_g: np.ndarray |
         covariance *= chi2_reduced  # the scatter exceeds what the stated uncertainties allow: widen, never hide
     sigma = np.full(12, np.nan)
     sigma[mask] = np.sqrt(np.diag(covariance))
-    return SfemFit(_full(result.x, mask), sigma, mask, chi2_reduced, result.fun, n_poses, mode)
+    return SfemFit(_full(result.x, mask), sigma, mask, chi2_reduced, result.fun, n_poses, mode, jacobian)
 
 
 def _full(theta: np.ndarray, mask: np.ndarray) -> np.ndarray:

@@ -14,6 +14,7 @@ import numpy as np
 
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.config.schedule import Schedule
 from accelcal_rig.plan import schedules
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.plan.steps import (
@@ -29,15 +30,20 @@ from accelcal_rig.plan.steps import (
     Stage,
     StartSoftwareRamp,
     Step,
+    VerifyPose,
 )
 
 
 @dataclass(frozen=True)
 class Plan:
+    """`setpoints_c`: every stage's, in the order run (calibration and verification setpoints); `poses`: the
+    calibration schedule's, `verification_poses` the verification schedule's."""
+
     setpoints_c: tuple[float, ...]
     poses: tuple[Pose, ...]
     stages: tuple[Stage, ...]
     axis_names: tuple[str, ...]
+    verification_poses: tuple[Pose, ...] = ()
 
     @property
     def steps(self) -> tuple[Step, ...]:
@@ -68,9 +74,8 @@ def setpoint_label(setpoint_c: float) -> str:
     return f"T{setpoint_c:g}"
 
 
-def pose_directions(procedure: Procedure, kinematics: TurntableKinematics) -> tuple[np.ndarray, np.ndarray | None]:
-    """(gravity directions in the fixture frame, explicit angles or None) for the procedure's schedule."""
-    schedule = procedure.schedule
+def pose_directions(schedule: Schedule, kinematics: TurntableKinematics) -> tuple[np.ndarray, np.ndarray | None]:
+    """(gravity directions in the fixture frame, explicit angles or None) for a schedule."""
     if schedule.kind == "paper-24":
         return schedules.paper_24(), None
     if schedule.kind == "six-position":
@@ -83,15 +88,16 @@ def pose_directions(procedure: Procedure, kinematics: TurntableKinematics) -> tu
     return kinematics.gravity_in_fixture(angles), angles
 
 
-def compile_poses(procedure: Procedure, rig: RigConfig) -> tuple[Pose, ...]:
-    """Turntable angles for each pose, each solved near the previous one so moves stay short."""
+def compile_poses(schedule: Schedule, rig: RigConfig, start_deg: tuple[float, ...] | None = None) -> tuple[Pose, ...]:
+    """Turntable angles for each pose, each solved near the previous one (the first near `start_deg`, else
+    zero) so moves stay short."""
     kinematics = TurntableKinematics(rig.turntable.axes)
-    directions, explicit = pose_directions(procedure, kinematics)
+    directions, explicit = pose_directions(schedule, kinematics)
     if explicit is not None:
         angles = kinematics.wrap(explicit)
     else:
         angles = np.empty((len(directions), len(kinematics.axes)))
-        current = np.zeros(len(kinematics.axes))
+        current = np.zeros(len(kinematics.axes)) if start_deg is None else np.array(start_deg)
         for i, direction in enumerate(directions):
             current = kinematics.solve(direction, current)
             angles[i] = current
@@ -113,8 +119,9 @@ def cooldown_records(procedure: Procedure) -> int:
 
 def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
     """Setpoints in procedure order; at each, the steps that bring the rig there, then every pose of the
-    schedule. A cool-down procedure: one setpoint, then its records (`T60/cool0001`, …) at the pose it holds."""
-    poses = compile_poses(procedure, rig)
+    schedule and the verification poses; verification setpoints where the sequence passes them. A cool-down
+    procedure: one setpoint, then its records (`T60/cool0001`, …) at the pose it holds."""
+    poses = compile_poses(procedure.schedule, rig)
     names = tuple(a.name for a in rig.turntable.axes)
     if procedure.cooldown is not None:
         if procedure.cooldown.pose > len(poses):
@@ -126,6 +133,10 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
         records = tuple(CooldownRecord(f"{label}/cool{k:04d}", setpoint, held, k)
                         for k in range(1, cooldown_records(procedure) + 1))
         return Plan((setpoint,), (held,), (Stage(setpoint, soaked, records, soaked),), names)
+    verify = procedure.verify
+    checks = compile_poses(verify.schedule, rig, poses[-1].angles_deg) if verify is not None else ()
+    if checks:
+        _check_verification_is_new(poses, checks)
     width = max(2, len(str(len(poses))))
     setpoints = tuple(procedure.setpoints_c)
     stages = []
@@ -133,7 +144,9 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
     restart: tuple[Step, ...]
     for index, setpoint in enumerate(setpoints):
         label = setpoint_label(setpoint)
-        measure = [MeasurePose(f"{label}/pose{p.number:0{width}d}", setpoint, p) for p in poses]
+        measure: list[MeasurePose | VerifyPose] = [MeasurePose(f"{label}/pose{p.number:0{width}d}", setpoint, p) for p in poses]
+        if verify is not None and verify.at_setpoints:
+            measure.extend(_verification(setpoint, checks))
         if procedure.method == "ramp":
             entry, restart = _ramp_method_entries(setpoints, index)
             body: tuple[Step, ...] = tuple(step for m in measure for step in (AdvanceRamp(setpoint), m))
@@ -141,7 +154,45 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
             entry = restart = _ramp_and_soak(setpoint)
             body = tuple(measure)
         stages.append(Stage(setpoint, entry, body, restart))
-    return Plan(setpoints, poses, tuple(stages), names)
+        if verify is not None and index + 1 < len(setpoints):
+            passed = _passed_between(setpoint, setpoints[index + 1], verify.setpoints_c, stages)
+            stages.extend(Stage(v, _ramp_and_soak(v), tuple(_verification(v, checks)), _ramp_and_soak(v))
+                          for v in passed)
+    return Plan(tuple(s.setpoint_c for s in stages), poses, tuple(stages), names, checks)
+
+
+def _verification(setpoint_c: float, checks: tuple[Pose, ...]) -> list[VerifyPose]:
+    width = max(2, len(str(len(checks))))
+    label = setpoint_label(setpoint_c)
+    return [VerifyPose(f"{label}/verify{p.number:0{width}d}", setpoint_c, p) for p in checks]
+
+
+def _passed_between(from_c: float, to_c: float, candidates_c: list[float], stages: list[Stage]) -> list[float]:
+    """The verification setpoints strictly between two calibration setpoints not visited yet, in the order
+    the chamber passes them."""
+    visited = {s.setpoint_c for s in stages}
+    inside = [v for v in candidates_c if min(from_c, to_c) < v < max(from_c, to_c) and v not in visited]
+    return sorted(inside, reverse=to_c < from_c)
+
+
+class VerificationSeenByFit(ValueError):
+    """A verification pose has a calibration pose's orientation."""
+
+
+#: Orientations closer than this are the same pose to the fit.
+SAME_POSE_DEG = 1.0
+
+
+def _check_verification_is_new(poses: tuple[Pose, ...], checks: tuple[Pose, ...]) -> None:
+    calibration = np.array([p.gravity_fixture for p in poses])
+    verification = np.array([p.gravity_fixture for p in checks])
+    cosine = np.clip(verification @ calibration.T, -1.0, 1.0)
+    close = np.argwhere(np.degrees(np.arccos(cosine)) < SAME_POSE_DEG)
+    if len(close):
+        check, pose = close[0]
+        raise VerificationSeenByFit(f"verification pose {check + 1} has the orientation of calibration pose "
+                                    f"{pose + 1} (within {SAME_POSE_DEG:g}°): verification poses must be ones the "
+                                    "fit does not see")
 
 
 def _ramp_and_soak(setpoint_c: float) -> tuple[Ramp, Soak]:

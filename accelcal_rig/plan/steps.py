@@ -73,6 +73,13 @@ class MeasurePose(Measurement):
 
 
 @dataclass(frozen=True)
+class VerifyPose(Measurement):
+    """A verification pose: measured like a calibration pose, stored apart, never seen by the fit."""
+
+    stored_kind: ClassVar[str] = "verify"
+
+
+@dataclass(frozen=True)
 class CooldownRecord(Measurement):
     """A cool-down's `number`-th record at the pose it holds: the first at the setpoint, after which the chamber
     is let go, then one every `cooldown.record_every_s`."""
@@ -80,7 +87,7 @@ class CooldownRecord(Measurement):
     number: int
 
 
-Step = Ramp | Soak | StartSoftwareRamp | RampSegment | AdvanceRamp | MeasurePose | CooldownRecord
+Step = Ramp | Soak | StartSoftwareRamp | RampSegment | AdvanceRamp | MeasurePose | VerifyPose | CooldownRecord
 #: The steps that store a record in the campaign (what its stored plan lists).
 Record = Soak | Measurement
 

@@ -15,7 +15,8 @@ import numpy as np
 
 from accelcal_rig.config.procedure import SoakCriterion
 from accelcal_rig.config.yaml_lines import parse_yaml_text
-from accelcal_rig.fit.campaign_fit import DutFitResult, FitOptions, fit_dut
+from accelcal_rig.fit.acceptance import Judgement, judge, recorded_acceptance
+from accelcal_rig.fit.campaign_fit import DutFitResult, FitOptions, fit_dut, partial_campaign
 from accelcal_rig.fit.recorded_options import recorded_options
 from accelcal_rig.store.read import DutPoses, campaign_status, load_campaign, read_dut_poses
 from accelcal_rig.store.records import StoredEvent
@@ -35,10 +36,11 @@ class SoakRecord:
 
 @dataclass(frozen=True)
 class DutReport:
-    poses: DutPoses
+    poses: DutPoses                   # the calibration poses (the verification poses' figures are in the fit's)
     pose_numbers: np.ndarray          # (N,) 1-based pose of the schedule
     fit: DutFitResult | None
     truth_by_setpoint: np.ndarray | None   # (K, 12) simulation truth averaged per setpoint, dry runs only
+    judgement: Judgement | None = None     # against the procedure's acceptance limits
 
 
 @dataclass(frozen=True)
@@ -66,22 +68,26 @@ def read_campaign_data(path: Path) -> CampaignData:
     options = recorded_options(attrs, str(path))
     pose_numbers = campaign.pose_column("pose_number")
     damaged = campaign.unusable_reasons()
+    limits = recorded_acceptance(campaign.header.procedure_yaml, str(path))
+    partial = partial_campaign(campaign)
     duts, reasons = {}, []
     for serial in campaign.serials:
-        poses = read_dut_poses(campaign, serial)
-        fit = None
+        stored = read_dut_poses(campaign, serial)
+        poses = stored.subset(~stored.verification)
+        fit, judgement = None, None
         if options is None:
             reasons.append("the procedure measures only (fit.mode: none)")
         elif damaged:
             reasons.append(f"damaged measurements: {damaged[0]}")
         elif len(poses.setpoint_c):
             try:
-                fit = fit_dut(poses, options)
+                fit = fit_dut(stored, options)
+                judgement = judge(fit.metrics, fit.thermal, options.mode, limits, partial)
             except (ValueError, np.linalg.LinAlgError) as exc:
                 reasons.append(str(exc))
         else:
             reasons.append("no poses stored")
-        duts[serial] = DutReport(poses, pose_numbers, fit, _truth_by_setpoint(poses))
+        duts[serial] = DutReport(poses, pose_numbers[~stored.verification], fit, _truth_by_setpoint(poses), judgement)
     soaks = [SoakRecord(name, s.setpoint_c, s.outcome, s.t_s, s.chamber_c, s.dut_c, s.t_reached_s, s.t_stable_s)
              for name, s in zip(campaign.soak_names(), campaign.soaks)]
     events = list(campaign.events)

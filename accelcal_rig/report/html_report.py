@@ -132,21 +132,39 @@ def _summary(data: CampaignData) -> list[str]:
         ["integrity", s.get("integrity", "?")],
     ]
     out = ["<h2>Campaign</h2>", _table(["", ""], rows, text_columns=2)]
-    sensors = []
+    sensors, verified, classes = [], [], []
     for serial, dut in data.duts.items():
         if dut.fit is None:
             sensors.append([serial, "—", "—", "—", "—", "—", "no fit"])
             continue
         m = dut.fit.metrics
-        sensors.append([serial, f"{m['rmse_before_mg']:.3f}", f"{m['rmse_after_mg']:.4f}", f"{m['noise_floor_mg']:.4f}",
-                        " / ".join(f"{v:.2f}" for v in m["drift_before_mg"]),
+        sensors.append([serial, f"{m['rmse_before_mg']:.3f}", f"{m['noise_floor_mg']:.4f}",
+                        f"{m['expected_fit_rmse_mg']:.4f}", f"{m['rmse_after_mg']:.4f}",
                         " / ".join(f"{v * 1e3:.1f}" for v in m["drift_after_mg"]),
                         "; ".join(dut.fit.thermal.warnings) or "—"])
-    out += ["<h2>Calibration</h2>",
-            _table(["DUT", "|g| RMSE before (mg)", "after (mg)", "noise floor (mg)", "drift before x/y/z (mg)",
+        v = m.get("verification")
+        verdict = dut.judgement.verdict if dut.judgement else "—"
+        reasons = "; ".join(dut.judgement.reasons) if dut.judgement else ""
+        verified.append([serial, verdict, reasons, *(["—"] * 6 if v is None else [
+            v["n_poses"], f"{v['rmse_mg']:.4f}", f"{v['rmse_mg'] / m['noise_floor_mg']:.2f}",
+            f"{v['max_axis_error_mg']:.4f}", f"{v['max_tilt_error_deg']:.4f}",
+            " / ".join(f"{d * 1e3:.1f}" for d in v["drift_mg"])])])
+        classes.append("" if verdict == "PASS" else "warning")
+    out += ["<h2>Calibration: verification (poses the fit never saw)</h2>",
+            _table(["DUT", "verdict", "reasons", "poses", "|g| RMSE (mg)", "÷ noise floor", "largest axis error (mg)",
+                    "largest tilt error (°)", "residual drift x/y/z (µg)"], verified, text_columns=3,
+                   row_classes=classes),
+            "<p class='note'>The figures that say how good the calibration is: each verification pose compensated at "
+            "its own temperature as the calibration file would, against the turntable's gravity. A pose the fit "
+            "never saw cannot beat its own noise: |g| RMSE ÷ noise floor is at least about 1.</p>"
+            if any(row[3] != "—" for row in verified) else
+            "<p><b>No verification poses:</b> every figure below is in-sample (on the poses fitted).</p>",
+            "<h2>Calibration: in-sample (the poses fitted)</h2>",
+            _table(["DUT", "|g| RMSE before (mg)", "noise floor (mg)", "expected fit (mg)", "after (mg)",
                     "drift after x/y/z (µg)", "warnings"], sensors),
-            "<p class='note'>After: every pose compensated with the polynomial model at its own temperature. "
-            "Noise floor: the RMSE the per-pose standard errors alone would leave after a perfect fit.</p>"]
+            "<p class='note'>In-sample: every calibration pose compensated with the polynomial model at its own "
+            "temperature — the fit has seen these poses, so they reach the expected fit RMSE, below the noise "
+            "floor (the RMSE the per-pose standard errors alone leave with the true parameters).</p>"]
     return out
 
 

@@ -27,10 +27,12 @@ def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[s
         f"{soak.window_min:g} min with the chamber within {soak.chamber_tolerance_c:g} °C; polled every "
         f"{soak.poll_s:g} s; deadline {soak.timeout_min:g} min ({soak.on_timeout})",
         _poses_line(prepared),
+        *_verification_lines(prepared),
         *_method_lines(prepared),
         "fit        none: measured only" if procedure.fit.mode == "none" else
         f"fit        {procedure.fit.mode}, {procedure.fit.parameters} parameters, polynomial degree "
         f"{procedure.fit.polynomial_degree}",
+        *(f"warning    {w}" for w in plan_warnings(prepared)),
         _storage_line(prepared),
         "",
         "pose  " + " ".join(f"{name + ' °':>9s}" for name in plan.axis_names) + "   gravity in the fixture frame (g)",
@@ -39,6 +41,10 @@ def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[s
         angles = " ".join(f"{a:9.3f}" for a in pose.angles_deg)
         gravity = " ".join(f"{g:+7.4f}" for g in pose.gravity_fixture)
         lines.append(f"{pose.number:4d}  {angles}   {gravity}")
+    for pose in plan.verification_poses:
+        angles = " ".join(f"{a:9.3f}" for a in pose.angles_deg)
+        gravity = " ".join(f"{g:+7.4f}" for g in pose.gravity_fixture)
+        lines.append(f"{'v' + str(pose.number):>4s}  {angles}   {gravity}")
     lines += ["", f"{'setpoint':>8s} {'ramp':>8s} {'soak':>8s} {'poses':>8s} {'ends at':>9s}  DUTs settle at (°C)"]
     t = 0.0
     for row in estimate.setpoints:
@@ -52,6 +58,20 @@ def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[s
     lines += ["", f"estimated duration {format_duration(estimate.total_s)} (h:mm:ss; from the rig's ramp rate, "
                   "thermal time constants and axis speeds; instrument communication not included)"]
     return lines
+
+
+def plan_warnings(prepared: PreparedCampaign) -> list[str]:
+    """What the plan cannot give the fit it asks for: too few setpoints for the polynomial's degree."""
+    procedure = prepared.procedure.model
+    n, degree = len(procedure.setpoints_c), procedure.fit.polynomial_degree
+    if procedure.fit.mode == "none" or procedure.cooldown is not None or n == 1:
+        return []
+    if n < degree + 1:
+        return [f"{n} calibration setpoints cannot fix a degree-{degree} polynomial: the fit will use degree {n - 1}"]
+    if n == degree + 1:
+        return [f"{n} calibration setpoints for degree {degree}: the polynomial will interpolate them, with nothing "
+                "left to check it (add setpoints, or verification setpoints)"]
+    return []
 
 
 def _storage_line(prepared: PreparedCampaign) -> str:
@@ -70,6 +90,29 @@ def _poses_line(prepared: PreparedCampaign) -> str:
         return (f"records    {len(plan.pose_steps)} at pose {cooldown.pose} of the {procedure.schedule.kind} schedule, "
                 f"every {cooldown.record_every_s:g} s for {cooldown.duration_min:g} min; {samples}")
     return f"poses      {len(plan.poses)} per setpoint ({procedure.schedule.kind}), {len(plan.pose_steps)} in all; {samples}"
+
+
+def _verification_lines(prepared: PreparedCampaign) -> list[str]:
+    procedure, plan = prepared.procedure.model, prepared.plan
+    verify = procedure.verify
+    if verify is None:
+        return ["verify     none: every figure of the fit is in-sample (add a verify: section)"]
+    where = [w for w in ("at every calibration setpoint" if verify.at_setpoints else "",
+                         "at " + ", ".join(f"{s:g}" for s in verify.setpoints_c) + " °C" if verify.setpoints_c else "")
+             if w]
+    total = sum(1 for s in plan.pose_steps if s.stored_kind == "verify")
+    lines = [f"verify     {len(plan.verification_poses)} poses ({verify.schedule.kind}, listed as v1…) "
+             f"{' and '.join(where)}: {total} in all, never fitted"]
+    limits = procedure.acceptance
+    judged = [f"{name} {getattr(limits, name):g}" for name in limits.verification_limits()]
+    if limits.parameters is not None:
+        p = limits.parameters
+        judged += [f"{name} {getattr(p, name):g} at {p.at_c:g} °C" for name in
+                   ("bias_mg", "scale_error_ppm", "nonorthogonality_mrad", "misalignment_mrad")
+                   if getattr(p, name) is not None]
+    lines.append("accept     " + ("; ".join(judged) if judged else "no limits: every DUT passes") +
+                 ("" if limits.allow_partial else "; a partial campaign fails"))
+    return lines
 
 
 def _method_lines(prepared: PreparedCampaign) -> list[str]:
@@ -97,7 +140,11 @@ def plan_json(prepared: PreparedCampaign, estimate: DurationEstimate) -> dict[st
         "axes": list(plan.axis_names),
         "poses": [{"number": p.number, "angles_deg": list(p.angles_deg), "gravity_fixture": list(p.gravity_fixture)}
                   for p in plan.poses],
+        "verification_poses": [{"number": p.number, "angles_deg": list(p.angles_deg),
+                                "gravity_fixture": list(p.gravity_fixture)} for p in plan.verification_poses],
         "poses_total": len(plan.pose_steps),
+        "acceptance": procedure.acceptance.model_dump(),
+        "warnings": plan_warnings(prepared),
         "storage": {"journal_bytes": storage.journal_bytes, "file_bytes": storage.file_bytes,
                     "need_bytes": storage.need_bytes, "start_free_bytes": int(START_MARGIN * storage.need_bytes)},
         "estimate": {

@@ -91,7 +91,7 @@ class Campaign:
 
     @property
     def poses_planned(self) -> int:
-        return self.header.plan.kind.count("pose")
+        return len(self.header.plan.pose_keys)
 
     @property
     def run_count(self) -> int:

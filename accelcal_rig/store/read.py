@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 import socket
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -229,6 +229,14 @@ class DutPoses:
     reference_g: np.ndarray           # (N, 3) expected reading from the turntable
     reference_accuracy_arcsec: float  # ± per turntable axis, from the rig config
     truth_parameters: np.ndarray | None  # (N, 12) simulation truth, dry runs only
+    verification: np.ndarray          # (N,) bool: a verification pose (the fit never sees it)
+
+    def subset(self, rows: np.ndarray) -> DutPoses:
+        """These poses only (a boolean mask or indices)."""
+        arrays = {name: getattr(self, name)[rows] for name in ("setpoint_c", "t_s", "temperature_c", "mean_g",
+                                                                "stderr_g", "reference_g", "verification")}
+        truth = self.truth_parameters[rows] if self.truth_parameters is not None else None
+        return replace(self, **arrays, truth_parameters=truth)
 
 
 def dut_description(campaign: Campaign, serial: str) -> dict[str, Any]:
@@ -249,6 +257,7 @@ def read_dut_poses(campaign: Campaign, serial: str) -> DutPoses:
         reference_g=campaign.dut_column(serial, "gravity_reference_g"),
         reference_accuracy_arcsec=float(campaign.header.turntable_accuracy_arcsec),
         truth_parameters=campaign.truth_column(serial, "parameters"),
+        verification=np.isin(campaign.pose_column("step_key"), list(campaign.header.plan.verification_keys)),
     )
 
 

@@ -92,12 +92,16 @@ class StoredEvent:
     message: str
 
 
+#: The plan kinds of steps that store a pose: a calibration pose, a verification pose.
+MEASUREMENT_KINDS = ("pose", "verify")
+
+
 @dataclass(frozen=True)
 class StoredPlan:
     """The compiled plan as the campaign keeps it: one row per step."""
 
     step_key: tuple[str, ...]
-    kind: tuple[str, ...]             # "soak" | "pose"
+    kind: tuple[str, ...]             # "soak" | "pose" | "verify" (a verification pose, never fitted)
     setpoint_c: np.ndarray            # (S,)
     pose_number: np.ndarray           # (S,) 1-based, 0 for soaks
     angles_deg: np.ndarray            # (S, A) commanded angles, NaN for soaks
@@ -107,7 +111,12 @@ class StoredPlan:
 
     @property
     def pose_keys(self) -> list[str]:
-        return [k for k, kind in zip(self.step_key, self.kind) if kind == "pose"]
+        """Every pose's key, calibration and verification."""
+        return [k for k, kind in zip(self.step_key, self.kind) if kind in MEASUREMENT_KINDS]
+
+    @property
+    def verification_keys(self) -> frozenset[str]:
+        return frozenset(k for k, kind in zip(self.step_key, self.kind) if kind == "verify")
 
 
 @dataclass(frozen=True)

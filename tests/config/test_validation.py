@@ -103,3 +103,39 @@ def test_a_schedule_that_cannot_determine_the_fit_is_refused_before_the_campaign
     with pytest.raises(ConfigError, match=r"tiny.yaml:7: fit.mode: too few poses: 6 poses give 6 equations"):
         prepare(write("tiny.yaml", text))
     prepare(write("tiny.yaml", TINY_PROCEDURE + "fit: {mode: norm-only, parameters: bias-scale}\n"))
+
+
+SETPOINTS = TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c: [20, 40]")
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        (SETPOINTS + "verify: {schedule: {kind: sphere, count: 8}, setpoints_c: [50]}\n",
+         r"verify.setpoints_c: 50 °C is outside the calibrated range 20 … 40 °C"),
+        (SETPOINTS + "verify: {schedule: {kind: sphere, count: 8}, setpoints_c: [40]}\n",
+         r"verify.setpoints_c: 40 °C is a calibration setpoint"),
+        (SETPOINTS + "verify: {schedule: {kind: sphere, count: 8}, at_setpoints: false}\n",
+         r"verify: .*verification needs at_setpoints: true or setpoints_c"),
+        (SETPOINTS + "acceptance: {max_verification_rmse_mg: 0.05}\n",
+         r"acceptance.max_verification_rmse_mg is judged on verification poses: add a verify: section"),
+        (SETPOINTS + "acceptance: {parameters: {at_c: 0, bias_mg: 25}}\n",
+         r"acceptance.parameters.at_c: 0 °C is outside the calibrated range 20 … 40 °C"),
+        (SETPOINTS + "acceptance: {max_tilt_error_deg: 0}\n", r"tiny.yaml:\d+: acceptance.max_tilt_error_deg: .*greater than 0"),
+        (SETPOINTS + "cooldown: {pose: 1}\nverify: {schedule: {kind: sphere, count: 8}}\n",
+         r"a cool-down procedure"),
+    ],
+)
+def test_verification_and_acceptance_errors_name_the_key(write, text: str, expected: str) -> None:
+    with pytest.raises(ConfigError, match=expected):
+        prepare(write("tiny.yaml", text))
+
+
+def test_verification_setpoints_run_where_the_sequence_passes_them(write) -> None:
+    text = TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c: [40, 0, 20]") + (
+        "verify: {schedule: {kind: sphere, count: 8}, at_setpoints: false, setpoints_c: [10, 30, 5]}\n")
+    plan = prepare(write("tiny.yaml", text)).plan
+    # 40 → 0 passes 30, 10 and 5 on the way down; nothing is left for 0 → 20.
+    assert plan.setpoints_c == (40, 30, 10, 5, 0, 20)
+    verify_keys = [s.key for s in plan.pose_steps if s.stored_kind == "verify"]
+    assert verify_keys[0] == "T30/verify01" and len(verify_keys) == 3 * 8

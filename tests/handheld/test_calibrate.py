@@ -84,7 +84,8 @@ def test_a_campaign_files_raw_samples_are_a_recording(paper_campaign: Path) -> N
     recording = read_campaign_recording(paper_campaign, "ADX355-A002", 20.0)
     detection = detect_static_intervals(recording.t_s, recording.accel_g, recording.temperature_c, DetectorSettings(),
                                         recording.source)
-    assert len(detection.intervals) == 24  # one per pose: the moves are gaps in time
+    # One per pose, the 24 calibration poses and the 12 verification poses: the moves are gaps in time.
+    assert len(detection.intervals) == 24 + 12
     result = fit_recording(recording, detection, "all", "ADX355-A002")
     assert result.report["rmse_after_mg"] < 1.5 * result.report["noise_floor_mg"]
     assert result.report["temperature_c"] == pytest.approx(20.0, abs=0.5)

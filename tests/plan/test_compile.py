@@ -1,23 +1,38 @@
 import numpy as np
+import pytest
 
 from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.plan.kinematics import TurntableKinematics
-from accelcal_rig.plan.steps import AdvanceRamp, CooldownRecord, MeasurePose, Ramp, RampSegment, Soak, StartSoftwareRamp
+from accelcal_rig.plan.steps import (
+    AdvanceRamp,
+    CooldownRecord,
+    MeasurePose,
+    Ramp,
+    RampSegment,
+    Soak,
+    StartSoftwareRamp,
+    VerifyPose,
+)
 from tests.conftest import REPO
 
 
-def test_paper_plan_ramps_and_soaks_then_measures_24_poses_at_each_of_11_setpoints() -> None:
+def test_paper_plan_ramps_soaks_measures_and_verifies_at_each_setpoint_and_between() -> None:
     plan = prepare(REPO / "procedures" / "paper-24pos-thermal.yaml").plan
-    assert [s.setpoint_c for s in plan.stages] == list(range(-40, 61, 10))
+    calibration, verification = list(range(-40, 61, 10)), [-15, 15, 45]
+    assert [s.setpoint_c for s in plan.stages] == sorted(calibration + verification)  # passed on the way up
     for stage in plan.stages:
         assert stage.entry == stage.restart_entry == (Ramp(stage.setpoint_c), Soak(f"T{stage.setpoint_c:g}/soak",
                                                                                     stage.setpoint_c))
-        assert [type(s) for s in stage.body] == [MeasurePose] * 24
-    assert len(plan.steps) == 11 * 26
-    assert len(plan.pose_steps) == 264
+        poses = [MeasurePose] * 24 if stage.setpoint_c in calibration else []
+        assert [type(s) for s in stage.body] == poses + [VerifyPose] * 12
+    assert len(plan.pose_steps) == 11 * 36 + 3 * 12
     keys = [s.key for s in plan.records]
-    assert keys[:2] == ["T-40/soak", "T-40/pose01"] and keys[-1] == "T60/pose24" and len(keys) == 11 * 25
-    assert len(set(keys)) == len(keys)  # keys are unique
+    assert keys[:2] == ["T-40/soak", "T-40/pose01"] and keys[25:27] == ["T-40/verify01", "T-40/verify02"]
+    assert keys[-1] == "T60/verify12" and len(set(keys)) == len(keys) == 14 + 11 * 24 + 14 * 12  # keys are unique
+    # Verification poses are the sphere's, none a calibration pose's orientation.
+    gravity = np.array([p.gravity_fixture for p in plan.verification_poses])
+    cosines = gravity @ np.array([p.gravity_fixture for p in plan.poses]).T
+    assert len(gravity) == 12 and np.degrees(np.arccos(np.max(cosines))) > 4  # the nearest is 4.4° from a Table 1 pose
 
 
 def test_ramp_plan_soaks_at_the_ends_and_measures_on_the_software_ramp_in_between() -> None:
@@ -72,3 +87,13 @@ def test_explicit_schedule_keeps_the_given_angles(write) -> None:
     plan = prepare(write("tiny.yaml", text)).plan
     assert [p.angles_deg for p in plan.poses][:3] == [(0, 0, 0), (0, 90, 0), (10, -180, 10)]
     np.testing.assert_allclose(plan.poses[1].gravity_fixture, [0, 1, 0], atol=1e-12)
+
+
+def test_a_verification_pose_the_fit_would_see_is_refused(write) -> None:
+    from accelcal_rig.errors import ConfigError
+    from tests.conftest import TINY_PROCEDURE
+
+    text = TINY_PROCEDURE + "verify: {schedule: {kind: six-position}}\n"
+    with pytest.raises(ConfigError, match=r"tiny.yaml:\d+: verify.schedule: verification pose 1 has the orientation "
+                                          r"of calibration pose 1"):
+        prepare(write("tiny.yaml", text))

@@ -56,11 +56,15 @@ def test_the_page_refers_only_to_files_beside_it(paper_report: Path) -> None:
 
 def test_the_page_holds_the_tables_an_engineer_looks_for(paper_report: Path) -> None:
     text = paper_report.read_text(encoding="utf-8")
-    for heading in ("Campaign", "Calibration", "RMSE of |g| per setpoint", "Error parameters over temperature",
-                    "Offset drift before and after compensation", "Soaks", "Against the simulated truth", "Event log"):
+    for heading in ("Campaign", "Calibration: verification (poses the fit never saw)",
+                    "Calibration: in-sample (the poses fitted)", "RMSE of |g| per setpoint",
+                    "Error parameters over temperature", "Offset drift before and after compensation", "Soaks",
+                    "Against the simulated truth", "Event log"):
         assert f"<h2>{heading}</h2>" in text
-    assert text.count("<td class=\"text\">T") >= 11  # one soak row per setpoint
-    assert "264 of 264 × 4 DUTs × 200 samples" in text
+    assert text.count("<td class=\"text\">T") >= 14  # one soak row per setpoint, verification setpoints too
+    assert "432 of 432 × 4 DUTs × 200 samples" in text
+    # Each DUT's verdict beside its verification figures: the 168 verification poses of each.
+    assert text.count('<td class="text">PASS</td>') == 4 and text.count("<td>168</td>") == 4
     assert "safe state: sensor ADX355-A004" in text  # the event log, info and above
 
 

@@ -1,0 +1,72 @@
+"""How a calibration is judged: verification poses the fit never sees, and the limits a DUT must meet to
+pass."""
+
+from __future__ import annotations
+
+from pydantic import BaseModel, Field, field_validator, model_validator
+
+from accelcal_rig.config.bounds import STRICT, TemperatureC
+from accelcal_rig.config.schedule import Schedule
+
+
+class _Strict(BaseModel):
+    model_config = STRICT
+
+
+class Verification(_Strict):
+    """Poses measured like the calibration's and kept out of the fit: every figure that says how good the
+    calibration is comes from them."""
+
+    schedule: Schedule
+    at_setpoints: bool = Field(True, description="verification poses after the calibration poses at every "
+                                                 "calibration setpoint")
+    setpoints_c: list[TemperatureC] = Field(
+        [], max_length=200, description="verification-only setpoints, between the calibration setpoints "
+                                        "(soaked like them, only the verification poses measured)")
+
+    @field_validator("setpoints_c")
+    @classmethod
+    def _distinct(cls, value: list[float]) -> list[float]:
+        if len(set(value)) != len(value):
+            raise ValueError("verification setpoints must be distinct")
+        return value
+
+    @model_validator(mode="after")
+    def _somewhere(self) -> Verification:
+        if not self.at_setpoints and not self.setpoints_c:
+            raise ValueError("verification needs at_setpoints: true or setpoints_c")
+        return self
+
+
+
+
+class ParameterLimits(_Strict):
+    """Limits on the calibration's parameters at `at_c`, e.g. the datasheet's zero-g offset; a limit left
+    out is not judged."""
+
+    at_c: TemperatureC = Field(25.0, description="temperature the parameters are judged at (inside the "
+                                                 "calibrated range)")
+    bias_mg: float | None = Field(None, gt=0, le=1000, description="|bias| of each axis")
+    scale_error_ppm: float | None = Field(None, gt=0, le=1e6, description="|scale − 1| of each axis")
+    nonorthogonality_mrad: float | None = Field(None, gt=0, le=1000, description="|each non-orthogonality|")
+    misalignment_mrad: float | None = Field(None, gt=0, le=1000, description="|each misalignment| (reference "
+                                                                              "mode only)")
+
+
+class Acceptance(_Strict):
+    """What a DUT's calibration must meet to PASS; each limit left out is not judged. The verification
+    limits are judged on the verification poses (a `verify:` section is needed for them)."""
+
+    max_verification_rmse_mg: float | None = Field(None, gt=0, le=1000, description="Eq. 9 |g| RMSE")
+    max_axis_error_mg: float | None = Field(None, gt=0, le=1000, description="largest per-axis error of the "
+                                            "compensated vector against the reference gravity")
+    max_drift_mg: float | None = Field(None, gt=0, le=1000, description="residual zero-g drift per axis over "
+                                       "the verification temperatures (max − min)")
+    max_tilt_error_deg: float | None = Field(None, gt=0, le=90, description="largest Eq. 10 pitch or roll error")
+    parameters: ParameterLimits | None = None
+    allow_partial: bool = Field(False, description="a campaign that stopped before its last pose may pass")
+
+    def verification_limits(self) -> list[str]:
+        """The keys of the limits that need verification poses."""
+        names = ["max_verification_rmse_mg", "max_axis_error_mg", "max_drift_mg", "max_tilt_error_deg"]
+        return [n for n in names if getattr(self, n) is not None]

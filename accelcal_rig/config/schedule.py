@@ -1,0 +1,79 @@
+"""Pose schedules as a procedure states them: the paper's 24 positions, six positions, a sphere, tilts, or
+explicit turntable angles."""
+
+from __future__ import annotations
+
+from typing import Annotated, ClassVar, Literal
+
+from pydantic import BaseModel, Field, field_validator
+
+from accelcal_rig.config.bounds import STRICT, AngleDeg
+
+#: Most orientations a schedule may list (each is solved for the turntable's angles when the plan compiles).
+MAX_SCHEDULE_POSES = 2_000
+
+
+class _Strict(BaseModel):
+    model_config = STRICT
+
+
+class Paper24Schedule(_Strict):
+    """Table 1 of the paper: eight 45° steps about each of the sensor's z, y and x axes."""
+
+    kind: Literal["paper-24"]
+    size: ClassVar[int] = 24
+
+
+class SixPositionSchedule(_Strict):
+    """The classic six positions: each sensor axis up, then down."""
+
+    kind: Literal["six-position"]
+    size: ClassVar[int] = 6
+
+
+class SphereSchedule(_Strict):
+    """`count` gravity directions spread evenly over the sphere (Fibonacci lattice)."""
+
+    kind: Literal["sphere"]
+    count: int = Field(ge=6, le=MAX_SCHEDULE_POSES)
+
+    @property
+    def size(self) -> int:
+        return self.count
+
+
+class TiltSchedule(_Strict):
+    """Poses given as pitch and roll of the fixture (paper Eq. 10, Table 5), in degrees: pitch tilts the
+    y axis up, roll tilts the x axis down; (0, 0) is level with z up."""
+
+    kind: Literal["tilt"]
+    pitch_roll_deg: list[tuple[float, float]] = Field(min_length=1, max_length=MAX_SCHEDULE_POSES)
+
+    @property
+    def size(self) -> int:
+        return len(self.pitch_roll_deg)
+
+    @field_validator("pitch_roll_deg")
+    @classmethod
+    def _within_quarter_turn(cls, value: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        if any(not -90.0 <= p <= 90.0 or not -180.0 <= r <= 180.0 for p, r in value):
+            raise ValueError("pitch must lie within ±90° and roll within ±180°")
+        return value
+
+
+class ExplicitSchedule(_Strict):
+    """Turntable axis angles given pose by pose, in degrees, in the rig's axis order."""
+
+    kind: Literal["explicit"]
+    angles_deg: list[Annotated[list[AngleDeg], Field(min_length=1, max_length=6)]] = Field(
+        min_length=1, max_length=MAX_SCHEDULE_POSES)
+
+    @property
+    def size(self) -> int:
+        return len(self.angles_deg)
+
+
+Schedule = Annotated[
+    Paper24Schedule | SixPositionSchedule | SphereSchedule | TiltSchedule | ExplicitSchedule,
+    Field(discriminator="kind")
+]

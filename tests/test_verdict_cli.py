@@ -1,0 +1,66 @@
+"""A verified campaign end to end through the commands: verification poses stored apart and never fitted,
+the verdict in the run summary, `rig status`, `rig fit --json` and the calibration file, and
+`--fail-on-reject` exiting 3."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from accelcal_rig.cli import main
+from accelcal_rig.fit.calibration import load_calibration
+from accelcal_rig.fit.campaign_fit import FitOptions, fit_dut
+from accelcal_rig.store.read import load_campaign, read_dut_poses
+from tests.conftest import TINY_PROCEDURE
+
+VERIFIED = TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c: [20, 40]") + """\
+verify: {schedule: {kind: sphere, count: 8}, setpoints_c: [30]}
+acceptance: {max_verification_rmse_mg: LIMIT, parameters: {at_c: 30, bias_mg: 100}}
+"""
+
+
+def test_a_dut_beyond_its_limits_fails_and_fail_on_reject_exits_3(write, workdir: Path, capsys) -> None:
+    procedure = write("verified.yaml", VERIFIED.replace("LIMIT", "0.001"))  # far below any noise: every DUT fails
+    campaign = workdir / "c.h5"
+    assert main(["run", str(procedure), "--dry-run", "-o", str(campaign), "-q", "--fail-on-reject"]) == 3
+    out, err = capsys.readouterr()
+    assert "4 PASS" not in out and "0 PASS, 4 FAIL" in out
+    assert out.count("  verdict    ") == 4 and "FAIL: verification |g| RMSE" in out and "> 0.001 mg" in out
+    assert "4 DUT(s) failed their acceptance limits" in err
+
+    assert main(["status", str(campaign), "--json"]) == 0
+    status = json.loads(capsys.readouterr().out)
+    assert {v["verdict"] for v in status["verdicts"].values()} == {"FAIL"}
+    assert status["calibration"] == str(campaign.with_suffix(".calibration.yaml"))
+
+    calibration = workdir / "again.yaml"
+    assert main(["fit", str(campaign), "-o", str(calibration), "--json"]) == 0  # without the flag: 0
+    report = json.loads(capsys.readouterr().out)
+    for sensor in report.values():
+        assert sensor["verdict"] == "FAIL" and sensor["verdict_reasons"][0].startswith("verification |g| RMSE")
+        verification = sensor["verification"]
+        assert verification["n_poses"] == 3 * 8 and {"rmse_mg", "max_axis_error_mg", "max_tilt_error_deg"} <= set(
+            verification)
+        assert verification["rmse_mg"] > 0.5 * sensor["noise_floor_mg"]  # held out: no fit can beat its noise here
+        assert sensor["in_sample"]["n_poses"] == 2 * 6
+        assert sensor["expected_fit_rmse_mg"] < sensor["noise_floor_mg"]
+    assert {s.verdict for s in load_calibration(calibration).sensors.values()} == {"FAIL"}
+    assert main(["fit", str(campaign), "-o", str(calibration), "--fail-on-reject"]) == 3
+
+
+def test_verification_poses_are_stored_apart_and_never_fitted(write, workdir: Path, capsys) -> None:
+    procedure = write("verified.yaml", VERIFIED.replace("LIMIT", "1"))
+    campaign = workdir / "c.h5"
+    assert main(["run", str(procedure), "--dry-run", "-o", str(campaign), "-q", "--fail-on-reject"]) == 0
+    assert "4 PASS" in capsys.readouterr().out
+    stored = load_campaign(campaign)
+    kinds = dict(zip(stored.header.plan.step_key, stored.header.plan.kind))
+    assert kinds["T30/verify01"] == "verify" and kinds["T20/pose01"] == "pose" and "T30/pose01" not in kinds
+    poses = read_dut_poses(stored, stored.serials[0])
+    assert poses.verification.sum() == 3 * 8 and len(poses.verification) == 2 * 6 + 3 * 8
+    with_checks = fit_dut(poses, FitOptions(degree=1))
+    without = fit_dut(poses.subset(~poses.verification), FitOptions(degree=1))
+    np.testing.assert_array_equal(with_checks.thermal.coefficients, without.thermal.coefficients)
+    assert "verification" in with_checks.metrics and "verification" not in without.metrics
