@@ -17,6 +17,7 @@ from accelcal_rig.cli_parser import build_parser
 from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.core.signals import TerminationRequested, stop_when_safe
+from accelcal_rig.core.units import gravity_statement
 from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
 
 if TYPE_CHECKING:
@@ -170,7 +171,10 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
         for signum, handler in previous.items():
             signal.signal(signum, handler)
     try:
-        return _print_summary(prepared, result, dry_run, args.fail_on_reject)
+        code = _print_summary(prepared, result, dry_run, args.fail_on_reject)
+        if result.summary.fit and not result.summary.fit_failed:
+            code = max(code, _certify_after_run(output, calibration, args))
+        return code
     except (KeyboardInterrupt, TerminationRequested):
         print(f"rig: interrupted after the campaign ended ({result.summary.state}); {result.output} holds all of it",
               file=sys.stderr)
@@ -192,6 +196,8 @@ def _print_summary(prepared: PreparedCampaign, result: RunResult, dry_run: bool,
         print(f"rig: campaign done but the fit failed: {_one_line(Exception(summary.fit))}", file=sys.stderr)
         return 1
     print(f"  fit        {summary.fit or 'none (the procedure measures only: fit.mode none)'}")
+    if summary.fit:
+        print(f"  gravity    {gravity_statement(prepared.rig.model.gravity_m_s2)}")
     for warning in summary.fit_warnings:
         print(f"  warning    {warning}")
     for serial, (verdict, reasons) in summary.verdicts.items():
@@ -282,6 +288,7 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     else:
         _print_fit_table(outcome.report)
         print(summary_line(outcome.report, args.output))
+        print(f"gravity: {gravity_statement(next(iter(outcome.report.values()))['gravity_m_s2'])}")
     rejected = [serial for serial, r in outcome.report.items() if r["verdict"] == "FAIL"]
     return _rejected_exit(rejected, args.fail_on_reject)
 
@@ -309,7 +316,7 @@ def _cmd_fit_recording(args: argparse.Namespace) -> int:
         serial = args.serial or args.recording.stem
     detection = detect_static_intervals(recording.t_s, recording.accel_g, recording.temperature_c, settings,
                                         recording.source)
-    result = fit_recording(recording, detection, args.parameters, serial, args.temperature_c)
+    result = fit_recording(recording, detection, args.parameters, serial, args.temperature_c, args.gravity_m_s2)
     save_calibration(result.calibration, args.output)
     if args.json:
         print(json.dumps(result.report))
@@ -328,7 +335,10 @@ def _cmd_fit_recording(args: argparse.Namespace) -> int:
         print(f"warning: {warning}")
     print(f"calibration → {args.output}: norm-only, {args.parameters} parameters, |g| RMSE "
           f"{report['rmse_before_mg']:.3f} → {report['rmse_after_mg']:.4f} mg (noise floor "
-          f"{report['noise_floor_mg']:.4f} mg) at {report['temperature_c']:.1f} °C")
+          f"{report['noise_floor_mg']:.4f} mg) at {report['temperature_c']:.1f} °C; χ²_red "
+          f"{report['chi2_reduced_before']:.2f}" + (f" → {report['chi2_reduced']:.2f} with a scatter floor of "
+                                                    f"{report['scatter_floor_mg']:.4f} mg" if report["scatter_floor_mg"]
+                                                    else "") + f"; outputs in {report['units']}")
     return 0
 
 
@@ -348,6 +358,38 @@ def _cmd_report(args: argparse.Namespace) -> int:
     page = write_report(args.campaign, args.output)
     print(f"report → {page}")
     return 0
+
+
+def _cmd_certificate(args: argparse.Namespace) -> int:
+    calibration = args.calibration or args.campaign.with_suffix(".calibration.yaml")
+    if not calibration.is_file():
+        raise ConfigError(f"{calibration}: no calibration file: fit the campaign first (rig fit), or name it with "
+                          "--calibration")
+    if args.output.exists() and not args.output.is_dir():
+        raise ConfigError(f"{args.output}: exists and is not a folder")
+    _certify(args.campaign, calibration, args.output, args.operator, not args.no_pdf)
+    return 0
+
+
+def _certify_after_run(output: Path, calibration: Path, args: argparse.Namespace) -> int:
+    """The certificates at the end of a run; one that cannot be written is one line, the campaign stands."""
+    try:
+        _certify(output, calibration, args.certificates or output.with_suffix(".certificates"), args.operator,
+                 not args.no_pdf)
+    except (RigError, OSError) as exc:
+        print(f"rig: error: campaign done, but no certificates: {_one_line(exc)}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _certify(campaign: Path, calibration: Path, folder: Path, operator: str, pdf: bool) -> None:
+    from accelcal_rig.report.certificate import write_certificates
+
+    written, warnings = write_certificates(campaign, calibration, folder, operator, pdf)
+    for warning in warnings:
+        print(f"rig: warning: {warning}", file=sys.stderr)
+    for w in written:
+        print(f"certificate {w.serial} → {w.html}" + (f", {w.pdf.name}" if w.pdf else ""))
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
@@ -372,13 +414,14 @@ def _print_fit_table(report: dict) -> None:
     """In-sample figures (the poses fitted) beside verification figures (poses the fit never saw)."""
     print(f"{'':14s} {'raw':>8s} {'in-sample (the fitted poses)':^36s}  {'verification (never fitted)':^33s}".rstrip())
     print(f"{'sensor':14s} {'|g| mg':>8s} {'floor':>7s} {'expected':>8s} {'|g| mg':>7s} {'drift mg':>10s}  "
-          f"{'|g| mg':>7s} {'axis mg':>7s} {'tilt °':>7s} {'drift mg':>9s}  verdict")
+          f"{'|g| mg':>7s} {'axis mg':>7s} {'tilt °':>7s} {'drift mg':>9s}  {'U k=2 mg':>8s}  verdict")
     for serial, r in report.items():
         v = r.get("verification")
         verification = (f"{v['rmse_mg']:7.4f} {v['max_axis_error_mg']:7.4f} {v['max_tilt_error_deg']:7.4f} "
                         f"{max(v['drift_mg']):9.4f}" if v else f"{'none':>7s} {'':7s} {'':7s} {'':9s}")
         print(f"{serial:14s} {r['rmse_before_mg']:8.3f} {r['noise_floor_mg']:7.4f} {r['expected_fit_rmse_mg']:8.4f} "
-              f"{r['rmse_after_mg']:7.4f} {max(r['drift_after_mg']):10.4f}  {verification}  {r['verdict']}")
+              f"{r['rmse_after_mg']:7.4f} {max(r['drift_after_mg']):10.4f}  {verification}  "
+              f"{max(r['expanded_uncertainty_mg']):8.4f}  {r['verdict']}")
         for reason in r["verdict_reasons"] if r["verdict"] == "FAIL" else ():
             print(f"  fails: {reason}")
         for warning in r["warnings"]:
@@ -416,7 +459,7 @@ def main(argv: list[str] | None = None) -> int:
     logging.getLogger("pymodbus").propagate = False
     handler = {"run": _cmd_run, "plan": _cmd_plan, "resume": _cmd_resume, "status": _cmd_status, "repair": _cmd_repair,
                "fit": _cmd_fit, "check": _cmd_check,
-               "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export,
+               "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export, "certificate": _cmd_certificate,
                "fit-recording": _cmd_fit_recording, "analyze": _cmd_analyze}[args.command]
     try:
         return handler(args)

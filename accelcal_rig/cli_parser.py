@@ -55,6 +55,14 @@ def _campaign_output_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("-v", "--verbose", action="store_true", help="log every transition and pose")
     command.add_argument("-q", "--quiet", action="store_true", help="print only warnings and the summary")
     _fail_on_reject(command)
+    command.add_argument("--certificates", type=Path, help="folder of the DUTs' certificates written after the fit "
+                                                            "(default: beside the campaign, .certificates)")
+    _certificate_options(command)
+
+
+def _certificate_options(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--operator", default="", help="who performed the calibration (on the certificates)")
+    command.add_argument("--no-pdf", action="store_true", help="HTML certificates only")
 
 
 def _fail_on_reject(command: argparse.ArgumentParser) -> None:
@@ -178,13 +186,16 @@ def build_parser() -> argparse.ArgumentParser:
     recording.add_argument("recording", type=Path, help="CSV file, or a campaign file (.h5)")
     recording.add_argument("-o", "--output", type=Path, required=True, help="calibration file to write (YAML)")
     recording.add_argument("--columns", default="time,x,y,z", metavar="TIME,X,Y,Z[,TEMPERATURE]",
-                           help="CSV column names, in this order (default: time,x,y,z)")
+                           help="columns by name (the header's) or by number from 1 (with or without a header), "
+                                "in this order; comma, semicolon, tab or white space between them (default: "
+                                "time,x,y,z)")
     recording.add_argument("--time-unit", choices=["s", "ms", "samples"], default="s", help="of the time column")
     recording.add_argument("--rate-hz", type=_number(1e-3, 1e7, "Hz"), help="sample rate, when the time column counts "
                                                                               "samples")
     recording.add_argument("--units", choices=["g", "counts", "m/s2"], default="g", help="of x, y, z (default g)")
-    recording.add_argument("--counts-per-g", type=_number(1e-6, 1e12), help="with --units counts (ADXL355 at ±2 g: "
-                                                                          "256000)")
+    recording.add_argument("--counts-per-g", type=_number(1e-6, 1e12),
+                           help="with --units counts (ADXL355 at ±2 g: 256000); if not given, taken from the median "
+                                "|reading| (the norm-only fit finds each axis's scale)")
     recording.add_argument("--zero-code", type=_number(-1e12, 1e12), default=0.0,
                            help="code of 0 g: 0 for signed codes (default), 32768 for a 16-bit offset-binary ADC")
     recording.add_argument("--serial", help="sensor name in the calibration (default: the file's name; campaign "
@@ -193,6 +204,8 @@ def build_parser() -> argparse.ArgumentParser:
     recording.add_argument("--parameters", choices=["all", "bias-scale"], default="all",
                            help="all: bias, scale, non-orthogonality (9); bias-scale: 6 (default all)")
     recording.add_argument("--temperature-c", type=_TEMPERATURE, help="the recording's temperature, if it has none")
+    recording.add_argument("--gravity-m-s2", type=_number(9.7, 9.9, "m/s²"),
+                           help="the site's gravity, which |g| is fitted to (default: the standard 9.80665, said so)")
     recording.add_argument("--window-s", type=_number(1e-3, 3600, "s"), default=0.5, help="variance window (default "
                                                                                           "0.5 s)")
     recording.add_argument("--init-s", type=_number(1e-3, 3600, "s"), default=2.0,
@@ -245,6 +258,18 @@ def build_parser() -> argparse.ArgumentParser:
                       "rig report campaign.h5 -o report/")
     report.add_argument("campaign", type=Path, help="campaign file (HDF5)")
     report.add_argument("-o", "--output", type=Path, required=True, help="folder to write (created if needed)")
+
+    certificate = _command(commands, "certificate", "write a calibration certificate per DUT (HTML and PDF)",
+                           "Write OUT/<serial>.html and OUT/<serial>.pdf for every DUT of the calibration: the item "
+                           "and its identity, the campaign and its instruments, the results, the verification, the "
+                           "uncertainty budget, the verdict and fields for signatures. PDFs need WeasyPrint (pip "
+                           "install 'accelcal-rig[certificate]'). `rig run` writes them at its end too.",
+                           "rig certificate campaign.h5 -o certs/ --operator 'A. Smith'")
+    certificate.add_argument("campaign", type=Path, help="campaign file (HDF5)")
+    certificate.add_argument("-o", "--output", type=Path, required=True, help="folder to write (created if needed)")
+    certificate.add_argument("--calibration", type=Path,
+                             help="its calibration file (default: beside the campaign, .calibration.yaml)")
+    _certificate_options(certificate)
 
     export = _command(commands, "export", "write a calibration file as JSON, CSV or a C header for firmware",
                       "Write the coefficients of a calibration file for other tools (json: the same structure; "

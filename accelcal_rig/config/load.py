@@ -10,7 +10,7 @@ from pydantic import BaseModel, ValidationError
 
 from accelcal_rig.config.procedure import MAX_POLLS, Procedure
 from accelcal_rig.config.rig import FaultInjection, RigConfig
-from accelcal_rig.config.yaml_lines import KeyPath, format_key, load_yaml_with_lines, locate
+from accelcal_rig.config.yaml_lines import CONFIG_LIMITS, KeyPath, YamlLimits, format_key, load_yaml_with_lines, locate
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.registry import part
 
@@ -32,10 +32,10 @@ class LoadedConfig(Generic[ModelT]):
         return ConfigError(f"{self.path}:{line}: {format_key(key_path)}: {message}")
 
 
-def load_validated(path: Path, model: type[ModelT]) -> LoadedConfig[ModelT]:
+def load_validated(path: Path, model: type[ModelT], limits: YamlLimits = CONFIG_LIMITS) -> LoadedConfig[ModelT]:
     """Parse and validate any of the project's YAML files; an error is one line, `file:line: key: message`
     for the first problem, with how many more there are (fix one, run again)."""
-    data, lines, text = load_yaml_with_lines(path)
+    data, lines, text = load_yaml_with_lines(path, limits)
     try:
         validated = model.model_validate(data)
     except ValidationError as exc:

@@ -9,6 +9,7 @@ import numpy as np
 from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
 
 from accelcal_rig.config.bounds import STRICT, AngleDeg, Baudrate, TemperatureC, TimeoutS
+from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
 from accelcal_rig.parts.registry import DEFAULT_PART, part
 from accelcal_rig.plugins import Kind, driver_problem
 from accelcal_rig.protocols.chamber_registers import ChamberRegisterMap, register_map
@@ -252,3 +253,12 @@ class RigConfig(_Strict):
     retry: RetryPolicy = RetryPolicy()
     notify: NotifyConfig = NotifyConfig()
     simulation: SimulationConfig = SimulationConfig()
+    gravity_m_s2: float = Field(STANDARD_GRAVITY_M_S2, ge=9.7, le=9.9,
+                                description="the site's gravity (a survey or a gravity model); the standard value "
+                                            "by default, said so in reports")
+    gravity_uncertainty_m_s2: float = Field(0.0, ge=0.0, le=0.05, description="its standard uncertainty")
+
+    @property
+    def gravity_g(self) -> float:
+        """The site's gravity in standard g: the magnitude every reference and every |g| figure uses."""
+        return site_gravity_g(self.gravity_m_s2)

@@ -9,6 +9,7 @@ contains itself, numbers longer than `MAX_NUMBER_CHARS` characters.
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +23,19 @@ KeyPath = tuple[str | int, ...]
 MAX_FILE_BYTES = 1 << 20
 MAX_DEPTH = 32
 MAX_NODES = 100_000
+
+
+@dataclass(frozen=True)
+class YamlLimits:
+    """How large a file of one kind may be: what a person writes (procedures, rig configs) or what the
+    program writes (a calibration of many DUTs over many setpoints)."""
+
+    file_bytes: int
+    nodes: int
+
+
+CONFIG_LIMITS = YamlLimits(MAX_FILE_BYTES, MAX_NODES)
+CALIBRATION_LIMITS = YamlLimits(64 << 20, 5_000_000)
 MAX_SCALAR_CHARS = 65_536
 MAX_NUMBER_CHARS = 40
 #: Characters YAML 1.1 forbids in a stream (PyYAML's reader would refuse them with a two-line message).
@@ -33,15 +47,15 @@ def _line_of(text: str, index: int) -> int:
     return text.count("\n", 0, index) + 1
 
 
-def _check_events(text: str, where: str) -> None:
+def _check_events(text: str, where: str, limits: YamlLimits) -> None:
     """One pass over the event stream (PyYAML's parser is not recursive): syntax, depth, sizes."""
     depth = count = 0
     try:
         for event in yaml.parse(text, Loader=yaml.SafeLoader):
             count += 1
             line = event.start_mark.line + 1 if event.start_mark else 1
-            if count > MAX_NODES:
-                raise ConfigError(f"{where}:{line}: more than {MAX_NODES} values: not a config file")
+            if count > limits.nodes:
+                raise ConfigError(f"{where}:{line}: more than {limits.nodes} values: not a config file")
             if isinstance(event, yaml.CollectionStartEvent):
                 depth += 1
                 if depth > MAX_DEPTH:
@@ -59,7 +73,7 @@ def _check_events(text: str, where: str) -> None:
         raise ConfigError(f"{where}:1: syntax: {str(exc).splitlines()[0]}") from None
 
 
-def _check_expansion(root: yaml.Node, where: str) -> None:
+def _check_expansion(root: yaml.Node, where: str, limits: YamlLimits) -> None:
     """Count the values the document holds with its aliases expanded, without expanding them."""
     sizes: dict[int, tuple[int, int]] = {}  # node id → (values, depth) once counted
     visiting: set[int] = set()
@@ -85,8 +99,8 @@ def _check_expansion(root: yaml.Node, where: str) -> None:
         for child in children:
             values, child_depth = size(child, depth + 1)
             total, deepest = total + values, max(deepest, child_depth + 1)
-            if total > MAX_NODES:
-                raise ConfigError(f"{where}:{line}: more than {MAX_NODES} values once its aliases are expanded")
+            if total > limits.nodes:
+                raise ConfigError(f"{where}:{line}: more than {limits.nodes} values once its aliases are expanded")
         visiting.discard(key)
         sizes[key] = (total, deepest)
         return sizes[key]
@@ -96,21 +110,21 @@ def _check_expansion(root: yaml.Node, where: str) -> None:
 
 def parse_yaml_text(text: str, where: str) -> Any:
     """The data of one YAML document, within the bounds above; ConfigError `where:line: problem`."""
-    return _parse(text, where)[0]
+    return _parse(text, where, CONFIG_LIMITS)[0]
 
 
-def _parse(text: str, where: str) -> tuple[Any, yaml.Node | None]:
+def _parse(text: str, where: str, limits: YamlLimits) -> tuple[Any, yaml.Node | None]:
     bad = _NOT_ALLOWED.search(text)
     if bad:
         raise ConfigError(f"{where}:{_line_of(text, bad.start())}: syntax: character U+{ord(bad.group()):04X} is "
                           "not allowed in YAML")
-    _check_events(text, where)
+    _check_events(text, where, limits)
     loader = yaml.SafeLoader(text)
     try:
         root = loader.get_single_node()
         if root is None:
             return None, None
-        _check_expansion(root, where)
+        _check_expansion(root, where, limits)
         return loader.construct_document(root), root
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
@@ -123,19 +137,19 @@ def _parse(text: str, where: str) -> tuple[Any, yaml.Node | None]:
         loader.dispose()
 
 
-def load_yaml_with_lines(path: Path) -> tuple[Any, dict[KeyPath, int], str]:
+def load_yaml_with_lines(path: Path, limits: YamlLimits = CONFIG_LIMITS) -> tuple[Any, dict[KeyPath, int], str]:
     """Parse `path`; return (data, {key path: 1-based line}, raw text).
 
     Syntax errors, duplicate keys (which PyYAML would silently overwrite) and files beyond the bounds
     above become ConfigError.
     """
-    raw = read_regular_file(path, MAX_FILE_BYTES, "a procedure, rig or calibration file")
+    raw = read_regular_file(path, limits.file_bytes, "a procedure, rig or calibration file")
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = raw[:exc.start].count(b"\n") + 1
         raise ConfigError(f"{path}:{line}: not UTF-8 text (byte 0x{raw[exc.start]:02x})") from None
-    data, root = _parse(text, str(path))
+    data, root = _parse(text, str(path), limits)
     if root is None:
         raise ConfigError(f"{path}:1: file is empty")
     if not isinstance(root, yaml.MappingNode):

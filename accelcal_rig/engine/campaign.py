@@ -221,8 +221,10 @@ class CampaignRunner:
             sensor.standby()
             sensor.configure(acquisition.range_g, acquisition.odr_hz)
             sensor.start_measurement()
-            self.events.info("preflight", f"sensor {sensor.serial}: {sensor.part.label} rev {identity.revid}, "
-                                          f"±{acquisition.range_g} g, {acquisition.odr_hz:g} Hz")
+            self.events.info("preflight", f"sensor {sensor.serial}: {sensor.part.label} rev {identity.revid} "
+                                          f"(DEVID_AD 0x{identity.devid_ad:02X}, DEVID_MST 0x{identity.devid_mst:02X}, "
+                                          f"PARTID 0x{identity.partid:02X}), ±{acquisition.range_g} g, "
+                                          f"{acquisition.odr_hz:g} Hz")
 
     # ----------------------------------------------------------------- the plan
     def _run_stages(self) -> None:

@@ -111,7 +111,7 @@ class PoseSteps:
         return DutPoseRecord(
             serial=sensor.serial, raw_codes=codes, mean_g=mean_g, stderr_g=stderr_g,
             temperature_c=block.temperature_c,
-            gravity_reference_g=self._mounts[sensor.serial].inv().apply(gravity_fixture),
+            gravity_reference_g=self.rig.gravity_g * self._mounts[sensor.serial].inv().apply(gravity_fixture),
             temperature_in_band=in_band,
             truth=self.truth.block_truth(sensor.serial, block) if self.truth is not None else None,
         )

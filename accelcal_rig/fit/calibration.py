@@ -15,6 +15,7 @@ from pydantic import BaseModel, Field, field_validator
 
 from accelcal_rig.config.bounds import STRICT, TemperatureC
 from accelcal_rig.config.load import load_validated
+from accelcal_rig.config.yaml_lines import CALIBRATION_LIMITS
 from accelcal_rig.durable import write_text_atomically
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
 
@@ -146,7 +147,7 @@ def save_calibration(calibration: CalibrationFile, path: Path) -> None:
 
 
 def load_calibration(path: Path) -> CalibrationFile:
-    return load_validated(path, CalibrationFile).model
+    return load_validated(path, CalibrationFile, CALIBRATION_LIMITS).model
 
 
 def plain(value: Any) -> Any:

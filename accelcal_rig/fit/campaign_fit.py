@@ -9,7 +9,16 @@ from typing import Any, Literal
 import numpy as np
 
 from accelcal_rig import __version__
+from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.fit.acceptance import judge, recorded_acceptance
+from accelcal_rig.fit.budget import (
+    budget,
+    calibration_covariance,
+    fitted_powers,
+    smoothed_temperature_u_c,
+    temperature_scatter_c,
+    truth_coverage,
+)
 from accelcal_rig.fit.calibration import FORMAT_NAME as CALIBRATION_FORMAT
 from accelcal_rig.fit.calibration import FORMAT_VERSION as CALIBRATION_VERSION
 from accelcal_rig.fit.calibration import (
@@ -26,6 +35,7 @@ from accelcal_rig.fit.lm import FitMode, FreeParameters, SfemFit, fit_sfem, norm
 from accelcal_rig.fit.metrics import drift_mg, noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, norm_only_gauge
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
+from accelcal_rig.fit.uncertainty import CoefficientCovariance
 from accelcal_rig.fit.verification import pose_figures
 from accelcal_rig.store.content import Campaign, measurements_sha256
 from accelcal_rig.store.read import DutPoses, read_dut_poses
@@ -84,7 +94,8 @@ def fit_dut(stored: DutPoses, options: FitOptions) -> DutFitResult:
         try:
             fits.append(fit_sfem(poses.mean_g[group], poses.stderr_g[group],
                                  poses.reference_g[group] if options.mode == "reference" else None,
-                                 options.mode, options.free, np.radians(poses.reference_accuracy_arcsec / 3600)))
+                                 options.mode, options.free, np.radians(poses.reference_accuracy_arcsec / 3600),
+                                 poses.gravity_g))
         except ValueError as exc:
             raise type(exc)(f"sensor {poses.serial} at {setpoint:g} °C: {exc}") from None
     estimates = np.array([f.parameters for f in fits])
@@ -94,7 +105,7 @@ def fit_dut(stored: DutPoses, options: FitOptions) -> DutFitResult:
     if options.temperature_model == "joint":
         thermal = fit_joint(thermal, free, pose_temperatures, poses.mean_g, poses.stderr_g,
                             poses.reference_g if options.mode == "reference" else None, options.mode,
-                            np.radians(poses.reference_accuracy_arcsec / 3600))
+                            np.radians(poses.reference_accuracy_arcsec / 3600), poses.gravity_g)
     compensated = correct(poses.mean_g, thermal.parameters_at(pose_temperatures, "extrapolate"))
     metrics = _metrics(poses, setpoints, groups, temperatures, fits, thermal, compensated, options)
     metrics["expected_fit_rmse_mg"] = _expected_rmse_mg(poses, groups, fits, thermal, pose_temperatures, options)
@@ -102,9 +113,18 @@ def fit_dut(stored: DutPoses, options: FitOptions) -> DutFitResult:
         row["expected_mg"] = _expected_rmse_mg(poses, [group], [fit], None, pose_temperatures, options)
     align = options.mode == "norm-only"
     metrics["in_sample"] = pose_figures(compensated, poses.reference_g, poses.stderr_g, poses.setpoint_c,
-                                        pose_temperatures, align)
+                                        pose_temperatures, align, poses.gravity_g)
+    joint = options.temperature_model == "joint"
+    covariance = calibration_covariance(poses, groups, fits, thermal, temperatures, pose_temperatures, options.mode,
+                                        joint)
+    scatter_c = temperature_scatter_c(poses, pose_temperatures, len(groups))
+    metrics["uncertainty_budget"] = budget(poses, covariance, thermal, temperatures, scatter_c)
+    metrics["expanded_uncertainty_mg"] = metrics["uncertainty_budget"]["expanded_mg"]
     if stored.verification.any():
-        metrics["verification"] = _verification(stored.subset(stored.verification), thermal, options)
+        checks = stored.subset(stored.verification)
+        metrics["verification"], coverage = _verification(checks, thermal, options, covariance, scatter_c)
+        if coverage is not None:
+            metrics["truth_coverage_k2"] = coverage
     calibration = SensorCalibration(
         serial=poses.serial, mode=options.mode,
         free_parameters=[n for n, f in zip(PARAMETER_NAMES, free) if f],
@@ -119,10 +139,19 @@ def fit_dut(stored: DutPoses, options: FitOptions) -> DutFitResult:
                         sigma=dict(zip(PARAMETER_NAMES, plain(f.sigma))))
             for s, t, f in zip(setpoints, temperatures, fits)
         ],
-        metrics={k: v for k, v in plain(metrics).items() if k != "truth_error"},
+        metrics=_file_metrics(plain(metrics)),
         warnings=thermal.warnings,
     )
     return DutFitResult(poses.serial, setpoints, temperatures, fits, thermal, compensated, metrics, calibration)
+
+
+def _file_metrics(metrics: dict[str, Any]) -> dict[str, Any]:
+    """What the calibration file keeps of the figures: all but the simulation truth's errors, and of the
+    budget at each temperature the totals (each source's share there is in `rig fit --json`)."""
+    kept = {k: v for k, v in metrics.items() if k != "truth_error"}
+    budget = dict(kept["uncertainty_budget"])
+    budget["by_temperature"] = [{k: v for k, v in row.items() if k != "sources_mg"} for row in budget["by_temperature"]]
+    return {**kept, "uncertainty_budget": budget}
 
 
 def _expected_rmse_mg(poses: DutPoses, groups: list[np.ndarray], fits: list[SfemFit], thermal: ThermalModel | None,
@@ -133,7 +162,7 @@ def _expected_rmse_mg(poses: DutPoses, groups: list[np.ndarray], fits: list[Sfem
     if thermal is None:
         jacobian = fits[0].jacobian
     else:
-        n_powers = min(thermal.degree, len(groups) - 1) + 1
+        n_powers = fitted_powers(thermal, len(groups), options.temperature_model == "joint")
         powers = [np.vander(thermal.scaled(pose_temperatures[g]), n_powers, increasing=True) for g in groups]
         jacobian = thermal_jacobian([f.jacobian for f in fits], powers, 3 if options.mode == "reference" else 1)
     if options.mode == "reference":
@@ -142,14 +171,19 @@ def _expected_rmse_mg(poses: DutPoses, groups: list[np.ndarray], fits: list[Sfem
     return expected_norm_rmse_mg(jacobian, norm_sigma(poses.mean_g[rows], poses.stderr_g[rows]))
 
 
-def _verification(checks: DutPoses, thermal: ThermalModel, options: FitOptions) -> dict[str, Any]:
+def _verification(checks: DutPoses, thermal: ThermalModel, options: FitOptions, covariance: CoefficientCovariance,
+                  scatter_c: float) -> tuple[dict[str, Any], float | None]:
     """The figures on poses the fit never saw, compensated as `apply` would (the calibration's out-of-range
-    rule), each at its own smoothed temperature."""
+    rule), each at its own smoothed temperature; and in a dry run the share of their axis errors against
+    the truth inside the expanded uncertainty."""
     groups = [np.flatnonzero(checks.setpoint_c == s) for s in dict.fromkeys(checks.setpoint_c.tolist())]
     temperatures = smoothed_temperatures(checks, groups)
     compensated = correct(checks.mean_g, thermal.parameters_at(temperatures, options.out_of_range))
-    return pose_figures(compensated, checks.reference_g, checks.stderr_g, checks.setpoint_c, temperatures,
-                        options.mode == "norm-only")
+    figures = pose_figures(compensated, checks.reference_g, checks.stderr_g, checks.setpoint_c, temperatures,
+                           options.mode == "norm-only", checks.gravity_g)
+    coverage = truth_coverage(checks, covariance, thermal, compensated, temperatures,
+                              smoothed_temperature_u_c(checks.t_s, groups, scatter_c), options.mode, options.out_of_range)
+    return figures, coverage
 
 
 def _metrics(poses: DutPoses, setpoints: np.ndarray, groups: list[np.ndarray], temperatures: np.ndarray,
@@ -159,17 +193,18 @@ def _metrics(poses: DutPoses, setpoints: np.ndarray, groups: list[np.ndarray], t
     for setpoint, temperature, group, fit in zip(setpoints, temperatures, groups, fits):
         by_setpoint.append({
             "setpoint_c": setpoint, "temperature_c": temperature,
-            "before_mg": norm_rmse_mg(poses.mean_g[group]),
-            "polynomial_mg": norm_rmse_mg(compensated[group]),
-            "measurement_mg": norm_rmse_mg(correct(poses.mean_g[group], fit.parameters)),
+            "before_mg": norm_rmse_mg(poses.mean_g[group], poses.gravity_g),
+            "polynomial_mg": norm_rmse_mg(compensated[group], poses.gravity_g),
+            "measurement_mg": norm_rmse_mg(correct(poses.mean_g[group], fit.parameters), poses.gravity_g),
         })
     # Zero-g offset at each temperature: before, the fitted raw bias; after, what the polynomial model
     # makes of that same raw zero-g reading.
     bias = np.array([f.parameters[0:3] for f in fits])
     offset_after = correct(bias, thermal.parameters_at(temperatures, "extrapolate"))
     metrics: dict[str, Any] = {
-        "rmse_before_mg": norm_rmse_mg(poses.mean_g),
-        "rmse_after_mg": norm_rmse_mg(compensated),
+        "rmse_before_mg": norm_rmse_mg(poses.mean_g, poses.gravity_g),
+        "rmse_after_mg": norm_rmse_mg(compensated, poses.gravity_g),
+        "gravity_m_s2": poses.gravity_g * STANDARD_GRAVITY_M_S2,
         "rmse_by_setpoint": by_setpoint,
         "drift_before_mg": drift_mg(bias),
         "drift_after_mg": drift_mg(offset_after),

@@ -36,14 +36,15 @@ def expected_reference_rmse_mg(jacobian: np.ndarray, reference_g: np.ndarray, st
     q_noise_q = np.einsum("nap,nab,nbr->pr", q, noise, q)
     variance = (np.einsum("na,nab,nb->n", projection, noise, projection) - 2.0 * np.sum(p_noise_q * p_q, axis=1)
                 + np.einsum("np,pr,nr->n", p_q, q_noise_q, p_q))
-    return float(np.sqrt(variance.mean()) * 1e3)
+    return float(np.sqrt(max(variance.mean(), 0.0)) * 1e3)
 
 
 def expected_norm_rmse_mg(jacobian: np.ndarray, sigma_norm_g: np.ndarray) -> float:
     """Norm-only mode: `jacobian` (N × p) of the residuals (|reading| − 1) / σ_norm."""
     q, _ = np.linalg.qr(jacobian)
     leverage = np.sum(q**2, axis=1)
-    return float(np.sqrt(np.mean(np.asarray(sigma_norm_g) ** 2 * (1.0 - leverage))) * 1e3)
+    # As many parameters as poses: every leverage is 1 and nothing is left (rounding may dip below zero).
+    return float(np.sqrt(max(np.mean(np.asarray(sigma_norm_g) ** 2 * (1.0 - leverage)), 0.0)) * 1e3)
 
 
 def thermal_jacobian(setpoint_jacobians: list[np.ndarray], powers: list[np.ndarray], per_pose_rows: int) -> np.ndarray:

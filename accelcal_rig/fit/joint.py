@@ -19,7 +19,7 @@ from accelcal_rig.fit.thermal import ThermalModel
 
 def fit_joint(start: ThermalModel, free: np.ndarray, temperature_c: np.ndarray, mean_g: np.ndarray,
               stderr_g: np.ndarray, reference_g: np.ndarray | None, mode: FitMode,
-              reference_accuracy_rad: float = 0.0) -> ThermalModel:
+              reference_accuracy_rad: float = 0.0, gravity_g: float = 1.0) -> ThermalModel:
     """Refine `start`'s coefficients of the `free` parameters against every pose; fixed ones keep theirs."""
     x = start.scaled(temperature_c)
     powers = np.vander(x, start.coefficients.shape[1], increasing=True)  # (n, degree + 1)
@@ -41,7 +41,7 @@ def fit_joint(start: ThermalModel, free: np.ndarray, temperature_c: np.ndarray, 
         weights = norm_sigma(mean_g, stderr_g)
 
         def residuals(theta: np.ndarray) -> np.ndarray:
-            return (np.linalg.norm(correct(mean_g, model(theta)), axis=1) - 1.0) / weights
+            return (np.linalg.norm(correct(mean_g, model(theta)), axis=1) - gravity_g) / weights
 
     result = least_squares(residuals, start.coefficients[rows].ravel(), method="lm", xtol=1e-12, ftol=1e-12)
     coefficients = start.coefficients.copy()

@@ -64,8 +64,12 @@ def norm_sigma(mean_g: np.ndarray, stderr_g: np.ndarray) -> np.ndarray:
 
 
 def fit_sfem(mean_g: np.ndarray, stderr_g: np.ndarray, reference_g: np.ndarray | None, mode: FitMode,
-             free: FreeParameters = "all", reference_accuracy_rad: float = 0.0) -> SfemFit:
-    """Fit Eq. 1 to per-pose means (n, 3) in g; `reference_g` (n, 3) is required in reference mode.
+             free: FreeParameters = "all", reference_accuracy_rad: float = 0.0, gravity_g: float = 1.0,
+             scatter_floor_g: float = 0.0) -> SfemFit:
+    """Fit Eq. 1 to per-pose means (n, 3) in g; `reference_g` (n, 3) is required in reference mode, and
+    norm-only mode fits |U_SF| to `gravity_g`, the site's gravity in standard g. `scatter_floor_g`
+    (norm-only): scatter between poses beyond their standard errors, added in quadrature to each pose's
+    |g| uncertainty (fit/robust.py estimates it).
 
     `reference_accuracy_rad` is the turntable's ± accuracy per axis (uniform): the expected gravity then
     turns by a small random rotation of variance a²/3 about each direction, adding (a²/3)(1 − g_i²) to
@@ -87,10 +91,10 @@ def fit_sfem(mean_g: np.ndarray, stderr_g: np.ndarray, reference_g: np.ndarray |
 
         n_residuals = 3 * n_poses
     else:
-        sigma_norm = norm_sigma(mean_g, stderr_g)
+        sigma_norm = np.sqrt(norm_sigma(mean_g, stderr_g) ** 2 + scatter_floor_g**2)
 
         def residuals(theta: np.ndarray) -> np.ndarray:
-            return (np.linalg.norm(correct(mean_g, _full(theta, mask)), axis=1) - 1.0) / sigma_norm
+            return (np.linalg.norm(correct(mean_g, _full(theta, mask)), axis=1) - gravity_g) / sigma_norm
 
         n_residuals = n_poses
     if n_residuals < n_free:

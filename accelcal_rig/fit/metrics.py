@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 
-def norm_rmse_mg(accel_g: np.ndarray) -> float:
-    """Eq. 9: RMS deviation of |a| from 1 g over all samples or poses, in mg."""
-    deviation = np.linalg.norm(np.asarray(accel_g, dtype=float), axis=-1) - 1.0
+def norm_rmse_mg(accel_g: np.ndarray, gravity_g: float = 1.0) -> float:
+    """Eq. 9: RMS deviation of |a| from the site's gravity (in standard g) over all samples or poses, in mg."""
+    deviation = np.linalg.norm(np.asarray(accel_g, dtype=float), axis=-1) - gravity_g
     return float(np.sqrt(np.mean(deviation**2)) * 1e3)
 
 

@@ -21,12 +21,12 @@ ROLL_DEFINED_G = 0.5
 
 
 def pose_figures(compensated_g: np.ndarray, reference_g: np.ndarray, stderr_g: np.ndarray, setpoint_c: np.ndarray,
-                 temperature_c: np.ndarray, align: bool) -> dict[str, Any]:
+                 temperature_c: np.ndarray, align: bool, gravity_g: float = 1.0) -> dict[str, Any]:
     """The figures of merit of compensated readings (N, 3) against the gravity each pose expects (N, 3).
 
     `align`: a norm-only fit fixes no rotation of the sensor frame, so its output is first turned by the one
     rotation that best aligns it with the references (per-axis and tilt errors are then those of a sensor
-    mounted as the fit found it).
+    mounted as the fit found it). `gravity_g`: the site's gravity in standard g, what |g| is judged against.
     """
     compensated_g = np.asarray(compensated_g, dtype=float)
     reference_g = np.asarray(reference_g, dtype=float)
@@ -37,14 +37,14 @@ def pose_figures(compensated_g: np.ndarray, reference_g: np.ndarray, stderr_g: n
     groups = [np.flatnonzero(setpoint_c == s) for s in dict.fromkeys(np.asarray(setpoint_c).tolist())]
     by_setpoint = [{
         "setpoint_c": float(setpoint_c[g[0]]), "temperature_c": float(np.mean(temperature_c[g])),
-        "n_poses": int(len(g)), "rmse_mg": norm_rmse_mg(compensated_g[g]),
+        "n_poses": int(len(g)), "rmse_mg": norm_rmse_mg(compensated_g[g], gravity_g),
         "max_axis_error_mg": float(np.max(np.abs(error_mg[g]))),
         "offset_mg": zero_g_offset_mg(error_mg[g], reference_g[g]).tolist(),
     } for g in groups]
     offsets = np.array([row["offset_mg"] for row in by_setpoint])
     return {
         "n_poses": int(len(compensated_g)),
-        "rmse_mg": norm_rmse_mg(compensated_g),
+        "rmse_mg": norm_rmse_mg(compensated_g, gravity_g),
         "noise_floor_mg": noise_floor_mg(compensated_g, stderr_g),
         "max_axis_error_mg": float(np.max(np.abs(error_mg))),
         "rms_axis_error_mg": np.sqrt(np.mean(error_mg**2, axis=0)).tolist(),

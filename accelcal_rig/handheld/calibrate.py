@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from accelcal_rig import __version__
+from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import (
     FORMAT_NAME,
@@ -19,8 +20,9 @@ from accelcal_rig.fit.calibration import (
     SetpointFit,
     plain,
 )
-from accelcal_rig.fit.lm import DegenerateDesign, FreeParameters, SfemFit, fit_sfem
+from accelcal_rig.fit.lm import DegenerateDesign, FreeParameters, SfemFit
 from accelcal_rig.fit.metrics import noise_floor_mg, norm_rmse_mg
+from accelcal_rig.fit.robust import fit_norm_only_with_floor
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
 from accelcal_rig.handheld.recording import Recording
 from accelcal_rig.handheld.static_intervals import Detection
@@ -56,7 +58,10 @@ def missing_orientations(mean_g: np.ndarray) -> list[str]:
 
 
 def fit_recording(recording: Recording, detection: Detection, free: FreeParameters, serial: str,
-                  temperature_c: float | None = None) -> RecordingFit:
+                  temperature_c: float | None = None, gravity_m_s2: float | None = None) -> RecordingFit:
+    """A norm-only fit of the static intervals: |U_SF| fitted to the site's gravity (`gravity_m_s2`, else the
+    standard value, with a warning), outputs in standard g."""
+    gravity_g = site_gravity_g(STANDARD_GRAVITY_M_S2 if gravity_m_s2 is None else gravity_m_s2)
     intervals = detection.intervals
     needed = 6 if free == "bias-scale" else 9
     if len(intervals) < needed:
@@ -73,11 +78,22 @@ def fit_recording(recording: Recording, detection: Detection, free: FreeParamete
                                 f"{', '.join(missing)} (≥ {VISITED_G:g} g along it): record orientations with every "
                                 "axis pointing up and down")
     try:
-        fit = fit_sfem(mean, stderr, None, "norm-only", free)
+        robust = fit_norm_only_with_floor(mean, stderr, free, gravity_g)
     except DegenerateDesign as exc:
         raise RecordingUnusable(f"{recording.source}: {exc}") from None
+    fit = robust.fit
+    if robust.scatter_floor_g > 0:
+        recording_notes = [f"the intervals scatter more than their standard errors say (χ²_red "
+                           f"{robust.chi2_reduced_before:.2f}): each weighed with a scatter floor of "
+                           f"{robust.scatter_floor_g * 1e3:.4f} mg added (χ²_red {fit.chi2_reduced:.2f} after), so no "
+                           "interval counts for more because it lasted longer"]
+    else:
+        recording_notes = []
     temperatures = np.array([i.temperature_c for i in intervals])
-    warnings = list(recording.notes)
+    warnings = list(recording.notes) + recording_notes
+    if gravity_m_s2 is None:
+        warnings.append(f"|g| fitted to the standard {STANDARD_GRAVITY_M_S2} m/s² (outputs in standard g); give the "
+                        "site's gravity with --gravity-m-s2")
     if len(intervals) == int(fit.free.sum()):
         warnings.append(f"{len(intervals)} intervals for {len(intervals)} parameters: the fit passes through every "
                         "one, with no check left (record more orientations)")
@@ -94,8 +110,10 @@ def fit_recording(recording: Recording, detection: Detection, free: FreeParamete
         low, high = temperature - 0.5, temperature + 0.5  # one temperature: valid within ±0.5 °C of it
     compensated = correct(mean, fit.parameters)
     metrics = {
-        "rmse_before_mg": norm_rmse_mg(mean), "rmse_after_mg": norm_rmse_mg(compensated),
+        "rmse_before_mg": norm_rmse_mg(mean, gravity_g), "rmse_after_mg": norm_rmse_mg(compensated, gravity_g),
+        "gravity_m_s2": gravity_g * STANDARD_GRAVITY_M_S2, "units": "standard g (9.80665 m/s²)",
         "noise_floor_mg": noise_floor_mg(mean, stderr), "chi2_reduced": fit.chi2_reduced,
+        "chi2_reduced_before": robust.chi2_reduced_before, "scatter_floor_mg": robust.scatter_floor_g * 1e3,
         "n_intervals": len(intervals), "temperature_c": temperature,
     }
     calibration = SensorCalibration(
@@ -120,8 +138,8 @@ def fit_recording(recording: Recording, detection: Detection, free: FreeParamete
         "source": recording.source, "rate_hz": detection.rate_hz, "samples": len(recording.t_s),
         "threshold_g2": detection.threshold_g2, "init_variance_g2": detection.init_variance_g2,
         "intervals": [{"start_s": i.start_s, "end_s": i.end_s, "samples": i.n_samples, "mean_g": i.mean_g,
-                       "norm_before_mg": float((np.linalg.norm(i.mean_g) - 1.0) * 1e3),
-                       "norm_after_mg": float((np.linalg.norm(c) - 1.0) * 1e3), "temperature_c": i.temperature_c}
+                       "norm_before_mg": float((np.linalg.norm(i.mean_g) - gravity_g) * 1e3),
+                       "norm_after_mg": float((np.linalg.norm(c) - gravity_g) * 1e3), "temperature_c": i.temperature_c}
                       for i, c in zip(intervals, compensated)],
         "parameters": dict(zip(PARAMETER_NAMES, fit.parameters)),
         "sigma": dict(zip(PARAMETER_NAMES, fit.sigma)),

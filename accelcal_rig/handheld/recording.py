@@ -13,11 +13,11 @@ from typing import Literal
 
 import numpy as np
 
+from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.durable import read_regular_file
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.store.read import dut_description, rows_at_setpoint, usable_campaign
 
-STANDARD_GRAVITY_M_S2 = 9.80665
 #: The largest number a recording's CSV may hold, and the largest reading (in g, once scaled) and
 #: temperature range taken for a recording of an accelerometer turned by hand.
 MAX_VALUE = 1e15
@@ -58,46 +58,90 @@ class CsvLayout:
 
     @classmethod
     def parse_columns(cls, spec: str, **options: object) -> CsvLayout:
-        """`time,x,y,z[,temperature]` column names, in that order."""
+        """`time,x,y,z[,temperature]`: column names from the file's header, or column numbers counted from 1
+        (as cut and awk count) for a file with or without one."""
         names = [n.strip() for n in spec.split(",")]
         if len(names) not in (4, 5) or not all(names):
-            raise ConfigError(f"--columns: {spec!r}: expected time,x,y,z or time,x,y,z,temperature column names")
+            raise ConfigError(f"--columns: {spec!r}: expected time,x,y,z or time,x,y,z,temperature column names "
+                              "or numbers")
+        numbered = [n.isdigit() for n in names]
+        if any(numbered) and not all(numbered):
+            raise ConfigError(f"--columns: {spec!r}: all names or all numbers, not both")
+        if all(numbered) and min(int(n) for n in names) < 1:
+            raise ConfigError(f"--columns: {spec!r}: column numbers count from 1")
         return cls(*names[:4], names[4] if len(names) == 5 else None, **options)  # type: ignore[arg-type, call-arg]
+
+    @property
+    def wanted(self) -> list[str]:
+        return [self.time, self.x, self.y, self.z] + ([self.temperature] if self.temperature else [])
+
+    @property
+    def numbered(self) -> bool:
+        return self.time.isdigit()
+
+
+def _split_rows(text: str) -> tuple[list[list[str]], str]:
+    """The rows of a delimited text, and what delimits them: a comma, a semicolon or a tab if the first line
+    has one, else runs of white space."""
+    lines = text.splitlines()
+    first = next((line for line in lines if line.strip()), "")
+    delimiter = next((d for d in (",", ";", "\t") if d in first), None)
+    if delimiter is None:
+        return [line.split() for line in lines], "white space"
+    return list(csv.reader(io.StringIO(text, newline=""), delimiter=delimiter)), repr(delimiter)
+
+
+def _column_index(path: Path, layout: CsvLayout, rows: list[list[str]]) -> tuple[list[int], int]:
+    """(each wanted column's index, the row the data starts at): by name from the header, or by number, with
+    a header line skipped if there is one."""
+    start = next((i for i, row in enumerate(rows) if row), None)
+    if start is None:
+        raise ConfigError(f"{path}: empty file")
+    if layout.numbered:
+        index = [int(n) - 1 for n in layout.wanted]
+        width = len(rows[start])
+        if max(index) >= width:
+            raise ConfigError(f"{path}: column {max(index) + 1} asked for, its first line has {width}")
+        try:
+            [float(rows[start][i]) for i in index]
+        except ValueError:
+            return index, start + 1  # a header line: skip it
+        return index, start
+    header = [h.strip() for h in rows[start]]
+    missing = [c for c in layout.wanted if c not in header]
+    if missing:
+        columns = repr(", ".join(header))[1:-1]
+        raise ConfigError(f"{path}: no column {', '.join(missing)} (columns: {columns[:120]}"
+                          f"{'…' if len(columns) > 120 else ''}); map them with --columns time,x,y,z[,temperature] "
+                          "(names, or numbers from 1)")
+    return [header.index(c) for c in layout.wanted], start + 1
 
 
 def read_csv_recording(path: Path, layout: CsvLayout) -> Recording:
-    if layout.units == "counts" and not layout.counts_per_g:
-        raise ConfigError("--counts-per-g is needed with --units counts (ADXL355: 256000 at ±2 g)")
+    """A delimited text recording: comma, semicolon, tab or white space; with a header (columns by name or
+    number) or without (by number)."""
     if layout.time_unit == "samples" and not layout.rate_hz:
         raise ConfigError("--rate-hz is needed when the time column counts samples")
     raw = read_regular_file(path, MAX_CSV_BYTES, "a recording")
-    reader = csv.reader(io.StringIO(raw.decode("utf-8-sig", errors="replace"), newline=""))
     try:
-        header = next(reader, None)
-        if header is None:
-            raise ConfigError(f"{path}: empty file")
-        header = [h.strip() for h in header]
-        wanted = [layout.time, layout.x, layout.y, layout.z] + ([layout.temperature] if layout.temperature else [])
-        missing = [c for c in wanted if c not in header]
-        if missing:
-            columns = repr(", ".join(header))[1:-1]
-            raise ConfigError(f"{path}: no column {', '.join(missing)} (columns: {columns[:120]}"
-                              f"{'…' if len(columns) > 120 else ''}); map them with --columns time,x,y,z[,temperature]")
-        index = [header.index(c) for c in wanted]
-        values = array("d")
-        for row in reader:
-            if not row:
-                continue
-            try:
-                numbers = [float(row[i]) for i in index]
-            except (ValueError, IndexError):
-                raise ConfigError(f"{path}:{reader.line_num}: not a number in columns {', '.join(wanted)}") from None
-            if not all(math.isfinite(v) and abs(v) <= MAX_VALUE for v in numbers):
-                raise ConfigError(f"{path}:{reader.line_num}: not a finite number of at most {MAX_VALUE:g} in "
-                                  f"columns {', '.join(wanted)}")
-            values.extend(numbers)
+        rows, delimiter = _split_rows(raw.decode("utf-8-sig", errors="replace"))
     except csv.Error as exc:
-        raise ConfigError(f"{path}:{reader.line_num}: not a CSV row: {exc}") from None
+        raise ConfigError(f"{path}: not a delimited text: {exc}") from None
+    index, start = _column_index(path, layout, rows)
+    wanted = layout.wanted
+    values = array("d")
+    for line, row in enumerate(rows[start:], start=start + 1):
+        if not row:
+            continue
+        try:
+            numbers = [float(row[i]) for i in index]
+        except (ValueError, IndexError):
+            raise ConfigError(f"{path}:{line}: not a number in columns {', '.join(wanted)} (delimited by "
+                              f"{delimiter})") from None
+        if not all(math.isfinite(v) and abs(v) <= MAX_VALUE for v in numbers):
+            raise ConfigError(f"{path}:{line}: not a finite number of at most {MAX_VALUE:g} in "
+                              f"columns {', '.join(wanted)}")
+        values.extend(numbers)
     data = np.array(values, dtype=float).reshape(-1, len(wanted))
     if len(data) < 10:
         raise ConfigError(f"{path}: {len(data)} rows: too short to be a calibration recording")
@@ -109,8 +153,18 @@ def read_csv_recording(path: Path, layout: CsvLayout) -> Recording:
     t = data[:, 0] * {"s": 1.0, "ms": 1e-3, "samples": 1.0 / (layout.rate_hz or 1.0)}[layout.time_unit]
     if np.any(np.diff(t) <= 0):
         raise ConfigError(f"{path}: column {layout.time} repeats a time: one row per sample expected")
-    lsb_g = {"g": 1.0, "m/s2": 1.0 / STANDARD_GRAVITY_M_S2, "counts": 1.0 / (layout.counts_per_g or 1.0)}[layout.units]
-    accel_g = (data[:, 1:4] - (layout.zero_code if layout.units == "counts" else 0.0)) * lsb_g
+    codes = data[:, 1:4] - (layout.zero_code if layout.units == "counts" else 0.0)
+    counts_per_g = layout.counts_per_g
+    if layout.units == "counts" and not counts_per_g:
+        # A norm-only fit finds each axis's scale itself: a provisional one that puts the median reading at
+        # 1 g is enough (the fitted scale absorbs the rest, and the calibration keeps the LSB it used).
+        counts_per_g = float(np.median(np.linalg.norm(codes, axis=1)))
+        if not counts_per_g > 0:
+            raise ConfigError(f"{path}: every reading is zero once --zero-code is taken off: give --counts-per-g")
+        notes.append(f"--counts-per-g not given: {counts_per_g:.6g} taken from the median |reading|; the fitted "
+                     "scale absorbs the difference")
+    lsb_g = {"g": 1.0, "m/s2": 1.0 / STANDARD_GRAVITY_M_S2, "counts": 1.0 / (counts_per_g or 1.0)}[layout.units]
+    accel_g = codes * lsb_g
     largest = float(np.abs(accel_g).max())
     if largest > MAX_ACCEL_G:
         raise ConfigError(f"{path}: readings up to {largest:.3g} g once scaled: not an accelerometer at rest and "

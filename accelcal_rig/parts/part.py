@@ -45,6 +45,7 @@ class AccelerometerPart:
     temperature: TemperatureFormat
     noise_density_ug_per_rthz: float           #: typical, on its most sensitive range
     source: str                                #: where these facts come from
+    zero_g_offset_mg: float | None = None      #: the data sheet's ± range of the 0 g offset at 25 °C, if known
 
     @property
     def ranges_g(self) -> tuple[int, ...]:

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from accelcal_rig.core.geometry import fibonacci_sphere
+
 _STEPS_DEG = np.arange(8) * 45.0
 
 
@@ -37,8 +39,4 @@ def tilt(pitch_roll_deg: np.ndarray) -> np.ndarray:
 
 def sphere(count: int) -> np.ndarray:
     """`count` directions spread evenly over the sphere (Fibonacci lattice, deterministic)."""
-    index = np.arange(count) + 0.5
-    z = 1.0 - 2.0 * index / count
-    radius = np.sqrt(1.0 - z**2)
-    azimuth = np.pi * (1.0 + np.sqrt(5.0)) * index
-    return np.column_stack([radius * np.cos(azimuth), radius * np.sin(azimuth), z])
+    return fibonacci_sphere(count)

@@ -13,12 +13,16 @@ from typing import Any
 
 import numpy as np
 
+from accelcal_rig.config.acceptance import Acceptance
 from accelcal_rig.config.procedure import SoakCriterion
 from accelcal_rig.config.yaml_lines import parse_yaml_text
+from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.fit.acceptance import Judgement, judge, recorded_acceptance
 from accelcal_rig.fit.campaign_fit import DutFitResult, FitOptions, fit_dut, partial_campaign
 from accelcal_rig.fit.recorded_options import recorded_options
-from accelcal_rig.store.read import DutPoses, campaign_status, load_campaign, read_dut_poses
+from accelcal_rig.parts.registry import DEFAULT_PART, known_parts
+from accelcal_rig.store.content import Campaign
+from accelcal_rig.store.read import DutPoses, campaign_status, dut_description, load_campaign, read_dut_poses
 from accelcal_rig.store.records import StoredEvent
 
 
@@ -56,6 +60,9 @@ class CampaignData:
     events: list[StoredEvent]
     pose_t_s: np.ndarray              # (N,) first sample of each pose
     no_fit_reason: str                # empty when every DUT was fitted
+    gravity_m_s2: float               # the site's, as the rig config stated it
+    acceptance: Acceptance            # the procedure's limits
+    zero_g_offset_mg: dict[str, float | None]  # per DUT, its part's data sheet range of the 0 g offset
 
 
 def read_campaign_data(path: Path) -> CampaignData:
@@ -94,7 +101,15 @@ def read_campaign_data(path: Path) -> CampaignData:
     soaks.sort(key=lambda s: s.t_reached_s)
     reason = "; ".join(dict.fromkeys(reasons))
     return CampaignData(path, status, str(attrs.get("procedure_path", "")), str(attrs.get("rig_name", "")), band_c,
-                        options, duts, soaks, events, campaign.pose_column("t_start_s"), reason)
+                        options, duts, soaks, events, campaign.pose_column("t_start_s"), reason,
+                        float(attrs.get("gravity_m_s2", STANDARD_GRAVITY_M_S2)), limits,
+                        {s: _datasheet_offset_mg(campaign, s) for s in campaign.serials})
+
+
+def _datasheet_offset_mg(campaign: Campaign, serial: str) -> float | None:
+    """The data sheet's 0 g offset range of the DUT's part (None for a part this installation does not know)."""
+    name = str(dut_description(campaign, serial).get("part", DEFAULT_PART))
+    return known_parts()[name].zero_g_offset_mg if name in known_parts() else None
 
 
 def _truth_by_setpoint(poses: DutPoses) -> np.ndarray | None:

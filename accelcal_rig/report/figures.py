@@ -67,8 +67,12 @@ def norm_deviation(data: CampaignData, path: Path) -> Path:
                                 sharex=True, constrained_layout=True)
     for column, serial in enumerate(serials):
         dut = data.duts[serial]
-        raw = (np.linalg.norm(dut.poses.mean_g, axis=1) - 1.0) * 1e3
-        after = (np.linalg.norm(dut.fit.compensated_g, axis=1) - 1.0) * 1e3 if dut.fit else None
+        gravity = dut.poses.gravity_g
+        raw = (np.linalg.norm(dut.poses.mean_g, axis=1) - gravity) * 1e3
+        after = (np.linalg.norm(dut.fit.compensated_g, axis=1) - gravity) * 1e3 if dut.fit else None
+        if dut.fit:  # what noise alone spreads a perfectly calibrated pose over
+            band = 2 * dut.fit.metrics["noise_floor_mg"]
+            axes[1, column].axhspan(-band, band, color="0.88", zorder=0, label="±2 × noise floor")
         for setpoint in dict.fromkeys(dut.poses.setpoint_c.tolist()):
             rows = dut.poses.setpoint_c == setpoint
             colour = cmap(norm(setpoint))
@@ -77,15 +81,17 @@ def norm_deviation(data: CampaignData, path: Path) -> Path:
                 axes[1, column].plot(dut.pose_numbers[rows], after[rows], "o-", ms=3, lw=0.8, color=colour)
         title = serial
         if dut.fit:
-            title += f"\nRMSE {dut.fit.metrics['rmse_before_mg']:.2f} → {dut.fit.metrics['rmse_after_mg']:.4f} mg"
+            title += f"\nRMSE {dut.fit.metrics['rmse_before_mg']:.2f} → {dut.fit.metrics['rmse_after_mg']:.4f} mg in-sample"
+            axes[1, column].legend(fontsize=7, loc="upper right")
         axes[0, column].set_title(title, fontsize=9)
         axes[1, column].set_xlabel("pose")
         if after is None:
             axes[1, column].text(0.5, 0.5, "no fit", ha="center", transform=axes[1, column].transAxes)
-    axes[0, 0].set_ylabel("|g| − 1 before (mg)")
-    axes[1, 0].set_ylabel("|g| − 1 after (mg)")
+    axes[0, 0].set_ylabel("|g| − g before (mg)")
+    axes[1, 0].set_ylabel("|g| − g after (mg)")
     figure.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=axes, label="setpoint (°C)", shrink=0.8)
-    figure.suptitle("Norm of gravity at each pose, before and after calibration (paper Fig. 6)")
+    figure.suptitle("Norm of gravity at each calibration pose, before and after calibration (paper Fig. 6); g: the "
+                    "site's gravity")
     return save(figure, path)
 
 
@@ -115,13 +121,19 @@ def ellipsoid(data: CampaignData, path: Path) -> Path:
     figure = plt.figure(figsize=(16, 4.2 * rows), constrained_layout=True)
     sphere = _sphere_grid()
     with_reference = data.options is not None and data.options.mode == "reference"
+
+    def error_of(serial: str) -> np.ndarray:
+        poses = data.duts[serial].poses
+        return poses.mean_g - poses.reference_g if with_reference else np.linalg.norm(poses.mean_g, axis=1) - 1.0
+
+    # One magnification for every panel, so the DUTs compare at a glance.
+    gain = 0.3 / max([float(np.max(np.abs(error_of(s)))) for s in fitted] + [1e-9])
+    panels = []
     for index, serial in enumerate(fitted):
         dut = data.duts[serial]
         assert dut.fit is not None
         raw, compensated = dut.poses.mean_g, dut.fit.compensated_g
         reference = dut.poses.reference_g if with_reference else None
-        error = raw - reference if reference is not None else np.linalg.norm(raw, axis=1) - 1.0
-        gain = 0.3 / max(float(np.max(np.abs(error))), 1e-9)
         middle = len(dut.fit.fits) // 2
         surface = _exaggerated(distort(sphere, dut.fit.fits[middle].parameters), sphere if with_reference else None,
                                gain)
@@ -132,14 +144,20 @@ def ellipsoid(data: CampaignData, path: Path) -> Path:
             axis = figure.add_subplot(rows, 4, 2 * index + column + 1, projection="3d")
             axis.plot_wireframe(*np.moveaxis(mesh, -1, 0), color="0.75", lw=0.4)
             axis.scatter(*_exaggerated(points, reference, gain).T, c=colours, s=12, depthshade=False)
-            axis.set_title(f"{title}\nerror × {gain:,.0f}", fontsize=9)
+            axis.set_title(title, fontsize=9)
             axis.set_box_aspect((1, 1, 1))
-            for setter, name in ((axis.set_xlabel, "x"), (axis.set_ylabel, "y"), (axis.set_zlabel, "z")):
-                setter(f"{name} (g)", fontsize=8)
-            axis.tick_params(labelsize=7)
+            for ticks, label, name in ((axis.set_xticks, axis.set_xlabel, "x"), (axis.set_yticks, axis.set_ylabel, "y"),
+                                       (axis.set_zticks, axis.set_zlabel, "z")):
+                ticks([-1, 0, 1])
+                label(f"{name} (g)", fontsize=8, labelpad=-8)
+            axis.tick_params(labelsize=7, pad=-2)
+            panels.append(axis)
     if not fitted:
         figure.text(0.5, 0.5, f"no fit: {data.no_fit_reason}", ha="center")
-    figure.suptitle("Raw ellipsoid and calibrated sphere, errors magnified (paper Fig. 7); colour: setpoint")
+    else:
+        figure.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=panels, label="setpoint (°C)", shrink=0.6)
+    figure.suptitle(f"Raw ellipsoid and calibrated sphere (paper Fig. 7): every pose's error magnified {gain:,.0f} "
+                    "times in every panel")
     return save(figure, path)
 
 
@@ -185,31 +203,55 @@ def parameters(data: CampaignData, path: Path) -> Path:
 
 def drift(data: CampaignData, path: Path) -> Path:
     """Fig. 11: zero-g offset per axis over temperature, before compensation (the fitted raw bias, mg) and
-    after (what the polynomial model makes of that raw zero-g reading, µg), each relative to its mean."""
+    after (what the polynomial model makes of that raw zero-g reading, µg), each relative to its mean; after
+    it, the verification poses' residual offsets (hollow) and the acceptance limit's band. A polynomial that
+    interpolates its temperatures has no drift after to show: the panel says so instead of plotting zeros."""
     plt = pyplot()
     figure, axes = plt.subplots(2, 3, figsize=(12, 7), sharex=True, constrained_layout=True)
     colours = plt.get_cmap("tab10")
+    interpolated = []
     for index, (serial, dut) in enumerate(data.duts.items()):
         if dut.fit is None:
             continue
-        fit = dut.fit
+        fit, colour = dut.fit, colours(index % 10)
         bias = np.array([f.parameters[0:3] for f in fit.fits])
         after = correct(bias, fit.thermal.parameters_at(fit.temperatures_c, "extrapolate"))
+        powers = min(fit.thermal.degree, len(fit.fits) - 1) + 1
+        verification = fit.metrics.get("verification")
         for axis_index in range(3):
-            for row, (values, scale, unit, key) in enumerate(((bias, 1e3, "mg", "drift_before_mg"),
-                                                              (after, 1e6, "µg", "drift_after_mg"))):
-                spread = fit.metrics[key][axis_index] * scale / 1e3
-                axes[row, axis_index].plot(fit.temperatures_c, (values[:, axis_index] - values[:, axis_index].mean())
-                                           * scale, "o-", ms=3, color=colours(index % 10),
-                                           label=f"{serial}: {spread:.{2 if unit == 'mg' else 1}f} {unit}")
+            axes[0, axis_index].plot(fit.temperatures_c, (bias[:, axis_index] - bias[:, axis_index].mean()) * 1e3,
+                                     "o-", ms=3, color=colour, label=serial if axis_index == 0 else None)
+            if len(fit.fits) > powers:
+                axes[1, axis_index].plot(fit.temperatures_c,
+                                         (after[:, axis_index] - after[:, axis_index].mean()) * 1e6, "o-", ms=3,
+                                         color=colour)
+            if verification is not None:
+                rows = verification["by_setpoint"]
+                offsets = np.array([r["offset_mg"][axis_index] for r in rows]) * 1e3
+                axes[1, axis_index].plot([r["temperature_c"] for r in rows], offsets - offsets.mean(), "o", ms=5,
+                                         mfc="none", color=colour)
+        if len(fit.fits) <= powers:
+            interpolated.append(f"{serial}: degree {fit.thermal.degree} through {len(fit.fits)} temperatures "
+                                "interpolates them: its drift after is 0 by construction, not measured")
+    limit = data.acceptance.max_drift_mg
     for axis_index, name in enumerate("xyz"):
         axes[0, axis_index].set_title(f"{name} axis", fontsize=10)
-        for row in range(2):
-            if axes[row, axis_index].has_data():
-                axes[row, axis_index].legend(fontsize=7, title="max − min", title_fontsize=7)
         axes[1, axis_index].set_xlabel("sensor temperature (°C)")
-    axes[0, 0].set_ylabel("offset before compensation, minus its mean (mg)")
-    axes[1, 0].set_ylabel("offset after compensation, minus its mean (µg)")
+        if limit is not None:  # max − min within the limit: every point inside some band this wide
+            axes[1, axis_index].axhspan(-limit * 500, limit * 500, color="0.9", zorder=0)
+    axes[0, 0].set_ylabel("before: offset − mean (mg)")
+    axes[1, 0].set_ylabel("after: offset − mean (µg)")
+    if interpolated:
+        axes[1, 1].text(0.5, 0.5, "\n".join(interpolated), ha="center", va="center", fontsize=8, wrap=True,
+                        transform=axes[1, 1].transAxes)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    handles += [plt.Line2D([], [], color="0.3", marker="o", ls="-", ms=3),
+                plt.Line2D([], [], color="0.3", marker="o", ls="", ms=5, mfc="none")]
+    labels += ["calibration setpoints (in-sample)", "verification poses (never fitted)"]
+    if limit is not None:
+        handles.append(plt.Rectangle((0, 0), 1, 1, color="0.9"))
+        labels.append(f"acceptance: max − min ≤ {limit:g} mg")
+    figure.legend(handles, labels, loc="outside lower center", ncol=min(len(labels), 4), fontsize=8)
     figure.suptitle("Zero-g offset drift per axis before and after thermal compensation (paper Fig. 11)")
     return save(figure, path)
 

@@ -14,6 +14,7 @@ import numpy as np
 
 from accelcal_rig import __version__
 from accelcal_rig.core.formatting import format_duration
+from accelcal_rig.core.units import gravity_statement
 from accelcal_rig.durable import write_text_atomically
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.campaign_fit import FitOptions
@@ -27,7 +28,7 @@ h1 { font-size: 1.5em; } h2 { font-size: 1.2em; margin-top: 2em; border-bottom: 
 table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0; }
 th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: right; }
 th { background: #f0f0f0; } td.text, th.text { text-align: left; }
-tr.warning td { background: #fff6d5; } tr.error td { background: #fde0e0; }
+tr.warning td { background: #fff6d5; } tr.error td { background: #fde0e0; } tr.total td { font-weight: bold; }
 img { max-width: 100%; border: 1px solid #eee; } .note { color: #555; font-size: 0.9em; }
 .state-done { color: #106010; } .state-aborted, .state-running { color: #a01010; }
 """
@@ -100,7 +101,9 @@ def _page(data: CampaignData) -> str:
               _figure("ellipsoid", "Per-pose mean readings with their error magnified by the same factor in both "
                                    "panels: the deviation from the turntable's reference direction (reference "
                                    "mode) or from 1 g (norm-only mode). Paper Fig. 7.")]
+    parts += ["<h2>Uncertainty budget</h2>", _uncertainty_table(data)]
     parts += ["<h2>RMSE of |g| per setpoint</h2>", _rmse_table(data)]
+    parts += ["<h2>Error parameters at the reference temperature</h2>", _parameter_table(data)]
     parts += ["<h2>Error parameters over temperature</h2>",
               _figure("parameters", "Each Eq. 1 parameter fitted at each setpoint (±1σ) and its polynomial over "
                                     "the sensor temperature (Eq. 8); crosses: the simulated truth (dry runs). "
@@ -129,6 +132,7 @@ def _summary(data: CampaignData) -> list[str]:
         ["started / finished", f"{s.get('started')} / {s.get('finished') or '—'}"],
         ["campaign time", format_duration(float(data.pose_t_s.max())) if len(data.pose_t_s) else "—"],
         ["fit", _fit_description(data.options)],
+        ["gravity", gravity_statement(data.gravity_m_s2)],
         ["integrity", s.get("integrity", "?")],
     ]
     out = ["<h2>Campaign</h2>", _table(["", ""], rows, text_columns=2)]
@@ -187,6 +191,64 @@ def _rmse_table(data: CampaignData) -> str:
                                    "polynomial: the thermal model at each pose's temperature. Paper Table 6.</p>")
 
 
+def _uncertainty_table(data: CampaignData) -> str:
+    """Per DUT, each source's standard uncertainty and the expanded one, worst case over the range."""
+    rows, classes, notes = [], [], []
+    for serial, dut in data.duts.items():
+        if dut.fit is None:
+            continue
+        budget = dut.fit.metrics["uncertainty_budget"]
+        for name, values in budget["sources_mg"].items():
+            rows.append([serial, name.replace("_", " "), *(f"{v * 1e3:.1f}" for v in values)])
+            classes.append("")
+        rows.append([serial, "combined (k = 1)", *(f"{v * 1e3:.1f}" for v in budget["standard_mg"])])
+        rows.append([serial, f"expanded (k = {budget['coverage_factor']:g})", *(f"{v * 1e3:.1f}" for v in budget["expanded_mg"])])
+        classes += ["", "total"]
+        coverage = dut.fit.metrics.get("truth_coverage_k2")
+        if coverage is not None:
+            notes.append(f"{serial}: {coverage * 100:.1f} % of its verification axis errors against the simulation "
+                         "truth lie inside their expanded uncertainty")
+        reading = budget["reading"]
+    if not rows:
+        return "<p>No fit.</p>"
+    return (_table(["DUT", "source", "x (µg)", "y (µg)", "z (µg)"], rows, text_columns=2, row_classes=classes)
+            + f"<p class='note'>Standard uncertainties of a compensated reading, each source's largest over every "
+              f"orientation and the calibrated range (GUM; sources uncorrelated): {_e(reading)}. Calibration noise "
+              "and turntable pointing reach the reading through the fitted coefficients.</p>"
+            + "".join(f"<p class='note'>{_e(n)} (a dry run; about 95 % is what k = 2 promises).</p>" for n in notes))
+
+
+def _parameter_table(data: CampaignData) -> str:
+    """Absolute values at the acceptance limits' temperature (else 25 °C, clamped into the range), beside the
+    data sheet's range and the procedure's limits."""
+    limits = data.acceptance.parameters
+    at_c = limits.at_c if limits is not None else 25.0
+    rows, classes = [], []
+    for serial, dut in data.duts.items():
+        if dut.fit is None:
+            continue
+        low, high = dut.fit.thermal.domain_c
+        t = min(max(at_c, low), high)
+        p = dut.fit.thermal.parameters_at(t, "clamp")
+        datasheet = data.zero_g_offset_mg.get(serial)
+        bias = np.abs(p[0:3]) * 1e3
+        outside = datasheet is not None and bool(np.any(bias > datasheet))
+        rows.append([serial, f"{t:.1f}", *(f"{v:+.3f}" for v in p[0:3] * 1e3), f"±{datasheet:g}" if datasheet else "—",
+                     *(f"{v:+.0f}" for v in (p[3:6] - 1.0) * 1e6), *(f"{v:+.3f}" for v in p[6:9] * 1e3)])
+        classes.append("warning" if outside else "")
+    if not rows:
+        return "<p>No fit.</p>"
+    stated = ("; the procedure's limits: " + ", ".join(
+        f"{name.replace('_', ' ')} {getattr(limits, name):g}" for name in
+        ("bias_mg", "scale_error_ppm", "nonorthogonality_mrad", "misalignment_mrad") if getattr(limits, name) is not None)
+              if limits is not None else "")
+    return (_table(["DUT", "at (°C)", "bias x (mg)", "bias y (mg)", "bias z (mg)", "data sheet 0 g offset (mg)",
+                    "scale error x (ppm)", "y (ppm)", "z (ppm)", "non-orth. yx (mrad)", "zx (mrad)", "zy (mrad)"],
+                   rows, text_columns=1, row_classes=classes)
+            + f"<p class='note'>The calibration's parameters themselves (not changes over temperature){_e(stated)}. "
+              "A highlighted row has a bias outside its part's data sheet range.</p>")
+
+
 def _drift_table(data: CampaignData) -> str:
     rows = []
     for serial, dut in data.duts.items():
@@ -194,8 +256,10 @@ def _drift_table(data: CampaignData) -> str:
             continue
         m = dut.fit.metrics
         low, high = m["temperature_range_c"]
-        rows.append([serial, f"{low:.1f} … {high:.1f}", *(f"{v:.3f}" for v in m["drift_before_mg"]),
-                     *(f"{v * 1e3:.1f}" for v in m["drift_after_mg"])])
+        interpolates = len(dut.fit.fits) <= min(dut.fit.thermal.degree, len(dut.fit.fits) - 1) + 1
+        after = (["0 by construction (the polynomial interpolates)"] + ["—"] * 2 if interpolates and len(dut.fit.fits) > 1
+                 else [f"{v * 1e3:.1f}" for v in m["drift_after_mg"]])
+        rows.append([serial, f"{low:.1f} … {high:.1f}", *(f"{v:.3f}" for v in m["drift_before_mg"]), *after])
     return _table(["DUT", "range (°C)", "before x (mg)", "before y (mg)", "before z (mg)", "after x (µg)",
                    "after y (µg)", "after z (µg)"], rows, text_columns=2) if rows else ""
 

@@ -13,6 +13,7 @@ from accelcal_rig.config.procedure import SimulatedEffects
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel, dut_time_constant_s
+from accelcal_rig.core.units import site_gravity_g
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.parts.part import AccelerometerPart
 from accelcal_rig.parts.registry import part
@@ -75,6 +76,10 @@ class VirtualLab:
         )
         self._gravity_angles_key = b""
         self._gravity_fixture = np.array([0.0, 0.0, 1.0])
+        #: The simulated site's true gravity in standard g: the rig config's value, off by a draw of its stated
+        #: uncertainty (its own stream, so a stated uncertainty of zero changes no other draw).
+        draw = np.random.default_rng([seed, 1_000_003]).normal() if rig.gravity_uncertainty_m_s2 > 0 else 0.0
+        self.site_gravity_g = site_gravity_g(rig.gravity_m_s2 + rig.gravity_uncertainty_m_s2 * draw)
 
     def chamber_reading_c(self) -> float:
         """Chamber air as its controller reads it, with regulation noise."""
@@ -126,9 +131,10 @@ class VirtualLab:
         return {"parameters": mean(3), "gravity_g": mean(4), "temperature_c": np.asarray(mean(5), dtype=float)}
 
     def gravity_in_dut(self, index: int) -> np.ndarray:
-        """True specific-force direction (+1 g up) in DUT `index`'s frame at the table's actual angles."""
+        """True specific force at rest (the site's gravity, up) in DUT `index`'s frame at the table's actual
+        angles, in standard g."""
         angles = self.motion.position_deg(self.clock.now())
         key = angles.tobytes()
         if key != self._gravity_angles_key:  # the table stands still between moves: one chain per pose
             self._gravity_angles_key, self._gravity_fixture = key, self.kinematics.gravity_in_fixture(angles)
-        return self.duts[index].fixture_to_dut @ self._gravity_fixture
+        return self.site_gravity_g * (self.duts[index].fixture_to_dut @ self._gravity_fixture)

@@ -17,6 +17,7 @@ from typing import Any
 import h5py
 import numpy as np
 
+from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
 from accelcal_rig.durable import stale_temporaries
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.store import lock
@@ -230,13 +231,17 @@ class DutPoses:
     reference_accuracy_arcsec: float  # ± per turntable axis, from the rig config
     truth_parameters: np.ndarray | None  # (N, 12) simulation truth, dry runs only
     verification: np.ndarray          # (N,) bool: a verification pose (the fit never sees it)
+    gravity_g: float = 1.0            # the site's gravity in standard g (the magnitude of every reference)
+    truth_gravity_g: np.ndarray | None = None  # (N, 3) the simulation's true specific force, dry runs only
+    gravity_uncertainty_g: float = 0.0
 
     def subset(self, rows: np.ndarray) -> DutPoses:
         """These poses only (a boolean mask or indices)."""
         arrays = {name: getattr(self, name)[rows] for name in ("setpoint_c", "t_s", "temperature_c", "mean_g",
                                                                 "stderr_g", "reference_g", "verification")}
         truth = self.truth_parameters[rows] if self.truth_parameters is not None else None
-        return replace(self, **arrays, truth_parameters=truth)
+        gravity = self.truth_gravity_g[rows] if self.truth_gravity_g is not None else None
+        return replace(self, **arrays, truth_parameters=truth, truth_gravity_g=gravity)
 
 
 def dut_description(campaign: Campaign, serial: str) -> dict[str, Any]:
@@ -258,6 +263,9 @@ def read_dut_poses(campaign: Campaign, serial: str) -> DutPoses:
         reference_accuracy_arcsec=float(campaign.header.turntable_accuracy_arcsec),
         truth_parameters=campaign.truth_column(serial, "parameters"),
         verification=np.isin(campaign.pose_column("step_key"), list(campaign.header.plan.verification_keys)),
+        gravity_g=site_gravity_g(float(campaign.attrs.get("gravity_m_s2", STANDARD_GRAVITY_M_S2))),
+        gravity_uncertainty_g=site_gravity_g(float(campaign.attrs.get("gravity_uncertainty_m_s2", 0.0))),
+        truth_gravity_g=campaign.truth_column(serial, "gravity_g"),
     )
 
 

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import apply, load_calibration, save_calibration
 from accelcal_rig.fit.sfem import norm_only_gauge
 from accelcal_rig.handheld.calibrate import RecordingUnusable, fit_recording
@@ -93,7 +94,7 @@ def test_a_campaign_files_raw_samples_are_a_recording(paper_campaign: Path) -> N
 
 @pytest.mark.parametrize("argv, expected", [
     (["--columns", "time_s,ax,ay,accel_z"], "no column accel_z (columns: time_s, ax, ay, az, temp_c)"),
-    (["--columns", "time_s,ax,ay,az,temp_c", "--units", "counts"], "--counts-per-g is needed with --units counts"),
+    (["--columns", "1,2,3,9"], "column 9 asked for, its first line has 5"),
     (["--columns", "t,x"], "--columns: 't,x': expected time,x,y,z"),
     (["--columns", "time_s,ax,ay,az", "--window-s", "0"], "--window-s: 0 is outside 0.001 … 3600 s"),
     (["--columns", "time_s,ax,ay,az", "--init-s", "nan"], "--init-s: nan is outside 0.001 … 3600 s"),
@@ -114,9 +115,45 @@ def test_fit_recording_input_errors_are_one_line(tmp_path: Path, capsys, argv: l
 
 
 def test_a_broken_row_is_named_by_its_line(tmp_path: Path) -> None:
-    from accelcal_rig.errors import ConfigError
-
     path = tmp_path / "s.csv"
     path.write_text("t,x,y,z\n" + "".join(f"{i / 100},0,0,1\n" for i in range(20)) + "0.2,0,zero,1\n")
-    with pytest.raises(ConfigError, match=r"s\.csv:22: not a number in columns t, x, y, z"):
+    with pytest.raises(ConfigError, match=r"s\.csv:22: not a number in columns t, x, y, z \(delimited by ','\)"):
         read_csv_recording(path, CsvLayout.parse_columns("t,x,y,z"))
+
+
+@pytest.mark.parametrize("layout", ["whitespace, no header", "tabs, header, by number", "semicolons, header"])
+def test_delimiters_headers_and_column_numbers(tmp_path: Path, layout: str) -> None:
+    simulated = handheld_recording("HH-7", 12, 100.0, np.random.default_rng(16))
+    write_csv(simulated, tmp_path / "s.csv")
+    lines = (tmp_path / "s.csv").read_text().splitlines()
+    if layout == "whitespace, no header":
+        text, columns = "\n".join("  ".join(line.split(",")) for line in lines[1:]), "1,2,3,4,5"
+    elif layout == "tabs, header, by number":
+        text, columns = "\n".join("\t".join(line.split(",")) for line in lines), "1,2,3,4,5"
+    else:
+        text, columns = "\n".join(";".join(line.split(",")) for line in lines), "time_s,ax,ay,az,temp_c"
+    (tmp_path / "other.txt").write_text(text + "\n")
+    _, result = calibrate_csv(tmp_path / "other.txt", CsvLayout.parse_columns(columns))
+    _, reference = calibrate_csv(tmp_path / "s.csv", CsvLayout.parse_columns("time_s,ax,ay,az,temp_c"))
+    np.testing.assert_array_equal(result.fit.parameters, reference.fit.parameters)  # the same numbers read
+
+
+def test_codes_without_counts_per_g_give_the_same_calibrated_output(tmp_path: Path) -> None:
+    simulated = handheld_recording("HH-7", 14, 100.0, np.random.default_rng(17))
+    write_csv(simulated, tmp_path / "codes.csv", counts_per_g=256000.0)
+    columns = "time_s,ax,ay,az,temp_c"
+    known, with_scale = calibrate_csv(tmp_path / "codes.csv", CsvLayout.parse_columns(columns, units="counts",
+                                                                                       counts_per_g=256000.0))
+    guessed, without = calibrate_csv(tmp_path / "codes.csv", CsvLayout.parse_columns(columns, units="counts"))
+    assert guessed.lsb_g != known.lsb_g and any("--counts-per-g not given" in n for n in guessed.notes)
+    codes = np.rint(simulated.raw_g[simulated.still][:50] * 256000.0)
+    a = apply(with_scale.calibration.sensor("HH-7"), codes * known.lsb_g, 25.0)
+    b = apply(without.calibration.sensor("HH-7"), codes * guessed.lsb_g, 25.0)
+    np.testing.assert_allclose(a, b, atol=2e-6)  # the fitted scale absorbs the provisional one
+
+
+def test_mixed_or_zero_column_numbers_are_refused() -> None:
+    with pytest.raises(ConfigError, match="all names or all numbers"):
+        CsvLayout.parse_columns("1,ax,ay,az")
+    with pytest.raises(ConfigError, match="count from 1"):
+        CsvLayout.parse_columns("0,1,2,3")

@@ -1,0 +1,164 @@
+"""The uncertainty of a compensated reading (GUM): each source's standard uncertainty per axis, combined in
+quadrature and expanded with k = 2.
+
+Sources:
+- `reading_noise`: the reading's own sample noise (its standard error per axis, through the compensation);
+- `calibration_noise`: the calibration poses' sample noise, through the fitted coefficients;
+- `turntable_pointing`: the table's pointing accuracy, through the fitted coefficients (reference mode);
+- `scatter_beyond_noise`: residual scatter the first two do not explain (the fit's χ²_red, when it is
+  significantly above 1 at the 99 % level), through the coefficients;
+- `thermal_model`: the per-setpoint estimates' scatter about the polynomial beyond their own 1σ (when
+  significant at the 95 % level);
+- `temperature`: the uncertainty of the temperature the reading is compensated at;
+- `gravity`: the site's gravity value (every output is relative to it).
+
+The coefficients' covariance is the sandwich G·Σ·Gᵀ of the linearised estimator, G the map from every
+calibration pose's whitened residuals to the thermal model's coefficients: (JᵀJ)⁻¹Jᵀ for the joint fit;
+for the two-stage fit, each setpoint's LM map followed by the weighted polynomial fit of each parameter
+(two_stage_map) — the estimator actually used, not an idealised one. The noise and the pointing
+covariances of each pose propagate separately, so the budget can say what each costs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import chi2
+
+from accelcal_rig.fit.sfem import correct, error_matrix
+from accelcal_rig.fit.thermal import OutOfRange, ThermalModel
+
+COVERAGE_FACTOR = 2.0
+SOURCES = ("reading_noise", "calibration_noise", "turntable_pointing", "scatter_beyond_noise", "thermal_model",
+           "temperature", "gravity")
+#: Step of the numerical derivatives of the compensation, in each parameter's own unit and in °C.
+_STEP = 1e-6
+_STEP_C = 1e-3
+
+
+@dataclass(frozen=True)
+class CoefficientCovariance:
+    """Covariances of the free coefficients, flattened parameter-major (parameter, then power)."""
+
+    free: np.ndarray                  # (12,) bool: the parameters the fit determined
+    n_powers: int
+    noise: np.ndarray                 # (P, P) from the calibration poses' sample noise
+    pointing: np.ndarray              # (P, P) from the turntable's pointing accuracy
+    excess: np.ndarray                # (P, P) from scatter beyond both (zero unless significant)
+    model_variance: np.ndarray        # (12,) the thermal model's excess variance per parameter (zero if none)
+
+
+def joint_map(jacobian: np.ndarray) -> np.ndarray:
+    """(JᵀJ)⁻¹Jᵀ: how the whitened residuals move a least-squares fit's coefficients."""
+    q, r = np.linalg.qr(jacobian)
+    return np.linalg.solve(r, q.T)
+
+
+def two_stage_map(setpoint_jacobians: list[np.ndarray], scaled_temperatures: np.ndarray, setpoint_sigma: np.ndarray,
+                  free: np.ndarray, n_powers: int) -> np.ndarray:
+    """How every pose's whitened residuals move the two-stage fit's coefficients: each setpoint's LM map to
+    its parameters, then each parameter's polynomial, weighted by the setpoints' 1σ (fit_thermal)."""
+    per_setpoint = [joint_map(j) for j in setpoint_jacobians]          # (p, R_j) each
+    columns = np.cumsum([0] + [m.shape[1] for m in per_setpoint])
+    powers = np.vander(scaled_temperatures, n_powers, increasing=True)  # (K, m)
+    rows = np.flatnonzero(free)
+    mapping = np.zeros((len(rows) * n_powers, columns[-1]))
+    for p, k in enumerate(rows):
+        weights = 1.0 / setpoint_sigma[:, k] ** 2
+        fit = np.linalg.solve(powers.T @ (weights[:, None] * powers), powers.T * weights)   # (m, K)
+        for j, setpoint_map in enumerate(per_setpoint):
+            mapping[p * n_powers:(p + 1) * n_powers, columns[j]:columns[j + 1]] = np.outer(fit[:, j], setpoint_map[p])
+    return mapping
+
+
+def coefficient_covariance(mapping: np.ndarray, reference_g: np.ndarray | None, stderr_g: np.ndarray,
+                           accuracy_rad: float, free: np.ndarray, n_powers: int, residuals: np.ndarray,
+                           thermal_residuals: np.ndarray, setpoint_sigma: np.ndarray) -> CoefficientCovariance:
+    """`mapping` (P, R): from every calibration pose's whitened residuals (pose by pose, as the fit weighs
+    them) to the coefficients; `residuals`: those residuals at the solution (for χ²); `thermal_residuals`
+    (K, 12) and `setpoint_sigma` (K, 12): the per-setpoint estimates about the polynomial and their 1σ."""
+    a = mapping
+    n_poses = len(stderr_g)
+    if reference_g is None:                                             # norm-only: |g| residuals, noise only
+        noise, pointing = a @ a.T, np.zeros((a.shape[0], a.shape[0]))
+    else:
+        stderr_g = np.maximum(np.asarray(stderr_g, dtype=float), 1e-9)
+        reference_g = np.asarray(reference_g, dtype=float)
+        spread = accuracy_rad**2 / 3.0
+        sigma = np.sqrt(stderr_g**2 + spread * (np.sum(reference_g**2, axis=1, keepdims=True) - reference_g**2))
+        blocks = a.reshape(a.shape[0], n_poses, 3) / sigma[None]       # A_i S_i⁻¹, pose by pose
+        noise = np.einsum("pna,na,qna->pq", blocks, stderr_g**2, blocks)
+        turn = spread * (np.einsum("na,na->n", reference_g, reference_g)[:, None, None] * np.eye(3)
+                         - np.einsum("na,nb->nab", reference_g, reference_g))
+        pointing = np.einsum("pna,nab,qnb->pq", blocks, turn, blocks)
+    dof = len(residuals) - a.shape[0]
+    chi2_total = float(residuals @ residuals)
+    excess = np.zeros_like(noise)
+    if dof > 0 and chi2_total > chi2.ppf(0.99, dof):
+        excess = (chi2_total / dof - 1.0) * (a @ a.T)
+    return CoefficientCovariance(free, n_powers, noise, pointing, excess,
+                                 _model_variance(thermal_residuals, setpoint_sigma, free, n_powers))
+
+
+def _model_variance(residuals: np.ndarray, sigma: np.ndarray, free: np.ndarray, n_powers: int) -> np.ndarray:
+    """Per parameter, the variance of the per-setpoint estimates about the polynomial beyond their 1σ, when
+    their χ² is significant at the 95 % level; zero otherwise, and when there is nothing left to check."""
+    variance = np.zeros(12)
+    dof = len(residuals) - n_powers
+    if dof <= 0:
+        return variance
+    for k in np.flatnonzero(free):
+        statistic = float(np.sum((residuals[:, k] / sigma[:, k]) ** 2))
+        if statistic > chi2.ppf(0.95, dof):
+            variance[k] = (statistic / dof - 1.0) * float(np.mean(sigma[:, k] ** 2))
+    return variance
+
+
+def output_uncertainty(raw_g: np.ndarray, temperature_c: np.ndarray, model: ThermalModel,
+                       covariance: CoefficientCovariance, reading_stderr_g: np.ndarray, temperature_u_c: np.ndarray,
+                       gravity_relative_u: float, out_of_range: OutOfRange = "extrapolate") -> dict[str, np.ndarray]:
+    """Per source, the standard uncertainty (n, 3) in g of `raw_g` (n, 3) compensated at `temperature_c` (n,)."""
+    raw_g = np.asarray(raw_g, dtype=float)
+    temperature_c = np.asarray(temperature_c, dtype=float)
+    params = model.parameters_at(temperature_c, out_of_range)            # (n, 12)
+    output = correct(raw_g, params)
+    by_parameter = _parameter_derivatives(raw_g, params)              # (n, 3, 12)
+    x = model.scaled(temperature_c)
+    if out_of_range == "clamp":
+        x = np.clip(x, -1.0, 1.0)
+    powers = np.vander(x, covariance.n_powers, increasing=True)       # (n, m)
+    by_coefficient = np.einsum("nap,nm->napm", by_parameter[:, :, covariance.free], powers).reshape(
+        len(raw_g), 3, -1)
+
+    def through(cov: np.ndarray) -> np.ndarray:
+        return np.sqrt(np.maximum(np.einsum("nap,pq,naq->na", by_coefficient, cov, by_coefficient), 0.0))
+
+    gain = error_matrix(params)                                        # ∂output/∂raw
+    reading = np.sqrt(np.einsum("nab,nb,nab->na", gain, np.asarray(reading_stderr_g, dtype=float) ** 2, gain))
+    warmer = correct(raw_g, model.parameters_at(temperature_c + _STEP_C, out_of_range))
+    cooler = correct(raw_g, model.parameters_at(temperature_c - _STEP_C, out_of_range))
+    by_temperature = (warmer - cooler) / (2 * _STEP_C)
+    model_u = np.sqrt(np.einsum("nap,p,nap->na", by_parameter, covariance.model_variance, by_parameter))
+    return {
+        "reading_noise": reading,
+        "calibration_noise": through(covariance.noise),
+        "turntable_pointing": through(covariance.pointing),
+        "scatter_beyond_noise": through(covariance.excess),
+        "thermal_model": model_u,
+        "temperature": np.abs(by_temperature) * np.asarray(temperature_u_c, dtype=float)[:, None],
+        "gravity": np.abs(output) * gravity_relative_u,
+    }
+
+
+def combined(sources: dict[str, np.ndarray]) -> np.ndarray:
+    """The combined standard uncertainty: the sources in quadrature (taken as uncorrelated)."""
+    return np.sqrt(sum(u**2 for u in sources.values()))
+
+
+def _parameter_derivatives(raw_g: np.ndarray, params: np.ndarray) -> np.ndarray:
+    """∂correct/∂θ (n, 3, 12) by central differences."""
+    steps = np.eye(12) * _STEP
+    up = correct(raw_g[:, None, :], params[:, None, :] + steps)       # (n, 12, 3)
+    down = correct(raw_g[:, None, :], params[:, None, :] - steps)
+    return np.moveaxis((up - down) / (2 * _STEP), 1, 2)

@@ -1,0 +1,232 @@
+"""`rig certificate`: one calibration certificate per DUT, an HTML page and (with WeasyPrint installed, the
+`certificate` extra) its PDF, from a campaign file and the calibration fitted to it.
+
+A certificate states only what the two files hold: the item and its identity as read at preflight, the
+campaign and its instruments, the calibration, its verification, its uncertainty budget and its verdict;
+fields for the signatures of who performed and who approved it. A dry run's certificate says on every
+page that no physical sensor was calibrated; a partial campaign's says it was partial.
+"""
+
+from __future__ import annotations
+
+import html
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from accelcal_rig import __version__
+from accelcal_rig.core.units import gravity_statement
+from accelcal_rig.durable import write_atomically, write_text_atomically
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.fit.calibration import CalibrationFile, SensorCalibration, load_calibration
+from accelcal_rig.store.content import Campaign, measurements_sha256
+from accelcal_rig.store.read import dut_description, usable_campaign
+from accelcal_rig.store.records import utc_now
+
+#: On every page of a dry run's certificate.
+DRY_RUN_PAGES = """
+@page { @top-center { content: "SIMULATED — no physical sensor was calibrated"; font-family: "DejaVu Sans",
+                      sans-serif; font-size: 9pt; font-weight: bold; color: #a00000; } }
+"""
+
+STYLE = """
+@page { size: A4; margin: 16mm 15mm 18mm 15mm;
+        @bottom-center { content: "Certificate " string(number) " — page " counter(page) " of " counter(pages);
+                         font-family: "DejaVu Sans", sans-serif; font-size: 8pt; color: #555; } }
+section { break-inside: avoid; }
+body { font-family: "DejaVu Sans", sans-serif; font-size: 9pt; color: #111; max-width: 190mm; margin: auto; }
+h1 { font-size: 15pt; margin: 0 0 2mm 0; } h2 { font-size: 10.5pt; margin: 4mm 0 1mm 0; border-bottom: 0.6pt solid #888; }
+.number { string-set: number content(); }
+table { border-collapse: collapse; width: 100%; margin: 1mm 0; }
+th, td { border: 0.4pt solid #bbb; padding: 1pt 4pt; text-align: right; vertical-align: top; }
+th { background: #eee; } td.text, th.text { text-align: left; } td.key { text-align: left; width: 34%; color: #333; }
+.verdict { font-size: 14pt; font-weight: bold; padding: 2mm 4mm; display: inline-block; border: 1.2pt solid; }
+.PASS { color: #0a5a0a; } .FAIL { color: #a00000; }
+.banner { border: 1.2pt solid #a00000; color: #a00000; font-weight: bold; padding: 1.5mm 3mm; margin: 2mm 0; }
+.note { color: #444; font-size: 8pt; }
+.signatures td { height: 14mm; vertical-align: bottom; text-align: left; }
+"""
+
+
+@dataclass(frozen=True)
+class Written:
+    serial: str
+    html: Path
+    pdf: Path | None
+
+
+def write_certificates(campaign_path: Path, calibration_path: Path, folder: Path, operator: str = "",
+                       pdf: bool = True) -> tuple[list[Written], list[str]]:
+    """One certificate per DUT of the calibration into `folder` (created); (what was written, warnings).
+    Refused in one line when the calibration was fitted to other measurements than the campaign's."""
+    campaign = usable_campaign(campaign_path)
+    calibration = load_calibration(calibration_path)
+    if calibration.source.get("measurements_sha256") != measurements_sha256(campaign):
+        raise ConfigError(f"{calibration_path}: fitted to other measurements than {campaign_path} holds now: fit it "
+                          "again (rig fit) before certifying")
+    folder.mkdir(parents=True, exist_ok=True)
+    render = _pdf_renderer() if pdf else None
+    warnings = [] if render is not None or not pdf else [
+        "PDFs need WeasyPrint: pip install 'accelcal-rig[certificate]' (HTML certificates written)"]
+    written = []
+    for serial, sensor in calibration.sensors.items():
+        page = certificate_html(campaign, campaign_path, calibration, calibration_path, serial, sensor, operator)
+        name = re.sub(r"[^A-Za-z0-9_.-]", "_", serial)
+        html_path = folder / f"{name}.html"
+        write_text_atomically(html_path, page, "the certificate")
+        pdf_path = None
+        if render is not None:
+            pdf_path = folder / f"{name}.pdf"
+            write_atomically(pdf_path, render(page), "the certificate")
+        written.append(Written(serial, html_path, pdf_path))
+    return written, warnings
+
+
+def _pdf_renderer() -> Any:
+    try:
+        from weasyprint import HTML
+    except (ImportError, OSError):  # not installed, or its system libraries (Pango) are missing
+        return None
+    return lambda page: HTML(string=page).write_pdf()
+
+
+def _e(value: object) -> str:
+    return html.escape(str(value))
+
+
+def _rows(rows: list[tuple[str, object]]) -> str:
+    return "<table>" + "".join(f"<tr><td class='key'>{_e(k)}</td><td class='text'>{_e(v)}</td></tr>"
+                               for k, v in rows) + "</table>"
+
+
+def _grid(header: list[str], rows: Sequence[Sequence[object]], text_columns: int = 1) -> str:
+    def cell(tag: str, i: int, value: object) -> str:
+        return f"<{tag}{' class=text' if i < text_columns else ''}>{_e(value)}</{tag}>"
+
+    head = "".join(cell("th", i, h) for i, h in enumerate(header))
+    body = "".join("<tr>" + "".join(cell("td", i, v) for i, v in enumerate(row)) + "</tr>" for row in rows)
+    return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def certificate_number(campaign: Campaign, sensor: SensorCalibration, calibration: CalibrationFile) -> str:
+    """Unique to the DUT and the measurements: its serial and the measured data's SHA-256."""
+    return f"{sensor.serial}-{str(calibration.source.get('measurements_sha256', ''))[:12]}"
+
+
+def certificate_html(campaign: Campaign, campaign_path: Path, calibration: CalibrationFile, calibration_path: Path,
+                     serial: str, sensor: SensorCalibration, operator: str = "") -> str:
+    dut = dut_description(campaign, serial)
+    attrs, metrics = campaign.attrs, sensor.metrics
+    number = certificate_number(campaign, sensor, calibration)
+    banners = []
+    if attrs.get("dry_run"):
+        banners.append("SIMULATED: a dry run against simulated instruments. No physical sensor was calibrated.")
+    if calibration.source.get("partial"):
+        banners.append(f"PARTIAL: {calibration.source['partial']}.")
+    style = STYLE + (DRY_RUN_PAGES if attrs.get("dry_run") else "")
+    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Calibration certificate {_e(number)}"
+             f"</title><style>{style}</style></head><body>",
+             "<h1>Calibration certificate: MEMS accelerometer</h1>",
+             f"<p>Certificate <b class='number'>{_e(number)}</b> — issued {_e(utc_now())} by accelcal-rig "
+             f"{_e(__version__)}</p>",
+             *(f"<div class='banner'>{_e(b)}</div>" for b in banners)]
+    parts += ["<h2>Item calibrated</h2>", _rows([
+        ("serial", serial),
+        ("part", f"{dut.get('part', '?')}: {_identity(campaign, serial)}"),
+        ("configured", f"±{dut.get('range_g', '?')} g, {dut.get('odr_hz', '?')} Hz, {float(dut.get('lsb_g', 0)) * 1e6:.4g} µg "
+                       "per code"),
+        ("interface", f"{dut.get('driver', '?')} at {dut.get('endpoint', '?')}"),
+        ("mount on the fixture", f"{dut.get('name', '')} ({', '.join(f'{a:g}' for a in dut.get('mount_euler_deg', []))}° "
+                                 "xyz Euler)"),
+    ])]
+    instruments = campaign.header.instruments
+    parts += ["<h2>Calibration</h2>", _rows([
+        ("procedure", f"{attrs.get('procedure_name', '')} ({attrs.get('procedure_path', '')})"),
+        ("rig", str(attrs.get("rig_name", ""))),
+        ("instruments", "; ".join(f"{name}: {i.get('driver', '?')} at {i.get('endpoint', '?')}"
+                                  for name, i in instruments.items()) or "—"),
+        ("campaign", f"{campaign_path} — started {campaign.header.created}, finished {campaign.finished or '—'}, "
+                     f"state {campaign.state}"),
+        ("measured data (SHA-256)", str(calibration.source.get("measurements_sha256", ""))),
+        ("calibration file", f"{calibration_path} (accelcal-rig {calibration.software_version}, {calibration.created})"),
+        ("method", f"Eq. 1 error model, {sensor.mode} fit of {len(sensor.free_parameters)} parameters, "
+                   f"polynomial degree {sensor.polynomial.degree} in temperature; {len(sensor.setpoints)} setpoints"),
+        ("gravity", gravity_statement(float(metrics.get("gravity_m_s2", 9.80665)))),
+        ("performed by", operator or "—"),
+    ])]
+    parts += ["<section>", "<h2>Results</h2>", _results(sensor), "</section>"]
+    parts += ["<section>", "<h2>Verification (poses the calibration never saw)</h2>", _verification(metrics), "</section>"]
+    parts += ["<section>", "<h2>Uncertainty of a compensated reading</h2>", _uncertainty(metrics), "</section>"]
+    verdict = sensor.verdict or "NOT JUDGED"
+    reasons = "".join(f"<li>{_e(r)}</li>" for r in sensor.verdict_reasons)
+    parts += ["<section><h2>Verdict against the procedure's acceptance limits</h2>",
+              f"<p><span class='verdict {_e(verdict)}'>{_e(verdict)}</span></p><ul>{reasons}</ul></section>"]
+    parts += ["<section><h2>Signatures</h2>",
+              "<table class='signatures'><tr><th class='text'></th><th class='text'>name</th><th class='text'>date"
+              "</th><th class='text'>signature</th></tr>"
+              f"<tr><td>performed by</td><td>{_e(operator)}</td><td></td><td></td></tr>"
+              "<tr><td>approved by</td><td></td><td></td><td></td></tr></table></section>",
+              "<p class='note'>The results refer only to the item calibrated, under the conditions stated, within "
+              f"the calibrated temperature range {sensor.validity_c[0]:.2f} … {sensor.validity_c[1]:.2f} °C. Outside "
+              f"it the calibration {'is clamped to its edge' if sensor.out_of_range == 'clamp' else 'extrapolates'}."
+              "</p></body></html>"]
+    return "\n".join(parts)
+
+
+def _identity(campaign: Campaign, serial: str) -> str:
+    """The identity registers as the last run's preflight read them (its event log)."""
+    prefix = f"sensor {serial}: "
+    found = [e.message[len(prefix):] for e in campaign.events if e.kind == "preflight" and e.message.startswith(prefix)]
+    return found[-1] if found else "identity not recorded"
+
+
+#: (label, parameter index, factor to the unit shown, offset, format) of each row of the results table.
+_RESULT_ROWS = [
+    *((f"bias {axis} (mg)", k, 1e3, 0.0, "+.3f") for k, axis in enumerate("xyz")),
+    *((f"scale error {axis} (ppm)", 3 + k, 1e6, -1.0, "+.0f") for k, axis in enumerate("xyz")),
+    *((f"non-orthogonality {name} (mrad)", 6 + k, 1e3, 0.0, "+.4f") for k, name in enumerate(("yx", "zx", "zy"))),
+]
+_MISALIGNMENT_ROWS = [(f"misalignment {axis} (mrad)", 9 + k, 1e3, 0.0, "+.4f") for k, axis in enumerate("xyz")]
+
+
+def _results(sensor: SensorCalibration) -> str:
+    low, high = sensor.validity_c
+    temperatures = np.array([low, 0.5 * (low + high), high])
+    values = sensor.parameters_at(temperatures)              # (3, 12)
+    rows = [[label, *(format((values[i, k] + offset) * factor, spec) for i in range(3))]
+            for label, k, factor, offset, spec in _RESULT_ROWS + (_MISALIGNMENT_ROWS if sensor.mode == "reference" else [])]
+    return (f"<p>Calibrated range {low:.2f} … {high:.2f} °C (the DUT's own temperature sensor). Parameters of Eq. 1, "
+            "U<sub>SF</sub> = M·C·S·(U − b), at the ends and the middle of the range; the full polynomials are in the "
+            "calibration file.</p>" + _grid(["parameter", *(f"at {t:.2f} °C" for t in temperatures)], rows))
+
+
+def _verification(metrics: dict[str, Any]) -> str:
+    v = metrics.get("verification")
+    if v is None:
+        return "<p><b>No verification poses:</b> the calibration was not checked on poses it was not fitted to.</p>"
+    temperatures = ", ".join(f"{r['setpoint_c']:g}" for r in v["by_setpoint"])
+    return _rows([
+        ("poses", f"{v['n_poses']} at {temperatures} °C"),
+        ("|g| RMSE (Eq. 9)", f"{v['rmse_mg']:.4f} mg (noise floor {metrics['noise_floor_mg']:.4f} mg)"),
+        ("largest axis error", f"{v['max_axis_error_mg']:.4f} mg ({v['frame']})"),
+        ("largest tilt error (Eq. 10)", f"{v['max_tilt_error_deg']:.4f}°"),
+        ("residual zero-g drift x, y, z", ", ".join(f"{d * 1e3:.1f}" for d in v["drift_mg"]) + " µg over the range"),
+    ])
+
+
+def _uncertainty(metrics: dict[str, Any]) -> str:
+    budget = metrics["uncertainty_budget"]
+    rows = [[name.replace("_", " "), *(f"{u * 1e3:.1f}" for u in values)] for name, values in budget["sources_mg"].items()]
+    rows.append(["combined standard uncertainty", *(f"{u * 1e3:.1f}" for u in budget["standard_mg"])])
+    rows.append([f"expanded uncertainty (k = {budget['coverage_factor']:g}, about 95 %)",
+                 *(f"{u * 1e3:.1f}" for u in budget["expanded_mg"])])
+    coverage = metrics.get("truth_coverage_k2")
+    check = (f"<p class='note'>Checked against the simulation truth: {coverage * 100:.1f} % of the verification "
+             "poses' axis errors lie inside their expanded uncertainty.</p>" if coverage is not None else "")
+    return ("<p>For " + _e(budget["reading"]) + ": each source's largest standard uncertainty over every orientation "
+            "and the calibrated range, per axis (GUM, sources uncorrelated).</p>"
+            + _grid(["source", "x (µg)", "y (µg)", "z (µg)"], rows) + check)
