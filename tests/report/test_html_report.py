@@ -57,7 +57,8 @@ def test_the_page_refers_only_to_files_beside_it(paper_report: Path) -> None:
 def test_the_page_holds_the_tables_an_engineer_looks_for(paper_report: Path) -> None:
     text = paper_report.read_text(encoding="utf-8")
     for heading in ("Campaign", "Calibration: verification (poses the fit never saw)",
-                    "Calibration: in-sample (the poses fitted)", "RMSE of |g| per setpoint",
+                    "Calibration: in-sample (the poses fitted)", "Uncertainty budget",
+                    "Error parameters at the reference temperature", "RMSE of |g| per setpoint",
                     "Error parameters over temperature", "Offset drift before and after compensation", "Soaks",
                     "Against the simulated truth", "Event log"):
         assert f"<h2>{heading}</h2>" in text
@@ -66,6 +67,8 @@ def test_the_page_holds_the_tables_an_engineer_looks_for(paper_report: Path) -> 
     # Each DUT's verdict beside its verification figures: the 168 verification poses of each.
     assert text.count('<td class="text">PASS</td>') == 4 and text.count("<td>168</td>") == 4
     assert "safe state: sensor ADX355-A004" in text  # the event log, info and above
+    assert text.count("<td>±25</td>") == 4  # each ADXL355's data sheet 0 g offset beside its bias
+    assert "expanded (k = 2)" in text and "of its verification axis errors against the simulation truth" in text
 
 
 def test_an_aborted_campaign_with_too_few_poses_gets_a_report_saying_why(write, workdir: Path) -> None:
@@ -92,3 +95,12 @@ def test_without_matplotlib_the_error_says_how_to_install_it(paper_campaign: Pat
     err = capsys.readouterr().err
     assert err.strip() == "rig: error: rig report needs matplotlib: pip install 'accelcal-rig[report]'"
     assert not (tmp_path / "out").exists()
+
+
+def test_a_polynomial_through_as_many_temperatures_as_coefficients_says_so(write, workdir: Path) -> None:
+    text = TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c: [20, 40]") + "fit: {polynomial_degree: 1}\n"
+    campaign = workdir / "two.h5"
+    run_campaign(prepare(write("two.yaml", text)), campaign, dry_run=True, seed=0, overwrite=False)
+    page = write_report(campaign, workdir / "report").read_text(encoding="utf-8")
+    assert "0 by construction (the polynomial interpolates)" in page  # not a drift of "0.0000 mg"
+    assert "No verification poses:" in page
