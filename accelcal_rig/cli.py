@@ -247,7 +247,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
     rig = with_faults(load_rig(args.rig), args.faults)
     with connected(rig, dry_run=args.dry_run) as instruments:
-        for line in check_lines(instruments):
+        for line in check_lines(instruments, rig.model):
             print(line, flush=True)
     print(f"rig {rig.model.name}: every instrument answered as configured")
     return 0

@@ -41,7 +41,9 @@ def test_rig_check_finds_an_installed_chamber_driver_and_its_simulator(installed
                             env=env, timeout=120)
     assert result.returncode == 0, result.stderr
     chamber = result.stdout.splitlines()[0]
-    assert chamber.startswith("chamber    acme 127.0.0.1:") and chamber.endswith(": ACME TC-1 (PV 23.0 °C), alarm clear")
+    assert chamber.startswith("chamber    acme 127.0.0.1:")
+    assert (": ACME TC-1 (PV 23.0 °C), alarm clear; set point limits: the rig's -55…100 °C, the controller exposes "
+            "none") in chamber
     assert "every instrument answered as configured" in result.stdout
 
 

@@ -203,6 +203,9 @@ class FaultInjection(_Strict):
     sensor_wrong_id: str | None = Field(None, max_length=64, description="serial of a DUT whose part ID reads wrong")
     sensor_stuck: str | None = Field(None, max_length=64, description="serial of a DUT whose samples freeze")
     sensor_stuck_after_min: float = Field(0.0, ge=0, le=_YEAR_MIN, description="when that DUT's samples freeze")
+    sensor_temperature_tear_rate: float = Field(
+        0.0, ge=0, le=1, description="share of every DUT's TEMP2/TEMP1 reads that straddle an update of the high "
+                                     "nibble (not double-buffered on a real ADXL355): off by 256 LSB, about 28 °C")
 
 
 class SimulationConfig(_Strict):
@@ -218,6 +221,9 @@ class SimulationConfig(_Strict):
     noise_density_ug_per_rthz: float | None = Field(None, ge=0, le=100_000, description="every DUT's noise "
                                                     "density; unset: each part's own (its data sheet's)")
     turntable_settle_s: float = Field(0.5, ge=0, le=600)
+    controller_limits_c: tuple[TemperatureC, TemperatureC] = Field(
+        (-70.0, 180.0), description="the simulated controller's own set point limits (low, high), where its "
+                                    "register map has them; it clamps set points to them as a real one does")
     faults: FaultInjection = FaultInjection()
 
 

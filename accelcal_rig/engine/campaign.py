@@ -34,7 +34,7 @@ from accelcal_rig.engine.resume import ResumePoint
 from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
 from accelcal_rig.engine.states import ACTIVE_STATES, State, StateMachine
 from accelcal_rig.engine.thermal_steps import SetpointSkipped, ThermalSteps
-from accelcal_rig.errors import CampaignAborted, RigError, TransientInstrumentError
+from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, TransientInstrumentError
 from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity
 from accelcal_rig.plan.compile import Plan, setpoint_label
 from accelcal_rig.plan.steps import (
@@ -213,6 +213,7 @@ class CampaignRunner:
     def _preflight(self) -> None:
         """Check identities and configure every DUT before anything moves."""
         self.events.info("preflight", f"chamber: {self.chamber.identify()} ({self.chamber.endpoint})")
+        self._check_controller_limits()
         self.events.info("preflight", f"turntable: {self.turntable.identify()} ({self.turntable.endpoint})")
         acquisition = self.procedure.acquisition
         for sensor in self.sensors:
@@ -225,6 +226,23 @@ class CampaignRunner:
                                           f"(DEVID_AD 0x{identity.devid_ad:02X}, DEVID_MST 0x{identity.devid_mst:02X}, "
                                           f"PARTID 0x{identity.partid:02X}), ±{acquisition.range_g} g, "
                                           f"{acquisition.odr_hz:g} Hz")
+
+    def _check_controller_limits(self) -> None:
+        """Every setpoint the campaign will write within what the controller itself accepts, or a fault now
+        (a controller clamps silently: the campaign would wait for a temperature it never sets)."""
+        limits = self.chamber.controller_limits_c()
+        if limits is None:
+            return
+        low, high = limits
+        self.events.info("preflight", f"chamber: the controller's own set point limits {low:g}…{high:g} °C")
+        wanted = [*self.plan.setpoints_c, self.safe_setpoint_c]
+        if self.procedure.cooldown is not None and self.procedure.cooldown.chamber == "ambient":
+            wanted.append(self.procedure.cooldown.ambient_c)
+        beyond = [t for t in wanted if not low <= t <= high]
+        if beyond:
+            raise InstrumentError(f"chamber ({self.chamber.endpoint}): {beyond[0]:g} °C is beyond the controller's own "
+                                  f"set point limits {low:g}…{high:g} °C: change them on the controller, or the "
+                                  "procedure")
 
     # ----------------------------------------------------------------- the plan
     def _run_stages(self) -> None:

@@ -10,7 +10,7 @@ import numpy as np
 
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.waits import wait_until
-from accelcal_rig.errors import InstrumentError, WaitTimeout
+from accelcal_rig.errors import InstrumentError, TransientInstrumentError, WaitTimeout
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import BlockCapture, RegisterTransport
 from accelcal_rig.instruments.capture import OVERFLOW_ATTEMPTS, capture_together
@@ -21,6 +21,10 @@ from accelcal_rig.parts.part import AccelerometerPart
 
 #: Samples to let accumulate between FIFO bursts: under its 32, so a burst is never late.
 DRAIN_EVERY_SAMPLES = 30
+#: Two temperature reads this close agree; a torn read is a whole TEMP2 step (256 LSB) off.
+TEMPERATURE_AGREE_LSB = 16
+#: Reads of a temperature before giving up (a glitch on the line: retried as any transient fault).
+TEMPERATURE_READS = 5
 
 
 @dataclass
@@ -94,8 +98,17 @@ class Adxl355:
         return ranges[range_code], self.part.output_data_rates_hz[filter_code]
 
     def read_temperature_c(self) -> float:
-        high, low = self._bus.read(adxl355.REG_TEMP2, 2)
-        return float(self.part.temperature.celsius(adxl355.raw_temperature(high, low)))
+        """TEMP2 and TEMP1 are not double-buffered (data sheet): a read can straddle an update of the high
+        nibble and be off by 256 LSB, ~28 °C. Read until two reads in a row agree; the later one counts."""
+        previous = None
+        for _ in range(TEMPERATURE_READS):
+            high, low = self._bus.read(adxl355.REG_TEMP2, 2)
+            raw = adxl355.raw_temperature(high, low)
+            if previous is not None and abs(raw - previous) <= TEMPERATURE_AGREE_LSB:
+                return float(self.part.temperature.celsius(raw))
+            previous = raw
+        raise TransientInstrumentError(f"sensor {self.serial} ({self.endpoint}): {TEMPERATURE_READS} temperature reads "
+                                       "in a row, no two consecutive ones agreeing (TEMP2/TEMP1 tearing)")
 
     def acquire(self, n_samples: int) -> SampleBlock:
         """`n_samples` consecutive samples, captured by the bridge if it can, else drained from the FIFO."""

@@ -94,6 +94,17 @@ class ModbusChamber:
             raise self._error("the register map has no power event")
         self._write(m.power_register, [m.power_on if on else m.power_off])
 
+    def controller_limits_c(self) -> tuple[float, float] | None:
+        m = self.registers
+        if m.setpoint_low_register is None or m.setpoint_high_register is None:
+            return None
+        low = self._plausible(self._read_temperature(m.setpoint_low_register), "set point low limit")
+        high = self._plausible(self._read_temperature(m.setpoint_high_register), "set point high limit")
+        if not low < high:
+            raise self._error(f"set point limits read {low:g}…{high:g} °C (registers {m.setpoint_low_register}/"
+                              f"{m.setpoint_high_register}): not a range")
+        return low, high
+
     def alarm_active(self) -> bool:
         m = self.registers
         if m.alarm_register is None:

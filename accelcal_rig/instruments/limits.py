@@ -13,12 +13,18 @@ SETPOINT_READBACK_TOLERANCE_C = 0.05
 
 
 class LimitedChamber:
-    """Refuses setpoints outside the rig's chamber limits before writing; verifies each write by reading back."""
+    """Refuses setpoints outside the rig's chamber limits, and outside the controller's own where it exposes
+    them (read once, at connect: a controller clamps silently what it will not take); verifies each write by
+    reading back."""
 
     def __init__(self, chamber: Chamber, limits: ChamberConfig) -> None:
         self._chamber = chamber
         self._limits = limits
         self.endpoint = chamber.endpoint
+        self.controller_limits = chamber.controller_limits_c()
+
+    def controller_limits_c(self) -> tuple[float, float] | None:
+        return self.controller_limits
 
     def write_setpoint_c(self, setpoint_c: float) -> None:
         low, high = self._limits.min_setpoint_c, self._limits.max_setpoint_c
@@ -26,6 +32,11 @@ class LimitedChamber:
             raise InstrumentError(
                 f"chamber ({self.endpoint}): setpoint {setpoint_c:g} °C refused, limits are {low:g}…{high:g} °C"
             )
+        if self.controller_limits is not None:
+            controller_low, controller_high = self.controller_limits
+            if not controller_low <= setpoint_c <= controller_high:
+                raise InstrumentError(f"chamber ({self.endpoint}): setpoint {setpoint_c:g} °C refused, the "
+                                      f"controller's own limits are {controller_low:g}…{controller_high:g} °C")
         self._chamber.write_setpoint_c(setpoint_c)
         readback = self._chamber.read_setpoint_c()
         if abs(readback - setpoint_c) > SETPOINT_READBACK_TOLERANCE_C:

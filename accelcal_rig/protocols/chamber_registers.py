@@ -34,14 +34,19 @@ class ChamberRegisterMap(BaseModel):
     power_off: int = Field(0, ge=0, le=65535)
     alarm_register: int | None = Field(None, ge=0, le=65535)
     alarm_inactive: list[Annotated[int, Field(ge=0, le=65535)]] = Field([0], max_length=64)
+    setpoint_low_register: int | None = Field(None, ge=0, le=65535, description="the controller's own set point "
+                                              "limits, encoded like the set point")
+    setpoint_high_register: int | None = Field(None, ge=0, le=65535)
 
 
 #: Watlow F4 (TestEquity, Thermotron, Cincinnati Sub-Zero): signed 16-bit, decimals from register 606,
-#: units at 901 (1 = °C), model code 5270 at 0, event 1 (chamber power) at 2000, alarm 1 at 102.
+#: units at 901 (1 = °C), model code 5270 at 0, event 1 (chamber power) at 2000, alarm 1 at 102, input 1's
+#: set point low / high limits at 602 / 603.
 WATLOW_F4 = ChamberRegisterMap(
     encoding="scaled-int16", process_value=100, setpoint=300, decimals=1, decimals_register=606,
     units_register=901, units_celsius=1, identity_register=0, identity_value=5270,
     power_register=2000, power_on=1, power_off=0, alarm_register=102, alarm_inactive=[0],
+    setpoint_low_register=602, setpoint_high_register=603,
 )
 
 #: Watlow F4T (Data Map 1): float32, low word first by default; set point 2782, process value 2820;

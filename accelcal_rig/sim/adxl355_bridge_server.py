@@ -26,8 +26,12 @@ class SimulatedAdxl355:
     """One DUT's ADXL355 (or ADXL357, ADXL359: the lab's part for it) at register level."""
 
     def __init__(self, lab: VirtualLab, index: int, wrong_part_id: bool = False,
-                 stuck_after_s: float | None = None) -> None:
+                 stuck_after_s: float | None = None, temperature_tear_rate: float = 0.0) -> None:
         self._lab = lab
+        #: A real ADXL355's TEMP2/TEMP1 are not double-buffered: this share of reads tears across the high
+        #: nibble. Its own stream, so a rate of zero changes no other draw.
+        self._tear_rate = temperature_tear_rate
+        self._tear_rng = np.random.default_rng([index, 7_000_003])
         self._index = index
         self._part = lab.duts[index].part
         # The wrong part fitted by mistake: an ADXL359 (PARTID 0xE9) where another part belongs, else an ADXL355.
@@ -77,6 +81,10 @@ class SimulatedAdxl355:
         )
         self._regs[adxl355.REG_FIFO_ENTRIES] = 3 * held
         raw = self._temperature_raw()
+        if self._tear_rate and address <= adxl355.REG_TEMP2 + 1 and adxl355.REG_TEMP2 < address + count \
+                and self._tear_rng.random() < self._tear_rate:
+            # TEMP2 read before, TEMP1 after an update that carried into the high nibble (or the other way).
+            raw = int(np.clip(raw + (256 if self._tear_rng.random() < 0.5 else -256), 0, 0xFFF))
         self._regs[adxl355.REG_TEMP2], self._regs[adxl355.REG_TEMP2 + 1] = raw >> 8, raw & 0xFF
         if address <= adxl355.REG_STATUS < address + count:
             self._overflow = False  # reading STATUS clears FIFO_OVR
@@ -178,10 +186,11 @@ class SimulatedBridgeServer:
     """The bridge line protocol on a pseudo-terminal, in front of one simulated ADXL355."""
 
     def __init__(self, lab: VirtualLab, index: int, protocol_version: int = 2, faults: ReplyFaults | None = None,
-                 wrong_part_id: bool = False, stuck_after_s: float | None = None) -> None:
+                 wrong_part_id: bool = False, stuck_after_s: float | None = None,
+                 temperature_tear_rate: float = 0.0) -> None:
         self._lab = lab
         self._version = protocol_version
-        self.device = SimulatedAdxl355(lab, index, wrong_part_id, stuck_after_s)
+        self.device = SimulatedAdxl355(lab, index, wrong_part_id, stuck_after_s, temperature_tear_rate)
         self._server = PtyLineServer(self._handle, b"\n", f"simulated-bridge-{lab.duts[index].serial}", faults)
         self.path = self.endpoint = self._server.path
 
@@ -221,4 +230,5 @@ def serve_bridge(lab: VirtualLab, config: SensorConfig, faults: InstrumentFaults
     index = [d.serial for d in lab.duts].index(config.serial)
     return SimulatedBridgeServer(lab, index, faults=faults.replies, wrong_part_id=config.serial == settings.sensor_wrong_id,
                                  stuck_after_s=faults.after_s(settings.sensor_stuck_after_min)
-                                 if config.serial == settings.sensor_stuck else None)
+                                 if config.serial == settings.sensor_stuck else None,
+                                 temperature_tear_rate=settings.sensor_temperature_tear_rate)

@@ -95,7 +95,7 @@ class SimulatedChamberServer:
         width = 2 if m.encoding == "float32" else 1
         addresses = {m.process_value: width, m.setpoint: width}
         for register in (m.identity_register, m.decimals_register, m.units_register, m.power_register,
-                         m.alarm_register):
+                         m.alarm_register, m.setpoint_low_register, m.setpoint_high_register):
             if register is not None:
                 addresses[register] = 1
         return [SimData(address=a, count=n, datatype=DataType.REGISTERS) for a, n in sorted(addresses.items())]
@@ -128,6 +128,9 @@ class SimulatedChamberServer:
                 return ExcCodes.ILLEGAL_VALUE  # half a float: real controllers refuse it too
             offset = m.setpoint - address
             setpoint = self._decode(values[offset:offset + width])
+            if m.setpoint_low_register is not None:  # a controller with limits clamps to them, silently
+                low, high = self._lab.controller_limits_c
+                setpoint = min(max(setpoint, low), high)
             if self._stall_after_s is None or now < self._stall_after_s:
                 self._lab.thermal.set_setpoint(now, setpoint)  # a stalled chamber takes it but does not follow
             self.last_setpoint_c = setpoint
@@ -155,6 +158,9 @@ class SimulatedChamberServer:
             values[m.power_register] = [m.power_on if self._lab.thermal.powered else m.power_off]
         if m.alarm_register is not None:
             values[m.alarm_register] = [m.alarm_inactive[0]]
+        if m.setpoint_low_register is not None and m.setpoint_high_register is not None:
+            low, high = self._lab.controller_limits_c
+            values[m.setpoint_low_register], values[m.setpoint_high_register] = self._encode(low), self._encode(high)
         return values
 
     def _encode(self, temperature_c: float) -> list[int]:

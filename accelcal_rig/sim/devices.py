@@ -42,6 +42,9 @@ class SimulatedChamber:
     def alarm_active(self) -> bool:
         return False
 
+    def controller_limits_c(self) -> tuple[float, float] | None:
+        return self._lab.controller_limits_c
+
     def set_power(self, on: bool) -> None:
         self._lab.thermal.set_power(self._lab.clock.now(), on)
 

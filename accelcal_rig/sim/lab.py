@@ -49,9 +49,12 @@ class VirtualLab:
         #: Simulators answer from their own threads (wire-level servers): one lab, one request at a time.
         self.lock = threading.RLock()
         self.rng = np.random.default_rng(seed)  # chamber and turntable: one request at a time
-        # One stream per DUT: sensors read concurrently draw their noise in their own order only.
+        # One stream per DUT: sensors read concurrently draw their noise in their own order only; their
+        # temperature sensors' noise another, so how often a driver reads temperatures changes no sample.
         self.dut_rngs = [np.random.default_rng([seed, index]) for index in range(len(rig.fixture.sensors))]
+        self.temperature_rngs = [np.random.default_rng([seed, index, 1]) for index in range(len(rig.fixture.sensors))]
         self.chamber_noise_c = sim.chamber_noise_c
+        self.controller_limits_c = sim.controller_limits_c
         self.kinematics = TurntableKinematics(rig.turntable.axes)
         self.duts = [
             SimulatedDut(s.serial, s.mount_euler_deg, sim.fixture_time_constant_min * 60.0, part(s.part))
@@ -94,7 +97,7 @@ class VirtualLab:
 
     def dut_reading_raw(self, index: int) -> int:
         """The DUT's temperature sensor's code now (true temperature, read noise, the part's format)."""
-        noisy = self.dut_true_c(index) + float(self.dut_rngs[index].normal(0.0, TEMPERATURE_READ_NOISE_C))
+        noisy = self.dut_true_c(index) + float(self.temperature_rngs[index].normal(0.0, TEMPERATURE_READ_NOISE_C))
         return int(self.duts[index].part.temperature.raw(noisy))
 
     def unmodelled_g(self, index: int, gravity_g: np.ndarray) -> np.ndarray:

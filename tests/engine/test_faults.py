@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import h5py
+import numpy as np
 import pytest
 
 from accelcal_rig.assembly import WiredRig
@@ -58,6 +59,14 @@ def test_transient_faults_are_retried_and_every_pose_is_stored_once(write, workd
     assert any("garbled" in m or "answered" in m or "unexpected reply" in m for m in retries)
 
 
+def test_torn_temperature_reads_do_not_reach_the_soak_or_the_poses(write, workdir: Path) -> None:
+    output, _, error = run_wired(write, workdir, "sensor_temperature_tear_rate=0.02")
+    assert error is None
+    soak = load_campaign(output).soaks[0]
+    # Every poll of every DUT through the driver: no step of a torn read's ~28 °C between polls.
+    assert soak.outcome == "stable" and len(soak.dut_c) > 20 and np.abs(np.diff(soak.dut_c, axis=0)).max() < 1.0
+
+
 def assert_safe_and_recorded(output: Path, rig: SimulatedRig, error: CampaignAborted | None, reason: str) -> None:
     assert error is not None and reason in str(error)
     assert rig.chamber.last_setpoint_c == 23.0  # what the simulator last heard: the safe setpoint
@@ -108,3 +117,20 @@ def test_a_stop_mid_campaign_leaves_the_simulators_safe(write, workdir: Path, mo
     assert all(not bridge.device._measuring for bridge in rig.bridges.values())
     with h5py.File(output, "r") as f:
         assert f.attrs["state"] == "aborted" and f["poses/step_key"].shape[0] == at_pose
+
+
+def test_a_setpoint_beyond_the_controllers_own_limits_is_refused_before_anything_moves(write, workdir: Path,
+                                                                                      capsys) -> None:
+    from accelcal_rig.cli import main
+
+    rig = (workdir / "sim.yaml").read_text().replace("profile: watlow-f4t", "profile: watlow-f4")
+    (workdir / "sim.yaml").write_text(rig.replace("simulation:\n", "simulation:\n  controller_limits_c: [-20, 25]\n"))
+    assert main(["check", str(workdir / "sim.yaml"), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert "set point limits: the rig's -55…100 °C, the controller's -20…25 °C" in out
+    output = workdir / "c.h5"
+    assert main(["run", str(write("tiny.yaml", TINY_PROCEDURE)), "--dry-run", "-o", str(output), "-q"]) == 1
+    assert "30 °C is beyond the controller's own set point limits -20…25 °C" in capsys.readouterr().err
+    campaign = load_campaign(output)
+    assert campaign.state == "aborted" and not campaign.poses
+    assert any("the controller's own set point limits -20…25 °C" in e.message for e in campaign.events)

@@ -41,9 +41,13 @@ def test_a_ramp_campaign_measures_while_the_temperature_moves(write, workdir: Pa
         temperature = f["duts/ADX355-A001/temperature_c"][:].mean(axis=1)
         setpoints = f["poses/setpoint_c"][:]
         messages = [m.decode() for m in f["events/message"][:]]
+        event_t_s = f["events/t_s"][:]
+        last_soak_s = float(f["soaks/T35"].attrs["t_reached_s"])
         assert f.attrs["fit_temperature_model"] == "joint"
     assert any("ramp method: chamber setpoint moving 20 → 35 °C at 0.5 °C/min" in m for m in messages)
-    assert not any("left the" in m for m in messages)
+    # While the ramp moves the temperature on purpose, no pose is judged against a soak's band (after the
+    # final soak it is again: the DUTs may still be settling, as the noise of a run decides).
+    assert not any("left the" in m for m, t in zip(messages, event_t_s) if t < last_soak_s)
     assert temperature[-1] - temperature[0] > 5.0  # the DUTs warmed through the campaign (lagging the air)
     later = setpoints == 30.0
     assert np.ptp(temperature[later]) > 0.3  # within one setpoint's poses the temperature moved

@@ -66,9 +66,22 @@ def test_the_driver_configures_the_part_its_table_describes() -> None:
         Adxl355(bridge(line), "X-1", VirtualClock(), ADXL357).configure(20, 125.0)
 
 
-def test_the_driver_reads_temperature_with_its_part_s_format() -> None:
-    with expected_protocol([(b"R 06 2\n", b"=075D\n")]) as line:
+def test_the_driver_reads_temperature_with_its_part_s_format_twice_in_agreement() -> None:
+    with expected_protocol([(b"R 06 2\n", b"=075D\n"), (b"R 06 2\n", b"=075C\n")]) as line:
+        assert Adxl355(bridge(line), "X-1", VirtualClock(), ADXL355).read_temperature_c() == pytest.approx(
+            25.0 + 1 / 9.05)  # the later of two reads a bit apart
+
+
+def test_a_torn_temperature_read_is_outvoted() -> None:
+    # TEMP2/TEMP1 are not double-buffered: 0x085D is 0x075D with the high nibble one step ahead (~28 °C off).
+    with expected_protocol([(b"R 06 2\n", b"=085D\n"), (b"R 06 2\n", b"=075D\n"), (b"R 06 2\n", b"=075D\n")]) as line:
         assert Adxl355(bridge(line), "X-1", VirtualClock(), ADXL355).read_temperature_c() == pytest.approx(25.0)
+
+
+def test_temperature_reads_that_never_agree_are_a_transient_fault() -> None:
+    replies = [(b"R 06 2\n", b"=085D\n" if k % 2 else b"=075D\n") for k in range(5)]
+    with expected_protocol(replies) as line, pytest.raises(TransientInstrumentError, match="no two consecutive ones"):
+        Adxl355(bridge(line), "X-1", VirtualClock(), ADXL355).read_temperature_c()
 
 
 class ExpectedSpi:

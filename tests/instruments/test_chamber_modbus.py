@@ -126,3 +126,12 @@ def test_out_of_limit_setpoint_never_reaches_the_wire(served) -> None:
     chamber.write_setpoint_c(-40)
     assert server.last_setpoint_c == -40
     chamber.close()
+
+
+def test_the_simulated_f4_serves_its_limits_and_clamps_beyond_them(served) -> None:
+    server, lab, _ = served("watlow-f4")
+    raw = ModbusChamber.tcp(server.host, server.port, register_map("watlow-f4"))
+    assert raw.controller_limits_c() == lab.controller_limits_c == (-70.0, 180.0)
+    raw.write_setpoint_c(190.0)  # what a controller does with a set point beyond its limits: clamps it
+    assert raw.read_setpoint_c() == 180.0
+    raw.close()

@@ -112,3 +112,19 @@ def test_silence_is_a_lost_reply_to_reconnect_after() -> None:
     with pytest.raises(TransientInstrumentError, match="no reply reading register 2820") as error:
         driver.read_temperature_c()
     assert error.value.reconnect
+
+
+def test_f4_reads_its_own_setpoint_limits_from_602_and_603() -> None:
+    driver, port = chamber([(read_request(1, 602, 1), read_reply(1, 0xFD44)),   # −70.0 °C
+                            (read_request(1, 603, 1), read_reply(1, 1800))],    # 180.0 °C
+                           profile="watlow-f4")
+    assert driver.controller_limits_c() == (-70.0, 180.0)
+    port.assert_finished()
+
+
+def test_limits_that_are_no_range_are_refused_and_a_map_without_them_says_none() -> None:
+    driver, _ = chamber([(read_request(1, 602, 1), read_reply(1, 500)), (read_request(1, 603, 1), read_reply(1, 400))],
+                        profile="watlow-f4")
+    with pytest.raises(InstrumentError, match=r"set point limits read 50…40 °C \(registers 602/603\): not a range"):
+        driver.controller_limits_c()
+    assert chamber([], profile="watlow-f4t")[0].controller_limits_c() is None  # F4T Data Map 1: not in our map

@@ -9,9 +9,13 @@ from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable
 class RecordingChamber:
     endpoint = "test-chamber"
 
-    def __init__(self, readback_offset_c: float = 0.0) -> None:
+    def __init__(self, readback_offset_c: float = 0.0, controller_limits_c: tuple[float, float] | None = None) -> None:
         self.writes: list[float] = []
         self._offset = readback_offset_c
+        self._controller = controller_limits_c
+
+    def controller_limits_c(self) -> tuple[float, float] | None:
+        return self._controller
 
     def write_setpoint_c(self, setpoint_c: float) -> None:
         self.writes.append(setpoint_c)
@@ -59,3 +63,12 @@ def test_turntable_limits_apply_to_limited_axes_only() -> None:
     with pytest.raises(InstrumentError, match="3 angles for 2 axes"):
         table.move_to(np.array([0.0, 0.0, 0.0]))
     assert len(inner.moves) == 1
+
+
+def test_the_controllers_own_limits_refuse_too() -> None:
+    raw = RecordingChamber(controller_limits_c=(-20.0, 50.0))
+    chamber = LimitedChamber(raw, ChamberConfig(min_setpoint_c=-40, max_setpoint_c=85, safe_setpoint_c=20))
+    with pytest.raises(InstrumentError, match=r"setpoint 60 °C refused, the controller's own limits are -20…50 °C"):
+        chamber.write_setpoint_c(60)
+    chamber.write_setpoint_c(50)
+    assert raw.writes == [50]

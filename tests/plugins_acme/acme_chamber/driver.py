@@ -26,6 +26,9 @@ class AcmeChamber:
     def alarm_active(self) -> bool:
         return self._line.ask("ALARM?") != "0"
 
+    def controller_limits_c(self):
+        return None  # the ACME TC-1 does not say
+
     def close(self) -> None:
         self._line.close()
 
