@@ -8,7 +8,7 @@ receives a `RigConnector` and never imports a simulator.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -24,7 +24,13 @@ from accelcal_rig.engine.preparation import PreparedCampaign
 from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.engine.session import RunResult
-from accelcal_rig.instruments.connect import Endpoints, configured_endpoints, connect_rig
+from accelcal_rig.instruments.connect import (
+    EVERY_INSTRUMENT,
+    SomeInstruments,
+    configured_endpoints,
+    connect_rig,
+    connect_some,
+)
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable
 from accelcal_rig.sim.devices import build_simulated_rig
@@ -109,17 +115,20 @@ def served_rig(rig: RigConfig, clock: Clock, seed: int,
 
 
 @contextmanager
-def connected(rig: LoadedConfig[RigConfig], *, dry_run: bool) -> Iterator[RigInstruments]:
-    """The rig's instruments in real time, each checked by hand (`rig check`): a dry run's are simulated."""
+def connected(rig: LoadedConfig[RigConfig], *, dry_run: bool,
+              only: frozenset[str] = EVERY_INSTRUMENT) -> Iterator[SomeInstruments]:
+    """The rig's instruments in `only`, in real time, each checked by hand (`rig check`): a dry run's are
+    simulated."""
     clock = RealClock()
-    if not dry_run:
-        with _closing(AssembledRig(rig.model, connect_rig(rig.model, configured_endpoints(rig), clock), clock)) as one:
-            yield one.instruments
-        return
-    with served_rig(rig.model, clock, 0) as simulated:
-        endpoints: Endpoints = simulated.endpoints
-        with _closing(AssembledRig(rig.model, connect_rig(rig.model, endpoints, clock), clock)) as one:
-            yield one.instruments
+    with ExitStack() as stack:
+        endpoints = (configured_endpoints(rig, only) if not dry_run
+                     else stack.enter_context(served_rig(rig.model, clock, 0)).endpoints)
+        instruments = connect_some(rig.model, endpoints, clock, only)
+        try:
+            yield instruments
+        finally:
+            for failure in instruments.close():
+                LOGGER.error(failure)
 
 
 def connector(prepared: PreparedCampaign, *, dry_run: bool,

@@ -242,14 +242,18 @@ def _cmd_repair(args: argparse.Namespace) -> int:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from accelcal_rig.assembly import connected
-    from accelcal_rig.config.load import load_rig, with_faults
+    from accelcal_rig.config.load import load_rig, load_rig_for_check, with_faults
     from accelcal_rig.engine.check import check_lines
 
-    rig = with_faults(load_rig(args.rig), args.faults)
-    with connected(rig, dry_run=args.dry_run) as instruments:
+    only = frozenset(args.only or ("chamber", "turntable", "sensors"))
+    rig = with_faults(load_rig_for_check(args.rig, only) if args.only else load_rig(args.rig), args.faults)
+    with connected(rig, dry_run=args.dry_run, only=only) as instruments:
         for line in check_lines(instruments, rig.model):
             print(line, flush=True)
-    print(f"rig {rig.model.name}: every instrument answered as configured")
+    if args.only:
+        print(f"rig {rig.model.name}: the {' and '.join(sorted(only))} answered as configured (only those checked)")
+    else:
+        print(f"rig {rig.model.name}: every instrument answered as configured")
     return 0
 
 

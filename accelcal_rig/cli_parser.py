@@ -148,6 +148,9 @@ def build_parser() -> argparse.ArgumentParser:
                      "rig check configs/example-lab.yaml")
     check.add_argument("rig", type=Path, help="rig config YAML")
     check.add_argument("--dry-run", action="store_true", help="check the rig's simulators instead")
+    check.add_argument("--only", action="append", choices=["chamber", "turntable", "sensors"],
+                       help="check only this instrument (repeat for more); the rig config may then leave out the "
+                            "others' sections")
     check.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
 
     sim = _command(commands, "sim", "serve the simulated rig as real endpoints until interrupted",

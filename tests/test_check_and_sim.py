@@ -79,3 +79,46 @@ def test_the_example_lab_config_is_valid() -> None:
     rig = load_rig(REPO / "configs" / "example-lab.yaml").model
     assert rig.chamber.driver == "modbus-rtu" and rig.chamber.register_map().encoding == "scaled-int16"
     assert rig.turntable.line_protocol().write_terminator == "\r\n"
+
+
+def chamber_only(folder: Path, endpoint: str | None = None) -> Path:
+    """A rig config a technician writes to bring up a new chamber: no turntable, no fixture."""
+    config = yaml.safe_load(SIM_RIG.read_text())
+    del config["turntable"], config["fixture"]
+    if endpoint is not None:
+        config["chamber"]["endpoint"] = endpoint
+    path = folder / "chamber-only.yaml"
+    path.write_text(yaml.safe_dump(config))
+    return path
+
+
+def test_rig_check_of_the_chamber_alone(running_sim: dict, tmp_path: Path) -> None:
+    endpoint = f"{running_sim['chamber']['host']}:{running_sim['chamber']['port']}"
+    result = subprocess.run([RIG, "check", str(chamber_only(tmp_path, endpoint)), "--only", "chamber"],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert len(lines) == 2 and lines[0].startswith(f"chamber    modbus-tcp {endpoint}: float32 controller")
+    assert lines[1] == "rig simulated-rig: the chamber answered as configured (only those checked)"
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    ([], "turntable: Field required"),                                   # a campaign's check needs all of it
+    (["--only", "turntable"], "turntable: missing, and --only checks it"),
+])
+def test_a_rig_config_without_an_instrument_is_refused_where_it_is_needed(tmp_path: Path, argv: list[str],
+                                                                        message: str) -> None:
+    result = subprocess.run([RIG, "check", str(chamber_only(tmp_path)), "--dry-run", *argv], capture_output=True,
+                            text=True, timeout=60)
+    assert result.returncode == 2 and message in result.stderr and len(result.stderr.strip().splitlines()) == 1
+
+
+def test_a_dry_run_check_of_the_sensors_alone(tmp_path: Path) -> None:
+    config = yaml.safe_load(SIM_RIG.read_text())
+    del config["turntable"]
+    (tmp_path / "sensors.yaml").write_text(yaml.safe_dump(config))
+    result = subprocess.run([RIG, "check", str(tmp_path / "sensors.yaml"), "--dry-run", "--only", "sensors"],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert sum(line.startswith("sensor ADX355-A") for line in lines) == 4 and not any("chamber" in line for line in lines)

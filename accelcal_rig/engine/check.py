@@ -6,20 +6,23 @@ from collections.abc import Iterator
 
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.errors import InstrumentError
-from accelcal_rig.instruments.interfaces import RigInstruments
+from accelcal_rig.instruments.connect import SomeInstruments
 
 
-def check_lines(instruments: RigInstruments, rig: RigConfig) -> Iterator[str]:
-    """One line per instrument; the first wrong answer raises InstrumentError naming it."""
+def check_lines(instruments: SomeInstruments, rig: RigConfig) -> Iterator[str]:
+    """One line per instrument connected; the first wrong answer raises InstrumentError naming it."""
     chamber, turntable = instruments.chamber, instruments.turntable
-    controller = chamber.controller_limits_c()
-    limits = (f"; set point limits: the rig's {rig.chamber.min_setpoint_c:g}…{rig.chamber.max_setpoint_c:g} °C, the "
-              + (f"controller's {controller[0]:g}…{controller[1]:g} °C" if controller else "controller exposes none"))
-    yield (f"chamber    {chamber.endpoint}: {chamber.identify()}, alarm "
-           f"{'ACTIVE' if chamber.alarm_active() else 'clear'}{limits}")
-    angles = " ".join(f"{a:.3f}" for a in turntable.read_angles_deg())
-    yield (f"turntable  {turntable.endpoint}: {turntable.identify()}, angles {angles}°, "
-           f"{'in position' if turntable.in_position() else 'moving'}")
+    if chamber is not None:
+        controller = chamber.controller_limits_c()
+        limits = (f"; set point limits: the rig's {rig.chamber.min_setpoint_c:g}…{rig.chamber.max_setpoint_c:g} °C, "
+                  "the " + (f"controller's {controller[0]:g}…{controller[1]:g} °C" if controller
+                            else "controller exposes none"))
+        yield (f"chamber    {chamber.endpoint}: {chamber.identify()}, alarm "
+               f"{'ACTIVE' if chamber.alarm_active() else 'clear'}{limits}")
+    if turntable is not None:
+        angles = " ".join(f"{a:.3f}" for a in turntable.read_angles_deg())
+        yield (f"turntable  {turntable.endpoint}: {turntable.identify()}, angles {angles}°, "
+               f"{'in position' if turntable.in_position() else 'moving'}")
     for sensor in instruments.sensors:
         identity = sensor.identify()
         wrong = sensor.part.wrong_identity((identity.devid_ad, identity.devid_mst, identity.partid))

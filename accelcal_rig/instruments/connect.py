@@ -10,7 +10,7 @@ from accelcal_rig.config.load import LoadedConfig
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.instruments.adxl355_driver import Adxl355
-from accelcal_rig.instruments.interfaces import RigInstruments
+from accelcal_rig.instruments.interfaces import Accelerometer, Chamber, RigInstruments, Turntable
 from accelcal_rig.parts.registry import part
 from accelcal_rig.plugins import load_driver
 
@@ -26,37 +26,77 @@ class Endpoints:
     drivers: dict[str, str] = field(default_factory=dict)
 
 
-def configured_endpoints(rig: LoadedConfig[RigConfig]) -> Endpoints:
-    """The endpoints the rig config names; a missing one is an error pointing at its key."""
+#: The instruments of a rig, as `rig check --only` names them.
+INSTRUMENTS = ("chamber", "turntable", "sensors")
+EVERY_INSTRUMENT = frozenset(INSTRUMENTS)
+
+
+@dataclass
+class SomeInstruments:
+    """The instruments of a rig that were asked for (`rig check --only`); the others are None or empty."""
+
+    chamber: Chamber | None
+    turntable: Turntable | None
+    sensors: list[Accelerometer]
+
+    def close(self) -> list[str]:
+        """Release every connection, each in its own guard; return the failures, one line each."""
+        failures = []
+        for device in [d for d in (self.chamber, self.turntable) if d is not None] + list(self.sensors):
+            try:
+                device.close()
+            except Exception as exc:  # noqa: BLE001 - one port that will not close must not keep the others open
+                failures.append(f"{device.endpoint}: not closed: {exc}")
+        return failures
+
+
+def configured_endpoints(rig: LoadedConfig[RigConfig], only: frozenset[str] = EVERY_INSTRUMENT) -> Endpoints:
+    """The endpoints the rig config names for the instruments in `only`; a missing one is an error pointing
+    at its key."""
     model = rig.model
     missing = "no endpoint given: set it, or run with --dry-run to simulate this rig"
-    if not model.chamber.endpoint:
+    if "chamber" in only and not model.chamber.endpoint:
         raise rig.error(("chamber", "endpoint"), missing)
-    if not model.turntable.endpoint:
+    if "turntable" in only and not model.turntable.endpoint:
         raise rig.error(("turntable", "endpoint"), missing)
     sensors = {}
-    for index, sensor in enumerate(model.fixture.sensors):
+    for index, sensor in enumerate(model.fixture.sensors if "sensors" in only else []):
         if not sensor.endpoint:
             raise rig.error(("fixture", "sensors", index, "endpoint"), missing)
         sensors[sensor.serial] = sensor.endpoint
-    return Endpoints(model.chamber.endpoint, model.turntable.endpoint, sensors)
+    return Endpoints(model.chamber.endpoint or "", model.turntable.endpoint or "", sensors)
 
 
-def connect_rig(rig: RigConfig, endpoints: Endpoints, clock: Clock) -> RigInstruments:
-    """Open chamber, turntable and every sensor; if one fails, close those already open and raise."""
+def connect_some(rig: RigConfig, endpoints: Endpoints, clock: Clock,
+                 only: frozenset[str] = EVERY_INSTRUMENT) -> SomeInstruments:
+    """Open the instruments in `only`; if one fails, close those already open and raise."""
     drivers = endpoints.drivers
     opened: list[Any] = []
+    chamber = turntable = None
     try:
-        opened.append(load_driver("chamber", drivers.get("chamber", rig.chamber.driver)).open(
-            rig.chamber, endpoints.chamber))
-        opened.append(load_driver("turntable", drivers.get("turntable", rig.turntable.driver)).open(
-            rig.turntable, endpoints.turntable))
-        for sensor in rig.fixture.sensors:
+        if "chamber" in only:
+            chamber = load_driver("chamber", drivers.get("chamber", rig.chamber.driver)).open(
+                rig.chamber, endpoints.chamber)
+            opened.append(chamber)
+        if "turntable" in only:
+            turntable = load_driver("turntable", drivers.get("turntable", rig.turntable.driver)).open(
+                rig.turntable, endpoints.turntable)
+            opened.append(turntable)
+        sensors: list[Accelerometer] = []
+        for sensor in rig.fixture.sensors if "sensors" in only else []:
             transport = load_driver("sensor", drivers.get(sensor.serial, sensor.driver)).open(
                 sensor, endpoints.sensors[sensor.serial], rig.retry.attempts, clock)
-            opened.append(Adxl355(transport, sensor.serial, clock, part(sensor.part)))
+            sensors.append(Adxl355(transport, sensor.serial, clock, part(sensor.part)))
+            opened.append(sensors[-1])
     except BaseException:
         for device in opened:
             device.close()
         raise
-    return RigInstruments(opened[0], opened[1], opened[2:])
+    return SomeInstruments(chamber, turntable, sensors)
+
+
+def connect_rig(rig: RigConfig, endpoints: Endpoints, clock: Clock) -> RigInstruments:
+    """Open chamber, turntable and every sensor; if one fails, close those already open and raise."""
+    some = connect_some(rig, endpoints, clock)
+    assert some.chamber is not None and some.turntable is not None
+    return RigInstruments(some.chamber, some.turntable, some.sensors)
