@@ -10,6 +10,7 @@ from pydantic import BaseModel, ValidationError
 
 from accelcal_rig.config.procedure import MAX_POLLS, Procedure
 from accelcal_rig.config.rig import FaultInjection, RigConfig
+from accelcal_rig.config.schedule import Schedule
 from accelcal_rig.config.yaml_lines import CONFIG_LIMITS, KeyPath, YamlLimits, format_key, load_yaml_with_lines, locate
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.registry import part
@@ -128,19 +129,24 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
     if cooldown is not None and cooldown.chamber == "power-off" and chamber.register_map().power_register is None:
         raise procedure.error(("cooldown", "chamber"), f"the chamber of {rig.path} has no power event in its register "
                                                        "map to switch it off: use chamber: ambient")
-    schedule = procedure.model.schedule
-    if schedule.kind == "explicit":
+    verify = procedure.model.verify
+    schedules: list[tuple[KeyPath, Schedule]] = [(("schedule",), procedure.model.schedule)]
+    if verify is not None:
+        schedules.append((("verify", "schedule"), verify.schedule))
+    for where, schedule in schedules:
+        if schedule.kind != "explicit":
+            continue
         axes = rig.model.turntable.axes
         for pose, angles in enumerate(schedule.angles_deg):
             if len(angles) != len(axes):
                 raise procedure.error(
-                    ("schedule", "angles_deg", pose),
+                    (*where, "angles_deg", pose),
                     f"{len(angles)} angles given, the turntable of {rig.path} has {len(axes)} axes",
                 )
             for axis, angle in zip(axes, angles):
                 if not axis.allows(angle):
                     raise procedure.error(
-                        ("schedule", "angles_deg", pose),
+                        (*where, "angles_deg", pose),
                         f"axis {axis.name} angle {angle:g}° is outside its limits {axis.min_deg:g}…{axis.max_deg:g}°",
                     )
 

@@ -7,13 +7,14 @@ from collections.abc import Iterator
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.instruments.connect import SomeInstruments
+from accelcal_rig.instruments.limits import controller_limits
 
 
 def check_lines(instruments: SomeInstruments, rig: RigConfig) -> Iterator[str]:
     """One line per instrument connected; the first wrong answer raises InstrumentError naming it."""
     chamber, turntable = instruments.chamber, instruments.turntable
     if chamber is not None:
-        controller = chamber.controller_limits_c()
+        controller = controller_limits(chamber)
         limits = (f"; set point limits: the rig's {rig.chamber.min_setpoint_c:g}…{rig.chamber.max_setpoint_c:g} °C, "
                   "the " + (f"controller's {controller[0]:g}…{controller[1]:g} °C" if controller
                             else "controller exposes none"))

@@ -277,8 +277,8 @@ def summary_line(report: dict[str, Any], calibration_path: Path) -> str:
     """`calibration → cal.yaml: verification |g| RMSE 0.013 mg (noise floor 0.012), …; 4 PASS` style: the
     held-out figures when there are verification poses, else the in-sample ones, said so."""
     before = max(r["rmse_before_mg"] for r in report.values())
-    floor = max(r["noise_floor_mg"] for r in report.values())
     verified = all("verification" in r for r in report.values())
+    floor = max((r["verification"] if verified else r)["noise_floor_mg"] for r in report.values())
     if verified:
         after = max(r["verification"]["rmse_mg"] for r in report.values())
         drift = max(max(r["verification"]["drift_mg"]) for r in report.values())

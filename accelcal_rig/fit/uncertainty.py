@@ -30,8 +30,6 @@ from accelcal_rig.fit.sfem import correct, error_matrix
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel
 
 COVERAGE_FACTOR = 2.0
-SOURCES = ("reading_noise", "calibration_noise", "turntable_pointing", "scatter_beyond_noise", "thermal_model",
-           "temperature", "gravity")
 #: Step of the numerical derivatives of the compensation, in each parameter's own unit and in °C.
 _STEP = 1e-6
 _STEP_C = 1e-3

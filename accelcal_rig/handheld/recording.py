@@ -39,6 +39,7 @@ class Recording:
     sha256: str                        # of the source data, for the calibration's provenance
     notes: list[str] = field(default_factory=list)
     serial: str | None = None          # the sensor, when the source names it (a campaign file's DUT)
+    gravity_m_s2: float | None = None  # the site's gravity, when the source states it (a campaign file)
 
 
 @dataclass(frozen=True)
@@ -196,5 +197,6 @@ def read_campaign_recording(path: Path, serial: str | None, setpoint_c: float | 
     t = (t_start[:, None] + np.arange(n)[None, :] / odr_hz).ravel()
     accel_g = codes.reshape(-1, 3).astype(float) * lsb_g
     digest = hashlib.sha256(np.ascontiguousarray(codes).tobytes()).hexdigest()
+    gravity = campaign.attrs.get("gravity_m_s2")
     return Recording(f"{path} sensor {serial} at {setpoint_c:g} °C", t, accel_g, np.repeat(pose_temperature, n), lsb_g,
-                     digest, serial=serial)
+                     digest, serial=serial, gravity_m_s2=float(gravity) if gravity is not None else None)

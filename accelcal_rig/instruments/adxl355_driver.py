@@ -10,7 +10,7 @@ import numpy as np
 
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.waits import wait_until
-from accelcal_rig.errors import InstrumentError, TransientInstrumentError, WaitTimeout
+from accelcal_rig.errors import InstrumentError, WaitTimeout
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import BlockCapture, RegisterTransport
 from accelcal_rig.instruments.capture import OVERFLOW_ATTEMPTS, capture_together
@@ -23,8 +23,8 @@ from accelcal_rig.parts.part import AccelerometerPart
 DRAIN_EVERY_SAMPLES = 30
 #: Two temperature reads this close agree; a torn read is a whole TEMP2 step (256 LSB) off.
 TEMPERATURE_AGREE_LSB = 16
-#: Reads of a temperature before giving up (a glitch on the line: retried as any transient fault).
-TEMPERATURE_READS = 5
+#: Reads of a temperature before giving up: a part that tears this often is faulty.
+TEMPERATURE_READS = 10
 
 
 @dataclass
@@ -98,17 +98,21 @@ class Adxl355:
         return ranges[range_code], self.part.output_data_rates_hz[filter_code]
 
     def read_temperature_c(self) -> float:
+        return self._agreed_temperature_c(None)[1]
+
+    def _agreed_temperature_c(self, first: tuple[int, int] | None) -> tuple[int, float]:
         """TEMP2 and TEMP1 are not double-buffered (data sheet): a read can straddle an update of the high
-        nibble and be off by 256 LSB, ~28 °C. Read until two reads in a row agree; the later one counts."""
-        previous = None
+        nibble and be off by 256 LSB, ~28 °C. Read until two reads in a row agree; the later one counts.
+        `first`: (STATUS, raw temperature) of a burst that read them already; returns (its STATUS, °C)."""
+        status, previous = first if first is not None else (0, None)
         for _ in range(TEMPERATURE_READS):
             high, low = self._bus.read(adxl355.REG_TEMP2, 2)
             raw = adxl355.raw_temperature(high, low)
             if previous is not None and abs(raw - previous) <= TEMPERATURE_AGREE_LSB:
-                return float(self.part.temperature.celsius(raw))
+                return status, float(self.part.temperature.celsius(raw))
             previous = raw
-        raise TransientInstrumentError(f"sensor {self.serial} ({self.endpoint}): {TEMPERATURE_READS} temperature reads "
-                                       "in a row, no two consecutive ones agreeing (TEMP2/TEMP1 tearing)")
+        raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {TEMPERATURE_READS} temperature reads in a "
+                              "row, no two consecutive ones agreeing (TEMP2/TEMP1 tearing)")
 
     def acquire(self, n_samples: int) -> SampleBlock:
         """`n_samples` consecutive samples, captured by the bridge if it can, else drained from the FIFO."""
@@ -211,9 +215,10 @@ class Adxl355:
         return adxl355.decode_fifo(raw, carried)
 
     def _status_and_temperature(self) -> tuple[int, float]:
-        """STATUS, FIFO_ENTRIES, TEMP2 and TEMP1 are neighbours: one burst, one round trip."""
+        """STATUS, FIFO_ENTRIES, TEMP2 and TEMP1 are neighbours: one burst, then the temperature read again
+        until two reads agree (the burst's may have torn)."""
         status, _, high, low = self._bus.read(adxl355.REG_STATUS, 4)
-        return status, float(self.part.temperature.celsius(adxl355.raw_temperature(high, low)))
+        return self._agreed_temperature_c((status, adxl355.raw_temperature(high, low)))
 
     def _status(self) -> int:
         return self._bus.read(adxl355.REG_STATUS, 1)[0]

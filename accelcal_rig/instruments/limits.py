@@ -12,6 +12,12 @@ from accelcal_rig.instruments.interfaces import Chamber, Turntable
 SETPOINT_READBACK_TOLERANCE_C = 0.05
 
 
+def controller_limits(chamber: Chamber) -> tuple[float, float] | None:
+    """The controller's own set point limits; None from a plug-in driver that predates the method."""
+    limits = getattr(chamber, "controller_limits_c", None)
+    return limits() if callable(limits) else None
+
+
 class LimitedChamber:
     """Refuses setpoints outside the rig's chamber limits, and outside the controller's own where it exposes
     them (read once, at connect: a controller clamps silently what it will not take); verifies each write by
@@ -21,7 +27,7 @@ class LimitedChamber:
         self._chamber = chamber
         self._limits = limits
         self.endpoint = chamber.endpoint
-        self.controller_limits = chamber.controller_limits_c()
+        self.controller_limits = controller_limits(chamber)
 
     def controller_limits_c(self) -> tuple[float, float] | None:
         return self.controller_limits

@@ -68,14 +68,20 @@ def write_certificates(campaign_path: Path, calibration_path: Path, folder: Path
     if calibration.source.get("measurements_sha256") != measurements_sha256(campaign):
         raise ConfigError(f"{calibration_path}: fitted to other measurements than {campaign_path} holds now: fit it "
                           "again (rig fit) before certifying")
+    old = [s for s, c in calibration.sensors.items() if "uncertainty_budget" not in c.metrics or c.verdict is None]
+    if old:
+        raise ConfigError(f"{calibration_path}: sensor {old[0]} has no uncertainty budget or verdict (written by an "
+                          "earlier accelcal-rig): fit it again (rig fit) before certifying")
     folder.mkdir(parents=True, exist_ok=True)
     render = _pdf_renderer() if pdf else None
     warnings = [] if render is not None or not pdf else [
         "PDFs need WeasyPrint: pip install 'accelcal-rig[certificate]' (HTML certificates written)"]
-    written = []
+    written: list[Written] = []
     for serial, sensor in calibration.sensors.items():
         page = certificate_html(campaign, campaign_path, calibration, calibration_path, serial, sensor, operator)
         name = re.sub(r"[^A-Za-z0-9_.-]", "_", serial)
+        if any(w.html.stem == name for w in written):  # two serials that differ only in what a file name drops
+            name += f"-{len(written) + 1}"
         html_path = folder / f"{name}.html"
         write_text_atomically(html_path, page, "the certificate")
         pdf_path = None
@@ -211,7 +217,7 @@ def _verification(metrics: dict[str, Any]) -> str:
     temperatures = ", ".join(f"{r['setpoint_c']:g}" for r in v["by_setpoint"])
     return _rows([
         ("poses", f"{v['n_poses']} at {temperatures} °C"),
-        ("|g| RMSE (Eq. 9)", f"{v['rmse_mg']:.4f} mg (noise floor {metrics['noise_floor_mg']:.4f} mg)"),
+        ("|g| RMSE (Eq. 9)", f"{v['rmse_mg']:.4f} mg (their noise floor {v['noise_floor_mg']:.4f} mg)"),
         ("largest axis error", f"{v['max_axis_error_mg']:.4f} mg ({v['frame']})"),
         ("largest tilt error (Eq. 10)", f"{v['max_tilt_error_deg']:.4f}°"),
         ("residual zero-g drift x, y, z", ", ".join(f"{d * 1e3:.1f}" for d in v["drift_mg"]) + " µg over the range"),

@@ -101,13 +101,14 @@ def _sphere_grid(n: int = 24) -> np.ndarray:
     return np.stack([np.sin(polar) * np.cos(azimuth), np.sin(polar) * np.sin(azimuth), np.cos(polar)], axis=-1)
 
 
-def _exaggerated(accel_g: np.ndarray, reference_g: np.ndarray | None, gain: float) -> np.ndarray:
+def _exaggerated(accel_g: np.ndarray, reference_g: np.ndarray | None, gain: float, gravity_g: float = 1.0) -> np.ndarray:
     """Readings with their error magnified `gain` times so millig errors show: the whole deviation from
-    the reference direction when there is one, else only the radial deviation from 1 g."""
+    the reference direction when there is one, else only the radial deviation from the site's gravity
+    (drawn on the unit sphere)."""
     if reference_g is not None:
-        return reference_g + gain * (accel_g - reference_g)
+        return (reference_g + gain * (accel_g - reference_g)) / gravity_g
     norm = np.linalg.norm(accel_g, axis=-1, keepdims=True)
-    return accel_g / norm * (1.0 + gain * (norm - 1.0))
+    return accel_g / norm * (1.0 + gain * (norm - gravity_g) / gravity_g)
 
 
 def ellipsoid(data: CampaignData, path: Path) -> Path:
@@ -124,7 +125,8 @@ def ellipsoid(data: CampaignData, path: Path) -> Path:
 
     def error_of(serial: str) -> np.ndarray:
         poses = data.duts[serial].poses
-        return poses.mean_g - poses.reference_g if with_reference else np.linalg.norm(poses.mean_g, axis=1) - 1.0
+        return (poses.mean_g - poses.reference_g if with_reference
+                else np.linalg.norm(poses.mean_g, axis=1) - poses.gravity_g)
 
     # One magnification for every panel, so the DUTs compare at a glance.
     gain = 0.3 / max([float(np.max(np.abs(error_of(s)))) for s in fitted] + [1e-9])
@@ -143,7 +145,8 @@ def ellipsoid(data: CampaignData, path: Path) -> Path:
                 (compensated, sphere, f"{serial} calibrated; unit sphere")]):
             axis = figure.add_subplot(rows, 4, 2 * index + column + 1, projection="3d")
             axis.plot_wireframe(*np.moveaxis(mesh, -1, 0), color="0.75", lw=0.4)
-            axis.scatter(*_exaggerated(points, reference, gain).T, c=colours, s=12, depthshade=False)
+            axis.scatter(*_exaggerated(points, reference, gain, dut.poses.gravity_g).T, c=colours, s=12,
+                         depthshade=False)
             axis.set_title(title, fontsize=9)
             axis.set_box_aspect((1, 1, 1))
             for ticks, label, name in ((axis.set_xticks, axis.set_xlabel, "x"), (axis.set_yticks, axis.set_ylabel, "y"),

@@ -150,7 +150,7 @@ def _summary(data: CampaignData) -> list[str]:
         verdict = dut.judgement.verdict if dut.judgement else "—"
         reasons = "; ".join(dut.judgement.reasons) if dut.judgement else ""
         verified.append([serial, verdict, reasons, *(["—"] * 6 if v is None else [
-            v["n_poses"], f"{v['rmse_mg']:.4f}", f"{v['rmse_mg'] / m['noise_floor_mg']:.2f}",
+            v["n_poses"], f"{v['rmse_mg']:.4f}", f"{v['rmse_mg'] / v['noise_floor_mg']:.2f}",
             f"{v['max_axis_error_mg']:.4f}", f"{v['max_tilt_error_deg']:.4f}",
             " / ".join(f"{d * 1e3:.1f}" for d in v["drift_mg"])])])
         classes.append("" if verdict == "PASS" else "warning")

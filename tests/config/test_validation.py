@@ -139,3 +139,9 @@ def test_verification_setpoints_run_where_the_sequence_passes_them(write) -> Non
     assert plan.setpoints_c == (40, 30, 10, 5, 0, 20)
     verify_keys = [s.key for s in plan.pose_steps if s.stored_kind == "verify"]
     assert verify_keys[0] == "T30/verify01" and len(verify_keys) == 3 * 8
+
+
+def test_explicit_verification_angles_are_checked_against_the_turntable(write) -> None:
+    base = TINY_PROCEDURE + "verify: {schedule: {kind: explicit, angles_deg: ANGLES}}\n"
+    with pytest.raises(ConfigError, match=r"tiny.yaml:7: verify.schedule.angles_deg\[0\]: 2 angles given, the turntable .* has 3 axes"):
+        prepare(write("tiny.yaml", base.replace("ANGLES", "[[10, 20]]")))

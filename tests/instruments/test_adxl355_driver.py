@@ -262,3 +262,21 @@ def test_torn_temperature_reads_from_the_part_never_reach_the_campaign() -> None
     finally:
         driver.close()
         server.stop()
+
+
+def test_torn_reads_in_the_status_burst_of_a_drained_block_are_outvoted_too() -> None:
+    """A version 1 bridge (and spidev): the host drains the FIFO and reads STATUS..TEMP1 in one burst around
+    the block; those temperatures are the pose's."""
+    clock = VirtualClock()
+    lab = VirtualLab(load_rig(SIM_RIG).model, clock, 3)
+    server = SimulatedBridgeServer(lab, 1, 1, temperature_tear_rate=0.05).start()
+    driver = Adxl355(SerialBridge.open(server.path), "ADX355-A002", clock)
+    try:
+        bring_up(driver)
+        true_c = lab.dut_true_c(1)
+        for _ in range(20):
+            block = driver.acquire(30)
+            assert all(abs(t - true_c) < 0.5 for t in block.temperature_c)
+    finally:
+        driver.close()
+        server.stop()

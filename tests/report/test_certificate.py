@@ -60,3 +60,16 @@ def test_a_partial_campaign_says_so_and_fails(paper_campaign: Path, tmp_path: Pa
     assert main(["certificate", str(campaign), "-o", str(tmp_path / "certs"), "--no-pdf"]) == 0
     page = next((tmp_path / "certs").glob("*.html")).read_text(encoding="utf-8")
     assert "PARTIAL: partial campaign: 300 of 432 poses stored" in page and "class='verdict FAIL'" in page
+
+
+def test_a_calibration_from_before_budgets_is_refused_in_one_line(fitted_paper_campaign: tuple[Path, Path],
+                                                                 tmp_path: Path) -> None:
+    import yaml
+
+    campaign, calibration = fitted_paper_campaign
+    old = yaml.safe_load(calibration.read_text())
+    for sensor in old["sensors"].values():
+        del sensor["metrics"]["uncertainty_budget"], sensor["verdict"]
+    (tmp_path / "old.yaml").write_text(yaml.safe_dump(old))
+    with pytest.raises(ConfigError, match="has no uncertainty budget or verdict .*: fit it again"):
+        write_certificates(campaign, tmp_path / "old.yaml", tmp_path / "certs")
