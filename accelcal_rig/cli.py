@@ -166,7 +166,13 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
                                       calibration=calibration, resume=resume, progress=progress)
     except NothingToResume as done:
         print(done)
-        return 0
+        if done.fit is None:
+            return 0
+        for serial, (verdict, reasons) in done.fit.verdicts.items():  # the fit this resume did, as a run's
+            print(f"  verdict    {serial} {verdict}" + (f": {'; '.join(reasons)}" if verdict == "FAIL" else ""))
+        code = _certify_after_run(output, calibration, args)
+        rejected = [serial for serial, (verdict, _) in done.fit.verdicts.items() if verdict == "FAIL"]
+        return max(code, _rejected_exit(rejected, args.fail_on_reject))
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)

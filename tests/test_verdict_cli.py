@@ -64,3 +64,19 @@ def test_verification_poses_are_stored_apart_and_never_fitted(write, workdir: Pa
     without = fit_dut(poses.subset(~poses.verification), FitOptions(degree=1))
     np.testing.assert_array_equal(with_checks.thermal.coefficients, without.thermal.coefficients)
     assert "verification" in with_checks.metrics and "verification" not in without.metrics
+
+
+def test_resuming_a_complete_campaign_whose_fit_is_missing_fits_judges_and_certifies(write, workdir: Path,
+                                                                                   capsys) -> None:
+    procedure = write("verified.yaml", VERIFIED.replace("LIMIT", "0.001"))
+    campaign = workdir / "c.h5"
+    assert main(["run", str(procedure), "--dry-run", "-o", str(campaign), "-q", "--no-pdf"]) == 0
+    capsys.readouterr()
+    campaign.with_suffix(".calibration.yaml").unlink()  # as a kill right after the last pose leaves it
+    for certificate in campaign.with_suffix(".certificates").iterdir():
+        certificate.unlink()
+    assert main(["resume", str(campaign), "-q", "--no-pdf", "--fail-on-reject"]) == 3
+    out = capsys.readouterr().out
+    assert "nothing to resume" in out and out.count("  verdict    ") == 4 and "FAIL: verification |g| RMSE" in out
+    assert campaign.with_suffix(".calibration.yaml").exists()
+    assert len(list(campaign.with_suffix(".certificates").glob("*.html"))) == 4

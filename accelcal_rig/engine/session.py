@@ -66,7 +66,11 @@ def run_campaign(prepared: PreparedCampaign, output: Path, connect: RigConnector
 
 
 class NothingToResume(Exception):
-    """The campaign in the file is complete."""
+    """The campaign in the file is complete; `fit` is the fit this resume did for it (None: none was due)."""
+
+    def __init__(self, message: str, fit: FitOutcome | None = None) -> None:
+        super().__init__(message)
+        self.fit = fit
 
 
 def resume_campaign(prepared: PreparedCampaign, output: Path, connect: RigConnector, *,
@@ -80,8 +84,8 @@ def resume_campaign(prepared: PreparedCampaign, output: Path, connect: RigConnec
     dry_run = connect.dry_run
     check_same_campaign(output, stored, prepared.procedure, prepared.rig, prepared.plan, dry_run)
     if stored.state == "done" and stored.poses_planned == len(stored.poses):
-        raise NothingToResume("; ".join([f"{output}: the campaign is complete: nothing to resume",
-                                         *_finish_complete(prepared, output, stored, calibration)]))
+        done, fit = _finish_complete(prepared, output, stored, calibration)
+        raise NothingToResume("; ".join([f"{output}: the campaign is complete: nothing to resume", *done]), fit)
     writer, reopened = CampaignWriter.reopen(output, prepared.storage(dry_run))
     try:
         # Noise of a resumed dry run is new noise (the same sensors, not a replay of the first run).
@@ -100,18 +104,20 @@ def resume_campaign(prepared: PreparedCampaign, output: Path, connect: RigConnec
         _close(writer)
 
 
-def _finish_complete(prepared: PreparedCampaign, output: Path, stored: Campaign, calibration: Path | None) -> list[str]:
+def _finish_complete(prepared: PreparedCampaign, output: Path, stored: Campaign,
+                     calibration: Path | None) -> tuple[list[str], FitOutcome | None]:
     """What a complete campaign may still lack after a full disk or a kill at its very end: a campaign
-    file as current as its journal, its calibration file. Done now; what was done, one line each."""
-    done = []
+    file as current as its journal, its calibration file. Done now; (what was done, one line each; the fit
+    done, if one was)."""
+    done, fit = [], None
     with campaign_lock(output, "rig resume"):
         if file_currency(output, stored, writing=False) != "current":
             repair_campaign(output)
             done.append(f"{output.name} brought up to date from its journal")
         if calibration is not None and not calibration.exists() and prepared.procedure.model.fit.mode != "none":
-            procedure = prepared.procedure.model
-            done.append(_fit_stage(procedure, output, calibration)(load_campaign(output)).summary)
-    return done
+            fit = _fit_stage(prepared.procedure.model, output, calibration)(load_campaign(output))
+            done.append(fit.summary)
+    return done, fit
 
 
 def _close(writer: CampaignWriter) -> tuple[str, ...]:
