@@ -166,6 +166,10 @@ class Procedure(_Strict):
             raise ValueError("a cool-down procedure has no verification poses (verify)")
         if verify.setpoints_c and self.method == "ramp":
             raise ValueError("verify.setpoints_c: the ramp passes every temperature; verify at_setpoints instead")
+        temperatures = len(verify.setpoints_c) + (len(self.setpoints_c) if verify.at_setpoints else 0)
+        if self.acceptance.max_drift_mg is not None and temperatures < 2:
+            raise ValueError("acceptance.max_drift_mg is judged across verification temperatures: verify at two or "
+                             "more")
         low, high = min(self.setpoints_c), max(self.setpoints_c)
         for setpoint in verify.setpoints_c:
             if setpoint in self.setpoints_c:

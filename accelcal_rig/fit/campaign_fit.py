@@ -258,7 +258,10 @@ def partial_campaign(campaign: Campaign) -> str:
     stored, planned = len(campaign.poses), campaign.poses_planned
     if stored >= planned and campaign.state != "aborted":
         return ""
-    return f"partial campaign: {stored} of {planned} poses stored (state {campaign.state})"
+    skipped = any(e.kind == "soak" and "setpoint skipped" in e.message for e in campaign.events)
+    why = "a soak timed out and its setpoint was skipped" if skipped and campaign.state != "aborted" else (
+        f"state {campaign.state}")
+    return f"partial campaign: {stored} of {planned} poses stored ({why})"
 
 
 def fit_and_save(campaign: Campaign, campaign_path: Path, calibration_path: Path,

@@ -124,6 +124,8 @@ SETPOINTS = TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c: [20, 40]")
         (SETPOINTS + "acceptance: {max_tilt_error_deg: 0}\n", r"tiny.yaml:\d+: acceptance.max_tilt_error_deg: .*greater than 0"),
         (SETPOINTS + "cooldown: {pose: 1}\nverify: {schedule: {kind: sphere, count: 8}}\n",
          r"a cool-down procedure"),
+        (TINY_PROCEDURE + "verify: {schedule: {kind: sphere, count: 8}}\nacceptance: {max_drift_mg: 0.1}\n",
+         r"acceptance.max_drift_mg is judged across verification temperatures: verify at two or more"),
     ],
 )
 def test_verification_and_acceptance_errors_name_the_key(write, text: str, expected: str) -> None:

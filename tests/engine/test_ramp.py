@@ -107,3 +107,8 @@ def test_after_a_skipped_first_soak_the_next_setpoint_soaks_and_starts_the_ramp_
             "T20": "timeout", "T25": "stable", "T35": "stable"}
         setpoints = f["poses/setpoint_c"][:]
     assert sorted(set(setpoints)) == [25.0, 30.0, 35.0] and len(setpoints) == 18
+    from accelcal_rig.fit.campaign_fit import partial_campaign
+    from accelcal_rig.store.read import load_campaign
+
+    assert partial_campaign(load_campaign(output)) == ("partial campaign: 18 of 24 poses stored (a soak timed out and "
+                                                       "its setpoint was skipped)")
