@@ -89,7 +89,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
     if args.output.is_dir():
         raise ConfigError(f"{args.output}: is a folder; name the campaign file to write")
-    prepared = prepare(args.procedure, args.config, args.faults)
+    if args.chamber_profile and not args.dry_run:
+        raise ConfigError("--chamber-profile swaps in a simulated chamber: only with --dry-run")
+    prepared = prepare(args.procedure, args.config, args.faults, args.chamber_profile)
     exists = args.output.exists() or journal_path(args.output).exists()
     if exists and not (args.overwrite or args.resume):
         raise ConfigError(f"{args.output}: campaign file exists; continue it with --resume, or choose another -o "
@@ -123,7 +125,7 @@ def _cmd_resume(args: argparse.Namespace) -> int:
     if not procedure.is_file():
         raise ConfigError(f"{args.campaign}: its procedure {procedure} is gone; pass --procedure with the same "
                           "procedure")
-    prepared = prepare(procedure, args.config, args.faults)
+    prepared = prepare(procedure, args.config, args.faults, str(stored.attrs.get("chamber_profile", "")) or None)
     return _execute(prepared, args.campaign, args, dry_run=bool(stored.attrs.get("dry_run", False)),
                     seed=int(stored.attrs.get("seed", 0)), overwrite=False, resume=True)
 
@@ -267,10 +269,10 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     import threading
 
     from accelcal_rig.assembly import served_rig
-    from accelcal_rig.config.load import load_rig, with_faults
+    from accelcal_rig.config.load import load_rig, with_chamber_profile, with_faults
     from accelcal_rig.core.clock import RealClock
 
-    rig = with_faults(load_rig(args.rig), args.faults)
+    rig = with_chamber_profile(with_faults(load_rig(args.rig), args.faults), args.chamber_profile)
     stop = threading.Event()
     previous = {signum: signal.signal(signum, lambda *_: stop.set()) for signum in (signal.SIGINT, signal.SIGTERM)}
     try:

@@ -99,6 +99,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--dry-run", action="store_true", help="simulated rig in virtual time")
     run.add_argument("--seed", type=_SEED, default=0, help="seed of the simulated noise (default 0)")
     run.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
+    run.add_argument("--chamber-profile", metavar="PROFILE",
+                     help="with --dry-run: simulate a chamber of this built-in profile instead of the rig's "
+                          "(watlow-f4, watlow-f4t)")
     run.add_argument("--overwrite", action="store_true", help="replace an existing campaign file")
     run.add_argument("--resume", action="store_true",
                      help="continue the campaign in the output file if it exists (after a crash, a fault or "
@@ -161,6 +164,8 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("rig", type=Path, help="rig config YAML")
     sim.add_argument("--seed", type=_SEED, default=0, help="seed of the simulated noise (default 0)")
     sim.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
+    sim.add_argument("--chamber-profile", metavar="PROFILE", help="serve a chamber of this built-in profile instead "
+                                                                  "of the rig's (watlow-f4, watlow-f4t)")
 
     fit = _command(commands, "fit", "fit the error model of every DUT and write a calibration file",
                    "LM fit of Eq. 1 at each setpoint, polynomials over the sensor temperature (Eq. 8), metrics. "

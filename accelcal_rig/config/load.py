@@ -14,6 +14,7 @@ from accelcal_rig.config.schedule import Schedule
 from accelcal_rig.config.yaml_lines import CONFIG_LIMITS, KeyPath, YamlLimits, format_key, load_yaml_with_lines, locate
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.registry import part
+from accelcal_rig.protocols.chamber_registers import PROFILES
 
 ModelT = TypeVar("ModelT", bound=BaseModel)
 
@@ -162,6 +163,21 @@ def worst_case_polls(procedure: Procedure, rig: RigConfig) -> float:
         polls += (ramp_s + soak.ramp_timeout_margin_min * 60.0 + soak.timeout_min * 60.0) / soak.poll_s
         previous = setpoint
     return polls
+
+
+def swap_chamber_profile(rig: RigConfig, profile: str) -> RigConfig:
+    """The rig with its chamber replaced by a simulated one of a built-in profile (its own driver, no endpoint,
+    none of the old profile's register overrides)."""
+    if profile not in PROFILES:
+        raise ConfigError(f"--chamber-profile: {profile!r} is not a chamber profile (known: {', '.join(sorted(PROFILES))})")
+    chamber = rig.chamber.model_copy(update={"profile": profile, "driver": "modbus-tcp", "registers": {},
+                                             "endpoint": None, "options": {}})
+    return rig.model_copy(update={"chamber": chamber})
+
+
+def with_chamber_profile(rig: LoadedConfig[RigConfig], profile: str | None) -> LoadedConfig[RigConfig]:
+    """`--chamber-profile`: a dry run (or `rig sim`) with the configured chamber swapped for that profile's."""
+    return rig if not profile else replace(rig, model=swap_chamber_profile(rig.model, profile))
 
 
 def with_faults(rig: LoadedConfig[RigConfig], spec: str | None) -> LoadedConfig[RigConfig]:

@@ -45,6 +45,7 @@ def create_campaign_file(prepared: PreparedCampaign, output: Path, connected: Co
              "rig_name": rig.model.name, "rig_path": str(rig.path.resolve()), "dry_run": dry_run, "seed": seed,
              "clock": clock.kind, "samples_per_pose": acquisition.samples_per_pose,
              "gravity_m_s2": rig.model.gravity_m_s2, "gravity_uncertainty_m_s2": rig.model.gravity_uncertainty_m_s2,
+             "chamber_profile": prepared.chamber_profile or "",
              **fit_attrs(procedure)}
     return CampaignWriter.create(
         output, {"attrs": attrs, "procedure_yaml": prepared.procedure.text, "rig_yaml": rig.text,

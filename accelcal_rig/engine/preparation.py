@@ -15,6 +15,7 @@ from accelcal_rig.config.load import (
     load_procedure,
     load_rig,
     resolve_rig_path,
+    with_chamber_profile,
     with_faults,
 )
 from accelcal_rig.config.procedure import Procedure
@@ -32,6 +33,7 @@ class PreparedCampaign:
     procedure: LoadedConfig[Procedure]
     rig: LoadedConfig[RigConfig]
     plan: Plan
+    chamber_profile: str | None = None   # `--chamber-profile`: the rig's chamber swapped for this profile's
 
     def storage(self, dry_run: bool) -> StorageEstimate:
         """The disk the campaign will take (a dry run also stores the simulation's truth)."""
@@ -40,10 +42,13 @@ class PreparedCampaign:
                                 acquisition.samples_per_pose, len(self.plan.axis_names), dry_run)
 
 
-def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str | None = None) -> PreparedCampaign:
-    """`faults`: fault injection for the simulators, `key=value,…` (see with_faults)."""
+def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str | None = None,
+            chamber_profile: str | None = None) -> PreparedCampaign:
+    """`faults`: fault injection for the simulators, `key=value,…` (see with_faults); `chamber_profile`: a
+    dry run's chamber swapped for a built-in profile's (see with_chamber_profile)."""
     procedure = load_procedure(procedure_path)
-    rig = with_faults(load_rig(resolve_rig_path(procedure, rig_override)), faults)
+    rig = with_chamber_profile(with_faults(load_rig(resolve_rig_path(procedure, rig_override)), faults),
+                               chamber_profile)
     check_procedure_against_rig(procedure, rig)
     try:
         plan = compile_plan(procedure.model, rig.model)
@@ -54,7 +59,7 @@ def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str 
     except VerificationSeenByFit as exc:
         raise procedure.error(("verify", "schedule"), str(exc)) from None
     _check_design_identifies_fit(procedure, rig.model, plan)
-    return PreparedCampaign(procedure, rig, plan)
+    return PreparedCampaign(procedure, rig, plan, chamber_profile)
 
 
 def _check_design_identifies_fit(procedure: LoadedConfig[Procedure], rig: RigConfig, plan: Plan) -> None:

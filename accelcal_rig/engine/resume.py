@@ -12,7 +12,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from accelcal_rig.config.load import LoadedConfig
+from accelcal_rig.config.load import LoadedConfig, swap_chamber_profile
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.config.yaml_lines import KeyPath, parse_yaml_text
@@ -51,6 +51,8 @@ def check_same_campaign(path: Path, stored: Campaign, procedure: LoadedConfig[Pr
     for kind, new, old_text, model, ignored in checks:
         try:
             old = model.model_validate(parse_yaml_text(old_text, f"{path}: its stored {kind}"))
+            if kind == "rig" and stored.attrs.get("chamber_profile"):  # the dry run's swapped-in chamber
+                old = swap_chamber_profile(old, str(stored.attrs["chamber_profile"]))
         except (ValidationError, ConfigError) as exc:
             raise ConfigError(f"{path}: the campaign's stored {kind} no longer validates: "
                               f"{str(exc).splitlines()[0]}") from None

@@ -1,0 +1,44 @@
+"""`--chamber-profile`: a dry run (and `rig sim`) with the rig's chamber swapped for any built-in profile's
+simulated controller — quick-6pos runs with each."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from accelcal_rig.cli import main
+from accelcal_rig.protocols.chamber_registers import PROFILES
+from accelcal_rig.store.read import load_campaign
+from tests.conftest import REPO
+
+QUICK = REPO / "procedures" / "quick-6pos.yaml"
+IDENTITY = {"watlow-f4": "scaled-int16 controller (model 5270", "watlow-f4t": "float32 controller"}
+
+
+@pytest.mark.parametrize("profile", sorted(PROFILES))
+def test_quick_6pos_dry_runs_with_each_chamber_profile(profile: str, tmp_path: Path, capsys) -> None:
+    campaign = tmp_path / "quick.h5"
+    assert main(["run", str(QUICK), "--dry-run", "--chamber-profile", profile, "-o", str(campaign), "-q",
+                 "--no-pdf"]) == 0
+    stored = load_campaign(campaign)
+    assert stored.state == "done" and len(stored.poses) == stored.poses_planned
+    assert stored.attrs["chamber_profile"] == profile
+    assert any(e.kind == "preflight" and IDENTITY[profile] in e.message for e in stored.events)
+
+
+def test_a_resumed_run_keeps_its_swapped_chamber(tmp_path: Path, capsys) -> None:
+    campaign = tmp_path / "quick.h5"
+    assert main(["run", str(QUICK), "--dry-run", "--chamber-profile", "watlow-f4", "-o", str(campaign), "-q",
+                 "--no-pdf", "--faults", "turntable_stall_after_min=60"]) == 1  # stops part-way
+    capsys.readouterr()
+    assert main(["resume", str(campaign), "-q", "--no-pdf"]) == 0
+    stored = load_campaign(campaign)
+    assert stored.state == "done" and stored.run_count == 2
+
+
+def test_a_profile_swap_is_for_simulated_chambers_and_known_profiles(tmp_path: Path, capsys) -> None:
+    assert main(["run", str(QUICK), "--chamber-profile", "watlow-f4", "-o", str(tmp_path / "q.h5")]) == 2
+    assert "only with --dry-run" in capsys.readouterr().err
+    assert main(["run", str(QUICK), "--dry-run", "--chamber-profile", "espec", "-o", str(tmp_path / "q.h5")]) == 2
+    assert "'espec' is not a chamber profile (known: watlow-f4, watlow-f4t)" in capsys.readouterr().err
