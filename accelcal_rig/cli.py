@@ -23,7 +23,7 @@ from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
 if TYPE_CHECKING:
     from accelcal_rig.engine.preparation import PreparedCampaign
     from accelcal_rig.engine.progress import ProgressListener
-    from accelcal_rig.engine.session import RunResult
+    from accelcal_rig.engine.session import NothingToResume, RunResult
 
 EXIT_INTERRUPTED = 130
 #: A failure the program did not foresee (a bug): one line, and this code.
@@ -91,8 +91,13 @@ def _cmd_run(args: argparse.Namespace) -> int:
         raise ConfigError(f"{args.output}: is a folder; name the campaign file to write")
     if args.chamber_profile and not args.dry_run:
         raise ConfigError("--chamber-profile swaps in a simulated chamber: only with --dry-run")
-    prepared = prepare(args.procedure, args.config, args.faults, args.chamber_profile)
     exists = args.output.exists() or journal_path(args.output).exists()
+    profile = args.chamber_profile
+    if args.resume and exists and profile is None:  # continue with the chamber the campaign was started with
+        from accelcal_rig.store.read import load_campaign
+
+        profile = str(load_campaign(args.output).attrs.get("chamber_profile", "")) or None
+    prepared = prepare(args.procedure, args.config, args.faults, profile)
     if exists and not (args.overwrite or args.resume):
         raise ConfigError(f"{args.output}: campaign file exists; continue it with --resume, or choose another -o "
                           "or pass --overwrite")
@@ -168,13 +173,7 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
                                       calibration=calibration, resume=resume, progress=progress)
     except NothingToResume as done:
         print(done)
-        if done.fit is None:
-            return 0
-        for serial, (verdict, reasons) in done.fit.verdicts.items():  # the fit this resume did, as a run's
-            print(f"  verdict    {serial} {verdict}" + (f": {'; '.join(reasons)}" if verdict == "FAIL" else ""))
-        code = _certify_after_run(output, calibration, args)
-        rejected = [serial for serial, (verdict, _) in done.fit.verdicts.items() if verdict == "FAIL"]
-        return max(code, _rejected_exit(rejected, args.fail_on_reject))
+        return _complete_campaign_verdicts(done, output, calibration, args)
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler)
@@ -382,6 +381,28 @@ def _cmd_certificate(args: argparse.Namespace) -> int:
         raise ConfigError(f"{args.output}: exists and is not a folder")
     _certify(args.campaign, calibration, args.output, args.operator, not args.no_pdf)
     return 0
+
+
+def _complete_campaign_verdicts(done: NothingToResume, output: Path, calibration: Path,
+                                args: argparse.Namespace) -> int:
+    """A complete campaign resumed: the verdicts of the fit this resume did (and its certificates and
+    warnings), else those of its calibration file; `--fail-on-reject` either way."""
+    from accelcal_rig.fit.campaign_file import calibration_verdicts
+
+    code = 0
+    fit = done.fit
+    if fit is not None:
+        verdicts = fit.verdicts
+        for warning in fit.warnings:
+            print(f"  warning    {warning}")
+        code = _certify_after_run(output, calibration, args)
+    else:
+        judged = calibration_verdicts(output, calibration)["verdicts"] or {}
+        verdicts = {serial: (str(v["verdict"]), tuple(v["reasons"])) for serial, v in judged.items()}
+    for serial, (verdict, reasons) in verdicts.items():
+        print(f"  verdict    {serial} {verdict}" + (f": {'; '.join(reasons)}" if verdict == "FAIL" else ""))
+    rejected = [serial for serial, (verdict, _) in verdicts.items() if verdict == "FAIL"]
+    return max(code, _rejected_exit(rejected, args.fail_on_reject))
 
 
 def _certify_after_run(output: Path, calibration: Path, args: argparse.Namespace) -> int:

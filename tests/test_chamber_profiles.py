@@ -37,6 +37,15 @@ def test_a_resumed_run_keeps_its_swapped_chamber(tmp_path: Path, capsys) -> None
     assert stored.state == "done" and stored.run_count == 2
 
 
+def test_run_resume_without_the_flag_continues_with_the_campaigns_chamber(tmp_path: Path, capsys) -> None:
+    campaign = tmp_path / "quick.h5"
+    common = [str(QUICK), "--dry-run", "-o", str(campaign), "-q", "--no-pdf"]
+    assert main(["run", *common, "--chamber-profile", "watlow-f4", "--faults", "turntable_stall_after_min=60"]) == 1
+    capsys.readouterr()
+    assert main(["run", *common, "--resume"]) == 0
+    assert load_campaign(campaign).state == "done"
+
+
 def test_a_profile_swap_is_for_simulated_chambers_and_known_profiles(tmp_path: Path, capsys) -> None:
     assert main(["run", str(QUICK), "--chamber-profile", "watlow-f4", "-o", str(tmp_path / "q.h5")]) == 2
     assert "only with --dry-run" in capsys.readouterr().err

@@ -80,3 +80,12 @@ def test_resuming_a_complete_campaign_whose_fit_is_missing_fits_judges_and_certi
     assert "nothing to resume" in out and out.count("  verdict    ") == 4 and "FAIL: verification |g| RMSE" in out
     assert campaign.with_suffix(".calibration.yaml").exists()
     assert len(list(campaign.with_suffix(".certificates").glob("*.html"))) == 4
+
+
+def test_resuming_a_complete_rejected_campaign_again_still_fails_on_reject(write, workdir: Path, capsys) -> None:
+    procedure = write("verified.yaml", VERIFIED.replace("LIMIT", "0.001"))
+    campaign = workdir / "c.h5"
+    assert main(["run", str(procedure), "--dry-run", "-o", str(campaign), "-q", "--no-pdf"]) == 0
+    capsys.readouterr()
+    assert main(["resume", str(campaign), "-q", "--fail-on-reject"]) == 3  # its calibration already judged it
+    assert capsys.readouterr().out.count("  verdict    ") == 4

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import NoReturn
 
+import numpy as np
+
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.logger import LOGGER
@@ -24,7 +26,7 @@ from accelcal_rig.engine.preparation import PreparedCampaign
 from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.resume import ResumePoint, check_same_campaign
 from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
-from accelcal_rig.errors import CampaignAborted
+from accelcal_rig.errors import CampaignAborted, RigError
 from accelcal_rig.fit.campaign_fit import fit_and_save, summary_line
 from accelcal_rig.fit.recorded_options import recorded_options
 from accelcal_rig.store.content import Campaign
@@ -115,7 +117,10 @@ def _finish_complete(prepared: PreparedCampaign, output: Path, stored: Campaign,
             repair_campaign(output)
             done.append(f"{output.name} brought up to date from its journal")
         if calibration is not None and not calibration.exists() and prepared.procedure.model.fit.mode != "none":
-            fit = _fit_stage(prepared.procedure.model, output, calibration)(load_campaign(output))
+            try:
+                fit = _fit_stage(prepared.procedure.model, output, calibration)(load_campaign(output))
+            except (ValueError, KeyError, OSError, np.linalg.LinAlgError) as exc:
+                raise RigError(f"{output}: the campaign is complete, but its fit failed: {exc}") from None
             done.append(fit.summary)
     return done, fit
 
@@ -191,7 +196,7 @@ def _fit_stage(procedure: Procedure, output: Path, calibration: Path) -> FitStag
     assert options is not None, "a procedure without a fit has no fit stage"
 
     def stage(campaign: Campaign) -> FitOutcome:
-        _, report = fit_and_save(campaign, output, calibration, options)
+        _, report = fit_and_save(campaign, output, calibration, options, run_end=True)
         return FitOutcome(summary_line(report, calibration),
                           {serial: (r["verdict"], tuple(r["verdict_reasons"])) for serial, r in report.items()},
                           tuple(f"sensor {serial}: {w}" for serial, r in report.items() for w in r["warnings"]))

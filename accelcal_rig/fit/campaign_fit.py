@@ -233,12 +233,13 @@ def _truth_error(truth: np.ndarray, setpoints: np.ndarray, groups: list[np.ndarr
 
 
 def fit_campaign(campaign: Campaign, options: FitOptions,
-                 source: dict[str, str]) -> tuple[CalibrationFile, dict[str, Any]]:
+                 source: dict[str, str], run_end: bool = False) -> tuple[CalibrationFile, dict[str, Any]]:
     """Fit every DUT of a stored campaign; the calibration file and the report `rig fit --json` prints
-    (per serial). Nothing is written: the campaign's measurements are only read."""
+    (per serial). Nothing is written: the campaign's measurements are only read. `run_end`: the fit stage of
+    the run itself, whose campaign is done but for the fit."""
     results = [fit_dut(read_dut_poses(campaign, serial), options) for serial in campaign.serials]
     limits = recorded_acceptance(campaign.header.procedure_yaml, source.get("campaign", "the campaign"))
-    partial = partial_campaign(campaign)
+    partial = partial_campaign(campaign, run_end)
     judged = {r.serial: judge(r.metrics, r.thermal, options.mode, limits, partial) for r in results}
     sensors = {r.serial: r.calibration.model_copy(update={"verdict": judged[r.serial].verdict,
                                                           "verdict_reasons": judged[r.serial].reasons})
@@ -252,26 +253,26 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     return calibration, report
 
 
-def partial_campaign(campaign: Campaign) -> str:
+def partial_campaign(campaign: Campaign, run_end: bool = False) -> str:
     """How a campaign fell short of its plan, or "" when every planned pose is stored (and it was not
     aborted: a run's own fit stage sees its campaign still running)."""
     stored, planned = len(campaign.poses), campaign.poses_planned
-    if stored >= planned and campaign.state != "aborted":
+    state = "done" if run_end else campaign.state  # a run's own fit stage: its campaign is done but for the fit
+    if stored >= planned and state != "aborted":
         return ""
     skipped = any(e.kind == "soak" and "setpoint skipped" in e.message for e in campaign.events)
-    why = "a soak timed out and its setpoint was skipped" if skipped and campaign.state != "aborted" else (
-        f"state {campaign.state}")
+    why = "a soak timed out and its setpoint was skipped" if skipped and state == "done" else f"state {state}"
     return f"partial campaign: {stored} of {planned} poses stored ({why})"
 
 
 def fit_and_save(campaign: Campaign, campaign_path: Path, calibration_path: Path,
-                 options: FitOptions) -> tuple[CalibrationFile, dict[str, Any]]:
+                 options: FitOptions, run_end: bool = False) -> tuple[CalibrationFile, dict[str, Any]]:
     """`fit_campaign`, then the calibration file written to `calibration_path` (replaced whole)."""
     if not campaign.poses:
         raise ValueError(f"{campaign_path}: no poses stored, nothing to fit")
     source = {"campaign": str(campaign_path), "measurements_sha256": measurements_sha256(campaign),
               "procedure": str(campaign.attrs.get("procedure_name", ""))}
-    calibration, report = fit_campaign(campaign, options, source)
+    calibration, report = fit_campaign(campaign, options, source, run_end)
     save_calibration(calibration, calibration_path)
     return calibration, report
 
