@@ -410,7 +410,7 @@ def _certify_after_run(output: Path, calibration: Path, args: argparse.Namespace
     try:
         _certify(output, calibration, args.certificates or output.with_suffix(".certificates"), args.operator,
                  not args.no_pdf)
-    except Exception as exc:  # noqa: BLE001 - the campaign and its calibration stand whatever a renderer does
+    except (RigError, OSError) as exc:
         print(f"rig: error: campaign done, but no certificates: {_one_line(exc)}", file=sys.stderr)
         return 1
     return 0

@@ -84,6 +84,10 @@ def _analysis_command(analyses: argparse._SubParsersAction, name: str, summary: 
     return command
 
 
+#: The built-in chamber profiles a dry run or `rig sim` may swap in (accelcal_rig.protocols.chamber_registers).
+CHAMBER_PROFILE_HELP = "simulate a chamber of this built-in profile instead of the rig's (watlow-f4, watlow-f4t)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="rig", description="Run MEMS accelerometer calibration campaigns.")
     parser.add_argument("--version", action="version", version=f"accelcal-rig {__version__}")
@@ -99,9 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--dry-run", action="store_true", help="simulated rig in virtual time")
     run.add_argument("--seed", type=_SEED, default=0, help="seed of the simulated noise (default 0)")
     run.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
-    run.add_argument("--chamber-profile", metavar="PROFILE",
-                     help="with --dry-run: simulate a chamber of this built-in profile instead of the rig's "
-                          "(watlow-f4, watlow-f4t)")
+    run.add_argument("--chamber-profile", metavar="PROFILE", help=f"with --dry-run: {CHAMBER_PROFILE_HELP}")
     run.add_argument("--overwrite", action="store_true", help="replace an existing campaign file")
     run.add_argument("--resume", action="store_true",
                      help="continue the campaign in the output file if it exists (after a crash, a fault or "
@@ -164,8 +166,7 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("rig", type=Path, help="rig config YAML")
     sim.add_argument("--seed", type=_SEED, default=0, help="seed of the simulated noise (default 0)")
     sim.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
-    sim.add_argument("--chamber-profile", metavar="PROFILE", help="serve a chamber of this built-in profile instead "
-                                                                  "of the rig's (watlow-f4, watlow-f4t)")
+    sim.add_argument("--chamber-profile", metavar="PROFILE", help=CHAMBER_PROFILE_HELP)
 
     fit = _command(commands, "fit", "fit the error model of every DUT and write a calibration file",
                    "LM fit of Eq. 1 at each setpoint, polynomials over the sensor temperature (Eq. 8), metrics. "

@@ -3,17 +3,13 @@ pass."""
 
 from __future__ import annotations
 
-from pydantic import BaseModel, Field, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
 
-from accelcal_rig.config.bounds import STRICT, TemperatureC
+from accelcal_rig.config.bounds import StrictModel, TemperatureC
 from accelcal_rig.config.schedule import Schedule
 
 
-class _Strict(BaseModel):
-    model_config = STRICT
-
-
-class Verification(_Strict):
+class Verification(StrictModel):
     """Poses measured like the calibration's and kept out of the fit: every figure that says how good the
     calibration is comes from them."""
 
@@ -40,7 +36,7 @@ class Verification(_Strict):
 
 
 
-class ParameterLimits(_Strict):
+class ParameterLimits(StrictModel):
     """Limits on the calibration's parameters at `at_c`, e.g. the datasheet's zero-g offset; a limit left
     out is not judged."""
 
@@ -53,7 +49,7 @@ class ParameterLimits(_Strict):
                                                                               "mode only)")
 
 
-class Acceptance(_Strict):
+class Acceptance(StrictModel):
     """What a DUT's calibration must meet to PASS; each limit left out is not judged. The verification
     limits are judged on the verification poses (a `verify:` section is needed for them)."""
 

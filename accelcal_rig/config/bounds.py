@@ -5,10 +5,16 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from pydantic import ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field
 
 #: Every config model: unknown keys and non-finite numbers (.inf, .nan) are refused.
 STRICT = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+class StrictModel(BaseModel):
+    """The base of every model read from a file: see STRICT."""
+
+    model_config = STRICT
 
 #: A temperature a calibration chamber can hold, °C.
 TemperatureC = Annotated[float, Field(ge=-100.0, le=300.0)]

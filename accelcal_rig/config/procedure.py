@@ -5,10 +5,10 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-from pydantic import BaseModel, Field, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from accelcal_rig.config.acceptance import Acceptance, Verification
-from accelcal_rig.config.bounds import STRICT, TemperatureC, TemperatureSpanC
+from accelcal_rig.config.bounds import StrictModel, TemperatureC, TemperatureSpanC
 from accelcal_rig.config.schedule import MAX_SCHEDULE_POSES, Schedule
 
 #: Most temperature polls a campaign's ramp and soak deadlines allow (`rig plan` plays them all).
@@ -17,11 +17,8 @@ MAX_POLLS = 200_000
 MAX_PLAN_POSES = 20_000
 
 
-class _Strict(BaseModel):
-    model_config = STRICT
 
-
-class SoakCriterion(_Strict):
+class SoakCriterion(StrictModel):
     """When the DUTs count as thermally stable at a setpoint (every wait has a deadline: `timeout_min`)."""
 
     min_dwell_min: float = Field(30.0, ge=0, le=2880, description="least time at setpoint before stability counts")
@@ -48,7 +45,7 @@ class SoakCriterion(_Strict):
         return self
 
 
-class Acquisition(_Strict):
+class Acquisition(StrictModel):
     """How each pose is measured."""
 
     samples_per_pose: int = Field(200, ge=2, le=100_000)
@@ -57,7 +54,7 @@ class Acquisition(_Strict):
     settle_s: float = Field(5.0, ge=0, le=3600, description="wait after the turntable is in position")
 
 
-class FitOptions(_Strict):
+class FitOptions(StrictModel):
     """How the campaign's data will be fitted (paper §3)."""
 
     temperature_model: Literal["per-setpoint", "joint"] = Field(
@@ -70,7 +67,7 @@ class FitOptions(_Strict):
     out_of_range: Literal["clamp", "extrapolate"] = "clamp"
 
 
-class SimulatedEffects(_Strict):
+class SimulatedEffects(StrictModel):
     """Effects of real sensors that Eq. 1 does not contain, for dry runs only (off by default).
 
     They show how the fit copes with reality: a calibration on such a sensor cannot reach the noise floor.
@@ -81,7 +78,7 @@ class SimulatedEffects(_Strict):
     nonlinearity_mg_per_g2: float = Field(0.0, ge=0, le=50, description="square-law term per axis, ± per DUT")
 
 
-class Cooldown(_Strict):
+class Cooldown(StrictModel):
     """Free cool-down validation (paper §4.3, Fig. 11): after the soak at the procedure's one setpoint,
     hold one pose, let the chamber go (switched off, or set to ambient) and record while the DUTs cool."""
 
@@ -94,7 +91,7 @@ class Cooldown(_Strict):
     duration_min: float = Field(240.0, gt=0, le=7 * 24 * 60, description="how long to record")
 
 
-class RampMethod(_Strict):
+class RampMethod(StrictModel):
     """Poses measured while the chamber ramps slowly, instead of soaking at each setpoint (paper §4.3 names
     both methods). After a soak at the first setpoint the chamber setpoint moves at `rate_c_per_min`
     towards the last; each setpoint's poses start once the ramp is half-way from the previous setpoint."""
@@ -103,7 +100,7 @@ class RampMethod(_Strict):
     update_s: float = Field(30.0, ge=1, le=600, description="how often the chamber setpoint is moved on")
 
 
-class Procedure(_Strict):
+class Procedure(StrictModel):
     """A whole campaign. Setpoints run in the order given."""
 
     name: str = Field(min_length=1, max_length=128, pattern=r"^[A-Za-z0-9_.-]+$")

@@ -6,9 +6,9 @@ from collections.abc import Callable
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
+from pydantic import Field, ValidationError, field_validator, model_validator
 
-from accelcal_rig.config.bounds import STRICT, AngleDeg, Baudrate, TemperatureC, TimeoutS
+from accelcal_rig.config.bounds import AngleDeg, Baudrate, StrictModel, TemperatureC, TimeoutS
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
 from accelcal_rig.parts.registry import DEFAULT_PART, part
 from accelcal_rig.plugins import Kind, driver_problem
@@ -18,9 +18,6 @@ from accelcal_rig.protocols.turntable_line import TurntableProtocol, turntable_p
 #: A year of campaign time, in minutes: the furthest a simulated fault may be scheduled.
 _YEAR_MIN = 365 * 24 * 60.0
 
-
-class _Strict(BaseModel):
-    model_config = STRICT
 
 
 def _known_driver(kind: Kind) -> classmethod:
@@ -33,7 +30,7 @@ def _known_driver(kind: Kind) -> classmethod:
     return field_validator("driver")(classmethod(check))  # type: ignore[return-value]
 
 
-class ChamberConfig(_Strict):
+class ChamberConfig(StrictModel):
     """Thermal chamber: how to reach its controller, its register map, limits and dynamics."""
 
     driver: str = Field("modbus-tcp", max_length=64, description="a chamber driver (accelcal_rig.plugins)")
@@ -69,7 +66,7 @@ class ChamberConfig(_Strict):
         return self
 
 
-class TurntableAxis(_Strict):
+class TurntableAxis(StrictModel):
     """One rotary axis of the kinematic chain, its direction given in its parent's frame at zero angles."""
 
     name: str = Field(min_length=1, max_length=32, pattern=r"^[A-Za-z0-9_.-]+$")
@@ -101,7 +98,7 @@ class TurntableAxis(_Strict):
         return self.continuous or self.min_deg <= angle_deg <= self.max_deg
 
 
-class TurntableConfig(_Strict):
+class TurntableConfig(StrictModel):
     """A chain of rotary axes, outermost first; the fixture sits on the innermost axis."""
 
     driver: str = Field("serial", max_length=64, description="a turntable driver (accelcal_rig.plugins)")
@@ -134,7 +131,7 @@ class TurntableConfig(_Strict):
         return self
 
 
-class SensorConfig(_Strict):
+class SensorConfig(StrictModel):
     """One DUT on the fixture. `mount_euler_deg`: rotation of the DUT frame in the fixture frame (xyz)."""
 
     serial: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.-]+$")
@@ -173,7 +170,7 @@ def _is_host_port(endpoint: str) -> bool:
     return bool(host) and port.isdigit() and 0 < int(port) < 65536
 
 
-class FixtureConfig(_Strict):
+class FixtureConfig(StrictModel):
     sensors: list[SensorConfig] = Field(min_length=1, max_length=64)
 
     @field_validator("sensors")
@@ -185,7 +182,7 @@ class FixtureConfig(_Strict):
         return value
 
 
-class FaultInjection(_Strict):
+class FaultInjection(StrictModel):
     """Faults the simulators inject (dry runs and `rig sim`), to prove the engine survives them.
 
     Transient faults hit each reply with probability `rate`, the kind drawn from `kinds`; persistent ones
@@ -208,7 +205,7 @@ class FaultInjection(_Strict):
                                      "nibble (not double-buffered on a real ADXL355): off by 256 LSB, about 28 °C")
 
 
-class SimulationConfig(_Strict):
+class SimulationConfig(StrictModel):
     """Physics of the virtual lab used by `--dry-run` (docs/procedures.md, "The simulated rig")."""
 
     ambient_c: TemperatureC = 23.0
@@ -227,7 +224,7 @@ class SimulationConfig(_Strict):
     faults: FaultInjection = FaultInjection()
 
 
-class RetryPolicy(_Strict):
+class RetryPolicy(StrictModel):
     """Transient communication failures (no reply, garbled reply, a port gone) are retried this way."""
 
     attempts: int = Field(5, ge=1, le=20, description="tries in all, the first included")
@@ -238,7 +235,7 @@ class RetryPolicy(_Strict):
 NotifyEvent = Literal["start", "soak", "fault", "safe", "finish"]
 
 
-class NotifyConfig(_Strict):
+class NotifyConfig(StrictModel):
     """Who hears about an unattended run: a webhook (JSON POST) and/or a local command (JSON on stdin)."""
 
     webhook_url: str | None = Field(None, max_length=2048, pattern=r"^https?://",
@@ -250,7 +247,7 @@ class NotifyConfig(_Strict):
     timeout_s: float = Field(10.0, gt=0, le=120, description="longest one delivery may take")
 
 
-class RigConfig(_Strict):
+class RigConfig(StrictModel):
     name: str = Field(min_length=1, max_length=128)
     description: str = Field("", max_length=10_000)
     chamber: ChamberConfig

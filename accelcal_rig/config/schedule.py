@@ -5,33 +5,30 @@ from __future__ import annotations
 
 from typing import Annotated, ClassVar, Literal
 
-from pydantic import BaseModel, Field, field_validator
+from pydantic import Field, field_validator
 
-from accelcal_rig.config.bounds import STRICT, AngleDeg
+from accelcal_rig.config.bounds import AngleDeg, StrictModel
 
 #: Most orientations a schedule may list (each is solved for the turntable's angles when the plan compiles).
 MAX_SCHEDULE_POSES = 2_000
 
 
-class _Strict(BaseModel):
-    model_config = STRICT
 
-
-class Paper24Schedule(_Strict):
+class Paper24Schedule(StrictModel):
     """Table 1 of the paper: eight 45° steps about each of the sensor's z, y and x axes."""
 
     kind: Literal["paper-24"]
     size: ClassVar[int] = 24
 
 
-class SixPositionSchedule(_Strict):
+class SixPositionSchedule(StrictModel):
     """The classic six positions: each sensor axis up, then down."""
 
     kind: Literal["six-position"]
     size: ClassVar[int] = 6
 
 
-class SphereSchedule(_Strict):
+class SphereSchedule(StrictModel):
     """`count` gravity directions spread evenly over the sphere (Fibonacci lattice)."""
 
     kind: Literal["sphere"]
@@ -42,7 +39,7 @@ class SphereSchedule(_Strict):
         return self.count
 
 
-class TiltSchedule(_Strict):
+class TiltSchedule(StrictModel):
     """Poses given as pitch and roll of the fixture (paper Eq. 10, Table 5), in degrees: pitch tilts the
     y axis up, roll tilts the x axis down; (0, 0) is level with z up."""
 
@@ -61,7 +58,7 @@ class TiltSchedule(_Strict):
         return value
 
 
-class ExplicitSchedule(_Strict):
+class ExplicitSchedule(StrictModel):
     """Turntable axis angles given pose by pose, in degrees, in the rig's axis order."""
 
     kind: Literal["explicit"]

@@ -15,7 +15,7 @@ import numpy as np
 
 from accelcal_rig.core.geometry import fibonacci_sphere
 from accelcal_rig.fit.expected import thermal_jacobian
-from accelcal_rig.fit.lm import FitMode, SfemFit, norm_sigma
+from accelcal_rig.fit.lm import FitMode, SfemFit, norm_sigma, reference_sigma_g
 from accelcal_rig.fit.sfem import correct, distort, norm_only_gauge
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel
 from accelcal_rig.fit.uncertainty import (
@@ -57,8 +57,7 @@ def calibration_covariance(poses: DutPoses, groups: list[np.ndarray], fits: list
     compensated = correct(poses.mean_g[rows], thermal.parameters_at(pose_temperatures[rows], "extrapolate"))
     if mode == "reference":
         reference = poses.reference_g[rows]
-        sigma = np.sqrt(np.maximum(poses.stderr_g[rows], 1e-9) ** 2 + accuracy**2 / 3 * (
-            np.sum(reference**2, axis=1, keepdims=True) - reference**2))
+        sigma = reference_sigma_g(np.maximum(poses.stderr_g[rows], 1e-9), reference, accuracy)
         residuals = ((compensated - reference) / sigma).ravel()
     else:
         reference = None

@@ -11,9 +11,9 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 import yaml
-from pydantic import BaseModel, Field, field_validator
+from pydantic import Field, field_validator
 
-from accelcal_rig.config.bounds import STRICT, TemperatureC
+from accelcal_rig.config.bounds import StrictModel, TemperatureC
 from accelcal_rig.config.load import load_validated
 from accelcal_rig.config.yaml_lines import CALIBRATION_LIMITS
 from accelcal_rig.durable import write_text_atomically
@@ -27,9 +27,6 @@ class CalibrationRangeWarning(UserWarning):
     """Samples outside the calibrated temperature range were clamped or extrapolated."""
 
 
-class _Strict(BaseModel):
-    model_config = STRICT
-
 
 def _ordered(value: tuple[float, float]) -> tuple[float, float]:
     if not value[0] < value[1]:
@@ -37,7 +34,7 @@ def _ordered(value: tuple[float, float]) -> tuple[float, float]:
     return value
 
 
-class PolynomialModel(_Strict):
+class PolynomialModel(StrictModel):
     """Each parameter's coefficients in x = (T − mid(domain)) / half-width(domain), increasing powers."""
 
     domain_c: tuple[TemperatureC, TemperatureC]
@@ -58,7 +55,7 @@ class PolynomialModel(_Strict):
         return np.array([self.coefficients[n] + [0.0] * (width - len(self.coefficients[n])) for n in PARAMETER_NAMES])
 
 
-class SetpointFit(_Strict):
+class SetpointFit(StrictModel):
     setpoint_c: float
     temperature_c: float
     n_poses: int
@@ -67,7 +64,7 @@ class SetpointFit(_Strict):
     sigma: dict[str, float | None]
 
 
-class SensorCalibration(_Strict):
+class SensorCalibration(StrictModel):
     serial: str = Field(min_length=1, max_length=128)
     mode: Literal["reference", "norm-only"]
     free_parameters: list[str] = Field(max_length=12)
@@ -99,7 +96,7 @@ class SensorCalibration(_Strict):
         return np.moveaxis(np.polynomial.polynomial.polyval(x, self.polynomial.matrix().T), 0, -1)
 
 
-class CalibrationFile(_Strict):
+class CalibrationFile(StrictModel):
     format: str
     format_version: int
     model: Literal["sfem-eq1"] = "sfem-eq1"

@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from accelcal_rig.fit.lm import pointing_covariance_g2, reference_sigma_g
+
 
 def expected_reference_rmse_mg(jacobian: np.ndarray, reference_g: np.ndarray, stderr_g: np.ndarray,
                                accuracy_rad: float) -> float:
@@ -20,11 +22,9 @@ def expected_reference_rmse_mg(jacobian: np.ndarray, reference_g: np.ndarray, st
     reference_g = np.asarray(reference_g, dtype=float)
     stderr_g = np.maximum(np.asarray(stderr_g, dtype=float), 1e-9)
     n = len(reference_g)
-    pointing = accuracy_rad**2 / 3.0
-    sigma_g = np.sqrt(stderr_g**2 + pointing * (1.0 - reference_g**2))
+    sigma_g = reference_sigma_g(stderr_g, reference_g, accuracy_rad)
     # The noise each pose's whitened residual carries: its samples' (diagonal) and a small rotation's.
-    noise = (np.einsum("na,ab->nab", stderr_g**2, np.eye(3))
-             + pointing * (np.eye(3) - np.einsum("na,nb->nab", reference_g, reference_g)))
+    noise = np.einsum("na,ab->nab", stderr_g**2, np.eye(3)) + pointing_covariance_g2(reference_g, accuracy_rad)
     noise /= sigma_g[:, :, None] * sigma_g[:, None, :]
     projection = reference_g * sigma_g                              # |g| residual = projection · whitened
     q, _ = np.linalg.qr(jacobian)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import least_squares
 
-from accelcal_rig.fit.lm import FitMode, norm_sigma
+from accelcal_rig.fit.lm import FitMode, norm_sigma, reference_sigma_g
 from accelcal_rig.fit.sfem import correct
 from accelcal_rig.fit.thermal import ThermalModel
 
@@ -33,7 +33,7 @@ def fit_joint(start: ThermalModel, free: np.ndarray, temperature_c: np.ndarray, 
 
     if mode == "reference":
         assert reference_g is not None
-        sigma_g = np.sqrt(stderr_g**2 + reference_accuracy_rad**2 / 3.0 * (1.0 - reference_g**2))
+        sigma_g = reference_sigma_g(stderr_g, reference_g, reference_accuracy_rad)
 
         def residuals(theta: np.ndarray) -> np.ndarray:
             return ((correct(mean_g, model(theta)) - reference_g) / sigma_g).ravel()

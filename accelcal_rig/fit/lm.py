@@ -57,6 +57,20 @@ class SfemFit:
     mode: FitMode
     jacobian: np.ndarray          # of the weighted residuals in the free parameters, at the solution
 
+def pointing_covariance_g2(reference_g: np.ndarray, accuracy_rad: float) -> np.ndarray:
+    """(n, 3, 3): a turntable uniform within ± `accuracy_rad` per axis turns the expected gravity g by a small
+    rotation of variance a²/3 about each axis: covariance (a²/3)(|g|² I − g gᵀ), which changes no |g|."""
+    reference_g = np.asarray(reference_g, dtype=float)
+    squared = np.einsum("na,na->n", reference_g, reference_g)
+    return accuracy_rad**2 / 3.0 * (squared[:, None, None] * np.eye(3) - np.einsum("na,nb->nab", reference_g, reference_g))
+
+
+def reference_sigma_g(stderr_g: np.ndarray, reference_g: np.ndarray, accuracy_rad: float) -> np.ndarray:
+    """(n, 3): each component's 1σ in reference mode, its samples' standard error and the table's pointing."""
+    pointing = np.diagonal(pointing_covariance_g2(reference_g, accuracy_rad), axis1=1, axis2=2)
+    return np.sqrt(np.asarray(stderr_g, dtype=float) ** 2 + pointing)
+
+
 def norm_sigma(mean_g: np.ndarray, stderr_g: np.ndarray) -> np.ndarray:
     """Standard error of |U| per pose: each axis's error projected on the measured direction."""
     direction = mean_g / np.linalg.norm(mean_g, axis=1, keepdims=True)
@@ -84,7 +98,7 @@ def fit_sfem(mean_g: np.ndarray, stderr_g: np.ndarray, reference_g: np.ndarray |
         if reference_g is None:
             raise ValueError("reference mode needs the expected gravity of each pose")
         reference_g = np.asarray(reference_g, dtype=float)
-        sigma_g = np.sqrt(stderr_g**2 + reference_accuracy_rad**2 / 3.0 * (1.0 - reference_g**2))
+        sigma_g = reference_sigma_g(stderr_g, reference_g, reference_accuracy_rad)
 
         def residuals(theta: np.ndarray) -> np.ndarray:
             return ((correct(mean_g, _full(theta, mask)) - reference_g) / sigma_g).ravel()

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import chi2
 
+from accelcal_rig.fit.lm import pointing_covariance_g2, reference_sigma_g
 from accelcal_rig.fit.sfem import correct, error_matrix
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel
 
@@ -83,12 +84,10 @@ def coefficient_covariance(mapping: np.ndarray, reference_g: np.ndarray | None, 
     else:
         stderr_g = np.maximum(np.asarray(stderr_g, dtype=float), 1e-9)
         reference_g = np.asarray(reference_g, dtype=float)
-        spread = accuracy_rad**2 / 3.0
-        sigma = np.sqrt(stderr_g**2 + spread * (np.sum(reference_g**2, axis=1, keepdims=True) - reference_g**2))
+        sigma = reference_sigma_g(stderr_g, reference_g, accuracy_rad)
         blocks = a.reshape(a.shape[0], n_poses, 3) / sigma[None]       # A_i S_i⁻¹, pose by pose
         noise = np.einsum("pna,na,qna->pq", blocks, stderr_g**2, blocks)
-        turn = spread * (np.einsum("na,na->n", reference_g, reference_g)[:, None, None] * np.eye(3)
-                         - np.einsum("na,nb->nab", reference_g, reference_g))
+        turn = pointing_covariance_g2(reference_g, accuracy_rad)
         pointing = np.einsum("pna,nab,qnb->pq", blocks, turn, blocks)
     dof = len(residuals) - a.shape[0]
     chi2_total = float(residuals @ residuals)

@@ -10,7 +10,7 @@ from accelcal_rig.config.load import LoadedConfig
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.instruments.adxl355_driver import Adxl355
-from accelcal_rig.instruments.interfaces import Accelerometer, Chamber, RigInstruments, Turntable
+from accelcal_rig.instruments.interfaces import Accelerometer, Chamber, RigInstruments, Turntable, close_each
 from accelcal_rig.parts.registry import part
 from accelcal_rig.plugins import load_driver
 
@@ -41,13 +41,7 @@ class SomeInstruments:
 
     def close(self) -> list[str]:
         """Release every connection, each in its own guard; return the failures, one line each."""
-        failures = []
-        for device in [d for d in (self.chamber, self.turntable) if d is not None] + list(self.sensors):
-            try:
-                device.close()
-            except Exception as exc:  # noqa: BLE001 - one port that will not close must not keep the others open
-                failures.append(f"{device.endpoint}: not closed: {exc}")
-        return failures
+        return close_each(self.chamber, self.turntable, self.sensors)
 
 
 def configured_endpoints(rig: LoadedConfig[RigConfig], only: frozenset[str] = EVERY_INSTRUMENT) -> Endpoints:

@@ -109,15 +109,22 @@ class RigInstruments:
 
     def close(self) -> list[str]:
         """Release every connection, each in its own guard; return the failures, one line each."""
-        failures = []
-        devices: list[tuple[str, Chamber | Turntable | Accelerometer]] = [
-            ("chamber", self.chamber), ("turntable", self.turntable), *((f"sensor {s.serial}", s) for s in self.sensors)]
-        for name, device in devices:
-            try:
-                device.close()
-            except Exception as exc:  # noqa: BLE001 - one stuck port must not keep the others open
-                failures.append(f"{name} ({device.endpoint}): close failed: {exc}")
-        return failures
+        return close_each(self.chamber, self.turntable, self.sensors)
+
+
+def close_each(chamber: Chamber | None, turntable: Turntable | None, sensors: list[Accelerometer]) -> list[str]:
+    """Close every instrument given, each in its own guard; the failures, one line each naming it."""
+    failures = []
+    devices: list[tuple[str, Chamber | Turntable | Accelerometer]] = [
+        *((("chamber", chamber),) if chamber is not None else ()),
+        *((("turntable", turntable),) if turntable is not None else ()),
+        *((f"sensor {s.serial}", s) for s in sensors)]
+    for name, device in devices:
+        try:
+            device.close()
+        except Exception as exc:  # noqa: BLE001 - one stuck port must not keep the others open
+            failures.append(f"{name} ({device.endpoint}): close failed: {exc}")
+    return failures
 
 
 class TruthSource(Protocol):

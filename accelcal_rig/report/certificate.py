@@ -21,7 +21,7 @@ import numpy as np
 from accelcal_rig import __version__
 from accelcal_rig.core.units import gravity_statement
 from accelcal_rig.durable import write_atomically, write_text_atomically
-from accelcal_rig.errors import ConfigError
+from accelcal_rig.errors import ConfigError, RigError
 from accelcal_rig.fit.calibration import CalibrationFile, SensorCalibration, load_calibration
 from accelcal_rig.store.content import Campaign, measurements_sha256
 from accelcal_rig.store.read import dut_description, usable_campaign
@@ -87,7 +87,11 @@ def write_certificates(campaign_path: Path, calibration_path: Path, folder: Path
         pdf_path = None
         if render is not None:
             pdf_path = folder / f"{name}.pdf"
-            write_atomically(pdf_path, render(page), "the certificate")
+            try:
+                pdf_bytes = render(page)
+            except Exception as exc:  # noqa: BLE001 - a renderer's failure is one line naming the file
+                raise RigError(f"{pdf_path}: the PDF could not be rendered: {str(exc).splitlines()[0]}") from None
+            write_atomically(pdf_path, pdf_bytes, "the certificate")
         written.append(Written(serial, html_path, pdf_path))
     return written, warnings
 

@@ -187,7 +187,8 @@ def _rmse_table(data: CampaignData) -> str:
             row += [f"{record['before_mg']:.3f}", f"{record['measurement_mg']:.4f}", f"{record['polynomial_mg']:.4f}"] \
                 if record else ["—"] * 3
         rows.append(row)
-    return _table(header, rows) + ("<p class='note'>mg. Own fit: the setpoint's LM estimate applied to its poses; "
+    return _table(header, rows) + ("<p class='note'>mg, in-sample (the calibration poses; the verification poses' "
+                                   "figures are above). Own fit: the setpoint's LM estimate applied to its poses; "
                                    "polynomial: the thermal model at each pose's temperature. Paper Table 6.</p>")
 
 
