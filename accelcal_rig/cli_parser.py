@@ -85,7 +85,8 @@ def _analysis_command(analyses: argparse._SubParsersAction, name: str, summary: 
 
 
 #: The built-in chamber profiles a dry run or `rig sim` may swap in (accelcal_rig.protocols.chamber_registers).
-CHAMBER_PROFILE_HELP = "simulate a chamber of this built-in profile instead of the rig's (watlow-f4, watlow-f4t)"
+CHAMBER_PROFILE_HELP = ("simulate a chamber of this built-in profile instead of the rig's (watlow-f4, watlow-f4t, "
+                        "espec-p300, thermotron-8800, simserv, watlow-f4t-scpi)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -159,8 +160,9 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
 
     sim = _command(commands, "sim", "serve the simulated rig as real endpoints until interrupted",
-                   "Start the simulated rig of a rig config: the chamber on Modbus TCP (127.0.0.1), the "
-                   "turntable and each sensor bridge on a pseudo-terminal, in real time. The first line on "
+                   "Start the simulated rig of a rig config: the chamber on Modbus TCP or its line protocol "
+                   "over TCP (127.0.0.1), the turntable and each sensor bridge on a pseudo-terminal, in real "
+                   "time. The first line on "
                    "stdout is one JSON object with the endpoints. Ctrl-C stops it.",
                    "rig sim configs/sim.yaml")
     sim.add_argument("rig", type=Path, help="rig config YAML")

@@ -20,7 +20,8 @@ GROUPS: dict[str, str] = {"chamber": "accelcal_rig.chambers", "turntable": "acce
                           "sensor": "accelcal_rig.sensors"}
 _BUILT_IN: dict[str, dict[str, str]] = {
     "chamber": {"modbus-tcp": "accelcal_rig.instruments.chamber_modbus:MODBUS_TCP",
-                "modbus-rtu": "accelcal_rig.instruments.chamber_modbus:MODBUS_RTU"},
+                "modbus-rtu": "accelcal_rig.instruments.chamber_modbus:MODBUS_RTU",
+                "line": "accelcal_rig.instruments.chamber_line:LINE"},
     "turntable": {"serial": "accelcal_rig.instruments.turntable_serial:SERIAL"},
     "sensor": {"serial-bridge": "accelcal_rig.instruments.sensor_links:SERIAL_BRIDGE",
                "spidev": "accelcal_rig.instruments.sensor_links:SPIDEV"},

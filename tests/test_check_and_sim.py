@@ -122,3 +122,24 @@ def test_a_dry_run_check_of_the_sensors_alone(tmp_path: Path) -> None:
     assert result.returncode == 0, result.stderr
     lines = result.stdout.splitlines()
     assert sum(line.startswith("sensor ADX355-A") for line in lines) == 4 and not any("chamber" in line for line in lines)
+
+
+def test_rig_check_of_a_line_chamber_says_what_frost_settings_can_count_on(tmp_path: Path) -> None:
+    """A new SIMSERV chamber on the network: identity, both limits, its humidity and dew point, its purge."""
+    process = subprocess.Popen([RIG, "sim", str(SIM_RIG), "--chamber-profile", "simserv"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        chamber = json.loads(process.stdout.readline())["chamber"]  # type: ignore[union-attr]
+        rig = tmp_path / "new-chamber.yaml"
+        rig.write_text(yaml.safe_dump({"name": "bring-up", "chamber": {
+            "driver": "line", "profile": "simserv", "endpoint": f"{chamber['host']}:{chamber['port']}"}}))
+        result = subprocess.run([RIG, "check", str(rig), "--only", "chamber"], capture_output=True, text=True,
+                                timeout=60)
+    finally:
+        process.send_signal(signal.SIGINT)
+        process.wait(timeout=20)
+    assert result.returncode == 0, result.stderr
+    line = result.stdout.splitlines()[0]
+    assert line.startswith(f"chamber    tcp {chamber['host']}:{chamber['port']}: accelcal-rig simulated simserv")
+    assert "the rig's -55…100 °C, the controller's -70…180 °C" in line
+    assert "% RH (dew point 12.0 °C); dry-air purge output" in line

@@ -14,7 +14,8 @@ from accelcal_rig.config.schedule import Schedule
 from accelcal_rig.config.yaml_lines import CONFIG_LIMITS, KeyPath, YamlLimits, format_key, load_yaml_with_lines, locate
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.registry import part
-from accelcal_rig.protocols.chamber_registers import PROFILES
+from accelcal_rig.protocols.chamber_lines import LINE_PROFILES
+from accelcal_rig.protocols.chamber_registers import PROFILES as REGISTER_PROFILES
 
 ModelT = TypeVar("ModelT", bound=BaseModel)
 
@@ -168,10 +169,12 @@ def worst_case_polls(procedure: Procedure, rig: RigConfig) -> float:
 def swap_chamber_profile(rig: RigConfig, profile: str) -> RigConfig:
     """The rig with its chamber replaced by a simulated one of a built-in profile (its own driver, no endpoint,
     none of the old profile's register overrides)."""
-    if profile not in PROFILES:
-        raise ConfigError(f"--chamber-profile: {profile!r} is not a chamber profile (known: {', '.join(sorted(PROFILES))})")
-    chamber = rig.chamber.model_copy(update={"profile": profile, "driver": "modbus-tcp", "registers": {},
-                                             "endpoint": None, "options": {}})
+    known = sorted({*REGISTER_PROFILES, *LINE_PROFILES})
+    if profile not in known:
+        raise ConfigError(f"--chamber-profile: {profile!r} is not a chamber profile (known: {', '.join(known)})")
+    driver = "line" if profile in LINE_PROFILES else "modbus-tcp"
+    chamber = rig.chamber.model_copy(update={"profile": profile, "driver": driver, "registers": {},
+                                             "protocol_overrides": {}, "endpoint": None, "options": {}})
     return rig.model_copy(update={"chamber": chamber})
 
 

@@ -100,6 +100,20 @@ class RampMethod(StrictModel):
     update_s: float = Field(30.0, ge=1, le=600, description="how often the chamber setpoint is moved on")
 
 
+class Frost(StrictModel):
+    """Frost and condensation on a cold fixture: dry air while cold, and no poses below the dew point.
+
+    Coming up from the cold, the DUTs lag the chamber air, and the air's moisture (the frost coming off
+    the evaporator, the room's air) condenses on anything colder than its dew point.
+    """
+
+    purge_below_c: TemperatureC | None = Field(None, description="hold the chamber's dry-air purge on while the "
+                                               "setpoint is below this (off at and above it)")
+    dew_point_margin_c: float | None = Field(None, ge=0, le=50, description="after a warming step, poses wait "
+                                             "until every DUT is this far above the chamber air's dew point")
+    dew_point_timeout_min: float = Field(60.0, gt=0, le=1440, description="longest wait for that margin")
+
+
 class Procedure(StrictModel):
     """A whole campaign. Setpoints run in the order given."""
 
@@ -119,6 +133,7 @@ class Procedure(StrictModel):
     simulation: SimulatedEffects = SimulatedEffects()
     verify: Verification | None = Field(None, description="verification poses the fit never sees")
     acceptance: Acceptance = Acceptance()
+    frost: Frost = Field(Frost(), description="dry-air purge and the dew point requirement")
 
     @model_validator(mode="after")
     def _ramp_fits(self) -> Procedure:

@@ -12,6 +12,8 @@ from accelcal_rig.config.bounds import AngleDeg, Baudrate, StrictModel, Temperat
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
 from accelcal_rig.parts.registry import DEFAULT_PART, part
 from accelcal_rig.plugins import Kind, driver_problem
+from accelcal_rig.protocols.chamber_lines import LINE_PROFILES, ChamberLineProtocol, line_protocol
+from accelcal_rig.protocols.chamber_registers import PROFILES as REGISTER_PROFILES
 from accelcal_rig.protocols.chamber_registers import ChamberRegisterMap, register_map
 from accelcal_rig.protocols.turntable_line import TurntableProtocol, turntable_protocol
 
@@ -30,6 +32,10 @@ def _known_driver(kind: Kind) -> classmethod:
     return field_validator("driver")(classmethod(check))  # type: ignore[return-value]
 
 
+#: Every built-in chamber profile: Modbus register maps and ASCII line protocols.
+ChamberProfile = Literal["watlow-f4", "watlow-f4t", "espec-p300", "thermotron-8800", "simserv", "watlow-f4t-scpi"]
+
+
 class ChamberConfig(StrictModel):
     """Thermal chamber: how to reach its controller, its register map, limits and dynamics."""
 
@@ -38,10 +44,12 @@ class ChamberConfig(StrictModel):
     #: Settings of a plug-in driver, which validates them itself.
     options: dict[str, Any] = Field({}, description="settings a plug-in chamber driver reads")
     endpoint: str | None = Field(None, max_length=1024, description="modbus-tcp: host:port; modbus-rtu: serial "
-                                 "device or URL")
+                                 "device or URL; line: host:port (TCP) or a serial device or URL")
     device_id: int = Field(1, ge=0, le=247)
-    profile: Literal["watlow-f4", "watlow-f4t"] = "watlow-f4t"
+    profile: ChamberProfile = Field("watlow-f4t", description="register map (modbus drivers) or line protocol "
+                                    "(line driver)")
     registers: dict[str, Any] = Field({}, description="fields of the profile's register map to override")
+    protocol_overrides: dict[str, Any] = Field({}, description="fields of the profile's line protocol to override")
     timeout_s: TimeoutS = 1.0
     baudrate: Baudrate = 9600
     parity: Literal["N", "E", "O"] = "N"
@@ -50,14 +58,29 @@ class ChamberConfig(StrictModel):
     max_setpoint_c: TemperatureC = 100.0
     safe_setpoint_c: TemperatureC = 23.0
     ramp_rate_c_per_min: float = Field(3.0, ge=0.1, le=50)
+    dew_point_c: TemperatureC | None = Field(None, description="the chamber air's dew point to assume where its "
+                                             "controller has no humidity reading (a procedure's frost check "
+                                             "needs one or the other)")
 
     def register_map(self) -> ChamberRegisterMap:
         return register_map(self.profile, self.registers)
 
+    def line_protocol(self) -> ChamberLineProtocol:
+        return line_protocol(self.profile, self.protocol_overrides)
+
     @model_validator(mode="after")
     def _consistent(self) -> ChamberConfig:
-        _first_error_as_value_error("registers", self.register_map)
-        if self.driver == "modbus-tcp" and self.endpoint and not _is_host_port(self.endpoint):
+        if self.driver in ("modbus-tcp", "modbus-rtu"):
+            if self.profile not in REGISTER_PROFILES:
+                raise ValueError(f"profile {self.profile} is a line protocol: use driver: line "
+                                 f"(register maps: {', '.join(REGISTER_PROFILES)})")
+            _first_error_as_value_error("registers", self.register_map)
+        if self.driver == "line":
+            if self.profile not in LINE_PROFILES:
+                raise ValueError(f"profile {self.profile} is a Modbus register map: use driver: modbus-tcp or "
+                                 f"modbus-rtu (line protocols: {', '.join(LINE_PROFILES)})")
+            _first_error_as_value_error("protocol_overrides", self.line_protocol)
+        if self.driver == "modbus-tcp" and self.endpoint and not is_host_port(self.endpoint):
             raise ValueError(f"modbus-tcp endpoint {self.endpoint!r} is not host:port")
         if self.min_setpoint_c >= self.max_setpoint_c:
             raise ValueError("min_setpoint_c must be below max_setpoint_c")
@@ -165,9 +188,10 @@ def _first_error_as_value_error(key: str, build: Callable[[], object]) -> None:
         raise ValueError(f"{key}.{'.'.join(map(str, first['loc']))}: {first['msg']}") from None
 
 
-def _is_host_port(endpoint: str) -> bool:
+def is_host_port(endpoint: str) -> bool:
+    """`host:port` (a TCP endpoint), not a device path or a URL."""
     host, _, port = endpoint.rpartition(":")
-    return bool(host) and port.isdigit() and 0 < int(port) < 65536
+    return bool(host) and "/" not in host and port.isdigit() and 0 < int(port) < 65536
 
 
 class FixtureConfig(StrictModel):
@@ -221,6 +245,11 @@ class SimulationConfig(StrictModel):
     controller_limits_c: tuple[TemperatureC, TemperatureC] = Field(
         (-70.0, 180.0), description="the simulated controller's own set point limits (low, high), where its "
                                     "register map has them; it clamps set points to them as a real one does")
+    room_dew_point_c: TemperatureC = Field(12.0, description="the room's air, which a chamber without purge "
+                                           "takes in (23 °C at 50 % RH has a dew point near 12 °C)")
+    purge_dew_point_c: TemperatureC = Field(-40.0, description="the dry-air purge's dew point (instrument air)")
+    moisture_time_constant_min: float = Field(5.0, ge=0.01, le=1440, description="the air's dew point follows "
+                                              "its target with this time constant")
     faults: FaultInjection = FaultInjection()
 
 

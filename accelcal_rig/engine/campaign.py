@@ -2,7 +2,8 @@
 while its audience is told (engine/audience.py).
 
 The runner does not know what a step does: it hands each to the handler for its type (thermal steps in
-engine/thermal_steps.py, poses in engine/pose_steps.py, a cool-down's records in engine/cooldown_steps.py).
+engine/thermal_steps.py, poses in engine/pose_steps.py, a cool-down's records in engine/cooldown_steps.py,
+the purge and the dew point in engine/frost_steps.py).
 It knows where a resumed run begins (the steps not stored yet, a setpoint's restart entry) and that a
 skipped soak skips the rest of its setpoint.
 
@@ -29,6 +30,7 @@ from accelcal_rig.engine.audience import Audience, Reporter
 from accelcal_rig.engine.connection import GuardedRig
 from accelcal_rig.engine.cooldown_steps import CooldownSteps
 from accelcal_rig.engine.events import EventLog
+from accelcal_rig.engine.frost_steps import FrostSteps
 from accelcal_rig.engine.pose_steps import PoseSteps
 from accelcal_rig.engine.resume import ResumePoint
 from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
@@ -39,11 +41,13 @@ from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity
 from accelcal_rig.plan.compile import Plan, setpoint_label
 from accelcal_rig.plan.steps import (
     AdvanceRamp,
+    AwaitDewPointMargin,
     CooldownRecord,
     Measurement,
     MeasurePose,
     Ramp,
     RampSegment,
+    SetPurge,
     Soak,
     StartSoftwareRamp,
     Step,
@@ -113,11 +117,13 @@ class CampaignRunner:
                                     self.machine, self.report)
         self.poses = PoseSteps(procedure, rig, guarded, clock, events, writer, self.machine, self.report, self.thermal)
         cooldown = CooldownSteps(procedure, self.chamber, clock, events, self.machine, self.thermal, self.poses)
+        self.frost = FrostSteps(procedure, rig, self.chamber, self.sensors, clock, events)
         #: What each type of step is done by.
         self.handlers: Mapping[type, Callable[[Any], None]] = {
             Ramp: self.thermal.ramp, Soak: self.thermal.soak, StartSoftwareRamp: self.thermal.start_software_ramp,
             RampSegment: self.thermal.follow_software_ramp, AdvanceRamp: self.thermal.advance_software_ramp,
             MeasurePose: self.poses.measure, VerifyPose: self.poses.measure, CooldownRecord: cooldown.record,
+            SetPurge: self.frost.set_purge, AwaitDewPointMargin: self.frost.await_dew_point_margin,
         }
 
     # ----------------------------------------------------------------- top level
@@ -214,6 +220,7 @@ class CampaignRunner:
         """Check identities and configure every DUT before anything moves."""
         self.events.info("preflight", f"chamber: {self.chamber.identify()} ({self.chamber.endpoint})")
         self._check_controller_limits()
+        self.frost.preflight(self.plan)
         self.events.info("preflight", f"turntable: {self.turntable.identify()} ({self.turntable.endpoint})")
         acquisition = self.procedure.acquisition
         for sensor in self.sensors:

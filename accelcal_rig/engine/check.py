@@ -6,8 +6,10 @@ from collections.abc import Iterator
 
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.errors import InstrumentError
+from accelcal_rig.core.humidity import dew_point_c
+from accelcal_rig.instruments.capabilities import controller_limits, has_purge, humidity_pct
+from accelcal_rig.instruments.interfaces import Chamber
 from accelcal_rig.instruments.connect import SomeInstruments
-from accelcal_rig.instruments.limits import controller_limits
 
 
 def check_lines(instruments: SomeInstruments, rig: RigConfig) -> Iterator[str]:
@@ -19,7 +21,7 @@ def check_lines(instruments: SomeInstruments, rig: RigConfig) -> Iterator[str]:
                   "the " + (f"controller's {controller[0]:g}…{controller[1]:g} °C" if controller
                             else "controller exposes none"))
         yield (f"chamber    {chamber.endpoint}: {chamber.identify()}, alarm "
-               f"{'ACTIVE' if chamber.alarm_active() else 'clear'}{limits}")
+               f"{'ACTIVE' if chamber.alarm_active() else 'clear'}{limits}{_moisture(chamber, rig)}")
     if turntable is not None:
         angles = " ".join(f"{a:.3f}" for a in turntable.read_angles_deg())
         yield (f"turntable  {turntable.endpoint}: {turntable.identify()}, angles {angles}°, "
@@ -32,3 +34,15 @@ def check_lines(instruments: SomeInstruments, rig: RigConfig) -> Iterator[str]:
         range_g, odr_hz = sensor.read_settings()
         yield (f"sensor {sensor.serial}  {sensor.endpoint}: {sensor.part.label} rev {identity.revid}, ±{range_g} g, "
                f"{odr_hz:g} Hz, {sensor.read_temperature_c():.1f} °C")
+
+
+def _moisture(chamber: Chamber, rig: RigConfig) -> str:
+    """What a procedure's frost settings can count on: the purge output, and the air's dew point."""
+    relative_humidity = humidity_pct(chamber)
+    if relative_humidity is not None:
+        dew = dew_point_c(chamber.read_temperature_c(), relative_humidity)
+        air = f"{relative_humidity:.1f} % RH (dew point {dew:.1f} °C)"
+    else:
+        air = "no humidity reading" + (f" (dew point {rig.chamber.dew_point_c:g} °C configured)"
+                                       if rig.chamber.dew_point_c is not None else "")
+    return f"; {air}; dry-air purge {'output' if has_purge(chamber) else 'none'}"

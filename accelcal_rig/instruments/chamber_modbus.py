@@ -7,7 +7,6 @@ decimals or units register that disagrees with the map, or values no chamber rea
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from typing import Any
 
@@ -18,11 +17,10 @@ from pymodbus.exceptions import ModbusException
 from accelcal_rig.config.rig import ChamberConfig
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.definitions import ChamberDriver
+from accelcal_rig.instruments.limits import plausible_c
 from accelcal_rig.instruments.retrying import RetryCall
 from accelcal_rig.protocols.chamber_registers import ChamberRegisterMap
 
-#: Readings outside this are not a chamber's air: the map or word order must be wrong.
-PLAUSIBLE_C = (-100.0, 300.0)
 #: Modbus exception codes that mean "try again": 5 acknowledge (still working), 6 server device busy.
 _BUSY_CODES = (5, 6)
 
@@ -94,6 +92,15 @@ class ModbusChamber:
             raise self._error("the register map has no power event")
         self._write(m.power_register, [m.power_on if on else m.power_off])
 
+    def has_purge(self) -> bool:
+        return self.registers.purge_register is not None
+
+    def set_purge(self, on: bool) -> None:
+        m = self.registers
+        if m.purge_register is None:
+            raise self._error("the register map has no purge output (set registers.purge_register)")
+        self._write(m.purge_register, [m.purge_on if on else m.purge_off])
+
     def controller_limits_c(self) -> tuple[float, float] | None:
         m = self.registers
         if m.setpoint_low_register is None or m.setpoint_high_register is None:
@@ -146,7 +153,7 @@ class ModbusChamber:
     def _plausible(self, value: float, what: str) -> float:
         """Swapped float words give NaN, huge values or, for round temperatures (zero low word), denormals."""
         tiny = value != 0.0 and abs(value) < 1e-6
-        if tiny or not (math.isfinite(value) and PLAUSIBLE_C[0] <= value <= PLAUSIBLE_C[1]):
+        if tiny or not plausible_c(value):
             raise self._error(f"{what} reads {value:g} °C: wrong register map or word order")
         return value
 

@@ -2,20 +2,24 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from accelcal_rig.config.rig import ChamberConfig, TurntableConfig
 from accelcal_rig.errors import InstrumentError
+from accelcal_rig.instruments.capabilities import controller_limits
 from accelcal_rig.instruments.interfaces import Chamber, Turntable
 
 #: A setpoint read back further than this from what was written means the controller did not take it.
 SETPOINT_READBACK_TOLERANCE_C = 0.05
+#: Readings outside this are not a chamber's air: the map, word order, profile or units must be wrong.
+PLAUSIBLE_C = (-100.0, 300.0)
 
 
-def controller_limits(chamber: Chamber) -> tuple[float, float] | None:
-    """The controller's own set point limits; None from a plug-in driver that predates the method."""
-    limits = getattr(chamber, "controller_limits_c", None)
-    return limits() if callable(limits) else None
+def plausible_c(value: float) -> bool:
+    """A temperature a chamber's air could have."""
+    return math.isfinite(value) and PLAUSIBLE_C[0] <= value <= PLAUSIBLE_C[1]
 
 
 class LimitedChamber:

@@ -16,25 +16,29 @@ from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 
 class LinePort:
     def __init__(self, port: serial.SerialBase, name: str, write_terminator: str = "\n",
-                 read_terminator: str = "\n", endpoint: str = "", baudrate: int = 9600) -> None:
+                 read_terminator: str = "\n", endpoint: str = "", baudrate: int = 9600,
+                 encoding: str = "ascii") -> None:
         self._port = port
         self._endpoint, self._baudrate = endpoint, baudrate
         self.name = name  # "turntable (serial /dev/ttyUSB0)": how errors name the instrument
-        self._write_terminator = write_terminator.encode()
-        self._read_terminator = read_terminator.encode()
+        self._encoding = encoding  # latin-1 where a protocol separates fields with a byte above 0x7F
+        self._write_terminator = write_terminator.encode(encoding)
+        self._read_terminator = read_terminator.encode(encoding)
 
     @classmethod
     def open(cls, endpoint: str, instrument: str, baudrate: int, timeout_s: float, write_terminator: str = "\n",
-             read_terminator: str = "\n") -> LinePort:
-        name = f"{instrument} (serial {endpoint})"
+             read_terminator: str = "\n", encoding: str = "ascii") -> LinePort:
+        """A device path or pyserial URL; `socket://host:port` is a TCP connection, named as one."""
+        where = f"tcp {endpoint.removeprefix('socket://')}" if endpoint.startswith("socket://") else f"serial {endpoint}"
+        name = f"{instrument} ({where})"
         return cls(_open_port(name, endpoint, baudrate, timeout_s), name, write_terminator, read_terminator,
-                   endpoint, baudrate)
+                   endpoint, baudrate, encoding)
 
     def ask(self, request: str) -> str:
         """Send one request, return its reply line without the terminator (stripped)."""
         try:
             self._port.reset_input_buffer()  # a late reply to an earlier, timed-out request is stale
-            self._port.write(request.encode() + self._write_terminator)
+            self._port.write(request.encode(self._encoding) + self._write_terminator)
             raw = self._read_line()
         except (serial.SerialException, OSError) as exc:
             raise TransientInstrumentError(f"{self.name}: {request!r}: port failed: {exc}", reconnect=True) from None
@@ -43,7 +47,15 @@ class LinePort:
             raise TransientInstrumentError(f"{self.name}: {request!r}: no reply within the timeout")
         # Lines before the last are late replies to earlier requests that arrived with this one.
         last = raw[: -len(self._read_terminator)].split(self._read_terminator)[-1]
-        return last.decode(errors="replace").strip()
+        return last.decode(self._encoding, errors="replace").strip()
+
+    def send(self, request: str) -> None:
+        """Send a request that has no reply (a SCPI setting)."""
+        try:
+            self._port.reset_input_buffer()
+            self._port.write(request.encode(self._encoding) + self._write_terminator)
+        except (serial.SerialException, OSError) as exc:
+            raise TransientInstrumentError(f"{self.name}: {request!r}: port failed: {exc}", reconnect=True) from None
 
     def close(self) -> None:
         self._port.close()

@@ -16,6 +16,7 @@ from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.config.schedule import Schedule
 from accelcal_rig.plan import schedules
+from accelcal_rig.plan.frost import with_frost_steps
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.plan.steps import (
     AdvanceRamp,
@@ -132,7 +133,8 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
         soaked = _ramp_and_soak(setpoint)
         records = tuple(CooldownRecord(f"{label}/cool{k:04d}", setpoint, held, k)
                         for k in range(1, cooldown_records(procedure) + 1))
-        return Plan((setpoint,), (held,), (Stage(setpoint, soaked, records, soaked),), names)
+        stage = with_frost_steps([Stage(setpoint, soaked, records, soaked)], procedure.frost)
+        return Plan((setpoint,), (held,), tuple(stage), names)
     verify = procedure.verify
     checks = compile_poses(verify.schedule, rig, poses[-1].angles_deg) if verify is not None else ()
     if checks:
@@ -158,6 +160,7 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
             passed = _passed_between(setpoint, setpoints[index + 1], verify.setpoints_c, stages)
             stages.extend(Stage(v, _ramp_and_soak(v), tuple(_verification(v, checks)), _ramp_and_soak(v))
                           for v in passed)
+    stages = with_frost_steps(stages, procedure.frost)
     return Plan(tuple(s.setpoint_c for s in stages), poses, tuple(stages), names, checks)
 
 

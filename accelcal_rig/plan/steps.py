@@ -36,6 +36,21 @@ class Soak:
 
 
 @dataclass(frozen=True)
+class SetPurge:
+    """Switch the chamber's dry-air purge on or off before going to the setpoint (`frost.purge_below_c`)."""
+
+    setpoint_c: float
+    on: bool
+
+
+@dataclass(frozen=True)
+class AwaitDewPointMargin:
+    """After a warming step: wait until every DUT is `frost.dew_point_margin_c` above the air's dew point."""
+
+    setpoint_c: float
+
+
+@dataclass(frozen=True)
 class StartSoftwareRamp:
     """The ramp method: from here on the chamber setpoint moves at the procedure's rate to the last setpoint."""
 
@@ -87,7 +102,8 @@ class CooldownRecord(Measurement):
     number: int
 
 
-Step = Ramp | Soak | StartSoftwareRamp | RampSegment | AdvanceRamp | MeasurePose | VerifyPose | CooldownRecord
+Step = (Ramp | Soak | SetPurge | AwaitDewPointMargin | StartSoftwareRamp | RampSegment | AdvanceRamp | MeasurePose
+        | VerifyPose | CooldownRecord)
 #: The steps that store a record in the campaign (what its stored plan lists).
 Record = Soak | Measurement
 

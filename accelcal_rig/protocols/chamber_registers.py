@@ -37,6 +37,10 @@ class ChamberRegisterMap(BaseModel):
     setpoint_low_register: int | None = Field(None, ge=0, le=65535, description="the controller's own set point "
                                               "limits, encoded like the set point")
     setpoint_high_register: int | None = Field(None, ge=0, le=65535)
+    purge_register: int | None = Field(None, ge=0, le=65535, description="event output wired to the chamber's "
+                                       "dry-air purge (chamber-specific: none in the built-in maps)")
+    purge_on: int = Field(1, ge=0, le=65535)
+    purge_off: int = Field(0, ge=0, le=65535)
 
 
 #: Watlow F4 (TestEquity, Thermotron, Cincinnati Sub-Zero): signed 16-bit, decimals from register 606,

@@ -9,21 +9,14 @@ controller error.
 from __future__ import annotations
 
 import re
-import string
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
+from accelcal_rig.protocols.line_templates import regular_expression, request_pattern, template
 
-def _regular_expression(value: str) -> str:
-    try:
-        re.compile(value)
-    except re.error as exc:
-        raise ValueError(f"not a regular expression: {exc}") from None
-    return value
-
-
-#: What a template may name: the request's axis (1-based) and angle, and the values replies carry.
-_TEMPLATE_FIELDS = frozenset({"axis", "angle", "identity", "busy", "fault"})
+#: What a template may name, with sample values: the request's axis (1-based) and angle, and the values
+#: replies carry.
+_TEMPLATE_SAMPLE: dict[str, object] = {"axis": 1, "angle": 0.0, "identity": "x", "busy": 0, "fault": 0}
 
 
 class Command(BaseModel):
@@ -34,33 +27,13 @@ class Command(BaseModel):
     answer: str = Field(min_length=1, max_length=256, description="what a controller answers (template), for "
                         "simulators")
 
-    _compiles = field_validator("reply")(classmethod(lambda cls, value: _regular_expression(value)))
-
-    @field_validator("send", "answer")
-    @classmethod
-    def _template(cls, value: str) -> str:
-        """A template must format: `{axis}` and `{angle:.5f}` style fields, nothing a request cannot fill."""
-        try:
-            fields = [f for _, f, _, _ in string.Formatter().parse(value) if f is not None]
-        except ValueError as exc:
-            raise ValueError(f"not a template: {exc}") from None
-        unknown = sorted(set(fields) - _TEMPLATE_FIELDS)
-        if unknown:
-            raise ValueError(f"template fields {', '.join(unknown)} unknown (known: {', '.join(sorted(_TEMPLATE_FIELDS))})")
-        try:
-            value.format(axis=1, angle=0.0, identity="x", busy=0, fault=0)
-        except (ValueError, TypeError, IndexError) as exc:
-            raise ValueError(f"template does not format: {exc}") from None
-        return value
+    _compiles = field_validator("reply")(classmethod(lambda cls, value: regular_expression(value)))
+    #: `{axis}` and `{angle:.5f}` style fields, nothing a request cannot fill.
+    _templates = field_validator("send", "answer")(classmethod(lambda cls, value: template(value, _TEMPLATE_SAMPLE)))
 
     def request_pattern(self) -> re.Pattern[str]:
         """The `send` template as a pattern, for a simulator to recognise the request."""
-        pattern = ""
-        for literal, field, _, _ in string.Formatter().parse(self.send):
-            pattern += re.escape(literal)
-            if field is not None:
-                pattern += rf"(?P<{field}>\S+)"
-        return re.compile(pattern)
+        return request_pattern(self.send)
 
 
 class TurntableProtocol(BaseModel):
@@ -79,7 +52,7 @@ class TurntableProtocol(BaseModel):
     busy_values: list[str] = Field(["1"], max_length=16)
     fault_ok: list[str] = Field(["0"], max_length=16)
 
-    _compiles = field_validator("error_pattern")(classmethod(lambda cls, value: _regular_expression(value)))
+    _compiles = field_validator("error_pattern")(classmethod(lambda cls, value: regular_expression(value)))
 
 
 #: The built-in profile: a plain SCPI-like line protocol, one command per line, one reply per command.

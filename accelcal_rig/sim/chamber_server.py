@@ -95,7 +95,7 @@ class SimulatedChamberServer:
         width = 2 if m.encoding == "float32" else 1
         addresses = {m.process_value: width, m.setpoint: width}
         for register in (m.identity_register, m.decimals_register, m.units_register, m.power_register,
-                         m.alarm_register, m.setpoint_low_register, m.setpoint_high_register):
+                         m.alarm_register, m.setpoint_low_register, m.setpoint_high_register, m.purge_register):
             if register is not None:
                 addresses[register] = 1
         return [SimData(address=a, count=n, datatype=DataType.REGISTERS) for a, n in sorted(addresses.items())]
@@ -139,6 +139,11 @@ class SimulatedChamberServer:
             if value not in (m.power_on, m.power_off):
                 return ExcCodes.ILLEGAL_VALUE
             self._lab.thermal.set_power(now, value == m.power_on)
+        if m.purge_register is not None and m.purge_register in requested:
+            value = values[m.purge_register - address]
+            if value not in (m.purge_on, m.purge_off):
+                return ExcCodes.ILLEGAL_VALUE
+            self._lab.moisture.set_purge(now, value == m.purge_on)
         return None
 
     def _values(self, requested: range) -> dict[int, list[int]]:
@@ -158,6 +163,8 @@ class SimulatedChamberServer:
             values[m.power_register] = [m.power_on if self._lab.thermal.powered else m.power_off]
         if m.alarm_register is not None:
             values[m.alarm_register] = [m.alarm_inactive[0]]
+        if m.purge_register is not None:
+            values[m.purge_register] = [m.purge_on if self._lab.moisture.purge_on else m.purge_off]
         if m.setpoint_low_register is not None and m.setpoint_high_register is not None:
             low, high = self._lab.controller_limits_c
             values[m.setpoint_low_register], values[m.setpoint_high_register] = self._encode(low), self._encode(high)

@@ -12,12 +12,14 @@ from scipy.spatial.transform import Rotation
 from accelcal_rig.config.procedure import SimulatedEffects
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
+from accelcal_rig.core.humidity import relative_humidity_pct
 from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel, dut_time_constant_s
 from accelcal_rig.core.units import site_gravity_g
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.parts.part import AccelerometerPart
 from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.kinematics import TurntableKinematics
+from accelcal_rig.sim.moisture import ChamberMoisture
 from accelcal_rig.sim.truth import DutTruth, truth_for_serial
 from accelcal_rig.sim.turntable_motion import TurntableMotion
 
@@ -71,6 +73,8 @@ class VirtualLab:
             self_heating_c=sim.self_heating_c,
             free_cooling_tau_s=sim.free_cooling_time_constant_min * 60.0,
         )
+        self.moisture = ChamberMoisture(sim.room_dew_point_c, sim.purge_dew_point_c,
+                                        sim.moisture_time_constant_min * 60.0, self.thermal.air_c, clock.now())
         self.motion = TurntableMotion(
             speeds_deg_s=np.array([a.speed_deg_s for a in rig.turntable.axes]),
             accuracy_deg=rig.turntable.accuracy_arcsec / 3600.0,
@@ -87,6 +91,11 @@ class VirtualLab:
     def chamber_reading_c(self) -> float:
         """Chamber air as its controller reads it, with regulation noise."""
         return self.thermal.air_c(self.clock.now()) + float(self.rng.normal(0.0, self.chamber_noise_c))
+
+    def chamber_humidity_pct(self) -> float:
+        """The air's relative humidity as the controller's sensor reads it (no noise: it is read rarely)."""
+        now = self.clock.now()
+        return relative_humidity_pct(self.thermal.air_c(now), self.moisture.dew_point_c(now))
 
     def dut_true_c(self, index: int) -> float:
         return self.thermal.dut_c(self.clock.now(), index)

@@ -5,21 +5,20 @@ from __future__ import annotations
 import os
 import select
 import threading
-import time
 import tty
-from collections.abc import Callable
 
 from accelcal_rig.sim.faults import ReplyFaults
+from accelcal_rig.sim.line_answers import Handler, LineAnswers
 
 
 class PtyLineServer:
-    """Reads requests ending in `terminator` from the pty and writes back `handle(request) + terminator`."""
+    """Reads requests ending in `terminator` from the pty and writes back `handle(request)` and the reply
+    terminator (the same unless given)."""
 
-    def __init__(self, handle: Callable[[str], str], terminator: bytes = b"\n", name: str = "pty",
-                 faults: ReplyFaults | None = None) -> None:
-        self._handle = handle
-        self._faults = faults
-        self._terminator = terminator
+    def __init__(self, handle: Handler, terminator: bytes = b"\n", name: str = "pty",
+                 faults: ReplyFaults | None = None, reply_terminator: bytes | None = None,
+                 encoding: str = "utf-8") -> None:
+        self._answers = LineAnswers(handle, terminator, reply_terminator, encoding, faults)
         self._master, self._slave = os.openpty()
         tty.setraw(self._master)
         tty.setraw(self._slave)  # the slave stays open so the path keeps working between clients
@@ -38,26 +37,12 @@ class PtyLineServer:
             os.close(fd)
 
     def _serve(self) -> None:
-        pending = b""
         while True:
             readable, _, _ = select.select([self._master, self._wake_read], [], [])
             if self._wake_read in readable:
                 return
             try:
-                pending += os.read(self._master, 65536)
+                data = os.read(self._master, 65536)
             except OSError:
                 return
-            while self._terminator in pending:
-                line, pending = pending.split(self._terminator, 1)
-                reply = self._handle(line.decode(errors="replace").strip()).encode() + self._terminator
-                self._send(reply)
-
-    def _send(self, reply: bytes) -> None:
-        fault = self._faults.draw(("drop", "delay", "corrupt", "disconnect")) if self._faults else None
-        if fault == "drop":
-            return
-        if fault == "delay":
-            time.sleep(self._faults.faults.delay_s)  # type: ignore[union-attr]
-        elif fault == "corrupt":
-            reply = self._faults.corrupt(reply)  # type: ignore[union-attr]
-        os.write(self._master, reply)
+            self._answers.feed(data, lambda reply: os.write(self._master, reply))

@@ -1,6 +1,6 @@
 """The whole simulated rig as real endpoints, each instrument served by the simulator its driver names
-(accelcal_rig.plugins): built in, the chamber on Modbus TCP (127.0.0.1), the turntable and each sensor
-bridge on a pseudo-terminal, all backed by one virtual lab on one clock.
+(accelcal_rig.plugins): built in, the chamber on Modbus TCP or its line protocol on TCP (127.0.0.1), the
+turntable and each sensor bridge on a pseudo-terminal, all backed by one virtual lab on one clock.
 
 A dry run connects the real drivers to these; `rig sim` leaves them up for any Modbus master or serial
 terminal. A driver whose simulator speaks another framing says which driver talks to it (`simulated_by`:
@@ -76,10 +76,11 @@ class SimulatedRig:
     def describe(self) -> dict[str, Any]:
         """The endpoints as `rig sim` prints them."""
         chamber: dict[str, Any] = {"protocol": self._drivers["chamber"], "endpoint": self.chamber.endpoint}
-        if self._drivers["chamber"] == "modbus-tcp":
+        if self._drivers["chamber"] in ("modbus-tcp", "line"):
             host, _, port = self.chamber.endpoint.rpartition(":")
-            chamber |= {"host": host, "port": int(port), "device_id": self.rig.chamber.device_id,
-                        "profile": self.rig.chamber.profile}
+            chamber |= {"host": host, "port": int(port), "profile": self.rig.chamber.profile}
+        if self._drivers["chamber"] == "modbus-tcp":
+            chamber["device_id"] = self.rig.chamber.device_id
         return {
             "chamber": chamber,
             "turntable": {"protocol": self.rig.turntable.protocol, "device": self.turntable.endpoint},

@@ -49,8 +49,9 @@ class ExpectedPort:
 
 @contextmanager
 def expected_protocol(conversation: Sequence[tuple[bytes, bytes | None]], name: str = "instrument (memory)",
-                      write_terminator: str = "\n", read_terminator: str = "\n") -> Iterator[LinePort]:
+                      write_terminator: str = "\n", read_terminator: str = "\n",
+                      encoding: str = "ascii") -> Iterator[LinePort]:
     """A LinePort over an ExpectedPort; on leaving, every request of the conversation must have been sent."""
     port = ExpectedPort(conversation)
-    yield LinePort(port, name, write_terminator, read_terminator)  # type: ignore[arg-type]
+    yield LinePort(port, name, write_terminator, read_terminator, encoding=encoding)  # type: ignore[arg-type]
     port.assert_finished()

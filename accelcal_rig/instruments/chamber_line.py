@@ -1,0 +1,147 @@
+"""Thermal chamber controller speaking an ASCII line protocol (a profile of accelcal_rig.protocols.chamber_lines),
+over TCP (`host:port`) or a serial line (a device path or any pyserial URL).
+
+Every failure is one line naming the chamber and its endpoint: a refusal (the profile's error replies,
+with their meaning: a controller in local mode says so), a garbled or unexpected reply (transient: asked
+again), silence, a controller not in °C, or values no chamber reads.
+"""
+
+from __future__ import annotations
+
+import re
+
+from accelcal_rig.config.rig import ChamberConfig, is_host_port
+from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.instruments.definitions import ChamberDriver
+from accelcal_rig.instruments.limits import plausible_c
+from accelcal_rig.instruments.line_port import LinePort
+from accelcal_rig.instruments.retrying import RetryCall
+from accelcal_rig.protocols.chamber_lines import ChamberLineProtocol, Operation
+
+
+class LineChamber:
+    def __init__(self, line: LinePort, endpoint: str, protocol: ChamberLineProtocol) -> None:
+        self._line = line
+        self.endpoint = endpoint
+        self.protocol = protocol
+        self._error = re.compile(protocol.error_pattern)
+        self._retry: RetryCall = lambda operation, reconnect: operation()
+
+    @classmethod
+    def open(cls, endpoint: str, protocol: ChamberLineProtocol, baudrate: int = 9600,
+             timeout_s: float = 1.0) -> LineChamber:
+        """`host:port` is TCP; anything else a serial device or pyserial URL."""
+        url = f"socket://{endpoint}" if is_host_port(endpoint) else endpoint
+        line = LinePort.open(url, "chamber", baudrate, timeout_s, protocol.write_terminator, protocol.read_terminator,
+                             protocol.encoding)
+        where = f"tcp {endpoint}" if is_host_port(endpoint) else f"serial {endpoint}"
+        return cls(line, where, protocol)
+
+    # ------------------------------------------------------------------ the Chamber interface
+    def identify(self) -> str:
+        """Refuse a controller not in °C (where the profile can ask); describe it."""
+        identity = self._ask("identify")["identity"]
+        if self.protocol.units is not None:
+            units = self._ask("units")["units"]
+            if units != self.protocol.units_celsius:
+                raise self._failure(f"controller is not in °C (units read {units!r}, expected "
+                                    f"{self.protocol.units_celsius!r})")
+        temperature, setpoint = self.read_temperature_c(), self.read_setpoint_c()
+        return f"{identity} (PV {temperature:.1f} °C, SP {setpoint:.1f} °C)"
+
+    def read_temperature_c(self) -> float:
+        return self._temperature("read_temperature", "pv", "process value")
+
+    def read_setpoint_c(self) -> float:
+        return self._temperature("read_setpoint", "sp", "set point")
+
+    def write_setpoint_c(self, setpoint_c: float) -> None:
+        """Limits are the caller's gate (LimitedChamber), which also reads the set point back."""
+        self._ask("write_setpoint", value=float(setpoint_c))
+
+    def controller_limits_c(self) -> tuple[float, float] | None:
+        if self.protocol.read_low_limit is None:
+            return None
+        low = self._temperature("read_low_limit", "low", "set point low limit")
+        high = self._temperature("read_high_limit", "high", "set point high limit")
+        if not low < high:
+            raise self._failure(f"set point limits read {low:g}…{high:g} °C: not a range")
+        return low, high
+
+    def set_power(self, on: bool) -> None:
+        if self.protocol.power_on is None:
+            raise self._failure("the protocol profile has no power command")
+        self._ask("power_on" if on else "power_off")
+
+    def read_humidity_pct(self) -> float | None:
+        """The controller's relative humidity reading; None where the profile has no humidity command."""
+        if self.protocol.humidity is None:
+            return None
+        value = float(self._ask("humidity")["humidity"])
+        if not 0.0 <= value <= 100.5:
+            raise self._failure(f"relative humidity reads {value:g} %: not a reading (wrong profile?)")
+        return value
+
+    def has_purge(self) -> bool:
+        return self.protocol.purge_on is not None
+
+    def set_purge(self, on: bool) -> None:
+        """Switch the dry-air purge output (frost and condensation on a cold fixture)."""
+        if self.protocol.purge_on is None:
+            raise self._failure("the protocol profile has no purge output (set purge_on/purge_off in "
+                                "protocol_overrides)")
+        self._ask("purge_on" if on else "purge_off")
+
+    def alarm_active(self) -> bool:
+        if self.protocol.alarm is None:
+            return False
+        return self._ask("alarm")["alarm"] not in self.protocol.alarm_inactive
+
+    def close(self) -> None:
+        self._line.close()
+
+    def retry_exchanges(self, call: RetryCall) -> None:
+        """Retry each request on its own (queries, and set points and outputs as absolute values, repeat safely)."""
+        self._retry = call
+
+    def reconnect(self) -> None:
+        self._line.reconnect()
+
+    # ------------------------------------------------------------------ values
+    def _temperature(self, operation: Operation, group: str, what: str) -> float:
+        value = float(self._ask(operation)[group])
+        if not plausible_c(value):
+            raise self._failure(f"{what} reads {value:g} °C: not a chamber's air (wrong profile or units?)")
+        return value
+
+    def _failure(self, message: str) -> InstrumentError:
+        return InstrumentError(f"chamber ({self.endpoint}): {message}")
+
+    # ------------------------------------------------------------------ wire
+    def _ask(self, operation: Operation, **fields: object) -> dict[str, str]:
+        return self._retry(lambda: self._ask_once(operation, **fields), self.reconnect)
+
+    def _ask_once(self, operation: Operation, **fields: object) -> dict[str, str]:
+        command = self.protocol.command(operation)
+        request = self.protocol.request(operation, **fields)
+        if command is None or command.reply is None:
+            self._line.send(request)
+            return {}
+        reply = self._line.ask(request)
+        refusal = self._error.search(reply)
+        if refusal is not None:
+            code = refusal.groupdict().get("code")
+            meaning = self.protocol.errors.get(code.strip()) if code else None
+            raise self._failure(f"{request!r} refused: {reply}" + (f" ({meaning})" if meaning else ""))
+        match = re.fullmatch(command.reply, reply)
+        if match is None:
+            raise TransientInstrumentError(f"chamber ({self.endpoint}): {request!r}: unexpected reply {reply!r}")
+        return {k: v for k, v in match.groupdict().items() if v is not None}
+
+
+def _open(config: ChamberConfig, endpoint: str) -> LineChamber:
+    return LineChamber.open(endpoint, config.line_protocol(), config.baudrate, config.timeout_s)
+
+
+LINE = ChamberDriver("line", _open, simulator="accelcal_rig.sim.chamber_line_server:serve_line",
+                     protocol="accelcal_rig.protocols.chamber_lines")

@@ -1,0 +1,206 @@
+"""Chamber controllers that speak ASCII lines (ESPEC, Thermotron, Vötsch/Weiss SIMSERV, Watlow F4T SCPI):
+their protocols as data, one profile each (facts and their sources: docs/instruments.md).
+
+Each operation is a command: what to send (a template; `{value}` is a set point in °C), the pattern a good
+reply matches in full (named groups carry values: `pv`, `sp`, `low`, `high`, `identity`, `alarm`, `units`,
+`humidity`), and the answer a controller gives (a template of the same names, for the simulator generated
+from the profile). A command without a reply pattern is sent and not answered (SCPI settings); the
+driver then reads back what it set. A reply matching `error_pattern` is the controller refusing; its
+`code` group is looked up in `errors` for a meaning a technician can act on.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+from accelcal_rig.protocols.line_templates import NUMBER, regular_expression, request_pattern, template
+
+#: What the templates may name, with sample values: the request's set point, and what replies carry.
+_SAMPLE: dict[str, object] = {"value": 0.0, "pv": 0.0, "sp": 0.0, "low": 0.0, "high": 0.0, "identity": "x",
+                              "alarm": "0", "units": "C", "humidity": 0.0}
+
+Operation = Literal["identify", "read_temperature", "read_setpoint", "write_setpoint", "read_low_limit",
+                    "read_high_limit", "power_on", "power_off", "alarm", "units", "humidity", "purge_on",
+                    "purge_off"]
+
+
+class LineCommand(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    send: str = Field(min_length=1, max_length=256)
+    reply: str | None = Field(None, min_length=1, max_length=256, description="regular expression a good reply "
+                              "matches in full; none: the controller does not answer this command")
+    answer: str | None = Field(None, min_length=1, max_length=256, description="what a controller answers "
+                               "(template), for simulators")
+
+    _compiles = field_validator("reply")(classmethod(lambda cls, v: v if v is None else regular_expression(v)))
+    _templates = field_validator("send", "answer")(classmethod(lambda cls, v: v if v is None else template(v, _SAMPLE)))
+
+    @model_validator(mode="after")
+    def _answered_if_replied(self) -> LineCommand:
+        if (self.reply is None) != (self.answer is None):
+            raise ValueError("a command has both a reply pattern and an answer, or neither")
+        return self
+
+
+class ChamberLineProtocol(BaseModel):
+    """One controller family's line protocol. Optional operations are absent where it has none."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    write_terminator: str = Field("\n", min_length=1, max_length=4)
+    read_terminator: str = Field("\n", min_length=1, max_length=4)
+    encoding: Literal["ascii", "latin-1"] = Field("ascii", description="latin-1 where fields are separated by a "
+                                                  "byte above 0x7F (SIMSERV's 0xB6)")
+    request_prefix: str = Field("", max_length=16, description="sent before every request: an RS-485 address")
+    default_port: int | None = Field(None, ge=1, le=65535, description="the controller's TCP port, documented")
+    error_pattern: str = Field("(?!)", max_length=256, description="a reply matching it is a refusal; group `code`")
+    errors: dict[str, str] = Field({}, description="error code → what it means, for the one-line error")
+    unknown_command_answer: str | None = Field(None, max_length=256, description="what the simulator answers to "
+                                               "a request it does not know (none: silence)")
+    local_mode_answer: str | None = Field(None, max_length=256, description="what the controller answers to a "
+                                          "remote write while it is in local/manual mode, for the simulator")
+    units_celsius: str = Field("C", max_length=16, description="the `units` reply that means °C")
+    alarm_inactive: list[str] = Field(["0"], max_length=64, description="`alarm` replies that mean no alarm")
+    identify: LineCommand
+    read_temperature: LineCommand
+    read_setpoint: LineCommand
+    write_setpoint: LineCommand
+    read_low_limit: LineCommand | None = None
+    read_high_limit: LineCommand | None = None
+    power_on: LineCommand | None = None
+    power_off: LineCommand | None = None
+    alarm: LineCommand | None = None
+    units: LineCommand | None = None
+    humidity: LineCommand | None = None
+    purge_on: LineCommand | None = None
+    purge_off: LineCommand | None = None
+
+    _compiles = field_validator("error_pattern")(classmethod(lambda cls, value: regular_expression(value)))
+
+    @model_validator(mode="after")
+    def _consistent(self) -> ChamberLineProtocol:
+        for operation, group in _CARRIES.items():
+            command = self.command(operation)
+            if command is not None and (command.reply is None or f"(?P<{group}>" not in command.reply):
+                raise ValueError(f"{operation}: the reply pattern must capture ({group})")
+        if (self.read_low_limit is None) != (self.read_high_limit is None):
+            raise ValueError("read_low_limit and read_high_limit come together")
+        if (self.power_on is None) != (self.power_off is None) or (self.purge_on is None) != (self.purge_off is None):
+            raise ValueError("an output's on and off commands come together")
+        for operation in OPERATIONS:
+            command = self.command(operation)
+            if command is not None:
+                try:
+                    (self.request_prefix + command.send + (command.answer or "")).encode(self.encoding)
+                except UnicodeEncodeError:
+                    raise ValueError(f"{operation}: not {self.encoding} text") from None
+        return self
+
+    def command(self, operation: Operation) -> LineCommand | None:
+        command: LineCommand | None = getattr(self, operation)
+        return command
+
+    def request(self, operation: Operation, **fields: object) -> str:
+        command = self.command(operation)
+        if command is None:
+            raise ValueError(f"the profile has no {operation} command")
+        return self.request_prefix + command.send.format(**fields)
+
+    def request_patterns(self) -> list[tuple[Operation, LineCommand, object]]:
+        """Every command's request as a pattern (after the prefix), for a simulator; in operation order."""
+        return [(operation, command, request_pattern(command.send))
+                for operation in OPERATIONS if (command := self.command(operation)) is not None]
+
+
+OPERATIONS: tuple[Operation, ...] = ("identify", "read_temperature", "read_setpoint", "write_setpoint",
+                                     "read_low_limit", "read_high_limit", "power_on", "power_off", "alarm",
+                                     "units", "humidity", "purge_on", "purge_off")
+#: The group each query's reply must capture.
+_CARRIES: dict[Operation, str] = {"identify": "identity", "read_temperature": "pv", "read_setpoint": "sp",
+                                  "read_low_limit": "low", "read_high_limit": "high", "alarm": "alarm",
+                                  "units": "units", "humidity": "humidity"}
+
+_N = NUMBER
+#: ESPEC P300 / SCP-220 class (ChamberConnectLibrary): `TEMP?` answers measured, set point, upper, lower.
+_ESPEC_TEMP = LineCommand(send="TEMP?", reply=rf"(?P<pv>{_N}),(?P<sp>{_N}),(?P<high>{_N}),(?P<low>{_N})",
+                          answer="{pv:.1f},{sp:.1f},{high:.1f},{low:.1f}")
+ESPEC_P300 = ChamberLineProtocol(
+    write_terminator="\r\n", read_terminator="\r\n", default_port=10001,
+    error_pattern=r"^NA:(?P<code>.*)",
+    errors={"CMD ERR": "command not known to this controller", "PARA ERR": "parameter not accepted",
+            "DATA OUT OF RANGE": "value beyond the controller's range",
+            "PROTECT ON": "the controller's key protection is on: remote writes are locked",
+            "CONT NOT READY-1": "the controller is in local mode (not ready for remote control)"},
+    unknown_command_answer="NA:CMD ERR", local_mode_answer="NA:CONT NOT READY-1",
+    identify=LineCommand(send="TYPE?", reply=r"(?P<identity>.+)", answer="{identity}"),
+    read_temperature=_ESPEC_TEMP, read_setpoint=_ESPEC_TEMP, read_low_limit=_ESPEC_TEMP, read_high_limit=_ESPEC_TEMP,
+    write_setpoint=LineCommand(send="TEMP, S{value:.1f}", reply=r"OK:.*", answer="OK:TEMP, S{value:.1f}"),
+    power_on=LineCommand(send="MODE, CONSTANT", reply=r"OK:.*", answer="OK:MODE, CONSTANT"),
+    power_off=LineCommand(send="MODE, STANDBY", reply=r"OK:.*", answer="OK:MODE, STANDBY"),
+    alarm=LineCommand(send="ALARM?", reply=r"(?P<alarm>\d+)(,.*)?", answer="{alarm}"),
+    humidity=LineCommand(send="HUMI?", reply=rf"(?P<humidity>{_N}),.*", answer="{humidity:.0f},0,100,0"),
+)
+
+#: Thermotron 8800 (8200 class): channel 1 is air temperature, 2 humidity; operations answer `0`.
+THERMOTRON_8800 = ChamberLineProtocol(
+    write_terminator="\r", read_terminator="\r\n", default_port=8888,
+    identify=LineCommand(send="IDEN?", reply=r"(?P<identity>.+)", answer="{identity}"),
+    read_temperature=LineCommand(send="PVAR1?", reply=rf"(?P<pv>{_N})", answer="{pv:.2f}"),
+    read_setpoint=LineCommand(send="SETP1?", reply=rf"(?P<sp>{_N})", answer="{sp:.2f}"),
+    write_setpoint=LineCommand(send="SETP1,{value:.1f}", reply="0", answer="0"),
+    power_on=LineCommand(send="RUNM", reply="0", answer="0"),
+    power_off=LineCommand(send="STOP", reply="0", answer="0"),
+    alarm=LineCommand(send="ALRM1?", reply=r"(?P<alarm>\d+)", answer="{alarm}"),
+    units=LineCommand(send="CCHR1?", reply=r"(?P<units>\S+)", answer="{units}"),
+    humidity=LineCommand(send="PVAR2?", reply=rf"(?P<humidity>{_N})", answer="{humidity:.1f}"),
+    purge_on=LineCommand(send="AUXE1,001", reply="0", answer="0"),
+    purge_off=LineCommand(send="AUXE1,000", reply="0", answer="0"),
+)
+
+#: Vötsch/Weiss SIMSERV: numbered commands, fields separated by ¶ (0xB6), chamber index 1; replies begin
+#: with a status, 1 = accepted.
+_S = "\u00b6"
+SIMSERV = ChamberLineProtocol(
+    write_terminator="\r", read_terminator="\r\n", encoding="latin-1", default_port=2049,
+    error_pattern=r"^(?P<code>-\d+)",
+    errors={"-5": "command number not known", "-6": "too few or incorrect parameters",
+            "-8": "data could not be read"},
+    unknown_command_answer="-5",
+    identify=LineCommand(send=f"99997{_S}1", reply=rf"1{_S}(?P<identity>.*)", answer=f"1{_S}{{identity}}"),
+    read_temperature=LineCommand(send=f"11004{_S}1{_S}1", reply=rf"1{_S}(?P<pv>{_N})", answer=f"1{_S}{{pv:.1f}}"),
+    read_setpoint=LineCommand(send=f"11002{_S}1{_S}1", reply=rf"1{_S}(?P<sp>{_N})", answer=f"1{_S}{{sp:.1f}}"),
+    write_setpoint=LineCommand(send=f"11001{_S}1{_S}1{_S}{{value:.1f}}", reply="1", answer="1"),
+    read_low_limit=LineCommand(send=f"11007{_S}1{_S}1", reply=rf"1{_S}(?P<low>{_N})", answer=f"1{_S}{{low:.1f}}"),
+    read_high_limit=LineCommand(send=f"11009{_S}1{_S}1", reply=rf"1{_S}(?P<high>{_N})", answer=f"1{_S}{{high:.1f}}"),
+    power_on=LineCommand(send=f"14001{_S}1{_S}1{_S}1", reply="1", answer="1"),
+    power_off=LineCommand(send=f"14001{_S}1{_S}1{_S}0", reply="1", answer="1"),
+    alarm=LineCommand(send=f"10012{_S}1", reply=rf"1{_S}(?P<alarm>\d+)", answer=f"1{_S}{{alarm}}"),
+    alarm_inactive=["1", "3", "5", "7"],  # status 1 idle, 3 running, +4 warnings; +8 means alarms
+    units=LineCommand(send=f"11023{_S}1{_S}1", reply=rf"1{_S}(?P<units>.+)", answer=f"1{_S}{{units}}"),
+    units_celsius="\u00b0C",
+    humidity=LineCommand(send=f"11004{_S}1{_S}2", reply=rf"1{_S}(?P<humidity>{_N})", answer=f"1{_S}{{humidity:.1f}}"),
+    purge_on=LineCommand(send=f"14001{_S}1{_S}8{_S}1", reply="1", answer="1"),
+    purge_off=LineCommand(send=f"14001{_S}1{_S}8{_S}0", reply="1", answer="1"),
+)
+
+#: Watlow F4T over SCPI (TCP port 5025 only): loop 1 is temperature, loop 2 humidity; settings are not answered.
+WATLOW_F4T_SCPI = ChamberLineProtocol(
+    write_terminator="\n", read_terminator="\n", default_port=5025,
+    identify=LineCommand(send="*IDN?", reply=r"(?P<identity>.+)", answer="{identity}"),
+    read_temperature=LineCommand(send=":SOURCE:CLOOP1:PVALUE?", reply=rf"(?P<pv>{_N})", answer="{pv:.2f}"),
+    read_setpoint=LineCommand(send=":SOURCE:CLOOP1:SPOINT?", reply=rf"(?P<sp>{_N})", answer="{sp:.2f}"),
+    write_setpoint=LineCommand(send=":SOURCE:CLOOP1:SPOINT {value:.2f}"),
+    units=LineCommand(send=":UNIT:TEMPERATURE?", reply=r"(?P<units>[A-Z]+)", answer="{units}"),
+    humidity=LineCommand(send=":SOURCE:CLOOP2:PVALUE?", reply=rf"(?P<humidity>{_N})", answer="{humidity:.2f}"),
+)
+
+LINE_PROFILES: dict[str, ChamberLineProtocol] = {"espec-p300": ESPEC_P300, "thermotron-8800": THERMOTRON_8800,
+                                                 "simserv": SIMSERV, "watlow-f4t-scpi": WATLOW_F4T_SCPI}
+
+
+def line_protocol(profile: str, overrides: dict[str, object] | None = None) -> ChamberLineProtocol:
+    """A built-in profile, with any fields the rig config overrides (validated)."""
+    return ChamberLineProtocol.model_validate({**LINE_PROFILES[profile].model_dump(), **(overrides or {})})

@@ -1,0 +1,46 @@
+"""What line-protocol profiles share: request templates, reply patterns, and a request template read back
+as a pattern (so that a simulator generated from a profile recognises the requests its driver sends)."""
+
+from __future__ import annotations
+
+import re
+import string
+from collections.abc import Mapping
+
+#: A decimal number as controllers print them (sign, decimals, exponent optional).
+NUMBER = r"[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?"
+
+
+def regular_expression(value: str) -> str:
+    """A reply pattern must compile."""
+    try:
+        re.compile(value)
+    except re.error as exc:
+        raise ValueError(f"not a regular expression: {exc}") from None
+    return value
+
+
+def template(value: str, sample: Mapping[str, object]) -> str:
+    """A template may name only the fields in `sample`, and must format with those values."""
+    try:
+        fields = [f for _, f, _, _ in string.Formatter().parse(value) if f is not None]
+    except ValueError as exc:
+        raise ValueError(f"not a template: {exc}") from None
+    unknown = sorted(set(fields) - set(sample))
+    if unknown:
+        raise ValueError(f"template fields {', '.join(unknown)} unknown (known: {', '.join(sorted(sample))})")
+    try:
+        value.format(**sample)
+    except (ValueError, TypeError, IndexError, KeyError) as exc:
+        raise ValueError(f"template does not format: {exc}") from None
+    return value
+
+
+def request_pattern(send: str) -> re.Pattern[str]:
+    """The `send` template as a pattern: literal text as it is, each field a run of non-blank characters."""
+    pattern = ""
+    for literal, field, _, _ in string.Formatter().parse(send):
+        pattern += re.escape(literal)
+        if field is not None:
+            pattern += rf"(?P<{field}>\S+)"
+    return re.compile(pattern)

@@ -1,0 +1,107 @@
+"""A simulated chamber controller speaking a line-protocol profile, generated from the profile itself: each
+request is recognised by its command's template and answered with the command's answer template, from
+the virtual lab at the shared clock's time. On loopback TCP (a controller's Ethernet port) or a pty (its
+serial port)."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from accelcal_rig.config.rig import ChamberConfig
+from accelcal_rig.protocols.chamber_lines import ChamberLineProtocol, Operation
+from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
+from accelcal_rig.sim.lab import VirtualLab
+from accelcal_rig.sim.pty_line_server import PtyLineServer
+from accelcal_rig.sim.tcp_line_server import TcpLineServer
+
+_WRITES: frozenset[Operation] = frozenset({"write_setpoint", "power_on", "power_off", "purge_on", "purge_off"})
+
+
+class SimulatedLineChamberServer:
+    def __init__(self, lab: VirtualLab, protocol: ChamberLineProtocol, transport: Literal["tcp", "pty"] = "tcp",
+                 identity: str = "accelcal-rig simulated chamber", units: str | None = None,
+                 faults: ReplyFaults | None = None, stall_after_s: float | None = None) -> None:
+        self._lab = lab
+        self._protocol = protocol
+        self._patterns = protocol.request_patterns()
+        self._identity = identity
+        #: What the controller says its units are (a test sets °F to see the driver refuse it).
+        self.units = protocol.units_celsius if units is None else units
+        #: A controller switched to local/manual mode refuses remote writes (tests set it).
+        self.local_mode = False
+        self._stall_after_s = stall_after_s
+        #: The last set point written over the wire, for tests that check the safe state.
+        self.last_setpoint_c: float | None = None
+        requests_end = protocol.write_terminator.encode(protocol.encoding)
+        replies_end = protocol.read_terminator.encode(protocol.encoding)
+        server = TcpLineServer if transport == "tcp" else PtyLineServer
+        self._server: TcpLineServer | PtyLineServer = server(self._handle, requests_end, "simulated-chamber", faults,
+                                                             replies_end, protocol.encoding)
+
+    @property
+    def endpoint(self) -> str:
+        """`host:port` on TCP, the device path on a pty: what the driver's config names."""
+        return self._server.endpoint if isinstance(self._server, TcpLineServer) else self._server.path
+
+    def start(self) -> SimulatedLineChamberServer:
+        self._server.start()
+        return self
+
+    def stop(self) -> None:
+        self._server.stop()
+
+    # ------------------------------------------------------------------ requests
+    def _handle(self, request: str) -> str | None:
+        prefix = self._protocol.request_prefix
+        if not request.startswith(prefix):
+            return None  # addressed to another controller on the bus
+        request = request[len(prefix):]
+        for operation, command, pattern in self._patterns:
+            match = pattern.fullmatch(request)  # type: ignore[attr-defined]
+            if match is None:
+                continue
+            if operation in _WRITES and self.local_mode and self._protocol.local_mode_answer is not None:
+                return self._protocol.local_mode_answer
+            try:
+                values = self._serve(operation, match.groupdict())
+            except ValueError:
+                return self._protocol.unknown_command_answer  # a parameter it cannot read
+            return None if command.answer is None else command.answer.format(**values)
+        return self._protocol.unknown_command_answer
+
+    def _serve(self, operation: Operation, fields: dict[str, str]) -> dict[str, object]:
+        lab = self._lab
+        with lab.lock:
+            now = lab.clock.now()
+            lab.moisture.dew_point_c(now)  # the air's moisture follows the air, request by request
+            if operation == "write_setpoint":
+                self._write_setpoint(now, float(fields["value"]))
+            elif operation in ("power_on", "power_off"):
+                lab.thermal.set_power(now, operation == "power_on")
+            elif operation in ("purge_on", "purge_off"):
+                lab.moisture.set_purge(now, operation == "purge_on")
+            shown = self.last_setpoint_c if self.last_setpoint_c is not None else lab.thermal.setpoint_c
+            low, high = lab.controller_limits_c
+            values: dict[str, object] = {"identity": self._identity, "sp": shown, "low": low, "high": high,
+                                         "alarm": self._protocol.alarm_inactive[0], "units": self.units,
+                                         "value": float(fields.get("value", shown)), "pv": 0.0, "humidity": 0.0}
+            if operation in ("read_temperature", "read_setpoint", "read_low_limit", "read_high_limit"):
+                values["pv"] = lab.chamber_reading_c()  # measured only when a reply may carry it (it draws noise)
+            if operation == "humidity":
+                values["humidity"] = lab.chamber_humidity_pct()
+        return values
+
+    def _write_setpoint(self, now: float, setpoint_c: float) -> None:
+        if self._protocol.read_low_limit is not None:  # a controller with limits clamps to them, silently
+            low, high = self._lab.controller_limits_c
+            setpoint_c = min(max(setpoint_c, low), high)
+        if self._stall_after_s is None or now < self._stall_after_s:
+            self._lab.thermal.set_setpoint(now, setpoint_c)  # a stalled chamber takes it but does not follow
+        self.last_setpoint_c = setpoint_c
+
+
+def serve_line(lab: VirtualLab, config: ChamberConfig, faults: InstrumentFaults) -> SimulatedLineChamberServer:
+    """The line chamber driver's simulator: a controller speaking the config's profile on loopback TCP."""
+    return SimulatedLineChamberServer(lab, config.line_protocol(), "tcp", identity=f"accelcal-rig simulated "
+                                      f"{config.profile}", faults=faults.replies,
+                                      stall_after_s=faults.after_s(faults.settings.chamber_stall_after_min))

@@ -1,0 +1,62 @@
+"""A line device on the network: a TCP server on loopback whose connections a simulator answers line by
+line (a chamber controller's Ethernet port, or a serial-to-Ethernet bridge in front of one)."""
+
+from __future__ import annotations
+
+import socketserver
+import threading
+from collections.abc import Callable
+
+from accelcal_rig.sim.faults import ReplyFaults
+from accelcal_rig.sim.line_answers import Handler, LineAnswers
+
+
+class _Connection(socketserver.BaseRequestHandler):
+    server: _Server
+
+    def handle(self) -> None:
+        answers = self.server.answers_for()
+        while True:
+            try:
+                data = self.request.recv(65536)
+                if not data:
+                    return
+                answers.feed(data, self.request.sendall)
+            except OSError:
+                return
+
+
+class _Server(socketserver.ThreadingTCPServer):
+    allow_reuse_address = True
+    daemon_threads = True
+
+    def __init__(self, address: tuple[str, int], answers_for: Callable[[], LineAnswers]) -> None:
+        self.answers_for = answers_for
+        super().__init__(address, _Connection)
+
+
+class TcpLineServer:
+    """Each connection is answered on its own thread (the handler takes the lab's lock); a client that
+    reconnects is served anew."""
+
+    def __init__(self, handle: Handler, terminator: bytes = b"\n", name: str = "tcp",
+                 faults: ReplyFaults | None = None, reply_terminator: bytes | None = None,
+                 encoding: str = "utf-8", host: str = "127.0.0.1", port: int = 0) -> None:
+        self._server = _Server((host, port), lambda: LineAnswers(handle, terminator, reply_terminator, encoding,
+                                                                 faults))
+        self.host, self.port = self._server.socket.getsockname()[:2]
+        self._thread = threading.Thread(target=self._server.serve_forever, kwargs={"poll_interval": 0.05},
+                                        name=name, daemon=True)
+
+    @property
+    def endpoint(self) -> str:
+        return f"{self.host}:{self.port}"
+
+    def start(self) -> TcpLineServer:
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        self._server.shutdown()
+        self._server.server_close()
+        self._thread.join(5.0)
