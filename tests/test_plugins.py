@@ -51,5 +51,5 @@ def test_without_the_package_the_driver_is_unknown_in_one_line(tmp_path: Path) -
     result = subprocess.run([RIG, "check", str(acme_rig(tmp_path)), "--dry-run"], capture_output=True, text=True,
                             timeout=120)
     assert result.returncode == 2
-    assert result.stderr.strip().endswith("chamber.driver: unknown chamber driver 'acme-ascii' (known: modbus-rtu, "
-                                          "modbus-tcp)")
+    assert result.stderr.strip().endswith("chamber.driver: unknown chamber driver 'acme-ascii' (known: line, "
+                                          "modbus-rtu, modbus-tcp)")

@@ -129,7 +129,7 @@ class TurntableConfig(StrictModel):
     endpoint: str | None = Field(None, max_length=1024, description="serial device or pyserial URL "
                                  "(socket://host:port, …)")
     baudrate: Baudrate = 9600
-    protocol: Literal["accelcal-line"] = "accelcal-line"
+    protocol: Literal["accelcal-line", "acutrol3000"] = "accelcal-line"
     protocol_overrides: dict[str, Any] = Field({}, description="fields of the line protocol to override")
     timeout_s: TimeoutS = 2.0
     axes: list[TurntableAxis] = Field(min_length=1, max_length=6)

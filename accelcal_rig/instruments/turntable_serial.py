@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import time
 
 import numpy as np
 
@@ -22,6 +23,8 @@ class SerialTurntable:
         self.n_axes = n_axes
         self._error = re.compile(protocol.error_pattern)
         self._retry: RetryCall = lambda operation, reconnect: operation()
+        self._set_up = False  # the profile's setup (interlock, mode) goes out before the first move
+        self._polls_at_rest = 0
 
     @classmethod
     def open(cls, endpoint: str, protocol: TurntableProtocol, n_axes: int, baudrate: int = 9600,
@@ -35,23 +38,41 @@ class SerialTurntable:
         return self._ask(self.protocol.identify)["identity"]
 
     def move_to(self, angles_deg: np.ndarray) -> None:
-        """Command every axis; limits are the caller's gate (LimitedTurntable)."""
-        for axis, angle in enumerate(np.asarray(angles_deg, dtype=float), start=1):
-            self._ask(self.protocol.move, axis=axis, angle=float(angle))
+        """Command every axis (in one line where the profile moves them together); limits are the caller's
+        gate (LimitedTurntable)."""
+        if not self._set_up:
+            self._setup()
+        p = self.protocol
+        moves = [(axis, float(angle)) for axis, angle in enumerate(np.asarray(angles_deg, dtype=float), start=1)]
+        self._polls_at_rest = 0
+        if p.multi_axis_move:
+            line = p.move_separator.join(p.move.send.format(axis=axis, angle=angle) for axis, angle in moves)
+            self._ask(p.move, request=line)
+        else:
+            for axis, angle in moves:
+                self._ask(p.move, axis=axis, angle=angle)
 
     def read_angles_deg(self) -> np.ndarray:
         return np.array([float(self._ask(self.protocol.position, axis=axis)["angle"])
                          for axis in range(1, self.n_axes + 1)])
 
     def in_position(self) -> bool:
-        """Not busy; a controller fault is raised, never waited out."""
-        fault = self._ask(self.protocol.fault)["fault"]
-        if fault not in self.protocol.fault_ok:
-            raise InstrumentError(f"turntable ({self.endpoint}): controller fault {fault}")
-        return self._ask(self.protocol.busy)["busy"] not in self.protocol.busy_values
+        """Not busy, or every axis at rest for the profile's polls; a controller fault (of any axis, named)
+        is raised, never waited out."""
+        p = self.protocol
+        for axis, reply in self._each(p.fault):
+            fault = reply["fault"]
+            if _is_fault(p, fault):
+                where = f"axis {axis}: " if axis else ""
+                raise InstrumentError(f"turntable ({self.endpoint}): {where}controller fault {fault}")
+        if p.busy is not None:
+            return not any(reply["busy"] in p.busy_values for _, reply in self._each(p.busy))
+        at_rest = all(abs(float(reply["rate"])) < p.at_rest_deg_s for _, reply in self._each(p.rate))
+        self._polls_at_rest = self._polls_at_rest + 1 if at_rest else 0
+        return self._polls_at_rest >= p.at_rest_polls
 
     def stop(self) -> None:
-        self._ask(self.protocol.stop)
+        self._each(self.protocol.stop)
 
     def close(self) -> None:
         self._line.close()
@@ -63,12 +84,30 @@ class SerialTurntable:
     def reconnect(self) -> None:
         self._line.reconnect()
 
-    # ------------------------------------------------------------------ wire
-    def _ask(self, command: Command, **fields: object) -> dict[str, str]:
-        return self._retry(lambda: self._ask_once(command, **fields), self.reconnect)
+    def _setup(self) -> None:
+        """The profile's setup commands (close the interlock, select position mode), each given its pause."""
+        for command in self.protocol.setup:
+            for axis in range(1, self.n_axes + 1) if command.per_axis else (None,):
+                self._ask(command, axis=axis)
+                time.sleep(self.protocol.setup_pause_s)
+        self._set_up = True
 
-    def _ask_once(self, command: Command, **fields: object) -> dict[str, str]:
-        request = command.send.format(**fields)
+    def _each(self, command: Command | None) -> list[tuple[int | None, dict[str, str]]]:
+        """A command sent once per axis if it names one (1-based axis numbers), else once (axis None)."""
+        assert command is not None
+        if command.per_axis:
+            return [(axis, self._ask(command, axis=axis)) for axis in range(1, self.n_axes + 1)]
+        return [(None, self._ask(command))]
+
+    # ------------------------------------------------------------------ wire
+    def _ask(self, command: Command, request: str | None = None, **fields: object) -> dict[str, str]:
+        return self._retry(lambda: self._ask_once(command, request, **fields), self.reconnect)
+
+    def _ask_once(self, command: Command, request: str | None, **fields: object) -> dict[str, str]:
+        request = command.send.format(**fields) if request is None else request
+        if command.reply is None:
+            self._line.send(request)
+            return {}
         reply = self._line.ask(request)
         if self._error.search(reply):
             raise InstrumentError(f"turntable ({self.endpoint}): {request!r} refused: {reply}")
@@ -76,6 +115,11 @@ class SerialTurntable:
         if match is None:
             raise TransientInstrumentError(f"turntable ({self.endpoint}): {request!r}: unexpected reply {reply!r}")
         return {k: v for k, v in match.groupdict().items() if v is not None}
+
+
+def _is_fault(protocol: TurntableProtocol, reply: str) -> bool:
+    """A fault reply: one of `fault_values` where the profile lists them, else anything not `fault_ok`."""
+    return reply in protocol.fault_values if protocol.fault_values else reply not in protocol.fault_ok
 
 
 def _open(config: TurntableConfig, endpoint: str) -> SerialTurntable:

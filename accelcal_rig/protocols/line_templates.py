@@ -37,10 +37,13 @@ def template(value: str, sample: Mapping[str, object]) -> str:
 
 
 def request_pattern(send: str) -> re.Pattern[str]:
-    """The `send` template as a pattern: literal text as it is, each field a run of non-blank characters."""
+    """The `send` template as a pattern: literal text as it is, each field a run of non-blank characters
+    (a field named twice must read the same both times)."""
     pattern = ""
+    seen: set[str] = set()
     for literal, field, _, _ in string.Formatter().parse(send):
         pattern += re.escape(literal)
         if field is not None:
-            pattern += rf"(?P<{field}>\S+)"
+            pattern += rf"(?P={field})" if field in seen else rf"(?P<{field}>\S+?)"
+            seen.add(field)
     return re.compile(pattern)

@@ -2,34 +2,52 @@
 
 A profile says, for each operation, what to send (a template with `{axis}`, 1-based, and `{angle}`),
 the pattern a good reply must match (named groups carry values), and — so that a simulator can speak
-the same profile — the answer template a controller gives. Any reply matching `error_pattern` is a
-controller error.
+the same profile — the answer template a controller gives; a command without a reply pattern is sent and
+not answered (SCPI settings). A status command that names `{axis}` is asked axis by axis, so a fault or a
+busy axis is named. Any reply matching `error_pattern` is a controller error.
+
+A move is complete when the controller says it is not busy, or — for controllers without such a query —
+when every axis's rate has read below `at_rest_deg_s` for `at_rest_polls` polls in a row; either way the
+engine then checks every angle against the rig's tolerance.
 """
 
 from __future__ import annotations
 
 import re
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from accelcal_rig.protocols.line_templates import regular_expression, request_pattern, template
+from accelcal_rig.protocols.line_templates import NUMBER, regular_expression, request_pattern, template
 
 #: What a template may name, with sample values: the request's axis (1-based) and angle, and the values
 #: replies carry.
-_TEMPLATE_SAMPLE: dict[str, object] = {"axis": 1, "angle": 0.0, "identity": "x", "busy": 0, "fault": 0}
+_TEMPLATE_SAMPLE: dict[str, object] = {"axis": 1, "angle": 0.0, "identity": "x", "busy": 0, "fault": 0, "rate": 0.0}
 
 
 class Command(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     send: str = Field(min_length=1, max_length=256)
-    reply: str = Field(min_length=1, max_length=256, description="regular expression a good reply matches in full")
-    answer: str = Field(min_length=1, max_length=256, description="what a controller answers (template), for "
-                        "simulators")
+    reply: str | None = Field(None, min_length=1, max_length=256, description="regular expression a good reply "
+                              "matches in full; none: the controller does not answer this command")
+    answer: str | None = Field(None, min_length=1, max_length=256, description="what a controller answers "
+                               "(template), for simulators")
 
-    _compiles = field_validator("reply")(classmethod(lambda cls, value: regular_expression(value)))
+    _compiles = field_validator("reply")(classmethod(lambda cls, v: v if v is None else regular_expression(v)))
     #: `{axis}` and `{angle:.5f}` style fields, nothing a request cannot fill.
-    _templates = field_validator("send", "answer")(classmethod(lambda cls, value: template(value, _TEMPLATE_SAMPLE)))
+    _templates = field_validator("send", "answer")(classmethod(
+        lambda cls, v: v if v is None else template(v, _TEMPLATE_SAMPLE)))
+
+    @model_validator(mode="after")
+    def _answered_if_replied(self) -> Command:
+        if (self.reply is None) != (self.answer is None):
+            raise ValueError("a command has both a reply pattern and an answer, or neither")
+        return self
+
+    @property
+    def per_axis(self) -> bool:
+        """Sent once for each axis (its template names `{axis}`)."""
+        return "{axis" in self.send
 
     def request_pattern(self) -> re.Pattern[str]:
         """The `send` template as a pattern, for a simulator to recognise the request."""
@@ -45,14 +63,40 @@ class TurntableProtocol(BaseModel):
     identify: Command
     move: Command
     position: Command
-    busy: Command
+    busy: Command | None = None
+    rate: Command | None = Field(None, description="an axis's rate (°/s), where there is no busy query")
     stop: Command
     home: Command
     fault: Command
-    busy_values: list[str] = Field(["1"], max_length=16)
-    fault_ok: list[str] = Field(["0"], max_length=16)
+    setup: list[Command] = Field([], max_length=16, description="sent before the first move (interlock, mode), "
+                                 "each once per axis if it names {axis}")
+    setup_pause_s: float = Field(0.0, ge=0, le=5, description="wall-clock pause after each setup command: "
+                                 "controllers that want time after a mode change")
+    multi_axis_move: bool = Field(False, description="every axis's move in one line, joined by move_separator: "
+                                  "the axes start together")
+    move_separator: str = Field(";", min_length=1, max_length=4)
+    busy_values: list[str] = Field(["1"], max_length=16, description="busy replies that mean moving")
+    not_busy: str = Field("0", max_length=32, description="the busy reply of a table at rest (for simulators)")
+    fault_ok: list[str] = Field(["0"], max_length=16, description="fault replies that mean no fault")
+    fault_values: list[str] = Field([], max_length=16, description="if given, only these fault replies are "
+                                    "faults (a controller whose healthy replies are not listed)")
+    at_rest_deg_s: float = Field(0.01, gt=0, le=10, description="rate completion: below this an axis is at rest")
+    at_rest_polls: int = Field(1, ge=1, le=100, description="rate completion: polls in a row at rest")
 
     _compiles = field_validator("error_pattern")(classmethod(lambda cls, value: regular_expression(value)))
+
+    @model_validator(mode="after")
+    def _completes(self) -> TurntableProtocol:
+        if self.busy is None and self.rate is None:
+            raise ValueError("a profile needs a busy query or a rate query to know a move is complete")
+        for name, group in (("identify", "identity"), ("position", "angle"), ("busy", "busy"), ("rate", "rate"),
+                            ("fault", "fault")):
+            command = getattr(self, name)
+            if command is not None and (command.reply is None or f"(?P<{group}>" not in command.reply):
+                raise ValueError(f"{name}: the reply pattern must capture ({group})")
+        if self.multi_axis_move and not self.move.per_axis:
+            raise ValueError("multi_axis_move joins one move per axis: the move must name {axis}")
+        return self
 
 
 #: The built-in profile: a plain SCPI-like line protocol, one command per line, one reply per command.
@@ -66,7 +110,26 @@ ACCELCAL_LINE = TurntableProtocol(
     fault=Command(send="FAULT?", reply=r"(?P<fault>\d+)", answer="{fault}"),
 )
 
-PROTOCOLS: dict[str, TurntableProtocol] = {"accelcal-line": ACCELCAL_LINE}
+_N = NUMBER
+#: Acutronic ACUTROL3000 (ACL, SCPI-like; facts and sources in docs/instruments.md): position demanded per
+#: axis, all axes in one compound line; no in-position query, so a move is complete when every axis's rate
+#: has read zero for three polls; a tripped interlock reads "Fault".
+ACUTROL3000 = TurntableProtocol(
+    identify=Command(send="*IDN?", reply=r"(?P<identity>.+)", answer="{identity}"),
+    move=Command(send=":demand:position {axis},{angle:.5f}"),
+    multi_axis_move=True, move_separator=";",
+    position=Command(send=":read:position? {axis}", reply=rf"(?P<angle>{_N})", answer="{angle:.5f}"),
+    rate=Command(send=":read:rate? {axis}", reply=rf"(?P<rate>{_N})", answer="{rate:.5f}"),
+    at_rest_deg_s=0.01, at_rest_polls=3,
+    stop=Command(send=":mode:rate {axis};:demand:rate {axis},0"),
+    home=Command(send=":demand:position {axis},0"),
+    fault=Command(send=":interlock? {axis}", reply=r"(?P<fault>\w+)", answer="{fault}"),
+    fault_values=["Fault"],
+    setup=[Command(send=":interlock:close {axis}"), Command(send=":mode:position {axis}")],
+    setup_pause_s=0.3,
+)
+
+PROTOCOLS: dict[str, TurntableProtocol] = {"accelcal-line": ACCELCAL_LINE, "acutrol3000": ACUTROL3000}
 
 
 def turntable_protocol(name: str, overrides: dict[str, object] | None = None) -> TurntableProtocol:

@@ -28,6 +28,11 @@ class TurntableMotion:
         delta = self._target - self._start
         return self._start + np.sign(delta) * np.minimum(np.abs(delta), travelled)
 
+    def rate_deg_s(self, t_s: float) -> np.ndarray:
+        """Each axis's rate now: its speed while it travels, zero once it has arrived."""
+        travelling = np.abs(self._target - self._start) > self.speeds_deg_s * np.maximum(t_s - self._t0, 0.0)
+        return np.where(travelling, np.sign(self._target - self._start) * self.speeds_deg_s, 0.0)
+
     def command_axis(self, t_s: float, axis: int, target_deg: float) -> None:
         self._start[axis] = self.position_deg(t_s)[axis]
         self._target[axis] = target_deg + self._rng.uniform(-self.accuracy_deg, self.accuracy_deg)
@@ -43,6 +48,7 @@ class TurntableMotion:
         self._start, self._target = here.copy(), here.copy()
         self._t0 = np.full_like(self._t0, t_s)
 
-    def in_position(self, t_s: float) -> bool:
+    def in_position(self, t_s: float, axis: int | None = None) -> bool:
+        """Arrived and settled: every axis, or the one given."""
         arrival = self._t0 + np.abs(self._target - self._start) / self.speeds_deg_s
-        return t_s >= arrival.max() + self.settle_s
+        return t_s >= (arrival.max() if axis is None else arrival[axis]) + self.settle_s

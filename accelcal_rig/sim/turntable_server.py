@@ -1,8 +1,8 @@
-"""A simulated turntable controller on a pseudo-terminal, speaking a line-protocol profile."""
+"""A simulated turntable controller on a pseudo-terminal, speaking a line-protocol profile: each request is
+recognised by its command's template and answered with the command's answer, from the lab's turntable
+motion at the shared clock's time."""
 
 from __future__ import annotations
-
-import numpy as np
 
 from accelcal_rig.config.rig import TurntableConfig
 from accelcal_rig.protocols.turntable_line import TurntableProtocol
@@ -10,10 +10,10 @@ from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 
+_OPERATIONS = ("identify", "move", "position", "busy", "rate", "stop", "home", "fault")
+
 
 class SimulatedTurntableServer:
-    """Answers each request from the lab's turntable motion at the shared clock's time."""
-
     def __init__(self, lab: VirtualLab, protocol: TurntableProtocol, identity: str = "accelcal-rig simulated turntable",
                  faults: ReplyFaults | None = None, stall_after_s: float | None = None):
         self._lab = lab
@@ -22,14 +22,27 @@ class SimulatedTurntableServer:
         self.last_command: str | None = None
         self._protocol = protocol
         self._identity = identity
-        self._patterns = [(name, getattr(protocol, name), getattr(protocol, name).request_pattern())
-                          for name in ("identify", "move", "position", "busy", "stop", "home", "fault")]
+        commands = [(name, getattr(protocol, name)) for name in _OPERATIONS if getattr(protocol, name) is not None]
+        commands += [(f"setup{i}", command) for i, command in enumerate(protocol.setup)]
+        self._patterns = [(name, command, command.request_pattern()) for name, command in commands]
         if protocol.write_terminator != protocol.read_terminator:
             raise ValueError("the simulated turntable needs one terminator for both directions")
         self._server = PtyLineServer(self._handle, protocol.write_terminator.encode(), "simulated-turntable", faults)
         self.path = self.endpoint = self._server.path
-        #: Fault code the controller reports (fault injection sets it).
-        self.fault = self._protocol.fault_ok[0]
+        n_axes = len(lab.motion.speeds_deg_s)
+        #: Fault reply of each axis (fault injection sets them); a profile without per-axis faults reads axis 1's.
+        self.faults = [protocol.fault_ok[0]] * n_axes
+        #: Axes whose setup (interlock, mode) has been received; a profile with setup ignores moves before it.
+        self._set_up = [not protocol.setup] * n_axes
+        self._setup_seen: list[set[str]] = [set() for _ in range(n_axes)]
+
+    @property
+    def fault(self) -> str:
+        return self.faults[0]
+
+    @fault.setter
+    def fault(self, value: str) -> None:
+        self.faults = [value] * len(self.faults)
 
     def start(self) -> SimulatedTurntableServer:
         self._server.start()
@@ -38,17 +51,32 @@ class SimulatedTurntableServer:
     def stop(self) -> None:
         self._server.stop()
 
-    def _handle(self, request: str) -> str:
+    def _handle(self, request: str) -> str | None:
+        protocol = self._protocol
+        if protocol.multi_axis_move and protocol.move_separator in request:  # every axis's move in one line
+            pattern = protocol.move.request_pattern()
+            matches = [pattern.fullmatch(part) for part in request.split(protocol.move_separator)]
+            if all(matches):
+                for match in matches:
+                    self._answer("move", "", match.groupdict())  # type: ignore[union-attr]
+                self.last_command = request
+                return protocol.move.answer
+        matched, answer = self._match(request)
+        return answer if matched else f"ERR unknown command {request!r}"
+
+    def _match(self, request: str) -> tuple[bool, str | None]:
+        """(whether one command's template matches the request, its answer: None if it is unanswered)."""
         for name, command, pattern in self._patterns:
             match = pattern.fullmatch(request)
             if match is not None:
                 if name in ("move", "stop", "home"):
                     self.last_command = request
                 try:
-                    return self._answer(name, command.answer, match.groupdict())
+                    answer = self._answer(name, command.answer or "", match.groupdict())
                 except (ValueError, IndexError) as exc:
-                    return f"ERR {exc}"
-        return f"ERR unknown command {request!r}"
+                    return True, f"ERR {exc}"
+                return True, None if command.answer is None else answer
+        return False, None
 
     def _answer(self, name: str, template: str, fields: dict[str, str]) -> str:
         lab, motion = self._lab, self._lab.motion
@@ -58,18 +86,27 @@ class SimulatedTurntableServer:
             axis = int(fields["axis"]) - 1 if "axis" in fields else None
             if axis is not None and not 0 <= axis < n_axes:
                 raise ValueError(f"no axis {axis + 1}")
+            axes = range(n_axes) if axis is None else (axis,)
             stalled = self._stall_after_s is not None and now >= self._stall_after_s
-            if name == "move" and not stalled and axis is not None:  # a stalled table says OK, stays put
-                motion.command_axis(now, axis, float(fields["angle"]))
+            if name.startswith("setup"):
+                for a in axes:
+                    self._setup_seen[a].add(name)
+                    self._set_up[a] = len(self._setup_seen[a]) == len(self._protocol.setup)
+            elif name == "move" and not stalled and axis is not None and self._set_up[axis]:
+                motion.command_axis(now, axis, float(fields["angle"]))  # a stalled or unarmed table stays put
             elif name == "stop":
                 motion.stop(now)
             elif name == "home":
-                motion.command(now, np.zeros(n_axes))
+                target = motion.position_deg(now)
+                target[list(axes)] = 0.0
+                motion.command(now, target)
+            shown = 0 if axis is None else axis
             values = {
                 "identity": self._identity,
-                "angle": float(motion.position_deg(now)[axis]) if axis is not None else 0.0,
-                "busy": "0" if motion.in_position(now) else self._protocol.busy_values[0],
-                "fault": self.fault,
+                "angle": float(motion.position_deg(now)[shown]),
+                "busy": self._protocol.not_busy if motion.in_position(now, axis) else self._protocol.busy_values[0],
+                "rate": float(motion.rate_deg_s(now)[shown]),
+                "fault": self.faults[shown],
             }
         return template.format(**values)
 

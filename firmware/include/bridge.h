@@ -1,0 +1,54 @@
+/*
+ * The ADXL355 serial bridge, protocol version 2: the core's entry points for a board's main loop.
+ *
+ * The protocol (one ASCII request per line, one reply per request, lines end in '\n'):
+ *   ?              -> ADXL355-BRIDGE 2 capture=4096 <text>
+ *   R <addr> <n>   -> =<2n hex digits>     n registers from addr in one SPI burst
+ *   W <addr> <v>   -> =                    one register
+ *   C <n>          -> =<TEMP2><TEMP1>      empty the FIFO, capture the next n samples
+ *   G <first>      -> =<hex>[T<TEMP2><TEMP1>]  captured samples from index first on
+ *   anything that fails -> !<message>
+ * addr and v are hexadecimal, n and first decimal.
+ */
+#ifndef BRIDGE_H
+#define BRIDGE_H
+
+#include <stdbool.h>
+
+#define BRIDGE_PROTOCOL_VERSION 2
+#define BRIDGE_FIRMWARE_VERSION "1.0"
+
+/* The capture buffer: 4096 samples of 9 bytes (X, Y, Z FIFO entries of 3 bytes) = 36 kB. */
+#define BRIDGE_CAPTURE_SAMPLES 4096u
+#define BRIDGE_SAMPLE_BYTES 9u
+
+/* The longest register burst `R` takes: the whole FIFO, 96 entries of 3 bytes. */
+#define BRIDGE_MAX_READ 288u
+
+/* Replies go to the HAL in pieces this long, with the capture serviced between them (64: one USB
+ * full-speed packet). */
+#ifndef BRIDGE_REPLY_CHUNK
+#define BRIDGE_REPLY_CHUNK 64u
+#endif
+
+/* How often a capture drains the FIFO. The FIFO holds 32 samples: 8 ms at 4 kHz, the fastest rate,
+ * so 1 ms leaves seven eighths of it as margin for a slow reply chunk or a long request. */
+#ifndef BRIDGE_DRAIN_PERIOD_US
+#define BRIDGE_DRAIN_PERIOD_US 1000u
+#endif
+
+/* Forget any capture and partial request. Call once before the first bridge_poll(). */
+void bridge_init(void);
+
+/* Do what is due: drain the FIFO if a capture is running and the drain period has passed, then
+ * read what the host has sent and answer a complete request. Call it from the main loop, often. */
+void bridge_poll(void);
+
+/* Service a running capture only (never reads or answers the host). Safe to call from inside
+ * bridge_hal_uart_write() while it waits for room; it does nothing when called re-entrantly. */
+void bridge_idle(void);
+
+/* True while a capture is running: a main loop may sleep between polls only when this is false. */
+bool bridge_capturing(void);
+
+#endif

@@ -1,0 +1,304 @@
+"""The bridge's reference firmware (firmware/): its core built for the host in front of the C model of an
+ADXL355, on a pseudo-terminal, driven by the project's own driver exactly as a board on a serial port would
+be; and the same core cross-compiled for the board's Cortex-M0+, within its RAM budget."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from accelcal_rig.core.clock import RealClock
+from accelcal_rig.errors import InstrumentError
+from accelcal_rig.instruments import adxl355
+from accelcal_rig.instruments.adxl355_driver import Adxl355
+from accelcal_rig.instruments.adxl355_transport import CaptureOverflow, SerialBridge
+from accelcal_rig.instruments.line_port import LinePort
+from accelcal_rig.parts.adxl35x import ADXL355
+from tests.conftest import REPO
+
+FIRMWARE = REPO / "firmware"
+# The C model's facts (firmware/host/adxl355_model.h): what every capture through the firmware must give back.
+GRAVITY_UG = np.array([200_000, -400_000, 894_000])
+NOISE_LSB = {2: 26, 4: 13, 8: 6}  # uniform within ±100 µg, rounded to whole LSB
+SEED = 1
+TEMPERATURE_C = 31.0  # what the tests tell the model its temperature sensor reads
+#: The board's RAM budget for the core: the 36 kB capture buffer and what little else it keeps.
+RAM_BOUND_BYTES = 40 * 1024
+
+
+def make(target: str, build: Path) -> str:
+    """Run the firmware's Makefile; a failing build fails the test with the compiler's own words."""
+    run = subprocess.run(["make", "-C", str(FIRMWARE), target, f"BUILD={build}"], capture_output=True, text=True)
+    assert run.returncode == 0, f"make {target} failed:\n{run.stdout}\n{run.stderr}"
+    return run.stdout
+
+
+@pytest.fixture(scope="session")
+def bridge_host(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The host build, made once per session in a folder of its own (the source tree stays clean)."""
+    build = tmp_path_factory.mktemp("firmware-build")
+    make("host", build)
+    return build / "host" / "bridge-host"
+
+
+@dataclass
+class Firmware:
+    path: str
+    process: subprocess.Popen[str]
+
+
+@contextmanager
+def running(binary: Path, *options: str) -> Iterator[Firmware]:
+    """The host firmware serving its pseudo-terminal; it exits when its stdin closes, so a test that dies
+    leaves nothing behind."""
+    process = subprocess.Popen([str(binary), "--exit-with-stdin", "--seed", str(SEED), *options],
+                               stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert process.stdout is not None
+        path = process.stdout.readline().strip()
+        assert path.startswith("/dev/"), f"the firmware printed no pseudo-terminal path ({path!r})"
+        yield Firmware(path, process)
+    finally:
+        assert process.stdin is not None
+        process.stdin.close()
+        try:
+            process.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+
+
+@dataclass
+class Opened:
+    driver: Adxl355
+    bridge: SerialBridge
+    firmware: Firmware
+
+
+@contextmanager
+def opened(binary: Path, *options: str) -> Iterator[Opened]:
+    """The project's driver on the firmware's port, on the wall clock (the model's samples come in real time)."""
+    with running(binary, "--temperature-c", str(TEMPERATURE_C), *options) as firmware:
+        bridge = SerialBridge.open(firmware.path)
+        try:
+            yield Opened(Adxl355(bridge, "FW-0001", RealClock()), bridge, firmware)
+        finally:
+            bridge.close()
+
+
+@pytest.fixture
+def sensor(bridge_host: Path) -> Iterator[Opened]:
+    with opened(bridge_host) as found:
+        yield found
+
+
+@pytest.fixture
+def line(bridge_host: Path) -> Iterator[LinePort]:
+    """The bare line to the firmware, for requests the driver never sends."""
+    with running(bridge_host) as firmware:
+        port = LinePort.open(firmware.path, "bridge", 921600, 1.0)
+        try:
+            yield port
+        finally:
+            port.close()
+
+
+def bring_up(driver: Adxl355, range_g: int, odr_hz: float) -> None:
+    driver.reset()
+    driver.standby()
+    driver.configure(range_g, odr_hz)
+    driver.start_measurement()
+
+
+def model_codes(first: int, count: int, range_g: int) -> np.ndarray:
+    """Samples `first` … `first + count - 1` since measuring began, as the C model makes them: the gravity
+    vector's codes plus the lowbias32 hash of each entry's index, reduced to ±NOISE_LSB."""
+    x = (np.arange(3 * first, 3 * (first + count), dtype=np.uint64) + SEED).astype(np.uint32)
+    x ^= x >> np.uint32(16)
+    x *= np.uint32(0x7FEB352D)
+    x ^= x >> np.uint32(15)
+    x *= np.uint32(0x846CA68B)
+    x ^= x >> np.uint32(16)
+    amplitude = NOISE_LSB[range_g]
+    noise = (x % np.uint32(2 * amplitude + 1)).astype(np.int64) - amplitude
+    gravity_codes = GRAVITY_UG * int(ADXL355.lsb_per_g[range_g]) // 1_000_000
+    return (gravity_codes + noise.reshape(-1, 3)).astype(np.int32)
+
+
+def first_sample_index(codes: np.ndarray, range_g: int, search: int = 200_000) -> int:
+    """Where in the model's sequence a block starts, if it is that sequence unbroken; else the test fails."""
+    sequence = model_codes(0, search + len(codes), range_g)
+    for start in np.flatnonzero((sequence[:search] == codes[0]).all(axis=1)):
+        if np.array_equal(sequence[start:start + len(codes)], codes):
+            return int(start)
+    raise AssertionError("the block is not the model's samples in unbroken order (a gap, a repeat or a corrupt byte)")
+
+
+def test_the_greeting_names_protocol_2_and_its_4096_sample_buffer(line: LinePort, sensor: Opened) -> None:
+    """The driver decides by the greeting whether the bridge captures, and how much at once."""
+    assert re.fullmatch(r"ADXL355-BRIDGE 2 capture=4096 .+", line.ask("?"))
+    assert sensor.driver.capture_capacity_samples == 4096
+
+
+def test_identity_reset_and_register_round_trips(sensor: Opened) -> None:
+    """Register access is the SPI framing the driver relies on: reads in bursts, writes one at a time."""
+    driver, bridge = sensor.driver, sensor.bridge
+    identity = driver.identify()
+    assert (identity.devid_ad, identity.devid_mst, identity.partid, identity.revid) == (0xAD, 0x1D, 0xED, 0x01)
+    bridge.write(0x1E, 0x5A)  # OFFSET_X_H: a register nothing else touches
+    assert bridge.read(0x1E, 1) == b"\x5a"
+    bring_up(driver, 4, 1000.0)
+    assert driver.read_settings() == (4, 1000.0)
+    driver.reset()
+    assert bridge.read(0x1E, 1) == b"\x00"
+    assert bridge.read(adxl355.REG_RANGE, 2) == bytes([0x81, 0x01])  # RANGE and POWER_CTL at their reset values
+    assert driver.read_temperature_c() == pytest.approx(TEMPERATURE_C, abs=0.3)
+
+
+@pytest.mark.parametrize(("range_g", "odr_hz", "n_samples"), [(2, 1000.0, 400), (8, 4000.0, 4096)],
+                         ids=["400-at-1kHz", "whole-buffer-at-4kHz"])
+def test_captures_are_the_models_samples_unbroken(sensor: Opened, range_g: int, odr_hz: float, n_samples: int) -> None:
+    """A version 2 capture through the firmware: every sample the model made, in order, none lost or repeated
+    (at 4 kHz the FIFO lasts 8 ms, so the firmware must drain it in time for a whole second), decoding to
+    the model's gravity vector, with the model's temperature at both ends."""
+    driver = sensor.driver
+    bring_up(driver, range_g, odr_hz)
+    started = time.monotonic()
+    block = driver.acquire(n_samples)
+    assert time.monotonic() - started >= (n_samples - 1) / odr_hz  # real samples, at the part's own rate
+    assert block.codes_xyz.shape == (n_samples, 3)
+    first_sample_index(block.codes_xyz, range_g)
+    measured_g = block.codes_xyz * ADXL355.lsb_g(range_g)
+    noise_g = NOISE_LSB[range_g] * ADXL355.lsb_g(range_g) / np.sqrt(3)
+    np.testing.assert_allclose(measured_g.mean(axis=0), GRAVITY_UG * 1e-6, atol=5 * noise_g / np.sqrt(n_samples))
+    assert block.temperature_c == pytest.approx((TEMPERATURE_C, TEMPERATURE_C), abs=0.3)
+
+
+def test_a_capture_larger_than_the_buffer_is_refused(sensor: Opened) -> None:
+    """The greeting's capture= is a promise: a count above it must be refused, not overrun the buffer."""
+    bring_up(sensor.driver, 2, 1000.0)
+    for count in (4097, 0):
+        with pytest.raises(InstrumentError, match=r"refused: capture count must be decimal 1\.\.4096"):
+            sensor.bridge.start_capture(count)
+    assert sensor.bridge.start_capture(4096) > 0  # the largest that is allowed (taken whole at 4 kHz above)
+
+
+def test_a_capture_needs_the_part_measuring(sensor: Opened) -> None:
+    """A part in standby makes no samples: the capture is refused at once instead of timing out."""
+    sensor.driver.standby()
+    with pytest.raises(InstrumentError, match=r"'C 50' refused: capture needs the part measuring"):
+        sensor.driver.acquire(50)
+
+
+def test_a_bridge_that_stalls_reports_the_overflow(sensor: Opened) -> None:
+    """The firmware stopped for 50 ms (6 FIFOs' worth at 4 kHz): the part's FIFO_OVR must reach the host as
+    `!overflow`, never a block with a hole in it; the next capture is whole again."""
+    bring_up(sensor.driver, 2, 4000.0)
+    sensor.bridge.start_capture(4000)
+    os.kill(sensor.firmware.process.pid, signal.SIGSTOP)
+    time.sleep(0.05)
+    os.kill(sensor.firmware.process.pid, signal.SIGCONT)
+    time.sleep(0.01)
+    with pytest.raises(CaptureOverflow, match=r"overflow: FIFO overflowed after \d+ of 4000 samples"):
+        sensor.bridge.fetch_capture(0)
+    first_sample_index(sensor.driver.acquire(400).codes_xyz, 2)
+
+
+def test_a_complete_capture_can_be_fetched_again(sensor: Opened) -> None:
+    """A reply lost on the line is asked for again: the capture stays until the next C."""
+    bring_up(sensor.driver, 2, 4000.0)
+    sensor.bridge.start_capture(200)
+    time.sleep(0.1)
+    first = sensor.bridge.fetch_capture(0)
+    assert len(first[0]) == 200 * 9 and first[1] is not None
+    assert sensor.bridge.fetch_capture(0) == first
+    assert sensor.bridge.fetch_capture(150) == (first[0][150 * 9:], first[1])
+    assert sensor.bridge.fetch_capture(200) == (b"", first[1])
+
+
+def test_the_host_can_still_drain_the_fifo_itself(sensor: Opened) -> None:
+    """R 11 288 passes through as one burst: the driver's own FIFO draining (version 1, and blocks above the
+    buffer) works through the firmware too, partial samples carried and all."""
+    bring_up(sensor.driver, 2, 125.0)
+    sensor.bridge.capture_capacity_samples = 0  # as a version 1 bridge: the driver drains the FIFO itself
+    block = sensor.driver.acquire(100)
+    first_sample_index(block.codes_xyz, 2)
+    assert block.temperature_c == pytest.approx((TEMPERATURE_C, TEMPERATURE_C), abs=0.3)
+
+
+@pytest.mark.parametrize(("request_line", "reply"), [
+    ("HELLO", "!unknown request"), ("R 00", "!unknown request"), ("R 80 1", "!R: address"),
+    ("R 11 289", "!R: count"), ("R 00 x", "!R: count"), ("W 2D 100", "!W: value"), ("G 0", "!G: no capture"),
+    ("C 50", "!capture needs the part measuring"), ("R 00 4", "=AD1DED01"), ("W 1F 07", "="), ("r 00 1", "!unknown"),
+])
+def test_every_request_gets_one_reply_and_failures_say_why(line: LinePort, request_line: str, reply: str) -> None:
+    """Malformed requests are refused with a message (the driver raises it naming the port), never guessed."""
+    assert line.ask(request_line).startswith(reply)
+
+
+def test_a_line_left_unfinished_does_not_spoil_the_next_request(bridge_host: Path) -> None:
+    """Half a request from a client that went away (or noise from plugging in) is dropped after a second,
+    so the next client's greeting is read whole; a byte that is not text is refused, not cut off unseen."""
+    with running(bridge_host) as firmware:
+        stray = os.open(firmware.path, os.O_RDWR | os.O_NOCTTY)
+        os.write(stray, b"R 0")
+        os.close(stray)
+        time.sleep(1.1)
+        port = LinePort.open(firmware.path, "bridge", 921600, 1.0)
+        try:
+            assert port.ask("?").startswith("ADXL355-BRIDGE 2 ")
+            assert port.ask("R 00 1\x00 4") == "!request has bytes that are not printable ASCII"
+        finally:
+            port.close()
+
+
+def test_the_fifo_is_not_lent_out_during_a_capture(line: LinePort) -> None:
+    """A FIFO burst from the host in the middle of a capture would steal its samples: refused."""
+    assert line.ask("W 28 00") == "=" and line.ask("W 2D 00") == "="  # 4000 Hz, measuring
+    assert line.ask("C 4000").startswith("=")
+    assert line.ask("R 11 9").startswith("!R: FIFO_DATA is being captured")
+    assert line.ask("R 00 1") == "=AD"
+
+
+def test_torn_temperature_reads_never_reach_the_capture(bridge_host: Path) -> None:
+    """With a fifth of the model's TEMP2/TEMP1 reads torn, a single read is ~28 °C off now and then; the
+    temperatures the firmware reports at each capture's start and end never are."""
+    with opened(bridge_host, "--tear-rate", "0.2") as sensor:
+        single = [ADXL355.temperature.celsius(adxl355.raw_temperature(*sensor.bridge.read(adxl355.REG_TEMP2, 2)))
+                  for _ in range(200)]
+        assert sum(abs(t - TEMPERATURE_C) > 20 for t in single) >= 15  # the quirk is there (~40 expected)
+        bring_up(sensor.driver, 2, 4000.0)
+        for _ in range(10):
+            block = sensor.driver.acquire(50)
+            assert block.temperature_c == pytest.approx((TEMPERATURE_C, TEMPERATURE_C), abs=0.3)
+
+
+def test_a_part_whose_temperature_never_agrees_is_refused(bridge_host: Path) -> None:
+    """Every read torn: no two reads agree in ten, and the capture says so rather than report a guess."""
+    with opened(bridge_host, "--tear-rate", "1") as sensor:
+        bring_up(sensor.driver, 2, 1000.0)
+        with pytest.raises(InstrumentError, match=r"refused: temperature: TEMP2/TEMP1 did not agree in 10 reads"):
+            sensor.bridge.start_capture(100)
+
+
+def test_the_core_cross_compiles_freestanding_within_its_ram_budget(tmp_path: Path) -> None:
+    """The core as the board builds it (arm-none-eabi-gcc, Cortex-M0+, -ffreestanding -Werror): it needs no
+    symbol but the HAL's, and its RAM (the static capture buffer and the rest) fits the stated bound."""
+    output = make("cross", tmp_path)
+    assert "undefined symbols: only the HAL's" in output
+    sizes = re.search(r"^\s*(\d+)\s+(\d+)\s+(\d+)\s+\d+\s+[0-9a-f]+\s+\S*bridge-core\.o$", output, re.MULTILINE)
+    assert sizes is not None, output
+    text, data, bss = (int(value) for value in sizes.groups())
+    assert bss >= 4096 * 9  # the capture buffer is static, counted here, not taken from a heap
+    assert data + bss < RAM_BOUND_BYTES
+    assert 0 < text < 8 * 1024
