@@ -58,9 +58,10 @@ class ChamberConfig(StrictModel):
     max_setpoint_c: TemperatureC = 100.0
     safe_setpoint_c: TemperatureC = 23.0
     ramp_rate_c_per_min: float = Field(3.0, ge=0.1, le=50)
-    dew_point_c: TemperatureC | None = Field(None, description="the chamber air's dew point to assume where its "
-                                             "controller has no humidity reading (a procedure's frost check "
-                                             "needs one or the other)")
+    dew_point_c: TemperatureC | None = Field(None, description="the chamber air's dew point to assume (used "
+                                             "instead of any humidity reading: a temperature-only chamber, or a "
+                                             "conservative value); a procedure's frost check needs this or a "
+                                             "humidity reading")
 
     def register_map(self) -> ChamberRegisterMap:
         return register_map(self.profile, self.registers)

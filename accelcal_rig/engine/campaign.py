@@ -117,7 +117,7 @@ class CampaignRunner:
                                     self.machine, self.report)
         self.poses = PoseSteps(procedure, rig, guarded, clock, events, writer, self.machine, self.report, self.thermal)
         cooldown = CooldownSteps(procedure, self.chamber, clock, events, self.machine, self.thermal, self.poses)
-        self.frost = FrostSteps(procedure, rig, self.chamber, self.sensors, clock, events)
+        self.frost = FrostSteps(procedure, rig, self.thermal, self.sensors, clock, events, self.report)
         #: What each type of step is done by.
         self.handlers: Mapping[type, Callable[[Any], None]] = {
             Ramp: self.thermal.ramp, Soak: self.thermal.soak, StartSoftwareRamp: self.thermal.start_software_ramp,
@@ -146,6 +146,7 @@ class CampaignRunner:
             self._run_stages()
             self.machine.go(State.SAFE, "campaign complete")
             safe = apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
+            self.frost.note_purge_left_on()
             self.report.notify("safe", "every pose measured; rig in its safe state" if safe else
                                  "every pose measured; safe state INCOMPLETE: see the event log")
             fit = self._fit() if self.fit_stage is not None else FitOutcome("")
@@ -177,6 +178,7 @@ class CampaignRunner:
         self.events.error("fault", f"campaign aborted: {reason}")
         self.report.notify("fault", f"campaign aborted: {reason}")
         safe = apply_safe_state(self.chamber, self.turntable, self.sensors, self.safe_setpoint_c, self.events)
+        self.frost.note_purge_left_on()
         self.report.notify("safe", f"rig in its safe state; {self.report.poses_done} of {len(self.plan.pose_steps)} poses stored"
                      if safe else "safe state INCOMPLETE: check the rig; see the event log")
         if self.machine.state is State.SAFE:
@@ -254,13 +256,15 @@ class CampaignRunner:
     # ----------------------------------------------------------------- the plan
     def _run_stages(self) -> None:
         """Each setpoint's steps not stored yet. A run begins at its first setpoint with something left to
-        measure through that setpoint's restart entry, and so does the setpoint after a skipped soak."""
+        measure through that setpoint's restart entry, and so does the setpoint after a skipped soak or after
+        one whose poses were all stored (the rig did not go there)."""
         restarting = True
         for stage in self.plan.stages:
             label = setpoint_label(stage.setpoint_c)
             body = [s for s in stage.body if not (isinstance(s, Measurement) and s.key in self._stored_keys)]
             if not any(isinstance(s, Measurement) for s in body):
                 self.events.info("setpoint", f"{label}: every pose already stored")
+                restarting = True  # the rig did not go there: the next setpoint assumes nothing of it
                 continue
             self.report.begin_setpoint(stage.setpoint_c)
             self.writer.check_space(sum(self.report.poses_left[self.report.setpoint_index:]))

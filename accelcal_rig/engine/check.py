@@ -46,12 +46,19 @@ _REST_POLLS = 5
 
 
 def _moisture(chamber: Chamber, rig: RigConfig) -> str:
-    """What a procedure's frost settings can count on: the purge output, and the air's dew point."""
-    relative_humidity = humidity_pct(chamber)
-    if relative_humidity is not None:
-        dew = dew_point_c(chamber.read_temperature_c(), relative_humidity)
-        air = f"{relative_humidity:.1f} % RH (dew point {dew:.1f} °C)"
+    """What a procedure's frost settings can count on: the dew point a campaign would use (the configured
+    one wins; else the controller's humidity reading, which a temperature-only chamber may refuse), and
+    whether there is a purge output."""
+    if rig.chamber.dew_point_c is not None:
+        air = f"dew point {rig.chamber.dew_point_c:g} °C configured"
     else:
-        air = "no humidity reading" + (f" (dew point {rig.chamber.dew_point_c:g} °C configured)"
-                                       if rig.chamber.dew_point_c is not None else "")
+        try:
+            relative_humidity = humidity_pct(chamber)
+        except InstrumentError as exc:
+            relative_humidity, air = None, f"humidity not read ({exc})"
+        else:
+            air = "no humidity reading"
+        if relative_humidity is not None:
+            dew = dew_point_c(chamber.read_temperature_c(), relative_humidity)
+            air = f"{relative_humidity:.1f} % RH (dew point {dew:.1f} °C)"
     return f"; {air}; dry-air purge {'output' if has_purge(chamber) else 'none'}"

@@ -64,9 +64,9 @@ class ThermalSteps:
 
     def advance_software_ramp(self, step: AdvanceRamp) -> None:
         """Between poses on the ramp: write its current setpoint."""
-        self._write_ramp_setpoint()
+        self.write_ramp_setpoint()
 
-    def _write_ramp_setpoint(self) -> None:
+    def write_ramp_setpoint(self) -> None:
         """Write the software ramp's current setpoint, at most every `ramp.update_s`."""
         if self._ramp_origin is None:
             return
@@ -83,11 +83,11 @@ class ThermalSteps:
         t0, start_c = self._ramp_origin
         arrival_s = t0 + abs(step.until_c - start_c) / (self.procedure.ramp.rate_c_per_min / 60.0)
         while self.clock.now() < arrival_s:
-            self._write_ramp_setpoint()
+            self.write_ramp_setpoint()
             self.read_chamber_c()  # the alarm, and what the progress display shows
             self.report.publish(self.machine.state)
             self.clock.sleep(min(self.procedure.ramp.update_s, arrival_s - self.clock.now()))
-        self._write_ramp_setpoint()
+        self.write_ramp_setpoint()
         self._reached_s = self.clock.now()
 
     def ramp(self, step: Ramp) -> None:

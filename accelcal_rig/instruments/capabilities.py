@@ -29,3 +29,10 @@ def humidity_pct(chamber: Chamber) -> float | None:
     """The controller's relative humidity reading; None where it has none."""
     read = getattr(chamber, "read_humidity_pct", None)
     return read() if callable(read) else None
+
+
+def setpoint_decimals(chamber: Chamber) -> int | None:
+    """The decimals a chamber's set point is written with (a 16-bit register's, a template's `.1f`); None:
+    written in full."""
+    decimals = getattr(chamber, "setpoint_decimals", None)
+    return decimals if isinstance(decimals, int) else None

@@ -55,6 +55,11 @@ class LineChamber:
     def read_setpoint_c(self) -> float:
         return self._temperature("read_setpoint", "sp", "set point")
 
+    @property
+    def setpoint_decimals(self) -> int | None:
+        """The decimals the profile writes a set point with: the limit gate rounds to them first."""
+        return self.protocol.setpoint_decimals
+
     def write_setpoint_c(self, setpoint_c: float) -> None:
         """Limits are the caller's gate (LimitedChamber), which also reads the set point back."""
         self._ask("write_setpoint", value=float(setpoint_c))
@@ -132,7 +137,7 @@ class LineChamber:
         if refusal is not None:
             code = refusal.groupdict().get("code")
             meaning = self.protocol.errors.get(code.strip()) if code else None
-            raise self._failure(f"{request!r} refused: {reply}" + (f" ({meaning})" if meaning else ""))
+            raise self._failure(f"{request!r} refused: {reply!r}" + (f" ({meaning})" if meaning else ""))
         match = re.fullmatch(command.reply, reply)
         if match is None:
             raise TransientInstrumentError(f"chamber ({self.endpoint}): {request!r}: unexpected reply {reply!r}")

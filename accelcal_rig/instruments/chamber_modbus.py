@@ -82,6 +82,11 @@ class ModbusChamber:
     def read_setpoint_c(self) -> float:
         return self._plausible(self._read_temperature(self.registers.setpoint), "set point")
 
+    @property
+    def setpoint_decimals(self) -> int | None:
+        """A scaled register holds the set point to its decimals (the limit gate rounds to them first)."""
+        return self.registers.decimals if self.registers.encoding == "scaled-int16" else None
+
     def write_setpoint_c(self, setpoint_c: float) -> None:
         """Write the static set point (both float words in one request). Limits are the caller's gate."""
         self._write(self.registers.setpoint, self._encode(setpoint_c))

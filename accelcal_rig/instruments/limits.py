@@ -8,7 +8,7 @@ import numpy as np
 
 from accelcal_rig.config.rig import ChamberConfig, TurntableConfig
 from accelcal_rig.errors import InstrumentError
-from accelcal_rig.instruments.capabilities import controller_limits
+from accelcal_rig.instruments.capabilities import controller_limits, setpoint_decimals
 from accelcal_rig.instruments.interfaces import Chamber, Turntable
 
 #: A setpoint read back further than this from what was written means the controller did not take it.
@@ -25,18 +25,22 @@ def plausible_c(value: float) -> bool:
 class LimitedChamber:
     """Refuses setpoints outside the rig's chamber limits, and outside the controller's own where it exposes
     them (read once, at connect: a controller clamps silently what it will not take); verifies each write by
-    reading back."""
+    reading back. A set point is first rounded to what the controller holds (a 0.1 °C register or template),
+    so the value checked against the limits and read back is the one on the wire."""
 
     def __init__(self, chamber: Chamber, limits: ChamberConfig) -> None:
         self._chamber = chamber
         self._limits = limits
         self.endpoint = chamber.endpoint
         self.controller_limits = controller_limits(chamber)
+        self.setpoint_decimals = setpoint_decimals(chamber)
 
     def controller_limits_c(self) -> tuple[float, float] | None:
         return self.controller_limits
 
     def write_setpoint_c(self, setpoint_c: float) -> None:
+        if self.setpoint_decimals is not None:
+            setpoint_c = round(setpoint_c, self.setpoint_decimals)
         low, high = self._limits.min_setpoint_c, self._limits.max_setpoint_c
         if not low <= setpoint_c <= high:
             raise InstrumentError(

@@ -29,8 +29,7 @@ class LinePort:
     def open(cls, endpoint: str, instrument: str, baudrate: int, timeout_s: float, write_terminator: str = "\n",
              read_terminator: str = "\n", encoding: str = "ascii") -> LinePort:
         """A device path or pyserial URL; `socket://host:port` is a TCP connection, named as one."""
-        where = f"tcp {endpoint.removeprefix('socket://')}" if endpoint.startswith("socket://") else f"serial {endpoint}"
-        name = f"{instrument} ({where})"
+        name = f"{instrument} ({describe_endpoint(endpoint)})"
         return cls(_open_port(name, endpoint, baudrate, timeout_s), name, write_terminator, read_terminator,
                    endpoint, baudrate, encoding)
 
@@ -86,6 +85,11 @@ class LinePort:
                 break
             line += chunk
         return bytes(line)
+
+
+def describe_endpoint(endpoint: str) -> str:
+    """How messages name a line's endpoint: `tcp host:port` for a pyserial socket URL, else `serial …`."""
+    return f"tcp {endpoint.removeprefix('socket://')}" if endpoint.startswith("socket://") else f"serial {endpoint}"
 
 
 def _open_port(name: str, endpoint: str, baudrate: int, timeout_s: float) -> serial.SerialBase:

@@ -10,7 +10,7 @@ import numpy as np
 from accelcal_rig.config.rig import TurntableConfig
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.definitions import TurntableDriver
-from accelcal_rig.instruments.line_port import LinePort
+from accelcal_rig.instruments.line_port import LinePort, describe_endpoint
 from accelcal_rig.instruments.retrying import RetryCall
 from accelcal_rig.protocols.turntable_line import Command, TurntableProtocol
 
@@ -31,7 +31,7 @@ class SerialTurntable:
              timeout_s: float = 2.0) -> SerialTurntable:
         line = LinePort.open(endpoint, "turntable", baudrate, timeout_s, protocol.write_terminator,
                              protocol.read_terminator)
-        return cls(line, f"serial {endpoint}", protocol, n_axes)
+        return cls(line, describe_endpoint(endpoint), protocol, n_axes)
 
     # ------------------------------------------------------------------ the Turntable interface
     def identify(self) -> str:
@@ -72,6 +72,8 @@ class SerialTurntable:
         return self._polls_at_rest >= p.at_rest_polls
 
     def stop(self) -> None:
+        """Stop every axis; a profile's stop may leave another mode, so the next move sets it up again."""
+        self._set_up = False
         self._each(self.protocol.stop)
 
     def close(self) -> None:
@@ -82,6 +84,8 @@ class SerialTurntable:
         self._retry = call
 
     def reconnect(self) -> None:
+        """A controller that dropped off the line may have lost its mode: the next move sets it up again."""
+        self._set_up = False
         self._line.reconnect()
 
     def _setup(self) -> None:
@@ -110,7 +114,7 @@ class SerialTurntable:
             return {}
         reply = self._line.ask(request)
         if self._error.search(reply):
-            raise InstrumentError(f"turntable ({self.endpoint}): {request!r} refused: {reply}")
+            raise InstrumentError(f"turntable ({self.endpoint}): {request!r} refused: {reply!r}")
         match = re.fullmatch(command.reply, reply)
         if match is None:
             raise TransientInstrumentError(f"turntable ({self.endpoint}): {request!r}: unexpected reply {reply!r}")

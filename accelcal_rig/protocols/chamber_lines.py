@@ -15,11 +15,21 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from accelcal_rig.protocols.line_templates import NUMBER, regular_expression, request_pattern, template
+from accelcal_rig.protocols.line_templates import (
+    NUMBER,
+    decimals_of,
+    fields_of,
+    regular_expression,
+    request_pattern,
+    round_trips,
+    template,
+)
 
-#: What the templates may name, with sample values: the request's set point, and what replies carry.
-_SAMPLE: dict[str, object] = {"value": 0.0, "pv": 0.0, "sp": 0.0, "low": 0.0, "high": 0.0, "identity": "x",
-                              "alarm": "0", "units": "C", "humidity": 0.0}
+#: What a request may name (the set point it writes), with a sample value.
+_SEND_SAMPLE: dict[str, object] = {"value": -12.5}
+#: What an answer may name: the request's set point, and the values replies carry.
+_ANSWER_SAMPLE: dict[str, object] = {**_SEND_SAMPLE, "pv": 0.0, "sp": 0.0, "low": 0.0, "high": 0.0, "identity": "x",
+                                     "alarm": "0", "units": "C", "humidity": 0.0}
 
 Operation = Literal["identify", "read_temperature", "read_setpoint", "write_setpoint", "read_low_limit",
                     "read_high_limit", "power_on", "power_off", "alarm", "units", "humidity", "purge_on",
@@ -36,7 +46,8 @@ class LineCommand(BaseModel):
                                "(template), for simulators")
 
     _compiles = field_validator("reply")(classmethod(lambda cls, v: v if v is None else regular_expression(v)))
-    _templates = field_validator("send", "answer")(classmethod(lambda cls, v: v if v is None else template(v, _SAMPLE)))
+    _sends = field_validator("send")(classmethod(lambda cls, v: template(v, _SEND_SAMPLE)))
+    _answers = field_validator("answer")(classmethod(lambda cls, v: v if v is None else template(v, _ANSWER_SAMPLE)))
 
     @model_validator(mode="after")
     def _answered_if_replied(self) -> LineCommand:
@@ -90,14 +101,52 @@ class ChamberLineProtocol(BaseModel):
             raise ValueError("read_low_limit and read_high_limit come together")
         if (self.power_on is None) != (self.power_off is None) or (self.purge_on is None) != (self.purge_off is None):
             raise ValueError("an output's on and off commands come together")
+        value_fields = fields_of(self.write_setpoint.send)
+        if [name for name, _ in value_fields] != ["value"] or decimals_of(self.write_setpoint.send, "value") is None \
+                and value_fields[0][1] not in ("", "f", "g"):
+            raise ValueError("write_setpoint: the request must name the set point once, as {value} or {value:.Nf}")
+        before, _, after = self.write_setpoint.send.partition("{value")
+        after = after.partition("}")[2]
+        if (before and before[-1] in _NUMBER_CHARACTERS) or (after and after[0] in _NUMBER_CHARACTERS):
+            raise ValueError("write_setpoint: the set point must not run into digits or signs around it (the "
+                             "controller would read another number)")
         for operation in OPERATIONS:
             command = self.command(operation)
-            if command is not None:
-                try:
-                    (self.request_prefix + command.send + (command.answer or "")).encode(self.encoding)
-                except UnicodeEncodeError:
-                    raise ValueError(f"{operation}: not {self.encoding} text") from None
+            if command is None:
+                continue
+            if operation != "write_setpoint" and fields_of(command.send):
+                raise ValueError(f"{operation}: only write_setpoint's request carries a value")
+            try:
+                (self.request_prefix + command.send + (command.answer or "")).encode(self.encoding)
+            except UnicodeEncodeError:
+                raise ValueError(f"{operation}: not {self.encoding} text") from None
+            if command.send != command.send.strip():
+                raise ValueError(f"{operation}: the request {command.send!r} has blanks at either end (lost on "
+                                 "the line)")
+            if not round_trips(command.send, _SEND_SAMPLE):
+                raise ValueError(f"{operation}: the request {command.send!r} does not read back as itself "
+                                 "(no padding or blanks inside a field)")
+        self._no_request_taken_for_another()
         return self
+
+    def _no_request_taken_for_another(self) -> None:
+        """A controller (and the simulator) tells requests apart by their text: one operation's request must
+        not read as an earlier operation's, unless they are the same command (ESPEC's TEMP? carries four)."""
+        seen: list[tuple[Operation, LineCommand]] = []
+        for operation in OPERATIONS:
+            command = self.command(operation)
+            if command is None:
+                continue
+            request = command.send.format(**_SEND_SAMPLE)
+            for earlier, other in seen:
+                if other.send != command.send and request_pattern(other.send).fullmatch(request):
+                    raise ValueError(f"{operation}: its request {request!r} reads as {earlier}'s")
+            seen.append((operation, command))
+
+    @property
+    def setpoint_decimals(self) -> int | None:
+        """The decimals the set point is written with (`{value:.1f}`: 1, a 0.1 °C step); None: in full."""
+        return decimals_of(self.write_setpoint.send, "value")
 
     def command(self, operation: Operation) -> LineCommand | None:
         command: LineCommand | None = getattr(self, operation)
@@ -114,6 +163,9 @@ class ChamberLineProtocol(BaseModel):
         return [(operation, command, request_pattern(command.send))
                 for operation in OPERATIONS if (command := self.command(operation)) is not None]
 
+
+#: Characters a number is written with: none may touch the set point's field in a request.
+_NUMBER_CHARACTERS = frozenset("0123456789.+-eE")
 
 OPERATIONS: tuple[Operation, ...] = ("identify", "read_temperature", "read_setpoint", "write_setpoint",
                                      "read_low_limit", "read_high_limit", "power_on", "power_off", "alarm",
@@ -144,7 +196,8 @@ ESPEC_P300 = ChamberLineProtocol(
     humidity=LineCommand(send="HUMI?", reply=rf"(?P<humidity>{_N}),.*", answer="{humidity:.0f},0,100,0"),
 )
 
-#: Thermotron 8800 (8200 class): channel 1 is air temperature, 2 humidity; operations answer `0`.
+#: Thermotron 8800 (8200 class): channel 1 is air temperature, 2 humidity; operations answer `0`. No purge
+#: command: its auxiliaries are set eight at a time (`AUXE1,ddd`), which would clobber the others wired there.
 THERMOTRON_8800 = ChamberLineProtocol(
     write_terminator="\r", read_terminator="\r\n", default_port=8888,
     identify=LineCommand(send="IDEN?", reply=r"(?P<identity>.+)", answer="{identity}"),
@@ -154,10 +207,8 @@ THERMOTRON_8800 = ChamberLineProtocol(
     power_on=LineCommand(send="RUNM", reply="0", answer="0"),
     power_off=LineCommand(send="STOP", reply="0", answer="0"),
     alarm=LineCommand(send="ALRM1?", reply=r"(?P<alarm>\d+)", answer="{alarm}"),
-    units=LineCommand(send="CCHR1?", reply=r"(?P<units>\S+)", answer="{units}"),
+    units=LineCommand(send="CCHR1?", reply=r"(?P<units>[A-Za-z°]+)", answer="{units}"),
     humidity=LineCommand(send="PVAR2?", reply=rf"(?P<humidity>{_N})", answer="{humidity:.1f}"),
-    purge_on=LineCommand(send="AUXE1,001", reply="0", answer="0"),
-    purge_off=LineCommand(send="AUXE1,000", reply="0", answer="0"),
 )
 
 #: Vötsch/Weiss SIMSERV: numbered commands, fields separated by ¶ (0xB6), chamber index 1; replies begin
@@ -179,7 +230,7 @@ SIMSERV = ChamberLineProtocol(
     power_off=LineCommand(send=f"14001{_S}1{_S}1{_S}0", reply="1", answer="1"),
     alarm=LineCommand(send=f"10012{_S}1", reply=rf"1{_S}(?P<alarm>\d+)", answer=f"1{_S}{{alarm}}"),
     alarm_inactive=["1", "3", "5", "7"],  # status 1 idle, 3 running, +4 warnings; +8 means alarms
-    units=LineCommand(send=f"11023{_S}1{_S}1", reply=rf"1{_S}(?P<units>.+)", answer=f"1{_S}{{units}}"),
+    units=LineCommand(send=f"11023{_S}1{_S}1", reply=rf"1{_S}(?P<units>[A-Za-z°]+)", answer=f"1{_S}{{units}}"),
     units_celsius="\u00b0C",
     humidity=LineCommand(send=f"11004{_S}1{_S}2", reply=rf"1{_S}(?P<humidity>{_N})", answer=f"1{_S}{{humidity:.1f}}"),
     purge_on=LineCommand(send=f"14001{_S}1{_S}8{_S}1", reply="1", answer="1"),

@@ -36,6 +36,24 @@ def template(value: str, sample: Mapping[str, object]) -> str:
     return value
 
 
+def fields_of(value: str) -> list[tuple[str, str]]:
+    """(name, format spec) of each field a template names, in order."""
+    return [(f, spec or "") for _, f, spec, _ in string.Formatter().parse(value) if f is not None]
+
+
+def decimals_of(value: str, field: str) -> int | None:
+    """The fixed decimals a template prints `field` with (`{value:.1f}` → 1); None if not fixed."""
+    specs = [spec for name, spec in fields_of(value) if name == field]
+    match = re.fullmatch(r"\.(\d+)f", specs[0]) if specs else None
+    return int(match.group(1)) if match else None
+
+
+def round_trips(send: str, sample: Mapping[str, object]) -> bool:
+    """The request a template makes of `sample` is recognised by the template's own pattern (no padding or
+    blanks inside a field that a simulator, or a controller's parser, would not read back)."""
+    return request_pattern(send).fullmatch(send.format(**sample)) is not None
+
+
 def request_pattern(send: str) -> re.Pattern[str]:
     """The `send` template as a pattern: literal text as it is, each field a run of non-blank characters
     (a field named twice must read the same both times)."""

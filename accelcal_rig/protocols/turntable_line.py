@@ -17,11 +17,12 @@ import re
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from accelcal_rig.protocols.line_templates import NUMBER, regular_expression, request_pattern, template
+from accelcal_rig.protocols.line_templates import NUMBER, regular_expression, request_pattern, round_trips, template
 
-#: What a template may name, with sample values: the request's axis (1-based) and angle, and the values
-#: replies carry.
-_TEMPLATE_SAMPLE: dict[str, object] = {"axis": 1, "angle": 0.0, "identity": "x", "busy": 0, "fault": 0, "rate": 0.0}
+#: What a request may name, with sample values: its axis (1-based) and angle.
+_SEND_SAMPLE: dict[str, object] = {"axis": 2, "angle": -45.0}
+#: What an answer may name: the request's fields and the values replies carry.
+_ANSWER_SAMPLE: dict[str, object] = {**_SEND_SAMPLE, "identity": "x", "busy": 0, "fault": 0, "rate": 0.0}
 
 
 class Command(BaseModel):
@@ -34,9 +35,9 @@ class Command(BaseModel):
                                "(template), for simulators")
 
     _compiles = field_validator("reply")(classmethod(lambda cls, v: v if v is None else regular_expression(v)))
-    #: `{axis}` and `{angle:.5f}` style fields, nothing a request cannot fill.
-    _templates = field_validator("send", "answer")(classmethod(
-        lambda cls, v: v if v is None else template(v, _TEMPLATE_SAMPLE)))
+    #: `{axis}` and `{angle:.5f}` style fields in a request, nothing it cannot fill; an answer also the values.
+    _sends = field_validator("send")(classmethod(lambda cls, v: template(v, _SEND_SAMPLE)))
+    _answers = field_validator("answer")(classmethod(lambda cls, v: v if v is None else template(v, _ANSWER_SAMPLE)))
 
     @model_validator(mode="after")
     def _answered_if_replied(self) -> Command:
@@ -96,6 +97,16 @@ class TurntableProtocol(BaseModel):
                 raise ValueError(f"{name}: the reply pattern must capture ({group})")
         if self.multi_axis_move and not self.move.per_axis:
             raise ValueError("multi_axis_move joins one move per axis: the move must name {axis}")
+        if self.multi_axis_move and self.move.reply is not None:
+            raise ValueError("multi_axis_move: the move must be unanswered (a controller answering each of the "
+                             "joined commands would leave replies on the line)")
+        for name in ("identify", "move", "position", "busy", "rate", "stop", "home", "fault"):
+            command = getattr(self, name)
+            if command is not None and command.send != command.send.strip():
+                raise ValueError(f"{name}: the request {command.send!r} has blanks at either end (lost on the line)")
+            if command is not None and not round_trips(command.send, _SEND_SAMPLE):
+                raise ValueError(f"{name}: the request {command.send!r} does not read back as itself "
+                                 "(no padding or blanks inside a field)")
         return self
 
 
@@ -121,10 +132,10 @@ ACUTROL3000 = TurntableProtocol(
     position=Command(send=":read:position? {axis}", reply=rf"(?P<angle>{_N})", answer="{angle:.5f}"),
     rate=Command(send=":read:rate? {axis}", reply=rf"(?P<rate>{_N})", answer="{rate:.5f}"),
     at_rest_deg_s=0.01, at_rest_polls=3,
-    stop=Command(send=":mode:rate {axis};:demand:rate {axis},0"),
+    stop=Command(send=":demand:rate {axis},0;:mode:rate {axis};:demand:rate {axis},0"),
     home=Command(send=":demand:position {axis},0"),
     fault=Command(send=":interlock? {axis}", reply=r"(?P<fault>\w+)", answer="{fault}"),
-    fault_values=["Fault"],
+    fault_values=["Fault", "Open"],  # tripped, or opened since the setup closed it
     setup=[Command(send=":interlock:close {axis}"), Command(send=":mode:position {axis}")],
     setup_pause_s=0.3,
 )

@@ -33,7 +33,9 @@ class ChamberMoisture:
         return self._dew_point_c
 
     def _advance(self, t_s: float) -> None:
-        """Step the relaxation to `t_s` in steps short against the time constant (the air moves meanwhile)."""
+        """Step the relaxation to `t_s` in steps short against the time constant. The air temperature is the
+        thermal model's, which only moves forward: over a gap between requests it is the latest one (the
+        line simulator advances the moisture on every request, a few seconds apart)."""
         step_s = self._tau_s / 10.0
         while self._t_s < t_s:
             dt = min(step_s, t_s - self._t_s)

@@ -32,7 +32,8 @@ class SimulatedTurntableServer:
         n_axes = len(lab.motion.speeds_deg_s)
         #: Fault reply of each axis (fault injection sets them); a profile without per-axis faults reads axis 1's.
         self.faults = [protocol.fault_ok[0]] * n_axes
-        #: Axes whose setup (interlock, mode) has been received; a profile with setup ignores moves before it.
+        #: Axes whose setup (interlock, mode) has been received since the last stop; a profile with setup
+        #: ignores moves before it, as a table out of position mode does.
         self._set_up = [not protocol.setup] * n_axes
         self._setup_seen: list[set[str]] = [set() for _ in range(n_axes)]
 
@@ -57,8 +58,17 @@ class SimulatedTurntableServer:
             pattern = protocol.move.request_pattern()
             matches = [pattern.fullmatch(part) for part in request.split(protocol.move_separator)]
             if all(matches):
-                for match in matches:
-                    self._answer("move", "", match.groupdict())  # type: ignore[union-attr]
+                moves = [m.groupdict() for m in matches if m is not None]
+                try:  # every part read before any moves: a bad one moves nothing
+                    n_axes = len(self._lab.motion.speeds_deg_s)
+                    for fields in moves:
+                        if not 1 <= int(fields["axis"]) <= n_axes:
+                            raise ValueError(f"no axis {fields['axis']}")
+                        float(fields["angle"])
+                except (ValueError, KeyError) as exc:
+                    return f"ERR {exc}"
+                for fields in moves:
+                    self._answer("move", "", fields)
                 self.last_command = request
                 return protocol.move.answer
         matched, answer = self._match(request)
@@ -96,6 +106,8 @@ class SimulatedTurntableServer:
                 motion.command_axis(now, axis, float(fields["angle"]))  # a stalled or unarmed table stays put
             elif name == "stop":
                 motion.stop(now)
+                for a in axes if self._protocol.setup else ():  # a stop leaves the mode a move needs
+                    self._set_up[a], self._setup_seen[a] = False, set()
             elif name == "home":
                 target = motion.position_deg(now)
                 target[list(axes)] = 0.0

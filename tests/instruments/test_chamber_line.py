@@ -10,7 +10,7 @@ from accelcal_rig.config.rig import ChamberConfig, FaultInjection, RetryPolicy
 from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.retry import Retrier
-from accelcal_rig.errors import InstrumentError
+from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.chamber_line import LineChamber
 from accelcal_rig.instruments.limits import LimitedChamber
 from accelcal_rig.protocols.chamber_lines import LINE_PROFILES, line_protocol
@@ -71,7 +71,7 @@ def test_a_controller_in_local_mode_refuses_remote_writes_in_one_line(served) ->
     chamber, server, _, _ = served("espec-p300")
     server.local_mode = True
     with pytest.raises(InstrumentError, match=r"^chamber \(tcp 127\.0\.0\.1:\d+\): 'TEMP, S25.0' refused: "
-                                              r"NA:CONT NOT READY-1 \(the controller is in local mode"):
+                                              r"'NA:CONT NOT READY-1' \(the controller is in local mode"):
         chamber.write_setpoint_c(25.0)
     assert server.last_setpoint_c is None
 
@@ -83,8 +83,14 @@ def test_a_controller_not_in_celsius_is_refused(served) -> None:
 
 
 def test_an_rs485_address_reaches_only_its_controller(served) -> None:
-    chamber, _, _, _ = served("espec-p300", "pty", overrides={"request_prefix": "2,"})
+    chamber, server, _, _ = served("espec-p300", "pty", overrides={"request_prefix": "2,"})
     assert chamber.read_setpoint_c() == pytest.approx(23.0)
+    other = LineChamber.open(server.endpoint, line_protocol("espec-p300", {"request_prefix": "3,"}), timeout_s=0.2)
+    try:
+        with pytest.raises(TransientInstrumentError, match="no reply within the timeout"):
+            other.read_setpoint_c()  # addressed to controller 3: controller 2 stays silent
+    finally:
+        other.close()
 
 
 def test_garbled_and_dropped_replies_are_retried_to_success(served) -> None:

@@ -102,10 +102,10 @@ def test_an_rs485_address_prefixes_every_request() -> None:
 
 @pytest.mark.parametrize(("profile", "sent", "reply", "message"), [
     ("espec-p300", b"TEMP, S25.0\r\n", b"NA:CONT NOT READY-1\r\n",
-     r"chamber \(memory\): 'TEMP, S25.0' refused: NA:CONT NOT READY-1 \(the controller is in local mode"),
-    ("espec-p300", b"TEMP, S25.0\r\n", b"NA:DATA OUT OF RANGE\r\n", r"refused: NA:DATA OUT OF RANGE \(value beyond"),
+     r"chamber \(memory\): 'TEMP, S25.0' refused: 'NA:CONT NOT READY-1' \(the controller is in local mode"),
+    ("espec-p300", b"TEMP, S25.0\r\n", b"NA:DATA OUT OF RANGE\r\n", r"refused: 'NA:DATA OUT OF RANGE' \(value beyond"),
     ("simserv", b"11001\xb61\xb61\xb625.0\r", b"-6\r\n",
-     r"chamber \(memory\): '11001¶1¶1¶25.0' refused: -6 \(too few or incorrect parameters\)"),
+     r"chamber \(memory\): '11001¶1¶1¶25.0' refused: '-6' \(too few or incorrect parameters\)"),
 ])
 def test_a_refusal_is_one_line_with_what_the_code_means(profile: str, sent: bytes, reply: bytes,
                                                          message: str) -> None:

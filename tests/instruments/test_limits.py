@@ -72,3 +72,23 @@ def test_the_controllers_own_limits_refuse_too() -> None:
         chamber.write_setpoint_c(60)
     chamber.write_setpoint_c(50)
     assert raw.writes == [50]
+
+
+class TenthsChamber(RecordingChamber):
+    """A controller that holds its set point to 0.1 °C (a scaled register, a `{value:.1f}` template)."""
+
+    setpoint_decimals = 1
+
+    def read_setpoint_c(self) -> float:
+        return float(f"{self.writes[-1]:.1f}")
+
+
+def test_a_set_point_is_rounded_to_what_the_controller_holds_before_the_limits_and_the_readback() -> None:
+    inner = TenthsChamber()
+    chamber = LimitedChamber(inner, ChamberConfig(min_setpoint_c=-40, max_setpoint_c=85, safe_setpoint_c=20))
+    chamber.write_setpoint_c(20.749)  # a software ramp's value: written, and read back, as 20.7
+    chamber.write_setpoint_c(85.04)   # rounds to the limit itself: allowed
+    assert inner.writes == [20.7, 85.0]
+    with pytest.raises(InstrumentError, match=r"setpoint 85.1 °C refused, limits are -40…85"):
+        chamber.write_setpoint_c(85.06)  # what would go on the wire is beyond the limit
+    assert inner.writes == [20.7, 85.0]

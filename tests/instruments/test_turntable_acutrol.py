@@ -4,8 +4,6 @@ and a quick campaign runs on it."""
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 import pytest
 
@@ -13,6 +11,7 @@ from accelcal_rig.cli import main
 from accelcal_rig.config.load import load_rig
 from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.errors import InstrumentError
+from accelcal_rig.instruments.line_port import LinePort
 from accelcal_rig.instruments.turntable_serial import SerialTurntable
 from accelcal_rig.protocols.turntable_line import turntable_protocol
 from accelcal_rig.sim.lab import VirtualLab
@@ -47,15 +46,38 @@ def test_all_axes_start_together_and_complete_by_rate(table) -> None:
     np.testing.assert_allclose(driver.read_angles_deg(), [100, 90, -45], atol=3 / 3600 + 1e-5)
 
 
-def test_the_simulated_table_ignores_a_move_before_it_is_armed(table) -> None:
-    _, server, lab, clock = table
-    fd = os.open(server.path, os.O_RDWR | os.O_NOCTTY)
+def test_the_simulated_table_ignores_a_move_before_it_is_armed_and_after_a_stop(table) -> None:
+    driver, server, lab, clock = table
+    line = LinePort.open(server.path, "turntable", 9600, 1.0)
     try:
-        os.write(fd, b":demand:position 1,30.00000\n")  # no interlock closed, no position mode
+        line.send(":demand:position 1,30.00000")  # no interlock closed, no position mode
+        line.ask("*IDN?")  # answered after the move was taken: the simulator has seen it
         clock.sleep(10.0)
+        assert lab.motion.position_deg(clock.now())[0] == pytest.approx(0.0)
+        driver.move_to(np.array([30.0, 0.0, 0.0]))  # the driver arms the table first
+        driver.read_angles_deg()
+        clock.sleep(10.0)
+        assert lab.motion.position_deg(clock.now())[0] == pytest.approx(30.0, abs=0.01)
+        driver.stop()  # rate mode now: the next move must set the table up again, and does
+        driver.move_to(np.array([60.0, 0.0, 0.0]))
+        driver.read_angles_deg()
+        clock.sleep(10.0)
+        assert lab.motion.position_deg(clock.now())[0] == pytest.approx(60.0, abs=0.01)
     finally:
-        os.close(fd)
-    assert lab.motion.position_deg(clock.now())[0] == pytest.approx(0.0)
+        line.close()
+
+
+def test_a_bad_part_of_a_compound_move_moves_nothing_and_the_simulator_lives_on(table) -> None:
+    driver, server, lab, clock = table
+    driver.move_to(np.array([0.0, 0.0, 0.0]))  # armed
+    line = LinePort.open(server.path, "turntable", 9600, 1.0)
+    try:
+        assert line.ask(":demand:position 1,30.00000;:demand:position 9,2.00000") == "ERR no axis 9"
+        clock.sleep(10.0)
+        assert lab.motion.position_deg(clock.now())[0] == pytest.approx(0.0, abs=0.01)
+        assert line.ask("*IDN?") == "accelcal-rig simulated turntable"
+    finally:
+        line.close()
 
 
 def test_a_tripped_interlock_on_one_axis_is_named(table) -> None:

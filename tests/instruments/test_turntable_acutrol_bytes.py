@@ -43,10 +43,15 @@ def test_a_tripped_interlock_names_its_axis() -> None:
             SerialTurntable(line, "memory", ACUTROL, 2).in_position()
 
 
-def test_stop_holds_each_axis_in_rate_mode_at_zero() -> None:
-    with expected_protocol([(b":mode:rate 1;:demand:rate 1,0\n", None),
-                            (b":mode:rate 2;:demand:rate 2,0\n", None)]) as line:
-        SerialTurntable(line, "memory", ACUTROL, 2).stop()
+def test_stop_holds_each_axis_at_zero_rate_and_the_next_move_sets_up_again() -> None:
+    stop = [(b":demand:rate 1,0;:mode:rate 1;:demand:rate 1,0\n", None),
+            (b":demand:rate 2,0;:mode:rate 2;:demand:rate 2,0\n", None)]
+    move = (b":demand:position 1,0.00000;:demand:position 2,0.00000\n", None)
+    with expected_protocol([*SETUP, move, *stop, *SETUP, move]) as line:
+        table = SerialTurntable(line, "memory", ACUTROL, 2)
+        table.move_to(np.zeros(2))
+        table.stop()
+        table.move_to(np.zeros(2))
 
 
 def test_positions_are_read_axis_by_axis() -> None:

@@ -82,7 +82,7 @@ def test_error_replies_garbage_and_silence_are_one_line_errors() -> None:
     server = PtyLineServer(lambda request: next(replies)).start()
     driver = SerialTurntable.open(server.path, ACCELCAL_LINE, n_axes=2, timeout_s=0.3)
     try:
-        with pytest.raises(InstrumentError, match=r"'MOV 1 0.00000' refused: ERR axis 2 not homed"):
+        with pytest.raises(InstrumentError, match=r"'MOV 1 0.00000' refused: 'ERR axis 2 not homed'"):
             driver.move_to(np.zeros(2))
         with pytest.raises(InstrumentError, match=r"'BUSY\?': unexpected reply 'what\?'"):
             driver._ask(ACCELCAL_LINE.busy)

@@ -44,7 +44,7 @@ def test_a_controller_fault_is_raised_not_waited_out() -> None:
 def test_an_error_reply_is_a_refusal_and_a_garbled_one_is_transient() -> None:
     with expected_protocol([(b"MOV 1 400.00000\n", b"ERR 3 limit\n"), (b"STOP\n", b"OK?\n")]) as line:
         driver = table(line, n_axes=1)
-        with pytest.raises(InstrumentError, match=r"'MOV 1 400.00000' refused: ERR 3 limit"):
+        with pytest.raises(InstrumentError, match=r"'MOV 1 400.00000' refused: 'ERR 3 limit'"):
             driver.move_to(np.array([400.0]))
         with pytest.raises(TransientInstrumentError, match=r"'STOP': unexpected reply 'OK\?'"):
             driver.stop()

@@ -1,31 +1,45 @@
-"""The frost steps woven into a plan: the purge switched where the setpoints cross its threshold, a dew-point
-wait before the poses of each warming step, and no change to what the campaign stores."""
+"""The frost steps woven into a plan: the purge on before going into the cold and off only once a warming
+step is over, a dew-point wait before the poses of each warming step, restart entries that assume nothing,
+and no change to what the campaign stores."""
 
 from __future__ import annotations
 
 from accelcal_rig.engine.preparation import prepare
-from accelcal_rig.plan.steps import AwaitDewPointMargin, Ramp, SetPurge, Soak
+from accelcal_rig.plan.steps import AwaitDewPointMargin, Ramp, SetPurge
 from tests.conftest import TINY_PROCEDURE
 
 FROSTY = TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c: [-40, 20, 60, -10, 0]")
 
 
-def test_purge_switches_where_the_threshold_is_crossed_and_waits_follow_warming_soaks(write) -> None:
+def names(steps) -> list[str]:
+    return [f"{type(s).__name__}({'on' if s.on else 'off'})" if isinstance(s, SetPurge) else type(s).__name__
+            for s in steps]
+
+
+def test_purge_goes_on_before_the_cold_and_off_after_the_warming_step(write) -> None:
     plan = prepare(write("frost.yaml", FROSTY + "frost: {purge_below_c: 0, dew_point_margin_c: 3}\n")).plan
-    entries = [[type(step).__name__ for step in stage.entry] for stage in plan.stages]
-    assert entries == [["SetPurge", "Ramp", "Soak"],                          # -40: on
-                       ["SetPurge", "Ramp", "Soak", "AwaitDewPointMargin"],   # 20: off, warming
-                       ["Ramp", "Soak", "AwaitDewPointMargin"],               # 60: still off, warming
-                       ["SetPurge", "Ramp", "Soak"],                          # -10: on, cooling
-                       ["SetPurge", "Ramp", "Soak", "AwaitDewPointMargin"]]   # 0: off (not below 0), warming
-    assert [s.on for stage in plan.stages for s in stage.entry if isinstance(s, SetPurge)] == [True, False, True, False]
-    # A run beginning at any setpoint sets the purge first, whatever the last run left it at.
-    for stage in plan.stages:
-        first = stage.restart_entry[0]
-        assert isinstance(first, SetPurge) and first.on == (stage.setpoint_c < 0)
-        assert isinstance(stage.restart_entry[1], Ramp) and isinstance(stage.restart_entry[2], Soak)
-        assert (AwaitDewPointMargin(stage.setpoint_c) in stage.restart_entry) == (
-            AwaitDewPointMargin(stage.setpoint_c) in stage.entry)
+    assert [names(stage.entry) for stage in plan.stages] == [
+        ["SetPurge(on)", "Ramp", "Soak"],                                  # -40
+        ["Ramp", "Soak", "AwaitDewPointMargin", "SetPurge(off)"],         # 20: warming out of the cold
+        ["Ramp", "Soak", "AwaitDewPointMargin"],                          # 60: warming, purge already off
+        ["SetPurge(on)", "Ramp", "Soak"],                                  # -10: cooling into the cold
+        ["Ramp", "Soak", "AwaitDewPointMargin", "SetPurge(off)"]]         # 0 (not below 0): warming out
+
+
+def test_a_run_beginning_anywhere_sets_the_purge_and_past_the_first_setpoint_waits_for_the_dew_point(write) -> None:
+    plan = prepare(write("frost.yaml", FROSTY + "frost: {purge_below_c: 0, dew_point_margin_c: 3}\n")).plan
+    assert [names(stage.restart_entry) for stage in plan.stages] == [
+        ["SetPurge(on)", "Ramp", "Soak"],                                          # the first: nothing before it
+        ["SetPurge(on)", "Ramp", "Soak", "AwaitDewPointMargin", "SetPurge(off)"],
+        ["SetPurge(off)", "Ramp", "Soak", "AwaitDewPointMargin"],
+        ["SetPurge(on)", "Ramp", "Soak", "AwaitDewPointMargin"],                  # cooling, but who knows
+        ["SetPurge(on)", "Ramp", "Soak", "AwaitDewPointMargin", "SetPurge(off)"]]
+
+
+def test_no_purge_steps_where_no_setpoint_is_below_the_threshold(write) -> None:
+    plan = prepare(write("warm.yaml", TINY_PROCEDURE.replace("[30]", "[20, 40]") + "frost: {purge_below_c: 0}\n")).plan
+    assert not any(isinstance(s, SetPurge) for stage in plan.stages for s in (*stage.entry, *stage.restart_entry))
+    assert isinstance(plan.stages[0].entry[0], Ramp)
 
 
 def test_frost_steps_store_nothing_so_the_plan_fingerprint_is_unchanged(write) -> None:

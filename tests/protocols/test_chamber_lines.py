@@ -41,10 +41,27 @@ def test_each_profile_answers_its_own_requests(profile: str) -> None:
     ({"read_low_limit": None}, "read_low_limit and read_high_limit come together"),
     ({"identify": {"send": "ID¶", "reply": "(?P<identity>.+)", "answer": "{identity}"}}, "not ascii text"),
     ({"write_setpoint": {"send": "S {value}", "reply": "OK"}}, "both a reply pattern and an answer, or neither"),
+    ({"write_setpoint": {"send": "TEMP, S25.0", "reply": "OK:.*", "answer": "OK:"}}, "must name the set point once"),
+    ({"write_setpoint": {"send": "TEMP, S{value:.0f}0", "reply": "OK:.*", "answer": "OK:"}},
+     "must not run into digits or signs"),
+    ({"identify": {"send": "TYPE? {pv}", "reply": "(?P<identity>.+)", "answer": "{identity}"}},
+     "template fields pv unknown"),
+    ({"alarm": {"send": "TEMP?", "reply": "(?P<alarm>.+)", "answer": "{alarm}"}}, None),
+    ({"humidity": {"send": "TEMP? ", "reply": "(?P<humidity>.+)", "answer": "{humidity}"}}, "blanks at either end"),
 ])
-def test_a_broken_override_names_its_problem(overrides: dict, message: str) -> None:
+def test_a_broken_override_names_its_problem(overrides: dict, message: str | None) -> None:
+    if message is None:  # the same command as another operation's (ESPEC's TEMP? carries four values): allowed
+        line_protocol("espec-p300", overrides)
+        return
     with pytest.raises(ValidationError, match=message):
         line_protocol("espec-p300", overrides)
+
+
+def test_one_requests_text_must_not_read_as_anothers() -> None:
+    """`S 1` to run would be taken for a set point of 1 °C (by the simulator, and by anyone reading a log)."""
+    with pytest.raises(ValidationError, match="power_on: its request 'S 1' reads as write_setpoint's"):
+        line_protocol("thermotron-8800", {"write_setpoint": {"send": "S {value:.1f}", "reply": "0", "answer": "0"},
+                                          "power_on": {"send": "S 1", "reply": "0", "answer": "0"}})
 
 
 def test_a_rig_config_pairs_line_profiles_with_the_line_driver() -> None:

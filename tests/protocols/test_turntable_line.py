@@ -16,6 +16,9 @@ from accelcal_rig.protocols.turntable_line import ACUTROL3000, PROTOCOLS, turnta
      "the move must name {axis}"),
     ({"stop": {"send": "STOP {speed}", "reply": "OK", "answer": "OK"}}, "template fields speed unknown"),
     ({"stop": {"send": "STOP", "reply": "OK"}}, "both a reply pattern and an answer, or neither"),
+    ({"stop": {"send": "STOP {busy}", "reply": "OK", "answer": "OK"}}, "template fields busy unknown"),
+    ({"move": {"send": "MOV {axis} {angle:>12.5f}", "reply": "OK", "answer": "OK"}}, "does not read back as itself"),
+    ({"multi_axis_move": True}, "the move must be unanswered"),
 ])
 def test_a_broken_profile_names_its_problem(overrides: dict, message: str) -> None:
     with pytest.raises(ValidationError, match=message):
@@ -24,8 +27,8 @@ def test_a_broken_profile_names_its_problem(overrides: dict, message: str) -> No
 
 def test_a_field_named_twice_must_read_the_same_both_times() -> None:
     pattern = ACUTROL3000.stop.request_pattern()
-    assert pattern.fullmatch(":mode:rate 2;:demand:rate 2,0")
-    assert pattern.fullmatch(":mode:rate 2;:demand:rate 3,0") is None
+    assert pattern.fullmatch(":demand:rate 2,0;:mode:rate 2;:demand:rate 2,0")
+    assert pattern.fullmatch(":demand:rate 2,0;:mode:rate 3;:demand:rate 2,0") is None
 
 
 def test_status_commands_naming_an_axis_are_asked_per_axis() -> None:
