@@ -8,7 +8,7 @@ import logging
 import os
 import signal
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -24,6 +24,7 @@ if TYPE_CHECKING:
     from accelcal_rig.engine.preparation import PreparedCampaign
     from accelcal_rig.engine.progress import ProgressListener
     from accelcal_rig.engine.session import NothingToResume, RunResult
+    from accelcal_rig.fit.calibration import CalibrationFile
 
 EXIT_INTERRUPTED = 130
 #: A failure the program did not foresee (a bug): one line, and this code.
@@ -181,6 +182,8 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
         code = _print_summary(prepared, result, dry_run, args.fail_on_reject)
         if result.summary.fit and not result.summary.fit_failed:
             code = max(code, _certify_after_run(output, calibration, args))
+            _record(args.registry, _rig_registry(prepared.rig.model.registry, prepared.rig.path), output,
+                    lambda: _campaign_entries(output, calibration))
         return code
     except (KeyboardInterrupt, TerminationRequested):
         print(f"rig: interrupted after the campaign ended ({result.summary.state}); {result.output} holds all of it",
@@ -213,6 +216,46 @@ def _print_summary(prepared: PreparedCampaign, result: RunResult, dry_run: bool,
         print(f"rig: error: campaign done, but {result.problems[0]}", file=sys.stderr)
         return 1
     return _rejected_exit(summary.rejected, fail_on_reject)
+
+
+def _campaign_entries(campaign: Path, calibration: Path) -> list:
+    from accelcal_rig.registry.entries import campaign_entries
+
+    return campaign_entries(campaign, calibration)
+
+
+def _rig_registry(value: str | None, rig_path: Path) -> str | None:
+    from accelcal_rig.registry.location import configured
+
+    return configured(value, rig_path)
+
+
+def _stored_rig_registry(campaign: Path) -> str | None:
+    """The `registry:` of the rig config a campaign was run with (as it stored it)."""
+    import yaml
+
+    from accelcal_rig.store.read import load_campaign
+
+    stored = load_campaign(campaign)
+    value = (yaml.safe_load(stored.header.rig_yaml) or {}).get("registry")
+    return _rig_registry(value, Path(str(stored.attrs.get("rig_path", campaign)))) if value else None
+
+
+def _record(flag: str | None, configured: str | None, source: Path, entries: Callable[[], list],
+            json_output: bool = False) -> None:
+    """Record a finished fit in the registry; a registry that cannot take it is a warning naming how to
+    record it later, never a loss: the calibration file is written already. Beside a JSON report the line
+    goes to stderr, so stdout stays one JSON object."""
+    from sqlalchemy.exc import SQLAlchemyError
+
+    from accelcal_rig.cli_registry import register
+    from accelcal_rig.registry.location import registry_url
+
+    try:
+        print(register(registry_url(flag, configured), entries()), file=sys.stderr if json_output else sys.stdout)
+    except (RigError, SQLAlchemyError, OSError) as exc:
+        print(f"rig: warning: not recorded in the registry: {_one_line(exc)} (record it later: rig registry add "
+              f"{source})", file=sys.stderr)
 
 
 def _rejected_exit(rejected: list[str], fail_on_reject: bool) -> int:
@@ -300,6 +343,8 @@ def _cmd_fit(args: argparse.Namespace) -> int:
         _print_fit_table(outcome.report)
         print(summary_line(outcome.report, args.output))
         print(f"gravity: {gravity_statement(next(iter(outcome.report.values()))['gravity_m_s2'])}")
+    _record(args.registry, _stored_rig_registry(args.campaign), args.campaign,
+            lambda: _campaign_entries(args.campaign, args.output), args.json)
     rejected = [serial for serial, r in outcome.report.items() if r["verdict"] == "FAIL"]
     return _rejected_exit(rejected, args.fail_on_reject)
 
@@ -330,8 +375,10 @@ def _cmd_fit_recording(args: argparse.Namespace) -> int:
     gravity = args.gravity_m_s2 if args.gravity_m_s2 is not None else recording.gravity_m_s2
     result = fit_recording(recording, detection, args.parameters, serial, args.temperature_c, gravity)
     save_calibration(result.calibration, args.output)
+    record = lambda: _recording_entries(args.recording, result.calibration, args.part)  # noqa: E731
     if args.json:
         print(json.dumps(result.report))
+        _record(args.registry, None, args.recording, record, json_output=True)
         return 0
     report = result.report
     print(f"{len(report['intervals'])} static intervals in {recording.source} ({report['samples']} samples at "
@@ -351,7 +398,20 @@ def _cmd_fit_recording(args: argparse.Namespace) -> int:
           f"{report['chi2_reduced_before']:.2f}" + (f" → {report['chi2_reduced']:.2f} with a scatter floor of "
                                                     f"{report['scatter_floor_mg']:.4f} mg" if report["scatter_floor_mg"]
                                                     else "") + f"; outputs in {report['units']}")
+    _record(args.registry, None, args.recording, record)
     return 0
+
+
+def _recording_entries(recording: Path, calibration: CalibrationFile, part: str) -> list:
+    from accelcal_rig.registry.entries import recording_entries
+
+    return recording_entries(recording, calibration, part)
+
+
+def _cmd_registry(args: argparse.Namespace) -> int:
+    from accelcal_rig.cli_registry import registry_command
+
+    return registry_command(args)
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
@@ -427,21 +487,21 @@ def _certify(campaign: Path, calibration: Path, folder: Path, operator: str, pdf
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
-    from accelcal_rig.durable import write_text_atomically
-    from accelcal_rig.export.c_header import to_c_header
-    from accelcal_rig.export.tables import to_csv, to_json
+    import h5py
+
+    from accelcal_rig.export.flight_stack import StackOptions
+    from accelcal_rig.export.formats import export, write_export
     from accelcal_rig.fit.calibration import load_calibration
 
+    if h5py.is_hdf5(args.calibration):  # the campaign, not what a fit of it wrote
+        raise ConfigError(f"{args.calibration}: an HDF5 campaign file, not a calibration file: export the calibration "
+                          f"YAML that rig fit {args.calibration} -o calibration.yaml (or rig run) writes from it")
     calibration = load_calibration(args.calibration)
-    text = {"json": to_json, "csv": to_csv, "c-header": to_c_header}[args.format](calibration)
-    if args.output is None:
-        sys.stdout.write(text)
-        return 0
-    if not args.output.parent.is_dir():
+    if args.output is not None and not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
-    write_text_atomically(args.output, text, f"the {args.format} export")
-    print(f"{args.format} of {len(calibration.sensors)} sensors → {args.output}")
-    return 0
+    exported = export(calibration, args.format, StackOptions(args.calibration, args.serial, args.instance,
+                                                             args.device_id))
+    return write_export(exported, args.format, args.output)
 
 
 def _print_fit_table(report: dict) -> None:
@@ -494,7 +554,7 @@ def main(argv: list[str] | None = None) -> int:
     handler = {"run": _cmd_run, "plan": _cmd_plan, "resume": _cmd_resume, "status": _cmd_status, "repair": _cmd_repair,
                "fit": _cmd_fit, "check": _cmd_check,
                "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export, "certificate": _cmd_certificate,
-               "fit-recording": _cmd_fit_recording, "analyze": _cmd_analyze}[args.command]
+               "fit-recording": _cmd_fit_recording, "analyze": _cmd_analyze, "registry": _cmd_registry}[args.command]
     try:
         return handler(args)
     except CampaignAborted as exc:

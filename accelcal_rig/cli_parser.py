@@ -58,6 +58,7 @@ def _campaign_output_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--certificates", type=Path, help="folder of the DUTs' certificates written after the fit "
                                                             "(default: beside the campaign, .certificates)")
     _certificate_options(command)
+    registry_option(command)
 
 
 def _certificate_options(command: argparse.ArgumentParser) -> None:
@@ -68,6 +69,63 @@ def _certificate_options(command: argparse.ArgumentParser) -> None:
 def _fail_on_reject(command: argparse.ArgumentParser) -> None:
     command.add_argument("--fail-on-reject", action="store_true",
                          help="exit with status 3 when any DUT fails the procedure's acceptance limits")
+
+
+REGISTRY_HELP = ("the registry: a postgresql:// URL or an SQLite file (default: the rig config's registry:, "
+                 "else $ACCELCAL_REGISTRY, else ~/.local/share/accelcal-rig/registry.sqlite)")
+
+
+def registry_option(command: argparse.ArgumentParser) -> None:
+    """`--registry URL`: the same on every command that records or reads calibrations."""
+    command.add_argument("--registry", metavar="URL", help=REGISTRY_HELP)
+
+
+def _registry_commands(commands: argparse._SubParsersAction) -> None:
+    registry = _command(commands, "registry", "the lab's calibrations by serial number: add, list, show, export, "
+                        "trend, stats",
+                        "Every finished fit is recorded by DUT serial: rig run, rig fit and rig fit-recording do it "
+                        "themselves; rig registry add records campaigns fitted before (idempotent: the same "
+                        "file again adds nothing). The database is an SQLite file by default, or PostgreSQL for "
+                        "several rigs (see docs/registry.md).",
+                        "rig registry show ADX355-A001")
+    actions = registry.add_subparsers(dest="registry_command", required=True, metavar="ACTION")
+
+    def action(name: str, summary: str, example: str) -> argparse.ArgumentParser:
+        command = _command(actions, name, summary, summary[0].upper() + summary[1:] + ".", example)
+        registry_option(command)
+        command.add_argument("--config", type=Path, metavar="RIG", help="rig config whose registry: to use")
+        return command
+
+    add = action("add", "record finished campaigns and their calibrations", "rig registry add campaign.h5")
+    add.add_argument("files", type=Path, nargs="+", metavar="FILE", help="campaign file (HDF5)")
+    add.add_argument("--calibration", type=Path, help="its calibration (default: FILE.calibration.yaml beside it)")
+    listing = action("list", "calibrations, newest first, filtered", "rig registry list --part adxl355 --since 2026-01-01")
+    listing.add_argument("--serial", help="only this DUT")
+    listing.add_argument("--part", help="only this part (adxl355, adxl357, …)")
+    listing.add_argument("--since", metavar="DATE", help="only those calibrated on or after this date (YYYY-MM-DD)")
+    listing.add_argument("--verdict", choices=["PASS", "FAIL"], help="only those with this verdict")
+    listing.add_argument("--limit", type=_number(1, 10_000_000, integer=True), help="at most this many")
+    listing.add_argument("--json", action="store_true", help="one JSON list")
+    show = action("show", "a sensor's valid calibration and its history", "rig registry show ADX355-A001")
+    show.add_argument("serial")
+    show.add_argument("--json", action="store_true", help="one JSON object")
+    export = action("export", "a sensor's valid calibration (or one by id) as a file other tools read",
+                    "rig registry export ADX355-A001 --format c-header -o accel.h")
+    export.add_argument("serial")
+    export.add_argument("--format", required=True, choices=["json", "csv", "c-header", "px4-params", "ardupilot-params"],
+                        help="what to write (as rig export)")
+    export.add_argument("--id", type=_number(1, 2**63 - 1, integer=True), help="this calibration, not the valid one")
+    export.add_argument("--instance", type=_number(0, 3, integer=True), help="px4-params, ardupilot-params: as rig export")
+    export.add_argument("--device-id", type=_number(1, 2**31 - 1, integer=True), help="px4-params: as rig export")
+    export.add_argument("-o", "--output", type=Path, help="file to write (default: standard output)")
+    trend = action("trend", "bias and scale at the reference temperature across recalibrations: ageing drift",
+                   "rig registry trend ADX355-A001")
+    trend.add_argument("serial")
+    trend.add_argument("--json", action="store_true", help="one JSON object")
+    stats = action("stats", "a part's lot: yield, distributions of bias, scale and non-orthogonality, outliers",
+                   "rig registry stats --part adxl355")
+    stats.add_argument("--part", required=True)
+    stats.add_argument("--json", action="store_true", help="one JSON object")
 
 
 def _analysis_command(analyses: argparse._SubParsersAction, name: str, summary: str, description: str,
@@ -184,6 +242,7 @@ def build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--temperature-model", choices=["per-setpoint", "joint"],
                      help="default: the procedure's fit.temperature_model")
     fit.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
+    registry_option(fit)
     _fail_on_reject(fit)
     recording = _command(
         commands, "fit-recording", "calibrate from a continuous recording of a sensor turned by hand (no turntable)",
@@ -212,6 +271,9 @@ def build_parser() -> argparse.ArgumentParser:
     recording.add_argument("--serial", help="sensor name in the calibration (default: the file's name; campaign "
                                             "files: the first DUT)")
     recording.add_argument("--setpoint", type=_TEMPERATURE, help="campaign files: the setpoint whose poses to use")
+    recording.add_argument("--part", default="unknown", help="the sensor's part, as the registry records it "
+                                                             "(adxl355, …; default unknown)")
+    registry_option(recording)
     recording.add_argument("--parameters", choices=["all", "bias-scale"], default="all",
                            help="all: bias, scale, non-orthogonality (9); bias-scale: 6 (default all)")
     recording.add_argument("--temperature-c", type=_TEMPERATURE, help="the recording's temperature, if it has none")
@@ -259,6 +321,8 @@ def build_parser() -> argparse.ArgumentParser:
         "rig analyze cooldown cooldown.h5 --calibration campaign.calibration.yaml --figure cool.png",
         calibration=True, figure=True)
 
+    _registry_commands(commands)
+
     report = _command(commands, "report", "write an HTML report with figures of a campaign",
                       "Write REPORT/index.html and REPORT/figures/*.png: the campaign's summary, |g| per pose "
                       "before and after calibration, the raw ellipsoid and calibrated sphere, every parameter "
@@ -282,12 +346,23 @@ def build_parser() -> argparse.ArgumentParser:
                              help="its calibration file (default: beside the campaign, .calibration.yaml)")
     _certificate_options(certificate)
 
-    export = _command(commands, "export", "write a calibration file as JSON, CSV or a C header for firmware",
+    export = _command(commands, "export", "write a calibration file as JSON, CSV, a C header or flight-stack parameters",
                       "Write the coefficients of a calibration file for other tools (json: the same structure; "
                       "csv: one row per sensor and parameter) or for firmware (c-header: every sensor's "
-                      "polynomials and C99 functions that apply them, accelcal_apply and accelcal_apply_codes).",
+                      "polynomials and C99 functions that apply them, accelcal_apply and accelcal_apply_codes), "
+                      "or one sensor's bias as a flight stack's thermal compensation (px4-params: TC_A<n>_ for "
+                      "QGroundControl; ardupilot-params: INS_TCAL<n>_). Those hold offsets only: what they cannot "
+                      "hold is stated on standard error and in the file.",
                       "rig export campaign.calibration.yaml --format c-header -o accel_calibration.h")
     export.add_argument("calibration", type=Path, help="calibration file (YAML, from rig run or rig fit)")
-    export.add_argument("--format", required=True, choices=["json", "csv", "c-header"], help="what to write")
+    export.add_argument("--format", required=True, choices=["json", "csv", "c-header", "px4-params", "ardupilot-params"],
+                        help="what to write (px4-params, ardupilot-params: one sensor's thermal offsets)")
+    export.add_argument("--serial", help="px4-params, ardupilot-params: the sensor (needed when the file has several)")
+    export.add_argument("--instance", type=_number(0, 3, integer=True),
+                        help="px4-params: n of TC_A<n>_ (0-3, default 0); ardupilot-params: the IMU, n of INS_TCAL<n>_ "
+                             "(1-3, default 1)")
+    export.add_argument("--device-id", type=_number(1, 2**31 - 1, integer=True),
+                        help="px4-params: TC_A<n>_ID, the device id of the accelerometer (its CAL_ACC<k>_ID; "
+                             "default 0, which PX4 matches to none)")
     export.add_argument("-o", "--output", type=Path, help="file to write (default: standard output)")
     return parser

@@ -20,6 +20,17 @@ acquisition: {samples_per_pose: 20, range_g: 2, odr_hz: 125, settle_s: 1}
 """
 
 
+@pytest.fixture(scope="session", autouse=True)
+def test_registry(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Every finished fit in the tests (and in the processes they start) is recorded in a registry of the
+    session's own, never in the user's."""
+    import os
+
+    path = tmp_path_factory.mktemp("registry") / "registry.sqlite"
+    os.environ["ACCELCAL_REGISTRY"] = str(path)
+    return path
+
+
 @pytest.fixture
 def workdir(tmp_path: Path) -> Path:
     """A folder holding a copy of the simulated rig config, for procedures that name `rig: sim.yaml`."""

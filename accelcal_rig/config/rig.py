@@ -290,6 +290,8 @@ class RigConfig(StrictModel):
                                 description="the site's gravity (a survey or a gravity model); the standard value "
                                             "by default, said so in reports")
     gravity_uncertainty_m_s2: float = Field(0.0, ge=0.0, le=0.05, description="its standard uncertainty")
+    registry: str | None = Field(None, max_length=4096, description="where finished calibrations are recorded: an "
+                                 "SQLite file (relative to this file) or a postgresql:// URL")
 
     @property
     def gravity_g(self) -> float:

@@ -1,0 +1,191 @@
+"""The registry database: opened by URL, brought to the current schema on first use (Alembic, under a lock
+so that two rigs opening it at once do not both create it), written so that concurrent writers never lose
+a record (each entry inserted on its own, a duplicate of a registered fit skipped by its unique key)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
+from datetime import datetime
+from pathlib import Path
+from typing import Any
+
+import sqlalchemy as sa
+from alembic import command
+from alembic.config import Config
+from alembic.runtime.migration import MigrationContext
+from alembic.script import ScriptDirectory
+from sqlalchemy.dialects import postgresql, sqlite
+from sqlalchemy.engine import Connection, Engine
+
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.registry.location import described
+from accelcal_rig.registry.schema import calibrations
+
+_MIGRATIONS = Path(__file__).parent / "migrations"
+#: A PostgreSQL advisory lock key for schema migrations (any constant the lab's other users do not take).
+_MIGRATION_LOCK = 0x0ACCE1CA1
+#: Entries per insert transaction.
+_BATCH = 500
+#: SQLite waits this long for another writer's lock before giving up.
+_SQLITE_BUSY_S = 60.0
+
+
+def migration_config() -> Config:
+    config = Config()
+    config.set_main_option("script_location", str(_MIGRATIONS))
+    return config
+
+
+def head_revision() -> str:
+    head = ScriptDirectory.from_config(migration_config()).get_current_head()
+    assert head is not None
+    return head
+
+
+class Registry:
+    def __init__(self, engine: Engine, url: str) -> None:
+        self.engine = engine
+        self.url = url
+
+    @classmethod
+    def open(cls, url: str, upgrade: bool = True) -> Registry:
+        """Connect, and bring the schema to the current version (creating it on first use)."""
+        engine = _engine(url)
+        registry = cls(engine, url)
+        try:
+            if upgrade:
+                registry.upgrade()
+            elif registry.revision() != head_revision():
+                raise ConfigError(f"registry {described(url)}: schema {registry.revision()}, this software needs "
+                                  f"{head_revision()}")
+        except sa.exc.OperationalError as exc:
+            raise ConfigError(f"registry {described(url)}: cannot open: {exc.orig}") from None
+        return registry
+
+    def upgrade(self, revision: str = "head") -> None:
+        """Apply every migration not applied yet, one process at a time."""
+        with self._migration_lock() as connection:
+            config = migration_config()
+            config.attributes["connection"] = connection
+            command.upgrade(config, revision)
+
+    def revision(self) -> str | None:
+        with self.engine.connect() as connection:
+            return MigrationContext.configure(connection).get_current_revision()
+
+    # ------------------------------------------------------------------ writing
+    def add(self, entries: Iterable[dict[str, Any]]) -> tuple[list[int], int]:
+        """Record each entry; (ids of those added, how many were registered already). Entries go in batches,
+        each its own transaction: a batch is all there or not at all, and one already registered is skipped."""
+        pending = list(entries)
+        added: list[int] = []
+        for start in range(0, len(pending), _BATCH):
+            batch = pending[start:start + _BATCH]
+            added += self._insert(batch)
+        return added, len(pending) - len(added)
+
+    def _insert(self, batch: list[dict[str, Any]]) -> list[int]:
+        """The ids of the entries of `batch` not registered before, inserted in one transaction."""
+        dialect = self.engine.dialect.name
+        insert = postgresql.insert(calibrations) if dialect == "postgresql" else sqlite.insert(calibrations)
+        statement = insert.on_conflict_do_nothing(index_elements=["source_sha256", "serial", "fit_sha256"])
+        for attempt in range(10):
+            try:
+                with self.engine.begin() as connection:
+                    result = connection.execute(statement.returning(calibrations.c.id), batch)
+                    return [int(row_id) for row_id in result.scalars()]
+            except sa.exc.OperationalError as exc:  # SQLite: "database is locked" past the busy timeout
+                if dialect != "sqlite" or "locked" not in str(exc.orig) or attempt == 9:
+                    raise
+                time.sleep(0.1 * (attempt + 1))
+        raise AssertionError("unreachable")
+
+    # ------------------------------------------------------------------ reading
+    def calibrations(self, serial: str | None = None, part: str | None = None, since: datetime | None = None,
+                     verdict: str | None = None, limit: int | None = None) -> list[dict[str, Any]]:
+        """Rows, newest calibration first, filtered as given; without the stored fit (`calibration(id)` has it:
+        a lot of thousands of sensors is listed without reading thousands of fits)."""
+        listed = [column for column in calibrations.columns if column.name != "calibration"]
+        query = sa.select(*listed).order_by(calibrations.c.calibrated_at.desc(), calibrations.c.id.desc())
+        if serial is not None:
+            query = query.where(calibrations.c.serial == serial)
+        if part is not None:
+            query = query.where(calibrations.c.part == part)
+        if since is not None:
+            query = query.where(calibrations.c.calibrated_at >= since)
+        if verdict is not None:
+            query = query.where(calibrations.c.verdict == verdict)
+        if limit is not None:
+            query = query.limit(limit)
+        with self.engine.connect() as connection:
+            return [dict(row._mapping) for row in connection.execute(query)]
+
+    def calibration(self, row_id: int) -> dict[str, Any]:
+        """One calibration's row with its stored fit."""
+        with self.engine.connect() as connection:
+            row = connection.execute(sa.select(calibrations).where(calibrations.c.id == row_id)).first()
+        if row is None:
+            raise ConfigError(f"registry {described(self.url)}: no calibration {row_id}")
+        return dict(row._mapping)
+
+    def current(self, serial: str) -> dict[str, Any] | None:
+        """The valid calibration of a serial: its newest that did not fail its acceptance limits."""
+        for row in self.calibrations(serial=serial):
+            if row["verdict"] != "FAIL":
+                return row
+        return None
+
+    def count(self) -> int:
+        with self.engine.connect() as connection:
+            return int(connection.execute(sa.select(sa.func.count()).select_from(calibrations)).scalar_one())
+
+    @contextmanager
+    def _migration_lock(self) -> Iterator[Connection]:
+        """A connection holding the schema for this process alone: PostgreSQL's advisory lock, SQLite's
+        write lock (BEGIN IMMEDIATE)."""
+        with self.engine.connect() as connection:
+            if self.engine.dialect.name == "postgresql":
+                connection.execute(sa.text("SELECT pg_advisory_lock(:key)"), {"key": _MIGRATION_LOCK})
+                try:
+                    yield connection
+                    connection.commit()
+                finally:
+                    connection.execute(sa.text("SELECT pg_advisory_unlock(:key)"), {"key": _MIGRATION_LOCK})
+                    connection.commit()
+            else:
+                connection.info["begin"] = "BEGIN IMMEDIATE"  # see _engine's begin hook
+                try:
+                    yield connection
+                    connection.commit()
+                finally:
+                    connection.info.pop("begin", None)
+
+
+def _engine(url: str) -> Engine:
+    if url.startswith("sqlite:///"):
+        path = Path(url.removeprefix("sqlite:///"))
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ConfigError(f"registry {url}: cannot create its folder: {exc}") from None
+        engine = sa.create_engine(url, connect_args={"timeout": _SQLITE_BUSY_S}, poolclass=sa.pool.NullPool)
+
+        @sa.event.listens_for(engine, "connect")
+        def _pragmas(dbapi_connection: Any, _: Any) -> None:
+            dbapi_connection.isolation_level = None  # SQLAlchemy's BEGIN, not pysqlite's own
+            cursor = dbapi_connection.cursor()
+            cursor.execute("PRAGMA journal_mode=WAL")  # readers never block the writer, nor it them
+            cursor.execute(f"PRAGMA busy_timeout={int(_SQLITE_BUSY_S * 1000)}")
+            cursor.close()
+
+        @sa.event.listens_for(engine, "begin")
+        def _begin(connection: Connection) -> None:
+            connection.exec_driver_sql(connection.info.get("begin", "BEGIN"))
+        return engine
+    try:
+        return sa.create_engine(url, pool_pre_ping=True)
+    except (sa.exc.ArgumentError, ModuleNotFoundError) as exc:
+        raise ConfigError(f"registry {described(url)}: {exc} (PostgreSQL needs: pip install "
+                          "'accelcal-rig[postgresql]')") from None

@@ -1,0 +1,84 @@
+"""A registry entry per DUT of a finished fit: who (serial, part), what (the fit, its validity, verdict and
+figures), from what (the source file and its SHA-256, procedure, rig, software) and when."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.fit.calibration import CalibrationFile, SensorCalibration, load_calibration
+from accelcal_rig.registry.figures import reference_figures
+from accelcal_rig.store.read import load_campaign
+
+#: Campaign states whose fit is final: a running campaign's file is still being written.
+FINISHED_STATES = ("done", "aborted")
+
+
+def file_sha256(path: Path) -> str:
+    digest = hashlib.sha256()
+    with path.open("rb") as stream:
+        for chunk in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+def campaign_entries(campaign_path: Path, calibration_path: Path | None = None) -> list[dict[str, Any]]:
+    """One entry per DUT of a campaign file and its calibration (by default the one `rig run`/`rig fit`
+    writes beside it, FILE.calibration.yaml)."""
+    calibration_path = calibration_path or campaign_path.with_suffix(".calibration.yaml")
+    if not calibration_path.is_file():
+        raise ConfigError(f"{campaign_path}: no calibration beside it ({calibration_path.name}): fit it first "
+                          f"(rig fit {campaign_path} -o {calibration_path})")
+    campaign = load_campaign(campaign_path)
+    if campaign.state not in FINISHED_STATES:
+        raise ConfigError(f"{campaign_path}: campaign is {campaign.state}, not finished: register it when it ends")
+    calibration = load_calibration(calibration_path)
+    parts = {str(d["serial"]): str(d.get("part", "unknown")) for d in campaign.header.duts}
+    source = {"kind": "campaign", "path": str(campaign_path.resolve()), "sha256": file_sha256(campaign_path),
+              "procedure": str(campaign.attrs.get("procedure_name", "")), "rig": str(campaign.attrs.get("rig_name", "")),
+              "simulated": bool(campaign.attrs.get("dry_run", False))}
+    return [_entry(calibration, sensor, parts.get(serial, "unknown"), source) for serial, sensor in calibration.sensors.items()]
+
+
+def recording_entries(recording_path: Path, calibration: CalibrationFile, part: str) -> list[dict[str, Any]]:
+    """The entry of a hand-held fit: its recording is the source."""
+    source = {"kind": "recording", "path": str(recording_path.resolve()), "sha256": file_sha256(recording_path),
+              "procedure": "hand-held", "rig": "hand-held", "simulated": False}
+    return [_entry(calibration, sensor, part, source) for sensor in calibration.sensors.values()]
+
+
+def _entry(calibration: CalibrationFile, sensor: SensorCalibration, part: str, source: dict[str, Any]) -> dict[str, Any]:
+    stored = {"file": {"format": calibration.format, "format_version": calibration.format_version,
+                       "model": calibration.model, "created": calibration.created,
+                       "software_version": calibration.software_version, "source": calibration.source},
+              "sensor": json.loads(sensor.model_dump_json())}
+    verification = sensor.metrics.get("verification") if isinstance(sensor.metrics.get("verification"), dict) else {}
+    rmse = verification.get("rmse_mg") if verification else None
+    return {
+        "serial": sensor.serial, "part": part, "source_kind": source["kind"], "source_path": source["path"],
+        "source_sha256": source["sha256"],
+        "fit_sha256": hashlib.sha256(json.dumps(stored["sensor"], sort_keys=True).encode()).hexdigest(),
+        "procedure": source["procedure"], "rig": source["rig"], "simulated": source["simulated"],
+        "software_version": calibration.software_version, "calibrated_at": _utc(calibration.created),
+        "registered_at": datetime.now(UTC).replace(tzinfo=None),
+        "valid_from_c": float(sensor.validity_c[0]), "valid_to_c": float(sensor.validity_c[1]),
+        "verdict": sensor.verdict, "verdict_reasons": list(sensor.verdict_reasons),
+        "verification_rmse_mg": float(rmse) if rmse is not None else None,
+        "calibration": stored, **reference_figures(stored),
+    }
+
+
+def _utc(timestamp: str) -> datetime:
+    """An ISO 8601 time as naive UTC (how the registry stores every time)."""
+    moment = datetime.fromisoformat(timestamp)
+    return (moment.astimezone(UTC) if moment.tzinfo else moment).replace(tzinfo=None)
+
+
+def calibration_file_of(row: dict[str, Any]) -> CalibrationFile:
+    """A registered calibration as a one-sensor calibration file again (for `rig registry export`)."""
+    stored = row["calibration"]
+    return CalibrationFile.model_validate({**stored["file"], "sensors": {row["serial"]: stored["sensor"]}})

@@ -1,0 +1,51 @@
+"""Which registry: `--registry URL`, else the rig config's `registry:`, else the ACCELCAL_REGISTRY
+environment variable, else an SQLite file in the user's data folder (created on first use)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from accelcal_rig.errors import ConfigError
+
+ENVIRONMENT_VARIABLE = "ACCELCAL_REGISTRY"
+
+
+def default_path() -> Path:
+    """`$XDG_DATA_HOME/accelcal-rig/registry.sqlite`, `~/.local/share/…` without it."""
+    data = os.environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
+    return Path(data) / "accelcal-rig" / "registry.sqlite"
+
+
+def registry_url(flag: str | None = None, configured: str | None = None) -> str:
+    """The first given of the flag, the rig config's value and the environment, else the default file; as a
+    SQLAlchemy URL (a bare path is an SQLite file, `postgresql://` is spoken with psycopg)."""
+    chosen = flag or configured or os.environ.get(ENVIRONMENT_VARIABLE) or str(default_path())
+    return normalised(chosen)
+
+
+def configured(value: str | None, config_path: Path) -> str | None:
+    """A rig config's `registry:`: a URL as it is, a file path relative to the config's folder."""
+    if value is None or "://" in value or value.startswith("sqlite:"):
+        return value
+    return str((config_path.parent / Path(value).expanduser()).resolve())
+
+
+def normalised(url: str) -> str:
+    if url.startswith(("postgresql://", "postgres://")):
+        return "postgresql+psycopg://" + url.split("://", 1)[1]
+    if url.startswith(("postgresql+", "sqlite:")):
+        return url
+    if "://" in url:
+        raise ConfigError(f"registry {url!r}: not an SQLite path or file, nor a postgresql:// URL")
+    return f"sqlite:///{Path(url).expanduser().resolve()}"
+
+
+def described(url: str) -> str:
+    """The URL as messages show it: without a password."""
+    scheme, _, rest = url.partition("://")
+    if "@" in rest:
+        credentials, _, where = rest.rpartition("@")
+        user = credentials.split(":", 1)[0]
+        rest = f"{user}@{where}" if user else where
+    return f"{scheme}://{rest}"

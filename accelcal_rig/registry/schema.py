@@ -1,0 +1,43 @@
+"""The registry's tables as the current migration leaves them (accelcal_rig/registry/migrations): one row
+per calibration of one DUT. What identifies a calibration is its source file's SHA-256, the DUT's serial
+and the fit's own digest: registering the same file again adds nothing; a refit of it with other options
+is another calibration."""
+
+from __future__ import annotations
+
+import sqlalchemy as sa
+
+metadata = sa.MetaData()
+
+calibrations = sa.Table(
+    "calibrations", metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("serial", sa.String(128), nullable=False, index=True),
+    sa.Column("part", sa.String(64), nullable=False),
+    sa.Column("source_kind", sa.String(16), nullable=False),       # campaign | recording
+    sa.Column("source_path", sa.String(4096), nullable=False),
+    sa.Column("source_sha256", sa.String(64), nullable=False),
+    sa.Column("fit_sha256", sa.String(64), nullable=False),
+    sa.Column("procedure", sa.String(128), nullable=False),
+    sa.Column("rig", sa.String(128), nullable=False),
+    sa.Column("simulated", sa.Boolean, nullable=False),
+    sa.Column("software_version", sa.String(64), nullable=False),
+    sa.Column("calibrated_at", sa.DateTime, nullable=False, index=True),   # UTC
+    sa.Column("registered_at", sa.DateTime, nullable=False),               # UTC
+    sa.Column("valid_from_c", sa.Float, nullable=False),
+    sa.Column("valid_to_c", sa.Float, nullable=False),
+    sa.Column("verdict", sa.String(8), nullable=True),                      # PASS | FAIL | none stated
+    sa.Column("verdict_reasons", sa.JSON, nullable=False),
+    sa.Column("verification_rmse_mg", sa.Float, nullable=True),
+    sa.Column("calibration", sa.JSON, nullable=False),                      # the whole fit, to export again
+    # Added by migration 0002: the figures queried across calibrations, at the reference temperature.
+    sa.Column("reference_c", sa.Float, nullable=True),
+    sa.Column("bias_mg", sa.JSON, nullable=True),                           # [x, y, z]
+    sa.Column("bias_uncertainty_mg", sa.JSON, nullable=True),               # [x, y, z], k = 2
+    sa.Column("scale_error_ppm", sa.JSON, nullable=True),                   # [x, y, z]
+    sa.Column("scale_uncertainty_ppm", sa.JSON, nullable=True),             # [x, y, z], k = 2
+    sa.Column("nonorthogonality_mrad", sa.Float, nullable=True),            # the largest of the three
+    sa.UniqueConstraint("source_sha256", "serial", "fit_sha256", name="one_calibration_per_fit"),
+)
+
+COLUMNS = tuple(column.name for column in calibrations.columns)

@@ -1,0 +1,53 @@
+"""Ageing drift and lot statistics from registry rows: a planted drift is found with its uncertainty, a
+planted outlier is named, and the yield counts each sensor's newest calibration."""
+
+from __future__ import annotations
+
+from datetime import datetime, timedelta
+
+import numpy as np
+import pytest
+
+from accelcal_rig.registry.analysis import lot_statistics, trend
+
+
+def row(k: int, serial: str, days: float, bias: list[float], scale: list[float], verdict: str | None = "PASS",
+        u_bias: list[float] | None = None, nonorth: float = 0.5) -> dict:
+    return {"id": k, "serial": serial, "calibrated_at": datetime(2025, 1, 1) + timedelta(days=days),
+            "verdict": verdict, "reference_c": 25.0, "bias_mg": bias, "bias_uncertainty_mg": u_bias,
+            "scale_error_ppm": scale, "scale_uncertainty_ppm": [40.0, 40.0, 40.0], "nonorthogonality_mrad": nonorth}
+
+
+def test_a_planted_drift_is_recovered_with_the_weighted_least_squares_uncertainty() -> None:
+    years = np.array([0.0, 0.5, 1.0, 2.0])
+    rows = [row(k, "S", 365.25 * t, [1.0 + 0.2 * t, -2.0, 0.3 * t], [100.0 - 50.0 * t, 0.0, 0.0],
+                u_bias=[0.1, 0.1, 0.2]) for k, t in enumerate(years)]
+    result = trend(rows)
+    drift = result["bias_drift_mg_per_year"]
+    assert [d["per_year"] for d in drift] == pytest.approx([0.2, 0.0, 0.3], abs=1e-9)
+    sigma = 0.1 / 2.0  # the stated uncertainty is expanded (k = 2)
+    expected = 2.0 * sigma / np.sqrt(np.sum((years - years.mean()) ** 2))  # equal weights: the textbook formula
+    assert drift[0]["expanded_uncertainty"] == pytest.approx(expected)
+    assert result["scale_drift_ppm_per_year"][0]["per_year"] == pytest.approx(-50.0)
+    assert [p["calibrated_at"][:10] for p in result["calibrations"]] == ["2025-01-01", "2025-07-02", "2026-01-01",
+                                                                          "2027-01-01"]
+
+
+def test_one_calibration_has_no_drift_to_state() -> None:
+    assert trend([row(1, "S", 0, [1, 2, 3], [0, 0, 0])])["bias_drift_mg_per_year"] is None
+
+
+def test_lot_statistics_count_the_newest_calibration_of_each_sensor_and_name_the_outlier() -> None:
+    rng = np.random.default_rng(0)
+    rows = [row(k, f"L-{k:03d}", 10, list(rng.normal(0, 5, 3)), list(rng.normal(0, 1000, 3)),
+                verdict="FAIL" if k < 3 else "PASS") for k in range(40)]
+    rows.append(row(100, "L-000", 20, [1.0, 1.0, 1.0], [0.0, 0.0, 0.0], verdict="PASS"))  # recalibrated: now passes
+    rows.append(row(101, "L-ODD", 10, [90.0, 0.0, 0.0], [0.0, 0.0, 0.0]))                  # a part far off the lot
+    result = lot_statistics(rows)
+    assert result["sensors"] == 41 and result["calibrations"] == 42
+    assert result["judged"] == 41 and result["passed"] == 39 and result["yield"] == pytest.approx(39 / 41)
+    bias_x = result["distributions"]["bias_mg"][0]
+    assert bias_x["n"] == 41 and abs(bias_x["median"]) < 3.0
+    flagged = {(o["serial"], o["figure"], o["axis"]) for o in result["outliers"]}
+    assert ("L-ODD", "bias_mg", "x") in flagged
+    assert result["outliers"][0]["serial"] == "L-ODD"

@@ -1,0 +1,120 @@
+"""`rig registry …` and the automatic recording of `rig run`, `rig fit` and `rig fit-recording`, as an operator
+uses them: which registry (flag, rig config, environment, default), idempotent adds, and one-line errors."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from accelcal_rig.cli import main
+from accelcal_rig.registry.database import Registry
+from accelcal_rig.registry.location import normalised
+from tests.conftest import REPO
+
+
+def rig(*argv: str) -> int:
+    return main([str(a) for a in argv])
+
+
+def test_rig_run_records_every_dut_and_add_is_idempotent(tmp_path: Path, capsys) -> None:
+    registry = tmp_path / "lab.sqlite"
+    campaign = tmp_path / "quick.h5"
+    assert rig("run", REPO / "procedures" / "quick-6pos.yaml", "--dry-run", "-o", campaign, "-q", "--no-pdf",
+               "--registry", registry) == 0
+    assert f"registry   4 calibrations recorded in sqlite:///{registry.resolve()}" in capsys.readouterr().out
+    assert rig("registry", "add", campaign, "--registry", registry) == 0
+    assert capsys.readouterr().out.strip() == f"{campaign}: 0 added, 4 registered already"
+    assert Registry.open(normalised(str(registry))).count() == 4
+
+
+def test_list_show_trend_stats_and_export(tmp_path: Path, capsys) -> None:
+    registry = tmp_path / "lab.sqlite"
+    campaign = tmp_path / "quick.h5"
+    rig("run", REPO / "procedures" / "quick-6pos.yaml", "--dry-run", "-o", campaign, "-q", "--no-pdf",
+        "--registry", registry)
+    # A refit with other options of the same campaign is another calibration of the same sensors.
+    assert rig("fit", campaign, "-o", tmp_path / "refit.yaml", "--parameters", "bias-scale", "--registry", registry) == 0
+    capsys.readouterr()
+    assert rig("registry", "list", "--serial", "ADX355-A002", "--json", "--registry", registry) == 0
+    listed = json.loads(capsys.readouterr().out)
+    assert len(listed) == 2 and all(r["serial"] == "ADX355-A002" and r["part"] == "adxl355" for r in listed)
+    assert all(r["calibrated_at"].endswith("Z") and "calibration" not in r for r in listed)
+    assert rig("registry", "show", "ADX355-A002", "--registry", registry) == 0
+    shown = capsys.readouterr().out
+    assert shown.startswith("ADX355-A002 (adxl355): valid calibration") and "history (2):" in shown
+    assert rig("registry", "trend", "ADX355-A002", "--json", "--registry", registry) == 0
+    assert len(json.loads(capsys.readouterr().out)["calibrations"]) == 2
+    assert rig("registry", "stats", "--part", "adxl355", "--json", "--registry", registry) == 0
+    stats = json.loads(capsys.readouterr().out)
+    assert stats["sensors"] == 4 and stats["calibrations"] == 8
+    header = tmp_path / "accel.h"
+    assert rig("registry", "export", "ADX355-A002", "--format", "c-header", "-o", header, "--registry", registry) == 0
+    assert "ADX355-A002" in header.read_text() and "accelcal_apply" in header.read_text()
+    capsys.readouterr()
+    params = tmp_path / "px4.params"
+    assert rig("registry", "export", "ADX355-A002", "--format", "px4-params", "--device-id", "1310988",
+               "-o", params, "--registry", registry) == 0
+    assert "TC_A0_X0_0" in params.read_text() and "TC_A0_ID\t1310988" in params.read_text()
+    assert "rig: warning:" in capsys.readouterr().err  # what PX4 cannot hold (scale, cross-axis) is said
+
+
+def test_which_registry_flag_rig_config_environment(tmp_path: Path, capsys, monkeypatch) -> None:
+    procedure_dir = tmp_path / "lab"
+    procedure_dir.mkdir()
+    shutil.copy(REPO / "configs" / "sim.yaml", procedure_dir / "sim.yaml")
+    (procedure_dir / "sim.yaml").write_text((procedure_dir / "sim.yaml").read_text() + "\nregistry: rig-registry.sqlite\n")
+    procedure = procedure_dir / "quick.yaml"
+    procedure.write_text((REPO / "procedures" / "quick-6pos.yaml").read_text().replace("../configs/sim.yaml", "sim.yaml"))
+    assert rig("run", procedure, "--dry-run", "-o", tmp_path / "a.h5", "-q", "--no-pdf") == 0
+    assert (procedure_dir / "rig-registry.sqlite").is_file()  # the rig config's, relative to it, over the environment
+    assert rig("run", procedure, "--dry-run", "-o", tmp_path / "b.h5", "-q", "--no-pdf", "--registry",
+               tmp_path / "flag.sqlite") == 0
+    assert (tmp_path / "flag.sqlite").is_file()  # the flag over the rig config
+    monkeypatch.setenv("ACCELCAL_REGISTRY", str(tmp_path / "environment.sqlite"))
+    capsys.readouterr()
+    assert rig("registry", "list", "--json") == 0  # no flag, no config: the environment's
+    assert json.loads(capsys.readouterr().out) == [] and (tmp_path / "environment.sqlite").is_file()
+    assert rig("registry", "list", "--config", procedure_dir / "sim.yaml", "--json") == 0
+    assert len(json.loads(capsys.readouterr().out)) == 4
+
+
+def test_hand_held_fits_are_recorded_with_their_part(tmp_path: Path, capsys) -> None:
+    """The real recording of tests/data (imucal's published hand-turned IMU session)."""
+    registry = tmp_path / "lab.sqlite"
+    recording = REPO / "tests" / "data" / "real" / "imucal-annotated-session.csv"
+    code = rig("fit-recording", recording, "--columns", "samples,acc_x,acc_y,acc_z", "--time-unit", "samples",
+               "--rate-hz", "204.8", "--units", "counts", "--counts-per-g", "2048", "--parameters", "bias-scale",
+               "-o", tmp_path / "hand.yaml", "--part", "imucal-imu", "--registry", registry, "--json")
+    assert code == 0, capsys.readouterr().err
+    rows = Registry.open(normalised(str(registry))).calibrations()
+    assert len(rows) == 1 and rows[0]["part"] == "imucal-imu" and rows[0]["source_kind"] == "recording"
+    assert rows[0]["procedure"] == "hand-held" and rows[0]["source_path"] == str(recording.resolve())
+
+
+@pytest.mark.parametrize(("argv", "message"), [
+    (["registry", "show", "NOBODY"], "serial NOBODY: no calibration in the registry"),
+    (["registry", "list", "--since", "yesterday"], "--since 'yesterday': not a date (YYYY-MM-DD)"),
+    (["registry", "stats", "--part", "nothing"], "part nothing: no calibration in the registry"),
+    (["registry", "list", "--registry", "mysql://lab/x"], "registry 'mysql://lab/x': not an SQLite path or file, nor a "
+                                                          "postgresql:// URL"),
+])
+def test_bad_requests_are_one_line(argv: list[str], message: str, tmp_path: Path, capsys) -> None:
+    if "--registry" not in argv:
+        argv = [*argv, "--registry", str(tmp_path / "empty.sqlite")]
+    assert rig(*argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith(message) and len(err.splitlines()) == 1
+
+
+def test_a_registry_that_cannot_take_the_record_loses_nothing(tmp_path: Path, capsys) -> None:
+    blocked = tmp_path / "file"
+    blocked.write_text("")
+    campaign = tmp_path / "quick.h5"
+    assert rig("run", REPO / "procedures" / "quick-6pos.yaml", "--dry-run", "-o", campaign, "-q", "--no-pdf",
+               "--registry", blocked / "lab.sqlite") == 0  # the campaign and its calibration are what matter
+    err = capsys.readouterr().err
+    assert "rig: warning: not recorded in the registry:" in err and f"rig registry add {campaign}" in err
+    assert campaign.with_suffix(".calibration.yaml").is_file()

@@ -1,0 +1,82 @@
+"""The registry on SQLite and on a real PostgreSQL server: created on first use at the current schema,
+recording each DUT's calibration once however often it is added, and answering by serial, part, date and
+verdict."""
+
+from __future__ import annotations
+
+from datetime import datetime, timedelta
+
+import pytest
+
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.fit.calibration import load_calibration
+from accelcal_rig.registry.database import Registry, head_revision
+from accelcal_rig.registry.entries import calibration_file_of, campaign_entries
+from accelcal_rig.registry.figures import reference_figures
+
+
+def test_first_use_creates_the_schema_at_its_current_version(registry_url: str) -> None:
+    registry = Registry.open(registry_url)
+    assert registry.revision() == head_revision() == "0002"
+    assert registry.count() == 0
+    assert Registry.open(registry_url).revision() == head_revision()  # opening again changes nothing
+
+
+def test_a_campaign_is_recorded_once_per_dut_however_often_it_is_added(registry_url: str, quick_campaign) -> None:
+    campaign, calibration = quick_campaign
+    registry = Registry.open(registry_url)
+    entries = campaign_entries(campaign, calibration)
+    added, already = registry.add(entries)
+    assert len(added) == 4 and already == 0
+    assert registry.add(campaign_entries(campaign, calibration)) == ([], 4)
+    rows = registry.calibrations()
+    assert sorted(r["serial"] for r in rows) == ["ADX355-A001", "ADX355-A002", "ADX355-A003", "ADX355-A004"]
+    assert "calibration" not in rows[0]  # listing leaves the stored fits out
+    row = registry.calibration(added[0])
+    assert row["part"] == "adxl355" and row["simulated"] and row["procedure"] == "quick-6pos"
+    assert row["source_path"] == str(campaign.resolve()) and len(row["source_sha256"]) == 64
+    assert row["bias_mg"] == pytest.approx(reference_figures(row["calibration"])["bias_mg"])
+    # What is stored is the whole fit: it makes the calibration file again, equal to the one fitted.
+    again = calibration_file_of(row).sensors[row["serial"]]
+    assert again == load_calibration(calibration).sensors[row["serial"]]
+
+
+def test_filters_and_the_valid_calibration(registry_url: str, quick_campaign) -> None:
+    campaign, calibration = quick_campaign
+    registry = Registry.open(registry_url)
+    base = campaign_entries(campaign, calibration)[0]
+    older = base | {"fit_sha256": "1" * 64, "calibrated_at": base["calibrated_at"] - timedelta(days=400)}
+    failed = base | {"fit_sha256": "2" * 64, "calibrated_at": base["calibrated_at"] + timedelta(days=1),
+                     "verdict": "FAIL"}
+    other_part = base | {"fit_sha256": "3" * 64, "serial": "X-1", "part": "adxl357"}
+    registry.add([older, base, failed, other_part])
+    serial = base["serial"]
+    assert [r["verdict"] for r in registry.calibrations(serial=serial)] == ["FAIL", "PASS", "PASS"]  # newest first
+    current = registry.current(serial)
+    assert current is not None and current["calibrated_at"] == base["calibrated_at"]  # the newest that did not fail
+    assert [r["serial"] for r in registry.calibrations(part="adxl357")] == ["X-1"]
+    assert len(registry.calibrations(since=base["calibrated_at"] - timedelta(days=1))) == 3
+    assert len(registry.calibrations(verdict="FAIL")) == 1
+    assert len(registry.calibrations(limit=2)) == 2
+    assert registry.current("NOBODY") is None
+    with pytest.raises(ConfigError, match="no calibration 999"):
+        registry.calibration(999)
+
+
+def test_a_registry_that_cannot_be_opened_is_one_line_naming_it(tmp_path) -> None:
+    blocked = tmp_path / "file"
+    blocked.write_text("not a folder")
+    with pytest.raises(ConfigError, match=r"registry sqlite:///.*/file/registry.sqlite: cannot create its folder"):
+        Registry.open(f"sqlite:///{blocked}/registry.sqlite")
+    with pytest.raises(ConfigError, match=r"registry postgresql\+psycopg://lab@127.0.0.1:9/x: cannot open"):
+        Registry.open("postgresql+psycopg://lab:secret@127.0.0.1:9/x")
+
+
+def test_times_are_stored_as_utc(registry_url: str, quick_campaign) -> None:
+    campaign, calibration = quick_campaign
+    registry = Registry.open(registry_url)
+    entry = campaign_entries(campaign, calibration)[0]
+    registry.add([entry])
+    stored = registry.calibrations()[0]
+    assert stored["calibrated_at"].tzinfo is None and stored["calibrated_at"] == entry["calibrated_at"]
+    assert abs(stored["registered_at"] - datetime.utcnow()) < timedelta(minutes=5)

@@ -1,0 +1,46 @@
+"""A lab upgrades without losing records: a database made by the first schema version, with calibrations
+in it, is brought to the current one, and the figures the new version adds are filled from each stored fit."""
+
+from __future__ import annotations
+
+import pytest
+import sqlalchemy as sa
+
+from accelcal_rig.registry.database import Registry, head_revision
+from accelcal_rig.registry.entries import campaign_entries
+from accelcal_rig.registry.figures import reference_figures
+from tests.registry.conftest import synthetic_entries
+
+_ADDED_BY_0002 = ("reference_c", "bias_mg", "bias_uncertainty_mg", "scale_error_ppm", "scale_uncertainty_ppm",
+                  "nonorthogonality_mrad")
+
+
+def test_a_first_version_database_upgrades_with_its_records_and_their_figures(registry_url: str, quick_campaign) -> None:
+    campaign, calibration = quick_campaign
+    registry = Registry(_engine_of(registry_url), registry_url)
+    registry.upgrade("0001")
+    assert registry.revision() == "0001"
+    version_1 = [{k: v for k, v in e.items() if k not in _ADDED_BY_0002}
+                 for e in [*campaign_entries(campaign, calibration),
+                           *synthetic_entries(campaign_entries(campaign, calibration)[0], 3)]]
+    table = sa.Table("calibrations", sa.MetaData(), autoload_with=registry.engine)
+    assert not set(_ADDED_BY_0002) & {c.name for c in table.columns}  # the first schema has none of them
+    with registry.engine.begin() as connection:
+        connection.execute(table.insert(), version_1)
+    upgraded = Registry.open(registry_url)
+    assert upgraded.revision() == head_revision()
+    rows = upgraded.calibrations()
+    assert len(rows) == 7
+    for listed in rows:
+        row = upgraded.calibration(listed["id"])
+        expected = reference_figures(row["calibration"])
+        assert row["reference_c"] == expected["reference_c"]
+        assert row["bias_mg"] == pytest.approx(expected["bias_mg"])
+        assert row["scale_error_ppm"] == pytest.approx(expected["scale_error_ppm"])
+        assert row["bias_uncertainty_mg"] == pytest.approx(expected["bias_uncertainty_mg"])
+
+
+def _engine_of(url: str) -> sa.Engine:
+    from accelcal_rig.registry.database import _engine
+
+    return _engine(url)
