@@ -408,6 +408,56 @@ def _recording_entries(recording: Path, calibration: CalibrationFile, part: str)
     return recording_entries(recording, calibration, part)
 
 
+def _cmd_serve(args: argparse.Namespace) -> int:
+    import ipaddress
+    import socket
+
+    from accelcal_rig.registry.location import configured, registry_url
+
+    try:
+        import uvicorn
+
+        from accelcal_rig.web.app import create_app
+    except ModuleNotFoundError as exc:
+        raise ConfigError(f"rig serve needs {exc.name}: pip install 'accelcal-rig[dashboard]'") from None
+    token = args.token or os.environ.get("ACCELCAL_DASHBOARD_TOKEN") or None
+    try:
+        loopback = args.host == "localhost" or ipaddress.ip_address(args.host).is_loopback
+    except ValueError:
+        loopback = False
+    if not loopback and token is None:
+        raise ConfigError(f"--host {args.host}: off 127.0.0.1 the dashboard needs --token (anyone on the network "
+                          "could read it otherwise)")
+    if (args.tls_cert is None) != (args.tls_key is None):
+        raise ConfigError("--tls-cert and --tls-key go together")
+    folders = args.campaigns or [Path.cwd()]
+    missing = [folder for folder in folders if not folder.is_dir()]
+    if missing:
+        raise ConfigError(f"--campaigns {missing[0]}: not a folder")
+    from_config = None
+    if args.config is not None:
+        from accelcal_rig.config.load import load_rig
+
+        rig = load_rig(args.config)
+        from_config = configured(rig.model.registry, rig.path)
+    app = create_app(folders, registry_url(args.registry, from_config), token)
+    # Listening before the address is printed: whoever reads it can connect at once (and port 0 works).
+    family = socket.AF_INET6 if ":" in args.host else socket.AF_INET
+    listening = socket.socket(family, socket.SOCK_STREAM)
+    listening.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        listening.bind((args.host, int(args.port)))
+    except OSError as exc:
+        raise ConfigError(f"--host {args.host} --port {args.port}: cannot listen there: {exc.strerror}") from None
+    listening.listen(128)
+    port = listening.getsockname()[1]
+    scheme = "https" if args.tls_cert else "http"
+    print(f"dashboard on {scheme}://{args.host}:{port}/" + (f"?token={token}" if token else ""), flush=True)
+    config = uvicorn.Config(app, log_level="warning", ssl_certfile=args.tls_cert, ssl_keyfile=args.tls_key)
+    uvicorn.Server(config).run(sockets=[listening])
+    return 0
+
+
 def _cmd_registry(args: argparse.Namespace) -> int:
     from accelcal_rig.cli_registry import registry_command
 
@@ -554,7 +604,8 @@ def main(argv: list[str] | None = None) -> int:
     handler = {"run": _cmd_run, "plan": _cmd_plan, "resume": _cmd_resume, "status": _cmd_status, "repair": _cmd_repair,
                "fit": _cmd_fit, "check": _cmd_check,
                "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export, "certificate": _cmd_certificate,
-               "fit-recording": _cmd_fit_recording, "analyze": _cmd_analyze, "registry": _cmd_registry}[args.command]
+               "fit-recording": _cmd_fit_recording, "analyze": _cmd_analyze, "registry": _cmd_registry,
+               "serve": _cmd_serve}[args.command]
     try:
         return handler(args)
     except CampaignAborted as exc:

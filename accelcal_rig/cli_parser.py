@@ -323,6 +323,26 @@ def build_parser() -> argparse.ArgumentParser:
 
     _registry_commands(commands)
 
+    serve = _command(commands, "serve", "a local web dashboard of campaigns and the registry",
+                     "Serve the dashboard: running and recent campaigns of the watched folders (state, phase, "
+                     "setpoint, temperatures, poses, time left, warnings, refreshed live), each campaign's "
+                     "temperature plot, report and certificates, and the registry (a serial's history and "
+                     "trend, a part's lot). Campaign files are only read, as rig status reads them. It listens "
+                     "on 127.0.0.1; another address needs --token (and TLS is advised: --tls-cert, --tls-key). "
+                     "Needs: pip install 'accelcal-rig[dashboard]'.",
+                     "rig serve --campaigns campaigns/ --port 8040")
+    serve.add_argument("--campaigns", type=Path, action="append", metavar="DIR",
+                       help="a folder of campaign files to show (repeatable; default: the current folder)")
+    registry_option(serve)
+    serve.add_argument("--config", type=Path, metavar="RIG", help="rig config whose registry: to use")
+    serve.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1)")
+    serve.add_argument("--port", type=_number(0, 65535, integer=True), default=8040,
+                       help="port (default 8040; 0: any free one, printed)")
+    serve.add_argument("--token", help="a secret every request must carry (needed off 127.0.0.1; default "
+                                       "$ACCELCAL_DASHBOARD_TOKEN)")
+    serve.add_argument("--tls-cert", type=Path, help="TLS certificate (PEM), with --tls-key: serve HTTPS")
+    serve.add_argument("--tls-key", type=Path, help="its private key (PEM)")
+
     report = _command(commands, "report", "write an HTML report with figures of a campaign",
                       "Write REPORT/index.html and REPORT/figures/*.png: the campaign's summary, |g| per pose "
                       "before and after calibration, the raw ellipsoid and calibrated sphere, every parameter "

@@ -24,6 +24,7 @@ from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.notify import Notifier
 from accelcal_rig.engine.preparation import PreparedCampaign
 from accelcal_rig.engine.progress import ProgressListener
+from accelcal_rig.engine.progress_file import ProgressFile
 from accelcal_rig.engine.resume import ResumePoint, check_same_campaign
 from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
 from accelcal_rig.errors import CampaignAborted, RigError
@@ -31,7 +32,7 @@ from accelcal_rig.fit.campaign_fit import fit_and_save, summary_line
 from accelcal_rig.fit.recorded_options import recorded_options
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.lock import campaign_lock
-from accelcal_rig.store.paths import journal_path
+from accelcal_rig.store.paths import journal_path, progress_path
 from accelcal_rig.store.read import file_currency, load_campaign
 from accelcal_rig.store.repair import repair_campaign
 from accelcal_rig.store.writer import CampaignWriter
@@ -149,7 +150,8 @@ def _run(prepared: PreparedCampaign, output: Path, open_writer: Callable[[], Cam
         notifier = Notifier(notify) if notify.webhook_url or notify.command else None
         clock = rig_connected.clock
         events = EventLog(clock, writer)
-        estimate = estimate_duration(procedure, rig, prepared.plan) if progress or notifier else None
+        progress = ProgressFile(progress_path(output), progress)
+        estimate = estimate_duration(procedure, rig, prepared.plan)
         runner = CampaignRunner(procedure, rig, prepared.plan, rig_connected.guarded(events), writer, clock, events,
                                 fit_stage=_fit_stage(procedure, output, calibration)
                                 if calibration and procedure.fit.mode != "none" else None,

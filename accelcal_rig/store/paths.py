@@ -18,3 +18,8 @@ def lock_path(campaign: Path) -> Path:
 def log_path(campaign: Path) -> Path:
     """`campaign.h5.log`: every line the runs printed, appended run after run."""
     return campaign.with_name(campaign.name + ".log")
+
+
+def progress_path(campaign: Path) -> Path:
+    """`campaign.h5.progress.json`: the running campaign's latest snapshot, for watchers (rig status, rig serve)."""
+    return campaign.with_name(campaign.name + ".progress.json")

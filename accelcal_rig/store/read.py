@@ -8,6 +8,7 @@ readable campaign is one ConfigError naming the file and what is wrong with it.
 
 from __future__ import annotations
 
+import json
 import os
 import socket
 from dataclasses import dataclass, replace
@@ -25,7 +26,7 @@ from accelcal_rig.store.codec import NotACampaignJournal, replay
 from accelcal_rig.store.content import Campaign, take_what_the_file_kept
 from accelcal_rig.store.hdf5_file import DamagedFile, read_campaign_file
 from accelcal_rig.store.journal import read_journal
-from accelcal_rig.store.paths import journal_path
+from accelcal_rig.store.paths import journal_path, progress_path
 
 
 def _first_line(exc: BaseException) -> str:
@@ -202,7 +203,17 @@ def campaign_status(path: Path, campaign: Campaign | None = None) -> dict[str, A
         "last_event": campaign.events[-1].message if campaign.events else "",
         "integrity": "; ".join(campaign.integrity_problems()) or "ok",
         "campaign_file": file_currency(path, campaign, alive),
+        "progress": read_progress(path) if alive else None,
     }
+
+
+def read_progress(path: Path) -> dict[str, Any] | None:
+    """The running campaign's latest snapshot (engine/progress_file.py), or None when there is none whole."""
+    try:
+        snapshot = json.loads(progress_path(path).read_text())
+    except (OSError, ValueError):
+        return None
+    return snapshot if isinstance(snapshot, dict) else None
 
 
 def usable_campaign(path: Path) -> Campaign:

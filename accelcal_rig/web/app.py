@@ -1,0 +1,171 @@
+"""The dashboard's web application (Starlette, pages rendered on the server with Jinja2): campaigns running
+and recent, each campaign's progress, temperatures, warnings, report and certificates, and the registry
+(search by serial, a sensor's history and trend, a part's lot). Pages refresh themselves by polling the
+JSON endpoints with the bundled script. With a token, every request must carry it."""
+
+from __future__ import annotations
+
+import hmac
+from pathlib import Path
+from typing import Any
+
+from jinja2 import Environment, PackageLoader, select_autoescape
+from starlette.applications import Starlette
+from starlette.middleware import Middleware
+from starlette.middleware.base import BaseHTTPMiddleware, RequestResponseEndpoint
+from starlette.requests import Request
+from starlette.responses import FileResponse, HTMLResponse, JSONResponse, PlainTextResponse, RedirectResponse, Response
+from starlette.routing import Mount, Route
+from starlette.staticfiles import StaticFiles
+
+from accelcal_rig.registry.analysis import lot_statistics, trend
+from accelcal_rig.registry.database import Registry
+from accelcal_rig.registry.location import described
+from accelcal_rig.web.campaigns import CampaignFolders
+from accelcal_rig.web.svg import line_plot
+
+_STATIC = Path(__file__).parent / "static"
+_TOKEN_COOKIE = "accelcal_token"
+
+
+class _TokenRequired(BaseHTTPMiddleware):
+    """Every request carries the token: `?token=` once (then a cookie), the cookie, or `Authorization: Bearer`."""
+
+    def __init__(self, app: Any, token: str) -> None:
+        super().__init__(app)
+        self._token = token
+
+    async def dispatch(self, request: Request, call_next: RequestResponseEndpoint) -> Response:
+        given = (request.query_params.get("token") or request.cookies.get(_TOKEN_COOKIE)
+                 or request.headers.get("authorization", "").removeprefix("Bearer ").strip())
+        if not given or not hmac.compare_digest(given, self._token):
+            return PlainTextResponse("a token is needed: open the address rig serve printed", status_code=401)
+        response = await call_next(request)
+        if request.query_params.get("token"):
+            response.set_cookie(_TOKEN_COOKIE, self._token, httponly=True, samesite="strict")
+        return response
+
+
+def create_app(campaign_folders: list[Path], registry_url: str | None, token: str | None = None) -> Starlette:
+    campaigns = CampaignFolders(campaign_folders)
+    registry = _LazyRegistry(registry_url)
+    templates = Environment(loader=PackageLoader("accelcal_rig.web", "templates"),
+                            autoescape=select_autoescape(["html"]))
+
+    def page(name: str, **values: Any) -> HTMLResponse:
+        return HTMLResponse(templates.get_template(name).render(registry=registry.label, **values))
+
+    async def front(request: Request) -> Response:
+        return page("front.html", campaigns=campaigns.summaries(), folders=campaigns.folders)
+
+    async def campaigns_json(request: Request) -> Response:
+        return JSONResponse(campaigns.summaries())
+
+    async def campaign(request: Request) -> Response:
+        name = request.path_params["name"]
+        try:
+            summary, series = campaigns.summary(name), campaigns.series(name)
+        except KeyError:
+            return PlainTextResponse(f"no campaign {name} in the watched folders", status_code=404)
+        path = campaigns.path(name)
+        plot = line_plot(series.get("t_h", []), {"chamber air": series.get("chamber_c", []),
+                                                  "DUTs (mean)": series.get("dut_c", [])},
+                         "campaign time (h)", "temperature (°C)")
+        return page("campaign.html", c=summary, plot=plot, certificates=_certificates(path),
+                    report=_report(path))
+
+    async def campaign_json(request: Request) -> Response:
+        try:
+            return JSONResponse(campaigns.summary(request.path_params["name"]))
+        except KeyError:
+            return JSONResponse({"error": "no such campaign"}, status_code=404)
+
+    async def campaign_file(request: Request) -> Response:
+        """A certificate or a report file beside a watched campaign; nothing outside its folders."""
+        try:
+            path = campaigns.path(request.path_params["name"])
+        except KeyError:
+            return PlainTextResponse("no such campaign", status_code=404)
+        kind, relative = request.path_params["kind"], request.path_params["file"]
+        base = {"certificates": path.with_suffix(".certificates"), "report": _report(path)}.get(kind)
+        if base is None:
+            return PlainTextResponse("no such file", status_code=404)
+        wanted = (base / relative).resolve()
+        if not wanted.is_relative_to(base.resolve()) or not wanted.is_file():
+            return PlainTextResponse("no such file", status_code=404)
+        return FileResponse(wanted)
+
+    async def registry_search(request: Request) -> Response:
+        serial = request.query_params.get("serial", "").strip()
+        if serial:
+            return RedirectResponse(f"/registry/serials/{serial}", status_code=303)
+        rows = registry.get().calibrations(limit=50)
+        parts = sorted({r["part"] for r in rows})
+        return page("registry.html", rows=rows, parts=parts)
+
+    async def serial_page(request: Request) -> Response:
+        serial = request.path_params["serial"]
+        reg = registry.get()
+        rows = reg.calibrations(serial=serial)
+        if not rows:
+            return page("registry.html", rows=[], parts=[], missing=serial)
+        result = trend(rows)
+        points = result["calibrations"]
+        times = [(r["calibrated_at"] - rows[-1]["calibrated_at"]).total_seconds() / 86400.0 for r in reversed(rows)]
+        plot = line_plot(times, {f"bias {axis}": [p["bias_mg"][k] for p in points] for k, axis in enumerate("xyz")},
+                         "days since the first calibration", "bias at the reference temperature (mg)")
+        return page("serial.html", serial=serial, rows=rows, current=reg.current(serial), trend=result, plot=plot)
+
+    async def part_page(request: Request) -> Response:
+        part = request.path_params["part"]
+        rows = registry.get().calibrations(part=part)
+        return page("part.html", part=part, stats=lot_statistics(rows) if rows else None)
+
+    async def serial_json(request: Request) -> Response:
+        rows = registry.get().calibrations(serial=request.path_params["serial"])
+        return JSONResponse(_jsonable(trend(rows)) if rows else {"calibrations": []})
+
+    middleware = [Middleware(_TokenRequired, token=token)] if token else []
+    return Starlette(routes=[
+        Route("/", front), Route("/api/campaigns", campaigns_json),
+        Route("/campaigns/{name}", campaign), Route("/api/campaigns/{name}", campaign_json),
+        Route("/campaigns/{name}/{kind}/{file:path}", campaign_file),
+        Route("/registry", registry_search), Route("/registry/serials/{serial}", serial_page),
+        Route("/registry/parts/{part}", part_page), Route("/api/registry/serials/{serial}", serial_json),
+        Mount("/static", StaticFiles(directory=_STATIC), name="static"),
+    ], middleware=middleware)
+
+
+class _LazyRegistry:
+    """The registry, opened at its first use (a dashboard of campaigns works without one)."""
+
+    def __init__(self, url: str | None) -> None:
+        self.url = url
+        self._registry: Registry | None = None
+        self.label = described(url) if url else "none"
+
+    def get(self) -> Registry:
+        if self._registry is None:
+            if self.url is None:
+                raise RuntimeError("no registry")
+            self._registry = Registry.open(self.url)
+        return self._registry
+
+
+def _certificates(campaign: Path) -> list[str]:
+    folder = campaign.with_suffix(".certificates")
+    return sorted(p.name for p in folder.glob("*") if p.suffix in (".html", ".pdf")) if folder.is_dir() else []
+
+
+def _report(campaign: Path) -> Path | None:
+    """A report `rig report` wrote for it: FILE.report/ beside it."""
+    folder = campaign.with_suffix(".report")
+    return folder if (folder / "index.html").is_file() else None
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _jsonable(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_jsonable(v) for v in value]
+    return value

@@ -1,0 +1,98 @@
+"""The campaigns in the watched folders, read as `rig status` reads them (the journal, never the writer's
+lock), each read again only when its files change."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from accelcal_rig.core.formatting import format_duration
+from accelcal_rig.store.paths import journal_path, progress_path
+from accelcal_rig.store.read import campaign_status, load_campaign
+
+_JOURNAL_SUFFIX = ".journal"
+
+
+@dataclass
+class _Cached:
+    stamp: tuple[float, ...]
+    summary: dict[str, Any]
+    series: dict[str, list[float]]
+
+
+class CampaignFolders:
+    def __init__(self, folders: list[Path]) -> None:
+        self.folders = [folder.resolve() for folder in folders]
+        self._cache: dict[Path, _Cached] = {}
+
+    def paths(self) -> dict[str, Path]:
+        """Every campaign file (or journal of one not built yet) in the folders, by its name."""
+        found: dict[str, Path] = {}
+        for folder in self.folders:
+            for candidate in [*folder.glob("*.h5"), *folder.glob(f"*.h5{_JOURNAL_SUFFIX}")]:
+                path = candidate.with_name(candidate.name.removesuffix(_JOURNAL_SUFFIX))
+                found.setdefault(path.name, path)
+        return found
+
+    def summaries(self) -> list[dict[str, Any]]:
+        """Newest first; a file that cannot be read is listed with its error, not dropped."""
+        rows = [self.summary(name) for name in self.paths()]
+        return sorted(rows, key=lambda r: r.get("started") or "", reverse=True)
+
+    def summary(self, name: str) -> dict[str, Any]:
+        return self._read(name).summary
+
+    def series(self, name: str) -> dict[str, list[float]]:
+        return self._read(name).series
+
+    def path(self, name: str) -> Path:
+        paths = self.paths()
+        if name not in paths:
+            raise KeyError(name)
+        return paths[name]
+
+    def _read(self, name: str) -> _Cached:
+        path = self.path(name)
+        stamp = tuple(_stamp(p) for p in (path, journal_path(path), progress_path(path)))
+        cached = self._cache.get(path)
+        if cached is not None and cached.stamp == stamp:
+            return cached
+        try:
+            campaign = load_campaign(path)
+            status = campaign_status(path, campaign)
+            warnings = [e.message for e in campaign.events if e.level in ("warning", "error")]
+            summary = {**status, "name": name, "warnings": warnings[-20:], "error": None}
+            if summary.get("progress"):
+                remaining = summary["progress"].get("remaining_s")
+                summary["progress"]["left"] = format_duration(remaining) if remaining is not None else None
+            series = _temperatures(campaign)
+        except Exception as exc:  # noqa: BLE001 - a damaged file is shown as such, the others still are
+            summary, series = {"name": name, "file": str(path), "state": "unreadable", "error": str(exc)}, {}
+        cached = _Cached(stamp, summary, series)
+        self._cache[path] = cached
+        return cached
+
+
+def _stamp(path: Path) -> float:
+    try:
+        status = path.stat()
+    except OSError:
+        return -1.0
+    return status.st_mtime_ns + status.st_size * 1e-3
+
+
+def _temperatures(campaign: Any) -> dict[str, list[float]]:
+    """Chamber air and the DUTs' mean temperature at every stored pose and soak poll, on the campaign clock."""
+    points: list[tuple[float, float, float]] = []
+    for soak in campaign.soaks:
+        for t, chamber, duts in zip(soak.t_s, soak.chamber_c, soak.dut_c):
+            points.append((float(t), float(chamber), float(np.mean(duts))))
+    for pose in campaign.poses:
+        points.append((float(pose.t_start_s), float(np.mean(pose.chamber_temperature_c)),
+                       float(np.mean([np.mean(d.temperature_c) for d in pose.duts]))))
+    points.sort()
+    return {"t_h": [p[0] / 3600.0 for p in points], "chamber_c": [p[1] for p in points],
+            "dut_c": [p[2] for p in points]}

@@ -1,0 +1,93 @@
+"""The dashboard's pages and JSON over HTTP (Starlette's test client): campaigns with their progress,
+temperatures, warnings and certificates, the registry by serial and by part, the token, and files outside
+the watched folders never served."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+from starlette.testclient import TestClient
+
+from accelcal_rig.registry.database import Registry
+from accelcal_rig.registry.location import normalised
+from accelcal_rig.web.app import create_app
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """A folder with one finished dry run (its certificates beside it) and a registry holding it."""
+    from accelcal_rig.cli import main
+    from tests.conftest import REPO
+
+    folder = tmp_path_factory.mktemp("campaigns")
+    registry = normalised(str(folder / "registry.sqlite"))
+    assert main(["run", str(REPO / "procedures" / "quick-6pos.yaml"), "--dry-run", "-o", str(folder / "quick.h5"),
+                 "-q", "--no-pdf", "--registry", registry]) == 0
+    return folder, registry
+
+
+def test_the_front_page_lists_the_campaign_and_its_duts(lab) -> None:
+    folder, registry = lab
+    client = TestClient(create_app([folder], registry))
+    page = client.get("/")
+    assert page.status_code == 200 and 'data-name="quick.h5"' in page.text
+    assert "ADX355-A001, ADX355-A002, ADX355-A003, ADX355-A004" in page.text and "12/12" in page.text
+    assert '<script src="/static/dashboard.js"' in page.text and "http" not in page.text.split("<body>")[0]
+    assert client.get("/static/dashboard.js").status_code == 200
+    rows = client.get("/api/campaigns").json()
+    assert [(r["name"], r["state"], r["poses_done"]) for r in rows] == [("quick.h5", "done", 12)]
+
+
+def test_a_campaign_page_has_its_plot_warnings_and_certificates(lab) -> None:
+    folder, registry = lab
+    client = TestClient(create_app([folder], registry))
+    page = client.get("/campaigns/quick.h5")
+    assert page.status_code == 200 and "<svg" in page.text and "chamber air" in page.text
+    assert "ADX355-A001.html" in page.text
+    certificate = client.get("/campaigns/quick.h5/certificates/ADX355-A001.html")
+    assert certificate.status_code == 200 and "ADX355-A001" in certificate.text
+    assert client.get("/campaigns/quick.h5/certificates/..%2F..%2Fquick.h5.journal").status_code == 404
+    assert client.get("/campaigns/nothing.h5").status_code == 404
+
+
+def test_the_registry_by_serial_and_by_part(lab) -> None:
+    folder, registry = lab
+    client = TestClient(create_app([folder], registry))
+    search = client.get("/registry", params={"serial": "ADX355-A003"}, follow_redirects=False)
+    assert search.status_code == 303 and search.headers["location"] == "/registry/serials/ADX355-A003"
+    page = client.get("/registry/serials/ADX355-A003")
+    assert page.status_code == 200 and "valid calibration" in page.text and "<svg" in page.text
+    assert 'id="history"' in page.text
+    lot = client.get("/registry/parts/adxl355")
+    assert lot.status_code == 200 and "4 sensors" in lot.text
+    assert "no calibration of NOBODY" in client.get("/registry/serials/NOBODY").text
+
+
+def test_with_a_token_nothing_is_served_without_it(lab) -> None:
+    folder, registry = lab
+    client = TestClient(create_app([folder], registry, token="s3cret"))
+    assert client.get("/").status_code == 401 and client.get("/api/campaigns").status_code == 401
+    assert client.get("/", params={"token": "wrong"}).status_code == 401
+    assert client.get("/", params={"token": "s3cret"}).status_code == 200  # and a cookie from now on
+    assert client.get("/api/campaigns").status_code == 200
+    bearer = TestClient(create_app([folder], registry, token="s3cret"))
+    assert bearer.get("/api/campaigns", headers={"Authorization": "Bearer s3cret"}).status_code == 200
+
+
+def test_a_damaged_campaign_file_is_listed_as_such(lab, tmp_path: Path) -> None:
+    folder, registry = lab
+    shutil.copy(folder / "quick.h5", tmp_path / "good.h5")
+    (tmp_path / "broken.h5").write_bytes(b"not a campaign")
+    rows = {r["name"]: r for r in TestClient(create_app([tmp_path], registry)).get("/api/campaigns").json()}
+    assert rows["good.h5"]["state"] == "done"
+    assert rows["broken.h5"]["state"] == "unreadable" and rows["broken.h5"]["error"]
+    assert Registry.open(registry).count() == 4  # reading campaigns leaves the registry as it was
+
+
+def test_rig_serve_refuses_an_open_address_without_a_token(capsys) -> None:
+    from accelcal_rig.cli import main
+
+    assert main(["serve", "--host", "0.0.0.0"]) == 2
+    assert "off 127.0.0.1 the dashboard needs --token" in capsys.readouterr().err
