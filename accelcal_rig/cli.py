@@ -267,19 +267,33 @@ def _rejected_exit(rejected: list[str], fail_on_reject: bool) -> int:
 
 def _cmd_status(args: argparse.Namespace) -> int:
     from accelcal_rig.fit.campaign_file import calibration_verdicts
+    from accelcal_rig.status_text import status_lines, watch_header
     from accelcal_rig.store.read import campaign_status
 
-    status = {**campaign_status(args.campaign), **calibration_verdicts(args.campaign, args.calibration)}
-    if args.json:
-        print(json.dumps(status))
+    def current() -> dict:
+        return {**campaign_status(args.campaign), **calibration_verdicts(args.campaign, args.calibration)}
+
+    if args.json and not args.watch:
+        print(json.dumps(current()))
         return 0
-    verdicts = status.pop("verdicts")
-    for key, value in status.items():
-        print(f"{key:17s}{value}")
-    for serial, judged in (verdicts or {}).items():
-        reasons = f": {'; '.join(judged['reasons'])}" if judged["verdict"] == "FAIL" else ""
-        print(f"{'verdict':17s}{serial} {judged['verdict'] or 'not judged'}{reasons}")
-    return 0
+    if not args.watch:
+        print("\n".join(status_lines(current())))
+        return 0
+    import time
+
+    try:
+        while True:
+            status = current()
+            if args.json:
+                print(json.dumps(status), flush=True)
+            else:
+                clear = "\x1b[H\x1b[2J" if sys.stdout.isatty() else ""
+                print(clear + "\n".join(status_lines(status)) + f"\n({watch_header(status, args.watch)})", flush=True)
+            if status["state"] not in ("created", "running"):
+                return 0
+            time.sleep(args.watch)
+    except KeyboardInterrupt:
+        return 0
 
 
 def _cmd_repair(args: argparse.Namespace) -> int:
@@ -406,6 +420,13 @@ def _recording_entries(recording: Path, calibration: CalibrationFile, part: str)
     from accelcal_rig.registry.entries import recording_entries
 
     return recording_entries(recording, calibration, part)
+
+
+def _cmd_completion(args: argparse.Namespace) -> int:
+    from accelcal_rig.cli_parser import bash_completion
+
+    sys.stdout.write(bash_completion(build_parser()))
+    return 0
 
 
 def _cmd_serve(args: argparse.Namespace) -> int:
@@ -605,11 +626,13 @@ def main(argv: list[str] | None = None) -> int:
                "fit": _cmd_fit, "check": _cmd_check,
                "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export, "certificate": _cmd_certificate,
                "fit-recording": _cmd_fit_recording, "analyze": _cmd_analyze, "registry": _cmd_registry,
-               "serve": _cmd_serve}[args.command]
+               "serve": _cmd_serve, "completion": _cmd_completion}[args.command]
     try:
         return handler(args)
     except CampaignAborted as exc:
-        print(f"rig: campaign aborted, rig in safe state: {_one_line(exc)}", file=sys.stderr)
+        campaign = args.output if args.command == "run" else getattr(args, "campaign", None)
+        resume = f"; continue it with: rig resume {campaign}" if campaign is not None else ""
+        print(f"rig: campaign aborted, rig in safe state: {_one_line(exc)}{resume}", file=sys.stderr)
         interrupted = isinstance(exc.__cause__, (KeyboardInterrupt, TerminationRequested))
         return EXIT_INTERRUPTED if interrupted else exc.exit_code
     except RigError as exc:

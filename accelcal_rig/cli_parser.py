@@ -197,6 +197,8 @@ def build_parser() -> argparse.ArgumentParser:
     status.add_argument("--json", action="store_true", help="print one JSON object")
     status.add_argument("--calibration", type=Path, help="its calibration file, for the verdicts (default: beside "
                                                          "the campaign, .calibration.yaml)")
+    status.add_argument("--watch", nargs="?", const=2.0, type=_number(0.2, 3600, "s"), metavar="S",
+                        help="show it again every S seconds (default 2) until the campaign ends or Ctrl-C")
 
     repair = _command(commands, "repair", "rebuild a campaign file from its journal",
                       "Bring a campaign's files back in step without losing a record: the campaign file (HDF5) "
@@ -322,6 +324,12 @@ def build_parser() -> argparse.ArgumentParser:
         calibration=True, figure=True)
 
     _registry_commands(commands)
+    completion = _command(commands, "completion", "print a shell completion script",
+                          "Print a completion script for bash (commands, their actions and options; file names "
+                          "elsewhere). Load it now with eval \"$(rig completion bash)\", or for good: "
+                          "rig completion bash > ~/.local/share/bash-completion/completions/rig",
+                          "rig completion bash > ~/.local/share/bash-completion/completions/rig")
+    completion.add_argument("shell", choices=["bash"])
 
     serve = _command(commands, "serve", "a local web dashboard of campaigns and the registry",
                      "Serve the dashboard: running and recent campaigns of the watched folders (state, phase, "
@@ -386,3 +394,45 @@ def build_parser() -> argparse.ArgumentParser:
                              "default 0, which PX4 matches to none)")
     export.add_argument("-o", "--output", type=Path, help="file to write (default: standard output)")
     return parser
+
+
+def bash_completion(parser: argparse.ArgumentParser) -> str:
+    """A bash completion script generated from the parser itself, so it never falls behind the commands."""
+    words: dict[str, list[str]] = {"": []}
+
+    def walk(command: argparse.ArgumentParser, key: str) -> None:
+        options = [o for action in command._actions for o in action.option_strings]
+        children: list[str] = []
+        for action in command._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, sub in action.choices.items():
+                    children.append(name)
+                    walk(sub, f"{key} {name}".strip())
+        words[key] = children + options
+
+    walk(parser, "")
+    cases = "\n".join(f'        "{key}") words="{" ".join(sorted(set(value)))}" ;;' for key, value in sorted(words.items()))
+    return f"""# bash completion for rig (accelcal-rig), made by `rig completion bash`
+_rig() {{
+    local current="${{COMP_WORDS[COMP_CWORD]}}" path="" word words
+    for word in "${{COMP_WORDS[@]:1:COMP_CWORD-1}}"; do
+        case "$word" in -*) continue ;; esac
+        if _rig_words "${{path:+$path }}$word" >/dev/null; then path="${{path:+$path }}$word"; fi
+    done
+    words=$(_rig_words "$path")
+    if [[ "$current" == -* || -n "$words" ]]; then
+        COMPREPLY=($(compgen -W "$words" -- "$current"))
+    fi
+    [[ ${{#COMPREPLY[@]}} -eq 0 ]] && COMPREPLY=($(compgen -f -- "$current"))
+    return 0
+}}
+_rig_words() {{
+    local words=""
+    case "$1" in
+{cases}
+        *) return 1 ;;
+    esac
+    echo "$words"
+}}
+complete -o filenames -F _rig rig
+"""

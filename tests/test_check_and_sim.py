@@ -103,7 +103,7 @@ def test_rig_check_of_the_chamber_alone(running_sim: dict, tmp_path: Path) -> No
 
 
 @pytest.mark.parametrize(("argv", "message"), [
-    ([], "turntable: Field required"),                                   # a campaign's check needs all of it
+    ([], "turntable: required, and missing"),                                 # a campaign's check needs all of it
     (["--only", "turntable"], "turntable: missing, and --only checks it"),
 ])
 def test_a_rig_config_without_an_instrument_is_refused_where_it_is_needed(tmp_path: Path, argv: list[str],

@@ -11,6 +11,7 @@ from pydantic import BaseModel, ValidationError
 from accelcal_rig.config.procedure import MAX_POLLS, Procedure
 from accelcal_rig.config.rig import FaultInjection, RigConfig
 from accelcal_rig.config.schedule import Schedule
+from accelcal_rig.config.suggestions import explained
 from accelcal_rig.config.yaml_lines import CONFIG_LIMITS, KeyPath, YamlLimits, format_key, load_yaml_with_lines, locate
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.registry import part
@@ -72,9 +73,9 @@ def _validated(path: Path, model: type[ModelT], data: Any, lines: dict[KeyPath, 
         messages = []
         for err in exc.errors(include_url=False):
             shown, line = locate(lines, tuple(err["loc"]))
-            message = str(err["msg"]).removeprefix("Value error, ")
+            message = explained(model, data, err) or str(err["msg"]).removeprefix("Value error, ")
             messages.append(f"{path}:{line}: {format_key(shown)}: {message}")
-        more = f" (and {len(messages) - 1} more problems)" if len(messages) > 1 else ""
+        more = (f" (and {len(messages) - 1} more problem{'s' if len(messages) > 2 else ''})" if len(messages) > 1 else "")
         raise ConfigError(messages[0] + more) from None
     return LoadedConfig(validated, path, text, lines)
 

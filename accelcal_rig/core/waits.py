@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from accelcal_rig.core.clock import Clock
+from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.errors import WaitTimeout
 
 #: Turntable position polling interval, from the time a move could first have arrived (its travel at the
@@ -24,5 +25,5 @@ def wait_until(clock: Clock, condition: Callable[[], bool], *, timeout_s: float,
             return clock.now()
         remaining = deadline - clock.now()
         if remaining <= 0:
-            raise WaitTimeout(f"{what}: not reached within {timeout_s:.0f} s")
+            raise WaitTimeout(f"{what}: not reached within {format_duration(timeout_s)}")
         clock.sleep(min(poll_s, remaining))

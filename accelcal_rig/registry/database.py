@@ -26,6 +26,8 @@ from accelcal_rig.registry.schema import calibrations
 _MIGRATIONS = Path(__file__).parent / "migrations"
 #: A PostgreSQL advisory lock key for schema migrations (any constant the lab's other users do not take).
 _MIGRATION_LOCK = 0x0ACCE1CA1
+#: Tries to open a registry another process is opening at the same moment (SQLite).
+_OPEN_ATTEMPTS = 20
 #: Entries per insert transaction.
 _BATCH = 500
 #: SQLite waits this long for another writer's lock before giving up.
@@ -54,15 +56,21 @@ class Registry:
         """Connect, and bring the schema to the current version (creating it on first use)."""
         engine = _engine(url)
         registry = cls(engine, url)
-        try:
-            if upgrade:
-                registry.upgrade()
-            elif registry.revision() != head_revision():
-                raise ConfigError(f"registry {described(url)}: schema {registry.revision()}, this software needs "
-                                  f"{head_revision()}")
-        except sa.exc.OperationalError as exc:
-            raise ConfigError(f"registry {described(url)}: cannot open: {exc.orig}") from None
-        return registry
+        for attempt in range(_OPEN_ATTEMPTS):
+            try:
+                if upgrade:
+                    registry.upgrade()
+                elif registry.revision() != head_revision():
+                    raise ConfigError(f"registry {described(url)}: schema {registry.revision()}, this software "
+                                      f"needs {head_revision()}")
+                return registry
+            except sa.exc.OperationalError as exc:
+                # SQLite answers "locked" at once, busy timeout or not, to a connection switching a new file
+                # to WAL while another does: the other is done in a moment.
+                if "locked" not in str(exc.orig) or attempt == _OPEN_ATTEMPTS - 1:
+                    raise ConfigError(f"registry {described(url)}: cannot open: {exc.orig}") from None
+                time.sleep(0.05 * (attempt + 1))
+        raise AssertionError("unreachable")
 
     def upgrade(self, revision: str = "head") -> None:
         """Apply every migration not applied yet, one process at a time."""

@@ -38,11 +38,12 @@ class StatusLine:
         self.stream = stream
         self.real_clock = real_clock
         self._text = ""
+        self._progress: Progress | None = None
         self._drawn_at = 0.0
         self._lock = threading.Lock()
 
     def __call__(self, progress: Progress) -> None:
-        self._text = progress.line() + finish_time(progress, self.real_clock)
+        self._progress = progress
         now = time.monotonic()
         if now - self._drawn_at >= REDRAW_S:
             self._drawn_at = now
@@ -50,8 +51,12 @@ class StatusLine:
                 self._draw()
 
     def _draw(self) -> None:
+        """The line as the terminal is wide now: what gives way is the temperatures, never the time left."""
         width = shutil.get_terminal_size((100, 24)).columns - 1
-        self.stream.write(_CLEAR + self._text[:width])
+        done = finish_time(self._progress, self.real_clock) if self._progress is not None else ""
+        text = self._progress.line(max(10, width - len(done))) + done if self._progress is not None else ""
+        self._text = text[:width]
+        self.stream.write(_CLEAR + self._text)
         self.stream.flush()
 
     def print_above(self, text: str) -> None:

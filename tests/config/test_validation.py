@@ -30,7 +30,7 @@ def test_setpoint_range_shorthand_expands() -> None:
         ("kind: six-position", "kind: seven-position", r"tiny.yaml:5: schedule: "),
         ("kind: six-position", "kind: sphere", r"tiny.yaml:5: schedule.count: Field required"),
         ("band_c: 0.3", "band_c: wide", r"tiny.yaml:4: soak.band_c: .*valid number"),
-        ("band_c: 0.3", "bnad_c: 0.3", r"tiny.yaml:4: soak.bnad_c: Extra inputs are not permitted"),
+        ("band_c: 0.3", "bnad_c: 0.3", r"tiny.yaml:4: soak.bnad_c: unknown key; did you mean band_c?"),
         ("timeout_min: 120", "timeout_min: 1", r"tiny.yaml:4: soak: timeout_min must be at least"),
         ("setpoints_c: [30]", "setpoints_c: [30, 30]", r"tiny.yaml:3: setpoints_c: setpoints must be distinct"),
         ("setpoints_c: [30]", "setpoints_c: {from_c: 0, to_c: 10}", r"tiny.yaml:3: setpoints_c: a setpoint range needs"),
@@ -147,3 +147,15 @@ def test_explicit_verification_angles_are_checked_against_the_turntable(write) -
     base = TINY_PROCEDURE + "verify: {schedule: {kind: explicit, angles_deg: ANGLES}}\n"
     with pytest.raises(ConfigError, match=r"tiny.yaml:7: verify.schedule.angles_deg\[0\]: 2 angles given, the turntable .* has 3 axes"):
         prepare(write("tiny.yaml", base.replace("ANGLES", "[[10, 20]]")))
+
+
+@pytest.mark.parametrize(("replace", "by", "expected"), [
+    ("band_c: 0.3", "bnd_c: 0.3", r"tiny.yaml:4: soak.bnd_c: unknown key; did you mean band_c\?$"),
+    ("setpoints_c: [30]", "setpoint_c: [30]",
+     r"tiny.yaml:1: setpoints_c: required, and missing: is 'setpoint_c' a misspelling of it\? \(and 1 more problem\)"),
+    ("samples_per_pose: 20", "samples_per_pose: 20, frobnicate: 1",
+     r"acquisition.frobnicate: unknown key \(known here: samples_per_pose, .*\)$"),
+])
+def test_a_misspelt_key_is_named_with_what_was_meant(write, replace: str, by: str, expected: str) -> None:
+    with pytest.raises(ConfigError, match=expected):
+        load_procedure(write("tiny.yaml", TINY_PROCEDURE.replace(replace, by)))

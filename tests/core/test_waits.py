@@ -13,7 +13,7 @@ def test_returns_the_time_the_condition_first_held() -> None:
 def test_deadline_passes_with_the_named_outcome_after_a_final_check() -> None:
     clock = VirtualClock()
     checks = []
-    with pytest.raises(WaitTimeout, match="chamber reaching 60 °C: not reached within 95 s"):
+    with pytest.raises(WaitTimeout, match="chamber reaching 60 °C: not reached within 0:01:35"):
         wait_until(clock, lambda: checks.append(clock.now()) and False, timeout_s=95, poll_s=10,
                    what="chamber reaching 60 °C")
     assert checks[-1] == 95  # checked once more at the deadline itself, never past it

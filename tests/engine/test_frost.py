@@ -43,7 +43,7 @@ def test_without_the_purge_a_margin_the_room_air_cannot_give_stops_the_run(write
     procedure = write("humid.yaml", COLD_THEN_WARM + "frost: {dew_point_margin_c: 10, dew_point_timeout_min: 20}\n")
     code, stored = run(procedure, "--chamber-profile", "simserv")
     assert code == 1 and stored.state == "aborted"
-    assert "T20: DUTs 10 °C above the chamber's dew point: not reached within 1200 s" in capsys.readouterr().err
+    assert "T20: DUTs 10 °C above the chamber's dew point: not reached within 0:20:00" in capsys.readouterr().err
     assert any("waiting" in m for m in messages(stored, "dew-point"))
     assert stored.poses and all(pose.setpoint_c == -40 for pose in stored.poses)  # none on a wet fixture
 

@@ -59,3 +59,12 @@ def test_progress_lines_at_each_phase_and_every_interval(caplog: pytest.LogCaptu
     assert [r.getMessage().split(" · ")[0] for r in logged] == [
         "progress: T-20 (3/11) soak 0:23:10", "progress: T-20 (3/11) soak 0:23:10", "progress: T-20 (3/11) poses 0:23:10"]
     assert all(getattr(r, "progress", False) for r in logged)
+
+
+@pytest.mark.parametrize("width", [100, 80, 60, 40, 25])
+def test_a_narrow_line_keeps_the_time_left(width: int) -> None:
+    line = snapshot().line(width)
+    assert len(line) <= width and line.endswith("6:12:00 left")
+    assert ("pose 48/264" in line) == (width >= 40)
+    if width >= 90:
+        assert "DUT -19.61…-19.42 °C" in line
