@@ -242,10 +242,11 @@ def _stored_rig_registry(campaign: Path) -> str | None:
 
 
 def _record(flag: str | None, configured: str | None, source: Path, entries: Callable[[], list],
-            json_output: bool = False) -> None:
+            json_output: bool = False, later: str | None = None) -> None:
     """Record a finished fit in the registry; a registry that cannot take it is a warning naming how to
     record it later, never a loss: the calibration file is written already. Beside a JSON report the line
     goes to stderr, so stdout stays one JSON object."""
+    from alembic.util.exc import CommandError
     from sqlalchemy.exc import SQLAlchemyError
 
     from accelcal_rig.cli_registry import register
@@ -253,9 +254,9 @@ def _record(flag: str | None, configured: str | None, source: Path, entries: Cal
 
     try:
         print(register(registry_url(flag, configured), entries()), file=sys.stderr if json_output else sys.stdout)
-    except (RigError, SQLAlchemyError, OSError) as exc:
-        print(f"rig: warning: not recorded in the registry: {_one_line(exc)} (record it later: rig registry add "
-              f"{source})", file=sys.stderr)
+    except (RigError, SQLAlchemyError, OSError, CommandError) as exc:
+        print(f"rig: warning: not recorded in the registry: {_one_line(exc)} (record it later: "
+              f"{later or f'rig registry add {source}'})", file=sys.stderr)
 
 
 def _rejected_exit(rejected: list[str], fail_on_reject: bool) -> int:
@@ -392,7 +393,8 @@ def _cmd_fit_recording(args: argparse.Namespace) -> int:
     record = lambda: _recording_entries(args.recording, result.calibration, args.part)  # noqa: E731
     if args.json:
         print(json.dumps(result.report))
-        _record(args.registry, None, args.recording, record, json_output=True)
+        _record(args.registry, None, args.recording, record, json_output=True,
+                later="run this rig fit-recording again once the registry is reachable")
         return 0
     report = result.report
     print(f"{len(report['intervals'])} static intervals in {recording.source} ({report['samples']} samples at "
@@ -406,13 +408,16 @@ def _cmd_fit_recording(args: argparse.Namespace) -> int:
               f"{interval['norm_before_mg']:13.3f} {interval['norm_after_mg']:11.4f}")
     for warning in report["warnings"]:
         print(f"warning: {warning}")
+    chi2 = "n/a (no degrees of freedom left)" if report["chi2_reduced_before"] is None else (
+        f"{report['chi2_reduced_before']:.2f}" + (f" → {report['chi2_reduced']:.2f} with a scatter floor of "
+                                                   f"{report['scatter_floor_mg']:.4f} mg" if report["scatter_floor_mg"]
+                                                   else ""))
     print(f"calibration → {args.output}: norm-only, {args.parameters} parameters, |g| RMSE "
           f"{report['rmse_before_mg']:.3f} → {report['rmse_after_mg']:.4f} mg (noise floor "
-          f"{report['noise_floor_mg']:.4f} mg) at {report['temperature_c']:.1f} °C; χ²_red "
-          f"{report['chi2_reduced_before']:.2f}" + (f" → {report['chi2_reduced']:.2f} with a scatter floor of "
-                                                    f"{report['scatter_floor_mg']:.4f} mg" if report["scatter_floor_mg"]
-                                                    else "") + f"; outputs in {report['units']}")
-    _record(args.registry, None, args.recording, record)
+          f"{report['noise_floor_mg']:.4f} mg) at {report['temperature_c']:.1f} °C; χ²_red {chi2}; outputs in "
+          f"{report['units']}")
+    _record(args.registry, None, args.recording, record,
+            later="run this rig fit-recording again once the registry is reachable")
     return 0
 
 
@@ -451,6 +456,13 @@ def _cmd_serve(args: argparse.Namespace) -> int:
                           "could read it otherwise)")
     if (args.tls_cert is None) != (args.tls_key is None):
         raise ConfigError("--tls-cert and --tls-key go together")
+    if args.tls_cert is not None:
+        import ssl
+
+        try:  # before anything is printed: a wrong file is one line naming it
+            ssl.create_default_context(ssl.Purpose.CLIENT_AUTH).load_cert_chain(args.tls_cert, args.tls_key)
+        except (OSError, ssl.SSLError) as exc:
+            raise ConfigError(f"--tls-cert {args.tls_cert} --tls-key {args.tls_key}: cannot load: {exc}") from None
     folders = args.campaigns or [Path.cwd()]
     missing = [folder for folder in folders if not folder.is_dir()]
     if missing:
@@ -461,7 +473,12 @@ def _cmd_serve(args: argparse.Namespace) -> int:
 
         rig = load_rig(args.config)
         from_config = configured(rig.model.registry, rig.path)
-    app = create_app(folders, registry_url(args.registry, from_config), token)
+    from urllib.parse import quote
+
+    from accelcal_rig.web.app import LOOPBACK_HOSTS
+
+    app = create_app(folders, registry_url(args.registry, from_config), token, tls=args.tls_cert is not None,
+                     hosts=[*LOOPBACK_HOSTS, args.host])
     # Listening before the address is printed: whoever reads it can connect at once (and port 0 works).
     family = socket.AF_INET6 if ":" in args.host else socket.AF_INET
     listening = socket.socket(family, socket.SOCK_STREAM)
@@ -473,7 +490,8 @@ def _cmd_serve(args: argparse.Namespace) -> int:
     listening.listen(128)
     port = listening.getsockname()[1]
     scheme = "https" if args.tls_cert else "http"
-    print(f"dashboard on {scheme}://{args.host}:{port}/" + (f"?token={token}" if token else ""), flush=True)
+    print(f"dashboard on {scheme}://{args.host}:{port}/" + (f"?token={quote(token, safe='')}" if token else ""),
+          flush=True)
     config = uvicorn.Config(app, log_level="warning", ssl_certfile=args.tls_cert, ssl_keyfile=args.tls_key)
     uvicorn.Server(config).run(sockets=[listening])
     return 0

@@ -109,6 +109,7 @@ def _registry_commands(commands: argparse._SubParsersAction) -> None:
     show = action("show", "a sensor's valid calibration and its history", "rig registry show ADX355-A001")
     show.add_argument("serial")
     show.add_argument("--json", action="store_true", help="one JSON object")
+    show.add_argument("--simulated", action="store_true", help="count dry runs too (left out by default)")
     export = action("export", "a sensor's valid calibration (or one by id) as a file other tools read",
                     "rig registry export ADX355-A001 --format c-header -o accel.h")
     export.add_argument("serial")
@@ -118,14 +119,17 @@ def _registry_commands(commands: argparse._SubParsersAction) -> None:
     export.add_argument("--instance", type=_number(0, 3, integer=True), help="px4-params, ardupilot-params: as rig export")
     export.add_argument("--device-id", type=_number(1, 2**31 - 1, integer=True), help="px4-params: as rig export")
     export.add_argument("-o", "--output", type=Path, help="file to write (default: standard output)")
+    export.add_argument("--simulated", action="store_true", help="count dry runs too (left out by default)")
     trend = action("trend", "bias and scale at the reference temperature across recalibrations: ageing drift",
                    "rig registry trend ADX355-A001")
     trend.add_argument("serial")
     trend.add_argument("--json", action="store_true", help="one JSON object")
+    trend.add_argument("--simulated", action="store_true", help="count dry runs too (left out by default)")
     stats = action("stats", "a part's lot: yield, distributions of bias, scale and non-orthogonality, outliers",
                    "rig registry stats --part adxl355")
     stats.add_argument("--part", required=True)
     stats.add_argument("--json", action="store_true", help="one JSON object")
+    stats.add_argument("--simulated", action="store_true", help="count dry runs too (left out by default)")
 
 
 def _analysis_command(analyses: argparse._SubParsersAction, name: str, summary: str, description: str,

@@ -17,9 +17,9 @@ def registry_command(args: argparse.Namespace) -> int:
             "export": _export}[args.registry_command](args)
 
 
-def open_registry(args: argparse.Namespace):  # noqa: ANN201 - the Registry, imported late (SQLAlchemy)
+def open_registry(args: argparse.Namespace, upgrade: bool = False):  # noqa: ANN201 - imported late (SQLAlchemy)
     """The registry the command names: --registry, else the rig config's (--config), else the environment's,
-    else the default file."""
+    else the default file. Only a recording command (`upgrade`) migrates an older schema."""
     from accelcal_rig.registry.database import Registry
     from accelcal_rig.registry.location import configured, registry_url
 
@@ -29,7 +29,7 @@ def open_registry(args: argparse.Namespace):  # noqa: ANN201 - the Registry, imp
 
         rig = load_rig(args.config)
         from_config = configured(rig.model.registry, rig.path)
-    return Registry.open(registry_url(args.registry, from_config))
+    return Registry.open(registry_url(args.registry, from_config), upgrade=upgrade)
 
 
 def register(url: str, entries: list[dict[str, Any]]) -> str:
@@ -37,7 +37,7 @@ def register(url: str, entries: list[dict[str, Any]]) -> str:
     from accelcal_rig.registry.database import Registry
     from accelcal_rig.registry.location import described
 
-    added, already = Registry.open(url).add(entries)
+    added, already = Registry.open(url, upgrade=True).add(entries)
     tail = f", {already} registered already" if already else ""
     return f"registry   {len(added)} calibration{'s' if len(added) != 1 else ''} recorded in {described(url)}{tail}"
 
@@ -47,7 +47,7 @@ def _add(args: argparse.Namespace) -> int:
 
     if args.calibration is not None and len(args.files) != 1:
         raise ConfigError("--calibration names the calibration of one campaign file: give one FILE with it")
-    registry = open_registry(args)
+    registry = open_registry(args, upgrade=True)
     for path in args.files:
         added, already = registry.add(campaign_entries(path, args.calibration))
         print(f"{path}: {len(added)} added" + (f", {already} registered already" if already else ""))
@@ -78,15 +78,20 @@ def _show(args: argparse.Namespace) -> int:
     rows = registry.calibrations(serial=args.serial)
     if not rows:
         raise ConfigError(f"serial {args.serial}: no calibration in the registry")
-    current = registry.current(args.serial)
+    current = registry.current(args.serial, simulated=args.simulated)
     if args.json:
         print(json.dumps({"serial": args.serial, "current": _public(current) if current else None,
                           "history": [_public(r) for r in rows]}, indent=2))
         return 0
     if current is None:
-        print(f"{args.serial}: no valid calibration (every one failed its acceptance limits)")
+        newest = next((r for r in rows if args.simulated or not r["simulated"]), None)
+        why = ("its newest calibration failed its acceptance limits" if newest is not None
+               else "only dry runs (simulated) are recorded: --simulated shows them")
+        print(f"{args.serial}: no valid calibration ({why})")
     else:
-        print(f"{args.serial} ({current['part']}): valid calibration {current['id']}, {current['calibrated_at']:%Y-%m-%d} "
+        simulated = " (SIMULATED: a dry run)" if current["simulated"] else ""
+        print(f"{args.serial} ({current['part']}): valid calibration {current['id']}{simulated}, "
+              f"measured {current['calibrated_at']:%Y-%m-%d} "
               f"by {current['procedure']} on {current['rig']}, {current['valid_from_c']:.1f}…{current['valid_to_c']:.1f} °C, "
               f"verdict {current['verdict'] or 'none stated'}")
         print(f"  at {current['reference_c']:g} °C: bias {_triple(current['bias_mg'], 'mg', current['bias_uncertainty_mg'])}; "
@@ -97,16 +102,17 @@ def _show(args: argparse.Namespace) -> int:
     print(f"history ({len(rows)}):")
     for r in rows:
         print(f"  {r['id']:>6}  {r['calibrated_at']:%Y-%m-%d %H:%M}  {r['verdict'] or '—':<4}  "
-              f"bias {_triple(r['bias_mg'], 'mg')}  {Path(r['source_path']).name}")
+              f"bias {_triple(r['bias_mg'], 'mg')}  {Path(r['source_path']).name}"
+              + (" (simulated)" if r["simulated"] else ""))
     return 0
 
 
 def _trend(args: argparse.Namespace) -> int:
     from accelcal_rig.registry.analysis import trend
 
-    rows = open_registry(args).calibrations(serial=args.serial)
+    rows = _real_unless(args, open_registry(args).calibrations(serial=args.serial))
     if not rows:
-        raise ConfigError(f"serial {args.serial}: no calibration in the registry")
+        raise ConfigError(f"serial {args.serial}: no calibration in the registry" + _simulated_hint(args))
     result = trend(rows)
     if args.json:
         print(json.dumps({"serial": args.serial, **result}, indent=2))
@@ -129,9 +135,9 @@ def _trend(args: argparse.Namespace) -> int:
 def _stats(args: argparse.Namespace) -> int:
     from accelcal_rig.registry.analysis import lot_statistics
 
-    rows = open_registry(args).calibrations(part=args.part)
+    rows = _real_unless(args, open_registry(args).calibrations(part=args.part))
     if not rows:
-        raise ConfigError(f"part {args.part}: no calibration in the registry")
+        raise ConfigError(f"part {args.part}: no calibration in the registry" + _simulated_hint(args))
     result = lot_statistics(rows)
     if args.json:
         print(json.dumps({"part": args.part, **result}, indent=2))
@@ -161,15 +167,24 @@ def _export(args: argparse.Namespace) -> int:
         if row["serial"] != args.serial:
             raise ConfigError(f"calibration {args.id} is of {row['serial']}, not {args.serial}")
     else:
-        found = registry.current(args.serial)
+        found = registry.current(args.serial, simulated=args.simulated)
         if found is None:
-            raise ConfigError(f"serial {args.serial}: no valid calibration in the registry")
+            raise ConfigError(f"serial {args.serial}: no valid calibration in the registry" + _simulated_hint(args))
         row = registry.calibration(found["id"])
     if args.output is not None and not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
     exported = export(calibration_file_of(row), args.format,
                       StackOptions(Path(f"registry calibration {row['id']}"), None, args.instance, args.device_id))
     return write_export(exported, args.format, args.output)
+
+
+def _real_unless(args: argparse.Namespace, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Dry runs are rehearsals, not calibrations: left out unless --simulated."""
+    return rows if args.simulated else [r for r in rows if not r["simulated"]]
+
+
+def _simulated_hint(args: argparse.Namespace) -> str:
+    return "" if args.simulated else " (dry runs are left out: --simulated includes them)"
 
 
 def _since(text: str) -> datetime:

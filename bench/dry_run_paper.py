@@ -19,7 +19,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from quiet import silence_campaign_log  # bench/quiet.py, beside this script
+from quiet import silence_campaign_log, throwaway_registry  # bench/quiet.py, beside this script
 
 REPO = Path(__file__).resolve().parent.parent
 PAPER = REPO / "procedures" / "paper-24pos-thermal.yaml"
@@ -61,6 +61,7 @@ def campaign_only(output: Path, seed: int, in_process: bool) -> float:
 
 
 def main() -> None:
+    throwaway_registry()
     import h5py
 
 

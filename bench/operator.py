@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 import h5py
-from quiet import silence_campaign_log  # bench/quiet.py, beside this script
+from quiet import silence_campaign_log, throwaway_registry  # bench/quiet.py, beside this script
 
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.core.formatting import format_duration
@@ -73,6 +73,7 @@ def command_times(folder: Path) -> None:
 
 
 def main() -> None:
+    throwaway_registry()
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seeds", type=int, default=5)
     args = parser.parse_args()

@@ -12,3 +12,15 @@ def silence_campaign_log() -> None:
     LOGGER.setLevel(logging.WARNING)
     LOGGER.propagate = False
     LOGGER.addHandler(logging.NullHandler())
+
+
+def throwaway_registry() -> None:
+    """The dry runs a benchmark starts record their calibrations in a registry of its own, not the user's."""
+    import atexit
+    import os
+    import shutil
+    import tempfile
+
+    folder = tempfile.mkdtemp(prefix="accelcal-bench-registry-")
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)
+    os.environ["ACCELCAL_REGISTRY"] = os.path.join(folder, "registry.sqlite")

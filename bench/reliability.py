@@ -41,6 +41,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from quiet import throwaway_registry  # bench/quiet.py, beside this script
+
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import load_calibration
 from accelcal_rig.store.content import Campaign
@@ -506,6 +508,7 @@ def fault_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, in
 
 
 def main() -> None:
+    throwaway_registry()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("kind", choices=["syscalls", "crash", "diskfull", "concurrent", "signals", "faults"])
     parser.add_argument("--trials", type=int, default=20)

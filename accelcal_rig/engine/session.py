@@ -164,6 +164,7 @@ def _run(prepared: PreparedCampaign, output: Path, open_writer: Callable[[], Cam
             _stopped_before_start(writer, rig_connected, procedure, rig, exc)
         raise
     finally:
+        progress_path(output).unlink(missing_ok=True)  # a view of this run only: gone with it
         try:
             if writer is not None:
                 problems = _close(writer)

@@ -8,6 +8,8 @@ from typing import Any
 import numpy as np
 
 _SECONDS_PER_YEAR = 365.25 * 86400.0
+#: The reason of a PASS that no limits judged: not counted in a yield.
+UNJUDGED = "no acceptance limits stated"
 #: A figure further than this from its lot's median, in robust z (0.6745 · deviation / MAD), is an outlier
 #: (Iglewicz & Hoaglin, "How to Detect and Handle Outliers", 1993).
 OUTLIER_Z = 3.5
@@ -29,8 +31,10 @@ def trend(rows: list[dict[str, Any]]) -> dict[str, Any]:
             "scale_drift_ppm_per_year": _drift(years, rows, "scale_error_ppm", "scale_uncertainty_ppm")}
 
 
-def _drift(years: np.ndarray, rows: list[dict[str, Any]], key: str, uncertainty_key: str) -> list[dict[str, float]] | None:
-    """Per axis: slope ± its expanded uncertainty (k = 2), or None with fewer than two distinct times."""
+def _drift(years: np.ndarray, rows: list[dict[str, Any]], key: str,
+           uncertainty_key: str) -> list[dict[str, float | None]] | None:
+    """Per axis: slope ± its expanded uncertainty (k = 2; None where a calibration states none), or None with
+    fewer than two distinct times."""
     usable = [i for i, r in enumerate(rows) if r[key] is not None]
     if len({float(years[i]) for i in usable}) < 2:
         return None
@@ -47,7 +51,7 @@ def _drift(years: np.ndarray, rows: list[dict[str, Any]], key: str, uncertainty_
         delta = s * sxx - sx * sx
         slope = (s * sxy - sx * sy) / delta
         result.append({"per_year": float(slope), "expanded_uncertainty": float(2.0 * np.sqrt(s / delta))
-                       if all(v is not None for v in stated) else float("nan")})
+                       if all(v is not None for v in stated) else None})
     return result
 
 
@@ -58,7 +62,7 @@ def lot_statistics(rows: list[dict[str, Any]]) -> dict[str, Any]:
     for row in sorted(rows, key=lambda r: (r["calibrated_at"], r["id"])):
         newest[row["serial"]] = row
     latest = list(newest.values())
-    judged = [r for r in latest if r["verdict"] in ("PASS", "FAIL")]
+    judged = [r for r in latest if r["verdict"] in ("PASS", "FAIL") and list(r["verdict_reasons"]) != [UNJUDGED]]
     passed = sum(r["verdict"] == "PASS" for r in judged)
     figures = {"bias_mg": _per_axis(latest, "bias_mg"), "scale_error_ppm": _per_axis(latest, "scale_error_ppm"),
                "nonorthogonality_mrad": _scalar(latest, "nonorthogonality_mrad")}

@@ -1,6 +1,7 @@
-"""The registry database: opened by URL, brought to the current schema on first use (Alembic, under a lock
-so that two rigs opening it at once do not both create it), written so that concurrent writers never lose
-a record (each entry inserted on its own, a duplicate of a registered fit skipped by its unique key)."""
+"""The registry database: opened by URL, created on first use and brought to the current schema by the
+commands that record (Alembic, under a lock so that two rigs opening it at once do not both migrate it),
+written so that concurrent writers never lose a record (batches in their own transactions, a duplicate of
+a registered fit skipped by its unique key, a transaction that lost a deadlock tried again)."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from alembic import command
 from alembic.config import Config
 from alembic.runtime.migration import MigrationContext
 from alembic.script import ScriptDirectory
+from alembic.util.exc import CommandError
 from sqlalchemy.dialects import postgresql, sqlite
 from sqlalchemy.engine import Connection, Engine
 
@@ -40,6 +42,10 @@ def migration_config() -> Config:
     return config
 
 
+def known_revisions() -> set[str]:
+    return {script.revision for script in ScriptDirectory.from_config(migration_config()).walk_revisions()}
+
+
 def head_revision() -> str:
     head = ScriptDirectory.from_config(migration_config()).get_current_head()
     assert head is not None
@@ -53,16 +59,22 @@ class Registry:
 
     @classmethod
     def open(cls, url: str, upgrade: bool = True) -> Registry:
-        """Connect, and bring the schema to the current version (creating it on first use)."""
+        """Connect. A new, empty database is created at the current schema; an older one is migrated when
+        `upgrade` (the commands that record), else refused in one line (readers do not change a schema);
+        one newer than this software is refused either way."""
         engine = _engine(url)
         registry = cls(engine, url)
         for attempt in range(_OPEN_ATTEMPTS):
             try:
-                if upgrade:
+                found = registry.revision()
+                if found is not None and found not in known_revisions():
+                    raise ConfigError(f"registry {described(url)}: schema {found} is newer than this software's "
+                                      f"{head_revision()}: upgrade accelcal-rig")
+                if found is None or (upgrade and found != head_revision()):
                     registry.upgrade()
-                elif registry.revision() != head_revision():
-                    raise ConfigError(f"registry {described(url)}: schema {registry.revision()}, this software "
-                                      f"needs {head_revision()}")
+                elif found != head_revision():
+                    raise ConfigError(f"registry {described(url)}: schema {found} is older than this software's "
+                                      f"{head_revision()}: a recording command (rig registry add, rig fit) upgrades it")
                 return registry
             except sa.exc.OperationalError as exc:
                 # SQLite answers "locked" at once, busy timeout or not, to a connection switching a new file
@@ -70,6 +82,8 @@ class Registry:
                 if "locked" not in str(exc.orig) or attempt == _OPEN_ATTEMPTS - 1:
                     raise ConfigError(f"registry {described(url)}: cannot open: {exc.orig}") from None
                 time.sleep(0.05 * (attempt + 1))
+            except (sa.exc.SQLAlchemyError, CommandError) as exc:
+                raise ConfigError(f"registry {described(url)}: {str(exc).splitlines()[0]}") from None
         raise AssertionError("unreachable")
 
     def upgrade(self, revision: str = "head") -> None:
@@ -87,7 +101,7 @@ class Registry:
     def add(self, entries: Iterable[dict[str, Any]]) -> tuple[list[int], int]:
         """Record each entry; (ids of those added, how many were registered already). Entries go in batches,
         each its own transaction: a batch is all there or not at all, and one already registered is skipped."""
-        pending = list(entries)
+        pending = sorted(entries, key=lambda e: (e["source_sha256"], e["serial"], e["fit_sha256"]))  # one lock order
         added: list[int] = []
         for start in range(0, len(pending), _BATCH):
             batch = pending[start:start + _BATCH]
@@ -104,8 +118,10 @@ class Registry:
                 with self.engine.begin() as connection:
                     result = connection.execute(statement.returning(calibrations.c.id), batch)
                     return [int(row_id) for row_id in result.scalars()]
-            except sa.exc.OperationalError as exc:  # SQLite: "database is locked" past the busy timeout
-                if dialect != "sqlite" or "locked" not in str(exc.orig) or attempt == 9:
+            except sa.exc.OperationalError as exc:  # SQLite past its busy timeout; PostgreSQL a lost deadlock
+                again = ("locked" in str(exc.orig) if dialect == "sqlite"
+                         else getattr(exc.orig, "sqlstate", None) in ("40P01", "40001"))
+                if not again or attempt == 9:
                     raise
                 time.sleep(0.1 * (attempt + 1))
         raise AssertionError("unreachable")
@@ -138,12 +154,16 @@ class Registry:
             raise ConfigError(f"registry {described(self.url)}: no calibration {row_id}")
         return dict(row._mapping)
 
-    def current(self, serial: str) -> dict[str, Any] | None:
-        """The valid calibration of a serial: its newest that did not fail its acceptance limits."""
-        for row in self.calibrations(serial=serial):
-            if row["verdict"] != "FAIL":
-                return row
-        return None
+    def current(self, serial: str, simulated: bool = False) -> dict[str, Any] | None:
+        """The valid calibration of a serial: its newest measured, unless that failed its acceptance limits
+        (then none is valid: the sensor is out of tolerance now). Dry runs count only when asked."""
+        rows = [r for r in self.calibrations(serial=serial) if simulated or not r["simulated"]]
+        return rows[0] if rows and rows[0]["verdict"] != "FAIL" else None
+
+    def parts(self) -> list[str]:
+        """Every part with a calibration recorded."""
+        with self.engine.connect() as connection:
+            return sorted(connection.execute(sa.select(calibrations.c.part).distinct()).scalars())
 
     def count(self) -> int:
         with self.engine.connect() as connection:
@@ -151,17 +171,15 @@ class Registry:
 
     @contextmanager
     def _migration_lock(self) -> Iterator[Connection]:
-        """A connection holding the schema for this process alone: PostgreSQL's advisory lock, SQLite's
+        """A connection whose transaction holds the schema for this process alone: PostgreSQL's
+        transaction-level advisory lock (released with the transaction, whatever happens in it), SQLite's
         write lock (BEGIN IMMEDIATE)."""
         with self.engine.connect() as connection:
             if self.engine.dialect.name == "postgresql":
-                connection.execute(sa.text("SELECT pg_advisory_lock(:key)"), {"key": _MIGRATION_LOCK})
-                try:
+                with connection.begin():
+                    connection.execute(sa.text("SET LOCAL lock_timeout = '120s'"))
+                    connection.execute(sa.text("SELECT pg_advisory_xact_lock(:key)"), {"key": _MIGRATION_LOCK})
                     yield connection
-                    connection.commit()
-                finally:
-                    connection.execute(sa.text("SELECT pg_advisory_unlock(:key)"), {"key": _MIGRATION_LOCK})
-                    connection.commit()
             else:
                 connection.info["begin"] = "BEGIN IMMEDIATE"  # see _engine's begin hook
                 try:

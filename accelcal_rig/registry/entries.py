@@ -1,5 +1,7 @@
 """A registry entry per DUT of a finished fit: who (serial, part), what (the fit, its validity, verdict and
-figures), from what (the source file and its SHA-256, procedure, rig, software) and when."""
+figures), from what (the source file and its SHA-256, procedure, rig, software) and when: `calibrated_at`
+is when the sensor was measured (the campaign's end, a recording's time), `fitted_at` when the fit was made
+(a refit of an old campaign is not a newer calibration)."""
 
 from __future__ import annotations
 
@@ -12,6 +14,7 @@ from typing import Any
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import CalibrationFile, SensorCalibration, load_calibration
 from accelcal_rig.registry.figures import reference_figures
+from accelcal_rig.store.content import measurements_sha256
 from accelcal_rig.store.read import load_campaign
 
 #: Campaign states whose fit is final: a running campaign's file is still being written.
@@ -37,17 +40,22 @@ def campaign_entries(campaign_path: Path, calibration_path: Path | None = None) 
     if campaign.state not in FINISHED_STATES:
         raise ConfigError(f"{campaign_path}: campaign is {campaign.state}, not finished: register it when it ends")
     calibration = load_calibration(calibration_path)
+    if calibration.source.get("measurements_sha256") != measurements_sha256(campaign):
+        raise ConfigError(f"{calibration_path}: fitted to other measurements than {campaign_path} holds (its "
+                          f"measurements_sha256 differs): fit this campaign (rig fit {campaign_path} -o CAL)")
     parts = {str(d["serial"]): str(d.get("part", "unknown")) for d in campaign.header.duts}
     source = {"kind": "campaign", "path": str(campaign_path.resolve()), "sha256": file_sha256(campaign_path),
               "procedure": str(campaign.attrs.get("procedure_name", "")), "rig": str(campaign.attrs.get("rig_name", "")),
-              "simulated": bool(campaign.attrs.get("dry_run", False))}
+              "simulated": bool(campaign.attrs.get("dry_run", False)),
+              "measured": campaign.finished or campaign.header.created}
     return [_entry(calibration, sensor, parts.get(serial, "unknown"), source) for serial, sensor in calibration.sensors.items()]
 
 
 def recording_entries(recording_path: Path, calibration: CalibrationFile, part: str) -> list[dict[str, Any]]:
     """The entry of a hand-held fit: its recording is the source."""
+    measured = datetime.fromtimestamp(recording_path.stat().st_mtime, UTC).isoformat()  # when it was recorded
     source = {"kind": "recording", "path": str(recording_path.resolve()), "sha256": file_sha256(recording_path),
-              "procedure": "hand-held", "rig": "hand-held", "simulated": False}
+              "procedure": "hand-held", "rig": "hand-held", "simulated": False, "measured": measured}
     return [_entry(calibration, sensor, part, source) for sensor in calibration.sensors.values()]
 
 
@@ -63,8 +71,8 @@ def _entry(calibration: CalibrationFile, sensor: SensorCalibration, part: str, s
         "source_sha256": source["sha256"],
         "fit_sha256": hashlib.sha256(json.dumps(stored["sensor"], sort_keys=True).encode()).hexdigest(),
         "procedure": source["procedure"], "rig": source["rig"], "simulated": source["simulated"],
-        "software_version": calibration.software_version, "calibrated_at": _utc(calibration.created),
-        "registered_at": datetime.now(UTC).replace(tzinfo=None),
+        "software_version": calibration.software_version, "calibrated_at": _utc(source["measured"]),
+        "fitted_at": _utc(calibration.created), "registered_at": datetime.now(UTC).replace(tzinfo=None),
         "valid_from_c": float(sensor.validity_c[0]), "valid_to_c": float(sensor.validity_c[1]),
         "verdict": sensor.verdict, "verdict_reasons": list(sensor.verdict_reasons),
         "verification_rmse_mg": float(rmse) if rmse is not None else None,

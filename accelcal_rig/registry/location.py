@@ -4,6 +4,7 @@ environment variable, else an SQLite file in the user's data folder (created on 
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 from accelcal_rig.errors import ConfigError
@@ -42,7 +43,8 @@ def normalised(url: str) -> str:
 
 
 def described(url: str) -> str:
-    """The URL as messages show it: without a password."""
+    """The URL as messages show it: without a password (in its user part or its query)."""
+    url = re.sub(r"([?&]password=)[^&]*", r"\1***", url)
     scheme, _, rest = url.partition("://")
     if "@" in rest:
         credentials, _, where = rest.rpartition("@")

@@ -22,7 +22,7 @@ calibrations = sa.Table(
     sa.Column("rig", sa.String(128), nullable=False),
     sa.Column("simulated", sa.Boolean, nullable=False),
     sa.Column("software_version", sa.String(64), nullable=False),
-    sa.Column("calibrated_at", sa.DateTime, nullable=False, index=True),   # UTC
+    sa.Column("calibrated_at", sa.DateTime, nullable=False, index=True),   # UTC: when the sensor was measured
     sa.Column("registered_at", sa.DateTime, nullable=False),               # UTC
     sa.Column("valid_from_c", sa.Float, nullable=False),
     sa.Column("valid_to_c", sa.Float, nullable=False),
@@ -30,7 +30,9 @@ calibrations = sa.Table(
     sa.Column("verdict_reasons", sa.JSON, nullable=False),
     sa.Column("verification_rmse_mg", sa.Float, nullable=True),
     sa.Column("calibration", sa.JSON, nullable=False),                      # the whole fit, to export again
-    # Added by migration 0002: the figures queried across calibrations, at the reference temperature.
+    # Added by migration 0002: when the fit was made, and the figures queried across calibrations, at the
+    # reference temperature.
+    sa.Column("fitted_at", sa.DateTime, nullable=True),                     # UTC
     sa.Column("reference_c", sa.Float, nullable=True),
     sa.Column("bias_mg", sa.JSON, nullable=True),                           # [x, y, z]
     sa.Column("bias_uncertainty_mg", sa.JSON, nullable=True),               # [x, y, z], k = 2

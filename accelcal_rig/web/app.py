@@ -8,11 +8,13 @@ from __future__ import annotations
 import hmac
 from pathlib import Path
 from typing import Any
+from urllib.parse import quote
 
 from jinja2 import Environment, PackageLoader, select_autoescape
 from starlette.applications import Starlette
 from starlette.middleware import Middleware
 from starlette.middleware.base import BaseHTTPMiddleware, RequestResponseEndpoint
+from starlette.middleware.trustedhost import TrustedHostMiddleware
 from starlette.requests import Request
 from starlette.responses import FileResponse, HTMLResponse, JSONResponse, PlainTextResponse, RedirectResponse, Response
 from starlette.routing import Mount, Route
@@ -31,22 +33,31 @@ _TOKEN_COOKIE = "accelcal_token"
 class _TokenRequired(BaseHTTPMiddleware):
     """Every request carries the token: `?token=` once (then a cookie), the cookie, or `Authorization: Bearer`."""
 
-    def __init__(self, app: Any, token: str) -> None:
+    def __init__(self, app: Any, token: str, secure: bool) -> None:
         super().__init__(app)
-        self._token = token
+        self._token = token.encode()
+        self._secure = secure
 
     async def dispatch(self, request: Request, call_next: RequestResponseEndpoint) -> Response:
         given = (request.query_params.get("token") or request.cookies.get(_TOKEN_COOKIE)
                  or request.headers.get("authorization", "").removeprefix("Bearer ").strip())
-        if not given or not hmac.compare_digest(given, self._token):
+        if not given or not hmac.compare_digest(given.encode(), self._token):  # bytes: any text compares
             return PlainTextResponse("a token is needed: open the address rig serve printed", status_code=401)
         response = await call_next(request)
         if request.query_params.get("token"):
-            response.set_cookie(_TOKEN_COOKIE, self._token, httponly=True, samesite="strict")
+            response.set_cookie(_TOKEN_COOKIE, self._token.decode(), httponly=True, samesite="strict",
+                                secure=self._secure)
         return response
 
 
-def create_app(campaign_folders: list[Path], registry_url: str | None, token: str | None = None) -> Starlette:
+#: Without a token, only these Host names are answered: a page elsewhere cannot reach the dashboard by
+#: pointing a name of its own at 127.0.0.1 (DNS rebinding).
+LOOPBACK_HOSTS = ["127.0.0.1", "localhost", "::1", "[::1]"]
+
+
+def create_app(campaign_folders: list[Path], registry_url: str | None, token: str | None = None,
+               tls: bool = False, hosts: list[str] | None = None) -> Starlette:
+    """`hosts`: the Host names answered without a token (default LOOPBACK_HOSTS); with a token, any."""
     campaigns = CampaignFolders(campaign_folders)
     registry = _LazyRegistry(registry_url)
     templates = Environment(loader=PackageLoader("accelcal_rig.web", "templates"),
@@ -55,13 +66,13 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
     def page(name: str, **values: Any) -> HTMLResponse:
         return HTMLResponse(templates.get_template(name).render(registry=registry.label, **values))
 
-    async def front(request: Request) -> Response:
+    def front(request: Request) -> Response:
         return page("front.html", campaigns=campaigns.summaries(), folders=campaigns.folders)
 
-    async def campaigns_json(request: Request) -> Response:
+    def campaigns_json(request: Request) -> Response:
         return JSONResponse(campaigns.summaries())
 
-    async def campaign(request: Request) -> Response:
+    def campaign(request: Request) -> Response:
         name = request.path_params["name"]
         try:
             summary, series = campaigns.summary(name), campaigns.series(name)
@@ -74,13 +85,13 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
         return page("campaign.html", c=summary, plot=plot, certificates=_certificates(path),
                     report=_report(path))
 
-    async def campaign_json(request: Request) -> Response:
+    def campaign_json(request: Request) -> Response:
         try:
             return JSONResponse(campaigns.summary(request.path_params["name"]))
         except KeyError:
             return JSONResponse({"error": "no such campaign"}, status_code=404)
 
-    async def campaign_file(request: Request) -> Response:
+    def campaign_file(request: Request) -> Response:
         """A certificate or a report file beside a watched campaign; nothing outside its folders."""
         try:
             path = campaigns.path(request.path_params["name"])
@@ -95,43 +106,50 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
             return PlainTextResponse("no such file", status_code=404)
         return FileResponse(wanted)
 
-    async def registry_search(request: Request) -> Response:
+    def registry_search(request: Request) -> Response:
         serial = request.query_params.get("serial", "").strip()
         if serial:
-            return RedirectResponse(f"/registry/serials/{serial}", status_code=303)
-        rows = registry.get().calibrations(limit=50)
-        parts = sorted({r["part"] for r in rows})
+            return RedirectResponse(f"/registry/serials/{quote(serial, safe='')}", status_code=303)
+        reg = registry.get()
+        rows = reg.calibrations(limit=50)
+        parts = reg.parts()
         return page("registry.html", rows=rows, parts=parts)
 
-    async def serial_page(request: Request) -> Response:
+    def serial_page(request: Request) -> Response:
         serial = request.path_params["serial"]
         reg = registry.get()
-        rows = reg.calibrations(serial=serial)
-        if not rows:
+        every = reg.calibrations(serial=serial)
+        if not every:
             return page("registry.html", rows=[], parts=[], missing=serial)
+        real = [r for r in every if not r["simulated"]]
+        rows = real or every  # a serial only dry runs know is shown as such, marked simulated
         result = trend(rows)
         points = result["calibrations"]
         times = [(r["calibrated_at"] - rows[-1]["calibrated_at"]).total_seconds() / 86400.0 for r in reversed(rows)]
         plot = line_plot(times, {f"bias {axis}": [p["bias_mg"][k] for p in points] for k, axis in enumerate("xyz")},
                          "days since the first calibration", "bias at the reference temperature (mg)")
-        return page("serial.html", serial=serial, rows=rows, current=reg.current(serial), trend=result, plot=plot)
+        return page("serial.html", serial=serial, rows=every, current=reg.current(serial, simulated=not real),
+                    trend=result, plot=plot, only_simulated=not real)
 
-    async def part_page(request: Request) -> Response:
+    def part_page(request: Request) -> Response:
         part = request.path_params["part"]
-        rows = registry.get().calibrations(part=part)
-        return page("part.html", part=part, stats=lot_statistics(rows) if rows else None)
+        every = registry.get().calibrations(part=part)
+        real = [r for r in every if not r["simulated"]]
+        rows = real or every
+        return page("part.html", part=part, stats=lot_statistics(rows) if rows else None, only_simulated=not real)
 
-    async def serial_json(request: Request) -> Response:
+    def serial_json(request: Request) -> Response:
         rows = registry.get().calibrations(serial=request.path_params["serial"])
         return JSONResponse(_jsonable(trend(rows)) if rows else {"calibrations": []})
 
-    middleware = [Middleware(_TokenRequired, token=token)] if token else []
+    middleware = ([Middleware(_TokenRequired, token=token, secure=tls)] if token
+                  else [Middleware(TrustedHostMiddleware, allowed_hosts=hosts or LOOPBACK_HOSTS)])
     return Starlette(routes=[
         Route("/", front), Route("/api/campaigns", campaigns_json),
         Route("/campaigns/{name}", campaign), Route("/api/campaigns/{name}", campaign_json),
         Route("/campaigns/{name}/{kind}/{file:path}", campaign_file),
-        Route("/registry", registry_search), Route("/registry/serials/{serial}", serial_page),
-        Route("/registry/parts/{part}", part_page), Route("/api/registry/serials/{serial}", serial_json),
+        Route("/registry", registry_search), Route("/registry/serials/{serial:path}", serial_page),
+        Route("/registry/parts/{part}", part_page), Route("/api/registry/serials/{serial:path}", serial_json),
         Mount("/static", StaticFiles(directory=_STATIC), name="static"),
     ], middleware=middleware)
 
@@ -148,7 +166,7 @@ class _LazyRegistry:
         if self._registry is None:
             if self.url is None:
                 raise RuntimeError("no registry")
-            self._registry = Registry.open(self.url)
+            self._registry = Registry.open(self.url, upgrade=False)  # a view changes no schema
         return self._registry
 
 

@@ -3,6 +3,7 @@ lock), each read again only when its files change."""
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -18,7 +19,7 @@ _JOURNAL_SUFFIX = ".journal"
 
 @dataclass
 class _Cached:
-    stamp: tuple[float, ...]
+    stamp: tuple[tuple[int, int], ...]
     summary: dict[str, Any]
     series: dict[str, list[float]]
 
@@ -27,6 +28,7 @@ class CampaignFolders:
     def __init__(self, folders: list[Path]) -> None:
         self.folders = [folder.resolve() for folder in folders]
         self._cache: dict[Path, _Cached] = {}
+        self._lock = threading.Lock()  # requests are answered on several threads
 
     def paths(self) -> dict[str, Path]:
         """Every campaign file (or journal of one not built yet) in the folders, by its name."""
@@ -39,14 +41,15 @@ class CampaignFolders:
 
     def summaries(self) -> list[dict[str, Any]]:
         """Newest first; a file that cannot be read is listed with its error, not dropped."""
-        rows = [self.summary(name) for name in self.paths()]
+        paths = self.paths()  # the folders looked through once per request
+        rows = [self._read(path, name).summary for name, path in paths.items()]
         return sorted(rows, key=lambda r: r.get("started") or "", reverse=True)
 
     def summary(self, name: str) -> dict[str, Any]:
-        return self._read(name).summary
+        return self._read(self.path(name), name).summary
 
     def series(self, name: str) -> dict[str, list[float]]:
-        return self._read(name).series
+        return self._read(self.path(name), name).series
 
     def path(self, name: str) -> Path:
         paths = self.paths()
@@ -54,10 +57,10 @@ class CampaignFolders:
             raise KeyError(name)
         return paths[name]
 
-    def _read(self, name: str) -> _Cached:
-        path = self.path(name)
+    def _read(self, path: Path, name: str) -> _Cached:
         stamp = tuple(_stamp(p) for p in (path, journal_path(path), progress_path(path)))
-        cached = self._cache.get(path)
+        with self._lock:
+            cached = self._cache.get(path)
         if cached is not None and cached.stamp == stamp:
             return cached
         try:
@@ -72,16 +75,18 @@ class CampaignFolders:
         except Exception as exc:  # noqa: BLE001 - a damaged file is shown as such, the others still are
             summary, series = {"name": name, "file": str(path), "state": "unreadable", "error": str(exc)}, {}
         cached = _Cached(stamp, summary, series)
-        self._cache[path] = cached
+        with self._lock:
+            self._cache[path] = cached
         return cached
 
 
-def _stamp(path: Path) -> float:
+def _stamp(path: Path) -> tuple[int, int]:
+    """(modification time, size): a file that changed differs in one or the other."""
     try:
         status = path.stat()
     except OSError:
-        return -1.0
-    return status.st_mtime_ns + status.st_size * 1e-3
+        return (-1, -1)
+    return (status.st_mtime_ns, status.st_size)
 
 
 def _temperatures(campaign: Any) -> dict[str, list[float]]:

@@ -14,7 +14,8 @@ from accelcal_rig.registry.analysis import lot_statistics, trend
 def row(k: int, serial: str, days: float, bias: list[float], scale: list[float], verdict: str | None = "PASS",
         u_bias: list[float] | None = None, nonorth: float = 0.5) -> dict:
     return {"id": k, "serial": serial, "calibrated_at": datetime(2025, 1, 1) + timedelta(days=days),
-            "verdict": verdict, "reference_c": 25.0, "bias_mg": bias, "bias_uncertainty_mg": u_bias,
+            "verdict": verdict, "verdict_reasons": ["within the procedure's acceptance limits"],
+            "reference_c": 25.0, "bias_mg": bias, "bias_uncertainty_mg": u_bias,
             "scale_error_ppm": scale, "scale_uncertainty_ppm": [40.0, 40.0, 40.0], "nonorthogonality_mrad": nonorth}
 
 
@@ -31,6 +32,22 @@ def test_a_planted_drift_is_recovered_with_the_weighted_least_squares_uncertaint
     assert result["scale_drift_ppm_per_year"][0]["per_year"] == pytest.approx(-50.0)
     assert [p["calibrated_at"][:10] for p in result["calibrations"]] == ["2025-01-01", "2025-07-02", "2026-01-01",
                                                                           "2027-01-01"]
+
+
+def test_a_calibration_without_stated_uncertainty_has_a_drift_but_no_uncertainty_in_valid_json() -> None:
+    import json
+
+    rows = [row(k, "S", 365.25 * k, [0.1 * k, 0.0, 0.0], [0.0, 0.0, 0.0], u_bias=None) for k in range(3)]
+    drift = trend(rows)["bias_drift_mg_per_year"]
+    assert drift[0]["per_year"] == pytest.approx(0.1) and drift[0]["expanded_uncertainty"] is None
+    json.loads(json.dumps(trend(rows), default=str), parse_constant=lambda c: pytest.fail(f"not JSON: {c}"))
+
+
+def test_a_pass_no_limits_judged_is_not_in_the_yield() -> None:
+    rows = [row(1, "A", 0, [0, 0, 0], [0, 0, 0]), row(2, "B", 0, [0, 0, 0], [0, 0, 0]) | {
+        "verdict_reasons": ["no acceptance limits stated"]}]
+    result = lot_statistics(rows)
+    assert result["judged"] == 1 and result["passed"] == 1 and result["sensors"] == 2
 
 
 def test_one_calibration_has_no_drift_to_state() -> None:

@@ -43,20 +43,27 @@ def test_list_show_trend_stats_and_export(tmp_path: Path, capsys) -> None:
     assert len(listed) == 2 and all(r["serial"] == "ADX355-A002" and r["part"] == "adxl355" for r in listed)
     assert all(r["calibrated_at"].endswith("Z") and "calibration" not in r for r in listed)
     assert rig("registry", "show", "ADX355-A002", "--registry", registry) == 0
+    shown = capsys.readouterr().out  # dry runs are rehearsals: no valid calibration unless asked for
+    assert shown.startswith("ADX355-A002: no valid calibration (only dry runs (simulated) are recorded")
+    assert rig("registry", "show", "ADX355-A002", "--simulated", "--registry", registry) == 0
     shown = capsys.readouterr().out
-    assert shown.startswith("ADX355-A002 (adxl355): valid calibration") and "history (2):" in shown
-    assert rig("registry", "trend", "ADX355-A002", "--json", "--registry", registry) == 0
+    assert shown.startswith("ADX355-A002 (adxl355): valid calibration") and "(SIMULATED: a dry run)" in shown
+    assert "history (2):" in shown
+    assert rig("registry", "trend", "ADX355-A002", "--json", "--simulated", "--registry", registry) == 0
     assert len(json.loads(capsys.readouterr().out)["calibrations"]) == 2
-    assert rig("registry", "stats", "--part", "adxl355", "--json", "--registry", registry) == 0
+    assert rig("registry", "stats", "--part", "adxl355", "--json", "--simulated", "--registry", registry) == 0
     stats = json.loads(capsys.readouterr().out)
     assert stats["sensors"] == 4 and stats["calibrations"] == 8
     header = tmp_path / "accel.h"
-    assert rig("registry", "export", "ADX355-A002", "--format", "c-header", "-o", header, "--registry", registry) == 0
+    assert rig("registry", "export", "ADX355-A002", "--format", "c-header", "-o", header, "--registry", registry) == 2
+    assert "no valid calibration in the registry (dry runs are left out" in capsys.readouterr().err
+    assert rig("registry", "export", "ADX355-A002", "--format", "c-header", "-o", header, "--simulated",
+               "--registry", registry) == 0
     assert "ADX355-A002" in header.read_text() and "accelcal_apply" in header.read_text()
     capsys.readouterr()
     params = tmp_path / "px4.params"
     assert rig("registry", "export", "ADX355-A002", "--format", "px4-params", "--device-id", "1310988",
-               "-o", params, "--registry", registry) == 0
+               "-o", params, "--simulated", "--registry", registry) == 0
     assert "TC_A0_X0_0" in params.read_text() and "TC_A0_ID\t1310988" in params.read_text()
     assert "rig: warning:" in capsys.readouterr().err  # what PX4 cannot hold (scale, cross-axis) is said
 
@@ -97,7 +104,8 @@ def test_hand_held_fits_are_recorded_with_their_part(tmp_path: Path, capsys) -> 
 @pytest.mark.parametrize(("argv", "message"), [
     (["registry", "show", "NOBODY"], "serial NOBODY: no calibration in the registry"),
     (["registry", "list", "--since", "yesterday"], "--since 'yesterday': not a date (YYYY-MM-DD)"),
-    (["registry", "stats", "--part", "nothing"], "part nothing: no calibration in the registry"),
+    (["registry", "stats", "--part", "nothing"], "part nothing: no calibration in the registry (dry runs are left "
+                                                 "out: --simulated includes them)"),
     (["registry", "list", "--registry", "mysql://lab/x"], "registry 'mysql://lab/x': not an SQLite path or file, nor a "
                                                           "postgresql:// URL"),
 ])

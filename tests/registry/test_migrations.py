@@ -11,7 +11,7 @@ from accelcal_rig.registry.entries import campaign_entries
 from accelcal_rig.registry.figures import reference_figures
 from tests.registry.conftest import synthetic_entries
 
-_ADDED_BY_0002 = ("reference_c", "bias_mg", "bias_uncertainty_mg", "scale_error_ppm", "scale_uncertainty_ppm",
+_ADDED_BY_0002 = ("fitted_at", "reference_c", "bias_mg", "bias_uncertainty_mg", "scale_error_ppm", "scale_uncertainty_ppm",
                   "nonorthogonality_mrad")
 
 
@@ -38,6 +38,7 @@ def test_a_first_version_database_upgrades_with_its_records_and_their_figures(re
         assert row["bias_mg"] == pytest.approx(expected["bias_mg"])
         assert row["scale_error_ppm"] == pytest.approx(expected["scale_error_ppm"])
         assert row["bias_uncertainty_mg"] == pytest.approx(expected["bias_uncertainty_mg"])
+        assert row["fitted_at"] is not None and row["fitted_at"].tzinfo is None
 
 
 def _engine_of(url: str) -> sa.Engine:

@@ -30,7 +30,7 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
 
 def test_the_front_page_lists_the_campaign_and_its_duts(lab) -> None:
     folder, registry = lab
-    client = TestClient(create_app([folder], registry))
+    client = TestClient(base_url="http://127.0.0.1", app=create_app([folder], registry))
     page = client.get("/")
     assert page.status_code == 200 and 'data-name="quick.h5"' in page.text
     assert "ADX355-A001, ADX355-A002, ADX355-A003, ADX355-A004" in page.text and "12/12" in page.text
@@ -42,19 +42,19 @@ def test_the_front_page_lists_the_campaign_and_its_duts(lab) -> None:
 
 def test_a_campaign_page_has_its_plot_warnings_and_certificates(lab) -> None:
     folder, registry = lab
-    client = TestClient(create_app([folder], registry))
+    client = TestClient(base_url="http://127.0.0.1", app=create_app([folder], registry))
     page = client.get("/campaigns/quick.h5")
     assert page.status_code == 200 and "<svg" in page.text and "chamber air" in page.text
     assert "ADX355-A001.html" in page.text
     certificate = client.get("/campaigns/quick.h5/certificates/ADX355-A001.html")
     assert certificate.status_code == 200 and "ADX355-A001" in certificate.text
-    assert client.get("/campaigns/quick.h5/certificates/..%2F..%2Fquick.h5.journal").status_code == 404
+    assert client.get("/campaigns/quick.h5/certificates/..%2Fquick.h5.journal").status_code == 404  # exists, outside
     assert client.get("/campaigns/nothing.h5").status_code == 404
 
 
 def test_the_registry_by_serial_and_by_part(lab) -> None:
     folder, registry = lab
-    client = TestClient(create_app([folder], registry))
+    client = TestClient(base_url="http://127.0.0.1", app=create_app([folder], registry))
     search = client.get("/registry", params={"serial": "ADX355-A003"}, follow_redirects=False)
     assert search.status_code == 303 and search.headers["location"] == "/registry/serials/ADX355-A003"
     page = client.get("/registry/serials/ADX355-A003")
@@ -67,12 +67,12 @@ def test_the_registry_by_serial_and_by_part(lab) -> None:
 
 def test_with_a_token_nothing_is_served_without_it(lab) -> None:
     folder, registry = lab
-    client = TestClient(create_app([folder], registry, token="s3cret"))
+    client = TestClient(base_url="http://127.0.0.1", app=create_app([folder], registry, token="s3cret"))
     assert client.get("/").status_code == 401 and client.get("/api/campaigns").status_code == 401
     assert client.get("/", params={"token": "wrong"}).status_code == 401
     assert client.get("/", params={"token": "s3cret"}).status_code == 200  # and a cookie from now on
     assert client.get("/api/campaigns").status_code == 200
-    bearer = TestClient(create_app([folder], registry, token="s3cret"))
+    bearer = TestClient(base_url="http://127.0.0.1", app=create_app([folder], registry, token="s3cret"))
     assert bearer.get("/api/campaigns", headers={"Authorization": "Bearer s3cret"}).status_code == 200
 
 
@@ -80,10 +80,27 @@ def test_a_damaged_campaign_file_is_listed_as_such(lab, tmp_path: Path) -> None:
     folder, registry = lab
     shutil.copy(folder / "quick.h5", tmp_path / "good.h5")
     (tmp_path / "broken.h5").write_bytes(b"not a campaign")
-    rows = {r["name"]: r for r in TestClient(create_app([tmp_path], registry)).get("/api/campaigns").json()}
+    rows = {r["name"]: r for r in TestClient(base_url="http://127.0.0.1", app=create_app([tmp_path], registry)).get("/api/campaigns").json()}
     assert rows["good.h5"]["state"] == "done"
     assert rows["broken.h5"]["state"] == "unreadable" and rows["broken.h5"]["error"]
     assert Registry.open(registry).count() == 4  # reading campaigns leaves the registry as it was
+
+
+def test_without_a_token_only_loopback_names_are_answered(lab) -> None:
+    """A page elsewhere pointing a name of its own at 127.0.0.1 (DNS rebinding) gets nothing."""
+    folder, registry = lab
+    client = TestClient(base_url="http://evil.example", app=create_app([folder], registry))
+    assert client.get("/api/campaigns").status_code == 400
+
+
+def test_a_token_of_any_text_is_compared_and_a_serial_of_any_text_is_a_path(lab) -> None:
+    folder, registry = lab
+    client = TestClient(base_url="http://127.0.0.1", app=create_app([folder], registry, token="s3cret"))
+    assert client.get("/", params={"token": "é"}).status_code == 401  # not a crash
+    client.get("/", params={"token": "s3cret"})
+    redirect = client.get("/registry", params={"serial": "S/N#1"}, follow_redirects=False)
+    assert redirect.headers["location"] == "/registry/serials/S%2FN%231"
+    assert "no calibration of S/N#1" in client.get(redirect.headers["location"]).text
 
 
 def test_rig_serve_refuses_an_open_address_without_a_token(capsys) -> None:
