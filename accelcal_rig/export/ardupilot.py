@@ -11,6 +11,7 @@ from __future__ import annotations
 from accelcal_rig import __version__
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.export.flight_stack import (
+    AXES_NOTE,
     STACK_DEGREE,
     OffsetCubic,
     ParamsExport,
@@ -79,4 +80,4 @@ def _notes(sensor: SensorCalibration, cubic: OffsetCubic, n: int) -> list[str]:
             f"the offset itself is not in the file (at {at_c:.2f} degC it is {mg(offset_at(cubic, at_c))} mg):"
             f" ArduPilot's cubic has no constant and removes only the change since T_cal; its accelerometer "
             f"calibration holds the offset ({_offsets_name(n)}, at the T_cal it records in INS_ACC{n}_CALTEMP): "
-            "run it after loading this file"]
+            "run it after loading this file", AXES_NOTE]

@@ -28,6 +28,12 @@ _GRID_POINTS = 401
 _DIGITS = 9
 
 
+#: The exported axes are the sensor's own; a stack applies its terms in the axes its driver publishes.
+AXES_NOTE = ("the coefficients are in the sensor chip's own x, y, z: where the flight controller's driver "
+             "publishes the accelerometer rotated (board orientation, a rotated mounting), permute and re-sign "
+             "the _0/_1/_2 (PX4) or _X/_Y/_Z (ArduPilot) terms to those axes before loading")
+
+
 @dataclass(frozen=True)
 class StackOptions:
     """`rig export`'s choices for a flight-stack export; None where the user left the default."""

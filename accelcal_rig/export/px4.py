@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from accelcal_rig import __version__
 from accelcal_rig.export.flight_stack import (
+    AXES_NOTE,
     STACK_DEGREE,
     OffsetCubic,
     ParamsExport,
@@ -80,7 +81,8 @@ def _notes(sensor: SensorCalibration, cubic: OffsetCubic, n: int, device_id: int
              f"TC_A{n}_X0_ holds the offset at TREF = {cubic.t_ref_c:.2f} degC ({mg(cubic.coefficients_m_s2[:, 0])} mg):"
              " the CAL_ACC offsets PX4 subtracts after it must not hold it again",
              f"PX4 renews the offset only after the temperature moved more than {_REPUBLISH_STEP_C:g} degC: up to "
-             f"{steepest_slope_mg_per_c(cubic) * _REPUBLISH_STEP_C:.4f} mg at this sensor's steepest bias slope"]
+             f"{steepest_slope_mg_per_c(cubic) * _REPUBLISH_STEP_C:.4f} mg at this sensor's steepest bias slope",
+             AXES_NOTE]
     if device_id == 0:
         notes.append(f"TC_A{n}_ID is 0, which names no accelerometer: PX4 compensates only the one whose device id "
                      "it holds; pass --device-id (that accelerometer's CAL_ACC<k>_ID) or set it before loading")
