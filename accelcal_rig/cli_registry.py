@@ -127,8 +127,7 @@ def _trend(args: argparse.Namespace) -> int:
         if drift is None:
             print(f"  {what} drift: needs two calibrations at different times")
         else:
-            print(f"  {what} drift per year: " + ", ".join(f"{axis} {d['per_year']:+.4g} ± {d['expanded_uncertainty']:.2g} {unit}"
-                                                         for axis, d in zip("xyz", drift)))
+            print(f"  {what} drift per year: " + ", ".join(f"{axis} {_drift_text(d, unit)}" for axis, d in zip("xyz", drift)))
     return 0
 
 
@@ -176,6 +175,13 @@ def _export(args: argparse.Namespace) -> int:
     exported = export(calibration_file_of(row), args.format,
                       StackOptions(Path(f"registry calibration {row['id']}"), None, args.instance, args.device_id))
     return write_export(exported, args.format, args.output)
+
+
+def _drift_text(drift: dict[str, float | None], unit: str) -> str:
+    """`+0.12 ± 0.03 mg`; without stated uncertainties (hand-held fits) the slope alone, said so."""
+    uncertainty = drift["expanded_uncertainty"]
+    spread = f" ± {uncertainty:.2g}" if uncertainty is not None else " (uncertainty not stated)"
+    return f"{drift['per_year']:+.4g}{spread} {unit}"
 
 
 def _real_unless(args: argparse.Namespace, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 from accelcal_rig.cli import main
@@ -51,8 +52,10 @@ def test_watch_follows_a_running_campaign_to_its_end(tmp_path: Path) -> None:
                             "-q", "--no-pdf", "--faults", "rate=1,kinds=delay,delay_s=0.005"],
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
+        deadline = time.monotonic() + 60
         while not campaign.with_name("live.h5.journal").exists():
-            assert run.poll() is None
+            assert run.poll() is None and time.monotonic() < deadline, "the campaign never started"
+            time.sleep(0.05)
         watched = subprocess.run([RIG, "status", str(campaign), "--watch", "0.5", "--json"], capture_output=True,
                                  text=True, timeout=300)
     finally:

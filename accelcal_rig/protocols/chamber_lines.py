@@ -17,12 +17,12 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 
 from accelcal_rig.protocols.line_templates import (
     NUMBER,
+    TemplateCommand,
     decimals_of,
     fields_of,
     regular_expression,
     request_pattern,
     round_trips,
-    template,
 )
 
 #: What a request may name (the set point it writes), with a sample value.
@@ -36,24 +36,9 @@ Operation = Literal["identify", "read_temperature", "read_setpoint", "write_setp
                     "purge_off"]
 
 
-class LineCommand(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-    send: str = Field(min_length=1, max_length=256)
-    reply: str | None = Field(None, min_length=1, max_length=256, description="regular expression a good reply "
-                              "matches in full; none: the controller does not answer this command")
-    answer: str | None = Field(None, min_length=1, max_length=256, description="what a controller answers "
-                               "(template), for simulators")
-
-    _compiles = field_validator("reply")(classmethod(lambda cls, v: v if v is None else regular_expression(v)))
-    _sends = field_validator("send")(classmethod(lambda cls, v: template(v, _SEND_SAMPLE)))
-    _answers = field_validator("answer")(classmethod(lambda cls, v: v if v is None else template(v, _ANSWER_SAMPLE)))
-
-    @model_validator(mode="after")
-    def _answered_if_replied(self) -> LineCommand:
-        if (self.reply is None) != (self.answer is None):
-            raise ValueError("a command has both a reply pattern and an answer, or neither")
-        return self
+class LineCommand(TemplateCommand):
+    send_fields = _SEND_SAMPLE
+    answer_fields = _ANSWER_SAMPLE
 
 
 class ChamberLineProtocol(BaseModel):

@@ -6,6 +6,9 @@ from __future__ import annotations
 import re
 import string
 from collections.abc import Mapping
+from typing import Any, ClassVar
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 #: A decimal number as controllers print them (sign, decimals, exponent optional).
 NUMBER = r"[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?"
@@ -65,3 +68,45 @@ def request_pattern(send: str) -> re.Pattern[str]:
             pattern += rf"(?P={field})" if field in seen else rf"(?P<{field}>\S+?)"
             seen.add(field)
     return re.compile(pattern)
+
+
+class TemplateCommand(BaseModel):
+    """One operation of a line protocol: what to send, the reply a good answer matches (none: the controller
+    does not answer it), and what a controller answers, for the simulator made from the profile. A
+    protocol family names the fields its requests and its answers may carry (class variables, with
+    sample values that every template must format with)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    send_fields: ClassVar[dict[str, Any]] = {}
+    answer_fields: ClassVar[dict[str, Any]] = {}
+
+    send: str = Field(min_length=1, max_length=256)
+    reply: str | None = Field(None, min_length=1, max_length=256, description="regular expression a good reply "
+                              "matches in full; none: the controller does not answer this command")
+    answer: str | None = Field(None, min_length=1, max_length=256, description="what a controller answers "
+                               "(template), for simulators")
+
+    @field_validator("reply")
+    @classmethod
+    def _compiles(cls, value: str | None) -> str | None:
+        return value if value is None else regular_expression(value)
+
+    @field_validator("send")
+    @classmethod
+    def _fills(cls, value: str) -> str:
+        return template(value, cls.send_fields)
+
+    @field_validator("answer")
+    @classmethod
+    def _answers(cls, value: str | None) -> str | None:
+        return value if value is None else template(value, {**cls.send_fields, **cls.answer_fields})
+
+    @model_validator(mode="after")
+    def _answered_if_replied(self) -> TemplateCommand:
+        if (self.reply is None) != (self.answer is None):
+            raise ValueError("a command has both a reply pattern and an answer, or neither")
+        return self
+
+    def request_pattern(self) -> re.Pattern[str]:
+        """The `send` template as a pattern, for a simulator to recognise the request."""
+        return request_pattern(self.send)

@@ -13,11 +13,9 @@ engine then checks every angle against the rig's tolerance.
 
 from __future__ import annotations
 
-import re
-
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from accelcal_rig.protocols.line_templates import NUMBER, regular_expression, request_pattern, round_trips, template
+from accelcal_rig.protocols.line_templates import NUMBER, TemplateCommand, regular_expression, round_trips
 
 #: What a request may name, with sample values: its axis (1-based) and angle.
 _SEND_SAMPLE: dict[str, object] = {"axis": 2, "angle": -45.0}
@@ -25,34 +23,16 @@ _SEND_SAMPLE: dict[str, object] = {"axis": 2, "angle": -45.0}
 _ANSWER_SAMPLE: dict[str, object] = {**_SEND_SAMPLE, "identity": "x", "busy": 0, "fault": 0, "rate": 0.0}
 
 
-class Command(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+class Command(TemplateCommand):
+    """`{axis}` (1-based) and `{angle:.5f}` style fields in a request; an answer also the values replies carry."""
 
-    send: str = Field(min_length=1, max_length=256)
-    reply: str | None = Field(None, min_length=1, max_length=256, description="regular expression a good reply "
-                              "matches in full; none: the controller does not answer this command")
-    answer: str | None = Field(None, min_length=1, max_length=256, description="what a controller answers "
-                               "(template), for simulators")
-
-    _compiles = field_validator("reply")(classmethod(lambda cls, v: v if v is None else regular_expression(v)))
-    #: `{axis}` and `{angle:.5f}` style fields in a request, nothing it cannot fill; an answer also the values.
-    _sends = field_validator("send")(classmethod(lambda cls, v: template(v, _SEND_SAMPLE)))
-    _answers = field_validator("answer")(classmethod(lambda cls, v: v if v is None else template(v, _ANSWER_SAMPLE)))
-
-    @model_validator(mode="after")
-    def _answered_if_replied(self) -> Command:
-        if (self.reply is None) != (self.answer is None):
-            raise ValueError("a command has both a reply pattern and an answer, or neither")
-        return self
+    send_fields = _SEND_SAMPLE
+    answer_fields = _ANSWER_SAMPLE
 
     @property
     def per_axis(self) -> bool:
         """Sent once for each axis (its template names `{axis}`)."""
         return "{axis" in self.send
-
-    def request_pattern(self) -> re.Pattern[str]:
-        """The `send` template as a pattern, for a simulator to recognise the request."""
-        return request_pattern(self.send)
 
 
 class TurntableProtocol(BaseModel):

@@ -126,3 +126,31 @@ def test_a_registry_that_cannot_take_the_record_loses_nothing(tmp_path: Path, ca
     err = capsys.readouterr().err
     assert "rig: warning: not recorded in the registry:" in err and f"rig registry add {campaign}" in err
     assert campaign.with_suffix(".calibration.yaml").is_file()
+
+
+def test_a_trend_of_fits_without_stated_uncertainty_is_printed_not_a_crash(tmp_path: Path, capsys) -> None:
+    """Hand-held fits state no uncertainty: the drift is given without one, on the command line and the page."""
+    from starlette.testclient import TestClient
+
+    from accelcal_rig.fit.calibration import load_calibration
+    from accelcal_rig.registry.entries import recording_entries
+    from accelcal_rig.web.app import create_app
+
+    registry = normalised(str(tmp_path / "lab.sqlite"))
+    recording = REPO / "tests" / "data" / "real" / "imucal-annotated-session.csv"
+    assert rig("fit-recording", recording, "--columns", "samples,acc_x,acc_y,acc_z", "--time-unit", "samples",
+               "--rate-hz", "204.8", "--units", "counts", "--counts-per-g", "2048", "--parameters", "bias-scale",
+               "-o", tmp_path / "hand.yaml", "--registry", registry) == 0
+    first = Registry.open(registry).calibrations()[0]
+    later = recording_entries(recording, load_calibration(tmp_path / "hand.yaml"), "unknown")[0]
+    from datetime import timedelta
+
+    Registry.open(registry).add([later | {"fit_sha256": "f" * 64, "calibrated_at": first["calibrated_at"]
+                                          + timedelta(days=100), "bias_mg": [b + 1.0 for b in first["bias_mg"]]}])
+    capsys.readouterr()
+    serial = first["serial"]
+    assert rig("registry", "trend", serial, "--registry", registry) == 0
+    assert "(uncertainty not stated) mg" in capsys.readouterr().out
+    page = TestClient(base_url="http://127.0.0.1", app=create_app([tmp_path], registry)).get(
+        f"/registry/serials/{serial}")
+    assert page.status_code == 200 and "uncertainty not stated" in page.text

@@ -19,7 +19,9 @@ from pathlib import Path
 from accelcal_rig.registry.database import Registry
 url, entries_file, go = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
 entries = pickle.loads(entries_file.read_bytes())
+deadline = time.monotonic() + 60
 while not go.exists():
+    assert time.monotonic() < deadline, "never told to go"
     time.sleep(0.001)
 added, already = Registry.open(url).add(entries)
 print(len(added), already)
