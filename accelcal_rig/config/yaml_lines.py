@@ -32,10 +32,17 @@ class YamlLimits:
 
     file_bytes: int
     nodes: int
+    #: Parse with libyaml where PyYAML has it: a program-written file may hold megabytes (a 64-DUT
+    #: calibration is 2 MB, 15 s in the pure-Python parser); a person's file keeps PyYAML's messages.
+    machine_written: bool = False
+
+    @property
+    def loader(self) -> type:
+        return getattr(yaml, "CSafeLoader", yaml.SafeLoader) if self.machine_written else yaml.SafeLoader
 
 
 CONFIG_LIMITS = YamlLimits(MAX_FILE_BYTES, MAX_NODES)
-CALIBRATION_LIMITS = YamlLimits(64 << 20, 5_000_000)
+CALIBRATION_LIMITS = YamlLimits(64 << 20, 5_000_000, machine_written=True)
 MAX_SCALAR_CHARS = 65_536
 MAX_NUMBER_CHARS = 40
 #: Characters YAML 1.1 forbids in a stream (PyYAML's reader would refuse them with a two-line message).
@@ -51,7 +58,7 @@ def _check_events(text: str, where: str, limits: YamlLimits) -> None:
     """One pass over the event stream (PyYAML's parser is not recursive): syntax, depth, sizes."""
     depth = count = 0
     try:
-        for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        for event in yaml.parse(text, Loader=limits.loader):
             count += 1
             line = event.start_mark.line + 1 if event.start_mark else 1
             if count > limits.nodes:
@@ -119,7 +126,7 @@ def _parse(text: str, where: str, limits: YamlLimits) -> tuple[Any, yaml.Node | 
         raise ConfigError(f"{where}:{_line_of(text, bad.start())}: syntax: character U+{ord(bad.group()):04X} is "
                           "not allowed in YAML")
     _check_events(text, where, limits)
-    loader = yaml.SafeLoader(text)
+    loader = limits.loader(text)
     try:
         root = loader.get_single_node()
         if root is None:

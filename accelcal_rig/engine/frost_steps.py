@@ -15,6 +15,7 @@ from accelcal_rig.engine.thermal_steps import ThermalSteps
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.instruments.capabilities import has_purge, humidity_pct, set_purge
 from accelcal_rig.instruments.interfaces import Accelerometer
+from accelcal_rig.instruments.temperatures import read_temperatures_together
 from accelcal_rig.plan.compile import Plan, setpoint_label
 from accelcal_rig.plan.steps import AwaitDewPointMargin, SetPurge
 
@@ -69,7 +70,8 @@ class FrostSteps:
             settles_c = condensation_point_c(dew_point)
             where = (f"dew point {dew_point:.1f} °C" if settles_c == dew_point
                      else f"frost point {settles_c:.1f} °C (dew point {dew_point:.1f} °C)") + f" ({source})"
-            coldest_c, serial = min((s.read_temperature_c(), s.serial) for s in self.sensors)
+            coldest_c, serial = min(zip(read_temperatures_together(self.sensors).tolist(),
+                                        (s.serial for s in self.sensors)))
             margin = coldest_c - settles_c
             self.report.publish(self.thermal.machine.state)
             if margin >= required:

@@ -17,6 +17,7 @@ from accelcal_rig.engine.soak import SoakDetector
 from accelcal_rig.engine.states import State, StateMachine
 from accelcal_rig.errors import InstrumentError, WaitTimeout
 from accelcal_rig.instruments.interfaces import Accelerometer, Chamber
+from accelcal_rig.instruments.temperatures import read_temperatures_together
 from accelcal_rig.plan.compile import Plan, setpoint_label
 from accelcal_rig.plan.steps import AdvanceRamp, Ramp, RampSegment, Soak, StartSoftwareRamp
 from accelcal_rig.store.records import SoakTrace
@@ -124,7 +125,7 @@ class ThermalSteps:
         detector = SoakDetector(criterion, setpoint_c, t_reached)
 
         def poll() -> bool:
-            dut_c = np.array([s.read_temperature_c() for s in self.sensors])
+            dut_c = read_temperatures_together(self.sensors)
             detector.add(self.clock.now(), self.read_chamber_c(), dut_c)
             self.report.dut_c = tuple(dut_c.tolist())
             self.report.publish(self.machine.state)

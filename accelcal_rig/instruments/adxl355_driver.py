@@ -4,20 +4,24 @@ numpy, not per sample) — captured by the bridge where it can, else drained fro
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any, TypeVar
 
 import numpy as np
 
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.waits import wait_until
-from accelcal_rig.errors import InstrumentError, WaitTimeout
+from accelcal_rig.errors import InstrumentError, TransientInstrumentError, WaitTimeout
 from accelcal_rig.instruments import adxl355
-from accelcal_rig.instruments.adxl355_transport import BlockCapture, RegisterTransport
+from accelcal_rig.instruments.adxl355_transport import RegisterTransport
 from accelcal_rig.instruments.capture import OVERFLOW_ATTEMPTS, capture_together
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
 from accelcal_rig.instruments.retrying import RetryCall, Retrying
 from accelcal_rig.parts.adxl35x import ADXL355
 from accelcal_rig.parts.part import AccelerometerPart
+
+T = TypeVar("T")
 
 #: Samples to let accumulate between FIFO bursts: under its 32, so a burst is never late.
 DRAIN_EVERY_SAMPLES = 30
@@ -25,6 +29,9 @@ DRAIN_EVERY_SAMPLES = 30
 TEMPERATURE_AGREE_LSB = 16
 #: Reads of a temperature before giving up: a part that tears this often is faulty.
 TEMPERATURE_READS = 10
+#: A single read within TEMPERATURE_AGREE_LSB of a temperature agreed this recently is not torn: a torn one
+#: is 240+ LSB (26 °C) from the truth, which no DUT in a chamber moves in a minute (ramps are ≤ 10 °C/min).
+AGREED_FRESH_S = 60.0
 
 
 @dataclass
@@ -51,6 +58,8 @@ class Adxl355:
         self._clock = clock
         self._odr_hz = 125.0
         self._capture: _Capture | None = None
+        #: (clock time, raw code) of the last temperature that two reads agreed on.
+        self._agreed: tuple[float, int] | None = None
 
     @property
     def capture_capacity_samples(self) -> int:
@@ -98,7 +107,36 @@ class Adxl355:
         return ranges[range_code], self.part.output_data_rates_hz[filter_code]
 
     def read_temperature_c(self) -> float:
+        """One read where it agrees with a fresh agreed temperature (a soak poll's usual case), else read
+        until two agree."""
+        if self._agreed is not None and self._clock.now() - self._agreed[0] <= AGREED_FRESH_S:
+            high, low = self._bus.read(adxl355.REG_TEMP2, 2)
+            raw = adxl355.raw_temperature(high, low)
+            if abs(raw - self._agreed[1]) <= TEMPERATURE_AGREE_LSB:
+                self._agreed = (self._clock.now(), raw)
+                return float(self.part.temperature.celsius(raw))
+            return self._agreed_temperature_c((0, raw))[1]
         return self._agreed_temperature_c(None)[1]
+
+    def begin_temperature_read(self) -> bool:
+        """Send the one read of `read_temperature_c`'s usual case without waiting for its reply (False: not
+        sent, read it with `read_temperature_c`)."""
+        if self._agreed is None or self._clock.now() - self._agreed[0] > AGREED_FRESH_S:
+            return False
+        return self._posted("post_read", adxl355.REG_TEMP2, 2)
+
+    def end_temperature_read(self) -> float | None:
+        """The temperature `begin_temperature_read` asked for; None where it does not agree with the last
+        agreed one or the exchange failed (read it again with `read_temperature_c`, which retries)."""
+        assert self._agreed is not None
+        read = self._received(True, lambda bridge: bridge.receive_read(adxl355.REG_TEMP2, 2))
+        if read is None:
+            return None
+        raw = adxl355.raw_temperature(*read)
+        if abs(raw - self._agreed[1]) > TEMPERATURE_AGREE_LSB:
+            return None
+        self._agreed = (self._clock.now(), raw)
+        return float(self.part.temperature.celsius(raw))
 
     def _agreed_temperature_c(self, first: tuple[int, int] | None) -> tuple[int, float]:
         """TEMP2 and TEMP1 are not double-buffered (data sheet): a read can straddle an update of the high
@@ -109,6 +147,7 @@ class Adxl355:
             high, low = self._bus.read(adxl355.REG_TEMP2, 2)
             raw = adxl355.raw_temperature(high, low)
             if previous is not None and abs(raw - previous) <= TEMPERATURE_AGREE_LSB:
+                self._agreed = (self._clock.now(), raw)
                 return status, float(self.part.temperature.celsius(raw))
             previous = raw
         raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {TEMPERATURE_READS} temperature reads in a "
@@ -139,24 +178,36 @@ class Adxl355:
             reopen()
 
     # ------------------------------------------------------------------ bridge-side capture
-    def begin_capture(self, n_samples: int) -> None:
-        """The bridge starts capturing the next `n_samples` (and says the temperature then)."""
-        capture: BlockCapture = self._bus  # type: ignore[assignment]
-        temperature_before = float(self.part.temperature.celsius(capture.start_capture(n_samples)))
-        self._capture = _Capture(n_samples, self._clock.now(), temperature_before)
+    def post_capture(self, n_samples: int) -> bool:
+        """Send the capture request without waiting for its reply (False: not sent; `begin_capture` asks)."""
+        return self._posted("post_capture", n_samples)
+
+    def begin_capture(self, n_samples: int, posted: bool = False) -> None:
+        """The bridge starts capturing the next `n_samples` (and says the temperature then). `posted`: the
+        request went out with `post_capture`; its reply is read here, or the request retried if it failed."""
+        raw = self._received(posted, lambda bridge: bridge.receive_capture(n_samples))
+        if raw is None:
+            raw = self._bus.start_capture(n_samples)  # type: ignore[attr-defined]
+        self._capture = _Capture(n_samples, self._clock.now(), float(self.part.temperature.celsius(raw)))
 
     def capture_wait_s(self) -> float:
         """Clock time until the rest of the block has been captured."""
         assert self._capture is not None
         return (self._capture.n_samples - self._capture.have) / self._odr_hz
 
-    def fetch_capture(self) -> bool:
+    def post_fetch(self) -> bool:
+        """Send the next fetch without waiting for its reply (False: not sent; `fetch_capture` asks)."""
+        assert self._capture is not None
+        return self._posted("post_fetch", self._capture.have)
+
+    def fetch_capture(self, posted: bool = False) -> bool:
         """Fetch what the bridge has captured since the last fetch (asked for by index, so a retry after
         a lost reply loses nothing); True once the block is complete. A capture that lost samples raises
-        CaptureOverflow; one that stalls past its deadline is a fault."""
-        capture, bridge = self._capture, self._bus
+        CaptureOverflow; one that stalls past its deadline is a fault. `posted`: as for `begin_capture`."""
+        capture = self._capture
         assert capture is not None
-        raw, temperature_raw = bridge.fetch_capture(capture.have)  # type: ignore[attr-defined]
+        fetched = self._received(posted, lambda bridge: bridge.receive_fetch(capture.have))
+        raw, temperature_raw = fetched if fetched is not None else self._bus.fetch_capture(capture.have)  # type: ignore[attr-defined]
         codes, capture.carried = adxl355.decode_fifo(raw, capture.carried)
         capture.blocks.append(codes)
         capture.have += len(codes)
@@ -167,6 +218,27 @@ class Adxl355:
             raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {capture.have} of {capture.n_samples} "
                                   "samples before the deadline: is it measuring?")
         return done
+
+    def _posted(self, request: str, *args: int) -> bool:
+        """Send `request` (a transport's `post_…`) on the bare transport, if it has it (no retry: a failure is
+        retried whole by the exchange that follows)."""
+        send = getattr(self._fifo_bus, request, None)
+        if send is None:
+            return False
+        try:
+            send(*args)
+        except TransientInstrumentError:
+            return False
+        return True
+
+    def _received(self, posted: bool, receive: Callable[[Any], T]) -> T | None:
+        """The reply to a posted request; None when none was posted or it failed transiently (ask again)."""
+        if not posted:
+            return None
+        try:
+            return receive(self._fifo_bus)
+        except TransientInstrumentError:
+            return None
 
     def end_capture(self) -> SampleBlock:
         """The completed block, with the temperature the bridge read as it completed."""

@@ -89,7 +89,16 @@ class SerialBridge:
         return bridge
 
     def read(self, address: int, count: int) -> bytes:
-        reply = self._ask(f"R {address:02X} {count}")
+        self.post_read(address, count)
+        return self.receive_read(address, count)
+
+    def post_read(self, address: int, count: int) -> None:
+        """Send a register read whose reply `receive_read` collects (several bridges read at once)."""
+        self._line.send(f"R {address:02X} {count}")
+
+    def receive_read(self, address: int, count: int) -> bytes:
+        request = f"R {address:02X} {count}"
+        reply = self._refusal_raised(request, self._line.receive(request))
         try:
             data = bytes.fromhex(reply[1:])
         except ValueError:
@@ -106,7 +115,16 @@ class SerialBridge:
                                   f"answered {reply[:40]!r}")
 
     def start_capture(self, n_samples: int) -> int:
-        reply = self._ask(f"C {n_samples}")
+        self.post_capture(n_samples)
+        return self.receive_capture(n_samples)
+
+    def post_capture(self, n_samples: int) -> None:
+        """Send `C` (its reply collected by `receive_capture`): several bridges start at once."""
+        self._line.send(f"C {n_samples}")
+
+    def receive_capture(self, n_samples: int) -> int:
+        request = f"C {n_samples}"
+        reply = self._refusal_raised(request, self._line.receive(request))
         temperature = _raw_temperature(reply[1:]) if reply.startswith("=") else None
         if temperature is None:
             raise TransientInstrumentError(f"sensor bridge ({self.endpoint}): capture of {n_samples} answered "
@@ -114,8 +132,16 @@ class SerialBridge:
         return temperature
 
     def fetch_capture(self, first: int) -> tuple[bytes, int | None]:
+        self.post_fetch(first)
+        return self.receive_fetch(first)
+
+    def post_fetch(self, first: int) -> None:
+        """Send `G` (its reply collected by `receive_fetch`): several bridges are fetched at once."""
+        self._line.send(f"G {first}")
+
+    def receive_fetch(self, first: int) -> tuple[bytes, int | None]:
         request = f"G {first}"
-        reply = self._line.ask(request)
+        reply = self._line.receive(request)
         if reply.startswith("!overflow"):
             raise CaptureOverflow(f"sensor bridge ({self.endpoint}): {reply[1:]}")
         reply = self._refusal_raised(request, reply)

@@ -1,4 +1,5 @@
-"""Block captures by the sensor bridges themselves: started together, fetched in rounds by one thread."""
+"""Block captures by the sensor bridges themselves: started together, fetched in rounds by one thread, each
+round's requests sent to every bridge before any reply is read."""
 
 from __future__ import annotations
 
@@ -19,14 +20,16 @@ def capture_together(sensors: Sequence[BlockCapturing], n_samples: int, clock: C
     blocks: dict[int, SampleBlock] = {}
     pending = list(range(len(sensors)))
     for _ in range(OVERFLOW_ATTEMPTS):
-        for index in pending:
-            sensors[index].begin_capture(n_samples)
+        posted = [sensors[index].post_capture(n_samples) for index in pending]  # every bridge asked first,
+        for index, sent in zip(pending, posted):  # then every reply read: they answer at the same time
+            sensors[index].begin_capture(n_samples, sent)
         capturing, overflowed = list(pending), []
         while capturing:
             clock.sleep(min(sensors[index].capture_wait_s() for index in capturing))
-            for index in list(capturing):
+            posted = [sensors[index].post_fetch() for index in capturing]
+            for index, sent in zip(list(capturing), posted):
                 try:
-                    complete = sensors[index].fetch_capture()
+                    complete = sensors[index].fetch_capture(sent)
                 except CaptureOverflow:
                     capturing.remove(index)
                     overflowed.append(index)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import hashlib
 import json
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -46,21 +47,21 @@ class Plan:
     axis_names: tuple[str, ...]
     verification_poses: tuple[Pose, ...] = ()
 
-    @property
+    @cached_property
     def steps(self) -> tuple[Step, ...]:
         """The program of a run that starts at the beginning."""
         return tuple(step for stage in self.stages for step in (*stage.entry, *stage.body))
 
-    @property
+    @cached_property
     def records(self) -> tuple[Record, ...]:
         """Every record the campaign may store, in plan order: what its file lists as the plan."""
         return tuple(record for stage in self.stages for record in stage.records)
 
-    @property
+    @cached_property
     def pose_steps(self) -> tuple[Measurement, ...]:
         return tuple(s for s in self.records if isinstance(s, Measurement))
 
-    @property
+    @cached_property
     def fingerprint(self) -> str:
         """SHA-256 over every record's key, setpoint and angles: equal plans, equal fingerprints."""
         rows = [

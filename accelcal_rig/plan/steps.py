@@ -7,6 +7,7 @@ a new kind of step is a new type here and a handler there; the runner itself doe
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import ClassVar
 
 
@@ -121,7 +122,7 @@ class Stage:
     body: tuple[Step, ...]
     restart_entry: tuple[Step, ...]
 
-    @property
+    @cached_property
     def records(self) -> tuple[Record, ...]:
         """Every record this setpoint may store: its soak (whichever entry soaks), then its measurements."""
         soaks = [s for s in (*self.entry, *self.restart_entry) if isinstance(s, Soak)]

@@ -135,7 +135,13 @@ class VirtualLab:
 
     def truth_between(self, index: int, t_start_s: float, t_end_s: float) -> dict[str, np.ndarray]:
         """The truth behind the samples of [t_start_s, t_end_s], averaged over the chunks that made them."""
-        chunks = [c for c in self.duts[index].truth_log if c[0] <= t_end_s and c[1] > t_start_s]
+        chunks = []
+        for chunk in reversed(self.duts[index].truth_log):  # in time order: only the newest are looked at
+            if chunk[1] <= t_start_s:
+                break
+            if chunk[0] <= t_end_s:
+                chunks.append(chunk)
+        chunks.reverse()
         if not chunks:
             raise ValueError(f"no samples of {self.duts[index].serial} between {t_start_s:g} and {t_end_s:g} s")
         weights = np.array([c[2] for c in chunks], dtype=float)

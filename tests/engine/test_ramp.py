@@ -50,7 +50,8 @@ def test_a_ramp_campaign_measures_while_the_temperature_moves(write, workdir: Pa
     assert not any("left the" in m for m, t in zip(messages, event_t_s) if t < last_soak_s)
     assert temperature[-1] - temperature[0] > 5.0  # the DUTs warmed through the campaign (lagging the air)
     later = setpoints == 30.0
-    assert np.ptp(temperature[later]) > 0.3  # within one setpoint's poses the temperature moved
+    # Within one setpoint's poses the temperature rose, by more than the reading's noise (σ ≈ 0.06 °C).
+    assert temperature[later][-1] - temperature[later][0] > 0.15
     # The joint fit follows each pose's temperature: the calibration matches the truth over the range.
     sensor = load_calibration(workdir / "cal.yaml").sensor("ADX355-A001")
     temperatures = np.linspace(*sensor.validity_c, 5)

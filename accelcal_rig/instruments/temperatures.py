@@ -1,0 +1,21 @@
+"""Every DUT's temperature at one poll, the bridges asked at once: a fixture of 64 DUTs is polled in the
+time of a few exchanges, not 64 of them in a row."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from accelcal_rig.instruments.interfaces import Accelerometer
+
+
+def read_temperatures_together(sensors: Sequence[Accelerometer]) -> np.ndarray:
+    """Each sensor's temperature (°C). Sensors that can (`begin_temperature_read`) get their request
+    first and are collected after; any whose quick read is not sure is read again on its own, as are
+    sensors without it."""
+    posted = [bool(getattr(sensor, "begin_temperature_read", lambda: False)()) for sensor in sensors]
+    quick = [sensor.end_temperature_read() if sent else None  # type: ignore[attr-defined]
+             for sensor, sent in zip(sensors, posted)]
+    return np.array([value if value is not None else sensor.read_temperature_c()
+                     for sensor, value in zip(sensors, quick)])
