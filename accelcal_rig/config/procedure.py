@@ -19,12 +19,27 @@ MAX_PLAN_POSES = 20_000
 
 
 class SoakCriterion(StrictModel):
-    """When the DUTs count as thermally stable at a setpoint (every wait has a deadline: `timeout_min`)."""
+    """When the DUTs count as thermally stable at a setpoint (every wait has a deadline: `timeout_min`).
 
+    `criterion: band` (the paper's way): each DUT's readings span at most `band_c` over the trailing window;
+    with more polls or more DUTs the noise makes a span wider, so the soak lasts longer. `criterion: settling`:
+    a settling curve fitted to each DUT's readings over the window predicts how much it will still change and
+    how fast it changes now; stable once both bounds (k = 2) are within `settle_c` and `max_rate_c_per_min`.
+    More polls only tighten the bounds (engine/soak.py, docs/procedures.md).
+    """
+
+    criterion: Literal["band", "settling"] = Field("band", description="band: readings within band_c over "
+                                                   "the window; settling: a fitted settling curve's prediction")
     min_dwell_min: float = Field(30.0, ge=0, le=2880, description="least time at setpoint before stability counts")
     window_min: float = Field(10.0, gt=0, le=1440, description="trailing window over which stability is judged")
     band_c: TemperatureSpanC = Field(0.3, description="max−min of each DUT's own temperature over the window")
     chamber_tolerance_c: TemperatureSpanC = Field(1.0, description="chamber air within this of the setpoint")
+    settle_c: float = Field(0.1, gt=0, le=10, description="criterion settling: most change still to come (k = 2) "
+                                                          "of each DUT's temperature")
+    max_rate_c_per_min: float = Field(0.02, gt=0, le=10, description="criterion settling: fastest each DUT's "
+                                      "temperature may still move (k = 2), °C/min")
+    time_constant_max_min: float = Field(60.0, gt=0, le=1440, description="criterion settling: the slowest "
+                                         "settling time constant fitted (the fixture's, with margin)")
     poll_s: float = Field(10.0, ge=1, le=600, description="temperature polling interval")
     timeout_min: float = Field(240.0, gt=0, le=2880, description="soak deadline, counted from reaching the setpoint")
     on_timeout: Literal["abort", "skip", "proceed"] = Field(

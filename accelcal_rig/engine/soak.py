@@ -1,13 +1,23 @@
-"""Soak criterion: when every DUT's own temperature has settled at a setpoint.
+"""Soak criteria: when every DUT's own temperature has settled at a setpoint.
 
 Stable at a poll when: the minimum dwell has passed since the chamber reached the setpoint; the polls
 cover a whole trailing window; within that window the chamber air stayed within tolerance of the
-setpoint and each DUT's readings spanned at most the band. `SoakDetector` judges it poll by poll as a
-campaign runs (each judgement costs the window, not the soak so far); `first_stable_poll` judges every
-poll of a whole trace at once, for the duration estimate.
+setpoint; and each DUT's readings over the window pass the criterion:
+
+- `band`: they span at most `band_c`. A span of noisy readings grows with their number, so a faster poll
+  or a larger fixture makes the soak longer (and a 64-DUT fixture's soak a lottery of minutes to hours).
+- `settling`: a settling curve T(t) = a + b·exp(−(t − now)/τ) per DUT, its τ the one of a geometric grid
+  that fits the DUT's whole soak best, a and b fitted over the window by least squares. |b| is the change still to come and
+  |b|/τ the rate now; each bound is the estimate plus twice its standard error. More polls narrow the
+  bounds, never widen them: the moment does not depend on the poll rate, to first order.
+
+`SoakDetector` judges poll by poll as a campaign runs (each judgement costs the window, not the soak so
+far); `first_stable_poll` judges the polls of a whole trace, for the duration estimate.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.ndimage import maximum_filter1d, minimum_filter1d
@@ -17,6 +27,61 @@ from accelcal_rig.config.procedure import SoakCriterion
 #: Window lengths (in polls) judged with running filters; rarer ones (the poll cut short at a deadline)
 #: one by one. Evenly spaced polls give one or two lengths, rounding the window to whole polls.
 _FILTERED_LENGTHS = 4
+#: Settling time constants tried, geometrically spaced from a few polls to `time_constant_max_min`.
+_TIME_CONSTANTS = 24
+#: Coverage factor of the settling bounds.
+_K = 2.0
+
+
+@dataclass(frozen=True)
+class Settling:
+    """A settling curve fitted to each DUT's readings over a window (arrays over the DUTs)."""
+
+    time_constant_s: np.ndarray
+    remaining_c: np.ndarray       # |b| + k·σ_b: how much each DUT may still change
+    rate_c_per_min: np.ndarray    # (|b| + k·σ_b) / τ: how fast it may be moving now
+    now_c: np.ndarray             # a + b: the fitted temperature at the last poll
+
+    def settled(self, criterion: SoakCriterion) -> bool:
+        return bool(np.all(self.remaining_c <= criterion.settle_c)
+                    and np.all(self.rate_c_per_min <= criterion.max_rate_c_per_min))
+
+
+def fit_settling(criterion: SoakCriterion, t_s: np.ndarray, dut_c: np.ndarray, window_start: int) -> Settling:
+    """Each DUT's τ from every poll of the soak (the one of the grid whose a + B·exp(−t/τ) fits it best: the
+    approach, large early on, fixes it), then a and b over the polls from `window_start` with that τ (a
+    linear fit: its b and σ_b carry no bias from choosing τ on the same noise)."""
+    taus = _time_constants(criterion, t_s)
+    best = np.argmin(_least_squares(t_s, dut_c, taus)[2], axis=0)            # per DUT
+    a, b, sse, det = (v[best, np.arange(len(best))] for v in _least_squares(t_s[window_start:], dut_c[window_start:],
+                                                                             taus))
+    n = len(t_s) - window_start
+    sigma_b = np.sqrt(np.maximum(sse, 0.0) / max(n - 2, 1) * n / det)
+    bound = np.abs(b) + _K * sigma_b
+    return Settling(taus[best], bound, bound / taus[best] * 60.0, a + b)
+
+
+def _time_constants(criterion: SoakCriterion, t_s: np.ndarray) -> np.ndarray:
+    """The grid of τ tried: from two poll intervals to `time_constant_max_min`."""
+    spacing_s = (t_s[-1] - t_s[0]) / max(len(t_s) - 1, 1)
+    shortest_s = max(2.0 * spacing_s, 1.0)
+    return np.geomspace(shortest_s, max(criterion.time_constant_max_min * 60.0, 2.0 * shortest_s), _TIME_CONSTANTS)
+
+
+def _least_squares(t_s: np.ndarray, y: np.ndarray, taus: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(a, b, residual sum of squares, det) of y ≈ a + B·exp(−(t − t_first)/τ), for every τ (rows) and DUT
+    (columns) at once: the design is the same for every DUT, so only sums are formed. b = B·exp(−(t_last −
+    t_first)/τ) is what is left of the approach at the last poll; det is scaled to b (σ_b² = s² n / det)."""
+    e = np.exp(-(np.asarray(t_s, dtype=float) - t_s[0])[None, :] / taus[:, None])   # (τ, polls), 1 at the first
+    n = e.shape[1]
+    sum_e, sum_ee = e.sum(axis=1), np.einsum("ki,ki->k", e, e)
+    det = np.maximum(n * sum_ee - sum_e**2, 1e-300)
+    sum_y, sum_ey, sum_yy = y.sum(axis=0), e @ y, np.einsum("ij,ij->j", y, y)
+    big_b = (n * sum_ey - sum_e[:, None] * sum_y[None, :]) / det[:, None]
+    a = (sum_y[None, :] - big_b * sum_e[:, None]) / n
+    sse = sum_yy[None, :] - a * sum_y[None, :] - big_b * sum_ey
+    last = e[:, -1:]
+    return a, big_b * last, sse, det[:, None] / last**2 * np.ones_like(big_b)
 
 
 class SoakDetector:
@@ -55,7 +120,14 @@ class SoakDetector:
         window = self._window()
         if np.any(np.abs(self._chamber[window] - self.setpoint_c) > c.chamber_tolerance_c):
             return False
+        if c.criterion == "settling":
+            return self.settling().settled(c)
         return bool(np.all(self.dut_spans_c() <= c.band_c))
+
+    def settling(self) -> Settling:
+        """The settling curve: τ from the whole soak, the rest from the trailing window."""
+        assert self._dut is not None
+        return fit_settling(self.criterion, self._t[:self._n], self._dut[:self._n], self._window().start)
 
     def dut_spans_c(self) -> np.ndarray:
         """Max − min of each DUT's temperature over the trailing window."""
@@ -64,8 +136,11 @@ class SoakDetector:
         return dut.max(axis=0) - dut.min(axis=0)
 
     def settled_dut_c(self) -> np.ndarray:
-        """Each DUT's mean temperature over the trailing window."""
+        """Each DUT's temperature where it settled: the mean over the trailing window (band), the fitted
+        curve's value at the last poll (settling: the mean would lag a DUT still creeping)."""
         assert self._dut is not None
+        if self.criterion.criterion == "settling" and self._window().stop - self._window().start >= 3:
+            return self.settling().now_c
         return self._dut[self._window()].mean(axis=0)
 
     def trace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -93,6 +168,11 @@ def first_stable_poll(criterion: SoakCriterion, setpoint_c: float, t_reached_s: 
     candidate &= outside[index + 1] - outside[start] == 0
     if not candidate.any():
         return None
+    if criterion.criterion == "settling":  # a fit per poll, in order, until one settles
+        for k in np.flatnonzero(candidate & (length >= 3)):
+            if fit_settling(criterion, t_s[:k + 1], dut_c[:k + 1], int(start[k])).settled(criterion):
+                return int(k)
+        return None
     settled = np.zeros(n, dtype=bool)
     values, counts = np.unique(length[candidate], return_counts=True)
     lengths = values[np.argsort(-counts, kind="stable")]  # the most common first
@@ -112,6 +192,8 @@ def first_stable_poll(criterion: SoakCriterion, setpoint_c: float, t_reached_s: 
 
 
 def settled_at(criterion: SoakCriterion, t_s: np.ndarray, dut_c: np.ndarray, poll: int) -> np.ndarray:
-    """Each DUT's mean over the trailing window ending at `poll` (what the detector reports as settled)."""
+    """What the detector reports as settled over the trailing window ending at `poll`."""
     start = int(np.searchsorted(t_s[:poll + 1], t_s[poll] - criterion.window_min * 60.0, side="left"))
+    if criterion.criterion == "settling" and poll + 1 - start >= 3:
+        return fit_settling(criterion, t_s[:poll + 1], dut_c[:poll + 1], start).now_c
     return dut_c[start:poll + 1].mean(axis=0)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from accelcal_rig.config.procedure import Procedure
+from accelcal_rig.config.procedure import Procedure, SoakCriterion
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.formatting import format_duration
@@ -134,7 +134,7 @@ class ThermalSteps:
         outcome, t_stable = "fault", float("nan")  # what the file says if anything but the deadline stops it
         try:
             t_stable = wait_until(self.clock, poll, timeout_s=criterion.timeout_min * 60.0, poll_s=criterion.poll_s,
-                                  what=f"{label}: DUT temperatures stable within {criterion.band_c:g} °C")
+                                  what=f"{label}: DUT temperatures {self._stable_means(criterion)}")
             outcome = "stable"
         except WaitTimeout as exc:
             outcome = "timeout"
@@ -157,11 +157,25 @@ class ThermalSteps:
             self.events.warning("soak", f"{timed_out}; measuring its poses anyway (soak.on_timeout: proceed)")
             self.report.notify("soak", f"{timed_out}; measuring its poses anyway (soak.on_timeout: proceed)")
             return
-        spans = detector.dut_spans_c()
-        message = (f"{label}: stable after {format_duration(t_stable - t_reached)} at DUT "
-                   f"{np.round(self.settled_dut_c, 2).tolist()} °C (spans ≤ {spans.max():.2f} °C)")
+        message = f"{label}: stable after {format_duration(t_stable - t_reached)} at DUT " \
+                  f"{np.round(self.settled_dut_c, 2).tolist()} °C ({self._how_stable(detector)})"
         self.events.info("soak", message)
         self.report.notify("soak", message)
+
+    @staticmethod
+    def _stable_means(criterion: SoakCriterion) -> str:
+        if criterion.criterion == "settling":
+            return (f"settled to within {criterion.settle_c:g} °C and {criterion.max_rate_c_per_min:g} °C/min "
+                    "(settling criterion)")
+        return f"stable within {criterion.band_c:g} °C"
+
+    @staticmethod
+    def _how_stable(detector: SoakDetector) -> str:
+        if detector.criterion.criterion == "settling":
+            settling = detector.settling()
+            return (f"still to come ≤ {settling.remaining_c.max():.3f} °C, moving ≤ "
+                    f"{settling.rate_c_per_min.max():.4f} °C/min, τ ≤ {settling.time_constant_s.max() / 60:.1f} min")
+        return f"spans ≤ {detector.dut_spans_c().max():.2f} °C"
 
     def read_chamber_c(self) -> float:
         """Chamber air temperature; an active controller alarm is a fault, never a reading to wait out."""

@@ -6,6 +6,7 @@ A versioned YAML artefact, checked on load. `apply` compensates raw readings wit
 from __future__ import annotations
 
 import warnings
+from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -138,12 +139,22 @@ def apply_codes(calibration: SensorCalibration, codes: np.ndarray, temperature_c
 
 def save_calibration(calibration: CalibrationFile, path: Path) -> None:
     """Write the calibration file, replacing any file at `path` whole (never a half-written one)."""
-    text = yaml.safe_dump(calibration.model_dump(mode="json"), sort_keys=False, width=120, allow_unicode=True)
+    dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml: a 64-DUT calibration is 2 MB of YAML
+    text = yaml.dump(calibration.model_dump(mode="json"), Dumper=dumper, sort_keys=False, width=120,
+                     allow_unicode=True)
     write_text_atomically(path, "# accelcal-rig calibration: Eq. 1 parameters as polynomials of the sensor "
                                 "temperature\n" + text, "the calibration")
 
 
 def load_calibration(path: Path) -> CalibrationFile:
+    """The calibration file at `path`, validated; read again only once the file has changed (a run's
+    certificates and its registry entries read the same file one after the other)."""
+    stat = path.stat()
+    return _load_calibration(path.resolve(), stat.st_ino, stat.st_size, stat.st_mtime_ns).model_copy(deep=True)
+
+
+@lru_cache(maxsize=4)
+def _load_calibration(path: Path, inode: int, size: int, mtime_ns: int) -> CalibrationFile:
     return load_validated(path, CalibrationFile, CALIBRATION_LIMITS).model
 
 

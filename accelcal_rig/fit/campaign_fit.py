@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial as bind
 from pathlib import Path
 from typing import Any, Literal
 
@@ -30,6 +31,7 @@ from accelcal_rig.fit.calibration import (
     save_calibration,
 )
 from accelcal_rig.fit.expected import expected_norm_rmse_mg, expected_reference_rmse_mg, thermal_jacobian
+from accelcal_rig.fit.fixture_pool import map_over_duts
 from accelcal_rig.fit.joint import fit_joint
 from accelcal_rig.fit.lm import FitMode, FreeParameters, SfemFit, fit_sfem, norm_sigma
 from accelcal_rig.fit.metrics import drift_mg, noise_floor_mg, norm_rmse_mg
@@ -237,7 +239,7 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     """Fit every DUT of a stored campaign; the calibration file and the report `rig fit --json` prints
     (per serial). Nothing is written: the campaign's measurements are only read. `run_end`: the fit stage of
     the run itself, whose campaign is done but for the fit."""
-    results = [fit_dut(read_dut_poses(campaign, serial), options) for serial in campaign.serials]
+    results = map_over_duts(bind(fit_dut, options=options), [read_dut_poses(campaign, s) for s in campaign.serials])
     limits = recorded_acceptance(campaign.header.procedure_yaml, source.get("campaign", "the campaign"))
     partial = partial_campaign(campaign, run_end)
     judged = {r.serial: judge(r.metrics, r.thermal, options.mode, limits, partial) for r in results}

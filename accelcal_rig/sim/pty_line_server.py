@@ -1,10 +1,19 @@
-"""A serial device with a real path: a pseudo-terminal whose far end a simulator answers line by line."""
+"""A serial device with a real path: a pseudo-terminal whose far end a simulator answers line by line.
+
+Every simulated serial device of a process is answered by one thread (`PtyHub`), which waits on all
+their pseudo-terminals at once: a fixture of 64 bridges as 64 threads would spend its time handing the
+interpreter from thread to thread. A reply a fault delays is written when due, holding up no other
+device (and no later reply of its own device: a device answers in order).
+"""
 
 from __future__ import annotations
 
+import heapq
+import itertools
 import os
-import select
+import selectors
 import threading
+import time
 import tty
 
 from accelcal_rig.sim.faults import ReplyFaults
@@ -18,31 +27,122 @@ class PtyLineServer:
     def __init__(self, handle: Handler, terminator: bytes = b"\n", name: str = "pty",
                  faults: ReplyFaults | None = None, reply_terminator: bytes | None = None,
                  encoding: str = "utf-8") -> None:
-        self._answers = LineAnswers(handle, terminator, reply_terminator, encoding, faults)
+        self.name = name
         self._master, self._slave = os.openpty()
         tty.setraw(self._master)
         tty.setraw(self._slave)  # the slave stays open so the path keeps working between clients
         self.path = os.ttyname(self._slave)
-        self._wake_read, self._wake_write = os.pipe()  # stop() writes here: the thread wakes at once
-        self._thread = threading.Thread(target=self._serve, name=name, daemon=True)
+        self._answers = LineAnswers(handle, terminator, reply_terminator, encoding, faults,
+                                    defer=lambda delay_s, reply, _: _HUB.send(self, delay_s, reply))
+        #: When this device's latest reply is due: a later one is never written before it.
+        self.due_s = 0.0
 
     def start(self) -> PtyLineServer:
-        self._thread.start()
+        _HUB.add(self)
         return self
 
     def stop(self) -> None:
-        os.write(self._wake_write, b"x")
-        self._thread.join(5.0)
-        for fd in (self._master, self._slave, self._wake_read, self._wake_write):
+        _HUB.remove(self)
+        for fd in (self._master, self._slave):
             os.close(fd)
 
-    def _serve(self) -> None:
+    @property
+    def fileno(self) -> int:
+        return self._master
+
+    def received(self) -> bool:
+        """Answer what has arrived; False once the pty is gone."""
+        try:
+            data = os.read(self._master, 65536)
+        except OSError:
+            return False
+        self._answers.feed(data, lambda reply: self.write(reply))
+        return True
+
+    def write(self, reply: bytes) -> None:
+        try:
+            os.write(self._master, reply)
+        except OSError:
+            pass  # the client side went away: nobody to answer
+
+
+class PtyHub:
+    """One thread answering every registered pty server, started with the first and ended with the last."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._selector: selectors.BaseSelector | None = None
+        self._thread: threading.Thread | None = None
+        self._wake_read, self._wake_write = -1, -1
+        self._servers: set[PtyLineServer] = set()
+        self._due: list[tuple[float, int, PtyLineServer, bytes]] = []  # delayed replies, soonest first
+        self._order = itertools.count()
+
+    def add(self, server: PtyLineServer) -> None:
+        with self._lock:
+            if self._thread is None:
+                self._selector = selectors.DefaultSelector()
+                self._wake_read, self._wake_write = os.pipe()
+                self._selector.register(self._wake_read, selectors.EVENT_READ, None)
+                self._thread = threading.Thread(target=self._serve, name="simulated-ptys", daemon=True,
+                                                args=(self._selector, self._wake_read, self._wake_write))
+                self._thread.start()
+            assert self._selector is not None
+            self._servers.add(server)
+            self._selector.register(server.fileno, selectors.EVENT_READ, server)
+            os.write(self._wake_write, b"r")  # the loop waits on the new set from now on
+
+    def remove(self, server: PtyLineServer) -> None:
+        with self._lock:
+            if server not in self._servers or self._selector is None:
+                return
+            self._servers.discard(server)
+            self._selector.unregister(server.fileno)
+            last = not self._servers
+            thread, wake = self._thread, self._wake_write
+            if last:
+                self._thread = None
+            os.write(wake, b"x" if last else b"r")
+        if last and thread is not None:
+            thread.join(5.0)
+
+    def send(self, server: PtyLineServer, delay_s: float, reply: bytes) -> None:
+        """Write `reply` now, or once `delay_s` has passed, after any reply of the device still due."""
+        now = time.monotonic()
+        due = max(now + delay_s, server.due_s)
+        server.due_s = due
+        if due <= now:
+            server.write(reply)
+            return
+        heapq.heappush(self._due, (due, next(self._order), server, reply))
+
+    def _serve(self, selector: selectors.BaseSelector, wake_read: int, wake_write: int) -> None:
+        """The loop of one run of the hub (its selector and wake-up pipe are its own: a hub started again
+        after its last server went has new ones)."""
         while True:
-            readable, _, _ = select.select([self._master, self._wake_read], [], [])
-            if self._wake_read in readable:
-                return
-            try:
-                data = os.read(self._master, 65536)
-            except OSError:
-                return
-            self._answers.feed(data, lambda reply: os.write(self._master, reply))
+            timeout = max(0.0, self._due[0][0] - time.monotonic()) if self._due else None
+            for key, _ in selector.select(timeout):
+                if key.data is None:
+                    if b"x" in os.read(wake_read, 64):
+                        selector.close()
+                        for fd in (wake_read, wake_write):
+                            os.close(fd)
+                        return
+                    continue
+                server: PtyLineServer = key.data
+                if server in self._servers and not server.received():
+                    self._forget(server, selector)
+            while self._due and self._due[0][0] <= time.monotonic():
+                _, _, server, reply = heapq.heappop(self._due)
+                if server in self._servers:
+                    server.write(reply)
+
+    def _forget(self, server: PtyLineServer, selector: selectors.BaseSelector) -> None:
+        """A pty that failed to read: no longer waited on."""
+        with self._lock:
+            if server in self._servers:
+                self._servers.discard(server)
+                selector.unregister(server.fileno)
+
+
+_HUB = PtyHub()

@@ -70,3 +70,91 @@ def test_the_estimates_vectorised_judgement_agrees_with_the_detector_poll_by_pol
             np.testing.assert_allclose(settled_at(criterion, t, dut, expected), detector.settled_dut_c())
         outcomes.add(expected is None)
     assert outcomes == {True, False}  # both stable and never-stable soaks were tried
+
+
+SETTLING = SoakCriterion(criterion="settling", min_dwell_min=5, window_min=20, settle_c=0.1, max_rate_c_per_min=0.02,
+                         chamber_tolerance_c=1.0, poll_s=10, timeout_min=240)
+
+
+def first_order_readings(t_s: np.ndarray, tau_s: np.ndarray, seed: int, start_c: float = 20.0,
+                         end_c: float = 30.0) -> np.ndarray:
+    """DUTs approaching `end_c` with their time constants, read with noise in the ADXL355's 0.11 °C steps."""
+    rng = np.random.default_rng(seed)
+    true = end_c + (start_c - end_c) * np.exp(-t_s[:, None] / tau_s[None, :])
+    return np.round((true + rng.normal(0, 0.05, true.shape)) / 0.11) * 0.11
+
+
+def test_the_settling_fit_finds_the_fixtures_time_constant_and_what_is_left_of_the_approach() -> None:
+    from accelcal_rig.engine.soak import fit_settling
+
+    t = np.arange(0.0, 40 * 60 + 1, 10.0)
+    tau = np.array([540.0, 600.0, 660.0])  # a fixture's DUTs: ±10 % of 10 min
+    readings = first_order_readings(t, tau, seed=2)
+    window_start = int(np.searchsorted(t, t[-1] - 20 * 60))
+    settling = fit_settling(SETTLING, t, readings, window_start)
+    assert np.all(np.abs(settling.time_constant_s - tau) < 0.2 * tau)
+    left = 10.0 * np.exp(-t[-1] / tau)  # the truth: 0.1…0.2 °C still to come after 40 min
+    assert np.all(settling.remaining_c >= left - 0.02)  # a bound (k = 2), not below what is left
+    assert np.all(settling.remaining_c <= left + 0.12)
+    np.testing.assert_allclose(settling.now_c, 30.0 - left, atol=0.06)
+
+
+def stable_after_s(criterion: SoakCriterion, poll_s: float, seed: int, n_duts: int) -> float:
+    from accelcal_rig.engine.soak import first_stable_poll
+
+    t = np.arange(0.0, criterion.timeout_min * 60 + 1, poll_s)
+    tau = np.random.default_rng(seed).uniform(540.0, 660.0, n_duts)
+    k = first_stable_poll(criterion, 30.0, 0.0, t, np.full(len(t), 30.0), first_order_readings(t, tau, seed))
+    assert k is not None
+    return float(t[k])
+
+
+def test_the_settling_criterion_does_not_depend_on_the_poll_rate_or_the_fixture_size_as_the_band_does() -> None:
+    """The band's span of noisy readings widens with more of them: a 10 s poll or a larger fixture holds
+    the soak open longer. The settling fit's bounds only narrow with more readings."""
+    band = SETTLING.model_copy(update={"criterion": "band", "band_c": 0.3, "window_min": 10})
+    seeds = range(6)
+
+    def median_s(criterion: SoakCriterion, poll_s: float, n_duts: int) -> float:
+        return float(np.median([stable_after_s(criterion, poll_s, seed, n_duts) for seed in seeds]))
+
+    assert median_s(band, 10, 16) > 1.3 * median_s(band, 30, 4)  # the band: longer, the more readings
+    settling_fast, settling_slow = median_s(SETTLING, 10, 16), median_s(SETTLING, 30, 4)
+    assert abs(settling_fast - settling_slow) < 0.15 * settling_slow
+
+
+def test_a_settling_soak_judged_poll_by_poll_agrees_with_the_estimates_judgement() -> None:
+    from accelcal_rig.engine.soak import first_stable_poll, settled_at
+
+    t = np.arange(0.0, 120 * 60 + 1, 30.0)
+    readings = first_order_readings(t, np.array([500.0, 700.0]), seed=5)
+    detector, found = SoakDetector(SETTLING, 30.0, 0.0), None
+    for k in range(len(t)):
+        detector.add(t[k], 30.0, readings[k])
+        if detector.is_stable():
+            found = k
+            break
+    assert found is not None and first_stable_poll(SETTLING, 30.0, 0.0, t, np.full(len(t), 30.0), readings) == found
+    np.testing.assert_allclose(settled_at(SETTLING, t, readings, found), detector.settled_dut_c())
+    assert abs(detector.settled_dut_c() - 30.0).max() < 0.15  # where they settled, not the window's lagging mean
+
+
+def test_a_dry_run_soaks_by_the_settling_criterion_and_says_how_settled(write, workdir) -> None:
+    import h5py
+
+    from accelcal_rig.assembly import run_campaign
+    from accelcal_rig.engine.preparation import prepare
+    from tests.conftest import TINY_PROCEDURE
+
+    text = TINY_PROCEDURE.replace("soak: {min_dwell_min: 5, window_min: 2, band_c: 0.3, poll_s: 10, timeout_min: 120}",
+                                  "soak: {criterion: settling, min_dwell_min: 5, window_min: 10, poll_s: 10, "
+                                  "timeout_min: 120}")
+    result = run_campaign(prepare(write("settle.yaml", text)), workdir / "s.h5", dry_run=True, seed=1,
+                          overwrite=False, calibration=None)
+    assert result.summary.state == "done"
+    with h5py.File(workdir / "s.h5", "r") as f:
+        messages = [m.decode() for m in f["events/message"][:]]
+        soak = f["soaks/T30"]
+        settled, last = soak["settled_dut_c"][:], soak["dut_c"][-20:].mean(axis=0)
+    assert any("stable after" in m and "still to come ≤" in m and "°C/min" in m for m in messages)
+    assert np.all(np.abs(settled - last) < 0.15)
