@@ -90,6 +90,14 @@ class SimulatedEffects(StrictModel):
 
     hysteresis_mg: float = Field(0.0, ge=0, le=50, description="bias difference between approaching a "
                                  "temperature from below and from above")
+    hysteresis_span_c: float = Field(0.0, ge=0, le=100, description="the travel over which the hysteresis swings "
+                                     "from one side to the other (0: at once)")
+    hysteresis_time_constant_h: float | None = Field(None, gt=0, le=1000, description="the hysteresis relaxes "
+                                                     "towards none with this time constant (unset: never)")
+    rate_bias_mg_per_c_per_min: float = Field(0.0, ge=0, le=50, description="bias per °C/min of the DUT's own "
+                                              "temperature change (package stress in a ramp), ± per axis and DUT")
+    rate_scale_ppm_per_c_per_min: float = Field(0.0, ge=0, le=10_000, description="scale factor change per "
+                                                "°C/min, ± per axis and DUT")
     nonlinearity_mg_per_g2: float = Field(0.0, ge=0, le=50, description="square-law term per axis, ± per DUT")
 
 

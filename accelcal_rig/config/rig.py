@@ -9,6 +9,7 @@ import numpy as np
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from accelcal_rig.config.bounds import AngleDeg, Baudrate, StrictModel, TemperatureC, TimeoutS
+from accelcal_rig.core.thermal import dut_time_constant_s
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
 from accelcal_rig.parts.registry import DEFAULT_PART, part
 from accelcal_rig.plugins import Kind, driver_problem
@@ -251,7 +252,34 @@ class SimulationConfig(StrictModel):
     purge_dew_point_c: TemperatureC = Field(-40.0, description="the dry-air purge's dew point (instrument air)")
     moisture_time_constant_min: float = Field(5.0, ge=0.01, le=1440, description="the air's dew point follows "
                                               "its target with this time constant")
+    chamber_overshoot_pct: float = Field(0.0, ge=0, le=50, description="the air overshoots a set point by this "
+                                         "share of the step, peaking one chamber time constant after the ramp arrives")
+    cooling_floor_c: TemperatureC | None = Field(None, description="cooling slows towards this temperature (the "
+                                                 "compressor's floor): at T, the ramp rate × (T − floor)/(ambient − floor)")
+    slot_gradient_c: float = Field(0.0, ge=0, le=20, description="at 60 °C from ambient, the last slot's air is "
+                                   "this much nearer ambient than the first's (the slot at the air inlet leads)")
+    slot_lead_pct: float = Field(0.0, ge=0, le=90, description="the first slot's time constant is this much "
+                                 "shorter than the last's, linearly between")
+    time_constant_per_dut_min: float = Field(0.0, ge=0, le=60, description="each DUT (its board and socket) adds "
+                                             "this to fixture_time_constant_min: a fuller fixture lags more")
     faults: FaultInjection = FaultInjection()
+
+    def fixture_time_constants_s(self, serials: list[str]) -> list[float]:
+        """Each DUT's time constant behind its slot's air: the fixture's, grown by its load of DUTs, ±10 % per
+        DUT, and shorter towards the inlet by `slot_lead_pct`."""
+        nominal_s = 60.0 * (self.fixture_time_constant_min + self.time_constant_per_dut_min * len(serials))
+        positions = _slot_positions(len(serials))
+        return [dut_time_constant_s(serial, nominal_s) * (1.0 - self.slot_lead_pct / 100.0 * (1.0 - position))
+                for serial, position in zip(serials, positions)]
+
+    def slot_offsets_per_c(self, n_duts: int) -> list[float]:
+        """Each slot's air offset per °C of air above ambient (negative: nearer ambient)."""
+        return [-self.slot_gradient_c / 60.0 * position for position in _slot_positions(n_duts)]
+
+
+def _slot_positions(n_duts: int) -> list[float]:
+    """Each slot's place along the air's path, 0 at the inlet to 1 at the far end."""
+    return [k / (n_duts - 1) if n_duts > 1 else 0.0 for k in range(n_duts)]
 
 
 class RetryPolicy(StrictModel):

@@ -1,5 +1,11 @@
 """Chamber air and DUT temperatures: a rate-limited setpoint, a first-order air lag, first-order DUT lags.
 
+Beyond that, each switched on by its own setting (docs/procedures.md, "Honest physics"): the controller's
+overshoot where a ramp arrives (a share of the step, peaking one air time constant after arrival); a
+cooling rate that falls towards the compressor's floor temperature; each slot's own air (the slots further
+from the inlet nearer the ambient temperature); and a hysteresis state per DUT that swings towards its
+direction of travel over `hysteresis_span_c` and relaxes with `hysteresis_time_constant_s`.
+
 Advanced lazily to the clock time of each query in sub-steps of at most `MAX_STEP_S`; each sub-step
 solves the lag exactly for an input that is linear over it. Every DUT is advanced at once (numpy). The
 number of sub-steps to reach a time is bounded by construction: at most one per `MAX_STEP_S`, plus one
@@ -28,19 +34,34 @@ def dut_time_constant_s(serial: str, fixture_tau_s: float) -> float:
     return fixture_tau_s * (0.9 + 0.2 * spread)
 
 
-def _lag(state: np.ndarray | float, input_start: float, input_end: float, step_s: float,
+def _lag(state: np.ndarray | float, input_start: np.ndarray | float, input_end: np.ndarray | float, step_s: float,
          tau_s: np.ndarray | float) -> np.ndarray | float:
     """First-order lag after `step_s` with its input moving linearly from `input_start` to `input_end`."""
     slope = (input_end - input_start) / step_s
     return input_end - slope * tau_s + (state - input_start + slope * tau_s) * np.exp(-step_s / tau_s)
 
 
+def _bump(u_s: float, tau_s: float) -> float:
+    """An overshoot's shape after the ramp arrived: 0 at arrival, 1 at one time constant, then decaying."""
+    return (u_s / tau_s) * math.exp(1.0 - u_s / tau_s) if u_s > 0 else 0.0
+
+
 class ThermalModel:
     """Temperatures in °C, times in clock seconds."""
 
     def __init__(self, ambient_c: float, ramp_rate_c_per_s: float, chamber_tau_s: float,
-                 dut_tau_s: list[float], self_heating_c: float, free_cooling_tau_s: float = 2700.0) -> None:
+                 dut_tau_s: list[float], self_heating_c: float, free_cooling_tau_s: float = 2700.0, *,
+                 overshoot_fraction: float = 0.0, cooling_floor_c: float | None = None,
+                 slot_offset_per_c: list[float] | None = None, hysteresis_span_c: float = 0.0,
+                 hysteresis_time_constant_s: float | None = None) -> None:
         self.ramp_rate_c_per_s = ramp_rate_c_per_s
+        self.overshoot_fraction = overshoot_fraction
+        self.cooling_floor_c = cooling_floor_c
+        #: Each slot's air: air + offset × (air − ambient) (0 for all: a uniform chamber).
+        self.slot_offset_per_c = np.zeros(len(dut_tau_s)) if slot_offset_per_c is None else np.asarray(
+            slot_offset_per_c, dtype=float)
+        self.hysteresis_span_c = hysteresis_span_c
+        self.hysteresis_time_constant_s = hysteresis_time_constant_s
         self.free_cooling_tau_s = free_cooling_tau_s
         self.chamber_tau_s = chamber_tau_s
         self.dut_tau_s = np.asarray(dut_tau_s, dtype=float)
@@ -50,13 +71,27 @@ class ThermalModel:
         self.powered = True
         self.setpoint_c = ambient_c
         self._reference_c = ambient_c
+        self._lagged_c = ambient_c   # the air without its overshoot
         self._air_c = ambient_c
         self._dut_c = np.full(len(dut_tau_s), ambient_c + self_heating_c)
-        #: +1 if each DUT last moved up in temperature, −1 if down: what a hysteretic sensor remembers.
-        self.approach_sign = np.ones(len(dut_tau_s))
+        #: Where the last ramp began and (once it arrived) when and by how much the air overshoots.
+        self._ramp_from_c = ambient_c
+        self._overshoot: tuple[float, float] | None = None
+        #: Each DUT's hysteresis state in −1…+1: +1 after warming through `hysteresis_span_c`, −1 after
+        #: cooling; what a hysteretic sensor remembers (with span 0: the sign of its last change).
+        self.hysteresis_state = np.ones(len(dut_tau_s))
+        #: Each DUT's rate of change over the last sub-step, °C/s.
+        self.dut_rate_c_per_s = np.zeros(len(dut_tau_s))
+
+    @property
+    def approach_sign(self) -> np.ndarray:
+        """+1 where a DUT last warmed, −1 where it last cooled (its hysteresis state's sign)."""
+        return np.where(self.hysteresis_state >= 0, 1.0, -1.0)
 
     def set_setpoint(self, t_s: float, setpoint_c: float) -> None:
         self.advance_to(t_s)
+        if setpoint_c != self.setpoint_c:
+            self._ramp_from_c = self._reference_c
         self.setpoint_c = setpoint_c
 
     def set_power(self, t_s: float, on: bool) -> None:
@@ -82,30 +117,62 @@ class ThermalModel:
         self.advance_to(t_s)
         return self._dut_c.copy()
 
+    def ramp_rate_at_c_per_s(self, reference_c: float, cooling: bool) -> float:
+        """How fast the chamber can move its air from `reference_c`: the rig's ramp rate, and cooling slower
+        towards `cooling_floor_c` (a compressor's capacity falls with its evaporator temperature)."""
+        if not cooling or self.cooling_floor_c is None or self.ambient_c <= self.cooling_floor_c:
+            return self.ramp_rate_c_per_s
+        share = (reference_c - self.cooling_floor_c) / (self.ambient_c - self.cooling_floor_c)
+        return self.ramp_rate_c_per_s * float(np.clip(share, 0.05, 1.0))
+
     def advance_to(self, t_s: float) -> None:
         while self._t < t_s:
             step = min(MAX_STEP_S, t_s - self._t)
             gap = self._target_c - self._reference_c
-            arrives_s = abs(gap) / self.ramp_rate_c_per_s
+            rate = self.ramp_rate_at_c_per_s(self._reference_c, gap < 0)
+            arrives_s = abs(gap) / rate
             if self.powered and 0.0 < arrives_s < step:  # end this sub-step where the ramp arrives
                 step = arrives_s
-            self._step(step, arrives=self.powered and arrives_s <= step)
+            self._step(step, rate, arrives=self.powered and 0.0 < arrives_s <= step)
             self._t = t_s if step >= t_s - self._t else self._t + step
 
-    def _step(self, step_s: float, arrives: bool) -> None:
+    def _step(self, step_s: float, rate_c_per_s: float, arrives: bool) -> None:
         gap = self._target_c - self._reference_c
         if arrives:
             reference_end = self._target_c
         elif self.powered:
-            reference_end = self._reference_c + math.copysign(self.ramp_rate_c_per_s * step_s, gap)
+            reference_end = self._reference_c + math.copysign(rate_c_per_s * step_s, gap) if gap else self._reference_c
         else:
             reference_end = self.ambient_c - gap * math.exp(-step_s / self.free_cooling_tau_s)
-        air_end = float(_lag(self._air_c, self._reference_c, reference_end, step_s, self.chamber_tau_s))
-        target_start = self._air_c + self.self_heating_c
-        target_end = air_end + self.self_heating_c
-        new_dut_c = _lag(self._dut_c, target_start, target_end, step_s, self.dut_tau_s)
+        lagged_end = float(_lag(self._lagged_c, self._reference_c, reference_end, step_s, self.chamber_tau_s))
+        t_end = self._t + step_s
+        if arrives and self.overshoot_fraction:
+            self._overshoot = (t_end, self.overshoot_fraction * (self._target_c - self._ramp_from_c))
+        if not self.powered:
+            self._overshoot = None
+        air_end = lagged_end
+        if self._overshoot is not None:
+            air_end += self._overshoot[1] * _bump(t_end - self._overshoot[0], self.chamber_tau_s)
+        offsets = self.slot_offset_per_c
+        target_start = self._air_c + offsets * (self._air_c - self.ambient_c) + self.self_heating_c
+        target_end = air_end + offsets * (air_end - self.ambient_c) + self.self_heating_c
+        new_dut_c = np.asarray(_lag(self._dut_c, target_start, target_end, step_s, self.dut_tau_s))
         change = new_dut_c - self._dut_c
-        self.approach_sign = np.where(np.abs(change) > _DIRECTION_THRESHOLD_C, np.sign(change), self.approach_sign)
-        self._dut_c = np.asarray(new_dut_c)
+        self._remember_direction(change, step_s)
+        self.dut_rate_c_per_s = change / step_s
+        self._dut_c = new_dut_c
         self._reference_c = reference_end
+        self._lagged_c = lagged_end
         self._air_c = air_end
+
+    def _remember_direction(self, change: np.ndarray, step_s: float) -> None:
+        """Swing each hysteresis state towards the direction of travel, then let it relax."""
+        moved = np.abs(change) > _DIRECTION_THRESHOLD_C
+        if self.hysteresis_span_c > 0:
+            share = np.minimum(np.abs(change) / self.hysteresis_span_c, 1.0)
+            self.hysteresis_state = np.where(moved, self.hysteresis_state + (np.sign(change) - self.hysteresis_state)
+                                             * share, self.hysteresis_state)
+        else:
+            self.hysteresis_state = np.where(moved, np.sign(change), self.hysteresis_state)
+        if self.hysteresis_time_constant_s is not None:
+            self.hysteresis_state = self.hysteresis_state * math.exp(-step_s / self.hysteresis_time_constant_s)

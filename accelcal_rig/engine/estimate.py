@@ -23,7 +23,7 @@ import numpy as np
 
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel, dut_time_constant_s
+from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel
 from accelcal_rig.core.waits import MOVE_POLL_S
 from accelcal_rig.engine.soak import first_stable_poll, settled_at
 from accelcal_rig.parts.part import TemperatureFormat
@@ -85,11 +85,12 @@ def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> Durat
     sim = rig.simulation
     soak = procedure.soak
     acquisition = procedure.acquisition
+    serials = [s.serial for s in rig.fixture.sensors]
     thermal = ThermalModel(
         ambient_c=sim.ambient_c, ramp_rate_c_per_s=rig.chamber.ramp_rate_c_per_min / 60.0,
-        chamber_tau_s=sim.chamber_time_constant_min * 60.0,
-        dut_tau_s=[dut_time_constant_s(s.serial, sim.fixture_time_constant_min * 60.0) for s in rig.fixture.sensors],
-        self_heating_c=sim.self_heating_c,
+        chamber_tau_s=sim.chamber_time_constant_min * 60.0, dut_tau_s=sim.fixture_time_constants_s(serials),
+        self_heating_c=sim.self_heating_c, overshoot_fraction=sim.chamber_overshoot_pct / 100.0,
+        cooling_floor_c=sim.cooling_floor_c, slot_offset_per_c=sim.slot_offsets_per_c(len(serials)),
     )
     readers = [part(s.part).temperature for s in rig.fixture.sensors]
     speeds = np.array([a.speed_deg_s for a in rig.turntable.axes])

@@ -13,7 +13,7 @@ from accelcal_rig.config.procedure import SimulatedEffects
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.humidity import relative_humidity_pct
-from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel, dut_time_constant_s
+from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel
 from accelcal_rig.core.units import site_gravity_g
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.parts.part import AccelerometerPart
@@ -27,18 +27,21 @@ from accelcal_rig.sim.turntable_motion import TurntableMotion
 class SimulatedDut:
     """A DUT's part, its place on the fixture, its hidden truth and its own thermal time constant."""
 
-    def __init__(self, serial: str, mount_euler_deg: tuple[float, float, float], fixture_tau_s: float,
+    def __init__(self, serial: str, mount_euler_deg: tuple[float, float, float], tau_s: float,
                  dut_part: AccelerometerPart) -> None:
         self.serial = serial
         self.part = dut_part
         self.truth: DutTruth = truth_for_serial(serial)
         #: Fixture frame → DUT frame.
         self.fixture_to_dut = Rotation.from_euler("xyz", mount_euler_deg, degrees=True).inv().as_matrix()
-        self.tau_s = dut_time_constant_s(serial, fixture_tau_s)
-        # Signs of the unmodelled effects on each axis, fixed per DUT like its truth.
+        self.tau_s = tau_s
+        # Signs of the unmodelled effects on each axis, fixed per DUT like its truth; the rate terms' sizes
+        # spread 0.5…1.5 × the procedure's (parts differ).
         signs = hashlib.sha256(f"effects:{serial}".encode()).digest()
         self.hysteresis_signs = np.array([1.0 if b & 1 else -1.0 for b in signs[:3]])
         self.nonlinearity_signs = np.array([1.0 if b & 1 else -1.0 for b in signs[3:6]])
+        self.rate_bias_factors = np.array([(1.0 if b & 1 else -1.0) * (0.5 + (b >> 1) / 127.0) for b in signs[6:9]])
+        self.rate_scale_factors = np.array([(1.0 if b & 1 else -1.0) * (0.5 + (b >> 1) / 127.0) for b in signs[9:12]])
         #: (t_start, t_end, n, parameters, gravity, temperature) of recently generated sample chunks.
         self.truth_log: deque[tuple] = deque(maxlen=4096)
 
@@ -58,10 +61,9 @@ class VirtualLab:
         self.chamber_noise_c = sim.chamber_noise_c
         self.controller_limits_c = sim.controller_limits_c
         self.kinematics = TurntableKinematics(rig.turntable.axes)
-        self.duts = [
-            SimulatedDut(s.serial, s.mount_euler_deg, sim.fixture_time_constant_min * 60.0, part(s.part))
-            for s in rig.fixture.sensors
-        ]
+        serials = [s.serial for s in rig.fixture.sensors]
+        self.duts = [SimulatedDut(s.serial, s.mount_euler_deg, tau_s, part(s.part))
+                     for s, tau_s in zip(rig.fixture.sensors, sim.fixture_time_constants_s(serials))]
         #: Each DUT's noise density: the rig config's, or its part's.
         self.noise_density_g_per_rthz = [1e-6 * (d.part.noise_density_ug_per_rthz if sim.noise_density_ug_per_rthz
                                                  is None else sim.noise_density_ug_per_rthz) for d in self.duts]
@@ -72,6 +74,12 @@ class VirtualLab:
             dut_tau_s=[d.tau_s for d in self.duts],
             self_heating_c=sim.self_heating_c,
             free_cooling_tau_s=sim.free_cooling_time_constant_min * 60.0,
+            overshoot_fraction=sim.chamber_overshoot_pct / 100.0,
+            cooling_floor_c=sim.cooling_floor_c,
+            slot_offset_per_c=sim.slot_offsets_per_c(len(serials)),
+            hysteresis_span_c=effects.hysteresis_span_c,
+            hysteresis_time_constant_s=None if effects.hysteresis_time_constant_h is None
+            else effects.hysteresis_time_constant_h * 3600.0,
         )
         self.moisture = ChamberMoisture(sim.room_dew_point_c, sim.purge_dew_point_c,
                                         sim.moisture_time_constant_min * 60.0, self.thermal.air_c, clock.now())
@@ -110,11 +118,15 @@ class VirtualLab:
         return int(self.duts[index].part.temperature.raw(noisy))
 
     def unmodelled_g(self, index: int, gravity_g: np.ndarray) -> np.ndarray:
-        """What the DUT adds beyond Eq. 1 (zero unless the procedure switches effects on), in g."""
-        dut = self.duts[index]
-        hysteresis = 0.5e-3 * self.effects.hysteresis_mg * self.thermal.approach_sign[index] * dut.hysteresis_signs
-        nonlinearity = 1e-3 * self.effects.nonlinearity_mg_per_g2 * dut.nonlinearity_signs * gravity_g**2
-        return hysteresis + nonlinearity
+        """What the DUT adds beyond Eq. 1 (zero unless the procedure switches effects on), in g: hysteresis
+        by its state, bias and scale by its rate of temperature change, a square law."""
+        dut, effects = self.duts[index], self.effects
+        hysteresis = 0.5e-3 * effects.hysteresis_mg * self.thermal.hysteresis_state[index] * dut.hysteresis_signs
+        rate_c_per_min = 60.0 * float(self.thermal.dut_rate_c_per_s[index])
+        rate_bias = 1e-3 * effects.rate_bias_mg_per_c_per_min * rate_c_per_min * dut.rate_bias_factors
+        rate_scale = 1e-6 * effects.rate_scale_ppm_per_c_per_min * rate_c_per_min * dut.rate_scale_factors * gravity_g
+        nonlinearity = 1e-3 * effects.nonlinearity_mg_per_g2 * dut.nonlinearity_signs * gravity_g**2
+        return hysteresis + rate_bias + rate_scale + nonlinearity
 
     def noise_g(self, index: int, odr_hz: float) -> float:
         """DUT `index`'s per-sample white noise: density × √(equivalent noise bandwidth of the ODR/4 low-pass,

@@ -50,7 +50,7 @@ def test_advancing_is_bounded_whatever_the_gaps() -> None:
     m = model()
     steps = []
     real_step = m._step
-    m._step = lambda step_s, arrives: (steps.append(step_s), real_step(step_s, arrives))  # type: ignore[method-assign]
+    m._step = lambda step_s, rate, arrives: (steps.append(step_s), real_step(step_s, rate, arrives))  # type: ignore[method-assign]
     for k in range(1, 200):
         m.set_setpoint(k * 1e-3, 23.0 + (-1) ** k * 1e-13)
         m.air_c(k * 1e-3 + 1e-12)
