@@ -80,6 +80,9 @@ class FitOptions(StrictModel):
     polynomial_degree: int = Field(3, ge=0, le=6)
     parameters: Literal["all", "bias-scale"] = "all"
     out_of_range: Literal["clamp", "extrapolate"] = "clamp"
+    hysteresis: bool = Field(False, description="joint fit of a bidirectional ramp: a bias ±h per axis by the "
+                             "direction each pose was approached from; the calibration is the mean of both "
+                             "directions, the difference 2h is reported")
 
 
 class SimulatedEffects(StrictModel):
@@ -121,6 +124,10 @@ class RampMethod(StrictModel):
 
     rate_c_per_min: float = Field(ge=0.01, le=10, description="the software ramp of the chamber setpoint")
     update_s: float = Field(30.0, ge=1, le=600, description="how often the chamber setpoint is moved on")
+    bidirectional: bool = Field(False, description="after a soak at the last setpoint, ramp back towards the "
+                                "first, the poses taken again half-way between the setpoints: every band "
+                                "measured warming and cooling, so rate and lag errors cancel in the joint fit "
+                                "and the hysteresis shows")
 
 
 class Frost(StrictModel):
@@ -163,6 +170,9 @@ class Procedure(StrictModel):
         if self.method == "soak":
             if self.ramp is not None:
                 raise ValueError("ramp settings need method: ramp")
+            if self.fit.hysteresis:
+                raise ValueError("fit.hysteresis needs poses approached from both sides: method: ramp with "
+                                 "ramp.bidirectional: true")
             return self
         if self.ramp is None:
             raise ValueError("method: ramp needs ramp.rate_c_per_min")
@@ -174,6 +184,8 @@ class Procedure(StrictModel):
         if self.fit.mode != "none" and self.fit.temperature_model != "joint":
             raise ValueError("a ramp campaign's poses spread over each setpoint's temperatures: set "
                              "fit.temperature_model: joint")
+        if self.fit.hysteresis and not self.ramp.bidirectional:
+            raise ValueError("fit.hysteresis needs poses approached from both sides: ramp.bidirectional: true")
         return self
 
     @model_validator(mode="after")

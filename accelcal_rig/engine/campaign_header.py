@@ -69,4 +69,5 @@ def stored_plan(plan: Plan) -> StoredPlan:
 
 def fit_attrs(procedure: Procedure) -> dict[str, object]:
     fit = procedure.fit
-    return options_attrs(fit.mode, fit.polynomial_degree, fit.parameters, fit.out_of_range, fit.temperature_model)
+    return options_attrs(fit.mode, fit.polynomial_degree, fit.parameters, fit.out_of_range, fit.temperature_model,
+                         fit.hysteresis)

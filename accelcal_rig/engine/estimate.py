@@ -17,7 +17,6 @@ import copy
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from itertools import groupby
 
 import numpy as np
 
@@ -29,6 +28,7 @@ from accelcal_rig.engine.soak import first_stable_poll, settled_at
 from accelcal_rig.parts.part import TemperatureFormat
 from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.compile import Plan
+from accelcal_rig.plan.steps import Measurement, Ramp, RampSegment, Soak, StartSoftwareRamp
 
 #: Draws of the temperature reading noise over which the soak duration is a median.
 SOAK_DRAWS = 9
@@ -101,62 +101,61 @@ def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> Durat
     table_deg = np.zeros(len(speeds))
     t = 0.0
     rows = []
-    ramp_origin: tuple[float, float] | None = None  # the ramp method, once its first soak is done
-    for index, (setpoint, steps) in enumerate(groupby(plan.pose_steps, key=lambda s: s.setpoint_c)):
-        angles = np.array([s.pose.angles_deg for s in steps if s.pose is not None])
+    ramp: tuple[float, float, float] | None = None  # the software ramp once started: (t, from °C, toward °C)
+    rate_c_per_s = procedure.ramp.rate_c_per_min / 60.0 if procedure.ramp is not None else 0.0
+    for stage in plan.stages:
+        angles = np.array([s.pose.angles_deg for s in stage.body if isinstance(s, Measurement) and s.pose is not None])
+        if not len(angles):
+            continue
         path = np.vstack([table_deg, angles])
         travel_s = np.max(np.abs(np.diff(path, axis=0)) / speeds, axis=1)
         table_deg = angles[-1]
         poses_s = float(travel_s.sum()) + len(angles) * pose_fixed_s
-        if ramp_origin is not None:
-            assert procedure.ramp is not None
-            last = index == len(plan.setpoints_c) - 1
-            start_c = setpoint if last else 0.5 * (plan.setpoints_c[index - 1] + setpoint)
-            wait_s = max(ramp_origin[0] + abs(start_c - ramp_origin[1]) / (procedure.ramp.rate_c_per_min / 60.0) - t, 0)
-            _follow_software_ramp(thermal, procedure, ramp_origin, setpoint if last else plan.setpoints_c[-1], t,
-                                  t + wait_s + (0.0 if last else poses_s))
-            t += wait_s
-            if not last:
-                rows.append(SetpointEstimate(setpoint, wait_s, 0.0, poses_s, len(angles), "ramp", ()))
-                t += poses_s
-                continue
-            soak_s, outcome, settled = _soak(thermal, procedure, setpoint, t, readers)
-            rows.append(SetpointEstimate(setpoint, wait_s, soak_s, poses_s, len(angles), outcome, settled))
-            t += soak_s + poses_s
-            continue
-        thermal.set_setpoint(t, setpoint)
-        ramp_start = t
-        ramp_deadline = t + soak.ramp_timeout_factor * abs(setpoint - thermal.air_c(t)) / (
-            rig.chamber.ramp_rate_c_per_min / 60.0) + soak.ramp_timeout_margin_min * 60.0
-        while abs(thermal.air_c(t) - setpoint) > soak.chamber_tolerance_c and t < ramp_deadline:
-            t = min(t + soak.poll_s, ramp_deadline)
-        t_reached = t
-        if abs(thermal.air_c(t) - setpoint) > soak.chamber_tolerance_c:
-            rows.append(SetpointEstimate(setpoint, t - ramp_start, 0.0, 0.0, len(angles), "ramp timeout", ()))
-            break  # the engine would abort here
-        soak_s, outcome, settled = _soak(thermal, procedure, setpoint, t_reached, readers)
-        t_stable = t = t_reached + soak_s
-        if procedure.method == "ramp":
-            ramp_origin = (t, setpoint)
-        if procedure.cooldown is None:
-            t += poses_s
-        else:  # the records come on a schedule from the first
-            t += float(travel_s[0]) + (len(angles) - 1) * procedure.cooldown.record_every_s + pose_fixed_s
-        rows.append(SetpointEstimate(setpoint, t_reached - ramp_start, soak_s, t - t_stable, len(angles), outcome,
-                                     settled))
+        setpoint = stage.setpoint_c
+        ramp_s = soak_s = 0.0
+        outcome, settled = "ramp", ()  # type: tuple[str, tuple[float, ...]]
+        for step in stage.entry:  # the plan is the program: its steps, played against the model
+            if isinstance(step, Ramp):
+                ramp = None
+                thermal.set_setpoint(t, setpoint)
+                ramp_start = t
+                ramp_deadline = t + soak.ramp_timeout_factor * abs(setpoint - thermal.air_c(t)) / (
+                    rig.chamber.ramp_rate_c_per_min / 60.0) + soak.ramp_timeout_margin_min * 60.0
+                while abs(thermal.air_c(t) - setpoint) > soak.chamber_tolerance_c and t < ramp_deadline:
+                    t = min(t + soak.poll_s, ramp_deadline)
+                ramp_s += t - ramp_start
+                if abs(thermal.air_c(t) - setpoint) > soak.chamber_tolerance_c:
+                    rows.append(SetpointEstimate(setpoint, ramp_s, 0.0, 0.0, len(angles), "ramp timeout", ()))
+                    return DurationEstimate(tuple(rows))  # the engine would abort here
+            elif isinstance(step, Soak):
+                soak_s, outcome, settled = _soak(thermal, procedure, setpoint, t, readers)
+                t += soak_s
+            elif isinstance(step, StartSoftwareRamp):
+                ramp = (t, step.setpoint_c, step.toward_c)
+            elif isinstance(step, RampSegment) and ramp is not None:
+                wait_s = max(ramp[0] + abs(step.until_c - ramp[1]) / rate_c_per_s - t, 0.0)
+                _follow_software_ramp(thermal, procedure, ramp, t, t + wait_s)
+                t += wait_s
+                ramp_s += wait_s
+        if procedure.cooldown is not None:  # the records come on a schedule from the first
+            poses_s = float(travel_s[0]) + (len(angles) - 1) * procedure.cooldown.record_every_s + pose_fixed_s
+        if ramp is not None and outcome == "ramp":
+            _follow_software_ramp(thermal, procedure, ramp, t, t + poses_s)
+        rows.append(SetpointEstimate(setpoint, ramp_s, soak_s, poses_s, len(angles), outcome, settled))
+        t += poses_s
     return DurationEstimate(tuple(rows))
 
 
-def _follow_software_ramp(thermal: ThermalModel, procedure: Procedure, origin: tuple[float, float], last_c: float,
+def _follow_software_ramp(thermal: ThermalModel, procedure: Procedure, ramp: tuple[float, float, float],
                           from_s: float, to_s: float) -> None:
     """Move the model's setpoint as the engine's software ramp writes it, every `ramp.update_s`."""
     assert procedure.ramp is not None
     rate_c_per_s = procedure.ramp.rate_c_per_min / 60.0
-    t0, start_c = origin
+    t0, start_c, toward_c = ramp
     for t in np.arange(from_s, to_s + 1e-9, procedure.ramp.update_s):
         travelled = rate_c_per_s * (t - t0)
-        thermal.set_setpoint(float(t), min(start_c + travelled, last_c) if last_c > start_c
-                             else max(start_c - travelled, last_c))
+        thermal.set_setpoint(float(t), min(start_c + travelled, toward_c) if toward_c > start_c
+                             else max(start_c - travelled, toward_c))
 
 
 def _soak(thermal: ThermalModel, procedure: Procedure, setpoint_c: float, t_reached_s: float,

@@ -41,25 +41,27 @@ class ThermalSteps:
         self.temperature_moving = False
         #: The ramp method's software ramp once running: (clock time, setpoint °C) it started from.
         self._ramp_origin: tuple[float, float] | None = None
+        self._ramp_toward_c = 0.0
         self._ramp_written_s = float("-inf")
         #: When the chamber air (or the software ramp) last reached its setpoint: where a soak's deadline starts.
         self._reached_s = 0.0
 
     def start_software_ramp(self, step: StartSoftwareRamp) -> None:
-        """From the soak at the step's setpoint on, move the chamber setpoint at the procedure's rate towards
-        the last setpoint, where it soaks again; the poses in between follow the ramp."""
+        """From the step's setpoint on, move the chamber setpoint at the procedure's rate towards the step's
+        target; the poses in between follow the ramp."""
         assert self.procedure.ramp is not None
         self._ramp_origin = (self.clock.now(), step.setpoint_c)
+        self._ramp_toward_c = step.toward_c
+        self._ramp_written_s = float("-inf")
         self.temperature_moving = True
-        last = self.plan.setpoints_c[-1]
-        self.events.info("ramp", f"ramp method: chamber setpoint moving {step.setpoint_c:g} → {last:g} °C at "
-                                 f"{self.procedure.ramp.rate_c_per_min:g} °C/min, poses taken as it goes")
+        self.events.info("ramp", f"ramp method: chamber setpoint moving {step.setpoint_c:g} → {step.toward_c:g} °C "
+                                 f"at {self.procedure.ramp.rate_c_per_min:g} °C/min, poses taken as it goes")
 
     def _ramp_setpoint_c(self, t_s: float) -> float:
         """Where the software ramp is at clock time `t_s`, stopping at the last setpoint."""
         assert self._ramp_origin is not None and self.procedure.ramp is not None
         t0, start_c = self._ramp_origin
-        last = self.plan.setpoints_c[-1]
+        last = self._ramp_toward_c
         travelled = self.procedure.ramp.rate_c_per_min / 60.0 * (t_s - t0)
         return float(min(start_c + travelled, last) if last > start_c else max(start_c - travelled, last))
 

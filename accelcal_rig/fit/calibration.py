@@ -149,7 +149,10 @@ def save_calibration(calibration: CalibrationFile, path: Path) -> None:
 def load_calibration(path: Path) -> CalibrationFile:
     """The calibration file at `path`, validated; read again only once the file has changed (a run's
     certificates and its registry entries read the same file one after the other)."""
-    stat = path.stat()
+    try:
+        stat = path.stat()
+    except OSError:  # missing or unreadable: the loader says so in its own words
+        return load_validated(path, CalibrationFile, CALIBRATION_LIMITS).model
     return _load_calibration(path.resolve(), stat.st_ino, stat.st_size, stat.st_mtime_ns).model_copy(deep=True)
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial as bind
 from pathlib import Path
 from typing import Any, Literal
@@ -12,6 +12,7 @@ import numpy as np
 from accelcal_rig import __version__
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.fit.acceptance import judge, recorded_acceptance
+from accelcal_rig.fit.approach import approach_directions
 from accelcal_rig.fit.budget import (
     budget,
     calibration_covariance,
@@ -53,6 +54,8 @@ class FitOptions:
     free: FreeParameters = "all"
     out_of_range: OutOfRange = "clamp"
     temperature_model: TemperatureModel = "per-setpoint"
+    #: "on": the joint fit's bias carries ±h by each pose's direction of approach (a bidirectional ramp).
+    hysteresis: str = "off"
 
 
 @dataclass(frozen=True)
@@ -104,13 +107,21 @@ def fit_dut(stored: DutPoses, options: FitOptions) -> DutFitResult:
     sigmas = np.array([f.sigma for f in fits])
     free = fits[0].free
     thermal = fit_thermal(temperatures, estimates, sigmas, free, options.degree)
+    approach = poses.approach if options.hysteresis == "on" else None
+    hysteresis_g = np.zeros(3)
     if options.temperature_model == "joint":
-        thermal = fit_joint(thermal, free, pose_temperatures, poses.mean_g, poses.stderr_g,
-                            poses.reference_g if options.mode == "reference" else None, options.mode,
-                            np.radians(poses.reference_accuracy_arcsec / 3600), poses.gravity_g)
-    compensated = correct(poses.mean_g, thermal.parameters_at(pose_temperatures, "extrapolate"))
+        thermal, hysteresis_g = fit_joint(thermal, free, pose_temperatures, poses.mean_g, poses.stderr_g,
+                                          poses.reference_g if options.mode == "reference" else None, options.mode,
+                                          np.radians(poses.reference_accuracy_arcsec / 3600), poses.gravity_g,
+                                          approach)
+    # In-sample: the fit as fitted (its hysteresis removed by direction); the calibration delivered, and so
+    # the verification, knows no direction: it is the mean of both.
+    unhysteretic_g = poses.mean_g - (approach[:, None] * hysteresis_g if approach is not None else 0.0)
+    compensated = correct(unhysteretic_g, thermal.parameters_at(pose_temperatures, "extrapolate"))
     metrics = _metrics(poses, setpoints, groups, temperatures, fits, thermal, compensated, options)
     metrics["expected_fit_rmse_mg"] = _expected_rmse_mg(poses, groups, fits, thermal, pose_temperatures, options)
+    if approach is not None:  # warming minus cooling, per axis: what the calibration (their mean) leaves ± half of
+        metrics["hysteresis_mg"] = (2e3 * hysteresis_g).tolist()
     for row, group, fit in zip(metrics["rmse_by_setpoint"], groups, fits):
         row["expected_mg"] = _expected_rmse_mg(poses, [group], [fit], None, pose_temperatures, options)
     align = options.mode == "norm-only"
@@ -239,7 +250,10 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     """Fit every DUT of a stored campaign; the calibration file and the report `rig fit --json` prints
     (per serial). Nothing is written: the campaign's measurements are only read. `run_end`: the fit stage of
     the run itself, whose campaign is done but for the fit."""
-    results = map_over_duts(bind(fit_dut, options=options), [read_dut_poses(campaign, s) for s in campaign.serials])
+    stored = [read_dut_poses(campaign, s) for s in campaign.serials]
+    if options.hysteresis == "on":
+        stored = [with_approach(campaign, poses) for poses in stored]
+    results = map_over_duts(bind(fit_dut, options=options), stored)
     limits = recorded_acceptance(campaign.header.procedure_yaml, source.get("campaign", "the campaign"))
     partial = partial_campaign(campaign, run_end)
     judged = {r.serial: judge(r.metrics, r.thermal, options.mode, limits, partial) for r in results}
@@ -253,6 +267,20 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     report = {r.serial: {**plain(r.metrics), "warnings": r.thermal.warnings, "verdict": judged[r.serial].verdict,
                          "verdict_reasons": judged[r.serial].reasons} for r in results}
     return calibration, report
+
+
+def with_approach(campaign: Campaign, poses: DutPoses) -> DutPoses:
+    """The DUT's poses with the direction each was approached from, read off its soaks and poses."""
+    history_t, history_c = [], []
+    for soak in campaign.soaks:
+        serials = list(soak.serials) or campaign.serials
+        if poses.serial in serials and len(soak.t_s):
+            history_t.append(np.asarray(soak.t_s, dtype=float))
+            history_c.append(np.asarray(soak.dut_c, dtype=float)[:, serials.index(poses.serial)])
+    empty = np.zeros(0)
+    approach = approach_directions(poses.t_s, poses.temperature_c, np.concatenate(history_t or [empty]),
+                                   np.concatenate(history_c or [empty]))
+    return replace(poses, approach=approach)
 
 
 def partial_campaign(campaign: Campaign, run_end: bool = False) -> str:

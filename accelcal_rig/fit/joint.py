@@ -19,32 +19,42 @@ from accelcal_rig.fit.thermal import ThermalModel
 
 def fit_joint(start: ThermalModel, free: np.ndarray, temperature_c: np.ndarray, mean_g: np.ndarray,
               stderr_g: np.ndarray, reference_g: np.ndarray | None, mode: FitMode,
-              reference_accuracy_rad: float = 0.0, gravity_g: float = 1.0) -> ThermalModel:
-    """Refine `start`'s coefficients of the `free` parameters against every pose; fixed ones keep theirs."""
+              reference_accuracy_rad: float = 0.0, gravity_g: float = 1.0,
+              approach: np.ndarray | None = None) -> tuple[ThermalModel, np.ndarray]:
+    """Refine `start`'s coefficients of the `free` parameters against every pose; fixed ones keep theirs.
+    With `approach` (±1 per pose: warming, cooling) each pose's reading also carries a bias of
+    approach × h, h per axis fitted with the rest: (the model, h in g; zeros without `approach`)."""
     x = start.scaled(temperature_c)
     powers = np.vander(x, start.coefficients.shape[1], increasing=True)  # (n, degree + 1)
     stderr_g = np.maximum(np.asarray(stderr_g, dtype=float), 1e-9)
     rows = np.flatnonzero(free)
 
+    n_coefficients = len(rows) * start.coefficients.shape[1]
+    direction = None if approach is None else np.asarray(approach, dtype=float)[:, None]
+
     def model(theta: np.ndarray) -> np.ndarray:
         coefficients = start.coefficients.copy()
-        coefficients[rows] = theta.reshape(len(rows), -1)
+        coefficients[rows] = theta[:n_coefficients].reshape(len(rows), -1)
         return powers @ coefficients.T  # (n, 12) parameters at each pose's temperature
+
+    def reading(theta: np.ndarray) -> np.ndarray:
+        return mean_g if direction is None else mean_g - direction * theta[n_coefficients:]
 
     if mode == "reference":
         assert reference_g is not None
         sigma_g = reference_sigma_g(stderr_g, reference_g, reference_accuracy_rad)
 
         def residuals(theta: np.ndarray) -> np.ndarray:
-            return ((correct(mean_g, model(theta)) - reference_g) / sigma_g).ravel()
+            return ((correct(reading(theta), model(theta)) - reference_g) / sigma_g).ravel()
     else:
         weights = norm_sigma(mean_g, stderr_g)
 
         def residuals(theta: np.ndarray) -> np.ndarray:
-            return (np.linalg.norm(correct(mean_g, model(theta)), axis=1) - gravity_g) / weights
+            return (np.linalg.norm(correct(reading(theta), model(theta)), axis=1) - gravity_g) / weights
 
-    result = least_squares(residuals, start.coefficients[rows].ravel(), method="lm", xtol=1e-12, ftol=1e-12)
+    initial = np.concatenate([start.coefficients[rows].ravel(), np.zeros(0 if direction is None else 3)])
+    result = least_squares(residuals, initial, method="lm", xtol=1e-12, ftol=1e-12)
     coefficients = start.coefficients.copy()
-    coefficients[rows] = result.x.reshape(len(rows), -1)
+    coefficients[rows] = result.x[:n_coefficients].reshape(len(rows), -1)
     refined = ThermalModel(start.domain_c, coefficients, np.empty((0, 12)), start.degree, list(start.warnings))
-    return refined
+    return refined, np.concatenate([result.x[n_coefficients:], np.zeros(3)])[:3]

@@ -1,7 +1,7 @@
 """The fit options a campaign file records from its procedure: written and read in this one place.
 
 A campaign remembers how its procedure asked it to be fitted (root attributes `fit_mode`,
-`polynomial_degree`, `fit_parameters`, `fit_out_of_range`, `fit_temperature_model`), so `rig fit`,
+`polynomial_degree`, `fit_parameters`, `fit_out_of_range`, `fit_temperature_model`, `fit_hysteresis`), so `rig fit`,
 `rig report` and the run's own fit stage agree; command-line options override single values.
 """
 
@@ -22,15 +22,17 @@ _RECORDED: dict[str, tuple[str, tuple[str, ...] | None]] = {
     "free": ("fit_parameters", get_args(FreeParameters)),
     "out_of_range": ("fit_out_of_range", get_args(OutOfRange)),
     "temperature_model": ("fit_temperature_model", get_args(TemperatureModel)),
+    "hysteresis": ("fit_hysteresis", ("off", "on")),
 }
 #: What the procedure says when it asks for no fit at all.
 NO_FIT = "none"
 
 
-def options_attrs(mode: str, degree: int, free: str, out_of_range: str, temperature_model: str) -> dict[str, Any]:
+def options_attrs(mode: str, degree: int, free: str, out_of_range: str, temperature_model: str,
+                  hysteresis: bool = False) -> dict[str, Any]:
     """The attributes a campaign file records for a procedure's `fit` section."""
     values = {"mode": mode, "degree": degree, "free": free, "out_of_range": out_of_range,
-              "temperature_model": temperature_model}
+              "temperature_model": temperature_model, "hysteresis": "on" if hysteresis else "off"}
     return {attribute: values[name] for name, (attribute, _) in _RECORDED.items()}
 
 

@@ -142,6 +142,9 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
         _check_verification_is_new(poses, checks)
     width = max(2, len(str(len(poses))))
     setpoints = tuple(procedure.setpoints_c)
+    bidirectional = procedure.method == "ramp" and procedure.ramp is not None and procedure.ramp.bidirectional
+    if bidirectional:  # and back, half-way between the setpoints
+        setpoints += tuple(0.5 * (a + b) for a, b in zip(setpoints[::-1], setpoints[-2::-1]))
     stages = []
     entry: tuple[Step, ...]
     restart: tuple[Step, ...]
@@ -151,7 +154,7 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
         if verify is not None and verify.at_setpoints:
             measure.extend(_verification(setpoint, checks))
         if procedure.method == "ramp":
-            entry, restart = _ramp_method_entries(setpoints, index)
+            entry, restart = _ramp_method_entries(setpoints, index, len(procedure.setpoints_c) - 1)
             body: tuple[Step, ...] = tuple(step for m in measure for step in (AdvanceRamp(setpoint), m))
         else:
             entry = restart = _ramp_and_soak(setpoint)
@@ -203,15 +206,25 @@ def _ramp_and_soak(setpoint_c: float) -> tuple[Ramp, Soak]:
     return Ramp(setpoint_c), Soak(f"{setpoint_label(setpoint_c)}/soak", setpoint_c)
 
 
-def _ramp_method_entries(setpoints_c: tuple[float, ...], index: int) -> tuple[tuple[Step, ...], tuple[Step, ...]]:
+def _ramp_method_entries(setpoints_c: tuple[float, ...], index: int,
+                         turn: int) -> tuple[tuple[Step, ...], tuple[Step, ...]]:
     """(entry, restart entry) of the ramp method's `index`-th setpoint. The first soaks and starts the software
-    ramp; each later one's poses begin half-way from the previous setpoint, on the ramp; the last holds its
-    setpoint until the DUTs, lagging the air, have caught up, so the calibrated range reaches it."""
+    ramp; each later one's poses begin half-way from the previous setpoint, on the ramp; the one at `turn`
+    (the last setpoint) holds until the DUTs, lagging the air, have caught up, so the calibrated range
+    reaches it. A bidirectional ramp goes on from there, back towards the first, its bands half-way between
+    the setpoints, the last of them taken where the ramp stops."""
     setpoint = setpoints_c[index]
+    last = setpoints_c[-1]
     ramp, soak = _ramp_and_soak(setpoint)
-    start = (ramp, soak, StartSoftwareRamp(setpoint))
+    toward = setpoints_c[turn] if index < turn else last
+    start = (ramp, soak, StartSoftwareRamp(setpoint, toward))
     if index == 0:
         return start, start
-    if index == len(setpoints_c) - 1:
+    if index == turn:
         return (RampSegment(setpoint, setpoint), soak), (ramp, soak)
-    return (RampSegment(setpoint, 0.5 * (setpoints_c[index - 1] + setpoint)),), start
+    halfway = RampSegment(setpoint, 0.5 * (setpoints_c[index - 1] + setpoint))
+    if index == turn + 1:  # the way back begins after the turn's poses
+        return (StartSoftwareRamp(setpoints_c[turn], last), halfway), start
+    if index == len(setpoints_c) - 1:
+        return (RampSegment(setpoint, setpoint),), (ramp, soak)
+    return (halfway,), start

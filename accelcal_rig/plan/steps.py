@@ -53,9 +53,11 @@ class AwaitDewPointMargin:
 
 @dataclass(frozen=True)
 class StartSoftwareRamp:
-    """The ramp method: from here on the chamber setpoint moves at the procedure's rate to the last setpoint."""
+    """The ramp method: from here on the chamber setpoint moves at the procedure's rate from `setpoint_c`
+    to `toward_c` (the last setpoint; a bidirectional ramp's way back, the last band of its return)."""
 
     setpoint_c: float
+    toward_c: float
 
 
 @dataclass(frozen=True)

@@ -245,6 +245,7 @@ class DutPoses:
     gravity_g: float = 1.0            # the site's gravity in standard g (the magnitude of every reference)
     truth_gravity_g: np.ndarray | None = None  # (N, 3) the simulation's true specific force, dry runs only
     gravity_uncertainty_g: float = 0.0
+    approach: np.ndarray | None = None  # (N,) +1 warming, −1 cooling towards each pose (fit.hysteresis)
 
     def subset(self, rows: np.ndarray) -> DutPoses:
         """These poses only (a boolean mask or indices)."""
@@ -252,7 +253,8 @@ class DutPoses:
                                                                 "stderr_g", "reference_g", "verification")}
         truth = self.truth_parameters[rows] if self.truth_parameters is not None else None
         gravity = self.truth_gravity_g[rows] if self.truth_gravity_g is not None else None
-        return replace(self, **arrays, truth_parameters=truth, truth_gravity_g=gravity)
+        approach = self.approach[rows] if self.approach is not None else None
+        return replace(self, **arrays, truth_parameters=truth, truth_gravity_g=gravity, approach=approach)
 
 
 def dut_description(campaign: Campaign, serial: str) -> dict[str, Any]:

@@ -40,7 +40,7 @@ def test_ramp_plan_soaks_at_the_ends_and_measures_on_the_software_ramp_in_betwee
     first, second, last = plan.stages[0], plan.stages[1], plan.stages[-1]
     setpoints = plan.setpoints_c
     assert first.entry == first.restart_entry == (Ramp(setpoints[0]), Soak(f"T{setpoints[0]:g}/soak", setpoints[0]),
-                                                  StartSoftwareRamp(setpoints[0]))
+                                                  StartSoftwareRamp(setpoints[0], setpoints[-1]))
     # Later setpoints ride on the ramp; their poses begin half-way from the previous setpoint.
     assert second.entry == (RampSegment(setpoints[1], 0.5 * (setpoints[0] + setpoints[1])),)
     assert [type(s) for s in second.restart_entry] == [Ramp, Soak, StartSoftwareRamp]
