@@ -253,7 +253,7 @@ class SimulationConfig(StrictModel):
     moisture_time_constant_min: float = Field(5.0, ge=0.01, le=1440, description="the air's dew point follows "
                                               "its target with this time constant")
     chamber_overshoot_pct: float = Field(0.0, ge=0, le=50, description="the air overshoots a set point by this "
-                                         "share of the step, peaking one chamber time constant after the ramp arrives")
+                                         "share of the step, peaking three chamber time constants after the ramp arrives")
     cooling_floor_c: TemperatureC | None = Field(None, description="cooling slows towards this temperature (the "
                                                  "compressor's floor): at T, the ramp rate × (T − floor)/(ambient − floor)")
     slot_gradient_c: float = Field(0.0, ge=0, le=20, description="at 60 °C from ambient, the last slot's air is "

@@ -1,7 +1,7 @@
 """Chamber air and DUT temperatures: a rate-limited setpoint, a first-order air lag, first-order DUT lags.
 
 Beyond that, each switched on by its own setting (docs/procedures.md, "Honest physics"): the controller's
-overshoot where a ramp arrives (a share of the step, peaking one air time constant after arrival); a
+overshoot where a ramp arrives (a share of the step, peaking three air time constants after arrival); a
 cooling rate that falls towards the compressor's floor temperature; each slot's own air (the slots further
 from the inlet nearer the ambient temperature); and a hysteresis state per DUT that swings towards its
 direction of travel over `hysteresis_span_c` and relaxes with `hysteresis_time_constant_s`.
@@ -23,6 +23,9 @@ MAX_STEP_S = 10.0
 #: A sub-step's change larger than this sets a DUT's direction of approach.
 _DIRECTION_THRESHOLD_C = 1e-4
 
+
+#: The controller's overshoot peaks this many air time constants after its ramp arrived.
+OVERSHOOT_PEAK_TIME_CONSTANTS = 3.0
 
 #: Noise of the DUT temperature reading before its 12-bit quantisation (dithers the 0.11 °C LSB).
 TEMPERATURE_READ_NOISE_C = 0.05
@@ -71,7 +74,6 @@ class ThermalModel:
         self.powered = True
         self.setpoint_c = ambient_c
         self._reference_c = ambient_c
-        self._lagged_c = ambient_c   # the air without its overshoot
         self._air_c = ambient_c
         self._dut_c = np.full(len(dut_tau_s), ambient_c + self_heating_c)
         #: Where the last ramp began and (once it arrived) when and by how much the air overshoots.
@@ -144,15 +146,13 @@ class ThermalModel:
             reference_end = self._reference_c + math.copysign(rate_c_per_s * step_s, gap) if gap else self._reference_c
         else:
             reference_end = self.ambient_c - gap * math.exp(-step_s / self.free_cooling_tau_s)
-        lagged_end = float(_lag(self._lagged_c, self._reference_c, reference_end, step_s, self.chamber_tau_s))
         t_end = self._t + step_s
         if arrives and self.overshoot_fraction:
             self._overshoot = (t_end, self.overshoot_fraction * (self._target_c - self._ramp_from_c))
         if not self.powered:
             self._overshoot = None
-        air_end = lagged_end
-        if self._overshoot is not None:
-            air_end += self._overshoot[1] * _bump(t_end - self._overshoot[0], self.chamber_tau_s)
+        air_end = float(_lag(self._air_c, self._reference_c + self._overshoot_c(self._t),
+                             reference_end + self._overshoot_c(t_end), step_s, self.chamber_tau_s))
         offsets = self.slot_offset_per_c
         target_start = self._air_c + offsets * (self._air_c - self.ambient_c) + self.self_heating_c
         target_end = air_end + offsets * (air_end - self.ambient_c) + self.self_heating_c
@@ -162,8 +162,15 @@ class ThermalModel:
         self.dut_rate_c_per_s = change / step_s
         self._dut_c = new_dut_c
         self._reference_c = reference_end
-        self._lagged_c = lagged_end
         self._air_c = air_end
+
+    def _overshoot_c(self, t_s: float) -> float:
+        """How far the controller drives past its set point at `t_s` after a ramp arrived: the share of the
+        step, peaking `OVERSHOOT_PEAK_TIME_CONSTANTS` air time constants after arrival (the air, lagging,
+        overshoots by somewhat less)."""
+        if self._overshoot is None:
+            return 0.0
+        return self._overshoot[1] * _bump(t_s - self._overshoot[0], OVERSHOOT_PEAK_TIME_CONSTANTS * self.chamber_tau_s)
 
     def _remember_direction(self, change: np.ndarray, step_s: float) -> None:
         """Swing each hysteresis state towards the direction of travel, then let it relax."""

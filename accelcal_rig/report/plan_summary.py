@@ -23,9 +23,9 @@ def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[s
         f"turntable {len(rig.turntable.axes)} axes, {len(rig.fixture.sensors)} DUTs "
         f"({', '.join(s.serial for s in rig.fixture.sensors)})",
         f"setpoints  {len(setpoints)}, in this order: {', '.join(f'{s:g}' for s in setpoints)} °C",
-        f"soak       at least {soak.min_dwell_min:g} min at setpoint, then each DUT within {soak.band_c:g} °C over "
-        f"{soak.window_min:g} min with the chamber within {soak.chamber_tolerance_c:g} °C; polled every "
-        f"{soak.poll_s:g} s; deadline {soak.timeout_min:g} min ({soak.on_timeout})",
+        f"soak       at least {soak.min_dwell_min:g} min at setpoint, then {_soak_criterion(procedure)} with the "
+        f"chamber within {soak.chamber_tolerance_c:g} °C; polled every {soak.poll_s:g} s; deadline "
+        f"{soak.timeout_min:g} min ({soak.on_timeout})",
         _poses_line(prepared),
         *_verification_lines(prepared),
         *_method_lines(prepared),
@@ -115,6 +115,14 @@ def _verification_lines(prepared: PreparedCampaign) -> list[str]:
     return lines
 
 
+def _soak_criterion(procedure: Any) -> str:
+    soak = procedure.soak
+    if soak.criterion == "settling":
+        return (f"each DUT's fitted settling curve over {soak.window_min:g} min leaving at most {soak.settle_c:g} °C "
+                f"to come and moving at most {soak.max_rate_c_per_min:g} °C/min (k = 2)")
+    return f"each DUT within {soak.band_c:g} °C over {soak.window_min:g} min"
+
+
 def _method_lines(prepared: PreparedCampaign) -> list[str]:
     procedure = prepared.procedure.model
     if procedure.cooldown is not None:
@@ -122,11 +130,52 @@ def _method_lines(prepared: PreparedCampaign) -> list[str]:
                else f"set to {procedure.cooldown.ambient_c:g} °C")
         return [f"cool-down  after the soak at {procedure.setpoints_c[0]:g} °C the chamber is {how} and the DUTs "
                 "cool while recording"]
-    if procedure.ramp is not None:
-        return [f"method     ramp: soak at {procedure.setpoints_c[0]:g} °C only, then the setpoint moves at "
-                f"{procedure.ramp.rate_c_per_min:g} °C/min to {procedure.setpoints_c[-1]:g} °C, poses taken as it "
-                "goes (each setpoint's poses from half-way to it)"]
-    return []
+    explained = method_explanation(procedure)
+    return [f"method     {explained['name']}: {explained['how']}",
+            f"           expected accurate because {explained['cancels']}",
+            f"           not cancelled: {explained['does_not_cancel']}"]
+
+
+def method_explanation(procedure: Any) -> dict[str, str]:
+    """Which method a procedure uses, and the effects of a real rig it cancels and those it does not."""
+    if procedure.ramp is None:
+        return {
+            "name": "soak",
+            "how": "the DUTs soaked at every setpoint, its poses taken with the temperature held",
+            "cancels": "every pose is taken with the DUTs settled: errors that follow the rate of temperature "
+                       "change (package stress, the temperature sensor's lag behind the proof mass) vanish with "
+                       "the rate; each DUT is fitted at its own sensor's temperature, so slot-to-slot "
+                       "differences do not matter",
+            "does_not_cancel": "hysteresis (the first setpoint is approached from one side, the rest from the "
+                               "other: a step no polynomial follows, and nothing measures it); the slowest "
+                               "method, every setpoint waits out the fixture's lag",
+        }
+    ramp = procedure.ramp
+    last = procedure.setpoints_c[-1]
+    if ramp.bidirectional:
+        return {
+            "name": "bidirectional ramp",
+            "how": f"soak at {procedure.setpoints_c[0]:g} °C, the setpoint moved at {ramp.rate_c_per_min:g} °C/min to "
+                   f"{last:g} °C (soaked there) and back, each band's poses on the way up and half-way between on the "
+                   "way down, every pose fitted at its own temperature",
+            "cancels": "each band is measured warming and cooling at the same rate: errors that follow the rate "
+                       "of change change sign between the two and cancel in the joint fit to first order"
+                       + ("; the fit's hysteresis term measures warming minus cooling and the calibration is their "
+                          "mean" if procedure.fit.hysteresis else ""),
+            "does_not_cancel": "what grows faster than the rate, and the ends of the range, each approached from "
+                               "one side; verification poses measured on the ramp carry its rate errors (the "
+                               "soaked ends are at rest)",
+        }
+    return {
+        "name": "ramp",
+        "how": f"soak at {procedure.setpoints_c[0]:g} °C only, then the setpoint moves at {ramp.rate_c_per_min:g} "
+               f"°C/min to {last:g} °C, poses taken as it goes (each setpoint's from half-way to it), every pose "
+               "fitted at its own temperature",
+        "cancels": "a slow ramp keeps errors that follow the rate of change small; each pose's own temperature "
+                   "follows the drift through the band",
+        "does_not_cancel": "errors that follow the rate of change are the same all along a one-way ramp and stay "
+                           "in the bias (an offset in static use); hysteresis, one direction only, is not seen",
+    }
 
 
 def plan_json(prepared: PreparedCampaign, estimate: DurationEstimate) -> dict[str, Any]:
@@ -137,6 +186,7 @@ def plan_json(prepared: PreparedCampaign, estimate: DurationEstimate) -> dict[st
         "rig": prepared.rig.model.name, "rig_path": str(prepared.rig.path),
         "setpoints_c": list(plan.setpoints_c),
         "soak": procedure.soak.model_dump(), "acquisition": procedure.acquisition.model_dump(),
+        **({"method": method_explanation(procedure)} if procedure.cooldown is None else {}),
         "axes": list(plan.axis_names),
         "poses": [{"number": p.number, "angles_deg": list(p.angles_deg), "gravity_fixture": list(p.gravity_fixture)}
                   for p in plan.poses],

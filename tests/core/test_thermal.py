@@ -1,4 +1,5 @@
 import numpy as np
+import pytest
 
 from accelcal_rig.core.thermal import ThermalModel
 
@@ -57,3 +58,43 @@ def test_advancing_is_bounded_whatever_the_gaps() -> None:
     assert len(steps) <= 2 * 2 * 200
     m.air_c(1e6)
     assert len(steps) <= 2 * 2 * 200 + 1e6 / thermal.MAX_STEP_S + 2
+
+
+def test_the_air_overshoots_a_step_by_about_its_share_after_the_ramp_arrives_then_settles() -> None:
+    m = model(overshoot_fraction=0.05)
+    m.set_setpoint(0.0, 43.0)  # a 20 °C step: the controller drives 1 °C past it once the ramp arrives (400 s)
+    times = np.arange(0.0, 6000.0, 5.0)
+    air = np.array([m.air_c(t) for t in times])
+    peak = int(np.argmax(air))
+    assert 43.6 < air[peak] < 44.1
+    assert 400.0 < times[peak] < 1600.0
+    assert abs(air[-1] - 43.0) < 0.1  # and settles back
+
+
+def test_cooling_slows_towards_the_compressors_floor_and_heating_does_not() -> None:
+    m = model(cooling_floor_c=-75.0)
+    assert m.ramp_rate_at_c_per_s(23.0, cooling=True) == 3 / 60
+    assert m.ramp_rate_at_c_per_s(-40.0, cooling=True) == pytest.approx(3 / 60 * 35 / 98)
+    assert m.ramp_rate_at_c_per_s(-40.0, cooling=False) == 3 / 60
+    m.set_setpoint(0.0, -40.0)
+    plain = model()
+    plain.set_setpoint(0.0, -40.0)
+    assert m.air_c(1260.0) > plain.air_c(1260.0) + 5.0  # 21 min: the plain chamber is there, this one is not
+
+
+def test_slots_further_from_the_inlet_sit_nearer_ambient() -> None:
+    m = model(slot_offset_per_c=[0.0, -1.0 / 60.0])
+    m.set_setpoint(0.0, 83.0)
+    m.air_c(20000.0)
+    first, last = m.dut_c(20000.0, 0), m.dut_c(20000.0, 1)
+    assert first - last == pytest.approx(1.0, abs=0.01)  # 60 °C above ambient: 1 °C apart
+
+
+def test_hysteresis_swings_over_its_span_and_relaxes() -> None:
+    m = model(hysteresis_span_c=10.0, hysteresis_time_constant_s=3600.0)
+    m.set_setpoint(0.0, 13.0)  # cooling 10 °C: the state swings from +1 towards −1
+    m.air_c(7200.0)
+    assert np.all(m.hysteresis_state < 0) and np.all(m.hysteresis_state > -1)
+    settled = m.hysteresis_state.copy()
+    m.air_c(7200.0 + 3 * 3600.0)  # held: it relaxes towards none with its time constant
+    np.testing.assert_allclose(m.hysteresis_state, settled * np.exp(-3.0), rtol=0.05)

@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from accelcal_rig.engine.estimate import estimate_duration
 from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.plan.steps import (
@@ -49,6 +50,24 @@ def test_ramp_plan_soaks_at_the_ends_and_measures_on_the_software_ramp_in_betwee
     assert [type(s) for s in second.body] == [AdvanceRamp, MeasurePose] * len(plan.poses)
     # The stored plan still lists a soak and the poses for every setpoint (a resumed run may soak at any).
     assert [s.key for s in second.records][:2] == [f"T{setpoints[1]:g}/soak", f"T{setpoints[1]:g}/pose01"]
+
+
+def test_a_bidirectional_ramp_turns_at_the_last_setpoint_and_measures_half_way_between_on_the_way_back() -> None:
+    plan = prepare(REPO / "procedures" / "fast-bidirectional-ramp.yaml").plan
+    up = [-40.0, -30.0, -20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0]
+    assert list(plan.setpoints_c) == up + [55.0, 45.0, 35.0, 25.0, 15.0, 5.0, -5.0, -15.0, -25.0, -35.0]
+    stages = {stage.setpoint_c: stage for stage in plan.stages}
+    assert stages[-40.0].entry[-1] == StartSoftwareRamp(-40.0, 60.0)
+    assert stages[60.0].entry == (RampSegment(60.0, 60.0), Soak("T60/soak", 60.0))  # the turn soaks
+    assert stages[55.0].entry == (StartSoftwareRamp(60.0, -35.0), RampSegment(55.0, 57.5))  # then back
+    assert stages[45.0].entry == (RampSegment(45.0, 50.0),)
+    assert stages[45.0].restart_entry[-1] == StartSoftwareRamp(45.0, -35.0)  # a resumed run goes on down
+    assert stages[-35.0].entry == (RampSegment(-35.0, -35.0),)  # the last band is taken where the ramp stops
+    keys = [s.key for s in plan.records]
+    assert len(set(keys)) == len(keys) and "T55/pose01" in keys and "T-35/verify07" in keys
+    estimate = estimate_duration(prepare(REPO / "procedures" / "fast-bidirectional-ramp.yaml").procedure.model,
+                                 prepare(REPO / "procedures" / "fast-bidirectional-ramp.yaml").rig.model, plan)
+    assert [r.soak_outcome for r in estimate.setpoints].count("stable") == 2  # the start and the turn only
 
 
 def test_cooldown_plan_soaks_once_then_numbers_its_records_at_the_held_pose() -> None:

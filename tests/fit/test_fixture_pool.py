@@ -1,0 +1,30 @@
+"""A large fixture's DUTs fitted in worker processes: the same results, in order, warnings raised here."""
+
+from __future__ import annotations
+
+import os
+import warnings
+
+import pytest
+
+from accelcal_rig.fit.fixture_pool import PARALLEL_FROM_DUTS, map_over_duts
+
+
+def square_warning_on_odd(value: int) -> tuple[int, int]:
+    if value % 2:
+        warnings.warn(f"odd {value}", RuntimeWarning, stacklevel=1)
+    return value * value, os.getpid()
+
+
+def test_many_duts_are_fitted_in_workers_in_order_with_their_warnings() -> None:
+    items = list(range(PARALLEL_FROM_DUTS + 3))
+    with pytest.warns(RuntimeWarning) as caught:
+        results = map_over_duts(square_warning_on_odd, items)
+    assert [square for square, _ in results] == [k * k for k in items]
+    assert os.getpid() not in {pid for _, pid in results}  # fitted elsewhere
+    assert [str(w.message) for w in caught] == [f"odd {k}" for k in items if k % 2]
+
+
+def test_a_small_fixture_is_fitted_here() -> None:
+    with pytest.warns(RuntimeWarning, match="odd 1"):
+        assert map_over_duts(square_warning_on_odd, [1, 2]) == [(1, os.getpid()), (4, os.getpid())]

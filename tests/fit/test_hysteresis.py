@@ -1,0 +1,63 @@
+"""A bidirectional ramp's poses: from which side each was approached, and the joint fit's hysteresis term."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from accelcal_rig.fit.approach import approach_directions
+from accelcal_rig.fit.joint import fit_joint
+from accelcal_rig.fit.sfem import distort
+from accelcal_rig.fit.thermal import ThermalModel
+from accelcal_rig.plan.schedules import sphere
+
+
+def test_the_direction_of_approach_is_read_off_the_temperature_history() -> None:
+    t = np.arange(0.0, 20000.0, 60.0)
+    temperature = np.interp(t, [0, 3000, 6000, 12000, 13000, 20000], [23, -40, -40, 60, 60, -35])  # cool, hold, …
+    poses = t[5::10]  # none exactly at a corner of the history
+    directions = approach_directions(poses, np.interp(poses, t, temperature), t, temperature)
+    expected = np.select([poses < 3000, poses < 6000, poses < 12000, poses < 13000], [-1, -1, 1, 1], -1)
+    assert np.array_equal(directions, expected)  # held temperatures keep the direction they were reached from
+
+
+def synthetic_ramp(h_g: np.ndarray, seed: int) -> tuple[ThermalModel, ThermalModel, np.ndarray, np.ndarray,
+                                                        np.ndarray, np.ndarray]:
+    """A sensor whose bias drifts linearly, read on a ramp up and down with ±h by direction."""
+    rng = np.random.default_rng(seed)
+    truth = np.zeros((12, 2))
+    truth[:, 0] = np.repeat([0.0, 1.0, 0.0, 0.0], 3) + rng.normal(0, 1e-3, 12)
+    truth[0:3, 1] = [5e-3, -4e-3, 6e-3]
+    model = ThermalModel((-40.0, 60.0), truth, np.empty((0, 12)), 1)
+    directions = sphere(12)
+    up, down = np.linspace(-40, 60, 11), np.linspace(55, -35, 10)
+    temperature = np.repeat(np.concatenate([up, down]), len(directions))
+    approach = np.repeat(np.concatenate([np.ones(len(up)), -np.ones(len(down))]), len(directions))
+    reference = np.tile(directions, (len(up) + len(down), 1))
+    readings = distort(reference, model.parameters_at(temperature)) + approach[:, None] * h_g
+    readings += rng.normal(0, 5e-6, readings.shape)
+    start = ThermalModel(model.domain_c, truth + rng.normal(0, 1e-4, truth.shape), np.empty((0, 12)), 1)
+    return model, start, temperature, readings, reference, approach
+
+
+def test_the_joint_fit_finds_the_hysteresis_and_the_mean_of_both_directions() -> None:
+    h_g = np.array([0.1e-3, -0.2e-3, 0.05e-3])
+    truth, start, temperature, readings, reference, approach = synthetic_ramp(h_g, seed=1)
+    stderr = np.full(readings.shape, 5e-6)
+    free = np.ones(12, dtype=bool)
+    fitted, found_h = fit_joint(start, free, temperature, readings, stderr, reference, "reference", 0.0, 1.0, approach)
+    np.testing.assert_allclose(found_h, h_g, atol=3e-6)
+    blind, none_h = fit_joint(start, free, temperature, readings, stderr, reference, "reference", 0.0, 1.0)
+    assert np.array_equal(none_h, np.zeros(3))
+    truth_bias = truth.parameters_at(temperature)[:, :3]  # the blind fit's bias is pulled towards ±h
+    aware_error = np.abs(fitted.parameters_at(temperature)[:, :3] - truth_bias).max()
+    blind_error = np.abs(blind.parameters_at(temperature)[:, :3] - truth_bias).max()
+    # Both directions over the same range: ±h cancels in the blind fit's bias to first order too, but its
+    # residuals carry it, and only the aware fit says how large it is.
+    assert aware_error < 3e-6 and blind_error < 0.2 * np.abs(h_g).max()
+    from accelcal_rig.fit.sfem import correct
+
+    def residual_rms(model: ThermalModel, h: np.ndarray) -> float:
+        corrected = correct(readings - approach[:, None] * h, model.parameters_at(temperature))
+        return float(np.sqrt(np.mean((corrected - reference) ** 2)))
+
+    assert residual_rms(fitted, found_h) < 1e-5 < 0.3 * np.abs(h_g).max() < residual_rms(blind, none_h)
