@@ -11,9 +11,11 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import sys
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from typing import TypeVar
 
 T = TypeVar("T")
@@ -31,7 +33,7 @@ def map_over_duts(fit: Callable[[T], R], items: Sequence[T]) -> list[R]:
     workers = min(cores, len(items))
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(["accelcal_rig.fit.fixture_worker"])  # not the main module: see above
-    with ProcessPoolExecutor(workers, mp_context=context) as pool:
+    with _main_module_hidden(), ProcessPoolExecutor(workers, mp_context=context) as pool:
         outcomes = list(pool.map(_recording_warnings, [fit] * len(items), items,
                                  chunksize=max(1, len(items) // (4 * workers))))
     results = []
@@ -40,6 +42,26 @@ def map_over_duts(fit: Callable[[T], R], items: Sequence[T]) -> list[R]:
             warnings.warn(message, category, stacklevel=2)
         results.append(result)
     return results
+
+
+@contextmanager
+def _main_module_hidden() -> Iterator[None]:
+    """While workers start: a worker is told which main module to import again (as multiprocessing does for
+    its spawned children) unless the main module has neither a file nor a spec. A worker needs only the
+    fit's modules; importing a script again would run its top level a second time (a script without a
+    `__main__` guard would start its campaign again in every worker)."""
+    main = sys.modules.get("__main__")
+    if main is None:
+        yield
+        return
+    saved: dict[str, object] = {name: main.__dict__[name] for name in ("__file__", "__spec__") if name in main.__dict__}
+    main.__dict__.pop("__file__", None)
+    main.__dict__["__spec__"] = None
+    try:
+        yield
+    finally:
+        main.__dict__.pop("__spec__", None)
+        main.__dict__.update(saved)
 
 
 def _recording_warnings(fit: Callable[[T], R], item: T) -> tuple[R, list[tuple[type[Warning], str]]]:

@@ -113,3 +113,29 @@ def test_after_a_skipped_first_soak_the_next_setpoint_soaks_and_starts_the_ramp_
 
     assert partial_campaign(load_campaign(output)) == ("partial campaign: 18 of 24 poses stored (a soak timed out and "
                                                        "its setpoint was skipped)")
+
+
+def test_a_bidirectional_ramp_measures_both_ways_and_its_fit_finds_the_hysteresis(write, workdir: Path) -> None:
+    """A sensor whose bias differs by 2 mg between warming and cooling: the bidirectional ramp's joint fit
+    finds that difference per axis, with its sign. (Less than all of it: on this short ramp the DUTs lag,
+    and many poses are taken while their hysteresis is still swinging over.)"""
+    text = RAMP.replace("ramp: {rate_c_per_min: 0.5, update_s: 20}", "ramp: {rate_c_per_min: 1, update_s: 20, "
+                        "bidirectional: true}").replace(
+        "fit: {mode: reference, polynomial_degree: 2, temperature_model: joint}",
+        "fit: {mode: reference, polynomial_degree: 2, temperature_model: joint, hysteresis: true}\n"
+        "simulation: {hysteresis_mg: 2, hysteresis_span_c: 1}")
+    prepared = prepare(write("both-ways.yaml", text))
+    assert list(prepared.plan.setpoints_c) == [20, 25, 30, 35, 32.5, 27.5, 22.5]
+    result = run_campaign(prepared, workdir / "both.h5", dry_run=True, seed=2, overwrite=False,
+                          calibration=workdir / "both.yaml")
+    assert result.summary.state == "done" and result.summary.poses_done == 7 * 6
+    sensor = load_calibration(workdir / "both.yaml").sensor("ADX355-A001")
+    found = np.array(sensor.metrics["hysteresis_mg"])
+    from accelcal_rig.sim.lab import SimulatedDut
+    from accelcal_rig.parts.adxl35x import ADXL355
+
+    signs = SimulatedDut("ADX355-A001", (0, 0, 0), 600.0, ADXL355).hysteresis_signs  # the simulated sensor's
+    assert np.array_equal(np.sign(found), signs)
+    assert np.all((0.8 < np.abs(found)) & (np.abs(found) < 2.4))
+    with h5py.File(workdir / "both.h5", "r") as f:
+        assert f.attrs["fit_hysteresis"] == "on"

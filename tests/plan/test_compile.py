@@ -53,20 +53,20 @@ def test_ramp_plan_soaks_at_the_ends_and_measures_on_the_software_ramp_in_betwee
 
 
 def test_a_bidirectional_ramp_turns_at_the_last_setpoint_and_measures_half_way_between_on_the_way_back() -> None:
-    plan = prepare(REPO / "procedures" / "fast-bidirectional-ramp.yaml").plan
-    up = [-40.0, -30.0, -20.0, -10.0, 0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0]
-    assert list(plan.setpoints_c) == up + [55.0, 45.0, 35.0, 25.0, 15.0, 5.0, -5.0, -15.0, -25.0, -35.0]
+    prepared = prepare(REPO / "procedures" / "fast-bidirectional-ramp.yaml")
+    plan = prepared.plan
+    down = [60.0, 50.0, 40.0, 30.0, 20.0, 10.0, 0.0, -10.0, -20.0, -30.0, -40.0]
+    assert list(plan.setpoints_c) == down + [-35.0, -25.0, -15.0, -5.0, 5.0, 15.0, 25.0, 35.0, 45.0, 55.0]
     stages = {stage.setpoint_c: stage for stage in plan.stages}
-    assert stages[-40.0].entry[-1] == StartSoftwareRamp(-40.0, 60.0)
-    assert stages[60.0].entry == (RampSegment(60.0, 60.0), Soak("T60/soak", 60.0))  # the turn soaks
-    assert stages[55.0].entry == (StartSoftwareRamp(60.0, -35.0), RampSegment(55.0, 57.5))  # then back
-    assert stages[45.0].entry == (RampSegment(45.0, 50.0),)
-    assert stages[45.0].restart_entry[-1] == StartSoftwareRamp(45.0, -35.0)  # a resumed run goes on down
-    assert stages[-35.0].entry == (RampSegment(-35.0, -35.0),)  # the last band is taken where the ramp stops
+    assert stages[60.0].entry[-1] == StartSoftwareRamp(60.0, -40.0)
+    assert stages[-40.0].entry == (RampSegment(-40.0, -40.0), Soak("T-40/soak", -40.0))  # the turn soaks
+    assert stages[-35.0].entry == (StartSoftwareRamp(-40.0, 55.0), RampSegment(-35.0, -37.5))  # then back
+    assert stages[-25.0].entry == (RampSegment(-25.0, -30.0),)
+    assert stages[-25.0].restart_entry[-1] == StartSoftwareRamp(-25.0, 55.0)  # a resumed run goes on up
+    assert stages[55.0].entry == (RampSegment(55.0, 55.0),)  # the last band is taken where the ramp stops
     keys = [s.key for s in plan.records]
-    assert len(set(keys)) == len(keys) and "T55/pose01" in keys and "T-35/verify07" in keys
-    estimate = estimate_duration(prepare(REPO / "procedures" / "fast-bidirectional-ramp.yaml").procedure.model,
-                                 prepare(REPO / "procedures" / "fast-bidirectional-ramp.yaml").rig.model, plan)
+    assert len(set(keys)) == len(keys) and "T-35/pose01" in keys and "T55/verify07" in keys
+    estimate = estimate_duration(prepared.procedure.model, prepared.rig.model, plan)
     assert [r.soak_outcome for r in estimate.setpoints].count("stable") == 2  # the start and the turn only
 
 
