@@ -54,6 +54,9 @@ class SoakCriterion(StrictModel):
     def _fits_in_timeout(self) -> SoakCriterion:
         if max(self.min_dwell_min, self.window_min) > self.timeout_min:
             raise ValueError("timeout_min must be at least min_dwell_min and window_min")
+        if self.criterion == "settling" and self.window_min * 60.0 < 5 * self.poll_s:
+            raise ValueError(f"criterion settling judges at least 5 polls in the window: window_min "
+                             f"{self.window_min:g} is {self.window_min * 60 / self.poll_s:.1f} polls of {self.poll_s:g} s")
         if self.timeout_min * 60.0 / self.poll_s > MAX_POLLS:
             raise ValueError(f"timeout_min / poll_s: a soak would be polled {self.timeout_min * 60 / self.poll_s:.0f} "
                              f"times (at most {MAX_POLLS}): poll less often or shorten the timeout")
@@ -238,9 +241,9 @@ class Procedure(StrictModel):
 
     @model_validator(mode="after")
     def _plan_size(self) -> Procedure:
-        poses = len(self.setpoints_c) * self.schedule_size() + self.verification_poses()
+        poses = self.bands() * self.schedule_size() + self.verification_poses()
         if self.cooldown is None and poses > MAX_PLAN_POSES:
-            raise ValueError(f"{len(self.setpoints_c)} setpoints × {self.schedule_size()} poses and "
+            raise ValueError(f"{self.bands()} setpoints × {self.schedule_size()} poses and "
                              f"{self.verification_poses()} verification poses = {poses} poses: a campaign holds "
                              f"at most {MAX_PLAN_POSES}")
         return self
@@ -249,12 +252,18 @@ class Procedure(StrictModel):
         """Poses of the schedule at one setpoint."""
         return self.schedule.size
 
+    def bands(self) -> int:
+        """Setpoints whose poses are measured: each calibration setpoint, and a bidirectional ramp's way back
+        half-way between them."""
+        n = len(self.setpoints_c)
+        return 2 * n - 1 if self.ramp is not None and self.ramp.bidirectional else n
+
     def verification_poses(self) -> int:
         """Verification poses of the whole campaign."""
         verify = self.verify
         if verify is None:
             return 0
-        setpoints = len(verify.setpoints_c) + (len(self.setpoints_c) if verify.at_setpoints else 0)
+        setpoints = len(verify.setpoints_c) + (self.bands() if verify.at_setpoints else 0)
         return setpoints * verify.schedule.size
 
     @field_validator("setpoints_c", mode="before")

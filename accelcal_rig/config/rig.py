@@ -321,6 +321,14 @@ class RigConfig(StrictModel):
     registry: str | None = Field(None, max_length=4096, description="where finished calibrations are recorded: an "
                                  "SQLite file (relative to this file) or a postgresql:// URL")
 
+    @model_validator(mode="after")
+    def _cooling_floor_below_the_chamber(self) -> RigConfig:
+        floor = self.simulation.cooling_floor_c
+        if floor is not None and floor >= min(self.chamber.min_setpoint_c, self.simulation.ambient_c):
+            raise ValueError(f"simulation.cooling_floor_c: {floor:g} °C is not below the chamber's lowest set point "
+                             f"({self.chamber.min_setpoint_c:g} °C) and the ambient: a compressor cools towards it")
+        return self
+
     @property
     def gravity_g(self) -> float:
         """The site's gravity in standard g: the magnitude every reference and every |g| figure uses."""

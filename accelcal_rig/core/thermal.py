@@ -4,7 +4,8 @@ Beyond that, each switched on by its own setting (docs/procedures.md, "Honest ph
 overshoot where a ramp arrives (a share of the step, peaking three air time constants after arrival); a
 cooling rate that falls towards the compressor's floor temperature; each slot's own air (the slots further
 from the inlet nearer the ambient temperature); and a hysteresis state per DUT that swings towards its
-direction of travel over `hysteresis_span_c` and relaxes with `hysteresis_time_constant_s`.
+direction of travel, a whole swing over `hysteresis_span_c` of travel, and relaxes with
+`hysteresis_time_constant_s`.
 
 Advanced lazily to the clock time of each query in sub-steps of at most `MAX_STEP_S`; each sub-step
 solves the lag exactly for an input that is linear over it. Every DUT is advanced at once (numpy). The
@@ -173,13 +174,12 @@ class ThermalModel:
         return self._overshoot[1] * _bump(t_s - self._overshoot[0], OVERSHOOT_PEAK_TIME_CONSTANTS * self.chamber_tau_s)
 
     def _remember_direction(self, change: np.ndarray, step_s: float) -> None:
-        """Swing each hysteresis state towards the direction of travel, then let it relax."""
-        moved = np.abs(change) > _DIRECTION_THRESHOLD_C
+        """Move each hysteresis state with the temperature: a whole swing, −1 to +1, over
+        `hysteresis_span_c` of travel (at once with span 0); then let it relax."""
         if self.hysteresis_span_c > 0:
-            share = np.minimum(np.abs(change) / self.hysteresis_span_c, 1.0)
-            self.hysteresis_state = np.where(moved, self.hysteresis_state + (np.sign(change) - self.hysteresis_state)
-                                             * share, self.hysteresis_state)
+            self.hysteresis_state = np.clip(self.hysteresis_state + 2.0 * change / self.hysteresis_span_c, -1.0, 1.0)
         else:
+            moved = np.abs(change) > _DIRECTION_THRESHOLD_C
             self.hysteresis_state = np.where(moved, np.sign(change), self.hysteresis_state)
         if self.hysteresis_time_constant_s is not None:
             self.hysteresis_state = self.hysteresis_state * math.exp(-step_s / self.hysteresis_time_constant_s)

@@ -31,6 +31,8 @@ _FILTERED_LENGTHS = 4
 _TIME_CONSTANTS = 24
 #: Coverage factor of the settling bounds.
 _K = 2.0
+#: Fewest polls in the window the settling criterion judges (two parameters, and their scatter).
+MIN_WINDOW_POLLS = 5
 
 
 @dataclass(frozen=True)
@@ -49,16 +51,39 @@ class Settling:
 
 def fit_settling(criterion: SoakCriterion, t_s: np.ndarray, dut_c: np.ndarray, window_start: int) -> Settling:
     """Each DUT's τ from every poll of the soak (the one of the grid whose a + B·exp(−t/τ) fits it best: the
-    approach, large early on, fixes it), then a and b over the polls from `window_start` with that τ (a
-    linear fit: its b and σ_b carry no bias from choosing τ on the same noise)."""
-    taus = _time_constants(criterion, t_s)
-    best = np.argmin(_least_squares(t_s, dut_c, taus)[2], axis=0)            # per DUT
-    a, b, sse, det = (v[best, np.arange(len(best))] for v in _least_squares(t_s[window_start:], dut_c[window_start:],
-                                                                             taus))
+    approach, large early on, fixes it), then a and b over the polls from `window_start` with that τ, or half
+    the window if that is longer (a τ much shorter than the window would leave b ≈ 0 whatever the window
+    holds); a linear fit, so its b and σ_b carry no bias from choosing τ on the same noise. The rate bound is
+    also that of a straight line through the window (a drift or a wobble the curve would not follow). Fewer
+    than MIN_WINDOW_POLLS polls in the window: nothing is known (infinite bounds)."""
     n = len(t_s) - window_start
-    sigma_b = np.sqrt(np.maximum(sse, 0.0) / max(n - 2, 1) * n / det)
+    if n < MIN_WINDOW_POLLS:
+        unknown = np.full(dut_c.shape[1], np.inf)
+        return Settling(unknown, unknown, unknown, dut_c[-1].astype(float))
+    taus = _time_constants(criterion, t_s)
+    best = np.argmin(_least_squares(t_s, dut_c - dut_c.mean(axis=0), taus)[2], axis=0)   # per DUT
+    t_window, y_window = t_s[window_start:], dut_c[window_start:]
+    shortest = int(np.searchsorted(taus, 0.5 * (t_window[-1] - t_window[0])))
+    chosen = np.minimum(np.maximum(best, shortest), len(taus) - 1)
+    offset = y_window.mean(axis=0)
+    big_a, big_b, sse, det = (v[chosen, np.arange(len(chosen))] for v in _least_squares(t_window, y_window - offset,
+                                                                                          taus))
+    last = np.exp(-(t_window[-1] - t_window[0]) / taus[chosen])
+    b = big_b * last
+    sigma_b = np.sqrt(np.maximum(sse, 0.0) / (n - 2) * n / det) * last
     bound = np.abs(b) + _K * sigma_b
-    return Settling(taus[best], bound, bound / taus[best] * 60.0, a + b)
+    return Settling(taus[chosen], bound, np.maximum(bound / taus[chosen], _line_rate_bound(t_window, y_window)) * 60.0,
+                    big_a + b + offset)
+
+
+def _line_rate_bound(t_s: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """|slope| + k·σ of a straight line through each DUT's readings, °C/s."""
+    dt = t_s - t_s.mean()
+    sxx = float(dt @ dt)
+    slope = dt @ (y - y.mean(axis=0)) / sxx
+    residual = y - y.mean(axis=0) - np.outer(dt, slope)
+    sigma = np.sqrt(np.einsum("ij,ij->j", residual, residual) / (len(t_s) - 2) / sxx)
+    return np.abs(slope) + _K * sigma
 
 
 def _time_constants(criterion: SoakCriterion, t_s: np.ndarray) -> np.ndarray:
@@ -69,9 +94,9 @@ def _time_constants(criterion: SoakCriterion, t_s: np.ndarray) -> np.ndarray:
 
 
 def _least_squares(t_s: np.ndarray, y: np.ndarray, taus: np.ndarray) -> tuple[np.ndarray, ...]:
-    """(a, b, residual sum of squares, det) of y ≈ a + B·exp(−(t − t_first)/τ), for every τ (rows) and DUT
-    (columns) at once: the design is the same for every DUT, so only sums are formed. b = B·exp(−(t_last −
-    t_first)/τ) is what is left of the approach at the last poll; det is scaled to b (σ_b² = s² n / det)."""
+    """(a, B, residual sum of squares, det of the normal matrix) of y ≈ a + B·exp(−(t − t_first)/τ), for every
+    τ (rows) and DUT (columns) at once: the design is the same for every DUT, so only sums are formed
+    (σ_B² = s² n / det). `y` is best centred: the sums then lose nothing to cancellation."""
     e = np.exp(-(np.asarray(t_s, dtype=float) - t_s[0])[None, :] / taus[:, None])   # (τ, polls), 1 at the first
     n = e.shape[1]
     sum_e, sum_ee = e.sum(axis=1), np.einsum("ki,ki->k", e, e)
@@ -80,8 +105,7 @@ def _least_squares(t_s: np.ndarray, y: np.ndarray, taus: np.ndarray) -> tuple[np
     big_b = (n * sum_ey - sum_e[:, None] * sum_y[None, :]) / det[:, None]
     a = (sum_y[None, :] - big_b * sum_e[:, None]) / n
     sse = sum_yy[None, :] - a * sum_y[None, :] - big_b * sum_ey
-    last = e[:, -1:]
-    return a, big_b * last, sse, det[:, None] / last**2 * np.ones_like(big_b)
+    return a, big_b, sse, det[:, None] * np.ones_like(big_b)
 
 
 class SoakDetector:
@@ -139,7 +163,7 @@ class SoakDetector:
         """Each DUT's temperature where it settled: the mean over the trailing window (band), the fitted
         curve's value at the last poll (settling: the mean would lag a DUT still creeping)."""
         assert self._dut is not None
-        if self.criterion.criterion == "settling" and self._window().stop - self._window().start >= 3:
+        if self.criterion.criterion == "settling" and self._window().stop - self._window().start >= MIN_WINDOW_POLLS:
             return self.settling().now_c
         return self._dut[self._window()].mean(axis=0)
 
@@ -169,7 +193,7 @@ def first_stable_poll(criterion: SoakCriterion, setpoint_c: float, t_reached_s: 
     if not candidate.any():
         return None
     if criterion.criterion == "settling":  # a fit per poll, in order, until one settles
-        for k in np.flatnonzero(candidate & (length >= 3)):
+        for k in np.flatnonzero(candidate & (length >= MIN_WINDOW_POLLS)):
             if fit_settling(criterion, t_s[:k + 1], dut_c[:k + 1], int(start[k])).settled(criterion):
                 return int(k)
         return None
@@ -194,6 +218,6 @@ def first_stable_poll(criterion: SoakCriterion, setpoint_c: float, t_reached_s: 
 def settled_at(criterion: SoakCriterion, t_s: np.ndarray, dut_c: np.ndarray, poll: int) -> np.ndarray:
     """What the detector reports as settled over the trailing window ending at `poll`."""
     start = int(np.searchsorted(t_s[:poll + 1], t_s[poll] - criterion.window_min * 60.0, side="left"))
-    if criterion.criterion == "settling" and poll + 1 - start >= 3:
+    if criterion.criterion == "settling" and poll + 1 - start >= MIN_WINDOW_POLLS:
         return fit_settling(criterion, t_s[:poll + 1], dut_c[:poll + 1], start).now_c
     return dut_c[start:poll + 1].mean(axis=0)

@@ -107,7 +107,7 @@ def fit_dut(stored: DutPoses, options: FitOptions) -> DutFitResult:
     sigmas = np.array([f.sigma for f in fits])
     free = fits[0].free
     thermal = fit_thermal(temperatures, estimates, sigmas, free, options.degree)
-    approach = poses.approach if options.hysteresis == "on" else None
+    approach = _both_ways(poses) if options.hysteresis == "on" and options.temperature_model == "joint" else None
     hysteresis_g = np.zeros(3)
     if options.temperature_model == "joint":
         thermal, hysteresis_g = fit_joint(thermal, free, pose_temperatures, poses.mean_g, poses.stderr_g,
@@ -122,6 +122,11 @@ def fit_dut(stored: DutPoses, options: FitOptions) -> DutFitResult:
     metrics["expected_fit_rmse_mg"] = _expected_rmse_mg(poses, groups, fits, thermal, pose_temperatures, options)
     if approach is not None:  # warming minus cooling, per axis: what the calibration (their mean) leaves ± half of
         metrics["hysteresis_mg"] = (2e3 * hysteresis_g).tolist()
+    elif options.hysteresis == "on":
+        thermal.warnings.append("fit.hysteresis not fitted: " + (
+            "the temperature model is not joint" if options.temperature_model != "joint" else
+            f"fewer than {MIN_POSES_EACH_WAY} poses approached warming and cooling over a common range of "
+            "temperature (a campaign stopped before its way back?)"))
     for row, group, fit in zip(metrics["rmse_by_setpoint"], groups, fits):
         row["expected_mg"] = _expected_rmse_mg(poses, [group], [fit], None, pose_temperatures, options)
     align = options.mode == "norm-only"
@@ -267,6 +272,23 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     report = {r.serial: {**plain(r.metrics), "warnings": r.thermal.warnings, "verdict": judged[r.serial].verdict,
                          "verdict_reasons": judged[r.serial].reasons} for r in results}
     return calibration, report
+
+
+#: Poses each direction of approach needs before the hysteresis term is fitted.
+MIN_POSES_EACH_WAY = 6
+
+
+def _both_ways(poses: DutPoses) -> np.ndarray | None:
+    """The poses' directions of approach if both occur often enough over a common range of temperature
+    (else ±h and the constant bias could not be told apart: no term, and no figure)."""
+    if poses.approach is None:
+        return None
+    warming, cooling = poses.temperature_c[poses.approach > 0], poses.temperature_c[poses.approach < 0]
+    if min(len(warming), len(cooling)) < MIN_POSES_EACH_WAY:
+        return None
+    if max(warming.min(), cooling.min()) >= min(warming.max(), cooling.max()):
+        return None
+    return poses.approach
 
 
 def with_approach(campaign: Campaign, poses: DutPoses) -> DutPoses:

@@ -85,7 +85,8 @@ class LinePort:
         talking without ever ending its line, at a deadline of the same length."""
         line = bytearray()
         deadline = time.monotonic() + (self._port.timeout or 0.0)
-        read = self._read_fd if isinstance(self._port, serial.Serial) and self._port.is_open else self._read_port
+        # A plain local device (not a spy:// or other URL's subclass, whose own read does more).
+        read = self._read_fd if type(self._port) is serial.Serial and self._port.is_open else self._read_port
         while not line.endswith(self._read_terminator):
             chunk = read(deadline)
             if not chunk or time.monotonic() > deadline:
@@ -101,10 +102,15 @@ class LinePort:
         """What has arrived on a local serial device, waiting until `deadline`: one select and one read,
         where pyserial's read costs four system calls (a fixture of 64 bridges asks ~10⁵ times a campaign)."""
         fd = self._port.fileno()
-        ready, _, _ = select.select([fd], [], [], max(0.0, deadline - time.monotonic()))
-        if not ready:
-            return b""
-        chunk = os.read(fd, 65536)
+        while True:
+            ready, _, _ = select.select([fd], [], [], max(0.0, deadline - time.monotonic()))
+            if not ready:
+                return b""
+            try:
+                chunk = os.read(fd, 65536)
+                break
+            except BlockingIOError:  # pyserial opens it non-blocking: readiness without data, wait again
+                continue
         if not chunk:
             raise serial.SerialException("device reports readiness to read but returned no data "
                                          "(device disconnected or multiple access on port?)")

@@ -156,15 +156,15 @@ def method_explanation(procedure: Any) -> dict[str, str]:
         return {
             "name": "bidirectional ramp",
             "how": f"soak at {procedure.setpoints_c[0]:g} °C, the setpoint moved at {ramp.rate_c_per_min:g} °C/min to "
-                   f"{last:g} °C (soaked there) and back, each band's poses on the way up and half-way between on the "
-                   "way down, every pose fitted at its own temperature",
+                   f"{last:g} °C (soaked there) and back, each band's poses on the way there and half-way between "
+                   "on the way back, every pose fitted at its own temperature",
             "cancels": "each band is measured warming and cooling at the same rate: errors that follow the rate "
                        "of change change sign between the two and cancel in the joint fit to first order"
                        + ("; the fit's hysteresis term measures warming minus cooling and the calibration is their "
                           "mean" if procedure.fit.hysteresis else ""),
-            "does_not_cancel": "what grows faster than the rate, and the ends of the range, each approached from "
-                               "one side; verification poses measured on the ramp carry its rate errors (the "
-                               "soaked ends are at rest)",
+            "does_not_cancel": "what grows faster than the rate, and the two end bands, each approached from one "
+                               "side; verification poses measured on the ramp carry its rate errors (the soaked "
+                               "ends are at rest)",
         }
     return {
         "name": "ramp",

@@ -16,6 +16,7 @@ import threading
 import time
 import tty
 
+from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.sim.faults import ReplyFaults
 from accelcal_rig.sim.line_answers import Handler, LineAnswers
 
@@ -36,6 +37,10 @@ class PtyLineServer:
                                     defer=lambda delay_s, reply, _: _HUB.send(self, delay_s, reply))
         #: When this device's latest reply is due: a later one is never written before it.
         self.due_s = 0.0
+        #: Held by the hub while it reads, answers or writes, and by `stop` while it closes: a descriptor is
+        #: never used once closed (its number may already be another file's).
+        self.lock = threading.Lock()
+        self.closed = False
 
     def start(self) -> PtyLineServer:
         _HUB.add(self)
@@ -43,23 +48,38 @@ class PtyLineServer:
 
     def stop(self) -> None:
         _HUB.remove(self)
-        for fd in (self._master, self._slave):
-            os.close(fd)
+        with self.lock:
+            self.closed = True
+            for fd in (self._master, self._slave):
+                os.close(fd)
 
     @property
     def fileno(self) -> int:
         return self._master
 
     def received(self) -> bool:
-        """Answer what has arrived; False once the pty is gone."""
-        try:
-            data = os.read(self._master, 65536)
-        except OSError:
-            return False
-        self._answers.feed(data, lambda reply: self.write(reply))
-        return True
+        """Answer what has arrived; False once the pty is gone. A simulator that fails on a request is
+        logged and answers nothing: the other devices of the hub go on."""
+        with self.lock:
+            if self.closed:
+                return False
+            try:
+                data = os.read(self._master, 65536)
+            except OSError:
+                return False
+            try:
+                self._answers.feed(data, self._write)
+            except Exception:  # noqa: BLE001 - one simulator's fault must not silence every device
+                LOGGER.exception("simulated device %s: request failed", self.name)
+            return True
 
     def write(self, reply: bytes) -> None:
+        """A reply written later (a delayed one), unless the device has been stopped since."""
+        with self.lock:
+            if not self.closed:
+                self._write(reply)
+
+    def _write(self, reply: bytes) -> None:
         try:
             os.write(self._master, reply)
         except OSError:
@@ -112,7 +132,7 @@ class PtyHub:
         due = max(now + delay_s, server.due_s)
         server.due_s = due
         if due <= now:
-            server.write(reply)
+            server._write(reply)  # from within its answer: the hub holds its lock
             return
         heapq.heappush(self._due, (due, next(self._order), server, reply))
 

@@ -1,4 +1,5 @@
 import numpy as np
+import pytest
 
 from accelcal_rig.config.procedure import SoakCriterion
 from accelcal_rig.engine.soak import SoakDetector
@@ -90,7 +91,7 @@ def test_the_settling_fit_finds_the_fixtures_time_constant_and_what_is_left_of_t
     t = np.arange(0.0, 40 * 60 + 1, 10.0)
     tau = np.array([540.0, 600.0, 660.0])  # a fixture's DUTs: ±10 % of 10 min
     readings = first_order_readings(t, tau, seed=2)
-    window_start = int(np.searchsorted(t, t[-1] - 20 * 60))
+    window_start = int(np.searchsorted(t, t[-1] - 10 * 60))  # half of it shorter than τ: the soak's τ is kept
     settling = fit_settling(SETTLING, t, readings, window_start)
     assert np.all(np.abs(settling.time_constant_s - tau) < 0.2 * tau)
     left = 10.0 * np.exp(-t[-1] / tau)  # the truth: 0.1…0.2 °C still to come after 40 min
@@ -158,3 +159,29 @@ def test_a_dry_run_soaks_by_the_settling_criterion_and_says_how_settled(write, w
         settled, last = soak["settled_dut_c"][:], soak["dut_c"][-20:].mean(axis=0)
     assert any("stable after" in m and "still to come ≤" in m and "°C/min" in m for m in messages)
     assert np.all(np.abs(settled - last) < 0.15)
+
+
+@pytest.mark.parametrize("trend", ["drift", "wobble", "slow mode"])
+def test_a_settling_fit_is_not_fooled_by_what_its_curve_would_not_follow(trend: str) -> None:
+    """A fast approach, then within the window: a drift of 2.5 × the rate allowed, a 0.5 °C wobble, or a
+    second, slow mode: none of these is settled."""
+    from accelcal_rig.engine.soak import fit_settling
+
+    criterion = SETTLING.model_copy(update={"window_min": 10})
+    t = np.arange(0.0, 60 * 60 + 1, 30.0)
+    fast = 30.0 - 10.0 * np.exp(-t / 180.0)
+    extra = {"drift": 0.05 / 60 * t, "wobble": 0.5 * np.sin(2 * np.pi * t / 1200.0),
+             "slow mode": -3.0 * np.exp(-t / 3000.0)}[trend]
+    readings = (fast + extra)[:, None]
+    window_start = int(np.searchsorted(t, t[-1] - 600))
+    assert not fit_settling(criterion, t, readings, window_start).settled(criterion)
+
+
+def test_too_few_polls_in_the_window_are_never_settled_and_such_a_window_is_refused() -> None:
+    from accelcal_rig.engine.soak import fit_settling
+
+    t = np.arange(0.0, 3600.0, 600.0)
+    flat = np.full((len(t), 2), 30.0)
+    assert not fit_settling(SETTLING, t, flat, len(t) - 2).settled(SETTLING)  # two polls: nothing is known
+    with pytest.raises(ValueError, match="at least 5 polls in the window"):
+        SoakCriterion(criterion="settling", window_min=5, poll_s=600, min_dwell_min=0)

@@ -61,3 +61,21 @@ def test_the_joint_fit_finds_the_hysteresis_and_the_mean_of_both_directions() ->
         return float(np.sqrt(np.mean((corrected - reference) ** 2)))
 
     assert residual_rms(fitted, found_h) < 1e-5 < 0.3 * np.abs(h_g).max() < residual_rms(blind, none_h)
+
+
+def test_poses_approached_one_way_only_fit_no_hysteresis_term() -> None:
+    """±h and the constant bias cannot be told apart from one direction: the term is left out, not fitted
+    to an arbitrary split (a campaign stopped before its way back)."""
+    from dataclasses import replace
+
+    from accelcal_rig.fit.campaign_fit import _both_ways
+    from accelcal_rig.store.read import DutPoses
+
+    n = 30
+    base = DutPoses("X", 2.0, 1e-6, np.zeros(n), np.arange(n, dtype=float), np.linspace(-40, 60, n),
+                    np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)), 3.0, None, np.zeros(n, dtype=bool))
+    assert _both_ways(replace(base, approach=-np.ones(n))) is None
+    split = np.where(np.arange(n) < n // 2, -1.0, 1.0)  # cooling over −40…10, warming over 10…60: no overlap
+    assert _both_ways(replace(base, approach=split)) is None
+    both = np.where(np.arange(n) % 2, -1.0, 1.0)
+    assert np.array_equal(_both_ways(replace(base, approach=both)), both)
