@@ -29,6 +29,7 @@ from accelcal_rig.engine.resume import ResumePoint, check_same_campaign
 from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
 from accelcal_rig.errors import CampaignAborted, RigError
 from accelcal_rig.fit.campaign_fit import fit_and_save, summary_line
+from accelcal_rig.fit.fixture_pool import warm_up_workers
 from accelcal_rig.fit.recorded_options import recorded_options
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.lock import campaign_lock
@@ -152,6 +153,8 @@ def _run(prepared: PreparedCampaign, output: Path, open_writer: Callable[[], Cam
         events = EventLog(clock, writer)
         progress = ProgressFile(progress_path(output), progress)
         estimate = estimate_duration(procedure, rig, prepared.plan)
+        if calibration and procedure.fit.mode != "none":
+            warm_up_workers(len(rig.fixture.sensors))  # a large fixture's fit workers load while it measures
         runner = CampaignRunner(procedure, rig, prepared.plan, rig_connected.guarded(events), writer, clock, events,
                                 fit_stage=_fit_stage(procedure, output, calibration)
                                 if calibration and procedure.fit.mode != "none" else None,

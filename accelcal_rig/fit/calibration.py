@@ -6,7 +6,6 @@ A versioned YAML artefact, checked on load. `apply` compensates raw readings wit
 from __future__ import annotations
 
 import warnings
-from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -140,25 +139,44 @@ def apply_codes(calibration: SensorCalibration, codes: np.ndarray, temperature_c
 def save_calibration(calibration: CalibrationFile, path: Path) -> None:
     """Write the calibration file, replacing any file at `path` whole (never a half-written one)."""
     dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml: a 64-DUT calibration is 2 MB of YAML
-    text = yaml.dump(calibration.model_dump(mode="json"), Dumper=dumper, sort_keys=False, width=120,
-                     allow_unicode=True)
+    data = calibration.model_dump(mode="json")
+    text = yaml.dump(data, Dumper=dumper, sort_keys=False, width=120, allow_unicode=True)
     write_text_atomically(path, "# accelcal-rig calibration: Eq. 1 parameters as polynomials of the sensor "
                                 "temperature\n" + text, "the calibration")
+    _remember(path, CalibrationFile.model_validate(data))  # what reading it back gives, without the parse
 
 
 def load_calibration(path: Path) -> CalibrationFile:
     """The calibration file at `path`, validated; read again only once the file has changed (a run's
     certificates and its registry entries read the same file one after the other)."""
+    key = _file_key(path)
+    if key is None:  # missing or unreadable: the loader says so in its own words
+        return load_validated(path, CalibrationFile, CALIBRATION_LIMITS).model
+    if key not in _LOADED:
+        _remember(path, load_validated(path, CalibrationFile, CALIBRATION_LIMITS).model)
+    return _LOADED[key].model_copy(deep=True)
+
+
+#: Calibrations read or written lately, by (path, inode, size, modification time): a changed file is read again.
+_LOADED: dict[tuple[Path, int, int, int], CalibrationFile] = {}
+_LOADED_AT_MOST = 4
+
+
+def _file_key(path: Path) -> tuple[Path, int, int, int] | None:
     try:
         stat = path.stat()
-    except OSError:  # missing or unreadable: the loader says so in its own words
-        return load_validated(path, CalibrationFile, CALIBRATION_LIMITS).model
-    return _load_calibration(path.resolve(), stat.st_ino, stat.st_size, stat.st_mtime_ns).model_copy(deep=True)
+    except OSError:
+        return None
+    return path.resolve(), stat.st_ino, stat.st_size, stat.st_mtime_ns
 
 
-@lru_cache(maxsize=4)
-def _load_calibration(path: Path, inode: int, size: int, mtime_ns: int) -> CalibrationFile:
-    return load_validated(path, CalibrationFile, CALIBRATION_LIMITS).model
+def _remember(path: Path, calibration: CalibrationFile) -> None:
+    key = _file_key(path)
+    if key is None:
+        return
+    _LOADED[key] = calibration
+    while len(_LOADED) > _LOADED_AT_MOST:
+        _LOADED.pop(next(iter(_LOADED)))
 
 
 def plain(value: Any) -> Any:

@@ -10,6 +10,8 @@ fit raises are raised again here, in the order the DUTs come.
 from __future__ import annotations
 
 import multiprocessing
+import multiprocessing.context
+import multiprocessing.forkserver
 import os
 import sys
 import warnings
@@ -25,15 +27,32 @@ R = TypeVar("R")
 PARALLEL_FROM_DUTS = 16
 
 
+def _cores() -> int:
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+def _context() -> multiprocessing.context.ForkServerContext:
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(["accelcal_rig.fit.fixture_worker"])  # not the main module: see above
+    return context  # type: ignore[return-value]
+
+
+def warm_up_workers(n_duts: int) -> None:
+    """Start the fork server now if a fit of `n_duts` will use it: it loads the fit's modules (a second or
+    two) on another core while the campaign measures, and the workers fork from it at once."""
+    if n_duts >= PARALLEL_FROM_DUTS and _cores() >= 2:
+        _context()
+        with _main_module_hidden():
+            multiprocessing.forkserver.ensure_running()
+
+
 def map_over_duts(fit: Callable[[T], R], items: Sequence[T]) -> list[R]:
     """`[fit(item) for item in items]`, in worker processes when there are many items and cores."""
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    cores = _cores()
     if len(items) < PARALLEL_FROM_DUTS or cores < 2:
         return [fit(item) for item in items]
     workers = min(cores, len(items))
-    context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(["accelcal_rig.fit.fixture_worker"])  # not the main module: see above
-    with _main_module_hidden(), ProcessPoolExecutor(workers, mp_context=context) as pool:
+    with _main_module_hidden(), ProcessPoolExecutor(workers, mp_context=_context()) as pool:
         outcomes = list(pool.map(_recording_warnings, [fit] * len(items), items,
                                  chunksize=max(1, len(items) // (4 * workers))))
     results = []

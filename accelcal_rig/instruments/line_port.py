@@ -56,9 +56,13 @@ class LinePort:
 
     def send(self, request: str) -> None:
         """Send a request: one that has no reply (a SCPI setting), or one whose reply `receive` reads."""
+        data = request.encode(self._encoding) + self._write_terminator
         try:
             self._port.reset_input_buffer()  # a late reply to an earlier, timed-out request is stale
-            self._port.write(request.encode(self._encoding) + self._write_terminator)
+            if self._local_device():
+                self._write_fd(data)
+            else:
+                self._port.write(data)
         except (serial.SerialException, OSError) as exc:
             raise TransientInstrumentError(f"{self.name}: {request!r}: port failed: {exc}", reconnect=True) from None
 
@@ -85,14 +89,33 @@ class LinePort:
         talking without ever ending its line, at a deadline of the same length."""
         line = bytearray()
         deadline = time.monotonic() + (self._port.timeout or 0.0)
-        # A plain local device (not a spy:// or other URL's subclass, whose own read does more).
-        read = self._read_fd if type(self._port) is serial.Serial and self._port.is_open else self._read_port
+        read = self._read_fd if self._local_device() else self._read_port
         while not line.endswith(self._read_terminator):
             chunk = read(deadline)
             if not chunk or time.monotonic() > deadline:
                 break
             line += chunk
         return bytes(line)
+
+    def _local_device(self) -> bool:
+        """A plain local device (not a spy:// or other URL's port, whose own read and write do more): read
+        and written on its descriptor directly."""
+        return type(self._port) is serial.Serial and self._port.is_open
+
+    def _write_fd(self, data: bytes) -> None:
+        """All of `data` to a local device within its write timeout: one write where pyserial's costs a select
+        and a loop in Python per call."""
+        fd = self._port.fileno()
+        deadline = time.monotonic() + (self._port.write_timeout or self._port.timeout or 1.0)
+        view = memoryview(data)
+        while view:
+            try:
+                view = view[os.write(fd, view):]
+                continue
+            except BlockingIOError:  # the device's buffer is full (it opens non-blocking): wait until it drains
+                pass
+            if not select.select([], [fd], [], max(0.0, deadline - time.monotonic()))[1]:
+                raise serial.SerialTimeoutException("write timeout")
 
     def _read_port(self, deadline: float) -> bytes:
         """What has arrived, waiting up to the port's timeout for the first byte (any pyserial port)."""
