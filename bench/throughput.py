@@ -5,9 +5,9 @@
 Each method's shipped procedure is run as a dry run on `configs/sim-honest.yaml` (the chamber's overshoot
 and cooling rate falling towards its floor, slot-to-slot air differences, a fixture lagging more with
 more DUTs) with `--duts` DUTs, its sensors given the effects Eq. 1 does not hold (`SENSOR_EFFECTS`:
-hysteresis relaxing over hours, bias and scale by the rate of temperature change) and 12 verification
-poses the fit never sees, at every band. Methods: the paper's soak at every setpoint, today's ramp (one
-way), the bidirectional ramp. Figures of the worst DUT of each run, the median over the seeds:
+hysteresis relaxing over hours, bias and scale by the rate of temperature change) and 7 verification
+poses the fit never sees, at rest (`verify.on_ramp: false`: a ramp's where it soaks, its ends). Methods:
+the paper's soak at every setpoint, today's ramp (one way), the bidirectional ramp. Figures of the worst DUT of each run, the median over the seeds:
 
 - `rig_hours`: the campaign's clock time, first ramp to last pose; `rig_hours_per_dut`;
 - `lower_bound_hours`: the least time the rig's physics allows to take the fixture once through the
@@ -59,8 +59,9 @@ METHODS = {
 #: The sensors' own effects beyond Eq. 1 (docs/procedures.md, "Honest physics", for their sources).
 SENSOR_EFFECTS = {"hysteresis_mg": 0.2, "hysteresis_span_c": 10.0, "hysteresis_time_constant_h": 2.0,
                   "rate_bias_mg_per_c_per_min": 0.1, "rate_scale_ppm_per_c_per_min": 5.0}
-#: Verification poses of every method (none of them a calibration pose of any schedule here).
-VERIFY = {"schedule": {"kind": "sphere", "count": 7}, "at_setpoints": True}
+#: Verification poses of every method (none of them a calibration pose of any schedule here), at rest: at
+#: every setpoint of the soak method, where the ramps soak (their ends) for theirs.
+VERIFY = {"schedule": {"kind": "sphere", "count": 7}, "at_setpoints": True, "on_ramp": False}
 #: The lower bound's DUTs come within this of each end of the range.
 END_WITHIN_C = 0.5
 

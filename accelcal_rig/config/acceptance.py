@@ -16,6 +16,8 @@ class Verification(StrictModel):
     schedule: Schedule
     at_setpoints: bool = Field(True, description="verification poses after the calibration poses at every "
                                                  "calibration setpoint")
+    on_ramp: bool = Field(True, description="method ramp: also where the poses are taken on the ramp (false: "
+                                            "only where the DUTs were soaked, at rest)")
     setpoints_c: list[TemperatureC] = Field(
         [], max_length=200, description="verification-only setpoints, between the calibration setpoints "
                                         "(soaked like them, only the verification poses measured)")

@@ -216,7 +216,7 @@ class Procedure(StrictModel):
             raise ValueError("a cool-down procedure has no verification poses (verify)")
         if verify.setpoints_c and self.method == "ramp":
             raise ValueError("verify.setpoints_c: the ramp passes every temperature; verify at_setpoints instead")
-        temperatures = len(verify.setpoints_c) + (len(self.setpoints_c) if verify.at_setpoints else 0)
+        temperatures = len(verify.setpoints_c) + (self.verified_bands() if verify.at_setpoints else 0)
         if self.acceptance.max_drift_mg is not None and temperatures < 2:
             raise ValueError("acceptance.max_drift_mg is judged across verification temperatures: verify at two or "
                              "more")
@@ -263,8 +263,15 @@ class Procedure(StrictModel):
         verify = self.verify
         if verify is None:
             return 0
-        setpoints = len(verify.setpoints_c) + (self.bands() if verify.at_setpoints else 0)
+        setpoints = len(verify.setpoints_c) + (self.verified_bands() if verify.at_setpoints else 0)
         return setpoints * verify.schedule.size
+
+    def verified_bands(self) -> int:
+        """Bands whose verification poses `verify.at_setpoints` measures: all, or with `verify.on_ramp: false`
+        a ramp's soaked ones only (its first setpoint and, bidirectional, its turn; one-way, its last)."""
+        if self.verify is None or self.ramp is None or self.verify.on_ramp:
+            return self.bands()
+        return 2
 
     @field_validator("setpoints_c", mode="before")
     @classmethod

@@ -69,13 +69,14 @@ class ThermalSteps:
         """Between poses on the ramp: write its current setpoint."""
         self.write_ramp_setpoint()
 
-    def write_ramp_setpoint(self) -> None:
-        """Write the software ramp's current setpoint, at most every `ramp.update_s`."""
+    def write_ramp_setpoint(self, arrived: bool = False) -> None:
+        """Write the software ramp's current setpoint, at most every `ramp.update_s` (`arrived`: now, where
+        a segment ends: the chamber must be left at the ramp's end, not an update short of it)."""
         if self._ramp_origin is None:
             return
         assert self.procedure.ramp is not None
         now = self.clock.now()
-        if now - self._ramp_written_s >= self.procedure.ramp.update_s:
+        if arrived or now - self._ramp_written_s >= self.procedure.ramp.update_s:
             self.chamber.write_setpoint_c(round(self._ramp_setpoint_c(now), 3))
             self._ramp_written_s = now
 
@@ -90,7 +91,7 @@ class ThermalSteps:
             self.read_chamber_c()  # the alarm, and what the progress display shows
             self.report.publish(self.machine.state)
             self.clock.sleep(min(self.procedure.ramp.update_s, arrival_s - self.clock.now()))
-        self.write_ramp_setpoint()
+        self.write_ramp_setpoint(arrived=True)
         self._reached_s = self.clock.now()
 
     def ramp(self, step: Ramp) -> None:

@@ -151,13 +151,16 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
     for index, setpoint in enumerate(setpoints):
         label = setpoint_label(setpoint)
         measure: list[MeasurePose | VerifyPose] = [MeasurePose(f"{label}/pose{p.number:0{width}d}", setpoint, p) for p in poses]
-        if verify is not None and verify.at_setpoints:
-            measure.extend(_verification(setpoint, checks))
         if procedure.method == "ramp":
             entry, restart = _ramp_method_entries(setpoints, index, len(procedure.setpoints_c) - 1)
-            body: tuple[Step, ...] = tuple(step for m in measure for step in (AdvanceRamp(setpoint), m))
         else:
             entry = restart = _ramp_and_soak(setpoint)
+        at_rest = any(isinstance(step, Soak) for step in entry)
+        if verify is not None and verify.at_setpoints and (at_rest or verify.on_ramp):
+            measure.extend(_verification(setpoint, checks))
+        if procedure.method == "ramp":
+            body: tuple[Step, ...] = tuple(step for m in measure for step in (AdvanceRamp(setpoint), m))
+        else:
             body = tuple(measure)
         stages.append(Stage(setpoint, entry, body, restart))
         if verify is not None and index + 1 < len(setpoints):

@@ -97,7 +97,9 @@ def _verification_lines(prepared: PreparedCampaign) -> list[str]:
     verify = procedure.verify
     if verify is None:
         return ["verify     none: every figure of the fit is in-sample (add a verify: section)"]
-    where = [w for w in ("at every calibration setpoint" if verify.at_setpoints else "",
+    every = ("at every calibration setpoint" if procedure.ramp is None or verify.on_ramp
+             else "where the DUTs were soaked (at rest)")
+    where = [w for w in (every if verify.at_setpoints else "",
                          "at " + ", ".join(f"{s:g}" for s in verify.setpoints_c) + " °C" if verify.setpoints_c else "")
              if w]
     total = sum(1 for s in plan.pose_steps if s.stored_kind == "verify")

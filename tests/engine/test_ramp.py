@@ -43,12 +43,14 @@ def test_a_ramp_campaign_measures_while_the_temperature_moves(write, workdir: Pa
         messages = [m.decode() for m in f["events/message"][:]]
         event_t_s = f["events/t_s"][:]
         last_soak_s = float(f["soaks/T35"].attrs["t_reached_s"])
+        final_chamber_c = f["soaks/T35/chamber_c"][-20:].mean()
         assert f.attrs["fit_temperature_model"] == "joint"
     assert any("ramp method: chamber setpoint moving 20 → 35 °C at 0.5 °C/min" in m for m in messages)
     # While the ramp moves the temperature on purpose, no pose is judged against a soak's band (after the
     # final soak it is again: the DUTs may still be settling, as the noise of a run decides).
     assert not any("left the" in m for m, t in zip(messages, event_t_s) if t < last_soak_s)
     assert temperature[-1] - temperature[0] > 5.0  # the DUTs warmed through the campaign (lagging the air)
+    assert abs(final_chamber_c - 35.0) < 0.05  # the ramp left the chamber at its end, not an update short
     later = setpoints == 30.0
     # Within one setpoint's poses the temperature rose, by more than the reading's noise (σ ≈ 0.06 °C).
     assert temperature[later][-1] - temperature[later][0] > 0.15
@@ -131,8 +133,8 @@ def test_a_bidirectional_ramp_measures_both_ways_and_its_fit_finds_the_hysteresi
     assert result.summary.state == "done" and result.summary.poses_done == 7 * 6
     sensor = load_calibration(workdir / "both.yaml").sensor("ADX355-A001")
     found = np.array(sensor.metrics["hysteresis_mg"])
-    from accelcal_rig.sim.lab import SimulatedDut
     from accelcal_rig.parts.adxl35x import ADXL355
+    from accelcal_rig.sim.lab import SimulatedDut
 
     signs = SimulatedDut("ADX355-A001", (0, 0, 0), 600.0, ADXL355).hysteresis_signs  # the simulated sensor's
     assert np.array_equal(np.sign(found), signs)
