@@ -84,8 +84,8 @@ class FitOptions(StrictModel):
     parameters: Literal["all", "bias-scale"] = "all"
     out_of_range: Literal["clamp", "extrapolate"] = "clamp"
     hysteresis: bool = Field(False, description="joint fit of a bidirectional ramp: a bias ±h per axis by the "
-                             "direction each pose was approached from; the calibration is the mean of both "
-                             "directions, the difference 2h is reported")
+                             "direction each pose was approached from and c × its rate of change; the "
+                             "calibration is the sensor at rest, 2h and c are reported")
 
 
 class SimulatedEffects(StrictModel):

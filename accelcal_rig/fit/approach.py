@@ -15,14 +15,27 @@ LOOKBACK_S = 600.0
 MOVED_C = 0.3
 
 
+def temperature_rates_c_per_min(t_s: np.ndarray, temperature_c: np.ndarray, history_t_s: np.ndarray,
+                                history_c: np.ndarray) -> np.ndarray:
+    """Each pose's rate of temperature change, °C/min: its change over the `LOOKBACK_S` before it (from the
+    same history as `approach_directions`)."""
+    times, readings = _history(t_s, temperature_c, history_t_s, history_c)
+    return (temperature_c - np.interp(t_s - LOOKBACK_S, times, readings)) / (LOOKBACK_S / 60.0)
+
+
+def _history(t_s: np.ndarray, temperature_c: np.ndarray, history_t_s: np.ndarray,
+             history_c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    times = np.concatenate([history_t_s, t_s])
+    readings = np.concatenate([history_c, temperature_c])
+    order = np.argsort(times, kind="stable")
+    return times[order], readings[order]
+
+
 def approach_directions(t_s: np.ndarray, temperature_c: np.ndarray, history_t_s: np.ndarray,
                         history_c: np.ndarray) -> np.ndarray:
     """+1 (warming) or −1 (cooling) for each pose at `t_s` with `temperature_c`, from the history of
     readings (`history_*`, any order; the poses' own readings are added)."""
-    times = np.concatenate([history_t_s, t_s])
-    readings = np.concatenate([history_c, temperature_c])
-    order = np.argsort(times, kind="stable")
-    times, readings = times[order], readings[order]
+    times, readings = _history(t_s, temperature_c, history_t_s, history_c)
     before = np.interp(t_s - LOOKBACK_S, times, readings)
     change = temperature_c - before
     directions = np.zeros(len(t_s))

@@ -12,7 +12,7 @@ import numpy as np
 from accelcal_rig import __version__
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.fit.acceptance import judge, recorded_acceptance
-from accelcal_rig.fit.approach import approach_directions
+from accelcal_rig.fit.approach import approach_directions, temperature_rates_c_per_min
 from accelcal_rig.fit.budget import (
     budget,
     calibration_covariance,
@@ -108,20 +108,24 @@ def fit_dut(stored: DutPoses, options: FitOptions) -> DutFitResult:
     free = fits[0].free
     thermal = fit_thermal(temperatures, estimates, sigmas, free, options.degree)
     approach = _both_ways(poses) if options.hysteresis == "on" and options.temperature_model == "joint" else None
-    hysteresis_g = np.zeros(3)
+    rate = poses.rate_c_per_min if approach is not None else None
+    hysteresis_g, rate_g = np.zeros(3), np.zeros(3)
     if options.temperature_model == "joint":
-        thermal, hysteresis_g = fit_joint(thermal, free, pose_temperatures, poses.mean_g, poses.stderr_g,
-                                          poses.reference_g if options.mode == "reference" else None, options.mode,
-                                          np.radians(poses.reference_accuracy_arcsec / 3600), poses.gravity_g,
-                                          approach)
-    # In-sample: the fit as fitted (its hysteresis removed by direction); the calibration delivered, and so
-    # the verification, knows no direction: it is the mean of both.
-    unhysteretic_g = poses.mean_g - (approach[:, None] * hysteresis_g if approach is not None else 0.0)
+        thermal, hysteresis_g, rate_g = fit_joint(thermal, free, pose_temperatures, poses.mean_g, poses.stderr_g,
+                                                  poses.reference_g if options.mode == "reference" else None,
+                                                  options.mode, np.radians(poses.reference_accuracy_arcsec / 3600),
+                                                  poses.gravity_g, approach, rate)
+    # In-sample: the fit as fitted (its hysteresis and rate terms removed); the calibration delivered, and
+    # so the verification, knows neither: it is the sensor at rest, the mean of both directions.
+    unhysteretic_g = poses.mean_g
+    if approach is not None and rate is not None:
+        unhysteretic_g = poses.mean_g - approach[:, None] * hysteresis_g - rate[:, None] * rate_g
     compensated = correct(unhysteretic_g, thermal.parameters_at(pose_temperatures, "extrapolate"))
     metrics = _metrics(poses, setpoints, groups, temperatures, fits, thermal, compensated, options)
     metrics["expected_fit_rmse_mg"] = _expected_rmse_mg(poses, groups, fits, thermal, pose_temperatures, options)
     if approach is not None:  # warming minus cooling, per axis: what the calibration (their mean) leaves ± half of
         metrics["hysteresis_mg"] = (2e3 * hysteresis_g).tolist()
+        metrics["rate_bias_mg_per_c_per_min"] = (1e3 * rate_g).tolist()
     elif options.hysteresis == "on":
         thermal.warnings.append("fit.hysteresis not fitted: " + (
             "the temperature model is not joint" if options.temperature_model != "joint" else
@@ -299,10 +303,9 @@ def with_approach(campaign: Campaign, poses: DutPoses) -> DutPoses:
         if poses.serial in serials and len(soak.t_s):
             history_t.append(np.asarray(soak.t_s, dtype=float))
             history_c.append(np.asarray(soak.dut_c, dtype=float)[:, serials.index(poses.serial)])
-    empty = np.zeros(0)
-    approach = approach_directions(poses.t_s, poses.temperature_c, np.concatenate(history_t or [empty]),
-                                   np.concatenate(history_c or [empty]))
-    return replace(poses, approach=approach)
+    history = (poses.t_s, poses.temperature_c, np.concatenate(history_t or [np.zeros(0)]),
+               np.concatenate(history_c or [np.zeros(0)]))
+    return replace(poses, approach=approach_directions(*history), rate_c_per_min=temperature_rates_c_per_min(*history))
 
 
 def partial_campaign(campaign: Campaign, run_end: bool = False) -> str:

@@ -20,17 +20,20 @@ from accelcal_rig.fit.thermal import ThermalModel
 def fit_joint(start: ThermalModel, free: np.ndarray, temperature_c: np.ndarray, mean_g: np.ndarray,
               stderr_g: np.ndarray, reference_g: np.ndarray | None, mode: FitMode,
               reference_accuracy_rad: float = 0.0, gravity_g: float = 1.0,
-              approach: np.ndarray | None = None) -> tuple[ThermalModel, np.ndarray]:
+              approach: np.ndarray | None = None,
+              rate_c_per_min: np.ndarray | None = None) -> tuple[ThermalModel, np.ndarray, np.ndarray]:
     """Refine `start`'s coefficients of the `free` parameters against every pose; fixed ones keep theirs.
     With `approach` (±1 per pose: warming, cooling) each pose's reading also carries a bias of
-    approach × h, h per axis fitted with the rest: (the model, h in g; zeros without `approach`)."""
+    approach × h, and with `rate_c_per_min` one of rate × c, h and c per axis fitted with the rest (a
+    hysteresis, which stays at rest, and what follows the rate of change, which does not): (the model,
+    h in g, c in g per °C/min; zeros for a term not fitted)."""
     x = start.scaled(temperature_c)
     powers = np.vander(x, start.coefficients.shape[1], increasing=True)  # (n, degree + 1)
     stderr_g = np.maximum(np.asarray(stderr_g, dtype=float), 1e-9)
     rows = np.flatnonzero(free)
 
     n_coefficients = len(rows) * start.coefficients.shape[1]
-    direction = None if approach is None else np.asarray(approach, dtype=float)[:, None]
+    terms = [np.asarray(v, dtype=float)[:, None] for v in (approach, rate_c_per_min) if v is not None]
 
     def model(theta: np.ndarray) -> np.ndarray:
         coefficients = start.coefficients.copy()
@@ -38,7 +41,8 @@ def fit_joint(start: ThermalModel, free: np.ndarray, temperature_c: np.ndarray, 
         return powers @ coefficients.T  # (n, 12) parameters at each pose's temperature
 
     def reading(theta: np.ndarray) -> np.ndarray:
-        return mean_g if direction is None else mean_g - direction * theta[n_coefficients:]
+        extra = theta[n_coefficients:].reshape(-1, 3)
+        return mean_g - sum((term * extra[k] for k, term in enumerate(terms)), np.zeros_like(mean_g))
 
     if mode == "reference":
         assert reference_g is not None
@@ -52,9 +56,11 @@ def fit_joint(start: ThermalModel, free: np.ndarray, temperature_c: np.ndarray, 
         def residuals(theta: np.ndarray) -> np.ndarray:
             return (np.linalg.norm(correct(reading(theta), model(theta)), axis=1) - gravity_g) / weights
 
-    initial = np.concatenate([start.coefficients[rows].ravel(), np.zeros(0 if direction is None else 3)])
+    initial = np.concatenate([start.coefficients[rows].ravel(), np.zeros(3 * len(terms))])
     result = least_squares(residuals, initial, method="lm", xtol=1e-12, ftol=1e-12)
     coefficients = start.coefficients.copy()
     coefficients[rows] = result.x[:n_coefficients].reshape(len(rows), -1)
     refined = ThermalModel(start.domain_c, coefficients, np.empty((0, 12)), start.degree, list(start.warnings))
-    return refined, np.concatenate([result.x[n_coefficients:], np.zeros(3)])[:3]
+    extra = iter(result.x[n_coefficients:].reshape(-1, 3))
+    fitted = [next(extra) if v is not None else np.zeros(3) for v in (approach, rate_c_per_min)]
+    return refined, fitted[0], fitted[1]

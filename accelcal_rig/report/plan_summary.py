@@ -162,8 +162,8 @@ def method_explanation(procedure: Any) -> dict[str, str]:
                    "on the way back, every pose fitted at its own temperature",
             "cancels": "each band is measured warming and cooling at the same rate: errors that follow the rate "
                        "of change change sign between the two and cancel in the joint fit to first order"
-                       + ("; the fit's hysteresis term measures warming minus cooling and the calibration is their "
-                          "mean" if procedure.fit.hysteresis else ""),
+                       + ("; the fit's hysteresis and rate terms measure warming minus cooling and the bias per "
+                          "°C/min, and the calibration is the sensor at rest" if procedure.fit.hysteresis else ""),
             "does_not_cancel": "what grows faster than the rate, and the two end bands, each approached from one "
                                "side; verification poses measured on the ramp carry its rate errors (the soaked "
                                "ends are at rest)",

@@ -246,6 +246,7 @@ class DutPoses:
     truth_gravity_g: np.ndarray | None = None  # (N, 3) the simulation's true specific force, dry runs only
     gravity_uncertainty_g: float = 0.0
     approach: np.ndarray | None = None  # (N,) +1 warming, −1 cooling towards each pose (fit.hysteresis)
+    rate_c_per_min: np.ndarray | None = None  # (N,) each pose's rate of temperature change (fit.hysteresis)
 
     def subset(self, rows: np.ndarray) -> DutPoses:
         """These poses only (a boolean mask or indices)."""
@@ -254,7 +255,9 @@ class DutPoses:
         truth = self.truth_parameters[rows] if self.truth_parameters is not None else None
         gravity = self.truth_gravity_g[rows] if self.truth_gravity_g is not None else None
         approach = self.approach[rows] if self.approach is not None else None
-        return replace(self, **arrays, truth_parameters=truth, truth_gravity_g=gravity, approach=approach)
+        rate = self.rate_c_per_min[rows] if self.rate_c_per_min is not None else None
+        return replace(self, **arrays, truth_parameters=truth, truth_gravity_g=gravity, approach=approach,
+                       rate_c_per_min=rate)
 
 
 def dut_description(campaign: Campaign, serial: str) -> dict[str, Any]:

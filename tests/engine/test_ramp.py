@@ -125,7 +125,9 @@ def test_a_bidirectional_ramp_measures_both_ways_and_its_fit_finds_the_hysteresi
                         "bidirectional: true}").replace(
         "fit: {mode: reference, polynomial_degree: 2, temperature_model: joint}",
         "fit: {mode: reference, polynomial_degree: 2, temperature_model: joint, hysteresis: true}\n"
-        "simulation: {hysteresis_mg: 2, hysteresis_span_c: 1}")
+        "simulation: {hysteresis_mg: 2, hysteresis_span_c: 1}").replace(
+        "soak: {min_dwell_min: 5, window_min: 2, band_c: 0.3, poll_s: 10, timeout_min: 120}",
+        "soak: {criterion: settling, min_dwell_min: 10, window_min: 10, poll_s: 10, timeout_min: 120}")  # ends at rest
     prepared = prepare(write("both-ways.yaml", text))
     assert list(prepared.plan.setpoints_c) == [20, 25, 30, 35, 32.5, 27.5, 22.5]
     result = run_campaign(prepared, workdir / "both.h5", dry_run=True, seed=2, overwrite=False,
