@@ -298,6 +298,20 @@ def test_rig_plan_prints_every_pose_and_an_estimate_without_touching_instruments
         s["ramp_s"] + s["soak_s"] + s["poses_s"] for s in report["estimate"]["setpoints"]))
 
 
+@pytest.mark.parametrize(("procedure", "method", "said"), [
+    ("paper-24pos-thermal.yaml", "soak", "hysteresis"),
+    ("paper-24pos-ramp.yaml", "ramp", "one direction only"),
+    ("fast-bidirectional-ramp.yaml", "bidirectional ramp", "cancel in the joint fit"),
+])
+def test_rig_plan_says_which_method_and_what_it_cancels(procedure: str, method: str, said: str, capsys) -> None:
+    assert main(["plan", str(REPO / "procedures" / procedure), "--json"]) == 0
+    explained = json.loads(capsys.readouterr().out)["method"]
+    assert explained["name"] == method and said in explained["cancels"] + explained["does_not_cancel"]
+    assert main(["plan", str(REPO / "procedures" / procedure)]) == 0
+    out = capsys.readouterr().out
+    assert f"method     {method}:" in out and "expected accurate because" in out and "not cancelled:" in out
+
+
 def test_rig_plan_shows_verification_limits_and_warns_of_too_few_setpoints(write, capsys) -> None:
     text = TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c: [20, 40]") + (
         "fit: {polynomial_degree: 2}\nverify: {schedule: {kind: sphere, count: 8}, setpoints_c: [30]}\n"
