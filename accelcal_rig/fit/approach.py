@@ -13,14 +13,24 @@ import numpy as np
 LOOKBACK_S = 600.0
 #: A change smaller than this is no direction (the reading's noise and its 0.11 °C steps).
 MOVED_C = 0.3
+#: A pose's rate of change is the slope of its DUT's readings this far either side of it.
+RATE_HALF_WINDOW_S = 150.0
 
 
 def temperature_rates_c_per_min(t_s: np.ndarray, temperature_c: np.ndarray, history_t_s: np.ndarray,
                                 history_c: np.ndarray) -> np.ndarray:
-    """Each pose's rate of temperature change, °C/min: its change over the `LOOKBACK_S` before it (from the
-    same history as `approach_directions`)."""
+    """Each pose's rate of temperature change, °C/min: the slope of a straight line through the DUT's
+    readings within RATE_HALF_WINDOW_S either side of it (its soak polls and poses; centred, so it does not
+    lag the rate where it changes, at a turn or a soak's start)."""
     times, readings = _history(t_s, temperature_c, history_t_s, history_c)
-    return (temperature_c - np.interp(t_s - LOOKBACK_S, times, readings)) / (LOOKBACK_S / 60.0)
+    start = np.searchsorted(times, t_s - RATE_HALF_WINDOW_S, side="left")
+    stop = np.searchsorted(times, t_s + RATE_HALF_WINDOW_S, side="right")
+    sums = [np.concatenate([[0.0], np.cumsum(v)]) for v in (np.ones_like(times), times, readings,
+                                                            times * times, times * readings)]
+    n, st, sy, stt, sty = (c[stop] - c[start] for c in sums)
+    spread = n * stt - st * st
+    slope = np.where(spread > 0, (n * sty - st * sy) / np.where(spread > 0, spread, 1.0), 0.0)
+    return 60.0 * slope
 
 
 def _history(t_s: np.ndarray, temperature_c: np.ndarray, history_t_s: np.ndarray,

@@ -96,3 +96,13 @@ def test_the_rate_term_tells_what_follows_the_rate_from_a_hysteresis_that_stays_
     np.testing.assert_allclose(found_h, h_g, atol=5e-6)
     np.testing.assert_allclose(found_c, c_g, atol=3e-6)
     assert np.abs(fitted.parameters_at(temperature)[:, :3] - truth.parameters_at(temperature)[:, :3]).max() < 5e-6
+
+
+def test_a_poses_rate_of_change_is_centred_on_it_and_does_not_lag_at_a_turn() -> None:
+    from accelcal_rig.fit.approach import temperature_rates_c_per_min
+
+    t = np.arange(0.0, 7200.0, 10.0)
+    temperature = np.interp(t, [0, 3000, 3600, 7200], [60, -40, -40, 20])  # 2 °C/min down, held, 1 °C/min up
+    poses = np.array([1500.0, 3300.0, 5400.0])
+    rates = temperature_rates_c_per_min(poses, np.interp(poses, t, temperature), t, temperature)
+    np.testing.assert_allclose(rates, [-2.0, 0.0, 1.0], atol=1e-9)  # mid-hold: 0, though cooled 10 min before
