@@ -17,7 +17,7 @@ import tempfile
 import time
 from pathlib import Path
 
-import yaml
+from fixtures import write_procedure, write_rig  # bench/fixtures.py, beside this script
 from quiet import throwaway_registry  # bench/quiet.py, beside this script
 
 REPO = Path(__file__).resolve().parent.parent
@@ -26,15 +26,8 @@ RIG = str(Path(sys.executable).parent / "rig")
 
 def rig_with(duts: int, folder: Path) -> Path:
     """The shipped simulated rig with `duts` sensors; a copy of the paper procedure that names it."""
-    rig = yaml.safe_load((REPO / "configs" / "sim.yaml").read_text())
-    rig["fixture"]["sensors"] = [{"serial": f"ADX355-L{k:03d}", "mount_euler_deg": [0, 0, 90 * (k % 4)]}
-                                 for k in range(duts)]
-    (folder / "sim.yaml").write_text(yaml.safe_dump(rig))
-    procedure = yaml.safe_load((REPO / "procedures" / "paper-24pos-thermal.yaml").read_text())
-    procedure["rig"] = "sim.yaml"
-    path = folder / "paper.yaml"
-    path.write_text(yaml.safe_dump(procedure))
-    return path
+    write_rig(REPO / "configs" / "sim.yaml", duts, "ADX355-L", folder)
+    return write_procedure(REPO / "procedures" / "paper-24pos-thermal.yaml", folder, "paper.yaml")
 
 
 def timed_run(duts: int) -> dict[str, float]:

@@ -19,11 +19,13 @@ from typing import Any
 
 import h5py
 import yaml
+from fixtures import write_procedure, write_rig  # bench/fixtures.py, beside this script
 from quiet import silence_campaign_log, throwaway_registry  # bench/quiet.py, beside this script
 
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.errors import CampaignAborted
+from accelcal_rig.fit.calibration import load_calibration
 
 REPO = Path(__file__).resolve().parent.parent
 #: Each criterion as the procedures have used it (the paper procedure's dwell, 30 min, for both).
@@ -36,15 +38,10 @@ CRITERIA = {
 def run(criterion: str, poll_s: float, duts: int, seed: int) -> dict[str, Any]:
     with tempfile.TemporaryDirectory() as name:
         folder = Path(name)
-        rig = yaml.safe_load((REPO / "configs" / "sim.yaml").read_text())
-        rig["fixture"]["sensors"] = [{"serial": f"ADX355-S{k:03d}", "mount_euler_deg": [0, 0, 90 * (k % 4)]}
-                                     for k in range(duts)]
-        (folder / "rig.yaml").write_text(yaml.safe_dump(rig))
-        procedure = yaml.safe_load((REPO / "procedures" / "paper-24pos-thermal.yaml").read_text())
-        procedure["rig"] = "rig.yaml"
-        procedure["soak"].update(CRITERIA[criterion], poll_s=poll_s)
-        path = folder / "paper.yaml"
-        path.write_text(yaml.safe_dump(procedure))
+        write_rig(REPO / "configs" / "sim.yaml", duts, "ADX355-S", folder)
+        paper = REPO / "procedures" / "paper-24pos-thermal.yaml"
+        soak = {**yaml.safe_load(paper.read_text())["soak"], **CRITERIA[criterion], "poll_s": poll_s}
+        path = write_procedure(paper, folder, "paper.yaml", soak=soak)
         output = folder / "campaign.h5"
         calibration = output.with_suffix(".calibration.yaml")
         record: dict[str, Any] = {"criterion": criterion, "poll_s": poll_s, "n_duts": duts, "seed": seed}
@@ -59,8 +56,7 @@ def run(criterion: str, poll_s: float, duts: int, seed: int) -> dict[str, Any]:
             record["soak_hours"] = sum(float(g["t_s"][-1] - g.attrs["t_reached_s"]) for g in soaks) / 3600
             record["soak_minutes"] = [round(float(g["t_s"][-1] - g.attrs["t_reached_s"]) / 60, 1) for g in soaks]
         if calibration.is_file() and record["state"] == "done":
-            sensors = yaml.load(calibration.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))["sensors"]
-            checks = [s["metrics"]["verification"] for s in sensors.values()]
+            checks = [s.metrics["verification"] for s in load_calibration(calibration).sensors.values()]
             record["verification_rmse_mg"] = max(v["rmse_mg"] for v in checks)
             record["residual_drift_mg"] = max(max(v["drift_mg"]) for v in checks)
         return record

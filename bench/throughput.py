@@ -39,7 +39,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
+from fixtures import write_procedure, write_rig  # bench/fixtures.py, beside this script
 from quiet import silence_campaign_log, throwaway_registry  # bench/quiet.py, beside this script
 
 from accelcal_rig.assembly import run_campaign
@@ -68,16 +68,10 @@ END_WITHIN_C = 0.5
 
 def variant(method: str, duts: int, folder: Path) -> Path:
     """The method's procedure on the honest rig with `duts` DUTs, the sensor effects and verification."""
-    rig = yaml.safe_load(RIG.read_text())
-    rig["fixture"]["sensors"] = [{"serial": f"ADX355-T{k:03d}", "mount_euler_deg": [0, 0, 90 * (k % 4)]}
-                                 for k in range(duts)]
-    (folder / "rig.yaml").write_text(yaml.safe_dump(rig))
-    procedure = yaml.safe_load(METHODS[method].read_text())
-    procedure.update(rig="rig.yaml", simulation=SENSOR_EFFECTS, verify=VERIFY)
-    procedure.pop("acceptance", None)  # the figures, not a verdict
-    path = folder / f"{method}.yaml"
-    path.write_text(yaml.safe_dump(procedure))
-    return path
+    write_rig(RIG, duts, "ADX355-T", folder)
+    # The figures, not a verdict: no acceptance limits.
+    return write_procedure(METHODS[method], folder, f"{method}.yaml", simulation=SENSOR_EFFECTS, verify=VERIFY,
+                           acceptance={})
 
 
 def lower_bound_s(prepared: Any) -> float:
@@ -137,9 +131,9 @@ def figures(method: str, duts: int, seed: int) -> dict[str, Any]:
         started = time.perf_counter()
         run = run_campaign(prepared, output, dry_run=True, seed=seed, overwrite=False, calibration=calibration_path)
         wall_s = time.perf_counter() - started
-        sensors = yaml.load(calibration_path.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))["sensors"]
+        sensors = load_calibration(calibration_path).sensors
         at_rest_rmse_mg, at_rest_drift_mg = at_rest(calibration_path)
-    metrics = [s["metrics"] for s in sensors.values()]
+    metrics = [s.metrics for s in sensors.values()]
     verification = [m["verification"] for m in metrics]
     hysteresis = [max(abs(h) for h in m["hysteresis_mg"]) for m in metrics if "hysteresis_mg" in m]
     rig_hours = run.summary.virtual_duration_s / 3600
@@ -153,8 +147,8 @@ def figures(method: str, duts: int, seed: int) -> dict[str, Any]:
         "residual_drift_mg": max(max(v["drift_mg"]) for v in verification),
         "hysteresis_mg": max(hysteresis) if hysteresis else None,
         "at_rest_rmse_mg": at_rest_rmse_mg, "at_rest_drift_mg": at_rest_drift_mg,
-        "calibrated_range_c": [max(s["validity_c"][0] for s in sensors.values()),
-                               min(s["validity_c"][1] for s in sensors.values())],
+        "calibrated_range_c": [max(s.validity_c[0] for s in sensors.values()),
+                               min(s.validity_c[1] for s in sensors.values())],
         "wall_s": wall_s,
     }
 

@@ -17,6 +17,7 @@ import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from typing import TypeVar
 
@@ -52,9 +53,14 @@ def map_over_duts(fit: Callable[[T], R], items: Sequence[T]) -> list[R]:
     if len(items) < PARALLEL_FROM_DUTS or cores < 2:
         return [fit(item) for item in items]
     workers = min(cores, len(items))
-    with _main_module_hidden(), ProcessPoolExecutor(workers, mp_context=_context()) as pool:
-        outcomes = list(pool.map(_recording_warnings, [fit] * len(items), items,
-                                 chunksize=max(1, len(items) // (4 * workers))))
+    try:
+        with _main_module_hidden(), ProcessPoolExecutor(workers, mp_context=_context()) as pool:
+            outcomes = list(pool.map(_recording_warnings, [fit] * len(items), items,
+                                     chunksize=max(1, len(items) // (4 * workers))))
+    except (BrokenProcessPool, OSError) as exc:  # no workers here (a sandbox, no room): fitted in this process
+        warnings.warn(f"fit workers unavailable ({type(exc).__name__}: {exc}); fitting {len(items)} DUTs in "
+                      "one process", RuntimeWarning, stacklevel=2)
+        return [fit(item) for item in items]
     results = []
     for result, caught in outcomes:
         for category, message in caught:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import heapq
 import itertools
 import os
+import select
 import selectors
 import threading
 import time
@@ -19,6 +20,9 @@ import tty
 from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.sim.faults import ReplyFaults
 from accelcal_rig.sim.line_answers import Handler, LineAnswers
+
+#: Longest a reply waits for its client to read it.
+WRITE_DEADLINE_S = 2.0
 
 
 class PtyLineServer:
@@ -32,6 +36,7 @@ class PtyLineServer:
         self._master, self._slave = os.openpty()
         tty.setraw(self._master)
         tty.setraw(self._slave)  # the slave stays open so the path keeps working between clients
+        os.set_blocking(self._master, False)  # the hub serves every device: none of them may block it
         self.path = os.ttyname(self._slave)
         self._answers = LineAnswers(handle, terminator, reply_terminator, encoding, faults,
                                     defer=lambda delay_s, reply, _: _HUB.send(self, delay_s, reply))
@@ -65,6 +70,8 @@ class PtyLineServer:
                 return False
             try:
                 data = os.read(self._master, 65536)
+            except BlockingIOError:  # readiness without data: nothing to answer yet
+                return True
             except OSError:
                 return False
             try:
@@ -80,10 +87,21 @@ class PtyLineServer:
                 self._write(reply)
 
     def _write(self, reply: bytes) -> None:
-        try:
-            os.write(self._master, reply)
-        except OSError:
-            pass  # the client side went away: nobody to answer
+        """All of `reply`, waiting for room at most WRITE_DEADLINE_S: a client that stopped reading (its
+        driver gave up on a long reply) loses the rest, and the hub, every other device and `stop` go on."""
+        view, deadline = memoryview(reply), time.monotonic() + WRITE_DEADLINE_S
+        while view:
+            try:
+                view = view[os.write(self._master, view):]
+                continue
+            except BlockingIOError:
+                pass
+            except OSError:
+                return  # the client side went away: nobody to answer
+            if not select.select([], [self._master], [], max(0.0, deadline - time.monotonic()))[1]:
+                LOGGER.warning("simulated device %s: %d bytes of a reply not read within %g s: dropped",
+                               self.name, len(view), WRITE_DEADLINE_S)
+                return
 
 
 class PtyHub:

@@ -28,3 +28,18 @@ def test_many_duts_are_fitted_in_workers_in_order_with_their_warnings() -> None:
 def test_a_small_fixture_is_fitted_here() -> None:
     with pytest.warns(RuntimeWarning, match="odd 1"):
         assert map_over_duts(square_warning_on_odd, [1, 2]) == [(1, os.getpid()), (4, os.getpid())]
+
+
+def test_without_workers_the_fixture_is_fitted_here_and_says_so(monkeypatch) -> None:
+    import accelcal_rig.fit.fixture_pool as pool
+
+    def no_workers(*args, **kwargs):
+        raise OSError("no room for a process")
+
+    monkeypatch.setattr(pool, "ProcessPoolExecutor", no_workers)
+    items = list(range(PARALLEL_FROM_DUTS))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        results = map_over_duts(square_warning_on_odd, items)
+    assert results == [(k * k, os.getpid()) for k in items]
+    assert "fit workers unavailable (OSError: no room for a process)" in str(caught[0].message)
