@@ -38,8 +38,9 @@ class PoseSteps:
         self.truth = instruments.truth
         self.clock, self.events, self.writer, self.machine, self.report = clock, events, writer, machine, report
         self.thermal = thermal
-        self._mounts = {s.serial: Rotation.from_euler("xyz", s.mount_euler_deg, degrees=True)
-                        for s in rig.fixture.sensors}
+        #: Fixture frame → each DUT's frame (the inverse of its mounting), by serial.
+        self._fixture_to_dut = {s.serial: Rotation.from_euler("xyz", s.mount_euler_deg, degrees=True).inv().as_matrix()
+                                for s in rig.fixture.sensors}
         #: The table's angles as last read, and the setpoint they were read at: the first move at each
         #: setpoint reads them afresh (hours of soak: the table may have been moved, or have drifted).
         self._table_angles_deg: np.ndarray | None = None
@@ -111,7 +112,7 @@ class PoseSteps:
         return DutPoseRecord(
             serial=sensor.serial, raw_codes=codes, mean_g=mean_g, stderr_g=stderr_g,
             temperature_c=block.temperature_c,
-            gravity_reference_g=self.rig.gravity_g * self._mounts[sensor.serial].inv().apply(gravity_fixture),
+            gravity_reference_g=self.rig.gravity_g * (self._fixture_to_dut[sensor.serial] @ gravity_fixture),
             temperature_in_band=in_band,
             truth=self.truth.block_truth(sensor.serial, block) if self.truth is not None else None,
         )

@@ -20,7 +20,7 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.stats import chi2
 
-from accelcal_rig.fit.sfem import IDENTITY_PARAMETERS, PARAMETER_NAMES, correct
+from accelcal_rig.fit.sfem import IDENTITY_PARAMETERS, PARAMETER_NAMES, correct, correct_jacobian
 
 FitMode = Literal["reference", "norm-only"]
 FreeParameters = Literal["all", "bias-scale"]
@@ -103,6 +103,9 @@ def fit_sfem(mean_g: np.ndarray, stderr_g: np.ndarray, reference_g: np.ndarray |
         def residuals(theta: np.ndarray) -> np.ndarray:
             return ((correct(mean_g, _full(theta, mask)) - reference_g) / sigma_g).ravel()
 
+        def derivatives(theta: np.ndarray) -> np.ndarray:
+            return (correct_jacobian(mean_g, _full(theta, mask))[:, :, mask] / sigma_g[:, :, None]).reshape(-1, n_free)
+
         n_residuals = 3 * n_poses
     else:
         sigma_norm = np.sqrt(norm_sigma(mean_g, stderr_g) ** 2 + scatter_floor_g**2)
@@ -110,12 +113,18 @@ def fit_sfem(mean_g: np.ndarray, stderr_g: np.ndarray, reference_g: np.ndarray |
         def residuals(theta: np.ndarray) -> np.ndarray:
             return (np.linalg.norm(correct(mean_g, _full(theta, mask)), axis=1) - gravity_g) / sigma_norm
 
+        def derivatives(theta: np.ndarray) -> np.ndarray:  # ∂|u|/∂θ = (u/|u|)·∂u/∂θ
+            params = _full(theta, mask)
+            output = correct(mean_g, params)
+            unit = output / np.linalg.norm(output, axis=1, keepdims=True)
+            return np.einsum("ni,nik->nk", unit, correct_jacobian(mean_g, params)[:, :, mask]) / sigma_norm[:, None]
+
         n_residuals = n_poses
     if n_residuals < n_free:
         raise DegenerateDesign(
             f"too few poses: {n_poses} poses give {n_residuals} equations for {n_free} parameters in {mode} mode"
         )
-    result = least_squares(residuals, IDENTITY_PARAMETERS[mask], method="lm", xtol=1e-12, ftol=1e-12)
+    result = least_squares(residuals, IDENTITY_PARAMETERS[mask], jac=derivatives, method="lm", xtol=1e-12, ftol=1e-12)
     jacobian = result.jac
     _check_identified(jacobian, mask, n_poses)
     dof = n_residuals - n_free

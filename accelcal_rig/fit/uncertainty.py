@@ -27,12 +27,11 @@ import numpy as np
 from scipy.stats import chi2
 
 from accelcal_rig.fit.lm import pointing_covariance_g2, reference_sigma_g
-from accelcal_rig.fit.sfem import correct, error_matrix
+from accelcal_rig.fit.sfem import correct, correct_jacobian, error_matrix
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel
 
 COVERAGE_FACTOR = 2.0
-#: Step of the numerical derivatives of the compensation, in each parameter's own unit and in °C.
-_STEP = 1e-6
+#: Step of the numerical derivative of the compensation by temperature, °C.
 _STEP_C = 1e-3
 
 
@@ -86,9 +85,10 @@ def coefficient_covariance(mapping: np.ndarray, reference_g: np.ndarray | None, 
         reference_g = np.asarray(reference_g, dtype=float)
         sigma = reference_sigma_g(stderr_g, reference_g, accuracy_rad)
         blocks = a.reshape(a.shape[0], n_poses, 3) / sigma[None]       # A_i S_i⁻¹, pose by pose
-        noise = np.einsum("pna,na,qna->pq", blocks, stderr_g**2, blocks)
+        flat = blocks.reshape(a.shape[0], 3 * n_poses)                          # sums over poses and axes as products
+        noise = (blocks * stderr_g**2).reshape(a.shape[0], 3 * n_poses) @ flat.T
         turn = pointing_covariance_g2(reference_g, accuracy_rad)
-        pointing = np.einsum("pna,nab,qnb->pq", blocks, turn, blocks)
+        pointing = np.einsum("pna,nab->pnb", blocks, turn).reshape(a.shape[0], 3 * n_poses) @ flat.T
     dof = len(residuals) - a.shape[0]
     chi2_total = float(residuals @ residuals)
     excess = np.zeros_like(noise)
@@ -120,7 +120,7 @@ def output_uncertainty(raw_g: np.ndarray, temperature_c: np.ndarray, model: Ther
     temperature_c = np.asarray(temperature_c, dtype=float)
     params = model.parameters_at(temperature_c, out_of_range)            # (n, 12)
     output = correct(raw_g, params)
-    by_parameter = _parameter_derivatives(raw_g, params)              # (n, 3, 12)
+    by_parameter = correct_jacobian(raw_g, params)                    # (n, 3, 12)
     x = model.scaled(temperature_c)
     if out_of_range == "clamp":
         x = np.clip(x, -1.0, 1.0)
@@ -128,8 +128,12 @@ def output_uncertainty(raw_g: np.ndarray, temperature_c: np.ndarray, model: Ther
     by_coefficient = np.einsum("nap,nm->napm", by_parameter[:, :, covariance.free], powers).reshape(
         len(raw_g), 3, -1)
 
+    rows = by_coefficient.reshape(3 * len(raw_g), by_coefficient.shape[-1])  # (n·3, P)
+
     def through(cov: np.ndarray) -> np.ndarray:
-        return np.sqrt(np.maximum(np.einsum("nap,pq,naq->na", by_coefficient, cov, by_coefficient), 0.0))
+        """√(dᵀ·cov·d) per output and axis, d its derivatives by the coefficients (a product, not a sum of
+        n·3·P² terms)."""
+        return np.sqrt(np.maximum(np.einsum("ip,ip->i", rows @ cov, rows), 0.0)).reshape(raw_g.shape)
 
     gain = error_matrix(params)                                        # ∂output/∂raw
     reading = np.sqrt(np.einsum("nab,nb,nab->na", gain, np.asarray(reading_stderr_g, dtype=float) ** 2, gain))
@@ -151,11 +155,3 @@ def output_uncertainty(raw_g: np.ndarray, temperature_c: np.ndarray, model: Ther
 def combined(sources: dict[str, np.ndarray]) -> np.ndarray:
     """The combined standard uncertainty: the sources in quadrature (taken as uncorrelated)."""
     return np.sqrt(sum(u**2 for u in sources.values()))
-
-
-def _parameter_derivatives(raw_g: np.ndarray, params: np.ndarray) -> np.ndarray:
-    """∂correct/∂θ (n, 3, 12) by central differences."""
-    steps = np.eye(12) * _STEP
-    up = correct(raw_g[:, None, :], params[:, None, :] + steps)       # (n, 12, 3)
-    down = correct(raw_g[:, None, :], params[:, None, :] - steps)
-    return np.moveaxis((up - down) / (2 * _STEP), 1, 2)

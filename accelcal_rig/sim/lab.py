@@ -5,6 +5,7 @@ from __future__ import annotations
 import hashlib
 import threading
 from collections import deque
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -20,7 +21,7 @@ from accelcal_rig.parts.part import AccelerometerPart
 from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.sim.moisture import ChamberMoisture
-from accelcal_rig.sim.truth import DutTruth, truth_for_serial
+from accelcal_rig.sim.truth import DutTruth, fixture_parameters_at, truth_for_serial
 from accelcal_rig.sim.turntable_motion import TurntableMotion
 
 
@@ -44,6 +45,17 @@ class SimulatedDut:
         self.rate_scale_factors = np.array([(1.0 if b & 1 else -1.0) * (0.5 + (b >> 1) / 127.0) for b in signs[9:12]])
         #: (t_start, t_end, n, parameters, gravity, temperature) of recently generated sample chunks.
         self.truth_log: deque[tuple] = deque(maxlen=4096)
+
+
+@dataclass(frozen=True)
+class _Instant:
+    """The fixture's truth at one time `t_s`, one row per DUT."""
+
+    t_s: float
+    temperature_c: np.ndarray  # (n,)
+    parameters: np.ndarray     # (n, 12) Eq. 1 parameters
+    gravity_g: np.ndarray      # (n, 3) true specific force in each DUT's frame
+    reading_g: np.ndarray      # (n, 3) what each reads for it by Eq. 1, before noise and unmodelled effects
 
 
 class VirtualLab:
@@ -91,6 +103,10 @@ class VirtualLab:
         )
         self._gravity_angles_key = b""
         self._gravity_fixture = np.array([0.0, 0.0, 1.0])
+        self._truth_coefficients = np.stack([d.truth.coefficients for d in self.duts]) if self.duts \
+            else np.zeros((0, 12, 4))
+        self._fixture_to_duts = np.stack([d.fixture_to_dut for d in self.duts]) if self.duts else np.zeros((0, 3, 3))
+        self._instant_cache: _Instant | None = None
         #: The simulated site's true gravity in standard g: the rig config's value, off by a draw of its stated
         #: uncertainty (its own stream, so a stated uncertainty of zero changes no other draw).
         draw = np.random.default_rng([seed, 1_000_003]).normal() if rig.gravity_uncertainty_m_s2 > 0 else 0.0
@@ -136,14 +152,25 @@ class VirtualLab:
     def dut_samples(self, index: int, t_start_s: float, n_samples: int, odr_hz: float, range_g: int) -> np.ndarray:
         """`n_samples` codes (n, 3) of DUT `index` from `t_start_s` on, at the DUT's state now (temperature
         and orientation change negligibly within a FIFO's worth); the truth behind them is recorded."""
-        dut = self.duts[index]
-        temperature = self.dut_true_c(index)
-        params = dut.truth.parameters_at(temperature)
-        gravity = self.gravity_in_dut(index)
+        dut, instant = self.duts[index], self._instant()
+        temperature, params, gravity = float(instant.temperature_c[index]), instant.parameters[index], \
+            instant.gravity_g[index]
         noise = self.dut_rngs[index].normal(0.0, self.noise_g(index, odr_hz), (n_samples, 3))
-        raw_g = distort(gravity, params) + self.unmodelled_g(index, gravity) + noise
+        raw_g = instant.reading_g[index] + self.unmodelled_g(index, gravity) + noise
         dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, params, gravity, temperature))
         return dut.part.quantise_g(raw_g, range_g)
+
+    def _instant(self) -> _Instant:
+        """Every DUT's truth at the clock's time, evaluated for the whole fixture at once: all its sensors are
+        sampled at the same instants (a capture fetched from each in turn), and 64 evaluations of Eq. 1 one
+        by one cost more than the samples they describe."""
+        now = self.clock.now()
+        if self._instant_cache is None or self._instant_cache.t_s != now:
+            temperature_c = self.thermal.duts_c(now)
+            parameters = fixture_parameters_at(self._truth_coefficients, temperature_c)
+            gravity_g = self.site_gravity_g * (self._fixture_to_duts @ self._gravity_in_fixture(now))
+            self._instant_cache = _Instant(now, temperature_c, parameters, gravity_g, distort(gravity_g, parameters))
+        return self._instant_cache
 
     def truth_between(self, index: int, t_start_s: float, t_end_s: float) -> dict[str, np.ndarray]:
         """The truth behind the samples of [t_start_s, t_end_s], averaged over the chunks that made them."""
@@ -156,6 +183,10 @@ class VirtualLab:
         chunks.reverse()
         if not chunks:
             raise ValueError(f"no samples of {self.duts[index].serial} between {t_start_s:g} and {t_end_s:g} s")
+        if len(chunks) == 1:  # a block fetched at once (every capture): nothing to average
+            _, _, _, parameters, gravity, temperature = chunks[0]
+            return {"parameters": np.array(parameters), "gravity_g": np.array(gravity),
+                    "temperature_c": np.asarray(temperature, dtype=float)}
         weights = np.array([c[2] for c in chunks], dtype=float)
         mean = lambda k: np.average(np.array([c[k] for c in chunks]), axis=0, weights=weights)  # noqa: E731
         return {"parameters": mean(3), "gravity_g": mean(4), "temperature_c": np.asarray(mean(5), dtype=float)}
@@ -163,8 +194,12 @@ class VirtualLab:
     def gravity_in_dut(self, index: int) -> np.ndarray:
         """True specific force at rest (the site's gravity, up) in DUT `index`'s frame at the table's actual
         angles, in standard g."""
-        angles = self.motion.position_deg(self.clock.now())
+        return self.site_gravity_g * (self.duts[index].fixture_to_dut @ self._gravity_in_fixture(self.clock.now()))
+
+    def _gravity_in_fixture(self, t_s: float) -> np.ndarray:
+        """The unit 'up' in the fixture frame at the table's actual angles at `t_s`."""
+        angles = self.motion.position_deg(t_s)
         key = angles.tobytes()
         if key != self._gravity_angles_key:  # the table stands still between moves: one chain per pose
             self._gravity_angles_key, self._gravity_fixture = key, self.kinematics.gravity_in_fixture(angles)
-        return self.site_gravity_g * (self.duts[index].fixture_to_dut @ self._gravity_fixture)
+        return self._gravity_fixture

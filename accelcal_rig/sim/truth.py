@@ -39,6 +39,13 @@ class DutTruth:
         return np.moveaxis(polynomial.polyval(x, self.coefficients.T), 0, -1)
 
 
+def fixture_parameters_at(coefficients: np.ndarray, temperature_c: np.ndarray) -> np.ndarray:
+    """Eq. 1 parameters (n, 12) of n DUTs whose cubics are `coefficients` (n, 12, powers), each at its own
+    temperature (n,): the whole fixture in one evaluation."""
+    x = (np.asarray(temperature_c, dtype=float) - T_REF_C) / HALF_RANGE_C
+    return polynomial.polyval(x[:, None], np.moveaxis(coefficients, -1, 0), tensor=False)
+
+
 def truth_for_serial(serial: str) -> DutTruth:
     """The deterministic hidden truth of the DUT with this serial number."""
     seed = int.from_bytes(hashlib.sha256(serial.encode()).digest()[:8], "little")

@@ -185,3 +185,17 @@ def test_too_few_polls_in_the_window_are_never_settled_and_such_a_window_is_refu
     assert not fit_settling(SETTLING, t, flat, len(t) - 2).settled(SETTLING)  # two polls: nothing is known
     with pytest.raises(ValueError, match="at least 5 polls in the window"):
         SoakCriterion(criterion="settling", window_min=5, poll_s=600, min_dwell_min=0)
+
+
+def test_the_quick_rejection_of_a_moving_window_judges_every_poll_as_the_full_settling_fit_does() -> None:
+    from accelcal_rig.engine.soak import MIN_WINDOW_POLLS, fit_settling, is_settled
+
+    t = np.arange(0.0, 90 * 60 + 1, 30.0)
+    readings = first_order_readings(t, np.array([540.0, 600.0, 900.0]), seed=5)
+    verdicts = []
+    for k in range(MIN_WINDOW_POLLS, len(t)):
+        start = int(np.searchsorted(t[:k + 1], t[k] - SETTLING.window_min * 60.0))
+        full = fit_settling(SETTLING, t[:k + 1], readings[:k + 1], start).settled(SETTLING)
+        assert is_settled(SETTLING, t[:k + 1], readings[:k + 1], start) == full, f"poll {k}"
+        verdicts.append(full)
+    assert not verdicts[0] and verdicts[-1]  # both verdicts were judged

@@ -1,6 +1,6 @@
 import numpy as np
 
-from accelcal_rig.fit.sfem import IDENTITY_PARAMETERS, correct, distort, error_matrix
+from accelcal_rig.fit.sfem import IDENTITY_PARAMETERS, correct, correct_jacobian, distort, error_matrix
 
 
 def random_parameters(rng: np.random.Generator, shape: tuple[int, ...] = ()) -> np.ndarray:
@@ -36,3 +36,18 @@ def test_bias_is_subtracted_before_the_matrix() -> None:
     params[0:3] = [0.01, -0.02, 0.03]
     params[3:6] = 2.0
     np.testing.assert_allclose(correct(np.array([0.01, -0.02, 1.03]), params), [0, 0, 2.0], atol=1e-15)
+
+
+def test_the_jacobian_of_correct_is_its_derivative_by_every_parameter() -> None:
+    rng = np.random.default_rng(4)
+    params = random_parameters(rng, (20,))
+    raw = rng.normal(size=(20, 3))
+    step = 1e-6
+    numeric = np.stack([(correct(raw, params + step * e) - correct(raw, params - step * e)) / (2 * step)
+                        for e in np.eye(12)], axis=-1)
+    jacobian = correct_jacobian(raw, params)
+    assert jacobian.shape == (20, 3, 12)
+    np.testing.assert_allclose(jacobian, numeric, atol=1e-8)
+    # It broadcasts as correct does: one parameter set for many readings.
+    np.testing.assert_allclose(correct_jacobian(raw, params[0]), correct_jacobian(raw, np.tile(params[0], (20, 1))),
+                               atol=1e-15)

@@ -108,3 +108,19 @@ def test_unmodelled_effects_are_off_unless_the_procedure_asks() -> None:
     lab.dut_true_c(0)
     np.testing.assert_allclose(lab.unmodelled_g(0, np.zeros(3)), -warm)
     assert np.allclose(np.abs(warm), 0.5e-3)
+
+
+def test_every_dut_sampled_at_one_instant_follows_its_own_truth_there() -> None:
+    from accelcal_rig.sim.lab import VirtualLab
+
+    lab = VirtualLab(load_rig(SIM_RIG).model, VirtualClock(), 3)
+    lab.thermal.set_setpoint(0.0, 50.0)
+    for t_s in (900.0, 1800.0):   # the fixture's state is evaluated afresh at each instant
+        lab.clock.sleep(t_s - lab.clock.now())
+        for index, dut in enumerate(lab.duts):
+            lab.dut_samples(index, t_s, 10, 125.0, 2)
+            _, _, _, parameters, gravity_g, temperature_c = dut.truth_log[-1]
+            assert temperature_c == lab.dut_true_c(index)
+            np.testing.assert_allclose(parameters, dut.truth.parameters_at(temperature_c), atol=1e-15)
+            np.testing.assert_allclose(gravity_g, lab.gravity_in_dut(index), atol=1e-15)
+    assert len({log.truth_log[-1][5] for log in lab.duts}) > 1   # DUTs lag differently: different truths

@@ -1,6 +1,6 @@
 import numpy as np
 
-from accelcal_rig.sim.truth import truth_for_serial
+from accelcal_rig.sim.truth import fixture_parameters_at, truth_for_serial
 
 
 def test_truth_is_fixed_by_the_serial_number() -> None:
@@ -24,3 +24,10 @@ def test_magnitudes_are_those_of_the_papers_part() -> None:
 def test_parameters_at_broadcasts_over_temperatures() -> None:
     truth = truth_for_serial("SN-1")
     assert truth.parameters_at(np.zeros((4, 5))).shape == (4, 5, 12)
+
+
+def test_a_fixture_evaluated_at_once_gives_each_dut_its_own_parameters() -> None:
+    truths = [truth_for_serial(f"SN-{k}") for k in range(5)]
+    temperature_c = np.array([-40.0, -3.5, 25.0, 41.2, 60.0])
+    together = fixture_parameters_at(np.stack([t.coefficients for t in truths]), temperature_c)
+    np.testing.assert_allclose(together, [t.parameters_at(c) for t, c in zip(truths, temperature_c)], rtol=0, atol=1e-15)
