@@ -11,24 +11,43 @@ from accelcal_rig.config.bounds import AngleDeg, StrictModel
 
 #: Most orientations a schedule may list (each is solved for the turntable's angles when the plan compiles).
 MAX_SCHEDULE_POSES = 2_000
+#: Most orientations `order: shortest-travel` orders (it solves every remaining pose from each one visited).
+MAX_ORDERED_POSES = 100
 
 
+class GeneratedSchedule(StrictModel):
+    """A schedule of gravity directions the plan solves for turntable angles. `order`: visit them as the
+    schedule lists them, or in the order that turns the table least (nearest next pose by travel time, from
+    where the table stands; each pose keeps its number): a sphere's poses as listed step ~140° about the
+    inner axis each, and at a soaked setpoint the table's travel is rig time."""
 
-class Paper24Schedule(StrictModel):
+    order: Literal["as-listed", "shortest-travel"] = "as-listed"
+
+    @property
+    def size(self) -> int:
+        raise NotImplementedError
+
+    def model_post_init(self, context: object) -> None:
+        if self.order == "shortest-travel" and self.size > MAX_ORDERED_POSES:
+            raise ValueError(f"order: shortest-travel orders at most {MAX_ORDERED_POSES} poses, this schedule has "
+                             f"{self.size}")
+
+
+class Paper24Schedule(GeneratedSchedule):
     """Table 1 of the paper: eight 45° steps about each of the sensor's z, y and x axes."""
 
     kind: Literal["paper-24"]
     size: ClassVar[int] = 24
 
 
-class SixPositionSchedule(StrictModel):
+class SixPositionSchedule(GeneratedSchedule):
     """The classic six positions: each sensor axis up, then down."""
 
     kind: Literal["six-position"]
     size: ClassVar[int] = 6
 
 
-class SphereSchedule(StrictModel):
+class SphereSchedule(GeneratedSchedule):
     """`count` gravity directions spread evenly over the sphere (Fibonacci lattice)."""
 
     kind: Literal["sphere"]
@@ -39,7 +58,7 @@ class SphereSchedule(StrictModel):
         return self.count
 
 
-class TiltSchedule(StrictModel):
+class TiltSchedule(GeneratedSchedule):
     """Poses given as pitch and roll of the fixture (paper Eq. 10, Table 5), in degrees: pitch tilts the
     y axis up, roll tilts the x axis down; (0, 0) is level with z up."""
 

@@ -92,21 +92,42 @@ def pose_directions(schedule: Schedule, kinematics: TurntableKinematics) -> tupl
 
 def compile_poses(schedule: Schedule, rig: RigConfig, start_deg: tuple[float, ...] | None = None) -> tuple[Pose, ...]:
     """Turntable angles for each pose, each solved near the previous one (the first near `start_deg`, else
-    zero) so moves stay short."""
+    zero) so moves stay short; in the schedule's `order` (as listed, or the shortest travel)."""
     kinematics = TurntableKinematics(rig.turntable.axes)
     directions, explicit = pose_directions(schedule, kinematics)
     if explicit is not None:
         angles = kinematics.wrap(explicit)
+        order = list(range(len(directions)))
     else:
-        angles = np.empty((len(directions), len(kinematics.axes)))
         current = np.zeros(len(kinematics.axes)) if start_deg is None else np.array(start_deg)
-        for i, direction in enumerate(directions):
-            current = kinematics.solve(direction, current)
-            angles[i] = current
-    return tuple(
-        Pose(i + 1, tuple(round(float(a), 9) + 0.0 for a in row), tuple(float(g) for g in gravity))  # type: ignore[arg-type]
-        for i, (row, gravity) in enumerate(zip(angles, directions))
+        if getattr(schedule, "order", "as-listed") == "shortest-travel":
+            order, angles = _shortest_travel(directions, current, kinematics,
+                                             np.array([a.speed_deg_s for a in rig.turntable.axes]))
+        else:
+            order, angles = list(range(len(directions))), np.empty((len(directions), len(kinematics.axes)))
+            for i, direction in enumerate(directions):
+                current = kinematics.solve(direction, current)
+                angles[i] = current
+    return tuple(  # in the order visited, each numbered as its schedule lists it
+        Pose(i + 1, tuple(round(float(a), 9) + 0.0 for a in angles[k]),
+             tuple(float(g) for g in directions[i]))  # type: ignore[arg-type]
+        for k, i in enumerate(order)
     )
+
+
+def _shortest_travel(directions: np.ndarray, start_deg: np.ndarray, kinematics: TurntableKinematics,
+                     speeds_deg_s: np.ndarray) -> tuple[list[int], np.ndarray]:
+    """(schedule indices in the order visited, their angles in that order): from where the table stands,
+    always the pose it reaches soonest (its slowest axis's travel at its speed), each solved near the last."""
+    left, order, angles = list(range(len(directions))), [], []
+    current = start_deg
+    while left:
+        reached = [kinematics.solve(directions[i], current) for i in left]
+        nearest = int(np.argmin([np.max(np.abs(a - current) / speeds_deg_s) for a in reached]))
+        order.append(left.pop(nearest))
+        current = reached[nearest]
+        angles.append(current)
+    return order, np.array(angles)
 
 
 class CooldownPoseMissing(ValueError):
@@ -128,7 +149,7 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
     if procedure.cooldown is not None:
         if procedure.cooldown.pose > len(poses):
             raise CooldownPoseMissing(f"pose {procedure.cooldown.pose} asked for, the schedule has {len(poses)}")
-        held = poses[procedure.cooldown.pose - 1]
+        held = next(p for p in poses if p.number == procedure.cooldown.pose)
         setpoint = procedure.setpoints_c[0]
         label = setpoint_label(setpoint)
         soaked = _ramp_and_soak(setpoint)
@@ -211,8 +232,9 @@ def _ramp_and_soak(setpoint_c: float) -> tuple[Ramp, Soak]:
 
 def _ramp_method_entries(setpoints_c: tuple[float, ...], index: int,
                          turn: int) -> tuple[tuple[Step, ...], tuple[Step, ...]]:
-    """(entry, restart entry) of the ramp method's `index`-th setpoint. The first soaks and starts the software
-    ramp; each later one's poses begin half-way from the previous setpoint, on the ramp; the one at `turn`
+    """(entry, restart entry) of the ramp method's `index`-th setpoint. The first soaks, its poses and checks
+    at rest; the software ramp starts after them, the second's poses begin half-way from the first, and
+    each later one's half-way from the previous setpoint, on the ramp; the one at `turn`
     (the last setpoint) holds until the DUTs, lagging the air, have caught up, so the calibrated range
     reaches it. A bidirectional ramp goes on from there, back towards the first, its bands half-way between
     the setpoints, the last of them taken where the ramp stops."""
@@ -222,10 +244,12 @@ def _ramp_method_entries(setpoints_c: tuple[float, ...], index: int,
     toward = setpoints_c[turn] if index < turn else last
     start = (ramp, soak, StartSoftwareRamp(setpoint, toward))
     if index == 0:
-        return start, start
+        return (ramp, soak), (ramp, soak)
     if index == turn:
         return (RampSegment(setpoint, setpoint), soak), (ramp, soak)
     halfway = RampSegment(setpoint, 0.5 * (setpoints_c[index - 1] + setpoint))
+    if index == 1:  # the ramp leaves the first setpoint once its poses are taken
+        return (StartSoftwareRamp(setpoints_c[0], toward), halfway), start
     if index == turn + 1:  # the way back begins after the turn's poses
         return (StartSoftwareRamp(setpoints_c[turn], last), halfway), start
     if index == len(setpoints_c) - 1:

@@ -38,12 +38,14 @@ def test_paper_plan_ramps_soaks_measures_and_verifies_at_each_setpoint_and_betwe
 
 def test_ramp_plan_soaks_at_the_ends_and_measures_on_the_software_ramp_in_between() -> None:
     plan = prepare(REPO / "procedures" / "paper-24pos-ramp.yaml").plan
-    first, second, last = plan.stages[0], plan.stages[1], plan.stages[-1]
+    first, second, third, last = plan.stages[0], plan.stages[1], plan.stages[2], plan.stages[-1]
     setpoints = plan.setpoints_c
-    assert first.entry == first.restart_entry == (Ramp(setpoints[0]), Soak(f"T{setpoints[0]:g}/soak", setpoints[0]),
-                                                  StartSoftwareRamp(setpoints[0], setpoints[-1]))
+    # The first soaks and takes its poses and checks at rest; the ramp leaves once they are taken.
+    assert first.entry == first.restart_entry == (Ramp(setpoints[0]), Soak(f"T{setpoints[0]:g}/soak", setpoints[0]))
+    assert second.entry == (StartSoftwareRamp(setpoints[0], setpoints[-1]),
+                            RampSegment(setpoints[1], 0.5 * (setpoints[0] + setpoints[1])))
     # Later setpoints ride on the ramp; their poses begin half-way from the previous setpoint.
-    assert second.entry == (RampSegment(setpoints[1], 0.5 * (setpoints[0] + setpoints[1])),)
+    assert third.entry == (RampSegment(setpoints[2], 0.5 * (setpoints[1] + setpoints[2])),)
     assert [type(s) for s in second.restart_entry] == [Ramp, Soak, StartSoftwareRamp]
     assert last.entry == (RampSegment(setpoints[-1], setpoints[-1]), Soak(f"T{setpoints[-1]:g}/soak", setpoints[-1]))
     assert [type(s) for s in last.restart_entry] == [Ramp, Soak]
@@ -58,7 +60,8 @@ def test_a_bidirectional_ramp_turns_at_the_last_setpoint_and_measures_half_way_b
     down = [60.0, 50.0, 40.0, 30.0, 20.0, 10.0, 0.0, -10.0, -20.0, -30.0, -40.0]
     assert list(plan.setpoints_c) == down + [-35.0, -25.0, -15.0, -5.0, 5.0, 15.0, 25.0, 35.0, 45.0, 55.0]
     stages = {stage.setpoint_c: stage for stage in plan.stages}
-    assert stages[60.0].entry[-1] == StartSoftwareRamp(60.0, -40.0)
+    assert stages[60.0].entry == (Ramp(60.0), Soak("T60/soak", 60.0))  # at rest until its poses are taken
+    assert stages[50.0].entry == (StartSoftwareRamp(60.0, -40.0), RampSegment(50.0, 55.0))
     assert stages[-40.0].entry == (RampSegment(-40.0, -40.0), Soak("T-40/soak", -40.0))  # the turn soaks
     assert stages[-35.0].entry == (StartSoftwareRamp(-40.0, 55.0), RampSegment(-35.0, -37.5))  # then back
     assert stages[-25.0].entry == (RampSegment(-25.0, -30.0),)
@@ -118,3 +121,39 @@ def test_a_verification_pose_the_fit_would_see_is_refused(write) -> None:
     with pytest.raises(ConfigError, match=r"tiny.yaml:\d+: verify.schedule: verification pose 1 has the orientation "
                                           r"of calibration pose 1"):
         prepare(write("tiny.yaml", text))
+
+
+def travel_s(poses, speeds_deg_s: np.ndarray) -> float:
+    """The table's travel through the poses in order from zero, its slowest axis at each move."""
+    path = np.array([np.zeros(len(speeds_deg_s))] + [p.angles_deg for p in poses])
+    return float(np.sum(np.max(np.abs(np.diff(path, axis=0)) / speeds_deg_s, axis=1)))
+
+
+def test_shortest_travel_visits_every_pose_once_each_keeping_its_number_and_direction_in_less_travel() -> None:
+    from accelcal_rig.config.load import load_rig
+    from accelcal_rig.config.schedule import SphereSchedule
+    from accelcal_rig.plan.compile import compile_poses
+    from tests.conftest import SIM_RIG
+
+    rig = load_rig(SIM_RIG).model
+    speeds = np.array([a.speed_deg_s for a in rig.turntable.axes])
+    listed = compile_poses(SphereSchedule(kind="sphere", count=12), rig)
+    ordered = compile_poses(SphereSchedule(kind="sphere", count=12, order="shortest-travel"), rig)
+    assert [p.number for p in listed] == list(range(1, 13))
+    assert sorted(p.number for p in ordered) == list(range(1, 13)) and [p.number for p in ordered] != list(range(1, 13))
+    by_number = {p.number: p for p in listed}
+    kinematics = TurntableKinematics(rig.turntable.axes)
+    for pose in ordered:  # the same direction under its number, reached by the angles given
+        np.testing.assert_allclose(pose.gravity_fixture, by_number[pose.number].gravity_fixture, atol=1e-12)
+        np.testing.assert_allclose(kinematics.gravity_in_fixture(np.array(pose.angles_deg)), pose.gravity_fixture,
+                                   atol=1e-6)
+    assert travel_s(ordered, speeds) < 0.5 * travel_s(listed, speeds)
+
+
+def test_shortest_travel_refuses_a_schedule_too_long_to_order() -> None:
+    from pydantic import ValidationError
+
+    from accelcal_rig.config.schedule import MAX_ORDERED_POSES, SphereSchedule
+
+    with pytest.raises(ValidationError, match="shortest-travel orders at most"):
+        SphereSchedule(kind="sphere", count=MAX_ORDERED_POSES + 1, order="shortest-travel")
