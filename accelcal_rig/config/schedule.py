@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated, ClassVar, Literal
 
-from pydantic import Field, field_validator
+from pydantic import Field, field_validator, model_validator
 
 from accelcal_rig.config.bounds import AngleDeg, StrictModel
 
@@ -27,10 +27,12 @@ class GeneratedSchedule(StrictModel):
     def size(self) -> int:
         raise NotImplementedError
 
-    def model_post_init(self, context: object) -> None:
+    @model_validator(mode="after")
+    def _few_enough_to_order(self) -> GeneratedSchedule:
         if self.order == "shortest-travel" and self.size > MAX_ORDERED_POSES:
             raise ValueError(f"order: shortest-travel orders at most {MAX_ORDERED_POSES} poses, this schedule has "
                              f"{self.size}")
+        return self
 
 
 class Paper24Schedule(GeneratedSchedule):
