@@ -62,9 +62,10 @@ def map_over_duts(fit: Callable[[T], R], items: Sequence[T]) -> list[R]:
                       "one process", RuntimeWarning, stacklevel=2)
         return [fit(item) for item in items]
     results = []
+    shown: dict = {}  # as one process's warnings: the same text from the same line once
     for result, caught in outcomes:
-        for category, message in caught:
-            warnings.warn(message, category, stacklevel=2)
+        for category, message, filename, lineno in caught:
+            warnings.warn_explicit(message, category, filename, lineno, registry=shown)
         results.append(result)
     return results
 
@@ -89,8 +90,9 @@ def _main_module_hidden() -> Iterator[None]:
         main.__dict__.update(saved)
 
 
-def _recording_warnings(fit: Callable[[T], R], item: T) -> tuple[R, list[tuple[type[Warning], str]]]:
+def _recording_warnings(fit: Callable[[T], R], item: T) -> tuple[R, list[tuple[type[Warning], str, str, int]]]:
+    """The fit's result and its warnings, each with the file and line that raised it (re-raised there)."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = fit(item)
-    return result, [(w.category, str(w.message)) for w in caught]
+    return result, [(w.category, str(w.message), w.filename, w.lineno) for w in caught]

@@ -23,6 +23,8 @@ def test_many_duts_are_fitted_in_workers_in_order_with_their_warnings() -> None:
     assert [square for square, _ in results] == [k * k for k in items]
     assert os.getpid() not in {pid for _, pid in results}  # fitted elsewhere
     assert [str(w.message) for w in caught] == [f"odd {k}" for k in items if k % 2]
+    raised_at = square_warning_on_odd.__code__.co_firstlineno + 2  # its warnings.warn line
+    assert {(w.filename, w.lineno) for w in caught} == {(__file__, raised_at)}  # where the worker raised them
 
 
 def test_a_small_fixture_is_fitted_here() -> None:
