@@ -245,11 +245,13 @@ def _ramp_method_entries(setpoints_c: tuple[float, ...], index: int,
     start = (ramp, soak, StartSoftwareRamp(setpoint, toward))
     if index == 0:
         return (ramp, soak), (ramp, soak)
+    # The ramp leaves the first setpoint once its poses are taken: as the second one begins.
+    leaving: tuple[Step, ...] = (StartSoftwareRamp(setpoints_c[0], setpoints_c[turn]),) if index == 1 else ()
     if index == turn:
-        return (RampSegment(setpoint, setpoint), soak), (ramp, soak)
+        return (*leaving, RampSegment(setpoint, setpoint), soak), (ramp, soak)
     halfway = RampSegment(setpoint, 0.5 * (setpoints_c[index - 1] + setpoint))
-    if index == 1:  # the ramp leaves the first setpoint once its poses are taken
-        return (StartSoftwareRamp(setpoints_c[0], toward), halfway), start
+    if leaving:
+        return (*leaving, halfway), start
     if index == turn + 1:  # the way back begins after the turn's poses
         return (StartSoftwareRamp(setpoints_c[turn], last), halfway), start
     if index == len(setpoints_c) - 1:

@@ -146,3 +146,22 @@ def test_a_bidirectional_ramp_measures_both_ways_and_its_fit_finds_the_hysteresi
     assert sensor.metrics["in_sample"]["rmse_mg"] < 0.2
     with h5py.File(workdir / "both.h5", "r") as f:
         assert f.attrs["fit_hysteresis"] == "on"
+
+
+@pytest.mark.parametrize("bidirectional", [False, True])
+def test_a_ramp_of_two_setpoints_leaves_the_first_once_its_poses_are_taken(write, workdir: Path,
+                                                                         bidirectional: bool) -> None:
+    text = RAMP.replace("setpoints_c: [20, 25, 30, 35]", "setpoints_c: [20, 30]")
+    if bidirectional:
+        text = text.replace("ramp: {rate_c_per_min: 0.5, update_s: 20}",
+                            "ramp: {rate_c_per_min: 0.5, update_s: 20, bidirectional: true}")
+    prepared = prepare(write("ramp2.yaml", text))
+    output = workdir / "ramp2.h5"
+    result = run_campaign(prepared, output, dry_run=True, seed=4, overwrite=False, calibration=workdir / "cal.yaml")
+    assert result.summary.state == "done" and result.summary.poses_done == len(prepared.plan.pose_steps)
+    with h5py.File(output, "r") as f:
+        messages = [m.decode() for m in f["events/message"][:]]
+        event_t_s = f["events/t_s"][:]
+        setpoints, pose_t_s = f["poses/setpoint_c"][:], f["poses/t_start_s"][:]
+    left_s = next(t for m, t in zip(messages, event_t_s) if "ramp method: chamber setpoint moving 20 → 30" in m)
+    assert pose_t_s[setpoints == 20.0].max() < left_s < pose_t_s[setpoints == 30.0].min()
