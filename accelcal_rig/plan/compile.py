@@ -221,8 +221,8 @@ def _check_verification_is_new(poses: tuple[Pose, ...], checks: tuple[Pose, ...]
     close = np.argwhere(np.degrees(np.arccos(cosine)) < SAME_POSE_DEG)
     if len(close):
         check, pose = close[0]
-        raise VerificationSeenByFit(f"verification pose {check + 1} has the orientation of calibration pose "
-                                    f"{pose + 1} (within {SAME_POSE_DEG:g}°): verification poses must be ones the "
+        raise VerificationSeenByFit(f"verification pose {checks[check].number} has the orientation of calibration "
+                                    f"pose {poses[pose].number} (within {SAME_POSE_DEG:g}°): verification poses must be ones the "
                                     "fit does not see")
 
 

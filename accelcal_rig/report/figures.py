@@ -74,7 +74,8 @@ def norm_deviation(data: CampaignData, path: Path) -> Path:
             band = 2 * dut.fit.metrics["noise_floor_mg"]
             axes[1, column].axhspan(-band, band, color="0.88", zorder=0, label="±2 × noise floor")
         for setpoint in dict.fromkeys(dut.poses.setpoint_c.tolist()):
-            rows = dut.poses.setpoint_c == setpoint
+            rows = np.flatnonzero(dut.poses.setpoint_c == setpoint)
+            rows = rows[np.argsort(dut.pose_numbers[rows], kind="stable")]  # by number, whatever the order visited
             colour = cmap(norm(setpoint))
             axes[0, column].plot(dut.pose_numbers[rows], raw[rows], "o-", ms=3, lw=0.8, color=colour)
             if after is not None:

@@ -153,8 +153,9 @@ class VirtualLab:
         """`n_samples` codes (n, 3) of DUT `index` from `t_start_s` on, at the DUT's state now (temperature
         and orientation change negligibly within a FIFO's worth); the truth behind them is recorded."""
         dut, instant = self.duts[index], self._instant()
-        temperature, params, gravity = float(instant.temperature_c[index]), instant.parameters[index], \
-            instant.gravity_g[index]
+        # Copies: the log keeps its rows for hours, not each instant's whole fixture behind them.
+        temperature, params, gravity = float(instant.temperature_c[index]), instant.parameters[index].copy(), \
+            instant.gravity_g[index].copy()
         noise = self.dut_rngs[index].normal(0.0, self.noise_g(index, odr_hz), (n_samples, 3))
         raw_g = instant.reading_g[index] + self.unmodelled_g(index, gravity) + noise
         dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, params, gravity, temperature))
