@@ -7,12 +7,11 @@ the wire's timeout, not campaign time (which is virtual in a dry run).
 
 from __future__ import annotations
 
-import os
-import select
 import time
 
 import serial
 
+from accelcal_rig.core.descriptors import read_within, write_within
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 
 
@@ -105,17 +104,9 @@ class LinePort:
     def _write_fd(self, data: bytes) -> None:
         """All of `data` to a local device within its write timeout: one write where pyserial's costs a select
         and a loop in Python per call."""
-        fd = self._port.fileno()
-        deadline = time.monotonic() + (self._port.write_timeout or self._port.timeout or 1.0)
-        view = memoryview(data)
-        while view:
-            try:
-                view = view[os.write(fd, view):]
-                continue
-            except BlockingIOError:  # the device's buffer is full (it opens non-blocking): wait until it drains
-                pass
-            if not select.select([], [fd], [], max(0.0, deadline - time.monotonic()))[1]:
-                raise serial.SerialTimeoutException("write timeout")
+        timeout_s = self._port.write_timeout or self._port.timeout or 1.0
+        if write_within(self._port.fileno(), data, time.monotonic() + timeout_s):
+            raise serial.SerialTimeoutException("write timeout")
 
     def _read_port(self, deadline: float) -> bytes:
         """What has arrived, waiting up to the port's timeout for the first byte (any pyserial port)."""
@@ -124,16 +115,9 @@ class LinePort:
     def _read_fd(self, deadline: float) -> bytes:
         """What has arrived on a local serial device, waiting until `deadline`: one select and one read,
         where pyserial's read costs four system calls (a fixture of 64 bridges asks ~10⁵ times a campaign)."""
-        fd = self._port.fileno()
-        while True:
-            ready, _, _ = select.select([fd], [], [], max(0.0, deadline - time.monotonic()))
-            if not ready:
-                return b""
-            try:
-                chunk = os.read(fd, 65536)
-                break
-            except BlockingIOError:  # pyserial opens it non-blocking: readiness without data, wait again
-                continue
+        chunk = read_within(self._port.fileno(), deadline)
+        if chunk is None:
+            return b""
         if not chunk:
             raise serial.SerialException("device reports readiness to read but returned no data "
                                          "(device disconnected or multiple access on port?)")

@@ -11,12 +11,12 @@ from __future__ import annotations
 import heapq
 import itertools
 import os
-import select
 import selectors
 import threading
 import time
 import tty
 
+from accelcal_rig.core.descriptors import write_within
 from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.sim.faults import ReplyFaults
 from accelcal_rig.sim.line_answers import Handler, LineAnswers
@@ -89,19 +89,13 @@ class PtyLineServer:
     def _write(self, reply: bytes) -> None:
         """All of `reply`, waiting for room at most WRITE_DEADLINE_S: a client that stopped reading (its
         driver gave up on a long reply) loses the rest, and the hub, every other device and `stop` go on."""
-        view, deadline = memoryview(reply), time.monotonic() + WRITE_DEADLINE_S
-        while view:
-            try:
-                view = view[os.write(self._master, view):]
-                continue
-            except BlockingIOError:
-                pass
-            except OSError:
-                return  # the client side went away: nobody to answer
-            if not select.select([], [self._master], [], max(0.0, deadline - time.monotonic()))[1]:
-                LOGGER.warning("simulated device %s: %d bytes of a reply not read within %g s: dropped",
-                               self.name, len(view), WRITE_DEADLINE_S)
-                return
+        try:
+            left = write_within(self._master, reply, time.monotonic() + WRITE_DEADLINE_S)
+        except OSError:
+            return  # the client side went away: nobody to answer
+        if left:
+            LOGGER.warning("simulated device %s: %d bytes of a reply not read within %g s: dropped",
+                           self.name, left, WRITE_DEADLINE_S)
 
 
 class PtyHub:
