@@ -1,9 +1,15 @@
-"""Directions spread evenly over the sphere: for pose schedules and for seeking a worst case over every
-orientation."""
+"""Directions spread evenly over the sphere (pose schedules, seeking a worst case over every orientation),
+and a DUT's mounting on the fixture."""
 
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial.transform import Rotation
+
+
+def fixture_to_dut(mount_euler_deg: tuple[float, float, float]) -> np.ndarray:
+    """Fixture frame → a DUT's frame: the inverse of its mounting (`mount_euler_deg`, extrinsic x-y-z)."""
+    return Rotation.from_euler("xyz", mount_euler_deg, degrees=True).inv().as_matrix()
 
 
 def fibonacci_sphere(count: int) -> np.ndarray:

@@ -8,8 +8,8 @@ from dataclasses import dataclass, field
 
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.logger import LOGGER
-from accelcal_rig.engine.estimate import DurationEstimate
 from accelcal_rig.engine.notify import Notification, Notifier
+from accelcal_rig.engine.played import DurationEstimate
 from accelcal_rig.engine.progress import COOLDOWN_PHASES, PHASES, Progress, ProgressListener
 from accelcal_rig.engine.states import State
 from accelcal_rig.plan.compile import Plan
@@ -55,6 +55,17 @@ class Reporter:
     def begin_setpoint(self, setpoint_c: float) -> None:
         self.setpoint_index = self.plan.setpoints_c.index(setpoint_c)
         self.setpoint_start_s = self.clock.now()
+
+    def pose_stored(self, chamber_c: float, dut_c: tuple[float, ...]) -> None:
+        """A pose is in the file: count it, and keep the temperatures read with it."""
+        self.poses_done += 1
+        self.poses_left[self.setpoint_index] -= 1
+        self.chamber_c, self.dut_c = chamber_c, dut_c
+
+    def skip_setpoint(self) -> int:
+        """The current setpoint's poses will not be measured: how many that is."""
+        skipped, self.poses_left[self.setpoint_index] = self.poses_left[self.setpoint_index], 0
+        return skipped
 
     def remaining_s(self, state: State) -> float | None:
         """The estimate of the time left, while there is measuring left to do."""

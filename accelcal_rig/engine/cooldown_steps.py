@@ -6,42 +6,44 @@ A resumed cool-down records its missing blocks on a fresh schedule, after a fres
 
 from __future__ import annotations
 
-from accelcal_rig.config.procedure import Procedure
-from accelcal_rig.core.clock import Clock
-from accelcal_rig.engine.events import EventLog
-from accelcal_rig.engine.pose_steps import PoseSteps
-from accelcal_rig.engine.states import State, StateMachine
-from accelcal_rig.engine.thermal_steps import ThermalSteps
-from accelcal_rig.instruments.interfaces import Chamber
+from accelcal_rig.engine.played import PlayedRig
+from accelcal_rig.engine.pose_steps import measure
+from accelcal_rig.engine.run_context import RunContext
+from accelcal_rig.engine.states import State
+from accelcal_rig.engine.step_handler import StepHandler
 from accelcal_rig.plan.steps import CooldownRecord
 
 
-class CooldownSteps:
-    def __init__(self, procedure: Procedure, chamber: Chamber, clock: Clock, events: EventLog,
-                 machine: StateMachine, thermal: ThermalSteps, poses: PoseSteps) -> None:
-        self.procedure, self.chamber, self.clock, self.events, self.machine = procedure, chamber, clock, events, machine
-        self.thermal, self.poses = thermal, poses
-        #: When this run let the chamber go (None: not yet), and the records taken since.
-        self._released_s: float | None = None
-        self._since_release = 0
-
-    def record(self, step: CooldownRecord) -> None:
-        cooldown = self.procedure.cooldown
+class CooldownRecordStep:
+    def run(self, step: CooldownRecord, run: RunContext) -> None:
+        cooldown, state = run.procedure.cooldown, run.cooldown
         assert cooldown is not None
-        if self._released_s is None:
-            self.thermal.temperature_moving = True
-            self.poses.measure(step)
-            self._released_s = self.clock.now()
+        if state.released_s is None:
+            run.dut.moving = True
+            measure(step, run)
+            state.released_s = run.clock.now()
             if cooldown.chamber == "power-off":
-                self.chamber.set_power(False)
-                self.events.info("cooldown", "chamber switched off: the DUTs cool freely; recording every "
-                                             f"{cooldown.record_every_s:g} s for {cooldown.duration_min:g} min")
+                run.chamber.set_power(False)
+                run.events.info("cooldown", "chamber switched off: the DUTs cool freely; recording every "
+                                            f"{cooldown.record_every_s:g} s for {cooldown.duration_min:g} min")
             else:
-                self.chamber.write_setpoint_c(cooldown.ambient_c)
-                self.events.info("cooldown", f"chamber set to ambient {cooldown.ambient_c:g} °C; recording every "
-                                             f"{cooldown.record_every_s:g} s for {cooldown.duration_min:g} min")
+                run.chamber.write_setpoint_c(cooldown.ambient_c)
+                run.events.info("cooldown", f"chamber set to ambient {cooldown.ambient_c:g} °C; recording every "
+                                            f"{cooldown.record_every_s:g} s for {cooldown.duration_min:g} min")
             return
-        self._since_release += 1
-        self.machine.go(State.COOL, step.key)
-        self.clock.sleep(max(self._released_s + self._since_release * cooldown.record_every_s - self.clock.now(), 0.0))
-        self.poses.measure(step)
+        state.since_release += 1
+        run.machine.go(State.COOL, step.key)
+        run.clock.sleep(max(state.released_s + state.since_release * cooldown.record_every_s - run.clock.now(), 0.0))
+        measure(step, run)
+
+    def estimate(self, step: CooldownRecord, played: PlayedRig) -> None:
+        """The first record is a pose; the others come on the schedule that starts when it is taken."""
+        cooldown = played.procedure.cooldown
+        assert cooldown is not None
+        travel_s = played.travel_to(step.pose.angles_deg)
+        first = played.tally.records == 0
+        played.tally.records += 1
+        played.wait("poses", travel_s + (played.pose_fixed_s if first else cooldown.record_every_s))
+
+
+COOLDOWN_RECORD: StepHandler[CooldownRecord] = CooldownRecordStep()

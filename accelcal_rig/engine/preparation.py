@@ -7,7 +7,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from accelcal_rig.config.load import (
     LoadedConfig,
@@ -20,6 +19,7 @@ from accelcal_rig.config.load import (
 )
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.core.geometry import fixture_to_dut
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
 from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, VerificationSeenByFit, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
@@ -73,7 +73,7 @@ def _check_design_identifies_fit(procedure: LoadedConfig[Procedure], rig: RigCon
         return
     gravity_fixture = np.array([p.gravity_fixture for p in plan.poses])
     for sensor in rig.fixture.sensors:
-        gravity = Rotation.from_euler("xyz", sensor.mount_euler_deg, degrees=True).inv().apply(gravity_fixture)
+        gravity = gravity_fixture @ fixture_to_dut(sensor.mount_euler_deg).T
         try:
             fit_sfem(gravity, np.full_like(gravity, 1e-5), gravity, fit.mode, fit.parameters)
         except DegenerateDesign as exc:

@@ -7,16 +7,13 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import NoReturn
 
 import numpy as np
 
 from accelcal_rig.config.procedure import Procedure
-from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.logger import LOGGER
-from accelcal_rig.core.signals import signals_deferred
 from accelcal_rig.engine.audience import Audience
-from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitOutcome, FitStage, one_line_reason
+from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitOutcome, FitStage
 from accelcal_rig.engine.campaign_header import create_campaign_file, fit_attrs, instrument_info
 from accelcal_rig.engine.connection import ConnectedRig, RigConnector
 from accelcal_rig.engine.estimate import estimate_duration
@@ -26,8 +23,7 @@ from accelcal_rig.engine.preparation import PreparedCampaign
 from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.progress_file import ProgressFile
 from accelcal_rig.engine.resume import ResumePoint, check_same_campaign
-from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
-from accelcal_rig.errors import CampaignAborted, RigError
+from accelcal_rig.errors import RigError
 from accelcal_rig.fit.campaign_fit import fit_and_save, summary_line
 from accelcal_rig.fit.fixture_pool import warm_up_workers
 from accelcal_rig.fit.recorded_options import recorded_options
@@ -138,63 +134,30 @@ def _close(writer: CampaignWriter) -> tuple[str, ...]:
 def _run(prepared: PreparedCampaign, output: Path, open_writer: Callable[[], CampaignWriter],
          rig_connected: ConnectedRig, resume: ResumePoint | None, calibration: Path | None, wall_start: float,
          progress: ProgressListener | None) -> RunResult:
-    """The campaign from its file's opening to its closing. A stop requested while the file is opened waits
-    until `writer` holds it, so any stop before the runner begins is recorded (_stopped_before_start)."""
+    """The campaign from its file's opening to its closing: the runner opens the file, and any stop once it
+    is open ends safe and recorded."""
     procedure, rig = prepared.procedure.model, prepared.rig.model
     notify = rig.notify
-    notifier: Notifier | None = None
-    writer: CampaignWriter | None = None
+    estimate = estimate_duration(procedure, rig, prepared.plan)
+    fit_stage = _fit_stage(procedure, output, calibration) if calibration and procedure.fit.mode != "none" else None
+    if fit_stage is not None:
+        warm_up_workers(len(rig.fixture.sensors))  # a large fixture's fit workers load while it measures
+    notifier = Notifier(notify) if notify.webhook_url or notify.command else None
+    audience = Audience(ProgressFile(progress_path(output), progress), estimate, notifier, str(output))
+    runner = CampaignRunner(procedure, rig, prepared.plan, rig_connected, open_writer, fit_stage=fit_stage,
+                            resume=resume, audience=audience)
     problems: tuple[str, ...] = ()
     try:
-        with signals_deferred():
-            writer = open_writer()
-        notifier = Notifier(notify) if notify.webhook_url or notify.command else None
-        clock = rig_connected.clock
-        events = EventLog(clock, writer)
-        progress = ProgressFile(progress_path(output), progress)
-        estimate = estimate_duration(procedure, rig, prepared.plan)
-        if calibration and procedure.fit.mode != "none":
-            warm_up_workers(len(rig.fixture.sensors))  # a large fixture's fit workers load while it measures
-        runner = CampaignRunner(procedure, rig, prepared.plan, rig_connected.guarded(events), writer, clock, events,
-                                fit_stage=_fit_stage(procedure, output, calibration)
-                                if calibration and procedure.fit.mode != "none" else None,
-                                resume=resume, audience=Audience(progress, estimate, notifier, str(output)))
         summary = runner.run()
-    except CampaignAborted:
-        raise  # the runner reached the safe state and recorded it
-    except BaseException as exc:  # noqa: BLE001 - a stop or failure before the first step still ends safe
-        if writer is not None and writer.campaign.state == "created":
-            _stopped_before_start(writer, rig_connected, procedure, rig, exc)
-        raise
     finally:
-        progress_path(output).unlink(missing_ok=True)  # a view of this run only: gone with it
         try:
-            if writer is not None:
-                problems = _close(writer)
+            if runner.writer is not None:
+                progress_path(output).unlink(missing_ok=True)  # a view of this run only: gone with it
+                problems = _close(runner.writer)
         finally:
             if notifier is not None:  # the fault, safe and finish events still go out
                 notifier.close()
     return RunResult(summary, time.perf_counter() - wall_start, output, problems)
-
-
-def _stopped_before_start(writer: CampaignWriter, connected: ConnectedRig, procedure: Procedure, rig: RigConfig,
-                          exc: BaseException) -> NoReturn:
-    """A stop or a failure between the campaign's creation and its first step: nothing has moved yet, but the
-    rig still goes to its safe state and the file says why the campaign ended, as after any other abort."""
-    reason = one_line_reason(exc)
-    with signals_deferred():
-        events = EventLog(connected.clock, writer)
-        try:
-            events.error("fault", f"campaign aborted before its first step: {reason}")
-        except Exception as failed:  # noqa: BLE001 - the safe state comes first, whatever the file does
-            LOGGER.error("could not record the abort in the campaign file: %s", failed)
-        raw = connected.instruments
-        apply_safe_state(raw.chamber, raw.turntable, raw.sensors, safe_setpoint_c(procedure, rig), events)
-        try:
-            writer.set_state("aborted", reason=reason, finished=True)
-        except Exception as failed:  # noqa: BLE001 - the reason still reaches the operator through the exception
-            LOGGER.error("could not record the abort in the campaign file: %s", failed)
-    raise CampaignAborted(reason) from exc
 
 
 def _fit_stage(procedure: Procedure, output: Path, calibration: Path) -> FitStage:

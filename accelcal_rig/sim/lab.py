@@ -8,11 +8,11 @@ from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from accelcal_rig.config.procedure import SimulatedEffects
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
+from accelcal_rig.core.geometry import fixture_to_dut
 from accelcal_rig.core.humidity import relative_humidity_pct
 from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel
 from accelcal_rig.core.units import site_gravity_g
@@ -34,7 +34,7 @@ class SimulatedDut:
         self.part = dut_part
         self.truth: DutTruth = truth_for_serial(serial)
         #: Fixture frame → DUT frame.
-        self.fixture_to_dut = Rotation.from_euler("xyz", mount_euler_deg, degrees=True).inv().as_matrix()
+        self.fixture_to_dut = fixture_to_dut(mount_euler_deg)
         self.tau_s = tau_s
         # Signs of the unmodelled effects on each axis, fixed per DUT like its truth; the rate terms' sizes
         # spread 0.5…1.5 × the procedure's (parts differ).
