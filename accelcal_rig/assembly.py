@@ -52,9 +52,9 @@ class AssembledRig:
         # Transient failures are retried below the safety limits, so a retried write is checked too.
         retrier = Retrier(self.config.retry, self.clock, events)
         raw = self.instruments
-        guarded = RigInstruments(LimitedChamber(retrier.retried(raw.chamber), self.config.chamber),
-                                 LimitedTurntable(retrier.retried(raw.turntable), self.config.turntable),
-                                 [retrier.retried(s) for s in raw.sensors], raw.truth)
+        guarded = RigInstruments(LimitedChamber(retrier.retried_chamber(raw.chamber), self.config.chamber),
+                                 LimitedTurntable(retrier.retried_turntable(raw.turntable), self.config.turntable),
+                                 [retrier.retried_sensor(s) for s in raw.sensors], raw.truth)
         return GuardedRig(guarded, retrier)
 
 

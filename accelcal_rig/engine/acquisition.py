@@ -13,6 +13,7 @@ import numpy as np
 
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.errors import TransientInstrumentError
+from accelcal_rig.instruments.capabilities import BlockCapturing
 from accelcal_rig.instruments.capture import capture_together
 from accelcal_rig.instruments.interfaces import Accelerometer, SampleBlock
 
@@ -21,8 +22,10 @@ def acquire_together(sensors: Sequence[Accelerometer], n_samples: int, clock: Cl
                      range_g: int) -> list[SampleBlock]:
     """One gap-free block of `n_samples` from each sensor, over the same instants, each checked by the
     data watchdog (a transient failure: the caller's retry takes a new block)."""
-    if all(0 < n_samples <= sensor.capture_capacity_samples for sensor in sensors):
-        blocks = capture_together(sensors, n_samples, clock)  # type: ignore[arg-type]
+    capturing = [sensor for sensor in sensors
+                 if 0 < n_samples <= sensor.capture_capacity_samples and isinstance(sensor, BlockCapturing)]
+    if len(capturing) == len(sensors):
+        blocks = capture_together(capturing, n_samples, clock)
     else:
         blocks = clock.run_concurrently([partial(sensor.acquire, n_samples) for sensor in sensors])
     for sensor, block in zip(sensors, blocks):

@@ -7,7 +7,7 @@ from collections.abc import Iterator
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.humidity import dew_point_c
 from accelcal_rig.errors import InstrumentError
-from accelcal_rig.instruments.capabilities import controller_limits, has_purge, humidity_pct
+from accelcal_rig.instruments.capabilities import AlarmReporting, controller_limits, has_purge, humidity_pct
 from accelcal_rig.instruments.connect import SomeInstruments
 from accelcal_rig.instruments.interfaces import Chamber, Turntable
 
@@ -20,8 +20,7 @@ def check_lines(instruments: SomeInstruments, rig: RigConfig) -> Iterator[str]:
         limits = (f"; set point limits: the rig's {rig.chamber.min_setpoint_c:g}…{rig.chamber.max_setpoint_c:g} °C, "
                   "the " + (f"controller's {controller[0]:g}…{controller[1]:g} °C" if controller
                             else "controller exposes none"))
-        yield (f"chamber    {chamber.endpoint}: {chamber.identify()}, alarm "
-               f"{'ACTIVE' if chamber.alarm_active() else 'clear'}{limits}{_moisture(chamber, rig)}")
+        yield f"chamber    {chamber.endpoint}: {chamber.identify()}{_alarm(chamber)}{limits}{_moisture(chamber, rig)}"
     if turntable is not None:
         angles = " ".join(f"{a:.3f}" for a in turntable.read_angles_deg())
         yield (f"turntable  {turntable.endpoint}: {turntable.identify()}, angles {angles}°, "
@@ -34,6 +33,13 @@ def check_lines(instruments: SomeInstruments, rig: RigConfig) -> Iterator[str]:
         range_g, odr_hz = sensor.read_settings()
         yield (f"sensor {sensor.serial}  {sensor.endpoint}: {sensor.part.label} rev {identity.revid}, ±{range_g} g, "
                f"{odr_hz:g} Hz, {sensor.read_temperature_c():.1f} °C")
+
+
+def _alarm(chamber: Chamber) -> str:
+    """The controller's alarm, where its profile can ask; nothing where it cannot (not "clear": not known)."""
+    if not isinstance(chamber, AlarmReporting):
+        return ""
+    return f", alarm {'ACTIVE' if chamber.alarm_active() else 'clear'}"
 
 
 def _at_rest(turntable: Turntable) -> bool:

@@ -13,7 +13,9 @@ from accelcal_rig.config.rig import RetryPolicy
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
-from accelcal_rig.instruments.retrying import Retrying
+from accelcal_rig.instruments.capabilities import RetriesExchanges
+from accelcal_rig.instruments.interfaces import Accelerometer, Chamber, Turntable
+from accelcal_rig.instruments.retrying import RetryingAccelerometer, RetryingChamber, RetryingTurntable
 
 T = TypeVar("T")
 
@@ -44,10 +46,21 @@ class Retrier:
                         self._events.warning("retry", f"reconnect failed: {failed}")
         raise AssertionError("unreachable")
 
-    def retried(self, device: T) -> T:
-        """The device with its wire exchanges retried: a driver retries its own exchanges (one request and
-        its reply each, safe to repeat); a device without them (a test double) is retried method by method."""
-        if hasattr(device, "retry_exchanges"):
-            device.retry_exchanges(self.call)  # type: ignore[attr-defined]
-            return device
-        return Retrying(device, self.call)  # type: ignore[return-value]
+    def retried_chamber(self, chamber: Chamber) -> Chamber:
+        """The chamber with its wire exchanges retried (see `_retries_its_own`), or a retrying stand-in."""
+        return chamber if self._retries_its_own(chamber) else RetryingChamber(chamber, self.call)
+
+    def retried_turntable(self, turntable: Turntable) -> Turntable:
+        return turntable if self._retries_its_own(turntable) else RetryingTurntable(turntable, self.call)
+
+    def retried_sensor(self, sensor: Accelerometer) -> Accelerometer:
+        return sensor if self._retries_its_own(sensor) else RetryingAccelerometer(sensor, self.call)
+
+    def _retries_its_own(self, device: object) -> bool:
+        """A driver retries its own exchanges (one request and its reply each, safe to repeat), given this
+        retrier's `call`; a device without them (a test double) is retried method by method by a stand-in
+        with its capabilities."""
+        if isinstance(device, RetriesExchanges):
+            device.retry_exchanges(self.call)
+            return True
+        return False

@@ -17,6 +17,7 @@ from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.engine.states import StateMachine
 from accelcal_rig.errors import InstrumentError
+from accelcal_rig.instruments.capabilities import alarm_active
 from accelcal_rig.instruments.interfaces import Accelerometer, Chamber, RigInstruments, TruthSource, Turntable
 from accelcal_rig.plan.compile import Plan
 from accelcal_rig.store.writer import CampaignWriter
@@ -118,7 +119,7 @@ class RunContext:
 
     def read_chamber_c(self) -> float:
         """Chamber air temperature; an active controller alarm is a fault, never a reading to wait out."""
-        if self.chamber.alarm_active():
+        if alarm_active(self.chamber):
             raise InstrumentError(f"chamber ({self.chamber.endpoint}): controller alarm active")
         self.report.chamber_c = self.chamber.read_temperature_c()
         return self.report.chamber_c

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, TypeVar
+from typing import TypeVar
 
 import numpy as np
 
@@ -14,10 +14,11 @@ from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.waits import wait_until
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError, WaitTimeout
 from accelcal_rig.instruments import adxl355
-from accelcal_rig.instruments.adxl355_transport import RegisterTransport
+from accelcal_rig.instruments.adxl355_transport import BlockCapture, PostedRequests, RegisterTransport
+from accelcal_rig.instruments.capabilities import Reconnecting
 from accelcal_rig.instruments.capture import OVERFLOW_ATTEMPTS, capture_together
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
-from accelcal_rig.instruments.retrying import RetryCall, Retrying
+from accelcal_rig.instruments.retrying import RetryCall, RetryingTransport
 from accelcal_rig.parts.adxl35x import ADXL355
 from accelcal_rig.parts.part import AccelerometerPart
 
@@ -51,8 +52,10 @@ class Adxl355:
     def __init__(self, transport: RegisterTransport, serial: str, clock: Clock,
                  part: AccelerometerPart = ADXL355) -> None:
         self.part = part
-        self._bus = transport
+        self._bus: RegisterTransport = transport
         self._fifo_bus = transport  # FIFO bursts are never retried alone: a lost reply took samples with it
+        #: The bare transport where it posts requests (asked once: it is asked for every DUT at every poll).
+        self._poster = transport if isinstance(transport, PostedRequests) else None
         self.serial = serial
         self.endpoint = transport.endpoint
         self._clock = clock
@@ -123,7 +126,7 @@ class Adxl355:
         sent, read it with `read_temperature_c`)."""
         if self._agreed is None or self._clock.now() - self._agreed[0] > AGREED_FRESH_S:
             return False
-        return self._posted("post_read", adxl355.REG_TEMP2, 2)
+        return self._posted(lambda bridge: bridge.post_read(adxl355.REG_TEMP2, 2))
 
     def end_temperature_read(self) -> float | None:
         """The temperature `begin_temperature_read` asked for; None where it does not agree with the last
@@ -170,24 +173,23 @@ class Adxl355:
     def retry_exchanges(self, call: RetryCall) -> None:
         """Retry each register access and capture request on its own (the capture is fetched by index, so
         that is safe); a FIFO burst is not, its block is taken again whole by the caller."""
-        self._bus = Retrying(self._fifo_bus, call)  # type: ignore[assignment]
+        self._bus = RetryingTransport(self._fifo_bus, call)
 
     def reconnect(self) -> None:
-        reopen = getattr(self._fifo_bus, "reconnect", None)
-        if reopen is not None:
-            reopen()
+        if isinstance(self._fifo_bus, Reconnecting):
+            self._fifo_bus.reconnect()
 
     # ------------------------------------------------------------------ bridge-side capture
     def post_capture(self, n_samples: int) -> bool:
         """Send the capture request without waiting for its reply (False: not sent; `begin_capture` asks)."""
-        return self._posted("post_capture", n_samples)
+        return self._posted(lambda bridge: bridge.post_capture(n_samples))
 
     def begin_capture(self, n_samples: int, posted: bool = False) -> None:
         """The bridge starts capturing the next `n_samples` (and says the temperature then). `posted`: the
         request went out with `post_capture`; its reply is read here, or the request retried if it failed."""
         raw = self._received(posted, lambda bridge: bridge.receive_capture(n_samples))
         if raw is None:
-            raw = self._bus.start_capture(n_samples)  # type: ignore[attr-defined]
+            raw = self._capturing_bus().start_capture(n_samples)
         self._capture = _Capture(n_samples, self._clock.now(), float(self.part.temperature.celsius(raw)))
 
     def capture_wait_s(self) -> float:
@@ -198,7 +200,8 @@ class Adxl355:
     def post_fetch(self) -> bool:
         """Send the next fetch without waiting for its reply (False: not sent; `fetch_capture` asks)."""
         assert self._capture is not None
-        return self._posted("post_fetch", self._capture.have)
+        have = self._capture.have
+        return self._posted(lambda bridge: bridge.post_fetch(have))
 
     def fetch_capture(self, posted: bool = False) -> bool:
         """Fetch what the bridge has captured since the last fetch (asked for by index, so a retry after
@@ -207,7 +210,7 @@ class Adxl355:
         capture = self._capture
         assert capture is not None
         fetched = self._received(posted, lambda bridge: bridge.receive_fetch(capture.have))
-        raw, temperature_raw = fetched if fetched is not None else self._bus.fetch_capture(capture.have)  # type: ignore[attr-defined]
+        raw, temperature_raw = fetched if fetched is not None else self._capturing_bus().fetch_capture(capture.have)
         codes, capture.carried = adxl355.decode_fifo(raw, capture.carried)
         capture.blocks.append(codes)
         capture.have += len(codes)
@@ -219,24 +222,30 @@ class Adxl355:
                                   "samples before the deadline: is it measuring?")
         return done
 
-    def _posted(self, request: str, *args: int) -> bool:
-        """Send `request` (a transport's `post_…`) on the bare transport, if it has it (no retry: a failure is
+    def _capturing_bus(self) -> BlockCapture:
+        """The (retried) transport, as one that captures blocks: only such a one has a capture capacity."""
+        bus = self._bus
+        if not isinstance(bus, BlockCapture):
+            raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): its transport captures no blocks")
+        return bus
+
+    def _posted(self, send: Callable[[PostedRequests], None]) -> bool:
+        """Send a request with `send` on the bare transport, if it posts requests (no retry: a failure is
         retried whole by the exchange that follows)."""
-        send = getattr(self._fifo_bus, request, None)
-        if send is None:
+        if self._poster is None:
             return False
         try:
-            send(*args)
+            send(self._poster)
         except TransientInstrumentError:
             return False
         return True
 
-    def _received(self, posted: bool, receive: Callable[[Any], T]) -> T | None:
+    def _received(self, posted: bool, receive: Callable[[PostedRequests], T]) -> T | None:
         """The reply to a posted request; None when none was posted or it failed transiently (ask again)."""
-        if not posted:
+        if not posted or self._poster is None:
             return None
         try:
-            return receive(self._fifo_bus)
+            return receive(self._poster)
         except TransientInstrumentError:
             return None
 

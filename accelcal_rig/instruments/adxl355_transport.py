@@ -23,7 +23,7 @@ firmware can.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments import adxl355
@@ -36,8 +36,10 @@ GREETING_ATTEMPTS = 3
 
 class RegisterTransport(Protocol):
     endpoint: str
-    #: Samples the transport can capture on its own (0: none; the host drains the FIFO itself).
-    capture_capacity_samples: int
+
+    @property
+    def capture_capacity_samples(self) -> int:
+        """Samples the transport can capture on its own (0: none; the host drains the FIFO itself)."""
 
     def read(self, address: int, count: int) -> bytes: ...
     def write(self, address: int, value: int) -> None: ...
@@ -48,6 +50,7 @@ class CaptureOverflow(InstrumentError):
     """A bridge-side capture lost samples (its buffer was not fetched in time)."""
 
 
+@runtime_checkable
 class BlockCapture(Protocol):
     """A transport that captures gap-free blocks itself (a version 2 serial bridge)."""
 
@@ -56,6 +59,19 @@ class BlockCapture(Protocol):
 
     def fetch_capture(self, first: int) -> tuple[bytes, int | None]:
         """(captured FIFO bytes from sample `first` on, raw temperature at the end once it is complete)."""
+
+
+@runtime_checkable
+class PostedRequests(Protocol):
+    """A transport whose requests can go out now and their replies be read later: one thread asks every
+    bridge first, then reads each reply, and the bridges answer at the same time."""
+
+    def post_read(self, address: int, count: int) -> None: ...
+    def receive_read(self, address: int, count: int) -> bytes: ...
+    def post_capture(self, n_samples: int) -> None: ...
+    def receive_capture(self, n_samples: int) -> int: ...
+    def post_fetch(self, first: int) -> None: ...
+    def receive_fetch(self, first: int) -> tuple[bytes, int | None]: ...
 
 
 class SerialBridge:

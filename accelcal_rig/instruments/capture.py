@@ -8,7 +8,8 @@ from collections.abc import Sequence
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.instruments.adxl355_transport import CaptureOverflow
-from accelcal_rig.instruments.interfaces import BlockCapturing, SampleBlock
+from accelcal_rig.instruments.capabilities import BlockCapturing
+from accelcal_rig.instruments.interfaces import SampleBlock
 
 #: Attempts at a gap-free block before lost samples are reported as a fault.
 OVERFLOW_ATTEMPTS = 3

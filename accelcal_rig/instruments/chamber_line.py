@@ -9,9 +9,11 @@ again), silence, a controller not in °C, or values no chamber reads.
 from __future__ import annotations
 
 import re
+from typing import Self
 
 from accelcal_rig.config.rig import ChamberConfig, is_host_port
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.instruments.composition import composed, instance_of
 from accelcal_rig.instruments.definitions import ChamberDriver
 from accelcal_rig.instruments.limits import plausible_c
 from accelcal_rig.instruments.line_port import LinePort
@@ -20,6 +22,12 @@ from accelcal_rig.protocols.chamber_lines import ChamberLineProtocol, Operation
 
 
 class LineChamber:
+    """A chamber of exactly the capabilities its profile has (an alarm query, its own limits, humidity, a purge
+    output, a set point to decimals: accelcal_rig.instruments.capabilities), whichever way it is made."""
+
+    def __new__(cls, line: LinePort, endpoint: str, protocol: ChamberLineProtocol) -> Self:
+        return instance_of(composed(cls, _capabilities(protocol)) if cls is LineChamber else cls)
+
     def __init__(self, line: LinePort, endpoint: str, protocol: ChamberLineProtocol) -> None:
         self._line = line
         self.endpoint = endpoint
@@ -55,52 +63,14 @@ class LineChamber:
     def read_setpoint_c(self) -> float:
         return self._temperature("read_setpoint", "sp", "set point")
 
-    @property
-    def setpoint_decimals(self) -> int | None:
-        """The decimals the profile writes a set point with: the limit gate rounds to them first."""
-        return self.protocol.setpoint_decimals
-
     def write_setpoint_c(self, setpoint_c: float) -> None:
         """Limits are the caller's gate (LimitedChamber), which also reads the set point back."""
         self._ask("write_setpoint", value=float(setpoint_c))
-
-    def controller_limits_c(self) -> tuple[float, float] | None:
-        if self.protocol.read_low_limit is None:
-            return None
-        low = self._temperature("read_low_limit", "low", "set point low limit")
-        high = self._temperature("read_high_limit", "high", "set point high limit")
-        if not low < high:
-            raise self._failure(f"set point limits read {low:g}…{high:g} °C: not a range")
-        return low, high
 
     def set_power(self, on: bool) -> None:
         if self.protocol.power_on is None:
             raise self._failure("the protocol profile has no power command")
         self._ask("power_on" if on else "power_off")
-
-    def read_humidity_pct(self) -> float | None:
-        """The controller's relative humidity reading; None where the profile has no humidity command."""
-        if self.protocol.humidity is None:
-            return None
-        value = float(self._ask("humidity")["humidity"])
-        if not 0.0 <= value <= 100.5:
-            raise self._failure(f"relative humidity reads {value:g} %: not a reading (wrong profile?)")
-        return value
-
-    def has_purge(self) -> bool:
-        return self.protocol.purge_on is not None
-
-    def set_purge(self, on: bool) -> None:
-        """Switch the dry-air purge output (frost and condensation on a cold fixture)."""
-        if self.protocol.purge_on is None:
-            raise self._failure("the protocol profile has no purge output (set purge_on/purge_off in "
-                                "protocol_overrides)")
-        self._ask("purge_on" if on else "purge_off")
-
-    def alarm_active(self) -> bool:
-        if self.protocol.alarm is None:
-            return False
-        return self._ask("alarm")["alarm"] not in self.protocol.alarm_inactive
 
     def close(self) -> None:
         self._line.close()
@@ -142,6 +112,51 @@ class LineChamber:
         if match is None:
             raise TransientInstrumentError(f"chamber ({self.endpoint}): {request!r}: unexpected reply {reply!r}")
         return {k: v for k, v in match.groupdict().items() if v is not None}
+
+
+class _Alarm(LineChamber):
+    def alarm_active(self) -> bool:
+        return self._ask("alarm")["alarm"] not in self.protocol.alarm_inactive
+
+
+class _Limits(LineChamber):
+    def controller_limits_c(self) -> tuple[float, float] | None:
+        low = self._temperature("read_low_limit", "low", "set point low limit")
+        high = self._temperature("read_high_limit", "high", "set point high limit")
+        if not low < high:
+            raise self._failure(f"set point limits read {low:g}…{high:g} °C: not a range")
+        return low, high
+
+
+class _Humidity(LineChamber):
+    def read_humidity_pct(self) -> float | None:
+        """The controller's relative humidity reading."""
+        value = float(self._ask("humidity")["humidity"])
+        if not 0.0 <= value <= 100.5:
+            raise self._failure(f"relative humidity reads {value:g} %: not a reading (wrong profile?)")
+        return value
+
+
+class _Purge(LineChamber):
+    def set_purge(self, on: bool) -> None:
+        """Switch the dry-air purge output (frost and condensation on a cold fixture)."""
+        self._ask("purge_on" if on else "purge_off")
+
+
+class _Resolution(LineChamber):
+    @property
+    def setpoint_decimals(self) -> int:
+        """The decimals the profile writes a set point with: the limit gate rounds to them first."""
+        decimals = self.protocol.setpoint_decimals
+        assert decimals is not None  # only a profile that writes to decimals has this capability
+        return decimals
+
+
+def _capabilities(protocol: ChamberLineProtocol) -> list[type[LineChamber]]:
+    """What a profile's commands let its chamber do beyond the core."""
+    offered = {_Alarm: protocol.alarm, _Limits: protocol.read_low_limit, _Humidity: protocol.humidity,
+               _Purge: protocol.purge_on, _Resolution: protocol.setpoint_decimals}
+    return [mixin for mixin, present in offered.items() if present is not None]
 
 
 def _open(config: ChamberConfig, endpoint: str) -> LineChamber:

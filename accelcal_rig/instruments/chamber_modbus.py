@@ -8,7 +8,7 @@ decimals or units register that disagrees with the map, or values no chamber rea
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import Any, Self
 
 from pymodbus.client import ModbusSerialClient, ModbusTcpClient
 from pymodbus.client.base import ModbusBaseSyncClient
@@ -16,6 +16,7 @@ from pymodbus.exceptions import ModbusException
 
 from accelcal_rig.config.rig import ChamberConfig
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.instruments.composition import composed, instance_of
 from accelcal_rig.instruments.definitions import ChamberDriver
 from accelcal_rig.instruments.limits import plausible_c
 from accelcal_rig.instruments.retrying import RetryCall
@@ -26,6 +27,13 @@ _BUSY_CODES = (5, 6)
 
 
 class ModbusChamber:
+    """A chamber of exactly the capabilities its register map has (an alarm register, limit registers, a purge
+    output, a scaled set point: accelcal_rig.instruments.capabilities), whichever way it is made."""
+
+    def __new__(cls, client: ModbusBaseSyncClient, endpoint: str, registers: ChamberRegisterMap,
+                device_id: int = 1) -> Self:
+        return instance_of(composed(cls, _capabilities(registers)) if cls is ModbusChamber else cls)
+
     def __init__(self, client: ModbusBaseSyncClient, endpoint: str, registers: ChamberRegisterMap,
                  device_id: int = 1) -> None:
         self._client = client
@@ -82,11 +90,6 @@ class ModbusChamber:
     def read_setpoint_c(self) -> float:
         return self._plausible(self._read_temperature(self.registers.setpoint), "set point")
 
-    @property
-    def setpoint_decimals(self) -> int | None:
-        """A scaled register holds the set point to its decimals (the limit gate rounds to them first)."""
-        return self.registers.decimals if self.registers.encoding == "scaled-int16" else None
-
     def write_setpoint_c(self, setpoint_c: float) -> None:
         """Write the static set point (both float words in one request). Limits are the caller's gate."""
         self._write(self.registers.setpoint, self._encode(setpoint_c))
@@ -96,32 +99,6 @@ class ModbusChamber:
         if m.power_register is None:
             raise self._error("the register map has no power event")
         self._write(m.power_register, [m.power_on if on else m.power_off])
-
-    def has_purge(self) -> bool:
-        return self.registers.purge_register is not None
-
-    def set_purge(self, on: bool) -> None:
-        m = self.registers
-        if m.purge_register is None:
-            raise self._error("the register map has no purge output (set registers.purge_register)")
-        self._write(m.purge_register, [m.purge_on if on else m.purge_off])
-
-    def controller_limits_c(self) -> tuple[float, float] | None:
-        m = self.registers
-        if m.setpoint_low_register is None or m.setpoint_high_register is None:
-            return None
-        low = self._plausible(self._read_temperature(m.setpoint_low_register), "set point low limit")
-        high = self._plausible(self._read_temperature(m.setpoint_high_register), "set point high limit")
-        if not low < high:
-            raise self._error(f"set point limits read {low:g}…{high:g} °C (registers {m.setpoint_low_register}/"
-                              f"{m.setpoint_high_register}): not a range")
-        return low, high
-
-    def alarm_active(self) -> bool:
-        m = self.registers
-        if m.alarm_register is None:
-            return False
-        return self._read(m.alarm_register, 1)[0] not in m.alarm_inactive
 
     def close(self) -> None:
         self._client.close()
@@ -197,6 +174,47 @@ class ModbusChamber:
 
     def _error(self, message: str) -> InstrumentError:
         return InstrumentError(f"chamber ({self.endpoint}): {message}")
+
+
+class _Alarm(ModbusChamber):
+    def alarm_active(self) -> bool:
+        m = self.registers
+        assert m.alarm_register is not None  # only a map with an alarm register has this capability
+        return self._read(m.alarm_register, 1)[0] not in m.alarm_inactive
+
+
+class _Limits(ModbusChamber):
+    def controller_limits_c(self) -> tuple[float, float] | None:
+        m = self.registers
+        assert m.setpoint_low_register is not None and m.setpoint_high_register is not None
+        low = self._plausible(self._read_temperature(m.setpoint_low_register), "set point low limit")
+        high = self._plausible(self._read_temperature(m.setpoint_high_register), "set point high limit")
+        if not low < high:
+            raise self._error(f"set point limits read {low:g}…{high:g} °C (registers {m.setpoint_low_register}/"
+                              f"{m.setpoint_high_register}): not a range")
+        return low, high
+
+
+class _Purge(ModbusChamber):
+    def set_purge(self, on: bool) -> None:
+        m = self.registers
+        assert m.purge_register is not None  # only a map with a purge output has this capability
+        self._write(m.purge_register, [m.purge_on if on else m.purge_off])
+
+
+class _Resolution(ModbusChamber):
+    @property
+    def setpoint_decimals(self) -> int:
+        """A scaled register holds the set point to its decimals (the limit gate rounds to them first)."""
+        return self.registers.decimals
+
+
+def _capabilities(m: ChamberRegisterMap) -> list[type[ModbusChamber]]:
+    """What a register map lets its chamber do beyond the core."""
+    offered = {_Alarm: m.alarm_register is not None,
+               _Limits: m.setpoint_low_register is not None and m.setpoint_high_register is not None,
+               _Purge: m.purge_register is not None, _Resolution: m.encoding == "scaled-int16"}
+    return [mixin for mixin, present in offered.items() if present]
 
 
 def _number(value: object) -> float:

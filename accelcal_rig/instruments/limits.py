@@ -8,7 +8,13 @@ import numpy as np
 
 from accelcal_rig.config.rig import ChamberConfig, TurntableConfig
 from accelcal_rig.errors import InstrumentError
-from accelcal_rig.instruments.capabilities import controller_limits, setpoint_decimals
+from accelcal_rig.instruments.capabilities import (
+    ControllerLimits,
+    SetpointResolution,
+    controller_limits,
+    setpoint_decimals,
+)
+from accelcal_rig.instruments.delegates import CHAMBER_CAPABILITIES, ChamberDelegate, TurntableDelegate
 from accelcal_rig.instruments.interfaces import Chamber, Turntable
 
 #: A setpoint read back further than this from what was written means the controller did not take it.
@@ -22,25 +28,22 @@ def plausible_c(value: float) -> bool:
     return math.isfinite(value) and PLAUSIBLE_C[0] <= value <= PLAUSIBLE_C[1]
 
 
-class LimitedChamber:
+class LimitedChamber(ChamberDelegate):
     """Refuses setpoints outside the rig's chamber limits, and outside the controller's own where it exposes
     them (read once, at connect: a controller clamps silently what it will not take); verifies each write by
     reading back. A set point is first rounded to what the controller holds (a 0.1 °C register or template),
-    so the value checked against the limits and read back is the one on the wire."""
+    so the value checked against the limits and read back is the one on the wire. Everything else is passed
+    on, with the capabilities of the chamber it guards and no others."""
 
     def __init__(self, chamber: Chamber, limits: ChamberConfig) -> None:
-        self._chamber = chamber
+        super().__init__(chamber)
         self._limits = limits
-        self.endpoint = chamber.endpoint
         self.controller_limits = controller_limits(chamber)
-        self.setpoint_decimals = setpoint_decimals(chamber)
-
-    def controller_limits_c(self) -> tuple[float, float] | None:
-        return self.controller_limits
+        self._decimals = setpoint_decimals(chamber)
 
     def write_setpoint_c(self, setpoint_c: float) -> None:
-        if self.setpoint_decimals is not None:
-            setpoint_c = round(setpoint_c, self.setpoint_decimals)
+        if self._decimals is not None:
+            setpoint_c = round(setpoint_c, self._decimals)
         low, high = self._limits.min_setpoint_c, self._limits.max_setpoint_c
         if not low <= setpoint_c <= high:
             raise InstrumentError(
@@ -58,17 +61,30 @@ class LimitedChamber:
                 f"chamber ({self.endpoint}): setpoint {setpoint_c:g} °C written but {readback:g} °C read back"
             )
 
-    def __getattr__(self, name: str):
-        return getattr(self._chamber, name)
+
+class _LimitsReadAtConnect(LimitedChamber):
+    def controller_limits_c(self) -> tuple[float, float] | None:
+        return self.controller_limits
 
 
-class LimitedTurntable:
-    """Refuses moves outside the axis limits (continuous axes excepted) or with the wrong axis count."""
+class _DecimalsReadAtConnect(LimitedChamber):
+    @property
+    def setpoint_decimals(self) -> int:
+        assert self._decimals is not None  # composed in only for a chamber with a set point resolution
+        return self._decimals
+
+
+LimitedChamber._passes_on = {**CHAMBER_CAPABILITIES, ControllerLimits: _LimitsReadAtConnect,
+                             SetpointResolution: _DecimalsReadAtConnect}
+
+
+class LimitedTurntable(TurntableDelegate):
+    """Refuses moves outside the axis limits (continuous axes excepted) or with the wrong axis count; the rest
+    is passed on."""
 
     def __init__(self, turntable: Turntable, config: TurntableConfig) -> None:
-        self._turntable = turntable
+        super().__init__(turntable)
         self._axes = config.axes
-        self.endpoint = turntable.endpoint
 
     def move_to(self, angles_deg: np.ndarray) -> None:
         angles = np.asarray(angles_deg, dtype=float)
@@ -81,6 +97,3 @@ class LimitedTurntable:
                     f"limits are {axis.min_deg:g}…{axis.max_deg:g}°"
                 )
         self._turntable.move_to(angles)
-
-    def __getattr__(self, name: str):
-        return getattr(self._turntable, name)

@@ -7,15 +7,15 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from accelcal_rig.instruments.capabilities import TemperaturePosting
 from accelcal_rig.instruments.interfaces import Accelerometer
 
 
 def read_temperatures_together(sensors: Sequence[Accelerometer]) -> np.ndarray:
-    """Each sensor's temperature (°C). Sensors that can (`begin_temperature_read`) get their request
-    first and are collected after; any whose quick read is not sure is read again on its own, as are
-    sensors without it."""
-    posted = [bool(getattr(sensor, "begin_temperature_read", lambda: False)()) for sensor in sensors]
-    quick = [sensor.end_temperature_read() if sent else None  # type: ignore[attr-defined]
-             for sensor, sent in zip(sensors, posted)]
+    """Each sensor's temperature (°C). Sensors that can (TemperaturePosting) get their request first and
+    are collected after; any whose quick read is not sure is read again on its own, as are sensors without it."""
+    posted = [sensor if isinstance(sensor, TemperaturePosting) and sensor.begin_temperature_read() else None
+              for sensor in sensors]
+    quick = [poster.end_temperature_read() if poster is not None else None for poster in posted]
     return np.array([value if value is not None else sensor.read_temperature_c()
                      for sensor, value in zip(sensors, quick)])

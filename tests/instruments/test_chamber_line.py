@@ -11,6 +11,7 @@ from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.instruments.capabilities import AlarmReporting, alarm_active, controller_limits, humidity_pct
 from accelcal_rig.instruments.chamber_line import LineChamber
 from accelcal_rig.instruments.limits import LimitedChamber
 from accelcal_rig.protocols.chamber_lines import LINE_PROFILES, line_protocol
@@ -51,10 +52,10 @@ def test_each_profile_drives_its_simulated_controller(profile: str, transport: s
     assert server.last_setpoint_c == pytest.approx(-40.0)
     clock.sleep(3600.0)
     assert chamber.read_temperature_c() == pytest.approx(-40.0, abs=0.5)
-    limits = chamber.controller_limits_c()
-    assert limits == ((-70.0, 180.0) if LINE_PROFILES[profile].read_low_limit else None)
-    assert chamber.alarm_active() is False
-    humidity = chamber.read_humidity_pct()
+    assert controller_limits(chamber) == ((-70.0, 180.0) if LINE_PROFILES[profile].read_low_limit else None)
+    assert alarm_active(chamber) is False
+    assert isinstance(chamber, AlarmReporting) == (LINE_PROFILES[profile].alarm is not None)
+    humidity = humidity_pct(chamber)
     assert humidity is not None and 0.0 < humidity <= 100.5
 
 

@@ -8,6 +8,7 @@ from collections.abc import Sequence
 import pytest
 
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.instruments.capabilities import ControllerLimits, controller_limits
 from accelcal_rig.instruments.chamber_line import LineChamber
 from accelcal_rig.protocols.chamber_lines import LINE_PROFILES, ChamberLineProtocol, line_protocol
 from tests.instruments.expected_protocol import expected_protocol
@@ -55,7 +56,8 @@ def test_thermotron_8800_checks_its_units_and_answers_operations_with_zero() -> 
         chamber.set_power(True)
         chamber.set_power(False)
         assert not chamber.alarm_active()
-        assert chamber.controller_limits_c() is None  # the 8800 profile exposes none
+        assert not isinstance(chamber, ControllerLimits)  # the 8800 profile exposes none
+        assert controller_limits(chamber) is None
 
 
 def test_simserv_numbered_commands_with_its_separator_byte() -> None:

@@ -9,6 +9,7 @@ import pytest
 from pymodbus.client import ModbusSerialClient
 
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.instruments.capabilities import ControllerLimits, controller_limits
 from accelcal_rig.instruments.chamber_modbus import ModbusChamber
 from accelcal_rig.protocols.chamber_registers import register_map
 from tests.instruments.expected_protocol import ExpectedPort
@@ -127,4 +128,5 @@ def test_limits_that_are_no_range_are_refused_and_a_map_without_them_says_none()
                         profile="watlow-f4")
     with pytest.raises(InstrumentError, match=r"set point limits read 50…40 °C \(registers 602/603\): not a range"):
         driver.controller_limits_c()
-    assert chamber([], profile="watlow-f4t")[0].controller_limits_c() is None  # F4T Data Map 1: not in our map
+    f4t = chamber([], profile="watlow-f4t")[0]  # F4T Data Map 1: not in our map
+    assert not isinstance(f4t, ControllerLimits) and controller_limits(f4t) is None

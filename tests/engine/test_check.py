@@ -1,0 +1,42 @@
+"""`rig check` says only what it asked: a chamber whose profile has no alarm query gets no word about an
+alarm (never "clear"), one whose profile has it gets its answer."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import yaml
+
+from accelcal_rig.assembly import connected
+from accelcal_rig.config.load import load_rig
+from accelcal_rig.engine.check import check_lines
+from tests.conftest import SIM_RIG
+
+
+def chamber_line(tmp_path: Path, driver: str, profile: str, **settings: object) -> str:
+    """The one line `rig check --dry-run --only chamber` prints for a rig whose chamber speaks `profile`."""
+    config = yaml.safe_load(SIM_RIG.read_text())
+    config["chamber"].update(driver=driver, profile=profile, **settings)
+    path = tmp_path / "rig.yaml"
+    path.write_text(yaml.safe_dump(config))
+    rig = load_rig(path)
+    with connected(rig, dry_run=True, only=frozenset({"chamber"})) as instruments:
+        (line,) = check_lines(instruments, rig.model)
+    return line
+
+
+@pytest.mark.parametrize(("driver", "profile", "settings"), [
+    ("line", "watlow-f4t-scpi", {}),  # the F4T's SCPI has no alarm query
+    ("modbus-tcp", "watlow-f4t", {"registers": {"alarm_register": None}}),  # a map without its alarm register
+])
+def test_a_chamber_without_an_alarm_query_says_nothing_about_an_alarm(tmp_path: Path, driver: str, profile: str,
+                                                                      settings: dict) -> None:
+    line = chamber_line(tmp_path, driver, profile, **settings)
+    assert line.startswith("chamber    ") and "°C); set point limits: the rig's" in line
+    assert "alarm" not in line
+
+
+@pytest.mark.parametrize(("driver", "profile"), [("line", "espec-p300"), ("modbus-tcp", "watlow-f4t")])
+def test_a_chamber_with_an_alarm_query_says_its_answer(tmp_path: Path, driver: str, profile: str) -> None:
+    assert "°C), alarm clear; set point limits: the rig's" in chamber_line(tmp_path, driver, profile)
