@@ -30,11 +30,11 @@ def throughput(protocol_version: int, seconds: float) -> tuple[int, float]:
     try:
         sensor.reset()
         sensor.standby()
-        sensor.configure(2, 4000.0)
+        sensor.configure({"accel": 2}, 4000.0)
         sensor.start_measurement()
         samples, start = 0, time.perf_counter()
         while time.perf_counter() - start < seconds:
-            samples += len(sensor.acquire(4000).codes_xyz)
+            samples += len(sensor.acquire(4000).codes["accel"])
         return samples, time.perf_counter() - start
     finally:
         sensor.close()

@@ -45,7 +45,7 @@ def firmware_sensor(binary: Path) -> Iterator[Adxl355]:
     try:
         sensor.reset()
         sensor.standby()
-        sensor.configure(2, ODR_HZ)
+        sensor.configure({"accel": 2}, ODR_HZ)
         sensor.start_measurement()
         yield sensor
     finally:
@@ -67,7 +67,7 @@ def sustained(sensor: Adxl355, seconds: float, block: int) -> dict[str, float]:
     bridge.start_capture = counted_start  # type: ignore[method-assign]
     samples, blocks, begun = 0, 0, time.perf_counter()
     while time.perf_counter() - begun < seconds:
-        samples += len(sensor.acquire(block).codes_xyz)
+        samples += len(sensor.acquire(block).codes["accel"])
         blocks += 1
     wall = time.perf_counter() - begun
     bridge.start_capture = real_start  # type: ignore[method-assign]

@@ -144,7 +144,7 @@ def test_sigterm_mid_campaign_reaches_the_safe_state_and_keeps_the_poses(tmp_pat
         stored = f["poses/step_key"].shape[0]
         assert 24 <= stored < 264
         for dut in f["duts"].values():
-            assert dut["raw_codes"].shape[0] == stored
+            assert dut["accel/raw_codes"].shape[0] == stored
         safe = [m.decode() for m, k in zip(f["events/message"][:], f["events/kind"][:]) if k.decode() == "safe"]
     assert any("chamber" in m and "to 23 °C" in m for m in safe)
     assert sum("standby" in m for m in safe) == 4

@@ -105,7 +105,7 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
     acquisition = procedure.model.acquisition
     for sensor in rig.model.fixture.sensors:
         dut_part = part(sensor.part)
-        for key, problem in (("range_g", dut_part.range_problem(acquisition.range_g)),
+        for key, problem in (("range_g", dut_part.range_problem("accel", acquisition.range_g)),
                              ("odr_hz", dut_part.rate_problem(acquisition.odr_hz))):
             if problem:
                 raise procedure.error(("acquisition", key), f"{problem}: sensor {sensor.serial} of {rig.path}")

@@ -71,6 +71,10 @@ class Acquisition(StrictModel):
     odr_hz: float = Field(125.0, gt=0, le=100_000, description="output data rate, one of every DUT part's")
     settle_s: float = Field(5.0, ge=0, le=3600, description="wait after the turntable is in position")
 
+    def ranges(self) -> dict[str, int]:
+        """The ± full scale asked of each channel, by the channel's name."""
+        return {"accel": self.range_g}
+
 
 class FitOptions(StrictModel):
     """How the campaign's data will be fitted (paper §3)."""

@@ -6,7 +6,7 @@ thread; any others are read by one thread each on the clock's concurrent runner.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from functools import partial
 
 import numpy as np
@@ -15,11 +15,11 @@ from accelcal_rig.core.clock import Clock
 from accelcal_rig.errors import TransientInstrumentError
 from accelcal_rig.instruments.capabilities import BlockCapturing
 from accelcal_rig.instruments.capture import capture_together
-from accelcal_rig.instruments.interfaces import Accelerometer, SampleBlock
+from accelcal_rig.instruments.interfaces import SampleBlock, Sensor
 
 
-def acquire_together(sensors: Sequence[Accelerometer], n_samples: int, clock: Clock,
-                     range_g: int) -> list[SampleBlock]:
+def acquire_together(sensors: Sequence[Sensor], n_samples: int, clock: Clock,
+                     ranges: Mapping[str, int]) -> list[SampleBlock]:
     """One gap-free block of `n_samples` from each sensor, over the same instants, each checked by the
     data watchdog (a transient failure: the caller's retry takes a new block)."""
     capturing = [sensor for sensor in sensors
@@ -29,18 +29,22 @@ def acquire_together(sensors: Sequence[Accelerometer], n_samples: int, clock: Cl
     else:
         blocks = clock.run_concurrently([partial(sensor.acquire, n_samples) for sensor in sensors])
     for sensor, block in zip(sensors, blocks):
-        check_block(sensor, block, range_g)
+        check_block(sensor, block, ranges)
     return blocks
 
 
-def check_block(sensor: Accelerometer, block: SampleBlock, range_g: int) -> None:
-    """Watchdog on the data: an axis whose every sample is the same code has stopped (real noise moves
-    it by many LSB at any data rate), and a code at either end of the ADC range is saturated."""
-    codes = block.codes_xyz
-    frozen = [axis for axis, values in zip("xyz", codes.T) if values.size > 1 and np.ptp(values) == 0]
-    if frozen:
-        raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): data stuck: every one of "
-                                       f"{len(codes)} samples of axis {','.join(frozen)} reads the same code")
-    if np.any(codes >= sensor.part.code_max) or np.any(codes <= sensor.part.code_min):
-        raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): saturated at ±{range_g} g "
-                                       "(a code at the end of the ADC range)")
+def check_block(sensor: Sensor, block: SampleBlock, ranges: Mapping[str, int]) -> None:
+    """Watchdog on the data, each channel of the part: an axis whose every sample is the same code has
+    stopped (real noise moves it by many LSB at any data rate), and a code at either end of the ADC range is
+    saturated."""
+    channels = sensor.part.channels
+    for channel in channels:
+        codes = block.codes[channel.name]
+        named = f"{channel.name} axis" if len(channels) > 1 else "axis"
+        frozen = [axis for axis, values in zip(channel.axes, codes.T) if values.size > 1 and np.ptp(values) == 0]
+        if frozen:
+            raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): data stuck: every one of "
+                                           f"{len(codes)} samples of {named} {','.join(frozen)} reads the same code")
+        if np.any(codes >= channel.code_max) or np.any(codes <= channel.code_min):
+            raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): saturated at "
+                                           f"±{ranges[channel.name]} {channel.unit} (a code at the end of the ADC range)")

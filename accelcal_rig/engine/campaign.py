@@ -37,7 +37,7 @@ from accelcal_rig.engine.step_table import handler_for
 from accelcal_rig.engine.thermal_steps import SetpointSkipped
 from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, TransientInstrumentError
 from accelcal_rig.instruments.capabilities import controller_limits
-from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity
+from accelcal_rig.instruments.interfaces import DeviceIdentity, Sensor
 from accelcal_rig.plan.compile import Plan, setpoint_label
 from accelcal_rig.plan.steps import Measurement
 from accelcal_rig.store.content import Campaign
@@ -262,12 +262,11 @@ class CampaignRunner:
             identity = run.retrier.call(partial(_checked_identity, sensor))
             sensor.reset()
             sensor.standby()
-            sensor.configure(acquisition.range_g, acquisition.odr_hz)
+            sensor.configure(acquisition.ranges(), acquisition.odr_hz)
             sensor.start_measurement()
-            events.info("preflight", f"sensor {sensor.serial}: {sensor.part.label} rev {identity.revid} "
-                                     f"(DEVID_AD 0x{identity.devid_ad:02X}, DEVID_MST 0x{identity.devid_mst:02X}, "
-                                     f"PARTID 0x{identity.partid:02X}), ±{acquisition.range_g} g, "
-                                     f"{acquisition.odr_hz:g} Hz")
+            events.info("preflight", f"sensor {sensor.serial}: {sensor.part.label} rev {identity.revision} "
+                                     f"({sensor.part.describe_identity(identity.registers)}), "
+                                     f"{sensor.part.describe_ranges(acquisition.ranges())}, {acquisition.odr_hz:g} Hz")
 
     def _check_controller_limits(self, run: RunContext) -> None:
         """Every setpoint the campaign will write within what the controller itself accepts, or a fault now
@@ -315,11 +314,11 @@ class CampaignRunner:
                                         f"({self.report.poses_done}/{len(self.plan.pose_steps)} in all)")
 
 
-def _checked_identity(sensor: Accelerometer) -> DeviceIdentity:
+def _checked_identity(sensor: Sensor) -> DeviceIdentity:
     """The sensor's identity registers; anything but its part's may be a glitch on the line (retried),
     and is a fault when it persists."""
     identity = sensor.identify()
-    wrong = sensor.part.wrong_identity((identity.devid_ad, identity.devid_mst, identity.partid))
+    wrong = sensor.part.wrong_identity(identity.registers)
     if wrong:
         raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): {wrong}")
     return identity

@@ -15,7 +15,7 @@ from accelcal_rig.fit.recorded_options import options_attrs
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.plan.compile import Plan
 from accelcal_rig.plan.steps import Measurement
-from accelcal_rig.store.records import StoredPlan
+from accelcal_rig.store.records import ChannelInfo, StoredPlan
 from accelcal_rig.store.writer import CampaignWriter
 
 
@@ -35,10 +35,13 @@ def create_campaign_file(prepared: PreparedCampaign, output: Path, connected: Co
     duts = [
         {"serial": s.serial, "name": mounts[s.serial].name, "mount_euler_deg": list(mounts[s.serial].mount_euler_deg),
          "part": s.part.name, "range_g": acquisition.range_g, "odr_hz": acquisition.odr_hz,
-         "lsb_g": s.part.lsb_g(acquisition.range_g),
+         "lsb_g": s.part.channel("accel").lsb(acquisition.range_g),
          "driver": type(s).__name__, "endpoint": s.endpoint}
         for s in instruments.sensors
     ]
+    ranges = acquisition.ranges()
+    channels = {s.serial: tuple(ChannelInfo(c.name, c.quantity, c.unit, c.axes, ranges[c.name], c.lsb(ranges[c.name]))
+                                for c in s.part.channels) for s in instruments.sensors}
     truth = ({s.serial: instruments.truth.describe(s.serial, acquisition.odr_hz) for s in instruments.sensors}
              if instruments.truth is not None else {})
     attrs = {"procedure_name": procedure.name, "procedure_path": str(prepared.procedure.path.resolve()),
@@ -50,7 +53,8 @@ def create_campaign_file(prepared: PreparedCampaign, output: Path, connected: Co
     return CampaignWriter.create(
         output, {"attrs": attrs, "procedure_yaml": prepared.procedure.text, "rig_yaml": rig.text,
                  "plan": stored_plan(prepared.plan), "duts": duts, "instruments": instrument_info(instruments),
-                 "turntable_accuracy_arcsec": rig.model.turntable.accuracy_arcsec, "truth": truth},
+                 "turntable_accuracy_arcsec": rig.model.turntable.accuracy_arcsec, "truth": truth,
+                 "channels": channels},
         overwrite=overwrite, storage=prepared.storage(dry_run))
 
 

@@ -27,11 +27,12 @@ def check_lines(instruments: SomeInstruments, rig: RigConfig) -> Iterator[str]:
                f"{'in position' if _at_rest(turntable) else 'moving'}")
     for sensor in instruments.sensors:
         identity = sensor.identify()
-        wrong = sensor.part.wrong_identity((identity.devid_ad, identity.devid_mst, identity.partid))
+        wrong = sensor.part.wrong_identity(identity.registers)
         if wrong:
             raise InstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): {wrong}")
-        range_g, odr_hz = sensor.read_settings()
-        yield (f"sensor {sensor.serial}  {sensor.endpoint}: {sensor.part.label} rev {identity.revid}, ±{range_g} g, "
+        ranges, odr_hz = sensor.read_settings()
+        yield (f"sensor {sensor.serial}  {sensor.endpoint}: {sensor.part.label} rev {identity.revision}, "
+               f"{sensor.part.describe_ranges(ranges)}, "
                f"{odr_hz:g} Hz, {sensor.read_temperature_c():.1f} °C")
 
 

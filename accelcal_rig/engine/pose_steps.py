@@ -1,9 +1,10 @@
 """One pose of a campaign: move the turntable, let it settle, read every DUT at once, store the pose — each
-DUT's mean in g, its standard error, its temperatures against the band its soak settled in, and the
-gravity its mount sees."""
+DUT's channels (their means in the channel's unit, standard errors and what they should read: the gravity
+its mount sees, the table's rate), and its temperatures against the band its soak settled in."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import partial
 
 import numpy as np
@@ -16,7 +17,7 @@ from accelcal_rig.engine.states import State
 from accelcal_rig.engine.step_handler import StepHandler
 from accelcal_rig.instruments.interfaces import SampleBlock
 from accelcal_rig.plan.steps import Measurement
-from accelcal_rig.store.records import DutPoseRecord, PoseRecord
+from accelcal_rig.store.records import ChannelPoseRecord, DutPoseRecord, PoseRecord
 
 #: A move's deadline is 1.5 × its travel time at the configured speeds plus this margin.
 MOVE_MARGIN_S = 30.0
@@ -47,7 +48,7 @@ def measure(step: Measurement, run: RunContext) -> None:
     measured = run.table.angles_deg = run.turntable.read_angles_deg()
     chamber_before = run.chamber.read_temperature_c()  # the alarm is checked once per pose, after it
     blocks = run.retrier.call(partial(acquire_together, run.sensors, acquisition.samples_per_pose, run.clock,
-                                      acquisition.range_g))
+                                      acquisition.ranges()))
     chamber_after = run.read_chamber_c()
     run.machine.go(State.STORE, step.key)
     gravity_fixture = np.array(step.pose.gravity_fixture)
@@ -84,12 +85,16 @@ def _move(run: RunContext, commanded: np.ndarray) -> None:
 
 
 def _dut_record(run: RunContext, index: int, block: SampleBlock, gravity_fixture: np.ndarray) -> DutPoseRecord:
+    """Each of the DUT's channels at the pose (its part's, in order), and its temperatures against the band."""
     sensor, settled_c = run.sensors[index], run.dut.settled_c[index]
-    lsb = sensor.part.lsb_g(run.procedure.acquisition.range_g)
-    codes = block.codes_xyz
-    n = codes.shape[0]
-    mean_g = codes.mean(axis=0) * lsb
-    stderr_g = codes.std(axis=0, ddof=1) * lsb / np.sqrt(n)
+    ranges = run.procedure.acquisition.ranges()
+    channels = {}
+    for channel in sensor.part.channels:
+        codes = block.codes[channel.name]
+        lsb, n = channel.lsb(ranges[channel.name]), codes.shape[0]
+        reference = REFERENCES[channel.quantity](run, sensor.serial, gravity_fixture)
+        channels[channel.name] = ChannelPoseRecord(codes, codes.mean(axis=0) * lsb,
+                                                   codes.std(axis=0, ddof=1) * lsb / np.sqrt(n), reference)
     band = run.procedure.soak.band_c
     in_band = bool(np.all(np.abs(np.array(block.temperature_c) - settled_c) <= band))
     if not in_band and not run.dut.moving:
@@ -97,12 +102,25 @@ def _dut_record(run: RunContext, index: int, block: SampleBlock, gravity_fixture
         run.events.warning("pose", f"sensor {sensor.serial}: temperature {before:.2f}/{after:.2f} °C left the "
                                    f"±{band:g} °C band around {settled_c:.2f} °C")
     return DutPoseRecord(
-        serial=sensor.serial, raw_codes=codes, mean_g=mean_g, stderr_g=stderr_g,
-        temperature_c=block.temperature_c,
-        gravity_reference_g=run.rig.gravity_g * (run.fixture_to_dut[sensor.serial] @ gravity_fixture),
-        temperature_in_band=in_band,
+        serial=sensor.serial, channels=channels, temperature_c=block.temperature_c, temperature_in_band=in_band,
         truth=run.truth.block_truth(sensor.serial, block) if run.truth is not None else None,
     )
+
+
+def _gravity_reference(run: RunContext, serial: str, gravity_fixture: np.ndarray) -> np.ndarray:
+    """The site's gravity (in standard g) in the DUT's frame: the commanded pose, the nominal mount."""
+    return run.rig.gravity_g * (run.fixture_to_dut[serial] @ gravity_fixture)
+
+
+def _rate_at_rest(run: RunContext, serial: str, gravity_fixture: np.ndarray) -> np.ndarray:
+    """The table's angular rate in the DUT's frame: zero, the table at rest through a pose (the Earth's
+    rotation, 0.004 °/s, is not included)."""
+    return np.zeros(3)
+
+
+#: What a channel should read at a pose, by the quantity it measures.
+REFERENCES: dict[str, Callable[[RunContext, str, np.ndarray], np.ndarray]] = {
+    "acceleration": _gravity_reference, "angular rate": _rate_at_rest}
 
 
 def _angle_difference(a_deg: np.ndarray, b_deg: np.ndarray) -> np.ndarray:

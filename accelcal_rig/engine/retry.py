@@ -14,8 +14,8 @@ from accelcal_rig.core.clock import Clock
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.capabilities import RetriesExchanges
-from accelcal_rig.instruments.interfaces import Accelerometer, Chamber, Turntable
-from accelcal_rig.instruments.retrying import RetryingAccelerometer, RetryingChamber, RetryingTurntable
+from accelcal_rig.instruments.interfaces import Chamber, Sensor, Turntable
+from accelcal_rig.instruments.retrying import RetryingChamber, RetryingSensor, RetryingTurntable
 
 T = TypeVar("T")
 
@@ -53,8 +53,8 @@ class Retrier:
     def retried_turntable(self, turntable: Turntable) -> Turntable:
         return turntable if self._retries_its_own(turntable) else RetryingTurntable(turntable, self.call)
 
-    def retried_sensor(self, sensor: Accelerometer) -> Accelerometer:
-        return sensor if self._retries_its_own(sensor) else RetryingAccelerometer(sensor, self.call)
+    def retried_sensor(self, sensor: Sensor) -> Sensor:
+        return sensor if self._retries_its_own(sensor) else RetryingSensor(sensor, self.call)
 
     def _retries_its_own(self, device: object) -> bool:
         """A driver retries its own exchanges (one request and its reply each, safe to repeat), given this

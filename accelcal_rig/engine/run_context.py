@@ -18,7 +18,7 @@ from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.engine.states import StateMachine
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.instruments.capabilities import alarm_active
-from accelcal_rig.instruments.interfaces import Accelerometer, Chamber, RigInstruments, TruthSource, Turntable
+from accelcal_rig.instruments.interfaces import Chamber, RigInstruments, Sensor, TruthSource, Turntable
 from accelcal_rig.plan.compile import Plan
 from accelcal_rig.store.writer import CampaignWriter
 
@@ -110,7 +110,7 @@ class RunContext:
         return self.instruments.turntable
 
     @property
-    def sensors(self) -> list[Accelerometer]:
+    def sensors(self) -> list[Sensor]:
         return self.instruments.sensors
 
     @property

@@ -10,10 +10,10 @@ from collections.abc import Callable
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.engine.events import EventLog
-from accelcal_rig.instruments.interfaces import Accelerometer, Chamber, Turntable
+from accelcal_rig.instruments.interfaces import Chamber, Sensor, Turntable
 
 
-def apply_safe_state(chamber: Chamber, turntable: Turntable, sensors: list[Accelerometer],
+def apply_safe_state(chamber: Chamber, turntable: Turntable, sensors: list[Sensor],
                      safe_setpoint_c: float, events: EventLog) -> bool:
     """Run every safe action; return True when all succeeded.
 

@@ -4,7 +4,7 @@ numpy, not per sample) — captured by the bridge where it can, else drained fro
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TypeVar
 
@@ -20,7 +20,7 @@ from accelcal_rig.instruments.capture import OVERFLOW_ATTEMPTS, capture_together
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
 from accelcal_rig.instruments.retrying import RetryCall, RetryingTransport
 from accelcal_rig.parts.adxl35x import ADXL355
-from accelcal_rig.parts.part import AccelerometerPart
+from accelcal_rig.parts.part import Part
 
 T = TypeVar("T")
 
@@ -50,7 +50,7 @@ class _Capture:
 
 class Adxl355:
     def __init__(self, transport: RegisterTransport, serial: str, clock: Clock,
-                 part: AccelerometerPart = ADXL355) -> None:
+                 part: Part = ADXL355) -> None:
         self.part = part
         self._bus: RegisterTransport = transport
         self._fifo_bus = transport  # FIFO bursts are never retried alone: a lost reply took samples with it
@@ -69,10 +69,10 @@ class Adxl355:
         """The largest block the bridge captures itself (0: none; the host drains the FIFO)."""
         return self._bus.capture_capacity_samples
 
-    # ------------------------------------------------------------------ the Accelerometer interface
+    # ------------------------------------------------------------------ the Sensor interface
     def identify(self) -> DeviceIdentity:
         ad, mst, part, rev = self._bus.read(adxl355.REG_DEVID_AD, 4)
-        return DeviceIdentity(ad, mst, part, rev)
+        return DeviceIdentity((ad, mst, part), rev)
 
     def reset(self) -> None:
         """Software reset, then wait (with a deadline) for the NVM to load."""
@@ -83,14 +83,15 @@ class Adxl355:
         except WaitTimeout as exc:
             raise InstrumentError(str(exc)) from None
 
-    def configure(self, range_g: int, odr_hz: float) -> None:
+    def configure(self, ranges: Mapping[str, int], odr_hz: float) -> None:
         """Range and filter, written explicitly; the part takes them only in standby."""
+        range_g, range_codes = ranges["accel"], self.part.channel("accel").range_codes
         if not self._bus.read(adxl355.REG_POWER_CTL, 1)[0] & adxl355.POWER_CTL_STANDBY:
             raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): range and filter can only change in standby")
-        self._bus.write(adxl355.REG_RANGE, self.part.range_codes[range_g])
+        self._bus.write(adxl355.REG_RANGE, range_codes[range_g])
         self._bus.write(adxl355.REG_FILTER, self.part.odr_code(odr_hz))
         readback = self._bus.read(adxl355.REG_FILTER, 1)[0], self._bus.read(adxl355.REG_RANGE, 1)[0] & 0x03
-        if readback != (self.part.odr_code(odr_hz), self.part.range_codes[range_g]):
+        if readback != (self.part.odr_code(odr_hz), range_codes[range_g]):
             raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): range/filter did not read back")
         self._odr_hz = odr_hz
 
@@ -100,14 +101,14 @@ class Adxl355:
     def standby(self) -> None:
         self._bus.write(adxl355.REG_POWER_CTL, adxl355.POWER_CTL_STANDBY)
 
-    def read_settings(self) -> tuple[int, float]:
-        """(range in g, output data rate in Hz) as the part is configured now."""
+    def read_settings(self) -> tuple[dict[str, int], float]:
+        """(the acceleration's range in g, output data rate in Hz) as the part is configured now."""
         filter_code = self._bus.read(adxl355.REG_FILTER, 1)[0] & 0x0F
         range_code = self._bus.read(adxl355.REG_RANGE, 1)[0] & 0x03
-        ranges = {code: g for g, code in self.part.range_codes.items()}
+        ranges = {code: g for g, code in self.part.channel("accel").range_codes.items()}
         if range_code not in ranges or filter_code >= len(self.part.output_data_rates_hz):
             raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): RANGE/FILTER read back invalid codes")
-        return ranges[range_code], self.part.output_data_rates_hz[filter_code]
+        return {"accel": ranges[range_code]}, self.part.output_data_rates_hz[filter_code]
 
     def read_temperature_c(self) -> float:
         """One read where it agrees with a fresh agreed temperature (a soak poll's usual case), else read
@@ -288,7 +289,7 @@ class Adxl355:
     def _block(self, blocks: list[np.ndarray], n_samples: int, t_start: float,
                temperature_c: tuple[float, float]) -> SampleBlock:
         codes = np.concatenate(blocks)[:n_samples]
-        return SampleBlock(codes, t_start, t_start + (n_samples - 1) / self._odr_hz, temperature_c)
+        return SampleBlock({"accel": codes}, t_start, t_start + (n_samples - 1) / self._odr_hz, temperature_c)
 
     def _burst(self, carried: bytes) -> tuple[np.ndarray, bytes]:
         """Read the whole FIFO in one burst."""

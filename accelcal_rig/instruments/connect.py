@@ -9,10 +9,10 @@ from typing import Any
 from accelcal_rig.config.load import LoadedConfig
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
-from accelcal_rig.instruments.adxl355_driver import Adxl355
-from accelcal_rig.instruments.interfaces import Accelerometer, Chamber, RigInstruments, Turntable, close_each
+from accelcal_rig.instruments.interfaces import Chamber, RigInstruments, Sensor, Turntable, close_each
+from accelcal_rig.parts.part import Part
 from accelcal_rig.parts.registry import part
-from accelcal_rig.plugins import load_driver
+from accelcal_rig.plugins import load_driver, load_object
 
 
 @dataclass(frozen=True)
@@ -37,7 +37,7 @@ class SomeInstruments:
 
     chamber: Chamber | None
     turntable: Turntable | None
-    sensors: list[Accelerometer]
+    sensors: list[Sensor]
 
     def close(self) -> list[str]:
         """Release every connection, each in its own guard; return the failures, one line each."""
@@ -76,17 +76,23 @@ def connect_some(rig: RigConfig, endpoints: Endpoints, clock: Clock,
             turntable = load_driver("turntable", drivers.get("turntable", rig.turntable.driver)).open(
                 rig.turntable, endpoints.turntable)
             opened.append(turntable)
-        sensors: list[Accelerometer] = []
+        sensors: list[Sensor] = []
         for sensor in rig.fixture.sensors if "sensors" in only else []:
             transport = load_driver("sensor", drivers.get(sensor.serial, sensor.driver)).open(
                 sensor, endpoints.sensors[sensor.serial], rig.retry.attempts, clock)
-            sensors.append(Adxl355(transport, sensor.serial, clock, part(sensor.part)))
+            sensors.append(sensor_device(transport, sensor.serial, clock, part(sensor.part)))
             opened.append(sensors[-1])
     except BaseException:
         for device in opened:
             device.close()
         raise
     return SomeInstruments(chamber, turntable, sensors)
+
+
+def sensor_device(transport: Any, serial: str, clock: Clock, dut_part: Part) -> Sensor:
+    """The DUT as the driver its part names speaks it, over `transport`: the device is built from the part."""
+    device = load_object(dut_part.device, f"part {dut_part.name!r}'s device")
+    return device(transport, serial, clock, dut_part)  # type: ignore[no-any-return]
 
 
 def connect_rig(rig: RigConfig, endpoints: Endpoints, clock: Clock) -> RigInstruments:

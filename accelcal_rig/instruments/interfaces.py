@@ -2,33 +2,34 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from accelcal_rig.parts.part import AccelerometerPart
+from accelcal_rig.parts.part import Part
 
 
 @dataclass(frozen=True)
 class DeviceIdentity:
-    """Identification registers (DEVID_AD, DEVID_MST, PARTID, REVID)."""
+    """A DUT's identification registers (those its part names, e.g. DEVID_AD, DEVID_MST, PARTID of an ADXL355;
+    WHO_AM_I of an ICM-42688-P) and its silicon revision where it has one (0 where not)."""
 
-    devid_ad: int
-    devid_mst: int
-    partid: int
-    revid: int
+    registers: tuple[int, ...]
+    revision: int = 0
 
 
 @dataclass(frozen=True)
 class SampleBlock:
-    """A gap-free block of raw samples from one DUT.
+    """A gap-free block of raw samples from one DUT, of every channel its part has at the same instants.
 
-    `codes_xyz` holds signed 20-bit codes, shape (n, 3); `t_start_s`/`t_end_s` are clock times of the first
-    and last sample; `temperature_c` is the DUT's own temperature sensor read before and after the block.
+    `codes` holds each channel's signed codes by the channel's name, shape (n, axes) (an ADXL355: `accel`,
+    20-bit codes on x, y, z); `t_start_s`/`t_end_s` are clock times of the first and last sample;
+    `temperature_c` is the DUT's own temperature sensor read before and after the block.
     """
 
-    codes_xyz: np.ndarray
+    codes: Mapping[str, np.ndarray]
     t_start_s: float
     t_end_s: float
     temperature_c: tuple[float, float]
@@ -71,12 +72,12 @@ class Turntable(Positioning, Protocol):
     def close(self) -> None: ...
 
 
-class Accelerometer(Protocol):
-    """One DUT: a digital accelerometer whose facts (ranges, codes, identity) its `part` gives."""
+class Sensor(Protocol):
+    """One DUT: a digital sensor whose facts (channels, ranges, codes, identity) its `part` gives."""
 
     serial: str
     endpoint: str
-    part: AccelerometerPart
+    part: Part
 
     @property
     def capture_capacity_samples(self) -> int:
@@ -84,10 +85,14 @@ class Accelerometer(Protocol):
 
     def identify(self) -> DeviceIdentity: ...
     def reset(self) -> None: ...
-    def configure(self, range_g: int, odr_hz: float) -> None: ...
+    def configure(self, ranges: Mapping[str, int], odr_hz: float) -> None:
+        """Each channel's range (± full scale in its unit, by channel name) and the output data rate."""
+
     def start_measurement(self) -> None: ...
     def standby(self) -> None: ...
-    def read_settings(self) -> tuple[int, float]: ...
+    def read_settings(self) -> tuple[dict[str, int], float]:
+        """(each channel's range, the output data rate) as the device reports them."""
+
     def read_temperature_c(self) -> float: ...
     def acquire(self, n_samples: int) -> SampleBlock: ...
     def close(self) -> None: ...
@@ -99,7 +104,7 @@ class RigInstruments:
 
     chamber: Chamber
     turntable: Turntable
-    sensors: list[Accelerometer]
+    sensors: list[Sensor]
     truth: TruthSource | None = None
 
     def close(self) -> list[str]:
@@ -107,10 +112,10 @@ class RigInstruments:
         return close_each(self.chamber, self.turntable, self.sensors)
 
 
-def close_each(chamber: Chamber | None, turntable: Turntable | None, sensors: list[Accelerometer]) -> list[str]:
+def close_each(chamber: Chamber | None, turntable: Turntable | None, sensors: list[Sensor]) -> list[str]:
     """Close every instrument given, each in its own guard; the failures, one line each naming it."""
     failures = []
-    devices: list[tuple[str, Chamber | Turntable | Accelerometer]] = [
+    devices: list[tuple[str, Chamber | Turntable | Sensor]] = [
         *((("chamber", chamber),) if chamber is not None else ()),
         *((("turntable", turntable),) if turntable is not None else ()),
         *((f"sensor {s.serial}", s) for s in sensors)]

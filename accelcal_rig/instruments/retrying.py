@@ -14,10 +14,10 @@ from accelcal_rig.instruments.adxl355_transport import BlockCapture, RegisterTra
 from accelcal_rig.instruments.capabilities import Reconnecting, RetryCall
 from accelcal_rig.instruments.composition import composed, instance_of
 from accelcal_rig.instruments.delegates import ChamberDelegate, TurntableDelegate
-from accelcal_rig.instruments.interfaces import Accelerometer, Chamber, Turntable
-from accelcal_rig.instruments.sensor_delegate import AccelerometerDelegate
+from accelcal_rig.instruments.interfaces import Chamber, Sensor, Turntable
+from accelcal_rig.instruments.sensor_delegate import SensorDelegate
 
-__all__ = ["RetryCall", "RetryingAccelerometer", "RetryingChamber", "RetryingTransport", "RetryingTurntable"]
+__all__ = ["RetryCall", "RetryingSensor", "RetryingChamber", "RetryingTransport", "RetryingTurntable"]
 
 T = TypeVar("T")
 
@@ -45,8 +45,8 @@ class RetryingTurntable(TurntableDelegate):
         return self._call(operation, self._reconnect)
 
 
-class RetryingAccelerometer(AccelerometerDelegate):
-    def __init__(self, sensor: Accelerometer, call: RetryCall) -> None:
+class RetryingSensor(SensorDelegate):
+    def __init__(self, sensor: Sensor, call: RetryCall) -> None:
         super().__init__(sensor)
         self._call, self._reconnect = call, _reconnect_of(sensor)
 

@@ -1,4 +1,4 @@
-"""A typed stand-in for a DUT (see delegates.py): the Accelerometer members passed on through `_through`,
+"""A typed stand-in for a DUT (see delegates.py): the Sensor members passed on through `_through`,
 and block capture, posted temperature reads and reconnecting only where the DUT has them."""
 
 from __future__ import annotations
@@ -8,21 +8,21 @@ from typing import Any, ClassVar, Self, TypeVar, cast
 
 from accelcal_rig.instruments.capabilities import BlockCapturing, Reconnecting, TemperaturePosting
 from accelcal_rig.instruments.composition import composed, instance_of
-from accelcal_rig.instruments.interfaces import Accelerometer, DeviceIdentity, SampleBlock
+from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock, Sensor
 
 T = TypeVar("T")
 
 
-class AccelerometerDelegate:
+class SensorDelegate:
     """Stands in for `sensor`: the core members passed on, each capability only where it has one."""
 
-    _passes_on: ClassVar[Mapping[type, type[AccelerometerDelegate]]] = {}
+    _passes_on: ClassVar[Mapping[type, type[SensorDelegate]]] = {}
 
-    def __new__(cls, sensor: Accelerometer, *args: Any, **kwargs: Any) -> Self:
+    def __new__(cls, sensor: Sensor, *args: Any, **kwargs: Any) -> Self:
         mixins = [mixin for capability, mixin in cls._passes_on.items() if isinstance(sensor, capability)]
         return instance_of(composed(cls, mixins))
 
-    def __init__(self, sensor: Accelerometer) -> None:
+    def __init__(self, sensor: Sensor) -> None:
         self._sensor = sensor
         self.serial = sensor.serial
         self.endpoint = sensor.endpoint
@@ -42,8 +42,8 @@ class AccelerometerDelegate:
     def reset(self) -> None:
         self._through(self._sensor.reset)
 
-    def configure(self, range_g: int, odr_hz: float) -> None:
-        self._through(lambda: self._sensor.configure(range_g, odr_hz))
+    def configure(self, ranges: Mapping[str, int], odr_hz: float) -> None:
+        self._through(lambda: self._sensor.configure(ranges, odr_hz))
 
     def start_measurement(self) -> None:
         self._through(self._sensor.start_measurement)
@@ -51,7 +51,7 @@ class AccelerometerDelegate:
     def standby(self) -> None:
         self._through(self._sensor.standby)
 
-    def read_settings(self) -> tuple[int, float]:
+    def read_settings(self) -> tuple[dict[str, int], float]:
         return self._through(self._sensor.read_settings)
 
     def read_temperature_c(self) -> float:
@@ -65,7 +65,7 @@ class AccelerometerDelegate:
 
 
 # Each mixin is composed in only where the DUT has the capability: the casts say what was checked.
-class PassBlockCapture(AccelerometerDelegate):
+class PassBlockCapture(SensorDelegate):
     def _capturing(self) -> BlockCapturing:
         return cast(BlockCapturing, self._sensor)
 
@@ -88,7 +88,7 @@ class PassBlockCapture(AccelerometerDelegate):
         return self._through(self._capturing().end_capture)
 
 
-class PassTemperaturePosting(AccelerometerDelegate):
+class PassTemperaturePosting(SensorDelegate):
     def begin_temperature_read(self) -> bool:
         return self._through(cast(TemperaturePosting, self._sensor).begin_temperature_read)
 
@@ -96,12 +96,12 @@ class PassTemperaturePosting(AccelerometerDelegate):
         return self._through(cast(TemperaturePosting, self._sensor).end_temperature_read)
 
 
-class PassSensorReconnect(AccelerometerDelegate):
+class PassSensorReconnect(SensorDelegate):
     def reconnect(self) -> None:
         cast(Reconnecting, self._sensor).reconnect()
 
 
 #: Every DUT capability a delegate passes on, and how.
-SENSOR_CAPABILITIES: Mapping[type, type[AccelerometerDelegate]] = {
+SENSOR_CAPABILITIES: Mapping[type, type[SensorDelegate]] = {
     BlockCapturing: PassBlockCapture, TemperaturePosting: PassTemperaturePosting, Reconnecting: PassSensorReconnect}
-AccelerometerDelegate._passes_on = SENSOR_CAPABILITIES
+SensorDelegate._passes_on = SENSOR_CAPABILITIES

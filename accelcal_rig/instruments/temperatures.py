@@ -8,10 +8,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from accelcal_rig.instruments.capabilities import TemperaturePosting
-from accelcal_rig.instruments.interfaces import Accelerometer
+from accelcal_rig.instruments.interfaces import Sensor
 
 
-def read_temperatures_together(sensors: Sequence[Accelerometer]) -> np.ndarray:
+def read_temperatures_together(sensors: Sequence[Sensor]) -> np.ndarray:
     """Each sensor's temperature (°C). Sensors that can (TemperaturePosting) get their request first and
     are collected after; any whose quick read is not sure is read again on its own, as are sensors without it."""
     posted = [sensor if isinstance(sensor, TemperaturePosting) and sensor.begin_temperature_read() else None

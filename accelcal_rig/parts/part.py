@@ -1,7 +1,9 @@
-"""What a digital accelerometer part is, as the rig needs to know it: the one place a part's facts live.
+"""What a sensor part is, as the rig needs to know it: the one place a part's facts live.
 
-The identity check, the procedure's range and data-rate validation, the driver's register writes, the
-simulator and the fit all read a part's facts from its `AccelerometerPart`; a new part is a new table.
+A part is data: the channels it measures (each a quantity on three axes, in a unit, with its sensitivity
+per range), its identity registers, its data rates, its own temperature sensor, and the driver that speaks
+it. The identity check, the procedure's range and data-rate validation, the driver's register writes, the
+simulator, the store and the fit all read a part's facts from here; a new part is a new table.
 """
 
 from __future__ import annotations
@@ -32,24 +34,23 @@ class TemperatureFormat:
 
 
 @dataclass(frozen=True)
-class AccelerometerPart:
-    """One part's facts. Ranges are the ± full scale in g, as a procedure's `acquisition.range_g` gives them."""
+class Channel:
+    """One quantity a part measures on its axes: what acquisition, the store, the fit and the outputs iterate.
+    Ranges are the ± full scale in the channel's unit, as a procedure's acquisition gives them."""
 
-    name: str                                  #: what a rig config's `part:` says, e.g. "adxl357"
-    label: str                                 #: how people write it, e.g. "ADXL357"
-    identity: tuple[int, int, int]             #: identification registers: DEVID_AD, DEVID_MST, PARTID
-    lsb_per_g: Mapping[int, float]             #: range → nominal sensitivity
-    range_codes: Mapping[int, int]             #: range → the RANGE register's code
-    output_data_rates_hz: tuple[float, ...]    #: by the FILTER register's ODR code 0, 1, …
-    code_bits: int                             #: acceleration codes are signed, this wide
-    temperature: TemperatureFormat
-    noise_density_ug_per_rthz: float           #: typical, on its most sensitive range
-    source: str                                #: where these facts come from
-    zero_g_offset_mg: float | None = None      #: the data sheet's ± range of the 0 g offset at 25 °C, if known
+    name: str                                  #: the key everything downstream uses: "accel", "gyro"
+    quantity: str                              #: "acceleration", "angular rate"
+    unit: str                                  #: "g", "dps" (°/s)
+    lsb_per_unit: Mapping[int, float]          #: range → nominal sensitivity
+    range_codes: Mapping[int, int]             #: range → the part's register code for it
+    code_bits: int                             #: codes are signed, this wide
+    noise_density_micro_per_rthz: float        #: typical, in µ(unit)/√Hz (µg/√Hz, µ°/s/√Hz), most sensitive range
+    axes: tuple[str, ...] = ("x", "y", "z")
+    zero_offset: float | None = None           #: the data sheet's ± range of the zero offset at 25 °C, in unit
 
     @property
-    def ranges_g(self) -> tuple[int, ...]:
-        return tuple(sorted(self.lsb_per_g))
+    def ranges(self) -> tuple[int, ...]:
+        return tuple(sorted(self.lsb_per_unit))
 
     @property
     def code_min(self) -> int:
@@ -59,27 +60,60 @@ class AccelerometerPart:
     def code_max(self) -> int:
         return (1 << (self.code_bits - 1)) - 1
 
-    def lsb_g(self, range_g: int) -> float:
-        """Size of one acceleration code in g on a range."""
-        return 1.0 / self.lsb_per_g[range_g]
+    def lsb(self, range_: int) -> float:
+        """Size of one code in the channel's unit on a range."""
+        return 1.0 / self.lsb_per_unit[range_]
 
-    def quantise_g(self, accel_g: np.ndarray, range_g: int) -> np.ndarray:
-        """Acceleration in g → signed codes as the ADC would output them (rounded, saturating)."""
-        codes = np.rint(np.asarray(accel_g, dtype=float) * self.lsb_per_g[range_g])
+    def quantise(self, values: np.ndarray, range_: int) -> np.ndarray:
+        """Values in the channel's unit → signed codes as the ADC would output them (rounded, saturating)."""
+        codes = np.rint(np.asarray(values, dtype=float) * self.lsb_per_unit[range_])
         return np.clip(codes, self.code_min, self.code_max).astype(np.int32)
 
+    def range_problem(self, range_: int, label: str) -> str | None:
+        """Why ±`range_` is not a range of this channel of the part `label`; None when it is."""
+        if range_ in self.lsb_per_unit:
+            return None
+        return (f"±{range_:g} {self.unit} is not a range of the {label} "
+                f"(±{'/'.join(map(str, self.ranges))} {self.unit})")
+
+
+@dataclass(frozen=True)
+class Part:
+    """One part's facts."""
+
+    name: str                                  #: what a rig config's `part:` says, e.g. "adxl357"
+    label: str                                 #: how people write it, e.g. "ADXL357"
+    identity: tuple[int, ...]                  #: identification registers, as its driver reads them
+    identity_names: tuple[str, ...]            #: their names in the data sheet, e.g. ("WHO_AM_I",)
+    channels: tuple[Channel, ...]              #: what it measures, the first its primary channel
+    output_data_rates_hz: tuple[float, ...]    #: by the part's ODR register code 0, 1, …
+    temperature: TemperatureFormat
+    source: str                                #: where these facts come from
+    #: The driver that speaks it ("module:attribute" of a class built as `Device(transport, serial, clock,
+    #: part)`): the device is built from the part, never by a caller naming a part's class.
+    device: str = "accelcal_rig.instruments.adxl355_driver:Adxl355"
+
+    def channel(self, name: str) -> Channel:
+        """The channel called `name`; KeyError naming the ones the part has."""
+        for channel in self.channels:
+            if channel.name == name:
+                return channel
+        raise KeyError(f"the {self.label} has no {name!r} channel ({', '.join(self.channel_names)})")
+
+    @property
+    def channel_names(self) -> tuple[str, ...]:
+        return tuple(c.name for c in self.channels)
+
     def odr_code(self, odr_hz: float) -> int:
-        """The FILTER register's code for an output data rate (the nearest one)."""
+        """The part's code for an output data rate (the nearest one)."""
         return int(np.argmin(np.abs(np.array(self.output_data_rates_hz) - odr_hz)))
 
     def has_rate(self, odr_hz: float) -> bool:
         return any(abs(odr_hz - rate) < 1e-3 for rate in self.output_data_rates_hz)
 
-    def range_problem(self, range_g: int) -> str | None:
-        """Why ±`range_g` g is not a range of this part; None when it is."""
-        if range_g in self.lsb_per_g:
-            return None
-        return f"±{range_g:g} g is not a range of the {self.label} (±{'/'.join(map(str, self.ranges_g))} g)"
+    def range_problem(self, channel: str, range_: int) -> str | None:
+        """Why ±`range_` is not a range of the part's `channel`; None when it is."""
+        return self.channel(channel).range_problem(range_, self.label)
 
     def rate_problem(self, odr_hz: float) -> str | None:
         """Why `odr_hz` is not an output data rate of this part; None when it is."""
@@ -88,7 +122,15 @@ class AccelerometerPart:
         rates = ", ".join(f"{r:g}" for r in self.output_data_rates_hz)
         return f"{odr_hz:g} Hz is not an {self.label} output data rate ({rates})"
 
-    def wrong_identity(self, found: tuple[int, int, int]) -> str | None:
+    def describe_identity(self, found: tuple[int, ...]) -> str:
+        """Identification registers as the data sheet names them: "DEVID_AD 0xAD, DEVID_MST 0x1D, …"."""
+        return ", ".join(f"{name} 0x{value:02X}" for name, value in zip(self.identity_names, found))
+
+    def describe_ranges(self, ranges: Mapping[str, int]) -> str:
+        """Each channel's range: "±2 g", "±4 g, ±2000 dps"."""
+        return ", ".join(f"±{ranges[c.name]} {c.unit}" for c in self.channels if c.name in ranges)
+
+    def wrong_identity(self, found: tuple[int, ...]) -> str | None:
         """Why identification registers `found` are not this part's; None when they are."""
         if tuple(found) == self.identity:
             return None

@@ -1,5 +1,5 @@
 """Parts by name: the built-in ones, and any a third-party package registers under the entry-point group
-`accelcal_rig.parts` (an entry point's object is an `AccelerometerPart`)."""
+`accelcal_rig.parts` (an entry point's object is a `Part`)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from importlib.metadata import entry_points
 
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.adxl35x import ADXL355, ADXL357, ADXL359
-from accelcal_rig.parts.part import AccelerometerPart
+from accelcal_rig.parts.part import Part
 
 ENTRY_POINT_GROUP = "accelcal_rig.parts"
 DEFAULT_PART = "adxl355"
@@ -16,7 +16,7 @@ _BUILT_IN = {part.name: part for part in (ADXL355, ADXL357, ADXL359)}
 
 
 @cache
-def known_parts() -> dict[str, AccelerometerPart]:
+def known_parts() -> dict[str, Part]:
     """Every part by name; a built-in name cannot be taken over by a plug-in."""
     parts = {}
     for entry in entry_points(group=ENTRY_POINT_GROUP):
@@ -24,14 +24,14 @@ def known_parts() -> dict[str, AccelerometerPart]:
             part = entry.load()
         except Exception as exc:  # noqa: BLE001 - a broken plug-in is one line naming it, not a traceback
             raise ConfigError(f"part plug-in {entry.name!r} ({entry.value}): cannot load: {exc}") from None
-        if not (isinstance(part, AccelerometerPart) and part.name == entry.name):
-            raise ConfigError(f"part plug-in {entry.name!r} ({entry.value}): not an AccelerometerPart named "
+        if not (isinstance(part, Part) and part.name == entry.name):
+            raise ConfigError(f"part plug-in {entry.name!r} ({entry.value}): not a Part named "
                               f"{entry.name!r}")
         parts[entry.name] = part
     return {**parts, **_BUILT_IN}
 
 
-def part(name: str) -> AccelerometerPart:
+def part(name: str) -> Part:
     """The part called `name`; KeyError names the ones known."""
     parts = known_parts()
     if name not in parts:

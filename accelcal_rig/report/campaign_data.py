@@ -109,7 +109,10 @@ def read_campaign_data(path: Path) -> CampaignData:
 def _datasheet_offset_mg(campaign: Campaign, serial: str) -> float | None:
     """The data sheet's 0 g offset range of the DUT's part (None for a part this installation does not know)."""
     name = str(dut_description(campaign, serial).get("part", DEFAULT_PART))
-    return known_parts()[name].zero_g_offset_mg if name in known_parts() else None
+    if name not in known_parts():
+        return None
+    offset_g = known_parts()[name].channel("accel").zero_offset
+    return None if offset_g is None else offset_g * 1000.0
 
 
 def _truth_by_setpoint(poses: DutPoses) -> np.ndarray | None:

@@ -64,7 +64,7 @@ class SimulatedAdxl355:
 
     @property
     def _range_g(self) -> int:
-        return {code: g for g, code in self._part.range_codes.items()}[self._regs[adxl355.REG_RANGE] & 0x03]
+        return {code: g for g, code in self._part.channel("accel").range_codes.items()}[self._regs[adxl355.REG_RANGE] & 0x03]
 
     def read(self, address: int, count: int) -> bytes:
         if not _FIFO_REGISTERS.isdisjoint(range(address, address + count)):

@@ -7,6 +7,8 @@ wire-level simulators (`sim/wire_rig.py`). `SimulationTruth` serves both.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from accelcal_rig.config.procedure import Procedure
@@ -89,21 +91,21 @@ class SimulatedAccelerometer:
         self._index = index
         self.serial = lab.duts[index].serial
         self.part = lab.duts[index].part
-        self._range_g = self.part.ranges_g[0]
+        self._range_g = self.part.channel("accel").ranges[0]
         self._odr_hz = 125.0
         self._measuring = False
 
     def identify(self) -> DeviceIdentity:
-        return DeviceIdentity(*self.part.identity, 1)
+        return DeviceIdentity(self.part.identity, 1)
 
     def reset(self) -> None:
         self._measuring = False
-        self._range_g, self._odr_hz = self.part.ranges_g[0], self.part.output_data_rates_hz[0]  # the reset state
+        self._range_g, self._odr_hz = self.part.channel("accel").ranges[0], self.part.output_data_rates_hz[0]  # the reset state
 
-    def configure(self, range_g: int, odr_hz: float) -> None:
+    def configure(self, ranges: Mapping[str, int], odr_hz: float) -> None:
         if self._measuring:
             raise InstrumentError(f"sensor {self.serial}: range and filter can only change in standby")
-        self._range_g = range_g
+        self._range_g = ranges["accel"]
         self._odr_hz = odr_hz
 
     def start_measurement(self) -> None:
@@ -112,8 +114,8 @@ class SimulatedAccelerometer:
     def standby(self) -> None:
         self._measuring = False
 
-    def read_settings(self) -> tuple[int, float]:
-        return self._range_g, self._odr_hz
+    def read_settings(self) -> tuple[dict[str, int], float]:
+        return {"accel": self._range_g}, self._odr_hz
 
     def read_temperature_c(self) -> float:
         return self._lab.dut_reading_c(self._index)
@@ -129,7 +131,7 @@ class SimulatedAccelerometer:
         t_start = clock.now()
         clock.sleep(n_samples / self._odr_hz)
         codes = self._lab.dut_samples(self._index, t_start, n_samples, self._odr_hz, self._range_g)
-        return SampleBlock(codes, t_start, t_start + (n_samples - 1) / self._odr_hz,
+        return SampleBlock({"accel": codes}, t_start, t_start + (n_samples - 1) / self._odr_hz,
                            (temperature_before, self.read_temperature_c()))
 
     def close(self) -> None:

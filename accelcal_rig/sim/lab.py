@@ -17,7 +17,7 @@ from accelcal_rig.core.humidity import relative_humidity_pct
 from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel
 from accelcal_rig.core.units import site_gravity_g
 from accelcal_rig.fit.sfem import distort
-from accelcal_rig.parts.part import AccelerometerPart
+from accelcal_rig.parts.part import Part
 from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.sim.moisture import ChamberMoisture
@@ -29,7 +29,7 @@ class SimulatedDut:
     """A DUT's part, its place on the fixture, its hidden truth and its own thermal time constant."""
 
     def __init__(self, serial: str, mount_euler_deg: tuple[float, float, float], tau_s: float,
-                 dut_part: AccelerometerPart) -> None:
+                 dut_part: Part) -> None:
         self.serial = serial
         self.part = dut_part
         self.truth: DutTruth = truth_for_serial(serial)
@@ -77,7 +77,8 @@ class VirtualLab:
         self.duts = [SimulatedDut(s.serial, s.mount_euler_deg, tau_s, part(s.part))
                      for s, tau_s in zip(rig.fixture.sensors, sim.fixture_time_constants_s(serials))]
         #: Each DUT's noise density: the rig config's, or its part's.
-        self.noise_density_g_per_rthz = [1e-6 * (d.part.noise_density_ug_per_rthz if sim.noise_density_ug_per_rthz
+        self.noise_density_g_per_rthz = [1e-6 * (d.part.channel("accel").noise_density_micro_per_rthz
+                                                 if sim.noise_density_ug_per_rthz
                                                  is None else sim.noise_density_ug_per_rthz) for d in self.duts]
         self.thermal = ThermalModel(
             ambient_c=sim.ambient_c,
@@ -159,7 +160,7 @@ class VirtualLab:
         noise = self.dut_rngs[index].normal(0.0, self.noise_g(index, odr_hz), (n_samples, 3))
         raw_g = instant.reading_g[index] + self.unmodelled_g(index, gravity) + noise
         dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, params, gravity, temperature))
-        return dut.part.quantise_g(raw_g, range_g)
+        return dut.part.channel("accel").quantise(raw_g, range_g)
 
     def _instant(self) -> _Instant:
         """Every DUT's truth at the clock's time, evaluated for the whole fixture at once: all its sensors are

@@ -1,7 +1,9 @@
 """The campaign's records as journal records, and a journal's records replayed into a `Campaign`.
 
 Kinds: `header` (first, once), `run` (each run's start), `instruments` (the drivers a run reached),
-`events`, `pose`, `soak`, `state`. Numbers travel as arrays, so they come back bit for bit.
+`events`, `pose`, `soak`, `state`. Numbers travel as arrays, so they come back bit for bit. A pose holds
+each channel's arrays under the channel's name (`accel/raw_codes`, …); a pose written before parts
+declared channels holds the acceleration's under its old names (`raw_codes`, `mean_g`, …), read the same.
 """
 
 from __future__ import annotations
@@ -12,6 +14,8 @@ from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.journal import Record, Scan, encode_record
 from accelcal_rig.store.records import (
     CampaignHeader,
+    ChannelInfo,
+    ChannelPoseRecord,
     DutPoseRecord,
     PoseRecord,
     RunStart,
@@ -46,7 +50,8 @@ def encode_header(header: CampaignHeader) -> bytes:
             "plan": {"step_key": list(plan.step_key), "kind": list(plan.kind), "fingerprint": plan.fingerprint,
                      "axis_names": list(plan.axis_names)},
             "duts": plain_value(header.duts), "instruments": header.instruments,
-            "turntable_accuracy_arcsec": float(header.turntable_accuracy_arcsec), "truth": truth_attrs}
+            "turntable_accuracy_arcsec": float(header.turntable_accuracy_arcsec), "truth": truth_attrs,
+            "channels": {serial: {c.name: c.attrs() for c in channels} for serial, channels in header.channels.items()}}
     return encode_record("header", meta, arrays)
 
 
@@ -68,24 +73,33 @@ def encode_events(events: list[StoredEvent]) -> bytes:
 
 
 def encode_pose(pose: PoseRecord) -> bytes:
+    """Each channel's arrays stacked over the DUTs that have it (`accel/raw_codes`, …, meta `channels`: which
+    DUTs, in order); the DUTs' own temperatures stacked over all of them."""
     duts = pose.duts
     arrays: dict[str, np.ndarray] = {
         "commanded_angles_deg": np.asarray(pose.commanded_angles_deg, dtype="f8"),
         "measured_angles_deg": np.asarray(pose.measured_angles_deg, dtype="f8"),
         "gravity_fixture": np.asarray(pose.gravity_fixture, dtype="f8"),
         "scalars": np.array([pose.setpoint_c, pose.t_start_s, pose.t_end_s, *pose.chamber_temperature_c], dtype="f8"),
-        "raw_codes": np.stack([np.asarray(d.raw_codes, dtype="i4") for d in duts]),
-        "mean_g": np.stack([np.asarray(d.mean_g, dtype="f8") for d in duts]),
-        "stderr_g": np.stack([np.asarray(d.stderr_g, dtype="f8") for d in duts]),
         "temperature_c": np.array([d.temperature_c for d in duts], dtype="f8"),
-        "gravity_reference_g": np.stack([np.asarray(d.gravity_reference_g, dtype="f8") for d in duts]),
         "temperature_in_band": np.array([d.temperature_in_band for d in duts], dtype="?"),
     }
+    having: dict[str, list[str]] = {}
+    for dut in duts:
+        for name in dut.channels:
+            having.setdefault(name, []).append(dut.serial)
+    by_serial = {d.serial: d for d in duts}
+    for name, serials in having.items():
+        channels = [by_serial[serial].channels[name] for serial in serials]
+        arrays[f"{name}/raw_codes"] = np.stack([np.asarray(c.raw_codes, dtype="i4") for c in channels])
+        for field in ("mean", "stderr", "reference"):
+            arrays[f"{name}/{field}"] = np.stack([np.asarray(getattr(c, field), dtype="f8") for c in channels])
     if all(d.truth is not None for d in duts) and duts:
         arrays["truth_parameters"] = np.stack([np.asarray(d.truth["parameters"], dtype="f8") for d in duts])  # type: ignore[index]
         arrays["truth_gravity_g"] = np.stack([np.asarray(d.truth["gravity_g"], dtype="f8") for d in duts])  # type: ignore[index]
         arrays["truth_temperature_c"] = np.array([float(d.truth["temperature_c"]) for d in duts], dtype="f8")  # type: ignore[index]
-    meta = {"step_key": pose.step_key, "pose_number": int(pose.pose_number), "serials": [d.serial for d in duts]}
+    meta = {"step_key": pose.step_key, "pose_number": int(pose.pose_number), "serials": [d.serial for d in duts],
+            "channels": having}
     return encode_record("pose", meta, arrays)
 
 
@@ -115,9 +129,13 @@ def _header(record: Record) -> CampaignHeader:
         raise ValueError("DUT serials missing or repeated")
     if not set(truth) <= {d["serial"] for d in duts} or not all(isinstance(n, str) for n in plan.axis_names):
         raise ValueError("truth of sensors not in the campaign, or axis names that are not text")
+    channels = {str(serial): tuple(ChannelInfo.from_attrs(name, attrs) for name, attrs in by_name.items())
+                for serial, by_name in meta.get("channels", {}).items()}  # absent before parts declared channels
+    if not set(channels) <= {d["serial"] for d in duts} or not all(channels.values()):
+        raise ValueError("channels of sensors not in the campaign, or a sensor without channels")
     return CampaignHeader(str(meta["campaign_id"]), str(meta["created"]), str(meta["software_version"]),
                           dict(meta["attrs"]), str(meta["procedure_yaml"]), str(meta["rig_yaml"]), plan, duts,
-                          dict(meta["instruments"]), float(meta["turntable_accuracy_arcsec"]), truth)
+                          dict(meta["instruments"]), float(meta["turntable_accuracy_arcsec"]), truth, channels)
 
 
 def _attributes(value: object) -> dict[str, object]:
@@ -139,18 +157,18 @@ def _pose(record: Record, header: CampaignHeader) -> PoseRecord:
         raise ValueError(f"its sensors {serials} are not the campaign's {header.serials}")
     n_duts, n_axes, n = len(serials), len(header.plan.axis_names), int(header.attrs.get("samples_per_pose", 0))
     shapes = {"commanded_angles_deg": (n_axes,), "measured_angles_deg": (n_axes,), "gravity_fixture": (3,),
-              "scalars": (5,), "raw_codes": (n_duts, n, 3), "mean_g": (n_duts, 3), "stderr_g": (n_duts, 3),
-              "temperature_c": (n_duts, 2), "gravity_reference_g": (n_duts, 3), "temperature_in_band": (n_duts,)}
+              "scalars": (5,), "temperature_c": (n_duts, 2), "temperature_in_band": (n_duts,)}
     for name, shape in shapes.items():
         if arrays[name].shape != shape:
             raise ValueError(f"{name} has shape {arrays[name].shape}, expected {shape}")
+    channels = _pose_channels(meta, arrays, serials, header, n)
     truth = "truth_parameters" in arrays
     setpoint, t_start, t_end, before, after = arrays["scalars"].tolist()
     duts = [
         DutPoseRecord(
-            serial=serial, raw_codes=arrays["raw_codes"][i], mean_g=arrays["mean_g"][i], stderr_g=arrays["stderr_g"][i],
+            serial=serial, channels=channels[serial],
             temperature_c=(float(arrays["temperature_c"][i, 0]), float(arrays["temperature_c"][i, 1])),
-            gravity_reference_g=arrays["gravity_reference_g"][i], temperature_in_band=bool(arrays["temperature_in_band"][i]),
+            temperature_in_band=bool(arrays["temperature_in_band"][i]),
             truth={"parameters": arrays["truth_parameters"][i], "gravity_g": arrays["truth_gravity_g"][i],
                    "temperature_c": np.asarray(arrays["truth_temperature_c"][i])} if truth else None)
         for i, serial in enumerate(serials)
@@ -159,6 +177,42 @@ def _pose(record: Record, header: CampaignHeader) -> PoseRecord:
         raise ValueError(f"pose number {meta['pose_number']!r}")
     return PoseRecord(str(meta["step_key"]), setpoint, int(meta["pose_number"]), arrays["commanded_angles_deg"],
                       arrays["measured_angles_deg"], arrays["gravity_fixture"], t_start, t_end, (before, after), duts)
+
+
+#: A pose record's acceleration arrays before parts declared channels (stacked over every DUT).
+_ACCELERATION_ARRAYS = {"raw_codes": "raw_codes", "mean": "mean_g", "stderr": "stderr_g", "reference": "gravity_reference_g"}
+
+
+def _pose_channels(meta: dict, arrays: dict[str, np.ndarray], serials: list[str], header: CampaignHeader,
+                   n: int) -> dict[str, dict[str, ChannelPoseRecord]]:
+    """Each DUT's channels at the pose, checked against the channels the header says it has."""
+    if "channels" in meta:
+        having = {str(name): [str(s) for s in owners] for name, owners in meta["channels"].items()}
+        names = {name: {field: f"{name}/{field}" for field in _ACCELERATION_ARRAYS} for name in having}
+    else:  # a record written before channels: acceleration, every DUT
+        having, names = {"accel": serials}, {"accel": _ACCELERATION_ARRAYS}
+    channels: dict[str, dict[str, ChannelPoseRecord]] = {serial: {} for serial in serials}
+    for name, owners in having.items():
+        if len(set(owners)) != len(owners) or not set(owners) <= set(serials):
+            raise ValueError(f"channel {name}: sensors {owners} are not the pose's")
+        for i, serial in enumerate(owners):
+            known = {c.name: c for c in header.dut_channels(serial)}
+            if name not in known:
+                raise ValueError(f"sensor {serial} has no channel {name!r}")
+            axes = len(known[name].axes)
+            fields = {field: arrays[path] for field, path in names[name].items()}
+            expected = {"raw_codes": (len(owners), n, axes), "mean": (len(owners), axes),
+                        "stderr": (len(owners), axes), "reference": (len(owners), axes)}
+            for field, shape in expected.items():
+                if fields[field].shape != shape:
+                    raise ValueError(f"{names[name][field]} has shape {fields[field].shape}, expected {shape}")
+            channels[serial][name] = ChannelPoseRecord(fields["raw_codes"][i], fields["mean"][i],
+                                                       fields["stderr"][i], fields["reference"][i])
+    for serial in serials:
+        if set(channels[serial]) != {c.name for c in header.dut_channels(serial)}:
+            raise ValueError(f"sensor {serial}: channels {sorted(channels[serial])}, the campaign says "
+                             f"{[c.name for c in header.dut_channels(serial)]}")
+    return channels
 
 
 def _soak(record: Record, header: CampaignHeader) -> SoakTrace:

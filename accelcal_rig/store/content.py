@@ -14,8 +14,12 @@ from typing import Any
 
 import numpy as np
 
-from accelcal_rig.store.records import CampaignHeader, PoseRecord, RunStart, SoakTrace, StoredEvent
+from accelcal_rig.store.records import CampaignHeader, ChannelInfo, PoseRecord, RunStart, SoakTrace, StoredEvent
 
+#: The acceleration channel's fields under their names in formats 1 and 2.
+_ACCELERATION_NAMES = {"raw_codes": "raw_codes", "mean_g": "mean", "stderr_g": "stderr", "gravity_reference_g": "reference"}
+#: A channel's fields, per pose.
+CHANNEL_FIELDS = ("raw_codes", "mean", "stderr", "reference")
 POSE_FIELDS = ("step_key", "setpoint_c", "pose_number", "commanded_angles_deg", "measured_angles_deg",
                "gravity_fixture", "t_start_s", "t_end_s", "chamber_temperature_c")
 
@@ -109,14 +113,37 @@ class Campaign:
         return self._columns[key]
 
     def dut_column(self, serial: str, name: str) -> np.ndarray:
+        """One of a DUT's own fields over the stored poses (`temperature_c`, `temperature_in_band`), or its
+        acceleration channel's under the names of formats 1 and 2 (`raw_codes`, `mean_g`, `stderr_g`,
+        `gravity_reference_g`), for the readers that handle only that channel."""
+        if name in _ACCELERATION_NAMES:
+            return self.channel_column(serial, "accel", _ACCELERATION_NAMES[name])
         key = f"duts/{serial}/{name}"
         if key not in self._columns:
             index = self.serials.index(serial)
             values = [getattr(p.duts[index], name) for p in self.poses]
-            tail = {"raw_codes": (self.samples_per_pose, 3), "temperature_c": (2,), "temperature_in_band": ()}.get(name, (3,))
-            dtype = {"raw_codes": "i4", "temperature_in_band": "?"}.get(name, "f8")
+            tail, dtype = {"temperature_c": ((2,), "f8"), "temperature_in_band": ((), "?")}[name]
             self._columns[key] = _stack(values, tail, dtype)
         return self._columns[key]
+
+    def channel_column(self, serial: str, channel: str, name: str) -> np.ndarray:
+        """One field of one of a DUT's channels over the stored poses: `raw_codes` (N, n, axes), `mean`,
+        `stderr`, `reference` (N, axes)."""
+        key = f"duts/{serial}/{channel}/{name}"
+        if key not in self._columns:
+            index = self.serials.index(serial)
+            info = self.channel_info(serial, channel)
+            values = [getattr(p.duts[index].channels[channel], name) for p in self.poses]
+            axes = len(info.axes)
+            tail = (self.samples_per_pose, axes) if name == "raw_codes" else (axes,)
+            self._columns[key] = _stack(values, tail, "i4" if name == "raw_codes" else "f8")
+        return self._columns[key]
+
+    def channel_info(self, serial: str, channel: str) -> ChannelInfo:
+        for info in self.header.dut_channels(serial):
+            if info.name == channel:
+                return info
+        raise KeyError(f"sensor {serial} has no {channel!r} channel")
 
     def truth_column(self, serial: str, name: str) -> np.ndarray | None:
         """Simulation truth of one field over the poses (dry runs), None when the campaign has none."""
@@ -194,27 +221,36 @@ def take_what_the_file_kept(campaign: Campaign, from_file: Campaign, journal_nam
 
 def measurements_sha256(campaign: Campaign) -> str:
     """Digest of the measured data (pose keys, raw codes, temperatures, references), not of a file: the
-    same campaign read from its journal or its HDF5 file has the same digest."""
+    same campaign read from its journal or its HDF5 file has the same digest. The acceleration channel
+    first, as formats 1 and 2 digested it, then any other channel: an accelerometer's campaign keeps its
+    digest in every format."""
     digest = hashlib.sha256()
     digest.update(b"".join(p.step_key.encode() for p in campaign.poses))
     for serial in sorted(campaign.serials):
         for name in ("raw_codes", "temperature_c", "gravity_reference_g"):
             digest.update(np.ascontiguousarray(campaign.dut_column(serial, name)).tobytes())
+        for info in campaign.header.dut_channels(serial):
+            if info.name != "accel":
+                for name in ("raw_codes", "reference"):
+                    digest.update(np.ascontiguousarray(campaign.channel_column(serial, info.name, name)).tobytes())
     return digest.hexdigest()
 
 
 def _implausible_rows(campaign: Campaign, serial: str) -> list[int]:
-    """Rows no real measurement produces: a reference gravity that is not a unit vector, a block of
-    codes all zero, or a non-finite mean or temperature."""
+    """Rows no real measurement produces: a reference gravity that is not a unit vector, a block of codes
+    all zero in any channel, or a non-finite mean or temperature."""
     if not campaign.poses:
         return []
-    reference = campaign.dut_column(serial, "gravity_reference_g")
-    codes = campaign.dut_column(serial, "raw_codes")
-    mean = campaign.dut_column(serial, "mean_g")
     temperature = campaign.dut_column(serial, "temperature_c")
-    with np.errstate(invalid="ignore"):
-        bad = (np.abs(np.linalg.norm(reference, axis=1) - 1.0) > 1e-6) | ~np.any(codes != 0, axis=(1, 2))
-    bad |= ~np.all(np.isfinite(mean), axis=1) | ~np.all(np.isfinite(temperature), axis=1)
+    bad = ~np.all(np.isfinite(temperature), axis=1)
+    for info in campaign.header.dut_channels(serial):
+        codes = campaign.channel_column(serial, info.name, "raw_codes")
+        mean = campaign.channel_column(serial, info.name, "mean")
+        bad |= ~np.any(codes != 0, axis=(1, 2)) | ~np.all(np.isfinite(mean), axis=1)
+        if info.name == "accel":
+            reference = campaign.channel_column(serial, info.name, "reference")
+            with np.errstate(invalid="ignore"):
+                bad |= np.abs(np.linalg.norm(reference, axis=1) - 1.0) > 1e-6
     return np.flatnonzero(bad).tolist()
 
 

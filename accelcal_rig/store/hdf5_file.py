@@ -4,8 +4,9 @@ The file is built whole in memory and handed back as bytes; the writer puts them
 replace, so the HDF5 library never writes to disk and a reader never meets a file half-written. Every
 dataset carries HDF5's Fletcher-32 checksum, so a flipped bit is an error on reading, not a wrong number.
 
-Reading checks every dataset's presence, type and shape before it reads a byte of it, and reads format 1
-(written in place by accelcal-rig before the journal) as well as format 2.
+Reading checks every dataset's presence, type and shape before it reads a byte of it, and reads formats 1
+(written in place by accelcal-rig before the journal) and 2 (one acceleration channel, its datasets beside
+the DUT's own) as well as format 3 (a group per channel).
 """
 
 from __future__ import annotations
@@ -19,9 +20,11 @@ import numpy as np
 
 from accelcal_rig.config.yaml_lines import parse_yaml_text
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.store.content import POSE_FIELDS, Campaign, measurements_sha256
+from accelcal_rig.store.content import CHANNEL_FIELDS, POSE_FIELDS, Campaign, measurements_sha256
 from accelcal_rig.store.records import (
     CampaignHeader,
+    ChannelInfo,
+    ChannelPoseRecord,
     DutPoseRecord,
     PoseRecord,
     RunStart,
@@ -32,8 +35,8 @@ from accelcal_rig.store.records import (
 )
 
 FORMAT_NAME = "accelcal-rig campaign"
-FORMAT_VERSION = 2
-READABLE_VERSIONS = (1, 2)
+FORMAT_VERSION = 3
+READABLE_VERSIONS = (1, 2, 3)
 TEXT = h5py.string_dtype("utf-8")
 #: Text columns are fixed-length UTF-8 (bytes per row; h5py returns bytes, `.decode()` them), longer text
 #: cut at a character boundary.
@@ -108,10 +111,17 @@ def _image(campaign: Campaign, journal_bytes: int) -> bytes:
             _dataset(poses, name, _fixed_text("step_key", list(column)) if name == "step_key" else column)
         duts = file.create_group("duts", track_order=True)
         for dut in header.duts:
-            group = duts.create_group(dut["serial"])
+            serial = dut["serial"]
+            group = duts.create_group(serial, track_order=True)
             group.attrs.update(dut)
-            for name in ("raw_codes", "mean_g", "stderr_g", "temperature_c", "gravity_reference_g", "temperature_in_band"):
-                _dataset(group, name, campaign.dut_column(dut["serial"], name))
+            for name in ("temperature_c", "temperature_in_band"):
+                _dataset(group, name, campaign.dut_column(serial, name))
+            for channel in header.dut_channels(serial):
+                channel_group = group.create_group(channel.name)
+                channel_group.attrs.update(channel.attrs())
+                for name in CHANNEL_FIELDS:
+                    _dataset(channel_group, name, campaign.channel_column(serial, channel.name, name),
+                             "LSB" if name == "raw_codes" else channel.unit)
         instruments = file.create_group("instruments")
         for name, info in campaign.instruments.items():
             instruments.create_group(name).attrs.update(info)
@@ -223,13 +233,11 @@ def read_campaign_file(file: h5py.File) -> Campaign:
              "commanded_angles_deg": ((n_axes,), "f"), "measured_angles_deg": ((n_axes,), "f"),
              "gravity_fixture": ((3,), "f"), "t_start_s": ((), "f"), "t_end_s": ((), "f"),
              "chamber_temperature_c": ((2,), "f")}
-    dut_tails = {"raw_codes": ((n, 3), "i"), "mean_g": ((3,), "f"), "stderr_g": ((3,), "f"),
-                 "temperature_c": ((2,), "f"), "gravity_reference_g": ((3,), "f"), "temperature_in_band": ((), "b")}
     truth_tails = {"parameters": ((12,), "f"), "gravity_g": ((3,), "f"), "temperature_c": ((), "f")}
+    dut_columns = {s: _dut_columns(header, s, version, n) for s in header.serials}
     lengths = {f"poses/{name}": reader.node(f"poses/{name}", h5py.Dataset).shape for name in tails}
     for serial in header.serials:
-        lengths.update({f"duts/{serial}/{name}": reader.node(f"duts/{serial}/{name}", h5py.Dataset).shape
-                        for name in dut_tails})
+        lengths.update({path: reader.node(path, h5py.Dataset).shape for path, _, _ in dut_columns[serial].values()})
         if serial in header.truth:
             lengths.update({f"simulation_truth/{serial}/{name}": reader.node(f"simulation_truth/{serial}/{name}",
                                                                              h5py.Dataset).shape for name in truth_tails})
@@ -242,16 +250,18 @@ def read_campaign_file(file: h5py.File) -> Campaign:
     elif longest > whole:
         campaign.notes.append(f"a pose written in part by a run that died (rows beyond pose {whole}) is not used")
     columns = {name: reader.array(f"poses/{name}", tail, kinds, whole) for name, (tail, kinds) in tails.items()}
-    duts = {s: {name: reader.array(f"duts/{s}/{name}", tail, kinds, whole) for name, (tail, kinds) in dut_tails.items()}
+    duts = {s: {key: reader.array(path, tail, kinds, whole) for key, (path, tail, kinds) in dut_columns[s].items()}
             for s in header.serials}
     truth = {s: {name: reader.array(f"simulation_truth/{s}/{name}", tail, kinds, whole)
                  for name, (tail, kinds) in truth_tails.items()} for s in header.serials if s in header.truth}
     keys = [_text(k) for k in columns["step_key"]]
     for i, key in enumerate(keys):
         pose_duts = [DutPoseRecord(
-            serial=s, raw_codes=duts[s]["raw_codes"][i], mean_g=duts[s]["mean_g"][i], stderr_g=duts[s]["stderr_g"][i],
-            temperature_c=(float(duts[s]["temperature_c"][i, 0]), float(duts[s]["temperature_c"][i, 1])),
-            gravity_reference_g=duts[s]["gravity_reference_g"][i], temperature_in_band=bool(duts[s]["temperature_in_band"][i]),
+            serial=s,
+            channels={c.name: ChannelPoseRecord(*(duts[s][(c.name, name)][i] for name in CHANNEL_FIELDS))
+                      for c in header.dut_channels(s)},
+            temperature_c=(float(duts[s][("", "temperature_c")][i, 0]), float(duts[s][("", "temperature_c")][i, 1])),
+            temperature_in_band=bool(duts[s][("", "temperature_in_band")][i]),
             truth={name: truth[s][name][i] for name in truth_tails} if s in truth else None) for s in header.serials]
         campaign.add_pose(PoseRecord(
             key, float(columns["setpoint_c"][i]), int(columns["pose_number"][i]), columns["commanded_angles_deg"][i],
@@ -283,6 +293,28 @@ def read_campaign_file(file: h5py.File) -> Campaign:
     return campaign
 
 
+#: Where formats 1 and 2 kept the acceleration channel's fields: beside the DUT's own.
+_ACCELERATION_DATASETS = {"raw_codes": "raw_codes", "mean": "mean_g", "stderr": "stderr_g",
+                          "reference": "gravity_reference_g"}
+
+
+def _dut_columns(header: CampaignHeader, serial: str, version: int,
+                 n: int) -> dict[tuple[str, str], tuple[str, tuple[int, ...], str]]:
+    """A DUT's pose-aligned datasets: (channel, field) → (path, shape after the pose, kinds); the DUT's own
+    fields under channel ""."""
+    base = f"duts/{serial}"
+    found: dict[tuple[str, str], tuple[str, tuple[int, ...], str]] = {
+        ("", "temperature_c"): (f"{base}/temperature_c", (2,), "f"),
+        ("", "temperature_in_band"): (f"{base}/temperature_in_band", (), "b")}
+    for info in header.dut_channels(serial):
+        axes = len(info.axes)
+        for name in CHANNEL_FIELDS:
+            path = f"{base}/{info.name}/{name}" if version >= 3 else f"{base}/{_ACCELERATION_DATASETS[name]}"
+            found[(info.name, name)] = (path, (n, axes) if name == "raw_codes" else (axes,),
+                                        "i" if name == "raw_codes" else "f")
+    return found
+
+
 _HEADER_ATTRS = ("procedure_name", "procedure_path", "rig_name", "rig_path", "dry_run", "seed", "clock",
                  "samples_per_pose", "fit_mode", "polynomial_degree", "fit_parameters", "fit_out_of_range",
                  "fit_temperature_model")
@@ -306,6 +338,7 @@ def _read_header(reader: _Reader) -> CampaignHeader:
     rig_yaml = reader.text("config/rig_yaml")
     duts = []
     groups = reader.node("duts", h5py.Group)
+    channels: dict[str, tuple[ChannelInfo, ...]] = {}
     for serial in _campaign_order(rig_yaml, list(groups)):
         group = groups[serial]
         if not isinstance(group, h5py.Group):
@@ -313,6 +346,8 @@ def _read_header(reader: _Reader) -> CampaignHeader:
         duts.append({"serial": serial, **{k: plain_value(v) for k, v in group.attrs.items() if k != "serial"}})
         for name in ("range_g", "lsb_g", "odr_hz"):
             reader.attr(group, name, float)
+        if int(file.attrs.get("format_version", 0)) >= 3:
+            channels[serial] = _read_channels(group)
     truth = {}
     if "simulation_truth" in file:
         for serial, group in reader.node("simulation_truth", h5py.Group).items():
@@ -325,7 +360,25 @@ def _read_header(reader: _Reader) -> CampaignHeader:
         software_version=_text(file.attrs.get("software_version", "")), attrs=attrs,
         procedure_yaml=reader.text("config/procedure_yaml"), rig_yaml=rig_yaml, plan=plan,
         duts=duts, instruments={}, turntable_accuracy_arcsec=float(poses_group.attrs.get("turntable_accuracy_arcsec", 0.0)),
-        truth=truth)
+        truth=truth, channels=channels)
+
+
+def _read_channels(group: h5py.Group) -> tuple[ChannelInfo, ...]:
+    """A format-3 DUT's channels: its subgroups, in the order they were written."""
+    found = []
+    for name, channel in group.items():
+        if not isinstance(channel, h5py.Group):
+            continue
+        try:
+            attrs = {k: channel.attrs[k] for k in ("quantity", "unit", "range", "lsb")}
+            attrs["axes"] = [_text(a) for a in channel.attrs["axes"]]
+            found.append(ChannelInfo.from_attrs(name, {k: _text(v) if isinstance(v, bytes) else v
+                                                       for k, v in attrs.items()}))
+        except (KeyError, TypeError, ValueError, OSError) as exc:
+            raise DamagedFile(f"{channel.name}: channel attributes missing or unreadable ({exc})") from None
+    if not found:
+        raise DamagedFile(f"{group.name}: no channel groups")
+    return tuple(found)
 
 
 def _campaign_order(rig_yaml: str, serials: list[str]) -> list[str]:

@@ -30,17 +30,75 @@ def utc_now() -> str:
 
 
 @dataclass(frozen=True)
+class ChannelInfo:
+    """One channel of one DUT as the campaign records it: what it measures, in what unit, on which axes, at
+    which range and code size (the part's channel at the procedure's range)."""
+
+    name: str                        # "accel", "gyro"
+    quantity: str                    # "acceleration", "angular rate"
+    unit: str                        # "g", "dps"
+    axes: tuple[str, ...]
+    range: float                     # ± full scale in `unit`
+    lsb: float                       # `unit` per code
+
+    def attrs(self) -> dict[str, Any]:
+        return {"quantity": self.quantity, "unit": self.unit, "axes": list(self.axes), "range": self.range,
+                "lsb": self.lsb}
+
+    @classmethod
+    def from_attrs(cls, name: str, attrs: dict[str, Any]) -> ChannelInfo:
+        """From what `attrs()` wrote; ValueError when anything is of another kind."""
+        axes = attrs["axes"]
+        if not (isinstance(name, str) and name.isidentifier() and isinstance(axes, list) and 0 < len(axes) <= 16
+                and all(isinstance(a, str) for a in axes)):
+            raise ValueError(f"channel {name!r}: name or axes of another kind")
+        return cls(name, str(attrs["quantity"]), str(attrs["unit"]), tuple(axes), float(attrs["range"]),
+                   float(attrs["lsb"]))
+
+
+def acceleration_channel(dut: dict[str, Any]) -> ChannelInfo:
+    """The one channel of a campaign recorded before parts declared channels (formats 1 and 2): acceleration
+    in g on x, y, z at the DUT's `range_g` and `lsb_g`."""
+    return ChannelInfo("accel", "acceleration", "g", ("x", "y", "z"), float(dut["range_g"]), float(dut["lsb_g"]))
+
+
+@dataclass(frozen=True)
+class ChannelPoseRecord:
+    """One channel of one DUT at one pose."""
+
+    raw_codes: np.ndarray            # (n, axes) signed codes
+    mean: np.ndarray                 # (axes,) in the channel's unit (codes × lsb)
+    stderr: np.ndarray               # (axes,) standard error of the mean
+    reference: np.ndarray            # (axes,) what the channel should read in the DUT frame: gravity from the
+                                     # commanded angles and the mount; the table's rate (zero at rest)
+
+
+@dataclass(frozen=True)
 class DutPoseRecord:
-    """One DUT's measurement of one pose."""
+    """One DUT's measurement of one pose: each of its channels, and its own temperature sensor."""
 
     serial: str
-    raw_codes: np.ndarray            # (n, 3) signed 20-bit codes
-    mean_g: np.ndarray               # (3,)
-    stderr_g: np.ndarray             # (3,) standard error of the mean
+    channels: dict[str, ChannelPoseRecord]
     temperature_c: tuple[float, float]  # DUT's own sensor, before and after the block
-    gravity_reference_g: np.ndarray  # (3,) expected reading from the commanded angles and the mount
     temperature_in_band: bool        # within the soak band of the temperature the soak settled at
     truth: dict[str, np.ndarray] | None = None
+
+    # The acceleration channel's fields, for the readers that handle only it.
+    @property
+    def raw_codes(self) -> np.ndarray:
+        return self.channels["accel"].raw_codes
+
+    @property
+    def mean_g(self) -> np.ndarray:
+        return self.channels["accel"].mean
+
+    @property
+    def stderr_g(self) -> np.ndarray:
+        return self.channels["accel"].stderr
+
+    @property
+    def gravity_reference_g(self) -> np.ndarray:
+        return self.channels["accel"].reference
 
 
 @dataclass(frozen=True)
@@ -136,10 +194,18 @@ class CampaignHeader:
     turntable_accuracy_arcsec: float
     #: Dry runs: each simulated DUT's hidden model (attributes and `polynomial_coefficients`).
     truth: dict[str, dict[str, Any]] = field(default_factory=dict)
+    #: Each DUT's channels by serial (absent: formats 1 and 2, whose DUTs measured acceleration only).
+    channels: dict[str, tuple[ChannelInfo, ...]] = field(default_factory=dict)
 
     @property
     def serials(self) -> list[str]:
         return [str(d["serial"]) for d in self.duts]
+
+    def dut_channels(self, serial: str) -> tuple[ChannelInfo, ...]:
+        """What the DUT `serial` measures, in its part's order."""
+        if serial in self.channels:
+            return self.channels[serial]
+        return (acceleration_channel(self.duts[self.serials.index(serial)]),)
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ import numpy as np
 
 from accelcal_rig.store.codec import encode_pose
 from accelcal_rig.store.hdf5_file import TEXT_BYTES
-from accelcal_rig.store.records import DutPoseRecord, PoseRecord
+from accelcal_rig.store.records import ChannelPoseRecord, DutPoseRecord, PoseRecord
 
 #: `rig run` starts only with this many times the estimated need free.
 START_MARGIN = 1.5
@@ -31,8 +31,9 @@ _CALIBRATION_BYTES = (32 * 1024, 24 * 1024)
 def pose_record_bytes(n_duts: int, samples_per_pose: int, n_axes: int, with_truth: bool) -> int:
     """The journal bytes of one pose, encoded as the writer encodes it."""
     truth = {"parameters": np.zeros(12), "gravity_g": np.zeros(3), "temperature_c": np.asarray(0.0)}
-    duts = [DutPoseRecord(f"DUT-{k:04d}", np.zeros((samples_per_pose, 3), dtype="i4"), np.zeros(3), np.zeros(3),
-                          (0.0, 0.0), np.zeros(3), True, truth if with_truth else None) for k in range(n_duts)]
+    accel = ChannelPoseRecord(np.zeros((samples_per_pose, 3), dtype="i4"), np.zeros(3), np.zeros(3), np.zeros(3))
+    duts = [DutPoseRecord(f"DUT-{k:04d}", {"accel": accel}, (0.0, 0.0), True, truth if with_truth else None)
+            for k in range(n_duts)]
     pose = PoseRecord("T-100/pose0001", -100.0, 1, np.zeros(n_axes), np.zeros(n_axes), np.zeros(3), 0.0, 0.0,
                       (0.0, 0.0), duts)
     return len(encode_pose(pose))

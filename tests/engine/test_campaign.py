@@ -64,7 +64,7 @@ def test_state_sequence_of_a_tiny_campaign(write, workdir: Path) -> None:
 
 def test_sensor_with_wrong_identity_aborts_before_anything_moves(write, workdir: Path) -> None:
     def wrong_part(instruments):
-        instruments.sensors[2].identify = lambda: DeviceIdentity(0xAD, 0x1D, 0xE9, 1)  # an ADXL359
+        instruments.sensors[2].identify = lambda: DeviceIdentity((0xAD, 0x1D, 0xE9), 1)  # an ADXL359
 
     output, instruments, error = run_tiny(write, workdir, wrong_part)
     assert error is not None
@@ -104,8 +104,8 @@ def test_interrupt_mid_campaign_keeps_every_stored_pose(write, workdir: Path) ->
     with h5py.File(output, "r") as f:
         assert [k.decode() for k in f["poses/step_key"][:]] == ["T30/pose01", "T30/pose02", "T30/pose03"]
         for serial in f["duts"]:
-            assert f[f"duts/{serial}/raw_codes"].shape == (3, 20, 3)
-            assert np.all(np.isfinite(f[f"duts/{serial}/mean_g"][:]))
+            assert f[f"duts/{serial}/accel/raw_codes"].shape == (3, 20, 3)
+            assert np.all(np.isfinite(f[f"duts/{serial}/accel/mean"][:]))
 
 
 def test_one_failing_device_does_not_keep_the_others_unsafe(write, workdir: Path) -> None:
@@ -152,7 +152,7 @@ def test_same_seed_same_data_other_seed_other_noise(write, workdir: Path) -> Non
         output = workdir / name
         run_campaign(prepare(write("tiny.yaml", TINY_PROCEDURE)), output, dry_run=True, seed=seed, overwrite=False)
         with h5py.File(output, "r") as f:
-            return f["duts/ADX355-A001/raw_codes"][:]
+            return f["duts/ADX355-A001/accel/raw_codes"][:]
 
     first, again, other = raw_codes(5, "a.h5"), raw_codes(5, "b.h5"), raw_codes(6, "c.h5")
     np.testing.assert_array_equal(first, again)

@@ -73,7 +73,7 @@ def test_an_aborted_campaign_resumes_from_the_first_pose_not_stored(write, workd
     with h5py.File(output, "r") as f:
         assert f.attrs["state"] == "done" and f.attrs["runs"] == 2 and f.attrs["abort_reason"] == ""
         for serial in f["duts"]:
-            assert f[f"duts/{serial}/raw_codes"].shape[0] == 12
+            assert f[f"duts/{serial}/accel/raw_codes"].shape[0] == 12
         assert sorted(f["soaks"]) == ["T20", "T30", "T30#2"]  # the interrupted setpoint soaked again
         t = f["poses/t_start_s"][:]
         assert np.all(np.diff(t) > 0)  # the resumed run's clock goes on from where the file ended

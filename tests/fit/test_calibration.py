@@ -46,7 +46,7 @@ def test_apply_undoes_the_simulated_sensor_at_any_temperature(calibration) -> No
     # reference mode recovers the full vector, not only its norm; the fit's noise is ~10 µg
     assert np.abs(compensated - directions).max() < 1e-4
     np.testing.assert_allclose(np.linalg.norm(compensated, axis=1), 1.0, atol=5e-5)
-    codes = ADXL355.quantise_g(raw, 2)
+    codes = ADXL355.channel("accel").quantise(raw, 2)
     np.testing.assert_allclose(apply_codes(calibration.sensor(serial), codes, temperatures), compensated, atol=1e-5)
 
 

@@ -57,14 +57,14 @@ def capturing_sensor():
 def bring_up(driver: Adxl355, range_g: int = 2, odr_hz: float = 125.0) -> None:
     driver.reset()
     driver.standby()
-    driver.configure(range_g, odr_hz)
+    driver.configure({"accel": range_g}, odr_hz)
     driver.start_measurement()
 
 
 def test_identity_and_temperature(sensor) -> None:
     driver, _, lab, _ = sensor
     identity = driver.identify()
-    assert (identity.devid_ad, identity.devid_mst, identity.partid) == (0xAD, 0x1D, 0xED)
+    assert identity.registers == (0xAD, 0x1D, 0xED)
     assert driver.read_temperature_c() == pytest.approx(lab.dut_true_c(1), abs=0.3)
 
 
@@ -72,11 +72,11 @@ def test_blocks_are_gap_free_and_match_the_truth(sensor) -> None:
     driver, _, lab, clock = sensor
     bring_up(driver)
     block = driver.acquire(1000)
-    assert block.codes_xyz.shape == (1000, 3) and block.codes_xyz.dtype == np.int32
+    assert block.codes["accel"].shape == (1000, 3) and block.codes["accel"].dtype == np.int32
     assert block.t_end_s - block.t_start_s == pytest.approx(999 / 125)
     truth = lab.truth_between(1, block.t_start_s, block.t_end_s)
     expected = distort(truth["gravity_g"], truth["parameters"])
-    measured = block.codes_xyz * ADXL355.lsb_g(2)
+    measured = block.codes["accel"] * ADXL355.channel("accel").lsb(2)
     noise = lab.noise_g(0, 125.0)
     np.testing.assert_allclose(measured.mean(axis=0), expected, atol=5 * noise / np.sqrt(1000))
     # gap-free white noise: no step between drains, lag-1 correlation ≈ 0
@@ -89,14 +89,14 @@ def test_range_setting_changes_the_codes(sensor) -> None:
     driver, _, _, _ = sensor
     bring_up(driver, range_g=8)
     block = driver.acquire(100)
-    assert np.abs(block.codes_xyz.mean(axis=0)).max() == pytest.approx(64000, rel=0.05)  # ~1 g at ±8 g
+    assert np.abs(block.codes["accel"].mean(axis=0)).max() == pytest.approx(64000, rel=0.05)  # ~1 g at ±8 g
 
 
 def test_configure_outside_standby_is_refused(sensor) -> None:
     driver, _, _, _ = sensor
     bring_up(driver)
     with pytest.raises(InstrumentError, match="only change in standby"):
-        driver.configure(4, 125.0)
+        driver.configure({"accel": 4}, 125.0)
 
 
 def test_the_greeting_says_whether_the_bridge_captures(sensor) -> None:
@@ -144,7 +144,7 @@ def test_a_lost_fetch_reply_is_asked_for_again_without_losing_samples(capturing_
         capturing_sensor.fetch_capture()
     assert capturing_sensor.fetch_capture()  # asked again from the same index: complete
     block = capturing_sensor.end_capture()
-    assert calls == [0, 0] and block.codes_xyz.shape == (100, 3)
+    assert calls == [0, 0] and block.codes["accel"].shape == (100, 3)
 
 
 def test_a_sensor_in_standby_gives_no_samples_before_the_deadline(fifo_sensor) -> None:
@@ -174,7 +174,7 @@ def test_bridge_protocol_bytes_and_refusals() -> None:
     try:
         transport = SerialBridge.open(server.path)
         identity = Adxl355(transport, "SN-9", VirtualClock()).identify()
-        assert identity.partid == 0xE9
+        assert identity.registers[2] == 0xE9
         with pytest.raises(InstrumentError, match=r"'W 2D 00' refused: not supported"):
             transport.write(0x2D, 0x00)
         transport.close()

@@ -63,7 +63,7 @@ def test_the_driver_configures_the_part_its_table_describes() -> None:
     """An ADXL357 at ±20 g and 125 Hz: RANGE code 0b10, FILTER code 5, both read back, in standby only."""
     with expected_protocol([(b"R 2D 1\n", b"=01\n"), (b"W 2C 02\n", b"=\n"), (b"W 28 05\n", b"=\n"),
                             (b"R 28 1\n", b"=05\n"), (b"R 2C 1\n", b"=82\n")]) as line:
-        Adxl355(bridge(line), "X-1", VirtualClock(), ADXL357).configure(20, 125.0)
+        Adxl355(bridge(line), "X-1", VirtualClock(), ADXL357).configure({"accel": 20}, 125.0)
 
 
 def test_the_driver_reads_temperature_with_its_part_s_format_twice_in_agreement() -> None:

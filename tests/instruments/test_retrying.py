@@ -13,7 +13,7 @@ from accelcal_rig.errors import TransientInstrumentError
 from accelcal_rig.instruments.adxl355_transport import BlockCapture
 from accelcal_rig.instruments.capabilities import BlockCapturing, Reconnecting, TemperaturePosting
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
-from accelcal_rig.instruments.retrying import RetryingAccelerometer, RetryingTransport
+from accelcal_rig.instruments.retrying import RetryingSensor, RetryingTransport
 from accelcal_rig.instruments.temperatures import read_temperatures_together
 from accelcal_rig.parts.adxl35x import ADXL355
 
@@ -34,7 +34,7 @@ class CoreSensor:
         self.temperature_reads = 0
 
     def identify(self) -> DeviceIdentity:
-        return DeviceIdentity(0xAD, 0x1D, 0xED, 1)
+        return DeviceIdentity((0xAD, 0x1D, 0xED), 1)
 
     def reset(self) -> None: ...
     def configure(self, range_g: int, odr_hz: float) -> None: ...
@@ -49,7 +49,7 @@ class CoreSensor:
         return 25.0
 
     def acquire(self, n_samples: int) -> SampleBlock:
-        return SampleBlock(np.zeros((n_samples, 3), dtype=np.int32), 0.0, 1.0, (25.0, 25.0))
+        return SampleBlock({"accel": np.zeros((n_samples, 3), dtype=np.int32)}, 0.0, 1.0, (25.0, 25.0))
 
     def close(self) -> None: ...
 
@@ -79,16 +79,16 @@ class CapturingSensor(CoreSensor):
 @pytest.mark.parametrize("inner_type", [CoreSensor, PostingSensor, CapturingSensor])
 def test_a_retrying_sensor_has_a_capability_exactly_when_its_sensor_has_it(inner_type) -> None:
     inner = inner_type()
-    wrapper = RetryingAccelerometer(inner, call())
+    wrapper = RetryingSensor(inner, call())
     for capability in (BlockCapturing, TemperaturePosting, Reconnecting):
         assert isinstance(wrapper, capability) == isinstance(inner, capability), capability
     assert isinstance(wrapper, BlockCapturing) == (inner_type is CapturingSensor)
-    assert wrapper.serial == "SN-1" and wrapper.part is ADXL355 and wrapper.identify().revid == 1
+    assert wrapper.serial == "SN-1" and wrapper.part is ADXL355 and wrapper.identify().revision == 1
 
 
 def test_temperatures_are_posted_through_the_wrapper_where_the_sensor_posts_them() -> None:
     posting, plain = PostingSensor(), CoreSensor()
-    wrapped = [RetryingAccelerometer(posting, call()), RetryingAccelerometer(plain, call())]
+    wrapped = [RetryingSensor(posting, call()), RetryingSensor(plain, call())]
     assert read_temperatures_together(wrapped).tolist() == [24.0, 25.0]
     assert posting.begun == 1 and posting.temperature_reads == 0 and plain.temperature_reads == 1
 

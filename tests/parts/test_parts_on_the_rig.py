@@ -37,10 +37,10 @@ def test_a_dry_run_of_adxl357_and_adxl359_duts_simulates_those_parts(write, work
     assert [(d["part"], d["lsb_g"]) for d in campaign.header.duts] == [("adxl357", 1 / 51_200), ("adxl359", 1 / 51_200)]
     for index, part in enumerate((ADXL357, ADXL359)):
         codes = np.stack([p.duts[index].raw_codes for p in campaign.poses])        # (poses, samples, 3)
-        norm_g = np.linalg.norm(codes.mean(axis=1), axis=1) * part.lsb_g(10)
+        norm_g = np.linalg.norm(codes.mean(axis=1), axis=1) * part.channel("accel").lsb(10)
         assert np.all(np.abs(norm_g - 1.0) < 0.05)                                  # 1 g at 51 200 LSB/g
         # Per-sample noise at 125 Hz: 80 µg/√Hz × √(π/2 · 125/4) ≈ 0.56 mg (an ADXL355 would give 0.18 mg).
-        noise_g = codes.std(axis=1, ddof=1).mean() * part.lsb_g(10)
+        noise_g = codes.std(axis=1, ddof=1).mean() * part.channel("accel").lsb(10)
         assert noise_g == pytest.approx(80e-6 * np.sqrt(np.pi / 2 * 125 / 4), rel=0.25)
     # Both DUTs sit in the same air: the ADXL359's reading agrees with the ADXL357's only when its own
     # intercept (1852 LSB, not 1885) turns its codes into °C; with the other one it would read 3.6 °C high.

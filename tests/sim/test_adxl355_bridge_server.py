@@ -69,7 +69,7 @@ def test_a_capture_delivers_consecutive_samples_in_pieces(part) -> None:
     for raw in (start_raw, end_raw):
         assert float(ADXL355.temperature.celsius(raw)) == pytest.approx(true_c, abs=0.3)
     codes, _ = adxl355.decode_fifo(first + second)
-    assert codes.shape == (200, 3) and np.abs(codes).max() < ADXL355.code_max
+    assert codes.shape == (200, 3) and np.abs(codes).max() < ADXL355.channel("accel").code_max
     log = [entry for entry in device._lab.duts[0].truth_log if entry[0] >= 50 / ODR_HZ]
     assert [entry[2] for entry in log] == [120, 80]
     assert log[1][0] == pytest.approx(log[0][1])  # the second piece starts where the first ended

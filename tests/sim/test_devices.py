@@ -20,14 +20,14 @@ def rig():
 def test_block_mean_matches_the_truth_within_the_noise(rig) -> None:
     clock, instruments = rig
     sensor = instruments.sensors[1]
-    sensor.configure(2, 125.0)
+    sensor.configure({"accel": 2}, 125.0)
     sensor.start_measurement()
     block = sensor.acquire(2000)
-    assert block.codes_xyz.shape == (2000, 3) and block.codes_xyz.dtype == np.int32
+    assert block.codes["accel"].shape == (2000, 3) and block.codes["accel"].dtype == np.int32
     truth = instruments.truth.block_truth(sensor.serial, block)
     expected = distort(truth["gravity_g"], truth["parameters"])
-    lsb = ADXL355.lsb_g(2)
-    measured = block.codes_xyz * lsb
+    lsb = ADXL355.channel("accel").lsb(2)
+    measured = block.codes["accel"] * lsb
     noise = sensor.noise_g()
     np.testing.assert_allclose(measured.mean(axis=0), expected, atol=5 * noise / np.sqrt(2000))
     np.testing.assert_allclose(measured.std(axis=0), noise, rtol=0.1)
@@ -36,9 +36,9 @@ def test_block_mean_matches_the_truth_within_the_noise(rig) -> None:
 def test_noise_follows_the_datasheet_density_and_data_rate(rig) -> None:
     _, instruments = rig
     sensor = instruments.sensors[0]
-    sensor.configure(2, 125.0)
+    sensor.configure({"accel": 2}, 125.0)
     slow = sensor.noise_g()
-    sensor.configure(2, 4000.0)
+    sensor.configure({"accel": 2}, 4000.0)
     assert sensor.noise_g() == pytest.approx(slow * np.sqrt(32))
     assert 0.15e-3 < slow < 0.25e-3  # 25 µg/√Hz over a 31 Hz corner
 
@@ -59,7 +59,7 @@ def test_standby_rules_of_the_part(rig) -> None:
         sensor.acquire(10)
     sensor.start_measurement()
     with pytest.raises(InstrumentError, match="only change in standby"):
-        sensor.configure(4, 125.0)
+        sensor.configure({"accel": 4}, 125.0)
 
 
 def test_turntable_moves_at_its_speed_then_settles(rig) -> None:

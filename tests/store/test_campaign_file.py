@@ -24,9 +24,9 @@ def test_layout_shapes_and_units(campaign: Path) -> None:
         assert "six-position" in f["config/procedure_yaml"][()].decode()
         assert set(f["duts"]) == {"ADX355-A001", "ADX355-A002", "ADX355-A003", "ADX355-A004"}
         for serial, dut in f["duts"].items():
-            assert dut["raw_codes"].shape == (6, 20, 3) and dut["raw_codes"].dtype == np.int32
-            assert dut["mean_g"].attrs["unit"] == "g"
-            np.testing.assert_allclose(dut["mean_g"][:], dut["raw_codes"][:].mean(axis=1) * dut.attrs["lsb_g"])
+            assert dut["accel/raw_codes"].shape == (6, 20, 3) and dut["accel/raw_codes"].dtype == np.int32
+            assert dut["accel/mean"].attrs["unit"] == "g"
+            np.testing.assert_allclose(dut["accel/mean"][:], dut["accel/raw_codes"][:].mean(axis=1) * dut.attrs["lsb_g"])
             settled = f["soaks/T30/settled_dut_c"][list(f["duts"]).index(serial)]
             drift = np.abs(dut["temperature_c"][:] - settled).max(axis=1)
             np.testing.assert_array_equal(dut["temperature_in_band"][:], drift <= 0.3)
@@ -42,9 +42,9 @@ def test_means_agree_with_the_simulation_truth_and_the_reference(campaign: Path)
             truth = f["simulation_truth"][serial]
             expected = distort(truth["gravity_g"][:], truth["parameters"][:])
             # 20 samples at 0.2 mg each: means within 5 standard errors of the truth
-            assert np.all(np.abs(dut["mean_g"][:] - expected) < 5 * dut["stderr_g"][:] + 1e-6)
+            assert np.all(np.abs(dut["accel/mean"][:] - expected) < 5 * dut["accel/stderr"][:] + 1e-6)
             # The reference from commanded angles is the truth but for turntable accuracy (3″ ≈ 15 µg)
-            np.testing.assert_allclose(dut["gravity_reference_g"][:], truth["gravity_g"][:], atol=3e-5)
+            np.testing.assert_allclose(dut["accel/reference"][:], truth["gravity_g"][:], atol=3e-5)
 
 
 def test_status_reports_progress(campaign: Path) -> None:
@@ -70,7 +70,7 @@ def test_every_dataset_carries_a_checksum_and_the_file_names_its_journal(campaig
         datasets = []
         f.visititems(lambda name, node: datasets.append(node) if isinstance(node, h5py.Dataset) and node.size > 1 else None)
         assert datasets and all(d.fletcher32 for d in datasets)
-        assert f.attrs["format_version"] == 2 and "fit" not in f
+        assert f.attrs["format_version"] == 3 and "fit" not in f
         assert f.attrs["journal_bytes"] == journal_path(campaign).stat().st_size
         assert f.attrs["campaign_id"] == load_campaign(campaign).header.campaign_id
 

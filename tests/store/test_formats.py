@@ -1,0 +1,63 @@
+"""Campaigns written before parts declared channels (format 2, tests/data/format2: written by an earlier
+accelcal-rig) read as one acceleration channel from their file and from their journal, and `rig repair`
+rewrites them as format 3, value for value."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from accelcal_rig.store.content import measurements_sha256
+from accelcal_rig.store.paths import journal_path
+from accelcal_rig.store.read import load_campaign, read_hdf5_campaign
+from accelcal_rig.store.repair import repair_campaign
+from tests.conftest import REPO
+
+FORMAT_2 = REPO / "tests" / "data" / "format2" / "format2.h5"
+_OLD_NAMES = {"raw_codes": "raw_codes", "mean": "mean_g", "stderr": "stderr_g", "reference": "gravity_reference_g"}
+
+
+@pytest.fixture
+def format2(tmp_path: Path) -> Path:
+    shutil.copy(FORMAT_2, tmp_path / "format2.h5")
+    shutil.copy(journal_path(FORMAT_2), journal_path(tmp_path / "format2.h5"))
+    return tmp_path / "format2.h5"
+
+
+def _datasets_as_written(path: Path) -> tuple[dict[str, dict[str, np.ndarray]], str]:
+    with h5py.File(path, "r") as f:
+        assert f.attrs["format_version"] == 2
+        return ({serial: {name: dut[old][:] for name, old in _OLD_NAMES.items()} for serial, dut in f["duts"].items()},
+                str(f.attrs["measurements_sha256"]))
+
+
+@pytest.mark.parametrize("source", ["journal", "file"])
+def test_a_format_2_campaign_reads_as_one_acceleration_channel(format2: Path, source: str) -> None:
+    written, digest = _datasets_as_written(format2)
+    campaign = load_campaign(format2) if source == "journal" else read_hdf5_campaign(format2)
+    assert campaign.source == source and not campaign.integrity_problems()
+    for serial, old in written.items():
+        (channel,) = campaign.header.dut_channels(serial)
+        assert (channel.name, channel.unit, channel.axes) == ("accel", "g", ("x", "y", "z"))
+        assert channel.lsb == campaign.header.duts[campaign.serials.index(serial)]["lsb_g"]
+        for name, values in old.items():
+            np.testing.assert_array_equal(campaign.channel_column(serial, "accel", name), values)
+    assert measurements_sha256(campaign) == digest  # the digest format 2 wrote still holds
+
+
+def test_rig_repair_rewrites_a_format_2_campaign_as_format_3_value_for_value(format2: Path) -> None:
+    written, digest = _datasets_as_written(format2)
+    repair_campaign(format2)
+    with h5py.File(format2, "r") as f:
+        assert f.attrs["format_version"] == 3 and f.attrs["measurements_sha256"] == digest
+        for serial, old in written.items():
+            accel = f[f"duts/{serial}/accel"]
+            assert accel.attrs["unit"] == "g" and list(accel.attrs["axes"]) == ["x", "y", "z"]
+            assert "raw_codes" not in f[f"duts/{serial}"]
+            for name, values in old.items():
+                np.testing.assert_array_equal(accel[name][:], values)
+    assert not load_campaign(format2).integrity_problems()
