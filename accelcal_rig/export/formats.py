@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -30,11 +31,19 @@ def export(calibration: CalibrationFile, format_name: str, options: StackOptions
     stacks = {"px4-params": to_px4_params, "ardupilot-params": to_ardupilot_params}
     if format_name in stacks:
         exported = stacks[format_name](calibration, options)
-        return Exported(exported.text, f"sensor {exported.serial}", tuple(exported.notes))
+        left = not_exported(calibration, [exported.serial])
+        return Exported(exported.text, f"sensor {exported.serial}", (*exported.notes, *left))
     if (options.serial, options.instance, options.device_id) != (None, None, None):
         raise ConfigError(f"--serial, --instance and --device-id are for px4-params and ardupilot-params, not {format_name}")
     text = {"json": to_json, "csv": to_csv, "c-header": to_c_header}[format_name](calibration)
-    return Exported(text, f"{len(calibration.sensors)} sensors")
+    return Exported(text, f"{len(calibration.sensors)} sensors", tuple(not_exported(calibration, calibration.sensors)))
+
+
+def not_exported(calibration: CalibrationFile, serials: Iterable[str]) -> list[str]:
+    """The channels of these DUTs an export leaves out, each with why: every export holds the accel channel."""
+    uncalibrated = calibration.not_calibrated()
+    return [f"sensor {serial}: its {channel} channel is not in this export: not calibrated ({why})"
+            for serial in serials for channel, why in uncalibrated.get(serial, {}).items()]
 
 
 def write_export(exported: Exported, format_name: str, output: Path | None) -> int:

@@ -1,6 +1,9 @@
-"""The calibration file: per sensor, the thermal polynomials of Eq. 1's parameters and how they were made.
+"""The calibration file: per DUT, one calibration per channel (the thermal polynomials of Eq. 1's parameters
+and how they were made), and the channels it measured that no channel model calibrates yet, each with why.
 
-A versioned YAML artefact, checked on load. `apply` compensates raw readings with it.
+A versioned YAML artefact, checked on load. Version 2 holds `duts: {serial: {channels: {accel: …},
+not_calibrated: {gyro: why}}}`; version 1 (`sensors: {serial: …}`, every DUT an accelerometer) is read as
+version 2 with each calibration its DUT's `accel` channel. `apply` compensates raw readings with it.
 """
 
 from __future__ import annotations
@@ -11,7 +14,7 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 import yaml
-from pydantic import Field, field_validator
+from pydantic import Field, field_validator, model_validator
 
 from accelcal_rig.config.bounds import StrictModel, TemperatureC
 from accelcal_rig.config.load import load_validated
@@ -20,7 +23,10 @@ from accelcal_rig.durable import write_text_atomically
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
 
 FORMAT_NAME = "accelcal-rig calibration"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+READABLE_VERSIONS = (1, 2)
+#: The channel every version-1 calibration is, and the one readers that handle a single channel take.
+ACCELERATION = "accel"
 
 
 class CalibrationRangeWarning(UserWarning):
@@ -96,6 +102,13 @@ class SensorCalibration(StrictModel):
         return np.moveaxis(np.polynomial.polynomial.polyval(x, self.polynomial.matrix().T), 0, -1)
 
 
+class DutCalibration(StrictModel):
+    """One DUT: a calibration per channel a channel model handles, and why each other channel has none."""
+
+    channels: dict[str, SensorCalibration] = Field(min_length=1, max_length=16)
+    not_calibrated: dict[str, Annotated[str, Field(max_length=500)]] = Field({}, max_length=16)
+
+
 class CalibrationFile(StrictModel):
     format: str
     format_version: int
@@ -103,7 +116,18 @@ class CalibrationFile(StrictModel):
     created: str
     software_version: str
     source: dict[str, str]
-    sensors: dict[str, SensorCalibration] = Field(min_length=1, max_length=1024)
+    duts: dict[str, DutCalibration] = Field(min_length=1, max_length=1024)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _version_1(cls, data: Any) -> Any:
+        """A version-1 file's `sensors` are its DUTs' acceleration channels."""
+        if isinstance(data, dict) and data.get("format_version") == 1 and "sensors" in data and "duts" not in data:
+            sensors = data["sensors"]
+            duts = ({serial: {"channels": {ACCELERATION: calibration}} for serial, calibration in sensors.items()}
+                    if isinstance(sensors, dict) else sensors)
+            data = {**{k: v for k, v in data.items() if k != "sensors"}, "duts": duts, "format_version": 2}
+        return data
 
     @field_validator("format")
     @classmethod
@@ -115,15 +139,38 @@ class CalibrationFile(StrictModel):
     @field_validator("format_version")
     @classmethod
     def _version(cls, value: int) -> int:
-        if value != FORMAT_VERSION:
-            raise ValueError(f"calibration format version {value} is not supported (this software reads {FORMAT_VERSION})")
+        if value not in READABLE_VERSIONS:
+            raise ValueError(f"calibration format version {value} is not supported (this software reads "
+                             f"{', '.join(map(str, READABLE_VERSIONS))})")
         return value
 
-    def sensor(self, serial: str) -> SensorCalibration:
-        try:
-            return self.sensors[serial]
-        except KeyError:
-            raise KeyError(f"no calibration for sensor {serial} (file has {', '.join(self.sensors)})") from None
+    @property
+    def sensors(self) -> dict[str, SensorCalibration]:
+        """Each DUT's acceleration calibration by serial, for the readers that handle only that channel."""
+        return {serial: dut.channels[ACCELERATION] for serial, dut in self.duts.items() if ACCELERATION in dut.channels}
+
+    def sensor(self, serial: str, channel: str = ACCELERATION) -> SensorCalibration:
+        """The calibration of one channel of one DUT; KeyError saying what the file has."""
+        if serial not in self.duts:
+            raise KeyError(f"no calibration for sensor {serial} (file has {', '.join(self.duts)})")
+        dut = self.duts[serial]
+        if channel not in dut.channels:
+            why = dut.not_calibrated.get(channel, "the file has none")
+            raise KeyError(f"sensor {serial}: no calibration of its {channel} channel ({why})")
+        return dut.channels[channel]
+
+    def with_sensors(self, sensors: dict[str, SensorCalibration]) -> CalibrationFile:
+        """A copy whose DUTs are `sensors`, each its DUT's acceleration calibration (what the others held
+        beside it kept)."""
+        duts = {serial: (self.duts[serial].model_copy(update={"channels": {**self.duts[serial].channels,
+                                                                           ACCELERATION: calibration}})
+                         if serial in self.duts else DutCalibration(channels={ACCELERATION: calibration}))
+                for serial, calibration in sensors.items()}
+        return self.model_copy(update={"duts": duts})
+
+    def not_calibrated(self) -> dict[str, dict[str, str]]:
+        """Each DUT's channels that no channel model calibrated yet, and why (empty: every channel is)."""
+        return {serial: dict(dut.not_calibrated) for serial, dut in self.duts.items() if dut.not_calibrated}
 
 
 def apply(calibration: SensorCalibration, accel_g: np.ndarray, temperature_c: np.ndarray | float) -> np.ndarray:

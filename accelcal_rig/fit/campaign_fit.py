@@ -21,16 +21,18 @@ from accelcal_rig.fit.budget import (
     temperature_scatter_c,
     truth_coverage,
 )
-from accelcal_rig.fit.calibration import FORMAT_NAME as CALIBRATION_FORMAT
-from accelcal_rig.fit.calibration import FORMAT_VERSION as CALIBRATION_VERSION
 from accelcal_rig.fit.calibration import (
+    ACCELERATION,
     CalibrationFile,
+    DutCalibration,
     PolynomialModel,
     SensorCalibration,
     SetpointFit,
     plain,
     save_calibration,
 )
+from accelcal_rig.fit.calibration import FORMAT_NAME as CALIBRATION_FORMAT
+from accelcal_rig.fit.calibration import FORMAT_VERSION as CALIBRATION_VERSION
 from accelcal_rig.fit.expected import expected_norm_rmse_mg, expected_reference_rmse_mg, thermal_jacobian
 from accelcal_rig.fit.fixture_pool import map_over_duts
 from accelcal_rig.fit.joint import fit_joint
@@ -259,23 +261,38 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     """Fit every DUT of a stored campaign; the calibration file and the report `rig fit --json` prints
     (per serial). Nothing is written: the campaign's measurements are only read. `run_end`: the fit stage of
     the run itself, whose campaign is done but for the fit."""
-    stored = [read_dut_poses(campaign, s) for s in campaign.serials]
+    stored = [read_dut_poses(campaign, s) for s in campaign.serials]  # each DUT's acceleration channel
     if options.hysteresis == "on":
         stored = [with_approach(campaign, poses) for poses in stored]
     results = map_over_duts(bind(fit_dut, options=options), stored)
     limits = recorded_acceptance(campaign.header.procedure_yaml, source.get("campaign", "the campaign"))
     partial = partial_campaign(campaign, run_end)
     judged = {r.serial: judge(r.metrics, r.thermal, options.mode, limits, partial) for r in results}
-    sensors = {r.serial: r.calibration.model_copy(update={"verdict": judged[r.serial].verdict,
-                                                          "verdict_reasons": judged[r.serial].reasons})
-               for r in results}
+    uncalibrated = {serial: not_calibrated(campaign, serial) for serial in campaign.serials}
+    duts = {r.serial: DutCalibration(
+        channels={ACCELERATION: r.calibration.model_copy(update={"verdict": judged[r.serial].verdict,
+                                                                 "verdict_reasons": judged[r.serial].reasons})},
+        not_calibrated=uncalibrated[r.serial]) for r in results}
     calibration = CalibrationFile(
         format=CALIBRATION_FORMAT, format_version=CALIBRATION_VERSION, created=utc_now(),
-        software_version=__version__, source={**source, **({"partial": partial} if partial else {})}, sensors=sensors,
+        software_version=__version__, source={**source, **({"partial": partial} if partial else {})}, duts=duts,
     )
     report = {r.serial: {**plain(r.metrics), "warnings": r.thermal.warnings, "verdict": judged[r.serial].verdict,
-                         "verdict_reasons": judged[r.serial].reasons} for r in results}
+                         "verdict_reasons": judged[r.serial].reasons,
+                         **({"not_calibrated": uncalibrated[r.serial]} if uncalibrated[r.serial] else {})}
+              for r in results}
     return calibration, report
+
+
+#: The quantities a channel model calibrates: Eq. 1 against a reference vector, here gravity.
+CHANNEL_MODELS = {"acceleration": "Eq. 1 sensor-frame error model against gravity"}
+
+
+def not_calibrated(campaign: Campaign, serial: str) -> dict[str, str]:
+    """The DUT's channels that no channel model calibrates yet, each with why (they are measured and stored)."""
+    return {channel.name: f"{channel.quantity} in {channel.unit}: measured and stored; no channel model "
+                          f"calibrates {channel.quantity} yet"
+            for channel in campaign.header.dut_channels(serial) if channel.quantity not in CHANNEL_MODELS}
 
 
 #: Poses each direction of approach needs before the hysteresis term is fitted.
@@ -351,4 +368,6 @@ def summary_line(report: dict[str, Any], calibration_path: Path) -> str:
     failed = [serial for serial, r in report.items() if r.get("verdict") == "FAIL"]
     verdicts = (f"{len(report) - len(failed)} PASS, {len(failed)} FAIL ({', '.join(failed)})" if failed
                 else f"{len(report)} PASS")
-    return f"calibration → {calibration_path}: {figures}, {len(report)} DUTs (worst of each); {verdicts}"
+    uncalibrated = sorted({channel for r in report.values() for channel in r.get("not_calibrated", {})})
+    left = f"; not calibrated (measured and stored): {', '.join(uncalibrated)}" if uncalibrated else ""
+    return f"calibration → {calibration_path}: {figures}, {len(report)} DUTs (worst of each); {verdicts}{left}"

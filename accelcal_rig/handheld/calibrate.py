@@ -12,9 +12,11 @@ from accelcal_rig import __version__
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import (
+    ACCELERATION,
     FORMAT_NAME,
     FORMAT_VERSION,
     CalibrationFile,
+    DutCalibration,
     PolynomialModel,
     SensorCalibration,
     SetpointFit,
@@ -132,7 +134,7 @@ def fit_recording(recording: Recording, detection: Detection, free: FreeParamete
         format=FORMAT_NAME, format_version=FORMAT_VERSION, created=utc_now(), software_version=__version__,
         source={"recording": recording.source, "measurements_sha256": recording.sha256,
                 "procedure": "hand-held recording, norm-only"},
-        sensors={serial: calibration},
+        duts={serial: DutCalibration(channels={ACCELERATION: calibration})},
     )
     report = plain({
         "source": recording.source, "rate_hz": detection.rate_hz, "samples": len(recording.t_s),

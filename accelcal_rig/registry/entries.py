@@ -12,7 +12,13 @@ from pathlib import Path
 from typing import Any
 
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.fit.calibration import CalibrationFile, SensorCalibration, load_calibration
+from accelcal_rig.fit.calibration import (
+    ACCELERATION,
+    FORMAT_VERSION,
+    CalibrationFile,
+    SensorCalibration,
+    load_calibration,
+)
 from accelcal_rig.registry.figures import reference_figures
 from accelcal_rig.store.content import measurements_sha256
 from accelcal_rig.store.read import load_campaign
@@ -67,7 +73,8 @@ def _entry(calibration: CalibrationFile, sensor: SensorCalibration, part: str, s
     verification = sensor.metrics.get("verification") if isinstance(sensor.metrics.get("verification"), dict) else {}
     rmse = verification.get("rmse_mg") if verification else None
     return {
-        "serial": sensor.serial, "part": part, "source_kind": source["kind"], "source_path": source["path"],
+        "serial": sensor.serial, "channel": ACCELERATION, "part": part, "source_kind": source["kind"],
+        "source_path": source["path"],
         "source_sha256": source["sha256"],
         "fit_sha256": hashlib.sha256(json.dumps(stored["sensor"], sort_keys=True).encode()).hexdigest(),
         "procedure": source["procedure"], "rig": source["rig"], "simulated": source["simulated"],
@@ -87,6 +94,9 @@ def _utc(timestamp: str) -> datetime:
 
 
 def calibration_file_of(row: dict[str, Any]) -> CalibrationFile:
-    """A registered calibration as a one-sensor calibration file again (for `rig registry export`)."""
+    """A registered calibration as a one-sensor calibration file again (for `rig registry export`): the
+    channel it is, in the current format whatever format it was fitted in."""
     stored = row["calibration"]
-    return CalibrationFile.model_validate({**stored["file"], "sensors": {row["serial"]: stored["sensor"]}})
+    channels = {row.get("channel") or ACCELERATION: stored["sensor"]}
+    return CalibrationFile.model_validate({**stored["file"], "format_version": FORMAT_VERSION,
+                                           "duts": {row["serial"]: {"channels": channels}}})

@@ -39,6 +39,9 @@ calibrations = sa.Table(
     sa.Column("scale_error_ppm", sa.JSON, nullable=True),                   # [x, y, z]
     sa.Column("scale_uncertainty_ppm", sa.JSON, nullable=True),             # [x, y, z], k = 2
     sa.Column("nonorthogonality_mrad", sa.Float, nullable=True),            # the largest of the three
+    # Added by migration 0003: which channel of its DUT the calibration is.
+    sa.Column("channel", sa.String(16), nullable=False, server_default="accel"),
+    sa.Index("calibrations_serial_channel", "serial", "channel"),
     sa.UniqueConstraint("source_sha256", "serial", "fit_sha256", name="one_calibration_per_fit"),
 )
 

@@ -7,7 +7,7 @@ are too few poses to fit, the report shows what was measured and says why there 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +18,7 @@ from accelcal_rig.config.procedure import SoakCriterion
 from accelcal_rig.config.yaml_lines import parse_yaml_text
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.fit.acceptance import Judgement, judge, recorded_acceptance
-from accelcal_rig.fit.campaign_fit import DutFitResult, FitOptions, fit_dut, partial_campaign
+from accelcal_rig.fit.campaign_fit import DutFitResult, FitOptions, fit_dut, not_calibrated, partial_campaign
 from accelcal_rig.fit.recorded_options import recorded_options
 from accelcal_rig.parts.registry import DEFAULT_PART, known_parts
 from accelcal_rig.store.content import Campaign
@@ -63,6 +63,8 @@ class CampaignData:
     gravity_m_s2: float               # the site's, as the rig config stated it
     acceptance: Acceptance            # the procedure's limits
     zero_g_offset_mg: dict[str, float | None]  # per DUT, its part's data sheet range of the 0 g offset
+    #: Per DUT, the channels it measured that no channel model calibrates yet, each with why.
+    not_calibrated: dict[str, dict[str, str]] = field(default_factory=dict)
 
 
 def read_campaign_data(path: Path) -> CampaignData:
@@ -103,7 +105,8 @@ def read_campaign_data(path: Path) -> CampaignData:
     return CampaignData(path, status, str(attrs.get("procedure_path", "")), str(attrs.get("rig_name", "")), band_c,
                         options, duts, soaks, events, campaign.pose_column("t_start_s"), reason,
                         float(attrs.get("gravity_m_s2", STANDARD_GRAVITY_M_S2)), limits,
-                        {s: _datasheet_offset_mg(campaign, s) for s in campaign.serials})
+                        {s: _datasheet_offset_mg(campaign, s) for s in campaign.serials},
+                        {s: left for s in campaign.serials if (left := not_calibrated(campaign, s))})
 
 
 def _datasheet_offset_mg(campaign: Campaign, serial: str) -> float | None:

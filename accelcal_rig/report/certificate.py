@@ -137,10 +137,13 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
         banners.append("SIMULATED: a dry run against simulated instruments. No physical sensor was calibrated.")
     if calibration.source.get("partial"):
         banners.append(f"PARTIAL: {calibration.source['partial']}.")
+    uncalibrated = calibration.duts[serial].not_calibrated if serial in calibration.duts else {}
+    banners += [f"NOT CALIBRATED: its {channel} channel ({why}). This certificate covers its accel channel only."
+                for channel, why in uncalibrated.items()]
     style = STYLE + (DRY_RUN_PAGES if attrs.get("dry_run") else "")
     parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Calibration certificate {_e(number)}"
              f"</title><style>{style}</style></head><body>",
-             "<h1>Calibration certificate: MEMS accelerometer</h1>",
+             f"<h1>Calibration certificate: MEMS accelerometer{' channel' if uncalibrated else ''}</h1>",
              f"<p>Certificate <b class='number'>{_e(number)}</b> — issued {_e(utc_now())} by accelcal-rig "
              f"{_e(__version__)}</p>",
              *(f"<div class='banner'>{_e(b)}</div>" for b in banners)]

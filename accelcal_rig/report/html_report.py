@@ -169,7 +169,15 @@ def _summary(data: CampaignData) -> list[str]:
             "<p class='note'>In-sample: every calibration pose compensated with the polynomial model at its own "
             "temperature — the fit has seen these poses, so they reach the expected fit RMSE, below the noise "
             "floor (the RMSE the per-pose standard errors alone leave with the true parameters).</p>"]
+    left = sorted({(channel, why) for channels in data.not_calibrated.values() for channel, why in channels.items()})
+    out += [f"<p><b>Not calibrated:</b> the {_e(channel)} channel of {len(_having(data, channel))} DUTs "
+            f"({_e(', '.join(_having(data, channel)))}): {_e(why)}; its raw codes are in the campaign file "
+            f"(duts/&lt;serial&gt;/{_e(channel)}/).</p>" for channel, why in left]
     return out
+
+
+def _having(data: CampaignData, channel: str) -> list[str]:
+    return [serial for serial, channels in data.not_calibrated.items() if channel in channels]
 
 
 def _rmse_table(data: CampaignData) -> str:

@@ -1,7 +1,7 @@
 /*
  * A simulated ADXL355 at register level, for the host build: what the bridge core talks to over
- * the host HAL's "SPI". Its samples follow the real monotonic clock, so the core's draining is
- * tested against time as it passes, as on a board.
+ * the host HAL's "SPI". Its samples follow the HAL's clock (the monotonic clock, or the board clock of
+ * pty_hal.h), so the core's draining is tested against time as it passes, as on a board.
  *
  * What it models (and the numbers a test can rely on):
  *   - identity DEVID_AD 0xAD, DEVID_MST 0x1D, PARTID 0xED, REVID 0x01;

@@ -20,15 +20,19 @@
 #include "pty_hal.h"
 
 static const char usage[] =
-    "usage: bridge-host [--temperature-c DEGC] [--tear-rate SHARE] [--seed N] [--exit-with-stdin]\n"
+    "usage: bridge-host [--temperature-c DEGC] [--tear-rate SHARE] [--seed N] [--clock monotonic|board]\n"
+    "                   [--exit-with-stdin]\n"
     "  --temperature-c  what the simulated part's temperature sensor reads (default 25)\n"
     "  --tear-rate      share 0..1 of TEMP2+TEMP1 reads that tear by 256 LSB (default 0)\n"
     "  --seed           of the simulated noise (default 1)\n"
+    "  --clock          monotonic (default): time as it passes; board: the time a board running only\n"
+    "                   this firmware would see (CPU time, sleeps as asked, stops), for a busy PC (Linux)\n"
     "  --exit-with-stdin  exit when stdin reaches its end\n";
 
 typedef struct {
     model_config model;
     bool exit_with_stdin;
+    bool board_clock;
 } options;
 
 static bool parse_number(const char *text, double low, double high, double *value)
@@ -48,10 +52,15 @@ static bool parse_options(int argc, char **argv, options *parsed)
     parsed->model.tear_rate = 0.0;
     parsed->model.seed = 1u;
     parsed->exit_with_stdin = false;
+    parsed->board_clock = false;
     for (int i = 1; i < argc; ++i) {
         const bool has_value = i + 1 < argc;
         if (strcmp(argv[i], "--exit-with-stdin") == 0) {
             parsed->exit_with_stdin = true;
+        } else if (strcmp(argv[i], "--clock") == 0 && has_value
+                   && (strcmp(argv[i + 1], "monotonic") == 0 || strcmp(argv[i + 1], "board") == 0)) {
+            parsed->board_clock = strcmp(argv[i + 1], "board") == 0;
+            ++i;
         } else if (strcmp(argv[i], "--temperature-c") == 0 && has_value
                    && parse_number(argv[i + 1], -40.0, 125.0, &number)) {
             parsed->model.temperature_c = number;
@@ -77,7 +86,7 @@ static bool wait_for_work(bool watch_stdin)
     struct pollfd watched[2] = {{pty_hal_fd(), POLLIN, 0}, {STDIN_FILENO, POLLIN, 0}};
     const int timeout_ms = pty_hal_pending() ? 0 : bridge_capturing() ? 1 : 50;
 
-    if (poll(watched, watch_stdin ? 2u : 1u, timeout_ms) > 0 && watch_stdin && watched[1].revents != 0) {
+    if (pty_hal_poll(watched, watch_stdin ? 2u : 1u, timeout_ms) > 0 && watch_stdin && watched[1].revents != 0) {
         char discarded[64];
         if (read(STDIN_FILENO, discarded, sizeof discarded) <= 0) {
             return false;
@@ -94,6 +103,9 @@ int main(int argc, char **argv)
     if (!parse_options(argc, argv, &parsed)) {
         fputs(usage, stderr);
         return 2;
+    }
+    if (parsed.board_clock && !pty_hal_use_board_clock()) {
+        return 1;
     }
     if (!pty_hal_open(path, sizeof path)) {
         perror("bridge-host: pseudo-terminal");

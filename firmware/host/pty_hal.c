@@ -6,7 +6,9 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
+#include <signal.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <termios.h>
@@ -24,6 +26,19 @@ static int slave = -1;
 static uint8_t inbox[512];
 static size_t inbox_next;
 static size_t inbox_used;
+
+/* The board clock (pty_hal_use_board_clock): its value at the last mark, and at that mark the monotonic
+ * clock, the thread's CPU time and its run_delay (all in microseconds). */
+static struct {
+    bool on;
+    int schedstat; /* /proc/self/schedstat */
+    uint64_t now_us;
+    uint64_t wall_us;
+    uint64_t cpu_us;
+    uint64_t waited_us;
+} board = {false, -1, 0, 0, 0, 0};
+/* Set by SIGCONT: the process was stopped (a stalled board) since the last mark. */
+static volatile sig_atomic_t continued;
 
 static bool make_raw(int fd)
 {
@@ -84,6 +99,100 @@ int bridge_hal_uart_read(void)
     return inbox[inbox_next++];
 }
 
+static uint64_t clock_us(clockid_t clock)
+{
+    struct timespec now;
+
+    clock_gettime(clock, &now);
+    return (uint64_t)now.tv_sec * 1000000u + (uint64_t)now.tv_nsec / 1000u;
+}
+
+/* The process's run_delay: how long it has waited, runnable, for a CPU. The second of the three numbers
+ * in /proc/<pid>/schedstat (nanoseconds), which is up to date while the process runs; re-read from the
+ * start on every call (the file is made afresh). */
+static bool read_waited_us(uint64_t *waited)
+{
+    char text[128];
+    const ssize_t got = pread(board.schedstat, text, sizeof text - 1u, 0);
+
+    if (got <= 0) {
+        return false;
+    }
+    text[got] = '\0';
+    char *end;
+    char *after;
+    errno = 0;
+    (void)strtoull(text, &end, 10);
+    const unsigned long long run_delay_ns = strtoull(end, &after, 10);
+    if (errno != 0 || after == end) {
+        return false;
+    }
+    *waited = (uint64_t)(run_delay_ns / 1000u);
+    return true;
+}
+
+/* Moves the board clock on to now. The time since the last mark counts as the CPU time used in it, plus
+ * (for a sleep asked to last at most `sleep_limit_us`; none: -1) the time asleep up to that limit, plus
+ * all the time neither running nor waiting for a CPU if the process was stopped meanwhile. */
+static void mark_board_clock(int64_t sleep_limit_us)
+{
+    const uint64_t wall = clock_us(CLOCK_MONOTONIC);
+    const uint64_t cpu = clock_us(CLOCK_THREAD_CPUTIME_ID);
+    uint64_t waited = board.waited_us;
+    (void)read_waited_us(&waited); /* on a failed read, no waiting is seen */
+
+    const uint64_t cpu_used = cpu - board.cpu_us;
+    const uint64_t not_idle = cpu_used + (waited - board.waited_us);
+    const uint64_t idle = wall - board.wall_us > not_idle ? wall - board.wall_us - not_idle : 0u;
+    uint64_t counted = cpu_used;
+    if (continued) {
+        continued = 0;
+        counted += idle;
+    } else if (sleep_limit_us > 0) {
+        counted += idle < (uint64_t)sleep_limit_us ? idle : (uint64_t)sleep_limit_us;
+    }
+    board.now_us += counted;
+    board.wall_us = wall;
+    board.cpu_us = cpu;
+    board.waited_us = waited;
+}
+
+static void on_continue(int signal_number)
+{
+    (void)signal_number;
+    continued = 1;
+}
+
+bool pty_hal_use_board_clock(void)
+{
+    struct sigaction action;
+
+    memset(&action, 0, sizeof action);
+    action.sa_handler = on_continue;
+    sigemptyset(&action.sa_mask);
+    board.schedstat = open("/proc/self/schedstat", O_RDONLY);
+    if (board.schedstat < 0 || !read_waited_us(&board.waited_us) || sigaction(SIGCONT, &action, NULL) != 0) {
+        fputs("bridge-host: --clock board needs a readable /proc/self/schedstat (Linux)\n", stderr);
+        return false;
+    }
+    board.now_us = board.wall_us = clock_us(CLOCK_MONOTONIC);
+    board.cpu_us = clock_us(CLOCK_THREAD_CPUTIME_ID);
+    board.on = true;
+    return true;
+}
+
+int pty_hal_poll(struct pollfd *fds, nfds_t count, int timeout_ms)
+{
+    if (board.on) {
+        mark_board_clock(-1);
+    }
+    const int ready = poll(fds, count, timeout_ms);
+    if (board.on) {
+        mark_board_clock(timeout_ms < 0 ? INT64_MAX : (int64_t)timeout_ms * 1000);
+    }
+    return ready;
+}
+
 void bridge_hal_uart_write(const uint8_t *bytes, size_t len)
 {
     while (len > 0) {
@@ -94,7 +203,7 @@ void bridge_hal_uart_write(const uint8_t *bytes, size_t len)
         } else if (sent < 0 && (errno == EAGAIN || errno == EINTR)) {
             /* The client is not reading fast enough: wait for room, keeping the capture drained. */
             struct pollfd room = {master, POLLOUT, 0};
-            (void)poll(&room, 1, 1);
+            (void)pty_hal_poll(&room, 1, 1);
             bridge_idle();
         } else {
             return; /* the terminal is gone: nobody to tell */
@@ -104,10 +213,11 @@ void bridge_hal_uart_write(const uint8_t *bytes, size_t len)
 
 uint64_t bridge_hal_micros(void)
 {
-    struct timespec now;
-
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    return (uint64_t)now.tv_sec * 1000000u + (uint64_t)now.tv_nsec / 1000u;
+    if (!board.on) {
+        return clock_us(CLOCK_MONOTONIC);
+    }
+    mark_board_clock(-1);
+    return board.now_us;
 }
 
 void bridge_hal_spi_transfer(const uint8_t *out, size_t out_len, uint8_t *in, size_t in_len)

@@ -1,8 +1,10 @@
 /* The bridge HAL on POSIX: the host's end of a pseudo-terminal as the UART, the simulated ADXL355
- * (adxl355_model.h) as the SPI bus, CLOCK_MONOTONIC as the microsecond clock. */
+ * (adxl355_model.h) as the SPI bus, CLOCK_MONOTONIC as the microsecond clock (or the board clock:
+ * see pty_hal_use_board_clock). */
 #ifndef PTY_HAL_H
 #define PTY_HAL_H
 
+#include <poll.h>
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -12,6 +14,19 @@ bool pty_hal_open(char *path, size_t path_size);
 
 /* The descriptor to wait on for bytes from the client. */
 int pty_hal_fd(void);
+
+/* From now on, bridge_hal_micros() (the core's clock, and so the model's) is the board clock: the time
+ * a board running only this firmware would have seen. It moves on by the CPU time the process uses, by
+ * each sleep in pty_hal_poll up to the timeout it asked for, and by the whole time the process was
+ * stopped (SIGSTOP: a stalled board); not by the time it waited for a CPU (Linux's run_delay, from
+ * /proc/self/schedstat), nor by a sleep's overrun (a late timer, a virtual machine's stolen time). On a
+ * busy PC the process can wait longer than the FIFO lasts (8 ms at 4 kHz), and on CLOCK_MONOTONIC the
+ * model would then lose samples no board would lose. It never runs ahead of CLOCK_MONOTONIC.
+ * False (and a message on stderr) if /proc/self/schedstat cannot be read. */
+bool pty_hal_use_board_clock(void);
+
+/* poll(), and on the board clock, a sleep that counts for `timeout_ms` at most. */
+int pty_hal_poll(struct pollfd *fds, nfds_t count, int timeout_ms);
 
 /* True if bytes already read from the descriptor wait for bridge_hal_uart_read(). */
 bool pty_hal_pending(void);

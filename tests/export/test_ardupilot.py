@@ -124,7 +124,7 @@ def test_a_polynomial_above_degree_3_is_refitted_and_how_far_it_strays_is_stated
     quintic = sensor.model_copy(update={"polynomial": sensor.polynomial.model_copy(
         update={"degree": 5, "coefficients": coefficients})})
     path = tmp_path / "quintic.calibration.yaml"
-    save_calibration(calibration.model_copy(update={"sensors": {sensor.serial: quintic}}), path)
+    save_calibration(calibration.with_sensors({sensor.serial: quintic}), path)
     quintic = load_calibration(path).sensor(sensor.serial)
     out, notes = ardupilot_export(capsys, path, tmp_path)  # the file's only sensor: no --serial needed
     params = read_ardupilot_params(out)

@@ -90,8 +90,8 @@ def calibration(fitted_paper_campaign: tuple[Path, Path]) -> CalibrationFile:
 
 @pytest.mark.parametrize("out_of_range", ["clamp", "extrapolate"])
 def test_compiled_header_matches_python_apply(calibration: CalibrationFile, tmp_path: Path, out_of_range: str) -> None:
-    calibration = calibration.model_copy(update={"sensors": {
-        k: s.model_copy(update={"out_of_range": out_of_range}) for k, s in calibration.sensors.items()}})
+    calibration = calibration.with_sensors({
+        k: s.model_copy(update={"out_of_range": out_of_range}) for k, s in calibration.sensors.items()})
     serials, sensor, temperature, reading, codes = inputs(calibration)
     stdin = "".join(f"{s} {float(t)!r} {float(a)!r} {float(b)!r} {float(c)!r} {int(k)}\n"
                     for s, t, (a, b, c), k in zip(sensor, temperature, reading, codes))

@@ -71,10 +71,32 @@ def test_a_file_of_another_version_is_refused_with_its_line(calibration, tmp_pat
     path = tmp_path / "cal.yaml"
     save_calibration(calibration, path)
     data = yaml.safe_load(path.read_text())
-    data["format_version"] = 2
+    data["format_version"] = 3
     path.write_text(yaml.safe_dump(data, sort_keys=False))
-    with pytest.raises(ConfigError, match=r"cal.yaml:\d+: format_version: calibration format version 2 is not supported"):
+    with pytest.raises(ConfigError, match=r"cal.yaml:\d+: format_version: calibration format version 3 is not supported"):
         load_calibration(path)
+
+
+def test_a_version_1_file_reads_as_each_duts_acceleration_channel(calibration, tmp_path: Path) -> None:
+    """Version 1 (before channels): `sensors` by serial, every one an accelerometer."""
+    path = tmp_path / "cal.yaml"
+    save_calibration(calibration, path)
+    data = yaml.safe_load(path.read_text())
+    assert data["format_version"] == 2 and set(data["duts"]["ADX355-A001"]["channels"]) == {"accel"}
+    version_1 = {**{k: v for k, v in data.items() if k != "duts"}, "format_version": 1,
+                 "sensors": {serial: dut["channels"]["accel"] for serial, dut in data["duts"].items()}}
+    path.write_text(yaml.safe_dump(version_1, sort_keys=False))
+    read = load_calibration(path)
+    assert read.sensors == calibration.sensors and read.sensor("ADX355-A001", "accel") == calibration.sensor("ADX355-A001")
+    assert read.not_calibrated() == {}
+
+
+def test_a_channel_no_model_calibrates_is_named_with_why(calibration) -> None:
+    dut = calibration.duts["ADX355-A001"].model_copy(update={"not_calibrated": {"gyro": "angular rate: no model yet"}})
+    with_gyro = calibration.model_copy(update={"duts": {**calibration.duts, "ADX355-A001": dut}})
+    with pytest.raises(KeyError, match=r"ADX355-A001: no calibration of its gyro channel \(angular rate: no model yet\)"):
+        with_gyro.sensor("ADX355-A001", "gyro")
+    assert with_gyro.not_calibrated() == {"ADX355-A001": {"gyro": "angular rate: no model yet"}}
 
 
 def test_unknown_sensor_is_named(calibration) -> None:

@@ -11,6 +11,7 @@ from accelcal_rig.registry.entries import campaign_entries
 from accelcal_rig.registry.figures import reference_figures
 from tests.registry.conftest import synthetic_entries
 
+_ADDED_BY_0003 = ("channel",)
 _ADDED_BY_0002 = ("fitted_at", "reference_c", "bias_mg", "bias_uncertainty_mg", "scale_error_ppm", "scale_uncertainty_ppm",
                   "nonorthogonality_mrad")
 
@@ -20,7 +21,7 @@ def test_a_first_version_database_upgrades_with_its_records_and_their_figures(re
     registry = Registry(_engine_of(registry_url), registry_url)
     registry.upgrade("0001")
     assert registry.revision() == "0001"
-    version_1 = [{k: v for k, v in e.items() if k not in _ADDED_BY_0002}
+    version_1 = [{k: v for k, v in e.items() if k not in _ADDED_BY_0002 + _ADDED_BY_0003}
                  for e in [*campaign_entries(campaign, calibration),
                            *synthetic_entries(campaign_entries(campaign, calibration)[0], 3)]]
     table = sa.Table("calibrations", sa.MetaData(), autoload_with=registry.engine)
@@ -39,6 +40,25 @@ def test_a_first_version_database_upgrades_with_its_records_and_their_figures(re
         assert row["scale_error_ppm"] == pytest.approx(expected["scale_error_ppm"])
         assert row["bias_uncertainty_mg"] == pytest.approx(expected["bias_uncertainty_mg"])
         assert row["fitted_at"] is not None and row["fitted_at"].tzinfo is None
+        assert row["channel"] == "accel"  # every calibration before channels: its DUT's accelerometer
+
+
+def test_a_second_version_database_upgrades_and_its_calibrations_are_acceleration_channels(
+        registry_url: str, quick_campaign) -> None:
+    campaign, calibration = quick_campaign
+    registry = Registry(_engine_of(registry_url), registry_url)
+    registry.upgrade("0002")
+    version_2 = [{k: v for k, v in e.items() if k not in _ADDED_BY_0003} for e in campaign_entries(campaign, calibration)]
+    table = sa.Table("calibrations", sa.MetaData(), autoload_with=registry.engine)
+    assert "channel" not in {c.name for c in table.columns}
+    with registry.engine.begin() as connection:
+        connection.execute(table.insert(), version_2)
+    upgraded = Registry.open(registry_url)
+    assert upgraded.revision() == head_revision() == "0003"
+    rows = [upgraded.calibration(listed["id"]) for listed in upgraded.calibrations()]
+    assert len(rows) == 4 and {row["channel"] for row in rows} == {"accel"}
+    indexes = sa.inspect(upgraded.engine).get_indexes("calibrations")
+    assert any(index["column_names"] == ["serial", "channel"] for index in indexes)
 
 
 def _engine_of(url: str) -> sa.Engine:

@@ -68,7 +68,8 @@ def test_a_calibration_from_before_budgets_is_refused_in_one_line(fitted_paper_c
 
     campaign, calibration = fitted_paper_campaign
     old = yaml.safe_load(calibration.read_text())
-    for sensor in old["sensors"].values():
+    for dut in old["duts"].values():
+        sensor = dut["channels"]["accel"]
         del sensor["metrics"]["uncertainty_budget"], sensor["verdict"]
     (tmp_path / "old.yaml").write_text(yaml.safe_dump(old))
     with pytest.raises(ConfigError, match="has no uncertainty budget or verdict .*: fit it again"):
