@@ -103,12 +103,21 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
     range and data rate among those of every DUT's part."""
     chamber = rig.model.chamber
     acquisition = procedure.model.acquisition
+    ranges = acquisition.ranges()
     for sensor in rig.model.fixture.sensors:
         dut_part = part(sensor.part)
-        for key, problem in (("range_g", dut_part.range_problem("accel", acquisition.range_g)),
-                             ("odr_hz", dut_part.rate_problem(acquisition.odr_hz))):
+        for channel in dut_part.channels:  # every channel of every DUT's part needs its range, and one it has
+            key = acquisition.RANGE_KEYS.get(channel.name, f"range of {channel.name}")
+            if channel.name not in ranges:
+                raise procedure.error(("acquisition", key), f"not set: sensor {sensor.serial} of {rig.path} is an "
+                                                             f"{dut_part.label}, whose {channel.name} channel needs "
+                                                             f"its ± full scale in {channel.unit}")
+            problem = channel.range_problem(ranges[channel.name], dut_part.label)
             if problem:
                 raise procedure.error(("acquisition", key), f"{problem}: sensor {sensor.serial} of {rig.path}")
+        problem = dut_part.rate_problem(acquisition.odr_hz)
+        if problem:
+            raise procedure.error(("acquisition", "odr_hz"), f"{problem}: sensor {sensor.serial} of {rig.path}")
     for index, setpoint in enumerate(procedure.model.setpoints_c):
         if not chamber.min_setpoint_c <= setpoint <= chamber.max_setpoint_c:
             raise procedure.error(

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
@@ -70,10 +70,18 @@ class Acquisition(StrictModel):
     range_g: int = Field(2, ge=1, le=1000, description="± full scale in g, one of every DUT part's ranges")
     odr_hz: float = Field(125.0, gt=0, le=100_000, description="output data rate, one of every DUT part's")
     settle_s: float = Field(5.0, ge=0, le=3600, description="wait after the turntable is in position")
+    range_dps: float | None = Field(None, gt=0, le=100_000, description="± full scale in °/s of every DUT part's "
+                                    "gyroscope, one of its ranges; needed where a part has one")
 
-    def ranges(self) -> dict[str, int]:
-        """The ± full scale asked of each channel, by the channel's name."""
-        return {"accel": self.range_g}
+    def ranges(self) -> dict[str, float]:
+        """The ± full scale asked of each channel, by the channel's name (a gyroscope's only when given)."""
+        ranges: dict[str, float] = {"accel": self.range_g}
+        if self.range_dps is not None:
+            ranges["gyro"] = self.range_dps
+        return ranges
+
+    #: Each channel's key in `acquisition`, as a configuration error names it.
+    RANGE_KEYS: ClassVar[dict[str, str]] = {"accel": "range_g", "gyro": "range_dps"}
 
 
 class FitOptions(StrictModel):

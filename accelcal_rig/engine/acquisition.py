@@ -19,7 +19,7 @@ from accelcal_rig.instruments.interfaces import SampleBlock, Sensor
 
 
 def acquire_together(sensors: Sequence[Sensor], n_samples: int, clock: Clock,
-                     ranges: Mapping[str, int]) -> list[SampleBlock]:
+                     ranges: Mapping[str, float]) -> list[SampleBlock]:
     """One gap-free block of `n_samples` from each sensor, over the same instants, each checked by the
     data watchdog (a transient failure: the caller's retry takes a new block)."""
     capturing = [sensor for sensor in sensors
@@ -33,7 +33,7 @@ def acquire_together(sensors: Sequence[Sensor], n_samples: int, clock: Clock,
     return blocks
 
 
-def check_block(sensor: Sensor, block: SampleBlock, ranges: Mapping[str, int]) -> None:
+def check_block(sensor: Sensor, block: SampleBlock, ranges: Mapping[str, float]) -> None:
     """Watchdog on the data, each channel of the part: an axis whose every sample is the same code has
     stopped (real noise moves it by many LSB at any data rate), and a code at either end of the ADC range is
     saturated."""

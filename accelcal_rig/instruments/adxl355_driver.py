@@ -83,7 +83,7 @@ class Adxl355:
         except WaitTimeout as exc:
             raise InstrumentError(str(exc)) from None
 
-    def configure(self, ranges: Mapping[str, int], odr_hz: float) -> None:
+    def configure(self, ranges: Mapping[str, float], odr_hz: float) -> None:
         """Range and filter, written explicitly; the part takes them only in standby."""
         range_g, range_codes = ranges["accel"], self.part.channel("accel").range_codes
         if not self._bus.read(adxl355.REG_POWER_CTL, 1)[0] & adxl355.POWER_CTL_STANDBY:
@@ -101,7 +101,7 @@ class Adxl355:
     def standby(self) -> None:
         self._bus.write(adxl355.REG_POWER_CTL, adxl355.POWER_CTL_STANDBY)
 
-    def read_settings(self) -> tuple[dict[str, int], float]:
+    def read_settings(self) -> tuple[dict[str, float], float]:
         """(the acceleration's range in g, output data rate in Hz) as the part is configured now."""
         filter_code = self._bus.read(adxl355.REG_FILTER, 1)[0] & 0x0F
         range_code = self._bus.read(adxl355.REG_RANGE, 1)[0] & 0x03

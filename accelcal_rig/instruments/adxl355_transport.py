@@ -17,7 +17,9 @@ The bridge protocol (docs/instruments.md): one ASCII request per line, one reply
 
 A version 2 bridge greets with `capture=<samples>`, its buffer and the largest `count`. At high data rates
 a host behind USB serial cannot drain a 32-sample FIFO in time (at 4 kHz it fills in 8 ms); the bridge's
-firmware can.
+firmware can. A version 3 bridge names the part behind it (`part=<name>`, e.g. `part=icm42688p`): `R` and `W`
+are register-generic (the bridge frames them for its part's SPI), `C` and `G` exist only where it greets with
+`capture=`. A bridge that names no part (versions 1 and 2) has an ADXL355, ADXL357 or ADXL359 behind it.
 """
 
 from __future__ import annotations
@@ -30,6 +32,8 @@ from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.line_port import LinePort
 
 BRIDGE_GREETING = "ADXL355-BRIDGE"
+#: The newest bridge protocol version this driver speaks (1: registers; 2: capture; 3: names its part).
+PROTOCOL_VERSION = 3
 #: Tries of the greeting when a bridge is opened (a board may still be booting, or the line noisy).
 GREETING_ATTEMPTS = 3
 
@@ -81,6 +85,8 @@ class SerialBridge:
         self._line = line
         self.endpoint = endpoint
         self.capture_capacity_samples = 0
+        #: The part the bridge says is behind it (version 3), None where it does not say.
+        self.part_name: str | None = None
 
     @classmethod
     def open(cls, endpoint: str, baudrate: int = 921600, timeout_s: float = 1.0,
@@ -101,7 +107,13 @@ class SerialBridge:
         if not greeting.startswith(BRIDGE_GREETING):
             bridge.close()
             raise InstrumentError(f"sensor bridge (serial {endpoint}): not an ADXL355 bridge (answers {greeting!r})")
+        version = _version(greeting)
+        if version is not None and version > PROTOCOL_VERSION:
+            bridge.close()
+            raise InstrumentError(f"sensor bridge (serial {endpoint}): speaks bridge protocol version {version}, this "
+                                  f"driver 1…{PROTOCOL_VERSION} (answers {greeting!r})")
         bridge.capture_capacity_samples = _capture_capacity(greeting)
+        bridge.part_name = _greeting_value(greeting, "part") if version is not None and version >= 3 else None
         return bridge
 
     def read(self, address: int, count: int) -> bytes:
@@ -195,12 +207,27 @@ def _raw_temperature(hex_digits: str) -> int | None:
     return adxl355.raw_temperature(high, low)
 
 
-def _capture_capacity(greeting: str) -> int:
-    """`ADXL355-BRIDGE 2 capture=4096 …` → 4096; a version 1 bridge captures nothing."""
+def _version(greeting: str) -> int | None:
+    """`ADXL355-BRIDGE 3 …` → 3; None where the greeting gives no version number."""
     words = greeting.split()
-    if len(words) < 3 or not words[1].isdigit() or int(words[1]) < 2 or not words[2].startswith("capture="):
+    return int(words[1]) if len(words) >= 2 and words[1].isdigit() else None
+
+
+def _greeting_value(greeting: str, key: str) -> str | None:
+    """The value of `key=value` among the greeting's words after the version (`capture`, `part`)."""
+    for word in greeting.split()[2:]:
+        name, sep, value = word.partition("=")
+        if sep and name == key:
+            return value
+    return None
+
+
+def _capture_capacity(greeting: str) -> int:
+    """`ADXL355-BRIDGE 2 capture=4096 …` → 4096; a version 1 bridge, or one that does not say, captures nothing."""
+    version = _version(greeting)
+    value = _greeting_value(greeting, "capture")
+    if version is None or version < 2 or value is None:
         return 0
-    value = words[2].removeprefix("capture=")
     return int(value) if value.isdigit() else 0
 
 

@@ -42,7 +42,7 @@ class SensorDelegate:
     def reset(self) -> None:
         self._through(self._sensor.reset)
 
-    def configure(self, ranges: Mapping[str, int], odr_hz: float) -> None:
+    def configure(self, ranges: Mapping[str, float], odr_hz: float) -> None:
         self._through(lambda: self._sensor.configure(ranges, odr_hz))
 
     def start_measurement(self) -> None:
@@ -51,7 +51,7 @@ class SensorDelegate:
     def standby(self) -> None:
         self._through(self._sensor.standby)
 
-    def read_settings(self) -> tuple[dict[str, int], float]:
+    def read_settings(self) -> tuple[dict[str, float], float]:
         return self._through(self._sensor.read_settings)
 
     def read_temperature_c(self) -> float:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -22,6 +23,7 @@ class TemperatureFormat:
     intercept_lsb: float
     slope_lsb_per_c: float
     reference_c: float = 25.0
+    signed: bool = False                       #: two's complement codes (an ICM-42688-P's), else unsigned
 
     def celsius(self, raw: np.ndarray | int) -> np.ndarray | float:
         """Raw reading → °C."""
@@ -30,26 +32,30 @@ class TemperatureFormat:
     def raw(self, temperature_c: np.ndarray | float) -> np.ndarray:
         """°C → what the part reports: rounded and clipped to its code width."""
         raw = self.intercept_lsb + self.slope_lsb_per_c * (np.asarray(temperature_c, dtype=float) - self.reference_c)
-        return np.clip(np.rint(raw), 0, (1 << self.bits) - 1).astype(np.int32)
+        low, high = (-(1 << (self.bits - 1)), (1 << (self.bits - 1)) - 1) if self.signed else (0, (1 << self.bits) - 1)
+        return np.clip(np.rint(raw), low, high).astype(np.int32)
 
 
 @dataclass(frozen=True)
 class Channel:
     """One quantity a part measures on its axes: what acquisition, the store, the fit and the outputs iterate.
-    Ranges are the ± full scale in the channel's unit, as a procedure's acquisition gives them."""
+    Ranges are the ± full scale in the channel's unit, as a procedure's acquisition gives them: whole numbers
+    where the data sheet's are (±2 g, ±2000 °/s), fractions where not (±15.625 °/s); a lookup by 2.0 finds 2."""
 
     name: str                                  #: the key everything downstream uses: "accel", "gyro"
     quantity: str                              #: "acceleration", "angular rate"
     unit: str                                  #: "g", "dps" (°/s)
-    lsb_per_unit: Mapping[int, float]          #: range → nominal sensitivity
-    range_codes: Mapping[int, int]             #: range → the part's register code for it
+    # Keyed by range (a float; tables write whole ranges as ints, and a Mapping's key type is invariant, so the
+    # keys are typed Any: {2: …} and {15.625: …} are both tables of float ranges).
+    lsb_per_unit: Mapping[Any, float]          #: range → nominal sensitivity
+    range_codes: Mapping[Any, int]             #: range → the part's register code for it
     code_bits: int                             #: codes are signed, this wide
     noise_density_micro_per_rthz: float        #: typical, in µ(unit)/√Hz (µg/√Hz, µ°/s/√Hz), most sensitive range
     axes: tuple[str, ...] = ("x", "y", "z")
     zero_offset: float | None = None           #: the data sheet's ± range of the zero offset at 25 °C, in unit
 
     @property
-    def ranges(self) -> tuple[int, ...]:
+    def ranges(self) -> tuple[float, ...]:
         return tuple(sorted(self.lsb_per_unit))
 
     @property
@@ -60,21 +66,21 @@ class Channel:
     def code_max(self) -> int:
         return (1 << (self.code_bits - 1)) - 1
 
-    def lsb(self, range_: int) -> float:
+    def lsb(self, range_: float) -> float:
         """Size of one code in the channel's unit on a range."""
         return 1.0 / self.lsb_per_unit[range_]
 
-    def quantise(self, values: np.ndarray, range_: int) -> np.ndarray:
+    def quantise(self, values: np.ndarray, range_: float) -> np.ndarray:
         """Values in the channel's unit → signed codes as the ADC would output them (rounded, saturating)."""
         codes = np.rint(np.asarray(values, dtype=float) * self.lsb_per_unit[range_])
         return np.clip(codes, self.code_min, self.code_max).astype(np.int32)
 
-    def range_problem(self, range_: int, label: str) -> str | None:
+    def range_problem(self, range_: float, label: str) -> str | None:
         """Why ±`range_` is not a range of this channel of the part `label`; None when it is."""
         if range_ in self.lsb_per_unit:
             return None
         return (f"±{range_:g} {self.unit} is not a range of the {label} "
-                f"(±{'/'.join(map(str, self.ranges))} {self.unit})")
+                f"(±{'/'.join(f'{r:g}' for r in self.ranges)} {self.unit})")
 
 
 @dataclass(frozen=True)
@@ -86,12 +92,17 @@ class Part:
     identity: tuple[int, ...]                  #: identification registers, as its driver reads them
     identity_names: tuple[str, ...]            #: their names in the data sheet, e.g. ("WHO_AM_I",)
     channels: tuple[Channel, ...]              #: what it measures, the first its primary channel
-    output_data_rates_hz: tuple[float, ...]    #: by the part's ODR register code 0, 1, …
+    output_data_rates_hz: tuple[float, ...]    #: by the part's ODR register code 0, 1, … (or `odr_codes`)
     temperature: TemperatureFormat
     source: str                                #: where these facts come from
     #: The driver that speaks it ("module:attribute" of a class built as `Device(transport, serial, clock,
     #: part)`): the device is built from the part, never by a caller naming a part's class.
     device: str = "accelcal_rig.instruments.adxl355_driver:Adxl355"
+    #: Each rate's register code where it is not the rate's index in `output_data_rates_hz`.
+    odr_codes: tuple[int, ...] | None = None
+    #: A dry run's simulated part behind a serial bridge ("module:attribute" of a factory
+    #: `(lab, sensor config, faults) -> served instrument`).
+    simulator: str = "accelcal_rig.sim.adxl355_bridge_server:serve_bridge"
 
     def channel(self, name: str) -> Channel:
         """The channel called `name`; KeyError naming the ones the part has."""
@@ -106,12 +117,18 @@ class Part:
 
     def odr_code(self, odr_hz: float) -> int:
         """The part's code for an output data rate (the nearest one)."""
-        return int(np.argmin(np.abs(np.array(self.output_data_rates_hz) - odr_hz)))
+        index = int(np.argmin(np.abs(np.array(self.output_data_rates_hz) - odr_hz)))
+        return index if self.odr_codes is None else self.odr_codes[index]
+
+    def odr_for_code(self, code: int) -> float | None:
+        """The output data rate of register code `code`; None for a code that is no rate of the part."""
+        codes = self.odr_codes if self.odr_codes is not None else tuple(range(len(self.output_data_rates_hz)))
+        return self.output_data_rates_hz[codes.index(code)] if code in codes else None
 
     def has_rate(self, odr_hz: float) -> bool:
         return any(abs(odr_hz - rate) < 1e-3 for rate in self.output_data_rates_hz)
 
-    def range_problem(self, channel: str, range_: int) -> str | None:
+    def range_problem(self, channel: str, range_: float) -> str | None:
         """Why ±`range_` is not a range of the part's `channel`; None when it is."""
         return self.channel(channel).range_problem(range_, self.label)
 
@@ -126,9 +143,9 @@ class Part:
         """Identification registers as the data sheet names them: "DEVID_AD 0xAD, DEVID_MST 0x1D, …"."""
         return ", ".join(f"{name} 0x{value:02X}" for name, value in zip(self.identity_names, found))
 
-    def describe_ranges(self, ranges: Mapping[str, int]) -> str:
+    def describe_ranges(self, ranges: Mapping[str, float]) -> str:
         """Each channel's range: "±2 g", "±4 g, ±2000 dps"."""
-        return ", ".join(f"±{ranges[c.name]} {c.unit}" for c in self.channels if c.name in ranges)
+        return ", ".join(f"±{ranges[c.name]:g} {c.unit}" for c in self.channels if c.name in ranges)
 
     def wrong_identity(self, found: tuple[int, ...]) -> str | None:
         """Why identification registers `found` are not this part's; None when they are."""

@@ -91,7 +91,7 @@ class SimulatedAccelerometer:
         self._index = index
         self.serial = lab.duts[index].serial
         self.part = lab.duts[index].part
-        self._range_g = self.part.channel("accel").ranges[0]
+        self._range_g: float = self.part.channel("accel").ranges[0]
         self._odr_hz = 125.0
         self._measuring = False
 
@@ -102,7 +102,7 @@ class SimulatedAccelerometer:
         self._measuring = False
         self._range_g, self._odr_hz = self.part.channel("accel").ranges[0], self.part.output_data_rates_hz[0]  # the reset state
 
-    def configure(self, ranges: Mapping[str, int], odr_hz: float) -> None:
+    def configure(self, ranges: Mapping[str, float], odr_hz: float) -> None:
         if self._measuring:
             raise InstrumentError(f"sensor {self.serial}: range and filter can only change in standby")
         self._range_g = ranges["accel"]
@@ -114,7 +114,7 @@ class SimulatedAccelerometer:
     def standby(self) -> None:
         self._measuring = False
 
-    def read_settings(self) -> tuple[dict[str, int], float]:
+    def read_settings(self) -> tuple[dict[str, float], float]:
         return {"accel": self._range_g}, self._odr_hz
 
     def read_temperature_c(self) -> float:

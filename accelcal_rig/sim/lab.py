@@ -21,7 +21,7 @@ from accelcal_rig.parts.part import Part
 from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.sim.moisture import ChamberMoisture
-from accelcal_rig.sim.truth import DutTruth, fixture_parameters_at, truth_for_serial
+from accelcal_rig.sim.truth import DutTruth, fixture_parameters_at, gyro_truth_for_serial, truth_for_serial
 from accelcal_rig.sim.turntable_motion import TurntableMotion
 
 
@@ -33,6 +33,8 @@ class SimulatedDut:
         self.serial = serial
         self.part = dut_part
         self.truth: DutTruth = truth_for_serial(serial)
+        #: A gyroscope's hidden truth, where the part has one (its own seed: the acceleration truth is unchanged).
+        self.gyro_truth: DutTruth | None = gyro_truth_for_serial(serial) if "gyro" in dut_part.channel_names else None
         #: Fixture frame → DUT frame.
         self.fixture_to_dut = fixture_to_dut(mount_euler_deg)
         self.tau_s = tau_s
@@ -70,6 +72,9 @@ class VirtualLab:
         # temperature sensors' noise another, so how often a driver reads temperatures changes no sample.
         self.dut_rngs = [np.random.default_rng([seed, index]) for index in range(len(rig.fixture.sensors))]
         self.temperature_rngs = [np.random.default_rng([seed, index, 1]) for index in range(len(rig.fixture.sensors))]
+        #: A gyroscope's noise its own stream, so a six-axis part's acceleration draws are those of its accelerometer
+        #: alone, and a rig without gyroscopes draws nothing more.
+        self.gyro_rngs = [np.random.default_rng([seed, index, 2]) for index in range(len(rig.fixture.sensors))]
         self.chamber_noise_c = sim.chamber_noise_c
         self.controller_limits_c = sim.controller_limits_c
         self.kinematics = TurntableKinematics(rig.turntable.axes)
@@ -150,7 +155,7 @@ class VirtualLab:
         ×π/2)."""
         return self.noise_density_g_per_rthz[index] * float(np.sqrt(np.pi / 2 * odr_hz / 4))
 
-    def dut_samples(self, index: int, t_start_s: float, n_samples: int, odr_hz: float, range_g: int) -> np.ndarray:
+    def dut_samples(self, index: int, t_start_s: float, n_samples: int, odr_hz: float, range_g: float) -> np.ndarray:
         """`n_samples` codes (n, 3) of DUT `index` from `t_start_s` on, at the DUT's state now (temperature
         and orientation change negligibly within a FIFO's worth); the truth behind them is recorded."""
         dut, instant = self.duts[index], self._instant()
@@ -161,6 +166,27 @@ class VirtualLab:
         raw_g = instant.reading_g[index] + self.unmodelled_g(index, gravity) + noise
         dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, params, gravity, temperature))
         return dut.part.channel("accel").quantise(raw_g, range_g)
+
+    def gyro_noise_dps(self, index: int, odr_hz: float) -> float:
+        """DUT `index`'s gyroscope's per-sample white noise: its part's density × √(ENBW of an ODR/4 low-pass)."""
+        density = 1e-6 * self.duts[index].part.channel("gyro").noise_density_micro_per_rthz
+        return density * float(np.sqrt(np.pi / 2 * odr_hz / 4))
+
+    def true_rate_dps(self, index: int) -> np.ndarray:
+        """The DUT's true angular rate in its own frame: zero, the table at rest (samples are taken at rest)."""
+        return np.zeros(3)
+
+    def dut_gyro_samples(self, index: int, t_start_s: float, n_samples: int, odr_hz: float,
+                         range_dps: float) -> np.ndarray:
+        """`n_samples` gyroscope codes (n, 3) of DUT `index` from `t_start_s` on: its hidden truth at its
+        temperature now applied to the true rate, white noise from its own stream, its part's codes."""
+        dut, instant = self.duts[index], self._instant()
+        if dut.gyro_truth is None:
+            raise ValueError(f"{dut.serial}: the {dut.part.label} has no gyroscope")
+        parameters = dut.gyro_truth.parameters_at(float(instant.temperature_c[index]))
+        reading = distort(self.true_rate_dps(index)[None, :], parameters[None, :])[0]
+        noise = self.gyro_rngs[index].normal(0.0, self.gyro_noise_dps(index, odr_hz), (n_samples, 3))
+        return dut.part.channel("gyro").quantise(reading + noise, range_dps)
 
     def _instant(self) -> _Instant:
         """Every DUT's truth at the clock's time, evaluated for the whole fixture at once: all its sensors are

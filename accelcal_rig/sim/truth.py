@@ -58,3 +58,26 @@ def truth_for_serial(serial: str) -> DutTruth:
     span = curves.max(axis=1) - curves.min(axis=1)
     coefficients = np.column_stack([nominal, shape * (drift / span)[:, None]])
     return DutTruth(serial, coefficients)
+
+
+# A gyroscope's hidden truth: the same twelve-parameter model on angular rate (bias in °/s, scale,
+# non-orthogonality, misalignment), the same smooth cubics over temperature. Magnitudes of a consumer IMU's
+# gyroscope (an ICM-42688-P: zero-rate offset ±0.5 °/s, a few mdps/K): bias within ±0.5 °/s at 25 °C drifting
+# 0.1–0.5 °/s over −40…60 °C, scale within ±0.5 %, axes within a few tenths of a degree.
+_GYRO_HALF_WIDTH = np.repeat([0.5, 0.005, 0.3 * _DEG, 0.3 * _DEG], 3)
+_GYRO_DRIFT_LOW = np.repeat([0.1, 100e-6, 0.005 * _DEG, 0.005 * _DEG], 3)
+_GYRO_DRIFT_HIGH = np.repeat([0.5, 2000e-6, 0.02 * _DEG, 0.02 * _DEG], 3)
+
+
+def gyro_truth_for_serial(serial: str) -> DutTruth:
+    """The deterministic hidden truth of the gyroscope of the DUT with this serial number: its own seed, so
+    an accelerometer's truth (`truth_for_serial`) is the same with or without a gyroscope beside it."""
+    seed = int.from_bytes(hashlib.sha256(f"gyro:{serial}".encode()).digest()[:8], "little")
+    rng = np.random.default_rng(seed)
+    nominal = _NOMINAL_CENTRE + rng.uniform(-1, 1, 12) * _GYRO_HALF_WIDTH
+    drift = rng.uniform(_GYRO_DRIFT_LOW, _GYRO_DRIFT_HIGH) * rng.choice([-1.0, 1.0], 12)
+    shape = np.column_stack([np.ones(12), rng.uniform(-0.4, 0.4, (12, 2))])
+    x = (np.linspace(*DRIFT_RANGE_C, 201) - T_REF_C) / HALF_RANGE_C
+    curves = polynomial.polyval(x, np.column_stack([np.zeros(12), shape]).T)
+    span = curves.max(axis=1) - curves.min(axis=1)
+    return DutTruth(serial, np.column_stack([nominal, shape * (drift / span)[:, None]]))

@@ -1,0 +1,122 @@
+"""A simulated ICM-42688-P at register level (user bank 0): WHO_AM_I, soft reset and RESET_DONE, the two
+CONFIG0 registers, PWR_MGMT0, and data registers that hold the newest sample of both sensors at the output
+data rate on the shared clock, made from the lab's hidden truth of each (DATA_RDY set by a new sample, cleared
+by reading INT_STATUS). Register facts: `instruments/icm42688.py`, shared with the driver.
+
+Simplifications (not claims about the chip): only bank 0 exists; TEMP_DATA reads the DUT's temperature
+whatever the power mode; a sensor off reads DATA_INVALID (-32768) in its data registers; the first sample
+comes one period after PWR_MGMT0 turns the sensors on; both sensors sample at ACCEL_CONFIG0's rate.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from accelcal_rig.instruments import icm42688 as regs
+from accelcal_rig.sim.lab import VirtualLab
+
+_READ_ONLY = frozenset({*range(regs.REG_TEMP_DATA1, regs.REG_INT_STATUS + 1), regs.REG_WHO_AM_I})
+_DATA = range(regs.REG_TEMP_DATA1, regs.REG_GYRO_DATA_Z0 + 1)
+#: Reset values (data sheet register map): both CONFIG0 registers FS_SEL 0, ODR code 6 (1 kHz).
+_CONFIG0_RESET = 0x06
+#: A read exactly at a sample instant sees that sample (in samples: far above the clock's rounding).
+_TICK_EPS = 1e-6
+
+
+class SimulatedIcm42688:
+    """One DUT's ICM-42688-P, fed by the lab's truth of its accelerometer and gyroscope."""
+
+    def __init__(self, lab: VirtualLab, index: int, wrong_who_am_i: bool = False) -> None:
+        self._lab = lab
+        self._index = index
+        self._part = lab.duts[index].part
+        self._who_am_i = (self._part.identity[0] ^ 0x07) if wrong_who_am_i else self._part.identity[0]
+        self.reset()
+
+    def reset(self) -> None:
+        self._regs = bytearray(0x80)
+        self._regs[regs.REG_WHO_AM_I] = self._who_am_i
+        self._regs[regs.REG_GYRO_CONFIG0] = self._regs[regs.REG_ACCEL_CONFIG0] = _CONFIG0_RESET
+        self._regs[regs.REG_INT_STATUS] = regs.INT_STATUS_RESET_DONE
+        self._on_since: float | None = None
+        self._last_tick = 0
+        self._sample = self._invalid()
+
+    def read(self, address: int, count: int) -> bytes:
+        self._check_bank(address)
+        if address + count > len(self._regs):
+            raise ValueError(f"read of {count} from 0x{address:02X} runs past the register map")
+        span = range(address, address + count)
+        if not set(span).isdisjoint(_DATA) or regs.REG_INT_STATUS in span:
+            self._update_data()
+        self._regs[regs.REG_TEMP_DATA1:regs.REG_TEMP_DATA1 + 2] = self._temperature()
+        self._regs[regs.REG_ACCEL_DATA_X1:regs.REG_GYRO_DATA_Z0 + 1] = self._sample[2:]
+        value = bytes(self._regs[address:address + count])
+        if regs.REG_INT_STATUS in span:
+            self._regs[regs.REG_INT_STATUS] = 0  # clear on read
+        return value
+
+    def write(self, address: int, value: int) -> None:
+        self._check_bank(address)
+        if address == regs.REG_DEVICE_CONFIG and value & regs.DEVICE_CONFIG_SOFT_RESET:
+            self.reset()
+            return
+        if address in _READ_ONLY or not 0 <= address < len(self._regs):
+            raise ValueError(f"register 0x{address:02X} is read-only or does not exist")
+        if address in (regs.REG_GYRO_CONFIG0, regs.REG_ACCEL_CONFIG0):
+            fs_sel, odr_code = regs.split_config0(value)
+            if self._part.odr_for_code(odr_code) is None:
+                raise ValueError(f"ODR code {odr_code} is no low-noise rate")
+        self._update_data()
+        was_on = self._measuring
+        self._regs[address] = value
+        if address == regs.REG_PWR_MGMT0 and was_on != self._measuring:
+            self._on_since = self._lab.clock.now() if self._measuring else None
+            self._last_tick = 0
+            self._sample = self._invalid()
+        elif address in (regs.REG_GYRO_CONFIG0, regs.REG_ACCEL_CONFIG0) and self._on_since is not None:
+            self._on_since, self._last_tick = self._lab.clock.now(), 0  # a new rate starts counting afresh
+
+    @property
+    def _measuring(self) -> bool:
+        mode = self._regs[regs.REG_PWR_MGMT0]
+        return (mode & 0x03) == 0x03 and (mode >> 2 & 0x03) == 0x03
+
+    @property
+    def _odr_hz(self) -> float:
+        rate = self._part.odr_for_code(regs.split_config0(self._regs[regs.REG_ACCEL_CONFIG0])[1])
+        assert rate is not None
+        return rate
+
+    def _range(self, channel: str, register: int) -> float:
+        fs_sel = regs.split_config0(self._regs[register])[0]
+        return {code: r for r, code in self._part.channel(channel).range_codes.items()}[fs_sel]
+
+    def _check_bank(self, address: int) -> None:
+        if address != regs.REG_BANK_SEL and self._regs[regs.REG_BANK_SEL] & 0x07:
+            raise ValueError(f"bank {self._regs[regs.REG_BANK_SEL] & 0x07} is not simulated (only bank 0)")
+
+    def _update_data(self) -> None:
+        """The newest sample due by the clock, made when first looked at (a sample nobody reads costs nothing);
+        DATA_RDY set when it is new."""
+        if self._on_since is None:
+            return
+        odr = self._odr_hz
+        tick = math.floor((self._lab.clock.now() - self._on_since) * odr + _TICK_EPS)
+        if tick <= self._last_tick:
+            return
+        self._last_tick = tick
+        t_sample = self._on_since + tick / odr
+        accel = self._lab.dut_samples(self._index, t_sample, 1, odr, self._range("accel", regs.REG_ACCEL_CONFIG0))
+        gyro = self._lab.dut_gyro_samples(self._index, t_sample, 1, odr, self._range("gyro", regs.REG_GYRO_CONFIG0))
+        self._sample = regs.encode_sample(0, accel[0], gyro[0])
+        self._regs[regs.REG_INT_STATUS] |= regs.INT_STATUS_DATA_RDY
+
+    def _temperature(self) -> bytes:
+        return int(self._lab.dut_reading_raw(self._index)).to_bytes(2, "big", signed=True)
+
+    @staticmethod
+    def _invalid() -> bytes:
+        return np.full(7, regs.DATA_INVALID, dtype=">i2").tobytes()

@@ -1,0 +1,129 @@
+"""The simulated ICM-42688-P: its register model against the data sheet's behaviour, its hidden truth for
+both sensors, and the driver through a version 3 serial bridge on a pseudo-terminal."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from accelcal_rig.config.load import load_rig
+from accelcal_rig.core.clock import VirtualClock
+from accelcal_rig.errors import InstrumentError
+from accelcal_rig.fit.sfem import distort
+from accelcal_rig.instruments import icm42688 as regs
+from accelcal_rig.instruments.adxl355_transport import SerialBridge
+from accelcal_rig.instruments.icm42688_driver import Icm42688
+from accelcal_rig.parts.icm42688 import ICM42688P
+from accelcal_rig.sim.icm42688_bridge_server import SimulatedIcm42688Bridge
+from accelcal_rig.sim.icm42688_registers import SimulatedIcm42688
+from accelcal_rig.sim.lab import VirtualLab
+from accelcal_rig.sim.truth import gyro_truth_for_serial, truth_for_serial
+from tests.conftest import REPO, SIM_RIG
+
+SIM_IMU_RIG = REPO / "configs" / "sim-imu.yaml"
+
+
+def imu_lab(seed: int = 5) -> tuple[VirtualLab, VirtualClock]:
+    clock = VirtualClock()
+    return VirtualLab(load_rig(SIM_IMU_RIG).model, clock, seed), clock
+
+
+def test_the_gyro_truth_has_its_own_seed_and_an_adxl_lab_draws_nothing_for_it() -> None:
+    assert not np.allclose(gyro_truth_for_serial("IMU-A001").coefficients, truth_for_serial("IMU-A001").coefficients)
+    np.testing.assert_array_equal(gyro_truth_for_serial("IMU-A001").coefficients,
+                                  gyro_truth_for_serial("IMU-A001").coefficients)
+    adxl_lab = VirtualLab(load_rig(SIM_RIG).model, VirtualClock(), 5)
+    assert all(d.gyro_truth is None for d in adxl_lab.duts)
+    imu, _ = imu_lab()
+    assert all(d.gyro_truth is not None for d in imu.duts)
+
+
+def test_registers_identity_reset_and_config() -> None:
+    lab, clock = imu_lab()
+    device = SimulatedIcm42688(lab, 0)
+    assert device.read(regs.REG_WHO_AM_I, 1) == b"\x47"
+    assert device.read(regs.REG_INT_STATUS, 1)[0] & regs.INT_STATUS_RESET_DONE
+    assert device.read(regs.REG_INT_STATUS, 1)[0] == 0                  # cleared by reading
+    device.write(regs.REG_GYRO_CONFIG0, 0x08)
+    device.write(regs.REG_ACCEL_CONFIG0, 0x68)
+    assert device.read(regs.REG_GYRO_CONFIG0, 2) == b"\x08\x68"
+    with pytest.raises(ValueError, match="read-only"):
+        device.write(regs.REG_WHO_AM_I, 0)
+    with pytest.raises(ValueError, match="no low-noise rate"):
+        device.write(regs.REG_ACCEL_CONFIG0, 0x0C)
+    device.write(regs.REG_DEVICE_CONFIG, regs.DEVICE_CONFIG_SOFT_RESET)
+    assert device.read(regs.REG_GYRO_CONFIG0, 2) == b"\x06\x06"          # reset values
+    assert device.read(regs.REG_INT_STATUS, 1)[0] & regs.INT_STATUS_RESET_DONE
+    device.write(regs.REG_BANK_SEL, 1)
+    with pytest.raises(ValueError, match="only bank 0"):
+        device.read(regs.REG_WHO_AM_I, 1)
+
+
+def test_data_registers_hold_a_new_sample_each_period_with_data_ready() -> None:
+    lab, clock = imu_lab()
+    device = SimulatedIcm42688(lab, 0)
+    device.write(regs.REG_GYRO_CONFIG0, 0x08)      # ±2000 °/s, 100 Hz
+    device.write(regs.REG_ACCEL_CONFIG0, 0x68)     # ±2 g, 100 Hz
+    _, accel, gyro = regs.decode_samples(device.read(regs.REG_TEMP_DATA1, regs.SAMPLE_BYTES))
+    assert np.all(accel == regs.DATA_INVALID) and np.all(gyro == regs.DATA_INVALID)   # off
+    device.write(regs.REG_PWR_MGMT0, regs.PWR_MGMT0_LOW_NOISE)
+    assert not device.read(regs.REG_INT_STATUS, 1)[0] & regs.INT_STATUS_DATA_RDY     # no sample yet
+    clock.sleep(0.01)
+    first = device.read(regs.REG_TEMP_DATA1, regs.SAMPLE_AND_STATUS_BYTES)
+    assert first[-1] & regs.INT_STATUS_DATA_RDY
+    again = device.read(regs.REG_TEMP_DATA1, regs.SAMPLE_AND_STATUS_BYTES)
+    assert again[2:14] == first[2:14] and not again[-1] & regs.INT_STATUS_DATA_RDY   # the same sample
+    clock.sleep(0.01)
+    assert device.read(regs.REG_TEMP_DATA1, regs.SAMPLE_AND_STATUS_BYTES)[-1] & regs.INT_STATUS_DATA_RDY
+
+
+def connected(lab: VirtualLab, clock: VirtualClock, index: int = 0):
+    server = SimulatedIcm42688Bridge(lab, index).start()
+    bridge = SerialBridge.open(server.path)
+    return Icm42688(bridge, lab.duts[index].serial, clock, ICM42688P), bridge, server
+
+
+def test_the_driver_through_a_version_3_bridge_reads_both_sensors_truth() -> None:
+    lab, clock = imu_lab(seed=7)
+    driver, bridge, server = connected(lab, clock)
+    try:
+        assert bridge.part_name == "icm42688p" and bridge.capture_capacity_samples == 0
+        assert ICM42688P.wrong_identity(driver.identify().registers) is None
+        driver.reset()
+        driver.standby()
+        driver.configure({"accel": 2, "gyro": 2000}, 100)
+        driver.start_measurement()
+        assert driver.read_settings() == ({"gyro": 2000, "accel": 2}, 100.0)
+        block = clock.run_concurrently([lambda: driver.acquire(400)])[0]
+    finally:
+        driver.close()
+        server.stop()
+    accel, gyro = block.codes["accel"], block.codes["gyro"]
+    assert accel.shape == gyro.shape == (400, 3)
+    assert block.t_end_s - block.t_start_s == pytest.approx(3.99)
+    assert len({tuple(row) for row in accel}) > 300                  # a new sample each read, not one re-read
+    dut = lab.duts[0]
+    temperature = lab.dut_true_c(0)
+    # The accelerometer sees gravity through its own truth (noise 70 µg/√Hz × √(π/2·25 Hz) ≈ 0.44 mg).
+    expected_g = distort(lab.gravity_in_dut(0), dut.truth.parameters_at(temperature))
+    assert accel.mean(axis=0) / 16384 == pytest.approx(expected_g, abs=3e-4)
+    assert accel.std(axis=0, ddof=1).mean() / 16384 == pytest.approx(70e-6 * np.sqrt(np.pi / 2 * 25), rel=0.25)
+    # The gyroscope at rest reads its hidden bias, in its own range's codes.
+    bias_dps = dut.gyro_truth.parameters_at(temperature)[:3]
+    assert gyro.mean(axis=0) / 16.4 == pytest.approx(bias_dps, abs=0.01)
+    assert np.all(np.abs(bias_dps) < 1.0) and np.any(np.abs(bias_dps) > 0.05)
+    assert block.temperature_c[0] == pytest.approx(temperature, abs=0.2)
+
+
+def test_a_wrong_who_am_i_is_what_the_identity_check_catches() -> None:
+    lab, clock = imu_lab()
+    server = SimulatedIcm42688Bridge(lab, 1, wrong_who_am_i=True).start()
+    bridge = SerialBridge.open(server.path)
+    driver = Icm42688(bridge, "IMU-A002", clock, ICM42688P)
+    try:
+        assert "is not an ICM-42688-P (47)" in ICM42688P.wrong_identity(driver.identify().registers)
+        with pytest.raises(InstrumentError, match="refused: register 0x75 is read-only"):
+            bridge.write(regs.REG_WHO_AM_I, 0)
+    finally:
+        driver.close()
+        server.stop()
