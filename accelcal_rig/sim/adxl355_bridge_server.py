@@ -55,8 +55,14 @@ class SimulatedAdxl355:
         self._capture_end_temperature_raw: int | None = None
 
     @property
-    def _measuring(self) -> bool:
+    def measuring(self) -> bool:
+        """Whether the part measures (POWER_CTL's standby bit clear): what the safe state must leave False."""
         return not self._regs[adxl355.REG_POWER_CTL] & adxl355.POWER_CTL_STANDBY
+
+    @property
+    def lab(self) -> VirtualLab:
+        """The virtual lab behind it (its clock, its truth): for tests and fault injection."""
+        return self._lab
 
     @property
     def _odr_hz(self) -> float:
@@ -97,22 +103,22 @@ class SimulatedAdxl355:
             return
         if address < _READ_ONLY_BELOW or address >= len(self._regs):
             raise ValueError(f"register 0x{address:02X} is read-only or does not exist")
-        if address in (adxl355.REG_RANGE, adxl355.REG_FILTER) and self._measuring:
+        if address in (adxl355.REG_RANGE, adxl355.REG_FILTER) and self.measuring:
             raise ValueError("RANGE and FILTER change only in standby")
         self._fill_fifo()
-        was_measuring = self._measuring
+        was_measuring = self.measuring
         self._regs[address] = value
-        if address == adxl355.REG_POWER_CTL and was_measuring != self._measuring:
+        if address == adxl355.REG_POWER_CTL and was_measuring != self.measuring:
             self._fifo.clear()  # standby resets the FIFO; measuring starts a fresh one
             self._fifo_pending = 0
             self._overflow = False
             self._capture_left = 0
-            self._next_sample_s = self._lab.clock.now() if self._measuring else None
+            self._next_sample_s = self._lab.clock.now() if self.measuring else None
 
     def start_capture(self, n_samples: int) -> int:
         """The bridge empties the FIFO and captures the next `n_samples` itself; returns the raw
         temperature as it starts."""
-        if not self._measuring:
+        if not self.measuring:
             raise ValueError("capture needs the part measuring")
         if not 0 < n_samples <= CAPTURE_CAPACITY_SAMPLES:
             raise ValueError(f"capture count {n_samples} must be 1…{CAPTURE_CAPACITY_SAMPLES}")
@@ -193,6 +199,11 @@ class SimulatedBridgeServer:
         self.device = SimulatedAdxl355(lab, index, wrong_part_id, stuck_after_s, temperature_tear_rate)
         self._server = PtyLineServer(self._handle, b"\n", f"simulated-bridge-{lab.duts[index].serial}", faults)
         self.path = self.endpoint = self._server.path
+
+    @property
+    def version(self) -> int:
+        """The bridge protocol version it speaks."""
+        return self._version
 
     def start(self) -> SimulatedBridgeServer:
         self._server.start()

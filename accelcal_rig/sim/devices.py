@@ -29,6 +29,11 @@ class SimulatedChamber:
     def __init__(self, lab: VirtualLab) -> None:
         self._lab = lab
 
+    @property
+    def lab(self) -> VirtualLab:
+        """The virtual lab behind it (its clock, its truth): for tests and fault injection."""
+        return self._lab
+
     def identify(self) -> str:
         return "simulated thermal chamber"
 
@@ -94,6 +99,11 @@ class SimulatedAccelerometer:
         self._range_g: float = self.part.channel("accel").ranges[0]
         self._odr_hz = 125.0
         self._measuring = False
+
+    @property
+    def measuring(self) -> bool:
+        """Whether it measures (not in standby): what the safe state must leave False."""
+        return self._measuring
 
     def identify(self) -> DeviceIdentity:
         return DeviceIdentity(self.part.identity, 1)

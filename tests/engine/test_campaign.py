@@ -45,7 +45,7 @@ def events(path: Path, kind: str | None = None) -> list[str]:
 
 def assert_safe(instruments, path: Path) -> None:
     assert instruments.chamber.read_setpoint_c() == 23.0
-    assert all(not s._measuring for s in instruments.sensors)
+    assert all(not s.measuring for s in instruments.sensors)
     with h5py.File(path, "r") as f:
         assert f.attrs["state"] == "aborted"
         assert f.attrs["finished"]
@@ -136,7 +136,7 @@ def test_soak_that_never_settles_stores_its_trace_and_aborts(write, workdir: Pat
 
 def test_chamber_alarm_during_the_soak_aborts(write, workdir: Path) -> None:
     def alarm_after_ten_minutes(instruments):
-        lab_clock = instruments.chamber._lab.clock
+        lab_clock = instruments.chamber.lab.clock
         instruments.chamber.alarm_active = lambda: lab_clock.now() > 600
 
     output, instruments, error = run_tiny(write, workdir, alarm_after_ten_minutes)

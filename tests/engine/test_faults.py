@@ -71,7 +71,7 @@ def assert_safe_and_recorded(output: Path, rig: SimulatedRig, error: CampaignAbo
     assert error is not None and reason in str(error)
     assert rig.chamber.last_setpoint_c == 23.0  # what the simulator last heard: the safe setpoint
     assert rig.turntable.last_command == "STOP"
-    assert all(not bridge.device._measuring for bridge in rig.bridges.values())
+    assert all(not bridge.device.measuring for bridge in rig.bridges.values())
     with h5py.File(output, "r") as f:
         assert f.attrs["state"] == "aborted" and reason in f.attrs["abort_reason"]
     assert load_campaign(output).integrity_problems() == []
@@ -114,7 +114,7 @@ def test_a_stop_mid_campaign_leaves_the_simulators_safe(write, workdir: Path, mo
     output, rig, error = run_wired(write, workdir, "rate=0")
     assert error is not None
     assert rig.chamber.last_setpoint_c == 23.0 and rig.turntable.last_command == "STOP"
-    assert all(not bridge.device._measuring for bridge in rig.bridges.values())
+    assert all(not bridge.device.measuring for bridge in rig.bridges.values())
     with h5py.File(output, "r") as f:
         assert f.attrs["state"] == "aborted" and f["poses/step_key"].shape[0] == at_pose
 

@@ -101,7 +101,7 @@ def test_configure_outside_standby_is_refused(sensor) -> None:
 
 def test_the_greeting_says_whether_the_bridge_captures(sensor) -> None:
     driver, server, _, _ = sensor
-    expected = 4096 if server._version >= 2 else 0
+    expected = 4096 if server.version >= 2 else 0
     assert driver.capture_capacity_samples == expected
 
 

@@ -50,7 +50,7 @@ def test_an_undrained_fifo_overflows_keeps_the_newest_and_status_read_clears_the
     assert not status_and_entries(device)[0] & adxl355.STATUS_FIFO_OVR  # cleared by the read above
     codes, _ = adxl355.decode_fifo(device.read(adxl355.REG_FIFO_DATA, 288))
     assert codes.shape == (32, 3)
-    newest = device._lab.duts[0].truth_log[-1]
+    newest = device.lab.duts[0].truth_log[-1]
     assert newest[0] == pytest.approx(68 / ODR_HZ) and newest[2] == 32  # samples 68…99, not 0…31
 
 
@@ -65,12 +65,12 @@ def test_a_capture_delivers_consecutive_samples_in_pieces(part) -> None:
     assert device.fetch_capture(0)[0] == first + second  # asked again: the same samples
     assert (len(first) // 9, len(second) // 9) == (120, 80)
     assert not_yet is None and end_raw is not None  # the end temperature comes with the completing piece
-    true_c = device._lab.dut_true_c(0)
+    true_c = device.lab.dut_true_c(0)
     for raw in (start_raw, end_raw):
         assert float(ADXL355.temperature.celsius(raw)) == pytest.approx(true_c, abs=0.3)
     codes, _ = adxl355.decode_fifo(first + second)
     assert codes.shape == (200, 3) and np.abs(codes).max() < ADXL355.channel("accel").code_max
-    log = [entry for entry in device._lab.duts[0].truth_log if entry[0] >= 50 / ODR_HZ]
+    log = [entry for entry in device.lab.duts[0].truth_log if entry[0] >= 50 / ODR_HZ]
     assert [entry[2] for entry in log] == [120, 80]
     assert log[1][0] == pytest.approx(log[0][1])  # the second piece starts where the first ended
 
