@@ -19,6 +19,7 @@ from pathlib import Path
 from accelcal_rig.registry.database import Registry
 url, entries_file, go = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
 entries = pickle.loads(entries_file.read_bytes())
+print("ready", flush=True)
 deadline = time.monotonic() + 60
 while not go.exists():
     assert time.monotonic() < deadline, "never told to go"
@@ -39,11 +40,12 @@ def test_two_writers_at_once_lose_nothing_and_duplicate_nothing(registry_url: st
         entries_file.write_bytes(pickle.dumps([*synthetic_entries(template, 100, prefix=f"RIG{rig}"), *shared]))
         writers.append(subprocess.Popen([sys.executable, "-c", WRITER, registry_url, str(entries_file), str(go)],
                                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True))
-    time.sleep(1.0)  # both started and waiting
+    for writer in writers:  # both started, their registries open to be, and waiting for the word
+        assert writer.stdout is not None and writer.stdout.readline().strip() == "ready"
     go.touch()
     results = [writer.communicate(timeout=120) for writer in writers]
     assert all(writer.returncode == 0 for writer in writers), [err for _, err in results]
-    counts = [tuple(int(n) for n in out.split()) for out, _ in results]
+    counts = [tuple(int(n) for n in out.split()) for out, _ in results]  # what each printed after "ready"
     assert sum(added for added, _ in counts) == 250 and sum(already for _, already in counts) == 50
     registry = Registry.open(registry_url)
     assert registry.count() == 250

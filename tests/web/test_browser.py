@@ -132,7 +132,7 @@ def test_a_running_campaign_advances_on_the_page_and_a_serial_has_its_history(br
         while not (folder / "live.h5.journal").exists() and time.monotonic() < deadline:
             time.sleep(0.1)
         browser.call("Page.navigate", url=f"{base}/")
-        time.sleep(1.0)
+        _wait_for(browser, "document.readyState === 'complete' && !!document.querySelector('tr[data-name=\"live.h5\"]')")
         browser.evaluate("window.loadedOnce = true")  # gone if the page ever reloads
         seen: list[int] = []
         cell = "document.querySelector('tr[data-name=\"live.h5\"] td[data-field=\"poses\"]')"
@@ -151,7 +151,7 @@ def test_a_running_campaign_advances_on_the_page_and_a_serial_has_its_history(br
         assert requested and all(url.startswith(base) for url in requested), requested  # nothing from elsewhere
         assert not [e for e in browser.events if e["method"] == "Network.loadingFailed"]
         browser.call("Page.navigate", url=f"{base}/registry/serials/ADX355-A001")
-        time.sleep(1.5)
+        _wait_for(browser, "document.readyState === 'complete' && document.querySelectorAll('#history tbody tr').length > 0")
         rows = browser.evaluate("document.querySelectorAll('#history tbody tr').length")
         valid = browser.evaluate("document.getElementById('valid') ? document.getElementById('valid').textContent : ''")
         assert rows == 1 and isinstance(valid, str) and valid.startswith("valid calibration")
@@ -159,3 +159,11 @@ def test_a_running_campaign_advances_on_the_page_and_a_serial_has_its_history(br
         if run.poll() is None:
             run.kill()
         _stop(server)
+
+
+def _wait_for(browser, condition: str, timeout_s: float = 30.0) -> None:
+    """Poll the page until the JavaScript `condition` holds, within a deadline."""
+    deadline = time.monotonic() + timeout_s
+    while browser.evaluate(condition) is not True:
+        assert time.monotonic() < deadline, f"the page never came to: {condition}"
+        time.sleep(0.05)
