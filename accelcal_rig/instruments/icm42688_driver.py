@@ -144,7 +144,10 @@ class Icm42688:
         raw = bytearray()
         t_start = previous = self._clock.now()
         for index in range(n_samples):
-            self._clock.sleep(max(0.0, previous + period - self._clock.now()))
+            # Paced from the block's first read, not from the last one: each read's round trip would
+            # otherwise push the next a little later, until a sample went by unread.
+            due = t_start + index * period if index else previous + period
+            self._clock.sleep(max(0.0, due - self._clock.now()))
             sample = self._fresh_sample(period)
             now = self._clock.now()
             if now - previous > LATE_PERIODS * period:

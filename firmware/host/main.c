@@ -1,6 +1,6 @@
 /*
- * bridge-host: the bridge firmware's core on a PC, in front of a simulated ADXL355, behind a
- * pseudo-terminal. Prints the terminal's path on the first line of stdout, then serves until it is
+ * bridge-host: the bridge firmware's core on a PC, in front of a simulated ADXL355 or ICM-42688-P, behind
+ * a pseudo-terminal. Prints the terminal's path on the first line of stdout, then serves until it is
  * killed (or, with --exit-with-stdin, until its stdin closes: a parent that dies takes it along).
  */
 #define _XOPEN_SOURCE 600
@@ -15,22 +15,27 @@
 #include <unistd.h>
 
 #include "adxl355_model.h"
+#include "icm42688_model.h"
 #include "bridge.h"
 #include "bridge_hal.h"
 #include "pty_hal.h"
 
 static const char usage[] =
-    "usage: bridge-host [--temperature-c DEGC] [--tear-rate SHARE] [--seed N] [--clock monotonic|board]\n"
-    "                   [--exit-with-stdin]\n"
+    "usage: bridge-host [--part adxl355|icm42688p|none] [--temperature-c DEGC] [--tear-rate SHARE] [--seed N]\n"
+    "                   [--clock monotonic|board] [--spi-log FILE] [--exit-with-stdin]\n"
+    "  --part           the simulated part on SPI (default adxl355; none: nothing answers)\n"
     "  --temperature-c  what the simulated part's temperature sensor reads (default 25)\n"
-    "  --tear-rate      share 0..1 of TEMP2+TEMP1 reads that tear by 256 LSB (default 0)\n"
+    "  --tear-rate      share 0..1 of TEMP2+TEMP1 reads that tear by 256 LSB (default 0; adxl355 only)\n"
     "  --seed           of the simulated noise (default 1)\n"
     "  --clock          monotonic (default): time as it passes; board: the time a board running only\n"
     "                   this firmware would see (CPU time, sleeps as asked, stops), for a busy PC (Linux)\n"
+    "  --spi-log        append every SPI transaction to FILE: sent hex, ':', received hex\n"
     "  --exit-with-stdin  exit when stdin reaches its end\n";
 
 typedef struct {
     model_config model;
+    pty_hal_part part;
+    const char *spi_log;
     bool exit_with_stdin;
     bool board_clock;
 } options;
@@ -51,12 +56,24 @@ static bool parse_options(int argc, char **argv, options *parsed)
     parsed->model.temperature_c = 25.0;
     parsed->model.tear_rate = 0.0;
     parsed->model.seed = 1u;
+    parsed->part = PTY_HAL_PART_ADXL355;
+    parsed->spi_log = NULL;
     parsed->exit_with_stdin = false;
     parsed->board_clock = false;
     for (int i = 1; i < argc; ++i) {
         const bool has_value = i + 1 < argc;
         if (strcmp(argv[i], "--exit-with-stdin") == 0) {
             parsed->exit_with_stdin = true;
+        } else if (strcmp(argv[i], "--part") == 0 && has_value
+                   && (strcmp(argv[i + 1], "adxl355") == 0 || strcmp(argv[i + 1], "icm42688p") == 0
+                       || strcmp(argv[i + 1], "none") == 0)) {
+            parsed->part = strcmp(argv[i + 1], "adxl355") == 0     ? PTY_HAL_PART_ADXL355
+                           : strcmp(argv[i + 1], "icm42688p") == 0 ? PTY_HAL_PART_ICM42688P
+                                                                   : PTY_HAL_PART_NONE;
+            ++i;
+        } else if (strcmp(argv[i], "--spi-log") == 0 && has_value) {
+            parsed->spi_log = argv[i + 1];
+            ++i;
         } else if (strcmp(argv[i], "--clock") == 0 && has_value
                    && (strcmp(argv[i + 1], "monotonic") == 0 || strcmp(argv[i + 1], "board") == 0)) {
             parsed->board_clock = strcmp(argv[i + 1], "board") == 0;
@@ -76,7 +93,7 @@ static bool parse_options(int argc, char **argv, options *parsed)
             return false;
         }
     }
-    return true;
+    return parsed->part == PTY_HAL_PART_ADXL355 || parsed->model.tear_rate == 0.0; /* tears: the ADXL355's */
 }
 
 /* Until the next thing to do: bytes from the client, stdin's end, or (while capturing) the next
@@ -111,7 +128,17 @@ int main(int argc, char **argv)
         perror("bridge-host: pseudo-terminal");
         return 1;
     }
-    model_init(&parsed.model, bridge_hal_micros());
+    if (parsed.spi_log != NULL && !pty_hal_log_spi(parsed.spi_log)) {
+        perror("bridge-host: --spi-log");
+        return 1;
+    }
+    pty_hal_use_part(parsed.part);
+    if (parsed.part == PTY_HAL_PART_ICM42688P) {
+        const icm_model_config icm = {parsed.model.temperature_c, parsed.model.seed};
+        icm_model_init(&icm, bridge_hal_micros());
+    } else {
+        model_init(&parsed.model, bridge_hal_micros());
+    }
     bridge_init();
     printf("%s\n", path);
     fflush(stdout);

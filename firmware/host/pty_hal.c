@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "adxl355_model.h"
+#include "icm42688_model.h"
 #include "bridge.h"
 #include "bridge_hal.h"
 
@@ -220,9 +221,51 @@ uint64_t bridge_hal_micros(void)
     return board.now_us;
 }
 
+static pty_hal_part bus_part = PTY_HAL_PART_ADXL355;
+static FILE *spi_log;
+
+void pty_hal_use_part(pty_hal_part part)
+{
+    bus_part = part;
+}
+
+bool pty_hal_log_spi(const char *path)
+{
+    spi_log = fopen(path, "a");
+    return spi_log != NULL;
+}
+
+static void log_bytes(const uint8_t *bytes, size_t len)
+{
+    for (size_t i = 0; i < len; ++i) {
+        fprintf(spi_log, "%02X", bytes[i]);
+    }
+}
+
 void bridge_hal_spi_transfer(const uint8_t *out, size_t out_len, uint8_t *in, size_t in_len)
 {
-    model_spi(out, out_len, in, in_len, bridge_hal_micros());
+    const uint64_t now = bridge_hal_micros();
+
+    switch (bus_part) {
+    case PTY_HAL_PART_ADXL355:
+        model_spi(out, out_len, in, in_len, now);
+        break;
+    case PTY_HAL_PART_ICM42688P:
+        icm_model_spi(out, out_len, in, in_len, now);
+        break;
+    case PTY_HAL_PART_NONE:
+        if (in_len > 0) {
+            memset(in, 0, in_len);
+        }
+        break;
+    }
+    if (spi_log != NULL) {
+        log_bytes(out, out_len);
+        fputc(':', spi_log);
+        log_bytes(in, in_len);
+        fputc('\n', spi_log);
+        fflush(spi_log);
+    }
 }
 
 const char *bridge_hal_board_name(void)

@@ -1,12 +1,27 @@
-/* The bridge HAL on POSIX: the host's end of a pseudo-terminal as the UART, the simulated ADXL355
- * (adxl355_model.h) as the SPI bus, CLOCK_MONOTONIC as the microsecond clock (or the board clock:
- * see pty_hal_use_board_clock). */
+/* The bridge HAL on POSIX: the host's end of a pseudo-terminal as the UART, a simulated part as the SPI
+ * bus (the ADXL355 of adxl355_model.h, the ICM-42688-P of icm42688_model.h, or nothing), CLOCK_MONOTONIC
+ * as the microsecond clock (or the board clock: see pty_hal_use_board_clock). */
 #ifndef PTY_HAL_H
 #define PTY_HAL_H
 
 #include <poll.h>
 #include <stdbool.h>
 #include <stddef.h>
+
+/* What sits on the simulated SPI bus. */
+typedef enum {
+    PTY_HAL_PART_ADXL355,   /* adxl355_model.h (the default) */
+    PTY_HAL_PART_ICM42688P, /* icm42688_model.h */
+    PTY_HAL_PART_NONE       /* nothing: every byte read is 0x00 */
+} pty_hal_part;
+
+/* The part the SPI transfers go to (its model initialised by the caller). */
+void pty_hal_use_part(pty_hal_part part);
+
+/* Appends every SPI transaction to the file at `path`, one line each, flushed: the bytes sent, a colon,
+ * the bytes received, both in upper-case hex (a read of WHO_AM_I: "F5:47"; a write: "4E0F:").
+ * False (errno set) if the file cannot be opened. */
+bool pty_hal_log_spi(const char *path);
 
 /* Opens the pseudo-terminal (both ends raw: no echo, no line editing, no CR/LF translation) and
  * copies the path of the end a serial client opens into `path`. False (errno set) on failure. */

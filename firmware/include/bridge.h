@@ -1,12 +1,13 @@
 /*
- * The ADXL355 serial bridge, protocol version 2: the core's entry points for a board's main loop.
+ * The sensor serial bridge, protocol version 3: the core's entry points for a board's main loop.
  *
  * The protocol (one ASCII request per line, one reply per request, lines end in '\n'):
- *   ?              -> ADXL355-BRIDGE 2 capture=4096 <text>
- *   R <addr> <n>   -> =<2n hex digits>     n registers from addr in one SPI burst
+ *   ?              -> ADXL355-BRIDGE 3 part=<part> [capture=4096] <text>
+ *                     part: adxl355, icm42688p (found on SPI by its identity register), or none
+ *   R <addr> <n>   -> =<2n hex digits>     n registers from addr in one SPI burst, framed for the part
  *   W <addr> <v>   -> =                    one register
- *   C <n>          -> =<TEMP2><TEMP1>      empty the FIFO, capture the next n samples
- *   G <first>      -> =<hex>[T<TEMP2><TEMP1>]  captured samples from index first on
+ *   C <n>          -> =<TEMP2><TEMP1>      empty the FIFO, capture the next n samples (adxl355 only)
+ *   G <first>      -> =<hex>[T<TEMP2><TEMP1>]  captured samples from index first on (adxl355 only)
  *   anything that fails -> !<message>
  * addr and v are hexadecimal, n and first decimal.
  */
@@ -15,8 +16,8 @@
 
 #include <stdbool.h>
 
-#define BRIDGE_PROTOCOL_VERSION 2
-#define BRIDGE_FIRMWARE_VERSION "1.0"
+#define BRIDGE_PROTOCOL_VERSION 3
+#define BRIDGE_FIRMWARE_VERSION "1.1"
 
 /* The capture buffer: 4096 samples of 9 bytes (X, Y, Z FIFO entries of 3 bytes) = 36 kB. */
 #define BRIDGE_CAPTURE_SAMPLES 4096u

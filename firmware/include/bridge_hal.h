@@ -14,12 +14,13 @@
 #include <stdint.h>
 
 /*
- * One SPI transaction with the ADXL355 (SPI mode 0, MSB first): chip select asserted, `out_len`
+ * One SPI transaction with the sensor (SPI mode 0, MSB first): chip select asserted, `out_len`
  * bytes of `out` clocked out (what comes back meanwhile is discarded), then `in_len` bytes clocked
  * in while zeros go out, then chip select released. Either length may be 0 (`in` may then be NULL).
  *
- * Half duplex on purpose: every ADXL355 access is a command byte (and for a write, the value)
- * followed by data read back, so no caller needs the bytes received during the command byte.
+ * Half duplex on purpose: every access to either part the core knows (ADXL355, ICM-42688-P) is a
+ * command byte (and for a write, the value) followed by data read back, so no caller needs the bytes
+ * received during the command byte.
  */
 void bridge_hal_spi_transfer(const uint8_t *out, size_t out_len, uint8_t *in, size_t in_len);
 

@@ -8,6 +8,7 @@
 #include "capture.h"
 #include "commands.h"
 #include "reply.h"
+#include "sensor.h"
 
 /* The longest request is "R 7F 288" or "C 4096"; 40 leaves room for stray spaces. */
 #define REQUEST_MAX 40u
@@ -33,6 +34,7 @@ void bridge_init(void)
 {
     forget_line();
     capture_reset();
+    (void)sensor_detect();
 }
 
 static void answer_line(void)

@@ -1,4 +1,5 @@
-/* The requests ?, R, W, C and G: parsed strictly, answered with exactly one line. */
+/* The requests ?, R, W, C and G: parsed strictly, answered with exactly one line. R and W are framed for
+ * the part found on SPI (sensor.h); C and G exist for a part the bridge captures (the ADXL355). */
 #include "commands.h"
 
 #include <stdbool.h>
@@ -14,16 +15,53 @@
 
 #define MAX_WORDS 3u
 
+/* ADXL355-BRIDGE 3 part=<name>[ capture=4096] <free text>: capture= only where C and G work. The part is
+ * looked for again on every greeting (a sensor powered after the board, or another one plugged in). */
 static void greet(void)
 {
+    if (sensor_detect()) {
+        capture_reset(); /* a capture of another part (or of none) means nothing now */
+    }
+    const sensor_identity part = sensor_part();
+
     reply_text("ADXL355-BRIDGE ");
     reply_decimal(BRIDGE_PROTOCOL_VERSION);
-    reply_text(" capture=");
-    reply_decimal(BRIDGE_CAPTURE_SAMPLES);
+    reply_text(" part=");
+    reply_text(part.name);
+    if (part.captures) {
+        reply_text(" capture=");
+        reply_decimal(BRIDGE_CAPTURE_SAMPLES);
+    }
     reply_text(" accelcal-rig reference firmware " BRIDGE_FIRMWARE_VERSION " (");
     reply_text(bridge_hal_board_name());
     reply_char(')');
     reply_end();
+}
+
+/* R, W, C and G need a part on the bus; false (and the refusal sent) if none answered. */
+static bool part_found(void)
+{
+    if (!sensor_part().found) {
+        reply_error("no sensor on SPI: no ICM-42688-P WHO_AM_I nor ADXL355 DEVID_AD answered (? looks again)");
+        return false;
+    }
+    return true;
+}
+
+/* C and G need a part the bridge captures; false (and the refusal sent) if it does not. */
+static bool part_captures(void)
+{
+    if (!part_found()) {
+        return false;
+    }
+    if (!sensor_part().captures) {
+        reply_char('!');
+        reply_text("capture: not supported for ");
+        reply_text(sensor_part().name);
+        reply_end();
+        return false;
+    }
+    return true;
 }
 
 static bool covers(uint8_t address, uint32_t count, uint8_t reg)
@@ -43,6 +81,9 @@ static void read_registers(const char *address_text, const char *count_text)
     }
     if (!parse_decimal(count_text, BRIDGE_MAX_READ, &count) || count == 0) {
         reply_error("R: count must be decimal 1..288");
+        return;
+    }
+    if (!part_found()) {
         return;
     }
     /* A burst from FIFO_DATA takes samples out of the FIFO: during a capture they belong to it. */
@@ -79,6 +120,9 @@ static void write_register(const char *address_text, const char *value_text)
         reply_error("W: value must be hex 00..FF");
         return;
     }
+    if (!part_found()) {
+        return;
+    }
     if (changes_the_stream(address)) {
         capture_stop("capture stopped: FILTER, FIFO_SAMPLES, RANGE, POWER_CTL or RESET written during it");
     }
@@ -92,6 +136,9 @@ static void start_capture(const char *count_text)
     uint32_t count;
     uint8_t temperature[2];
 
+    if (!part_captures()) {
+        return;
+    }
     if (!parse_decimal(count_text, BRIDGE_CAPTURE_SAMPLES, &count) || count == 0) {
         capture_reset();
         reply_error("capture count must be decimal 1..4096 (capture=4096)");
@@ -126,6 +173,9 @@ static void fetch_capture(const char *first_text)
     uint32_t first;
     capture_view view;
 
+    if (!part_captures()) {
+        return;
+    }
     if (!parse_decimal(first_text, BRIDGE_CAPTURE_SAMPLES, &first)) {
         reply_error("G: first must be decimal 0..4096");
         return;

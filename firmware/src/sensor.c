@@ -1,20 +1,82 @@
-/* The ADXL355's SPI framing and the agreed temperature read. */
+/* The parts the bridge knows, their SPI framing, and the ADXL355's agreed temperature read. */
 #include "sensor.h"
 
 #include "bridge_hal.h"
 
-void sensor_read(uint8_t address, uint8_t *dst, size_t count)
+/*
+ * One part: how a register access is framed (the command byte is (address << shift) | read_flag for a
+ * read, address << shift for a write, then the value), the register and value that identify it, the
+ * bank select register written 0 before probing again (0: the part has no banks), and whether the
+ * bridge captures blocks of it (C and G: the ADXL355's FIFO).
+ */
+typedef struct {
+    sensor_identity identity;
+    uint8_t shift;
+    uint8_t read_flag;
+    uint8_t identity_register;
+    uint8_t identity_value;
+    uint8_t bank_select;
+} sensor_part_entry;
+
+/* Probed in this order (see sensor_detect in sensor.h). */
+static const sensor_part_entry parts[] = {
+    {{"icm42688p", true, false}, 0u, 0x80u, 0x75u, 0x47u, 0x76u}, /* WHO_AM_I; REG_BANK_SEL */
+    {{"adxl355", true, true}, 1u, 0x01u, 0x00u, 0xADu, 0x00u},    /* DEVID_AD */
+};
+#define PART_COUNT (sizeof parts / sizeof parts[0])
+
+static const sensor_identity nothing = {"none", false, false};
+static const sensor_part_entry *found;
+
+static void read_framed(const sensor_part_entry *part, uint8_t address, uint8_t *dst, size_t count)
 {
-    const uint8_t command = (uint8_t)((address << 1) | 1u);
+    const uint8_t command = (uint8_t)((address << part->shift) | part->read_flag);
 
     bridge_hal_spi_transfer(&command, 1, dst, count);
 }
 
-void sensor_write(uint8_t address, uint8_t value)
+static void write_framed(const sensor_part_entry *part, uint8_t address, uint8_t value)
 {
-    const uint8_t frame[2] = {(uint8_t)(address << 1), value};
+    const uint8_t frame[2] = {(uint8_t)(address << part->shift), value};
 
     bridge_hal_spi_transfer(frame, sizeof frame, NULL, 0);
+}
+
+bool sensor_detect(void)
+{
+    const sensor_part_entry *before = found;
+
+    if (before != NULL && before->bank_select != 0u) {
+        write_framed(before, before->bank_select, 0u);
+    }
+    found = NULL;
+    for (size_t i = 0; i < PART_COUNT && found == NULL; ++i) {
+        uint8_t value = 0;
+        read_framed(&parts[i], parts[i].identity_register, &value, 1);
+        if (value == parts[i].identity_value) {
+            found = &parts[i];
+        }
+    }
+    return found != before;
+}
+
+sensor_identity sensor_part(void)
+{
+    return found != NULL ? found->identity : nothing;
+}
+
+void sensor_read(uint8_t address, uint8_t *dst, size_t count)
+{
+    if (found != NULL) {
+        read_framed(found, address, dst, count);
+    }
+}
+
+void sensor_write(uint8_t address, uint8_t value)
+{
+    if (found != NULL) {
+        write_framed(found, address, value);
+    }
 }
 
 /* TEMP2 carries bits 11..8 in its low nibble (the high nibble is reserved), TEMP1 bits 7..0. */

@@ -1,6 +1,7 @@
 /*
- * The ADXL355 over the HAL's SPI: register addresses and bits the core uses, burst reads and writes,
- * and the temperature read that survives TEMP2/TEMP1 tearing.
+ * The part on the HAL's SPI: which one it is (found by its identity register, each part probed in its
+ * own framing), the SPI framing of register reads and writes for that part, and, for the ADXL355, the
+ * registers and bits the capture uses and the temperature read that survives TEMP2/TEMP1 tearing.
  */
 #ifndef SENSOR_H
 #define SENSOR_H
@@ -9,6 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* ADXL355 registers (its capture's). */
 #define SENSOR_REG_STATUS 0x04u
 #define SENSOR_REG_FIFO_ENTRIES 0x05u
 #define SENSOR_REG_TEMP2 0x06u
@@ -18,7 +20,8 @@
 #define SENSOR_REG_RANGE 0x2Cu
 #define SENSOR_REG_POWER_CTL 0x2Du
 #define SENSOR_REG_RESET 0x2Fu
-/* Register addresses are 7 bits: the SPI command byte is the address shifted left once. */
+/* Register addresses are 7 bits for both parts: the ADXL355's command byte is the address shifted
+ * left once, the ICM-42688-P's is the address with bit 7 as the read flag. */
 #define SENSOR_REG_LAST 0x7Fu
 
 #define SENSOR_STATUS_FIFO_OVR 0x04u
@@ -34,15 +37,35 @@
 #define SENSOR_TEMPERATURE_AGREE_LSB 16u
 #define SENSOR_TEMPERATURE_READS 10u
 
-/* `count` registers from `address` in one burst (from FIFO_DATA the part does not auto-increment:
- * the burst drains the FIFO). */
+/* What sensor_detect() found: the part's name as the greeting says it ("adxl355", "icm42688p", or
+ * "none" where no part answered), and whether the bridge captures blocks of it (C and G). */
+typedef struct {
+    const char *name;
+    bool found;
+    bool captures;
+} sensor_identity;
+
+/*
+ * Which part is on the bus: the ICM-42688-P's WHO_AM_I (0x75 = 0x47, read as 0xF5), then the ADXL355's
+ * DEVID_AD (0x00 = 0xAD, read as 0x01). In that order because the ICM probe reaches an ADXL355 as a read
+ * of its register 0x7A, which changes nothing; the ADXL355 probe would reach an ICM-42688-P as a write.
+ * A part found before whose registers are banked (the ICM-42688-P) gets bank 0 selected first, so a
+ * client that left it in another bank does not hide it. True if the part differs from the last found.
+ */
+bool sensor_detect(void);
+
+/* The part found by the last sensor_detect() ("none" before the first). */
+sensor_identity sensor_part(void);
+
+/* `count` registers from `address` in one burst, framed for the part found (from the ADXL355's
+ * FIFO_DATA the part does not auto-increment: the burst drains the FIFO). Only with a part found. */
 void sensor_read(uint8_t address, uint8_t *dst, size_t count);
 
-/* One register. */
+/* One register, framed for the part found. Only with a part found. */
 void sensor_write(uint8_t address, uint8_t value);
 
-/* TEMP2, TEMP1 read until two reads in a row agree within SENSOR_TEMPERATURE_AGREE_LSB; the later
- * read goes to `pair`. False if SENSOR_TEMPERATURE_READS reads never agreed (`pair` untouched). */
+/* ADXL355: TEMP2, TEMP1 read until two reads in a row agree within SENSOR_TEMPERATURE_AGREE_LSB; the
+ * later read goes to `pair`. False if SENSOR_TEMPERATURE_READS reads never agreed (`pair` untouched). */
 bool sensor_agreed_temperature(uint8_t pair[2]);
 
 #endif

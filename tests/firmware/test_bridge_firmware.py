@@ -20,9 +20,8 @@ from __future__ import annotations
 import os
 import re
 import signal
-import subprocess
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,68 +36,12 @@ from accelcal_rig.instruments.adxl355_driver import Adxl355
 from accelcal_rig.instruments.adxl355_transport import CaptureOverflow, SerialBridge
 from accelcal_rig.instruments.line_port import LinePort
 from accelcal_rig.parts.adxl35x import ADXL355
-from tests.conftest import REPO
+from tests.firmware.host_firmware import DEADLINE_S, SEED, Firmware, running, wait_until
 
-FIRMWARE = REPO / "firmware"
 # The C model's facts (firmware/host/adxl355_model.h): what every capture through the firmware must give back.
 GRAVITY_UG = np.array([200_000, -400_000, 894_000])
 NOISE_LSB = {2: 26, 4: 13, 8: 6}  # uniform within ±100 µg, rounded to whole LSB
-SEED = 1
 TEMPERATURE_C = 31.0  # what the tests tell the model its temperature sensor reads
-
-
-def make(target: str, build: Path) -> str:
-    """Run the firmware's Makefile; a failing build fails the test with the compiler's own words."""
-    run = subprocess.run(["make", "-C", str(FIRMWARE), target, f"BUILD={build}"], capture_output=True, text=True)
-    assert run.returncode == 0, f"make {target} failed:\n{run.stdout}\n{run.stderr}"
-    return run.stdout
-
-
-@pytest.fixture(scope="session")
-def bridge_host(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The host build, made once per session in a folder of its own (the source tree stays clean)."""
-    build = tmp_path_factory.mktemp("firmware-build")
-    make("host", build)
-    return build / "host" / "bridge-host"
-
-
-@dataclass
-class Firmware:
-    path: str
-    process: subprocess.Popen[str]
-
-
-#: How long a wait on the firmware may take before the test fails: generous, as a loaded machine is slow.
-DEADLINE_S = 10.0
-
-
-def wait_until(done: Callable[[], bool], what: str, deadline_s: float = DEADLINE_S) -> None:
-    """Poll `done` until it holds; fail naming `what` if it does not within the deadline."""
-    give_up = time.monotonic() + deadline_s
-    while not done():
-        assert time.monotonic() < give_up, f"{what}: not within {deadline_s} s"
-        time.sleep(0.002)
-
-
-@contextmanager
-def running(binary: Path, *options: str, clock: str = "board") -> Iterator[Firmware]:
-    """The host firmware serving its pseudo-terminal, on `clock` (see the module's docstring); it exits when
-    its stdin closes, so a test that dies leaves nothing behind."""
-    process = subprocess.Popen([str(binary), "--exit-with-stdin", "--seed", str(SEED), "--clock", clock, *options],
-                               stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-    try:
-        assert process.stdout is not None
-        path = process.stdout.readline().strip()
-        assert path.startswith("/dev/"), f"the firmware printed no pseudo-terminal path ({path!r})"
-        yield Firmware(path, process)
-    finally:
-        assert process.stdin is not None
-        process.stdin.close()
-        try:
-            process.wait(timeout=5)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait()
 
 
 @dataclass
@@ -174,10 +117,13 @@ def first_sample_index(codes: np.ndarray, range_g: int, search: int = 200_000) -
     raise AssertionError("the block is not the model's samples in unbroken order (a gap, a repeat or a corrupt byte)")
 
 
-def test_the_greeting_names_protocol_2_and_its_4096_sample_buffer(line: LinePort, sensor: Opened) -> None:
-    """The driver decides by the greeting whether the bridge captures, and how much at once."""
-    assert re.fullmatch(r"ADXL355-BRIDGE 2 capture=4096 .+", line.ask("?"))
+def test_the_greeting_names_protocol_3_its_part_and_its_4096_sample_buffer(line: LinePort, sensor: Opened) -> None:
+    """The driver decides by the greeting whether the bridge captures, and how much at once; version 3 also
+    names the part the firmware found on SPI (by DEVID_AD, for an ADXL355)."""
+    assert re.fullmatch(r"ADXL355-BRIDGE 3 part=adxl355 capture=4096 accelcal-rig reference firmware .+ \(host\)",
+                        line.ask("?"))
     assert sensor.driver.capture_capacity_samples == 4096
+    assert sensor.bridge.part_name == "adxl355"
 
 
 def test_identity_reset_and_register_round_trips(sensor: Opened) -> None:
@@ -198,7 +144,7 @@ def test_identity_reset_and_register_round_trips(sensor: Opened) -> None:
 @pytest.mark.parametrize(("range_g", "odr_hz", "n_samples"), [(2, 1000.0, 400), (8, 4000.0, 4096)],
                          ids=["400-at-1kHz", "whole-buffer-at-4kHz"])
 def test_captures_are_the_models_samples_unbroken(sensor: Opened, range_g: int, odr_hz: float, n_samples: int) -> None:
-    """A version 2 capture through the firmware: every sample the model made, in order, none lost or repeated,
+    """A capture through the firmware: every sample the model made, in order, none lost or repeated,
     decoding to the model's gravity vector, with the model's temperature at both ends. At 4 kHz the FIFO
     lasts 8 ms, so for the whole buffer (a second) the core must drain it in time at every turn, and between
     the chunks of its replies, or the capture overflows (three times, and the driver raises). Time is the
@@ -299,7 +245,7 @@ def test_a_line_left_unfinished_does_not_spoil_the_next_request(bridge_host: Pat
         time.sleep(1.1)  # the partial line's age under test
         port = LinePort.open(firmware.path, "bridge", 921600, 1.0)
         try:
-            assert port.ask("?").startswith("ADXL355-BRIDGE 2 ")
+            assert port.ask("?").startswith("ADXL355-BRIDGE 3 part=adxl355 ")
             assert port.ask("R 00 1\x00 4") == "!request has bytes that are not printable ASCII"
         finally:
             port.close()

@@ -166,7 +166,8 @@ def test_acquire_reads_one_burst_per_sample_at_the_rate_and_rereads_a_stale_one(
     ])
     block = driver.acquire(3)
     assert bus.done
-    assert bus.at[3:] == pytest.approx([0.0, 0.01, 0.02, 0.02125, 0.03125])
+    # Paced from the block's first read (0.01): the third is due at 0.03, not a period after the re-read.
+    assert bus.at[3:] == pytest.approx([0.0, 0.01, 0.02, 0.02125, 0.03])
     assert block.codes["accel"].tolist() == [[10, -20, 16380], [12, -22, 16382], [13, -23, 16383]]
     assert block.codes["gyro"].tolist() == [[1, -1, 2], [2, -2, 3], [2, -2, 4]]
     assert block.codes["accel"].dtype == np.int32

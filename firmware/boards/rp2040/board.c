@@ -1,6 +1,8 @@
 /*
- * The bridge HAL on an RP2040 with the pico-sdk: SPI0 to the ADXL355, USB CDC (the SDK's stdio) to
- * the host, time_us_64() as the clock. Wiring (Raspberry Pi Pico pin numbers in brackets):
+ * The bridge HAL on an RP2040 with the pico-sdk: SPI0 to the sensor (an ADXL355 or an ICM-42688-P: the
+ * core finds which, and frames its accesses for it), USB CDC (the SDK's stdio) to the host, time_us_64()
+ * as the clock. Wiring for the ADXL355 (an ICM-42688-P's SPI pins go to the same GPIOs) (Raspberry Pi
+ * Pico pin numbers in brackets):
  *   GP16 (21) SPI0 RX  <- ADXL355 MISO      GP18 (24) SPI0 SCK -> ADXL355 SCLK
  *   GP17 (22) CS, a plain GPIO -> ADXL355 CS   GP19 (25) SPI0 TX  -> ADXL355 MOSI
  *   3V3 (36) -> VDDIO and VSUPPLY, GND -> GND (the ADXL355 takes 2.25..3.6 V, no 5 V).
