@@ -30,6 +30,8 @@ from typing import Any, Protocol, runtime_checkable
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.line_port import LinePort
+from accelcal_rig.parts.adxl35x import ADXL355
+from accelcal_rig.parts.part import SpiFraming
 
 BRIDGE_GREETING = "ADXL355-BRIDGE"
 #: The newest bridge protocol version this driver speaks (1: registers; 2: capture; 3: names its part).
@@ -232,17 +234,20 @@ def _capture_capacity(greeting: str) -> int:
 
 
 class SpidevBus:
-    """Linux spidev (optional extra `spidev`): mode 0; command byte (addr << 1) | 1 reads, addr << 1 writes.
-    The host is on the SPI bus itself and drains the FIFO in time: no capture of its own."""
+    """Linux spidev (optional extra `spidev`): mode 0, the command byte framed as the part says (an ADXL355:
+    (addr << 1) | 1 reads, addr << 1 writes; an ICM-42688-P: addr | 0x80 reads, addr writes). The host is on
+    the SPI bus itself and reads in time: no capture of its own."""
 
     capture_capacity_samples = 0
 
-    def __init__(self, device: Any, endpoint: str) -> None:
+    def __init__(self, device: Any, endpoint: str, framing: SpiFraming = ADXL355.spi) -> None:
         self._device = device  # a spidev.SpiDev (untyped)
         self.endpoint = endpoint
+        self._framing = framing
 
     @classmethod
-    def open(cls, bus: int, chip_select: int, speed_hz: int = 5_000_000) -> SpidevBus:
+    def open(cls, bus: int, chip_select: int, speed_hz: int = 5_000_000,
+             framing: SpiFraming = ADXL355.spi) -> SpidevBus:
         try:
             import spidev  # type: ignore[import-not-found]
         except ImportError:
@@ -254,13 +259,13 @@ class SpidevBus:
             raise InstrumentError(f"sensor (spidev {bus}.{chip_select}): cannot open: {exc}") from None
         device.mode = 0
         device.max_speed_hz = speed_hz
-        return cls(device, f"spidev {bus}.{chip_select}")
+        return cls(device, f"spidev {bus}.{chip_select}", framing)
 
     def read(self, address: int, count: int) -> bytes:
-        return bytes(self._device.xfer2([(address << 1) | 1] + [0] * count)[1:])
+        return bytes(self._device.xfer2([self._framing.read_command(address)] + [0] * count)[1:])
 
     def write(self, address: int, value: int) -> None:
-        self._device.xfer2([address << 1, value])
+        self._device.xfer2([self._framing.write_command(address), value])
 
     def close(self) -> None:
         self._device.close()

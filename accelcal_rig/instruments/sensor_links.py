@@ -7,13 +7,11 @@ from accelcal_rig.core.clock import Clock
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.instruments.adxl355_transport import RegisterTransport, SerialBridge, SpidevBus
 from accelcal_rig.instruments.definitions import SensorDriver
-from accelcal_rig.parts.adxl35x import ADXL355
 from accelcal_rig.parts.registry import part
 
 #: The simulated part the DUT's `part:` names (its part's `simulator`), behind a bridge.
 _BRIDGE_SIMULATOR = "accelcal_rig.sim.sensor_bridges:serve_part_bridge"
 _PROTOCOL = "accelcal_rig.instruments.adxl355_transport"
-_ADXL35X_DEVICE = ADXL355.device  # the driver of the parts whose SPI framing SpidevBus speaks
 
 
 def _open_bridge(sensor: SensorConfig, endpoint: str, attempts: int, clock: Clock) -> RegisterTransport:
@@ -21,13 +19,10 @@ def _open_bridge(sensor: SensorConfig, endpoint: str, attempts: int, clock: Cloc
 
 
 def _open_spidev(sensor: SensorConfig, endpoint: str, attempts: int, clock: Clock) -> RegisterTransport:
-    if part(sensor.part).device != _ADXL35X_DEVICE:  # SpidevBus frames commands as an ADXL35x wants them
-        raise InstrumentError(f"sensor {sensor.serial} (spidev {endpoint}): spidev speaks the ADXL355's SPI framing; "
-                              f"the {part(sensor.part).label} is reached through a serial bridge for now")
     bus, _, chip_select = endpoint.partition(".")
     if not (bus.isdigit() and chip_select.isdigit()):
         raise InstrumentError(f"sensor {sensor.serial} (spidev {endpoint}): endpoint is not bus.chip_select")
-    return SpidevBus.open(int(bus), int(chip_select), sensor.spi_speed_hz)
+    return SpidevBus.open(int(bus), int(chip_select), sensor.spi_speed_hz, part(sensor.part).spi)
 
 
 SERIAL_BRIDGE = SensorDriver("serial-bridge", _open_bridge, simulator=_BRIDGE_SIMULATOR, protocol=_PROTOCOL)

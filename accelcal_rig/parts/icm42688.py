@@ -8,7 +8,7 @@ sensitivities per range, temperature formula); the Linux IIO driver drivers/iio/
 
 from __future__ import annotations
 
-from accelcal_rig.parts.part import Channel, Part, TemperatureFormat
+from accelcal_rig.parts.part import Channel, Part, SpiFraming, TemperatureFormat
 
 #: Output data rates in low-noise mode (both sensors), in Hz, and their ACCEL_CONFIG0/GYRO_CONFIG0 ODR codes
 #: (bits 3:0). 6.25, 3.125 and 1.5625 Hz (codes 12–14) are the accelerometer's low-power mode only: not listed.
@@ -42,4 +42,5 @@ ICM42688P = Part(
     source="ICM-42688-P data sheet DS-000347; Linux IIO inv_icm42600 driver",
     device="accelcal_rig.instruments.icm42688_driver:Icm42688",
     simulator="accelcal_rig.sim.icm42688_bridge_server:serve_bridge",
+    spi=SpiFraming(address_shift=0, read_bit=0x80),  # bit 7 set reads (docs/instruments.md, TDK ICM-42688-P)
 )

@@ -84,6 +84,21 @@ class Channel:
 
 
 @dataclass(frozen=True)
+class SpiFraming:
+    """How the part's SPI command byte carries a register address and the read bit (mode 0, the address
+    first, then the data): an ADXL355 reads with (address << 1) | 1; an ICM-42688-P with address | 0x80."""
+
+    address_shift: int
+    read_bit: int
+
+    def read_command(self, address: int) -> int:
+        return (address << self.address_shift) | self.read_bit
+
+    def write_command(self, address: int) -> int:
+        return address << self.address_shift
+
+
+@dataclass(frozen=True)
 class Part:
     """One part's facts."""
 
@@ -103,6 +118,8 @@ class Part:
     #: A dry run's simulated part behind a serial bridge ("module:attribute" of a factory
     #: `(lab, sensor config, faults) -> served instrument`).
     simulator: str = "accelcal_rig.sim.adxl355_bridge_server:serve_bridge"
+    #: Its SPI command framing, for a host on the bus itself (spidev); the ADXL35x's by default.
+    spi: SpiFraming = SpiFraming(address_shift=1, read_bit=0x01)
 
     def channel(self, name: str) -> Channel:
         """The channel called `name`; KeyError naming the ones the part has."""

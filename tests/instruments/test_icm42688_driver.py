@@ -208,10 +208,23 @@ def test_invalid_data_in_a_block_is_a_fault() -> None:
         driver.acquire(1)
 
 
-def test_spidev_refuses_a_part_of_another_spi_framing() -> None:
-    from accelcal_rig.config.rig import SensorConfig
-    from accelcal_rig.instruments.sensor_links import SPIDEV
+def test_over_spidev_the_command_byte_is_framed_as_the_icm42688p_wants() -> None:
+    """Mode 0 SPI, bit 7 set to read (WHO_AM_I 0x75 → 0xF5), clear to write (PWR_MGMT0 0x4E → 0x4E): the
+    framing is the part's, not the ADXL355's (address << 1 | 1)."""
+    from accelcal_rig.instruments.adxl355_transport import SpidevBus
+    from accelcal_rig.parts.icm42688 import ICM42688P
 
-    sensor = SensorConfig(serial="IMU-A001", part="icm42688p", driver="spidev", endpoint="0.1")
-    with pytest.raises(InstrumentError, match="the ICM-42688-P is reached through a serial bridge for now"):
-        SPIDEV.open(sensor, "0.1", 1, VirtualClock())
+    sent: list[list[int]] = []
+
+    class Spi:
+        def xfer2(self, data: list[int]) -> list[int]:
+            sent.append(list(data))
+            return [0, 0x47] if data[0] == 0xF5 else [0] * len(data)
+
+        def close(self) -> None:
+            pass
+
+    bus = SpidevBus(Spi(), "spidev 0.1", ICM42688P.spi)
+    assert bus.read(0x75, 1) == bytes([0x47])
+    bus.write(0x4E, 0x0F)
+    assert sent == [[0xF5, 0x00], [0x4E, 0x0F]]
