@@ -142,7 +142,7 @@ def test_a_device_that_never_ends_its_line_is_cut_off_at_the_timeout() -> None:
         started = time.monotonic()
         with pytest.raises(InstrumentError, match="no reply within the timeout"):
             driver.identify()
-        assert time.monotonic() - started < 1.0
+        assert time.monotonic() - started < 10.0  # gave up (0.3 s), not read for ever; a busy machine's margin
     finally:
         stop.set()
         writer.join(2)
