@@ -1,4 +1,8 @@
-"""`rig`: the command line. Every failure a user can cause is one line on stderr and a non-zero exit."""
+"""`rig`: the command line. Every failure a user can cause is one line on stderr and a non-zero exit.
+
+Each command parses (the grammar: cli_parser), calls one function and prints what it returns, formatted beside
+what it formats (status_text, cli_format_*); the work of a command lives below it (cli_campaign,
+cli_recording, cli_serve, cli_registry, cli_analyze, the assembly, the engine)."""
 
 from __future__ import annotations
 
@@ -8,104 +12,31 @@ import logging
 import os
 import signal
 import sys
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from accelcal_rig.cli_parser import build_parser
-from accelcal_rig.core.formatting import format_duration
-from accelcal_rig.core.logger import LOGGER
-from accelcal_rig.core.signals import TerminationRequested, stop_when_safe
-from accelcal_rig.core.units import gravity_statement
+from accelcal_rig.core.signals import TerminationRequested
 from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
 
 if TYPE_CHECKING:
     from accelcal_rig.engine.preparation import PreparedCampaign
-    from accelcal_rig.engine.progress import ProgressListener
     from accelcal_rig.engine.session import NothingToResume, RunResult
-    from accelcal_rig.fit.calibration import CalibrationFile
 
 EXIT_INTERRUPTED = 130
 #: A failure the program did not foresee (a bug): one line, and this code.
 EXIT_INTERNAL = 70
 #: `--fail-on-reject`: the campaign and the fit went through, and at least one DUT failed its limits.
 EXIT_REJECTED = 3
-@contextmanager
-def _campaign_logging(output: Path, verbose: bool, quiet: bool, append: bool,
-                      real_clock: bool) -> Iterator[ProgressListener]:
-    """Console on stderr at the chosen level (a live status line on a terminal, timestamped lines
-    otherwise), the full debug log with progress lines in a file beside the campaign file (appended to by
-    a resumed run); yields the progress listener. Everything is detached and closed when the run ends."""
-    from accelcal_rig.report.live import LogFileHandler, ProgressLines, StatusLine, TerminalHandler, listeners
-    from accelcal_rig.store.paths import log_path
-
-    status = StatusLine(sys.stderr, real_clock) if sys.stderr.isatty() and not quiet else None
-    console: logging.Handler
-    if status is not None:
-        console = TerminalHandler(status)
-        console.setFormatter(logging.Formatter("%(message)s"))
-    else:
-        console = logging.StreamHandler(sys.stderr)
-        console.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s", "%Y-%m-%d %H:%M:%S"))
-    console.setLevel(logging.DEBUG if verbose else logging.WARNING if quiet else logging.INFO)
-    try:
-        log_file = LogFileHandler(str(log_path(output)), mode="a" if append else "w")
-    except OSError as exc:
-        raise ConfigError(f"{log_path(output)}: cannot write the campaign's log: {exc.strerror}") from None
-    log_file.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s"))
-    LOGGER.setLevel(logging.DEBUG)
-    propagate, LOGGER.propagate = LOGGER.propagate, False
-    for handler in (console, log_file):
-        LOGGER.addHandler(handler)
-    lines = ProgressLines(real_clock)
-    try:
-        yield listeners(lines, status) if status is not None else lines
-    finally:
-        if status is not None:
-            status.close()
-        for handler in (console, log_file):
-            LOGGER.removeHandler(handler)
-            handler.close()
-        LOGGER.propagate = propagate
-
-
-class _StopOnFirstSignal:
-    """SIGINT or SIGTERM stops the campaign through its safe state; later signals must not cut that short."""
-
-    def __init__(self) -> None:
-        self.stopping = False
-
-    def __call__(self, signum: int, frame: object) -> None:
-        if self.stopping:
-            LOGGER.warning("%s ignored: already stopping, the rig is being made safe", signal.Signals(signum).name)
-            return
-        self.stopping = True
-        stop_when_safe(KeyboardInterrupt() if signum == signal.SIGINT else TerminationRequested())
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from accelcal_rig.engine.preparation import prepare
-    from accelcal_rig.store.paths import journal_path
+    from accelcal_rig.cli_campaign import prepare_run
 
-    if args.output.is_dir():
-        raise ConfigError(f"{args.output}: is a folder; name the campaign file to write")
-    if args.chamber_profile and not args.dry_run:
-        raise ConfigError("--chamber-profile swaps in a simulated chamber: only with --dry-run")
-    exists = args.output.exists() or journal_path(args.output).exists()
-    profile = args.chamber_profile
-    if args.resume and exists and profile is None:  # continue with the chamber the campaign was started with
-        from accelcal_rig.store.read import load_campaign
-
-        profile = str(load_campaign(args.output).attrs.get("chamber_profile", "")) or None
-    prepared = prepare(args.procedure, args.config, args.faults, profile)
-    if exists and not (args.overwrite or args.resume):
-        raise ConfigError(f"{args.output}: campaign file exists; continue it with --resume, or choose another -o "
-                          "or pass --overwrite")
-    if not args.output.parent.is_dir():
-        raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
+    prepared, resume = prepare_run(args)
     return _execute(prepared, args.output, args, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite,
-                    resume=args.resume and exists)
+                    resume=resume)
 
 
 def _cmd_plan(args: argparse.Namespace) -> int:
@@ -123,67 +54,44 @@ def _cmd_plan(args: argparse.Namespace) -> int:
 
 
 def _cmd_resume(args: argparse.Namespace) -> int:
-    from accelcal_rig.engine.preparation import prepare
-    from accelcal_rig.store.read import load_campaign
+    from accelcal_rig.cli_campaign import prepare_resume
 
-    stored = load_campaign(args.campaign)
-    procedure = args.procedure or Path(str(stored.attrs.get("procedure_path", "")))
-    if not procedure.is_file():
-        raise ConfigError(f"{args.campaign}: its procedure {procedure} is gone; pass --procedure with the same "
-                          "procedure")
-    prepared = prepare(procedure, args.config, args.faults, str(stored.attrs.get("chamber_profile", "")) or None)
-    return _execute(prepared, args.campaign, args, dry_run=bool(stored.attrs.get("dry_run", False)),
-                    seed=int(stored.attrs.get("seed", 0)), overwrite=False, resume=True)
-
-
-def _check_free_space(prepared: PreparedCampaign, output: Path, dry_run: bool, overwrite: bool) -> None:
-    """Refuse to start a campaign the disk cannot hold (with a margin), before anything is touched."""
-    from accelcal_rig.durable import free_bytes
-    from accelcal_rig.store.paths import journal_path
-    from accelcal_rig.store.space import START_MARGIN, megabytes
-
-    estimate = prepared.storage(dry_run)
-    replaced = sum(p.stat().st_size for p in (output, journal_path(output)) if overwrite and p.is_file())
-    free = free_bytes(output.parent) + replaced
-    needed = int(START_MARGIN * estimate.need_bytes)
-    if free < needed:
-        raise ConfigError(f"{output}: {megabytes(free)} free on {output.parent.resolve()}, the campaign needs about "
-                          f"{megabytes(needed)} ({START_MARGIN:g} × its estimated {megabytes(estimate.need_bytes)}): "
-                          "free some space or choose another -o")
+    prepared, dry_run, seed = prepare_resume(args)
+    return _execute(prepared, args.campaign, args, dry_run=dry_run, seed=seed, overwrite=False, resume=True)
 
 
 def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace, *, dry_run: bool, seed: int,
              overwrite: bool, resume: bool) -> int:
-    """Run or resume under the CLI's signal handling and logging; print the summary. The campaign is
-    locked before anything of it changes, the log included."""
+    """Run or resume under the CLI's signal handling and logging, the campaign locked before anything of it
+    changes (the log included); print the summary."""
     from accelcal_rig.assembly import run_campaign
+    from accelcal_rig.cli_campaign import calibration_path, campaign_session, stop_on_first_signal
     from accelcal_rig.engine.session import NothingToResume
-    from accelcal_rig.store.lock import campaign_lock
 
-    calibration = args.calibration or output.with_suffix(".calibration.yaml")
-    if not calibration.parent.is_dir():
-        raise ConfigError(f"{calibration}: folder {calibration.parent} does not exist")
-    stop = _StopOnFirstSignal()
-    previous = {signum: signal.signal(signum, stop) for signum in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        with campaign_lock(output, "rig resume" if resume else "rig run"):
-            if not resume:
-                _check_free_space(prepared, output, dry_run, overwrite)
-            with _campaign_logging(output, args.verbose, args.quiet, append=resume, real_clock=not dry_run) as progress:
+    calibration = calibration_path(args.calibration, output)
+    with stop_on_first_signal():
+        try:
+            with campaign_session(prepared, output, verbose=args.verbose, quiet=args.quiet, dry_run=dry_run,
+                                  overwrite=overwrite, resume=resume) as progress:
                 result = run_campaign(prepared, output, dry_run=dry_run, seed=seed, overwrite=overwrite,
                                       calibration=calibration, resume=resume, progress=progress)
-    except NothingToResume as done:
-        print(done)
-        return _complete_campaign_verdicts(done, output, calibration, args)
-    finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+        except NothingToResume as done:
+            print(done)
+            return _complete_campaign_verdicts(done, output, calibration, args)
+    return _after_campaign(prepared, result, output, calibration, args, dry_run)
+
+
+def _after_campaign(prepared: PreparedCampaign, result: RunResult, output: Path, calibration: Path,
+                    args: argparse.Namespace, dry_run: bool) -> int:
+    """The summary; after a fit, the certificates and the registry. A signal now only cuts the printing short."""
+    from accelcal_rig.cli_registry import campaign_entries, rig_registry
+
     try:
         code = _print_summary(prepared, result, dry_run, args.fail_on_reject)
         if result.summary.fit and not result.summary.fit_failed:
             code = max(code, _certify_after_run(output, calibration, args))
-            _record(args.registry, _rig_registry(prepared.rig.model.registry, prepared.rig.path), output,
-                    lambda: _campaign_entries(output, calibration))
+            _record(args.registry, rig_registry(prepared.rig.model.registry, prepared.rig.path), output,
+                    lambda: campaign_entries(output, calibration))
         return code
     except (KeyboardInterrupt, TerminationRequested):
         print(f"rig: interrupted after the campaign ended ({result.summary.state}); {result.output} holds all of it",
@@ -192,53 +100,40 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
 
 
 def _print_summary(prepared: PreparedCampaign, result: RunResult, dry_run: bool, fail_on_reject: bool) -> int:
+    from accelcal_rig.cli_format_campaign import run_summary_lines
+
     summary = result.summary
-    setpoints = summary.setpoints_c
-    size_mb = result.output.stat().st_size / 1e6 if result.output.is_file() else 0.0
-    print(f"campaign {summary.state}: {prepared.procedure.model.name}")
-    print(f"  setpoints  {len(setpoints)} ({min(setpoints):g} … {max(setpoints):g} °C)")
-    print(f"  poses      {summary.poses_done} of {summary.poses_total} × {summary.n_duts} DUTs × "
-          f"{prepared.procedure.model.acquisition.samples_per_pose} samples")
-    print(f"  duration   {format_duration(summary.virtual_duration_s)} {'virtual' if dry_run else 'clock'}, "
-          f"{result.wall_s:.1f} s wall")
-    print(f"  output     {result.output} ({size_mb:.1f} MB)")
+    print("\n".join(run_summary_lines(prepared, result, dry_run)))
     if summary.fit_failed:
         print(f"rig: campaign done but the fit failed: {_one_line(Exception(summary.fit))}", file=sys.stderr)
         return 1
-    print(f"  fit        {summary.fit or 'none (the procedure measures only: fit.mode none)'}")
-    if summary.fit:
-        print(f"  gravity    {gravity_statement(prepared.rig.model.gravity_m_s2)}")
-    for warning in summary.fit_warnings:
-        print(f"  warning    {warning}")
-    for serial, (verdict, reasons) in summary.verdicts.items():
-        print(f"  verdict    {serial} {verdict}" + (f": {'; '.join(reasons)}" if verdict == "FAIL" else ""))
     if result.problems:
         print(f"rig: error: campaign done, but {result.problems[0]}", file=sys.stderr)
         return 1
     return _rejected_exit(summary.rejected, fail_on_reject)
 
 
-def _campaign_entries(campaign: Path, calibration: Path) -> list:
-    from accelcal_rig.registry.entries import campaign_entries
+def _complete_campaign_verdicts(done: NothingToResume, output: Path, calibration: Path,
+                                args: argparse.Namespace) -> int:
+    """A complete campaign resumed: the verdicts of the fit this resume did (and its certificates and
+    warnings), else those of its calibration file; `--fail-on-reject` either way."""
+    from accelcal_rig.cli_format_campaign import verdict_lines, warning_lines
+    from accelcal_rig.fit.campaign_file import calibration_verdicts
 
-    return campaign_entries(campaign, calibration)
-
-
-def _rig_registry(value: str | None, rig_path: Path) -> str | None:
-    from accelcal_rig.registry.location import configured
-
-    return configured(value, rig_path)
-
-
-def _stored_rig_registry(campaign: Path) -> str | None:
-    """The `registry:` of the rig config a campaign was run with (as it stored it)."""
-    import yaml
-
-    from accelcal_rig.store.read import load_campaign
-
-    stored = load_campaign(campaign)
-    value = (yaml.safe_load(stored.header.rig_yaml) or {}).get("registry")
-    return _rig_registry(value, Path(str(stored.attrs.get("rig_path", campaign)))) if value else None
+    code = 0
+    fit = done.fit
+    if fit is not None:
+        verdicts = fit.verdicts
+        for line in warning_lines(fit.warnings):
+            print(line)
+        code = _certify_after_run(output, calibration, args)
+    else:
+        judged = calibration_verdicts(output, calibration)["verdicts"] or {}
+        verdicts = {serial: (str(v["verdict"]), tuple(v["reasons"])) for serial, v in judged.items()}
+    for line in verdict_lines(verdicts):
+        print(line)
+    rejected = [serial for serial, (verdict, _) in verdicts.items() if verdict == "FAIL"]
+    return max(code, _rejected_exit(rejected, args.fail_on_reject))
 
 
 def _record(flag: str | None, configured: str | None, source: Path, entries: Callable[[], list],
@@ -267,29 +162,27 @@ def _rejected_exit(rejected: list[str], fail_on_reject: bool) -> int:
 
 
 def _cmd_status(args: argparse.Namespace) -> int:
-    from accelcal_rig.fit.campaign_file import calibration_verdicts
-    from accelcal_rig.status_text import status_lines, watch_header
-    from accelcal_rig.store.read import campaign_status
+    from accelcal_rig.cli_campaign import campaign_status
+    from accelcal_rig.status_text import status_lines
 
-    def current() -> dict:
-        return {**campaign_status(args.campaign), **calibration_verdicts(args.campaign, args.calibration)}
+    if args.watch:
+        return _watch_status(args)
+    status = campaign_status(args.campaign, args.calibration)
+    print(json.dumps(status) if args.json else "\n".join(status_lines(status)))
+    return 0
 
-    if args.json and not args.watch:
-        print(json.dumps(current()))
-        return 0
-    if not args.watch:
-        print("\n".join(status_lines(current())))
-        return 0
+
+def _watch_status(args: argparse.Namespace) -> int:
+    """`rig status --watch`: again every so many seconds, until the campaign ends or Ctrl-C."""
     import time
+
+    from accelcal_rig.cli_campaign import campaign_status
+    from accelcal_rig.status_text import watch_text
 
     try:
         while True:
-            status = current()
-            if args.json:
-                print(json.dumps(status), flush=True)
-            else:
-                clear = "\x1b[H\x1b[2J" if sys.stdout.isatty() else ""
-                print(clear + "\n".join(status_lines(status)) + f"\n({watch_header(status, args.watch)})", flush=True)
+            status = campaign_status(args.campaign, args.calibration)
+            print(json.dumps(status) if args.json else watch_text(status, args.watch, sys.stdout.isatty()), flush=True)
             if status["state"] not in ("created", "running"):
                 return 0
             time.sleep(args.watch)
@@ -307,6 +200,7 @@ def _cmd_repair(args: argparse.Namespace) -> int:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from accelcal_rig.assembly import connected
+    from accelcal_rig.cli_format_campaign import check_closing_line
     from accelcal_rig.config.load import load_rig, load_rig_for_check, with_faults
     from accelcal_rig.engine.check import check_lines
 
@@ -315,116 +209,53 @@ def _cmd_check(args: argparse.Namespace) -> int:
     with connected(rig, dry_run=args.dry_run, only=only) as instruments:
         for line in check_lines(instruments, rig.model):
             print(line, flush=True)
-    if args.only:
-        print(f"rig {rig.model.name}: the {' and '.join(sorted(only))} answered as configured (only those checked)")
-    else:
-        print(f"rig {rig.model.name}: every instrument answered as configured")
+    print(check_closing_line(rig.model.name, only if args.only else None))
     return 0
 
 
 def _cmd_sim(args: argparse.Namespace) -> int:
-    import threading
-
     from accelcal_rig.assembly import served_rig
+    from accelcal_rig.cli_campaign import until_signalled
     from accelcal_rig.config.load import load_rig, with_chamber_profile, with_faults
     from accelcal_rig.core.clock import RealClock
 
     rig = with_chamber_profile(with_faults(load_rig(args.rig), args.faults), args.chamber_profile)
-    stop = threading.Event()
-    previous = {signum: signal.signal(signum, lambda *_: stop.set()) for signum in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        with served_rig(rig.model, RealClock(), args.seed) as simulated:
-            print(json.dumps(simulated.describe()), flush=True)
-            while not stop.wait(0.5):
-                pass
-    finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+    with until_signalled() as stop, served_rig(rig.model, RealClock(), args.seed) as simulated:
+        print(json.dumps(simulated.describe()), flush=True)
+        while not stop.wait(0.5):
+            pass
     print("rig sim: stopped", file=sys.stderr)
     return 0
 
 
 def _cmd_fit(args: argparse.Namespace) -> int:
+    from accelcal_rig.cli_format_fit import fit_lines
+    from accelcal_rig.cli_registry import campaign_entries, stored_rig_registry
     from accelcal_rig.fit.campaign_file import fit_campaign_file
-    from accelcal_rig.fit.campaign_fit import summary_line
 
     outcome = fit_campaign_file(args.campaign, args.output, mode=args.mode, degree=args.degree, free=args.parameters,
                                 out_of_range=args.out_of_range, temperature_model=args.temperature_model)
     for warning in outcome.warnings:
         print(f"rig: warning: {warning}", file=sys.stderr)
-    if args.json:
-        print(json.dumps(outcome.report))
-    else:
-        _print_fit_table(outcome.report)
-        print(summary_line(outcome.report, args.output))
-        print(f"gravity: {gravity_statement(next(iter(outcome.report.values()))['gravity_m_s2'])}")
-    _record(args.registry, _stored_rig_registry(args.campaign), args.campaign,
-            lambda: _campaign_entries(args.campaign, args.output), args.json)
+    print(json.dumps(outcome.report) if args.json else "\n".join(fit_lines(outcome.report, args.output)))
+    _record(args.registry, stored_rig_registry(args.campaign), args.campaign,
+            lambda: campaign_entries(args.campaign, args.output), args.json)
     rejected = [serial for serial, r in outcome.report.items() if r["verdict"] == "FAIL"]
     return _rejected_exit(rejected, args.fail_on_reject)
 
 
 def _cmd_fit_recording(args: argparse.Namespace) -> int:
-    from accelcal_rig.fit.calibration import save_calibration
-    from accelcal_rig.handheld.calibrate import fit_recording
-    from accelcal_rig.handheld.recording import CsvLayout, read_campaign_recording, read_csv_recording
-    from accelcal_rig.handheld.static_intervals import DetectorSettings, detect_static_intervals
+    from accelcal_rig.cli_format_fit import recording_lines
+    from accelcal_rig.cli_recording import calibrate_recording
+    from accelcal_rig.cli_registry import recording_entries
 
-    if not args.recording.exists():
-        raise ConfigError(f"{args.recording}: no such file")
-    if not args.output.parent.is_dir():
-        raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
-    if args.output.is_dir():
-        raise ConfigError(f"{args.output}: is a folder; name the calibration file to write")
-    settings = DetectorSettings(args.window_s, args.init_s, args.threshold_factor, args.min_interval_s)
-    if args.recording.suffix in (".h5", ".hdf5"):
-        recording = read_campaign_recording(args.recording, args.serial, args.setpoint)
-        serial = recording.serial or args.recording.stem
-    else:
-        layout = CsvLayout.parse_columns(args.columns, time_unit=args.time_unit, rate_hz=args.rate_hz,
-                                         units=args.units, counts_per_g=args.counts_per_g, zero_code=args.zero_code)
-        recording = read_csv_recording(args.recording, layout)
-        serial = args.serial or args.recording.stem
-    detection = detect_static_intervals(recording.t_s, recording.accel_g, recording.temperature_c, settings,
-                                        recording.source)
-    gravity = args.gravity_m_s2 if args.gravity_m_s2 is not None else recording.gravity_m_s2
-    result = fit_recording(recording, detection, args.parameters, serial, args.temperature_c, gravity)
-    save_calibration(result.calibration, args.output)
-    record = lambda: _recording_entries(args.recording, result.calibration, args.part)  # noqa: E731
-    if args.json:
-        print(json.dumps(result.report))
-        _record(args.registry, None, args.recording, record, json_output=True,
-                later="run this rig fit-recording again once the registry is reachable")
-        return 0
-    report = result.report
-    print(f"{len(report['intervals'])} static intervals in {recording.source} ({report['samples']} samples at "
-          f"{report['rate_hz']:.4g} Hz; threshold {report['threshold_g2']:.3g} g², {args.threshold_factor:g} × the "
-          f"first {args.init_s:g} s)")
-    print(f"{'#':>3s} {'start s':>9s} {'end s':>9s} {'samples':>8s} {'mean x, y, z (g)':>29s} {'|g|−1 before':>13s} "
-          f"{'after (mg)':>11s}")
-    for k, interval in enumerate(report["intervals"], start=1):
-        mean = " ".join(f"{v:+9.5f}" for v in interval["mean_g"])
-        print(f"{k:3d} {interval['start_s']:9.2f} {interval['end_s']:9.2f} {interval['samples']:8d} {mean:>29s} "
-              f"{interval['norm_before_mg']:13.3f} {interval['norm_after_mg']:11.4f}")
-    for warning in report["warnings"]:
-        print(f"warning: {warning}")
-    chi2 = "n/a (no degrees of freedom left)" if report["chi2_reduced_before"] is None else (
-        f"{report['chi2_reduced_before']:.2f}" + (f" → {report['chi2_reduced']:.2f} with a scatter floor of "
-                                                   f"{report['scatter_floor_mg']:.4f} mg" if report["scatter_floor_mg"]
-                                                   else ""))
-    print(f"calibration → {args.output}: norm-only, {args.parameters} parameters, |g| RMSE "
-          f"{report['rmse_before_mg']:.3f} → {report['rmse_after_mg']:.4f} mg (noise floor "
-          f"{report['noise_floor_mg']:.4f} mg) at {report['temperature_c']:.1f} °C; χ²_red {chi2}; outputs in "
-          f"{report['units']}")
-    _record(args.registry, None, args.recording, record,
-            later="run this rig fit-recording again once the registry is reachable")
+    recording, result = calibrate_recording(args)
+    print(json.dumps(result.report) if args.json else "\n".join(recording_lines(
+        result.report, recording.source, threshold_factor=args.threshold_factor, init_s=args.init_s,
+        output=args.output, parameters=args.parameters)))
+    _record(args.registry, None, args.recording, lambda: recording_entries(args.recording, result.calibration, args.part),
+            json_output=args.json, later="run this rig fit-recording again once the registry is reachable")
     return 0
-
-
-def _recording_entries(recording: Path, calibration: CalibrationFile, part: str) -> list:
-    from accelcal_rig.registry.entries import recording_entries
-
-    return recording_entries(recording, calibration, part)
 
 
 def _cmd_completion(args: argparse.Namespace) -> int:
@@ -435,65 +266,11 @@ def _cmd_completion(args: argparse.Namespace) -> int:
 
 
 def _cmd_serve(args: argparse.Namespace) -> int:
-    import ipaddress
-    import socket
+    from accelcal_rig.cli_serve import open_dashboard
 
-    from accelcal_rig.registry.location import configured, registry_url
-
-    try:
-        import uvicorn
-
-        from accelcal_rig.web.app import create_app
-    except ModuleNotFoundError as exc:
-        raise ConfigError(f"rig serve needs {exc.name}: pip install 'accelcal-rig[dashboard]'") from None
-    token = args.token or os.environ.get("ACCELCAL_DASHBOARD_TOKEN") or None
-    try:
-        loopback = args.host == "localhost" or ipaddress.ip_address(args.host).is_loopback
-    except ValueError:
-        loopback = False
-    if not loopback and token is None:
-        raise ConfigError(f"--host {args.host}: off 127.0.0.1 the dashboard needs --token (anyone on the network "
-                          "could read it otherwise)")
-    if (args.tls_cert is None) != (args.tls_key is None):
-        raise ConfigError("--tls-cert and --tls-key go together")
-    if args.tls_cert is not None:
-        import ssl
-
-        try:  # before anything is printed: a wrong file is one line naming it
-            ssl.create_default_context(ssl.Purpose.CLIENT_AUTH).load_cert_chain(args.tls_cert, args.tls_key)
-        except (OSError, ssl.SSLError) as exc:
-            raise ConfigError(f"--tls-cert {args.tls_cert} --tls-key {args.tls_key}: cannot load: {exc}") from None
-    folders = args.campaigns or [Path.cwd()]
-    missing = [folder for folder in folders if not folder.is_dir()]
-    if missing:
-        raise ConfigError(f"--campaigns {missing[0]}: not a folder")
-    from_config = None
-    if args.config is not None:
-        from accelcal_rig.config.load import load_rig
-
-        rig = load_rig(args.config)
-        from_config = configured(rig.model.registry, rig.path)
-    from urllib.parse import quote
-
-    from accelcal_rig.web.app import LOOPBACK_HOSTS
-
-    app = create_app(folders, registry_url(args.registry, from_config), token, tls=args.tls_cert is not None,
-                     hosts=[*LOOPBACK_HOSTS, args.host])
-    # Listening before the address is printed: whoever reads it can connect at once (and port 0 works).
-    family = socket.AF_INET6 if ":" in args.host else socket.AF_INET
-    listening = socket.socket(family, socket.SOCK_STREAM)
-    listening.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-    try:
-        listening.bind((args.host, int(args.port)))
-    except OSError as exc:
-        raise ConfigError(f"--host {args.host} --port {args.port}: cannot listen there: {exc.strerror}") from None
-    listening.listen(128)
-    port = listening.getsockname()[1]
-    scheme = "https" if args.tls_cert else "http"
-    print(f"dashboard on {scheme}://{args.host}:{port}/" + (f"?token={quote(token, safe='')}" if token else ""),
-          flush=True)
-    config = uvicorn.Config(app, log_level="warning", ssl_certfile=args.tls_cert, ssl_keyfile=args.tls_key)
-    uvicorn.Server(config).run(sockets=[listening])
+    dashboard = open_dashboard(args)
+    print(f"dashboard on {dashboard.url}", flush=True)
+    dashboard.serve()
     return 0
 
 
@@ -532,28 +309,6 @@ def _cmd_certificate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _complete_campaign_verdicts(done: NothingToResume, output: Path, calibration: Path,
-                                args: argparse.Namespace) -> int:
-    """A complete campaign resumed: the verdicts of the fit this resume did (and its certificates and
-    warnings), else those of its calibration file; `--fail-on-reject` either way."""
-    from accelcal_rig.fit.campaign_file import calibration_verdicts
-
-    code = 0
-    fit = done.fit
-    if fit is not None:
-        verdicts = fit.verdicts
-        for warning in fit.warnings:
-            print(f"  warning    {warning}")
-        code = _certify_after_run(output, calibration, args)
-    else:
-        judged = calibration_verdicts(output, calibration)["verdicts"] or {}
-        verdicts = {serial: (str(v["verdict"]), tuple(v["reasons"])) for serial, v in judged.items()}
-    for serial, (verdict, reasons) in verdicts.items():
-        print(f"  verdict    {serial} {verdict}" + (f": {'; '.join(reasons)}" if verdict == "FAIL" else ""))
-    rejected = [serial for serial, (verdict, _) in verdicts.items() if verdict == "FAIL"]
-    return max(code, _rejected_exit(rejected, args.fail_on_reject))
-
-
 def _certify_after_run(output: Path, calibration: Path, args: argparse.Namespace) -> int:
     """The certificates at the end of a run; one that cannot be written is one line, the campaign stands."""
     try:
@@ -566,13 +321,14 @@ def _certify_after_run(output: Path, calibration: Path, args: argparse.Namespace
 
 
 def _certify(campaign: Path, calibration: Path, folder: Path, operator: str, pdf: bool) -> None:
+    from accelcal_rig.cli_format_campaign import certificate_line
     from accelcal_rig.report.certificate import write_certificates
 
     written, warnings = write_certificates(campaign, calibration, folder, operator, pdf)
     for warning in warnings:
         print(f"rig: warning: {warning}", file=sys.stderr)
     for w in written:
-        print(f"certificate {w.serial} → {w.html}" + (f", {w.pdf.name}" if w.pdf else ""))
+        print(certificate_line(w))
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
@@ -593,22 +349,9 @@ def _cmd_export(args: argparse.Namespace) -> int:
     return write_export(exported, args.format, args.output)
 
 
-def _print_fit_table(report: dict) -> None:
-    """In-sample figures (the poses fitted) beside verification figures (poses the fit never saw)."""
-    print(f"{'':14s} {'raw':>8s} {'in-sample (the fitted poses)':^36s}  {'verification (never fitted)':^33s}".rstrip())
-    print(f"{'sensor':14s} {'|g| mg':>8s} {'floor':>7s} {'expected':>8s} {'|g| mg':>7s} {'drift mg':>10s}  "
-          f"{'|g| mg':>7s} {'axis mg':>7s} {'tilt °':>7s} {'drift mg':>9s}  {'U k=2 mg':>8s}  verdict")
-    for serial, r in report.items():
-        v = r.get("verification")
-        verification = (f"{v['rmse_mg']:7.4f} {v['max_axis_error_mg']:7.4f} {v['max_tilt_error_deg']:7.4f} "
-                        f"{max(v['drift_mg']):9.4f}" if v else f"{'none':>7s} {'':7s} {'':7s} {'':9s}")
-        print(f"{serial:14s} {r['rmse_before_mg']:8.3f} {r['noise_floor_mg']:7.4f} {r['expected_fit_rmse_mg']:8.4f} "
-              f"{r['rmse_after_mg']:7.4f} {max(r['drift_after_mg']):10.4f}  {verification}  "
-              f"{max(r['expanded_uncertainty_mg']):8.4f}  {r['verdict']}")
-        for reason in r["verdict_reasons"] if r["verdict"] == "FAIL" else ():
-            print(f"  fails: {reason}")
-        for warning in r["warnings"]:
-            print(f"  warning: {warning}")
+def _one_line(error: BaseException) -> str:
+    """An error's message as one line, whatever text from a file it quotes."""
+    return " ".join(str(error).splitlines())
 
 
 def run_program() -> None:
@@ -628,11 +371,6 @@ def run_program() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
     raise SystemExit(code)
-
-
-def _one_line(error: BaseException) -> str:
-    """An error's message as one line, whatever text from a file it quotes."""
-    return " ".join(str(error).splitlines())
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,13 +1,21 @@
 """`rig analyze`: the paper's other experiments on a campaign file — each computes with accelcal_rig.analysis,
-prints its table or one JSON object, and draws its figure on request."""
+prints its table or one JSON object (cli_format_analysis), and draws its figure on request."""
 
 from __future__ import annotations
 
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from accelcal_rig.errors import ConfigError
+
+if TYPE_CHECKING:
+    from accelcal_rig.analysis.cooldown import CooldownResult
+    from accelcal_rig.analysis.positions import SizeSummary
+    from accelcal_rig.analysis.tilt import TiltRow
+    from accelcal_rig.fit.calibration import CalibrationFile
+    from accelcal_rig.fit.lm import FreeParameters
 
 
 def analyze(args: argparse.Namespace) -> int:
@@ -15,112 +23,82 @@ def analyze(args: argparse.Namespace) -> int:
     return {"positions": _analyze_positions, "tilt": _analyze_tilt, "cooldown": _analyze_cooldown}[args.analysis](args)
 
 
-def _calibrations_for(calibration_path: Path, campaign: Path, serials: list[str]):  # noqa: ANN202
-    from accelcal_rig.fit.calibration import load_calibration
-
-    calibration = load_calibration(calibration_path)
-    missing = [serial for serial in serials if serial not in calibration.sensors]
-    if missing:
-        raise ConfigError(f"{calibration_path}: no calibration for {', '.join(missing)} of {campaign} "
-                          f"(it has {', '.join(calibration.sensors)})")
-    return calibration
-
-
 def _analyze_cooldown(args: argparse.Namespace) -> int:
-    import dataclasses
+    from accelcal_rig.cli_format_analysis import cooldown_json, cooldown_lines
 
-    from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
-    from accelcal_rig.analysis.cooldown import analyse_cooldown
-    from accelcal_rig.fit.calibration import plain
-
-    if args.figure is not None:
-        _check_figure_path(args.figure)
-    _, duts, _ = poses_at_setpoint(args.campaign, args.setpoint)
-    calibration = _calibrations_for(args.calibration, args.campaign, list(duts))
-    results = [analyse_cooldown(poses, calibration.sensors[serial]) for serial, poses in duts.items()]
-    if args.figure is not None:
-        from accelcal_rig.report.analysis_figures import cooldown_figure
-
-        cooldown_figure(results, args.figure)
-    if args.json:
-        print(json.dumps(plain({"calibration": str(args.calibration), "sensors": [
-            {k: v for k, v in dataclasses.asdict(r).items() if k not in ("t_s", "before_g", "after_g")}
-            | {"records": len(r.t_s)} for r in results]})))
-        return 0
-    print(f"{args.campaign}: free cool-down, temperature coefficient per axis (µg/K) with {args.calibration}")
-    print(f"{'sensor':14s} {'records':>7s} {'from … to (°C)':>16s} {'before x, y, z':>26s} {'after x, y, z':>26s}")
-    for r in results:
-        before = " ".join(f"{v:+8.1f}" for v in r.coefficient_before_ug_per_k)
-        after = " ".join(f"{v:+8.2f}" for v in r.coefficient_after_ug_per_k)
-        print(f"{r.serial:14s} {len(r.t_s):7d} {r.temperature_c.max():7.1f} … {r.temperature_c.min():5.1f} "
-              f"{before:>26s} {after:>26s}")
-        if r.outside_range:
-            print(f"  warning: {r.outside_range} records outside the calibrated range: clamped or extrapolated as "
-                  "the calibration file says")
-    if args.figure is not None:
-        print(f"figure → {args.figure}")
+    results = cooldown_results(args.campaign, args.calibration, args.setpoint, args.figure)
+    print(json.dumps(cooldown_json(args.calibration, results)) if args.json
+          else "\n".join(cooldown_lines(args.campaign, args.calibration, results, args.figure)))
     return 0
 
 
 def _analyze_tilt(args: argparse.Namespace) -> int:
-    import dataclasses
+    from accelcal_rig.cli_format_analysis import tilt_json, tilt_lines
 
+    setpoint, rows, outside = tilt_results(args.campaign, args.calibration, args.setpoint)
+    print(json.dumps(tilt_json(setpoint, args.calibration, outside, rows)) if args.json
+          else "\n".join(tilt_lines(args.campaign, setpoint, args.calibration, outside, rows)))
+    return 0
+
+
+def _analyze_positions(args: argparse.Namespace) -> int:
+    from accelcal_rig.cli_format_analysis import positions_json, positions_lines
+
+    setpoint, mode, rows, floors = positions_results(args)
+    print(json.dumps(positions_json(setpoint, mode, floors, rows)) if args.json
+          else "\n".join(positions_lines(args.campaign, setpoint, mode, args.subsets, floors, rows, args.figure)))
+    return 0
+
+
+def cooldown_results(campaign: Path, calibration_path: Path, setpoint: float | None,
+                     figure: Path | None) -> list[CooldownResult]:
+    """Each DUT's temperature coefficients over a free cool-down, before and after compensation; the figure
+    drawn if asked for."""
     from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
-    from accelcal_rig.analysis.tilt import tilt_rows, worst_errors_deg
-    from accelcal_rig.fit.calibration import plain
+    from accelcal_rig.analysis.cooldown import analyse_cooldown
 
-    setpoint, duts, numbers = poses_at_setpoint(args.campaign, args.setpoint)
-    calibration = _calibrations_for(args.calibration, args.campaign, list(duts))
+    if figure is not None:
+        _check_figure_path(figure)
+    _, duts, _ = poses_at_setpoint(campaign, setpoint)
+    calibration = _calibrations_for(calibration_path, campaign, list(duts))
+    results = [analyse_cooldown(poses, calibration.sensors[serial]) for serial, poses in duts.items()]
+    if figure is not None:
+        from accelcal_rig.report.analysis_figures import cooldown_figure
+
+        cooldown_figure(results, figure)
+    return results
+
+
+def tilt_results(campaign: Path, calibration_path: Path,
+                 setpoint_c: float | None) -> tuple[float, dict[str, list[TiltRow]], list[str]]:
+    """The setpoint, every DUT's tilt rows, and the DUTs whose temperatures lie outside their calibration's
+    range (one note each)."""
+    from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
+    from accelcal_rig.analysis.tilt import tilt_rows
+
+    setpoint, duts, numbers = poses_at_setpoint(campaign, setpoint_c)
+    calibration = _calibrations_for(calibration_path, campaign, list(duts))
     rows = {serial: tilt_rows(poses, numbers, calibration.sensors[serial]) for serial, poses in duts.items()}
     outside = [f"{s} ({duts[s].temperature_c.min():.1f}…{duts[s].temperature_c.max():.1f} °C outside "
                f"{calibration.sensors[s].validity_c[0]:.1f}…{calibration.sensors[s].validity_c[1]:.1f} °C)"
                for s in duts if not (calibration.sensors[s].validity_c[0] <= duts[s].temperature_c.min()
                                      and duts[s].temperature_c.max() <= calibration.sensors[s].validity_c[1])]
-    if args.json:
-        print(json.dumps(plain({"setpoint_c": setpoint, "calibration": str(args.calibration), "outside_range": outside,
-                                "rows": [dataclasses.asdict(r) for sensor in rows.values() for r in sensor]})))
-        return 0
-    print(f"{args.campaign} at {setpoint:g} °C with {args.calibration}: pitch; roll (degrees), paper Eq. 10")
-    print(f"{'sensor':14s} {'pose':>4s} {'reference':>16s} {'without calibration':>20s} {'after calibration':>20s} "
-          f"{'SEOQ (%)':>12s}")
-    for serial, sensor_rows in rows.items():
-        for r in sensor_rows:
-            pair = lambda v, d: f"{v[0]:.{d}f}; {v[1]:.{d}f}"  # noqa: E731
-            print(f"{serial:14s} {r.pose_number:4d} {pair(r.reference_deg, 2):>16s} {pair(r.before_deg, 3):>20s} "
-                  f"{pair(r.after_deg, 3):>20s} {pair(r.seoq_percent, 2):>12s}")
-        before, after = worst_errors_deg(sensor_rows)
-        print(f"{serial:14s} worst |error|: {before:.3f}° without, {after:.4f}° after calibration")
-    for note in outside:
-        print(f"warning: {note}: the calibration was clamped to its range")
-    return 0
+    return setpoint, rows, outside
 
 
-def _analyze_positions(args: argparse.Namespace) -> int:
-    import dataclasses
-
+def positions_results(args: argparse.Namespace) -> tuple[float, str, list[SizeSummary], dict[str, float]]:
+    """The setpoint, the fit mode, each DUT's scores per subset size and its noise floor; the figure drawn
+    if asked for."""
     import numpy as np
 
     from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
-    from accelcal_rig.analysis.positions import PAPER_SIZES, floor_mg, score_subsets, summarise
-    from accelcal_rig.fit.calibration import plain
-    from accelcal_rig.fit.recorded_options import NO_FIT, recorded_options, requested_mode
-    from accelcal_rig.store.read import load_campaign
+    from accelcal_rig.analysis.positions import floor_mg, score_subsets, summarise
 
-    try:
-        sizes = tuple(int(v) for v in args.sizes.split(",")) if args.sizes else PAPER_SIZES
-    except ValueError:
-        raise ConfigError(f"--sizes: {args.sizes!r}: expected whole numbers separated by commas") from None
-    if min(sizes) < 6 or args.subsets < 1:
-        raise ConfigError("--sizes: at least 6 positions per subset; --subsets: at least 1")
+    sizes = _subset_sizes(args.sizes, args.subsets)
     if args.figure is not None:
         _check_figure_path(args.figure)
     setpoint, duts, _ = poses_at_setpoint(args.campaign, args.setpoint)
-    attrs = load_campaign(args.campaign).attrs
-    recorded = requested_mode(attrs)
-    mode = args.mode or ("reference" if recorded == NO_FIT else recorded)  # measure-only: the table's reference
-    options = recorded_options(attrs, str(args.campaign), mode=mode)
-    assert options is not None
-    free = options.free
+    mode, free = _positions_fit(args.campaign, args.mode)
     rows, floors = [], {}
     for serial, poses in duts.items():
         scores = score_subsets(poses, sizes, mode, free, args.subsets, np.random.default_rng(args.seed))  # type: ignore[arg-type]
@@ -130,22 +108,44 @@ def _analyze_positions(args: argparse.Namespace) -> int:
         from accelcal_rig.report.analysis_figures import positions_figure
 
         positions_figure(rows, floors, mode, args.figure)
-    if args.json:
-        print(json.dumps(plain({"setpoint_c": setpoint, "mode": mode, "noise_floor_mg": floors,
-                                "sizes": [dataclasses.asdict(r) for r in rows]})))
-        return 0
-    print(f"{args.campaign}: {mode} fits at {setpoint:g} °C, RMSE of |g| on the poses each fit left out (mg); "
-          f"{args.subsets} random subsets per size")
-    print(f"{'sensor':14s} {'positions':>9s} {'before':>8s} {'evenly spread':>14s} {'random median':>14s} "
-          f"{'random worst':>13s} {'failed':>7s}")
-    for r in rows:
-        print(f"{r.serial:14s} {r.size:9d} {r.before_mg:8.3f} {r.structured_mg:14.4f} {r.random_median_mg:14.4f} "
-              f"{r.random_max_mg:13.4f} {r.failed:7d}")
-    print("noise floor (mg): " + ", ".join(f"{k} {v:.4f}" for k, v in floors.items())
-          + "; the full set is scored on its own poses")
-    if args.figure is not None:
-        print(f"figure → {args.figure}")
-    return 0
+    return setpoint, mode, rows, floors
+
+
+def _subset_sizes(text: str | None, subsets: int) -> tuple[int, ...]:
+    from accelcal_rig.analysis.positions import PAPER_SIZES
+
+    try:
+        sizes = tuple(int(v) for v in text.split(",")) if text else PAPER_SIZES
+    except ValueError:
+        raise ConfigError(f"--sizes: {text!r}: expected whole numbers separated by commas") from None
+    if min(sizes) < 6 or subsets < 1:
+        raise ConfigError("--sizes: at least 6 positions per subset; --subsets: at least 1")
+    return sizes
+
+
+def _positions_fit(campaign: Path, requested: str | None) -> tuple[str, FreeParameters]:
+    """The mode to refit with (the one asked for, else the campaign's; a measure-only campaign: reference) and
+    the parameters the campaign frees."""
+    from accelcal_rig.fit.recorded_options import NO_FIT, recorded_options, requested_mode
+    from accelcal_rig.store.read import load_campaign
+
+    attrs = load_campaign(campaign).attrs
+    recorded = requested_mode(attrs)
+    mode = requested or ("reference" if recorded == NO_FIT else recorded)  # measure-only: the table's reference
+    options = recorded_options(attrs, str(campaign), mode=mode)
+    assert options is not None
+    return mode, options.free
+
+
+def _calibrations_for(calibration_path: Path, campaign: Path, serials: list[str]) -> CalibrationFile:
+    from accelcal_rig.fit.calibration import load_calibration
+
+    calibration = load_calibration(calibration_path)
+    missing = [serial for serial in serials if serial not in calibration.sensors]
+    if missing:
+        raise ConfigError(f"{calibration_path}: no calibration for {', '.join(missing)} of {campaign} "
+                          f"(it has {', '.join(calibration.sensors)})")
+    return calibration
 
 
 def _check_figure_path(path: Path) -> None:

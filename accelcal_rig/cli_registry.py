@@ -1,5 +1,6 @@
 """`rig registry`: the lab's calibrations by serial number — register campaigns, list and show them, a
-sensor's trend across recalibrations, a part's lot statistics, and its calibration exported again."""
+sensor's trend across recalibrations, a part's lot statistics, and its calibration exported again; and what
+`rig run`, `rig fit` and `rig fit-recording` record. The lines they print are cli_format_registry's."""
 
 from __future__ import annotations
 
@@ -7,9 +8,13 @@ import argparse
 import json
 from datetime import date, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from accelcal_rig.cli_format_registry import calibration_table, lot_lines, public, sensor_lines, trend_lines
 from accelcal_rig.errors import ConfigError
+
+if TYPE_CHECKING:
+    from accelcal_rig.fit.calibration import CalibrationFile
 
 
 def registry_command(args: argparse.Namespace) -> int:
@@ -42,9 +47,39 @@ def register(url: str, entries: list[dict[str, Any]]) -> str:
     return f"registry   {len(added)} calibration{'s' if len(added) != 1 else ''} recorded in {described(url)}{tail}"
 
 
-def _add(args: argparse.Namespace) -> int:
-    from accelcal_rig.registry.entries import campaign_entries
+def campaign_entries(campaign: Path, calibration: Path | None) -> list[dict[str, Any]]:
+    """What the registry records of a fitted campaign (read when it is recorded)."""
+    from accelcal_rig.registry.entries import campaign_entries as entries
 
+    return entries(campaign, calibration)
+
+
+def recording_entries(recording: Path, calibration: CalibrationFile, part: str) -> list[dict[str, Any]]:
+    """What the registry records of a hand-held recording's fit."""
+    from accelcal_rig.registry.entries import recording_entries as entries
+
+    return entries(recording, calibration, part)
+
+
+def rig_registry(value: str | None, rig_path: Path) -> str | None:
+    """A rig config's `registry:` (relative to the config's folder)."""
+    from accelcal_rig.registry.location import configured
+
+    return configured(value, rig_path)
+
+
+def stored_rig_registry(campaign: Path) -> str | None:
+    """The `registry:` of the rig config a campaign was run with (as it stored it)."""
+    import yaml
+
+    from accelcal_rig.store.read import load_campaign
+
+    stored = load_campaign(campaign)
+    value = (yaml.safe_load(stored.header.rig_yaml) or {}).get("registry")
+    return rig_registry(value, Path(str(stored.attrs.get("rig_path", campaign)))) if value else None
+
+
+def _add(args: argparse.Namespace) -> int:
     if args.calibration is not None and len(args.files) != 1:
         raise ConfigError("--calibration names the calibration of one campaign file: give one FILE with it")
     registry = open_registry(args, upgrade=True)
@@ -58,18 +93,7 @@ def _list(args: argparse.Namespace) -> int:
     since = _since(args.since) if args.since else None
     rows = open_registry(args).calibrations(serial=args.serial, part=args.part, since=since, verdict=args.verdict,
                                             limit=args.limit)
-    if args.json:
-        print(json.dumps([_public(r) for r in rows], indent=2))
-        return 0
-    if not rows:
-        print("no calibrations match")
-        return 0
-    print(f"{'id':>6}  {'serial':<16} {'part':<8} {'calibrated (UTC)':<19} {'verdict':<7} {'valid °C':<15} "
-          f"{'procedure':<22} source")
-    for r in rows:
-        print(f"{r['id']:>6}  {r['serial']:<16} {r['part']:<8} {r['calibrated_at']:%Y-%m-%d %H:%M:%S} "
-              f"{r['verdict'] or '—':<7} {r['valid_from_c']:>6.1f}…{r['valid_to_c']:<7.1f} {r['procedure'][:22]:<22} "
-              f"{Path(r['source_path']).name}{' (simulated)' if r['simulated'] else ''}")
+    print(json.dumps([public(r) for r in rows], indent=2) if args.json else "\n".join(calibration_table(rows)))
     return 0
 
 
@@ -80,30 +104,10 @@ def _show(args: argparse.Namespace) -> int:
         raise ConfigError(f"serial {args.serial}: no calibration in the registry")
     current = registry.current(args.serial, simulated=args.simulated)
     if args.json:
-        print(json.dumps({"serial": args.serial, "current": _public(current) if current else None,
-                          "history": [_public(r) for r in rows]}, indent=2))
-        return 0
-    if current is None:
-        newest = next((r for r in rows if args.simulated or not r["simulated"]), None)
-        why = ("its newest calibration failed its acceptance limits" if newest is not None
-               else "only dry runs (simulated) are recorded: --simulated shows them")
-        print(f"{args.serial}: no valid calibration ({why})")
+        print(json.dumps({"serial": args.serial, "current": public(current) if current else None,
+                          "history": [public(r) for r in rows]}, indent=2))
     else:
-        simulated = " (SIMULATED: a dry run)" if current["simulated"] else ""
-        print(f"{args.serial} ({current['part']}): valid calibration {current['id']}{simulated}, "
-              f"measured {current['calibrated_at']:%Y-%m-%d} "
-              f"by {current['procedure']} on {current['rig']}, {current['valid_from_c']:.1f}…{current['valid_to_c']:.1f} °C, "
-              f"verdict {current['verdict'] or 'none stated'}")
-        print(f"  at {current['reference_c']:g} °C: bias {_triple(current['bias_mg'], 'mg', current['bias_uncertainty_mg'])}; "
-              f"scale error {_triple(current['scale_error_ppm'], 'ppm', current['scale_uncertainty_ppm'], 0)}; "
-              f"non-orthogonality ≤ {current['nonorthogonality_mrad']:.3f} mrad")
-        print(f"  source {current['source_path']} (SHA-256 {current['source_sha256'][:16]}…), software "
-              f"{current['software_version']}")
-    print(f"history ({len(rows)}):")
-    for r in rows:
-        print(f"  {r['id']:>6}  {r['calibrated_at']:%Y-%m-%d %H:%M}  {r['verdict'] or '—':<4}  "
-              f"bias {_triple(r['bias_mg'], 'mg')}  {Path(r['source_path']).name}"
-              + (" (simulated)" if r["simulated"] else ""))
+        print("\n".join(sensor_lines(args.serial, current, rows, args.simulated)))
     return 0
 
 
@@ -116,18 +120,8 @@ def _trend(args: argparse.Namespace) -> int:
     result = trend(rows)
     if args.json:
         print(json.dumps({"serial": args.serial, **result}, indent=2))
-        return 0
-    print(f"{args.serial}: {len(rows)} calibrations, figures at the reference temperature (± expanded, k = 2)")
-    for point in result["calibrations"]:
-        print(f"  {point['calibrated_at'][:10]}  bias {_triple(point['bias_mg'], 'mg', point['bias_uncertainty_mg'])}"
-              f"  scale {_triple(point['scale_error_ppm'], 'ppm', point['scale_uncertainty_ppm'], 0)}")
-    for key, unit in (("bias_drift_mg_per_year", "mg"), ("scale_drift_ppm_per_year", "ppm")):
-        drift = result[key]
-        what = key.split("_drift")[0]
-        if drift is None:
-            print(f"  {what} drift: needs two calibrations at different times")
-        else:
-            print(f"  {what} drift per year: " + ", ".join(f"{axis} {_drift_text(d, unit)}" for axis, d in zip("xyz", drift)))
+    else:
+        print("\n".join(trend_lines(args.serial, len(rows), result)))
     return 0
 
 
@@ -138,20 +132,7 @@ def _stats(args: argparse.Namespace) -> int:
     if not rows:
         raise ConfigError(f"part {args.part}: no calibration in the registry" + _simulated_hint(args))
     result = lot_statistics(rows)
-    if args.json:
-        print(json.dumps({"part": args.part, **result}, indent=2))
-        return 0
-    judged = f"{result['passed']} of {result['judged']} judged passed ({result['yield']:.1%})" if result["judged"] \
-        else "none judged against acceptance limits"
-    print(f"{args.part}: {result['sensors']} sensors ({result['calibrations']} calibrations), newest of each: {judged}")
-    for name, columns in result["distributions"].items():
-        for axis, summary in zip("xyz" if len(columns) == 3 else " ", columns):
-            if summary is not None:
-                print(f"  {name:<22} {axis}  median {summary['median']:+10.4g}  p5…p95 {summary['p5']:+.4g}…"
-                      f"{summary['p95']:+.4g}  std {summary['std']:.3g}  (n {summary['n']})")
-    for outlier in result["outliers"]:
-        print(f"  outlier: {outlier['serial']} (calibration {outlier['id']}) {outlier['figure']} "
-              f"{outlier['axis'] or ''} {outlier['value']:+.4g} (robust z {outlier['robust_z']:+.1f})")
+    print(json.dumps({"part": args.part, **result}, indent=2) if args.json else "\n".join(lot_lines(args.part, result)))
     return 0
 
 
@@ -177,13 +158,6 @@ def _export(args: argparse.Namespace) -> int:
     return write_export(exported, args.format, args.output)
 
 
-def _drift_text(drift: dict[str, float | None], unit: str) -> str:
-    """`+0.12 ± 0.03 mg`; without stated uncertainties (hand-held fits) the slope alone, said so."""
-    uncertainty = drift["expanded_uncertainty"]
-    spread = f" ± {uncertainty:.2g}" if uncertainty is not None else " (uncertainty not stated)"
-    return f"{drift['per_year']:+.4g}{spread} {unit}"
-
-
 def _real_unless(args: argparse.Namespace, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Dry runs are rehearsals, not calibrations: left out unless --simulated."""
     return rows if args.simulated else [r for r in rows if not r["simulated"]]
@@ -198,16 +172,3 @@ def _since(text: str) -> datetime:
         return datetime.combine(date.fromisoformat(text), datetime.min.time())
     except ValueError:
         raise ConfigError(f"--since {text!r}: not a date (YYYY-MM-DD)") from None
-
-
-def _triple(values: list[float] | None, unit: str, uncertainty: list[float] | None = None, digits: int = 3) -> str:
-    if values is None:
-        return "—"
-    if uncertainty is None:
-        return "/".join(f"{v:+.{digits}f}" for v in values) + f" {unit}"
-    return "/".join(f"{v:+.{digits}f}±{u:.{digits}f}" for v, u in zip(values, uncertainty)) + f" {unit}"
-
-
-def _public(row: dict[str, Any]) -> dict[str, Any]:
-    """A row as JSON: times as ISO 8601 UTC, the stored fit left out (`rig registry export` gives it)."""
-    return {k: (v.isoformat() + "Z" if isinstance(v, datetime) else v) for k, v in row.items() if k != "calibration"}

@@ -69,3 +69,9 @@ def watch_header(status: dict[str, Any], interval_s: float) -> str:
     remaining = (status.get("progress") or {}).get("remaining_s")
     left = f", about {format_duration(remaining)} left" if remaining is not None else ""
     return f"every {interval_s:g} s (Ctrl-C to stop){left}"
+
+
+def watch_text(status: dict[str, Any], interval_s: float, clear: bool) -> str:
+    """One screen of `rig status --watch`: the status (the terminal cleared first if `clear`), then how often
+    it is shown again."""
+    return ("\x1b[H\x1b[2J" if clear else "") + "\n".join(status_lines(status)) + f"\n({watch_header(status, interval_s)})"

@@ -1,0 +1,184 @@
+"""The work behind `rig run`, `rig resume`, `rig status` and `rig sim` that is not the engine's: the
+campaign's files checked and its procedure prepared from the command line, the signal handling and the
+logging a run has on the console and in its log file, the lock and the free-space check around it."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import signal
+import sys
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from accelcal_rig.core.logger import LOGGER
+from accelcal_rig.core.signals import TerminationRequested, stop_when_safe
+from accelcal_rig.errors import ConfigError
+
+if TYPE_CHECKING:
+    from accelcal_rig.engine.preparation import PreparedCampaign
+    from accelcal_rig.engine.progress import ProgressListener
+
+
+def prepare_run(args: argparse.Namespace) -> tuple[PreparedCampaign, bool]:
+    """`rig run`'s campaign prepared, its output checked; and whether it continues the file there (--resume)."""
+    from accelcal_rig.engine.preparation import prepare
+    from accelcal_rig.store.paths import journal_path
+
+    if args.output.is_dir():
+        raise ConfigError(f"{args.output}: is a folder; name the campaign file to write")
+    if args.chamber_profile and not args.dry_run:
+        raise ConfigError("--chamber-profile swaps in a simulated chamber: only with --dry-run")
+    exists = args.output.exists() or journal_path(args.output).exists()
+    profile = args.chamber_profile
+    if args.resume and exists and profile is None:  # continue with the chamber the campaign was started with
+        from accelcal_rig.store.read import load_campaign
+
+        profile = str(load_campaign(args.output).attrs.get("chamber_profile", "")) or None
+    prepared = prepare(args.procedure, args.config, args.faults, profile)
+    if exists and not (args.overwrite or args.resume):
+        raise ConfigError(f"{args.output}: campaign file exists; continue it with --resume, or choose another -o "
+                          "or pass --overwrite")
+    if not args.output.parent.is_dir():
+        raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
+    return prepared, args.resume and exists
+
+
+def prepare_resume(args: argparse.Namespace) -> tuple[PreparedCampaign, bool, int]:
+    """`rig resume`'s campaign prepared from the procedure it was started with; whether it is a dry run, its seed."""
+    from accelcal_rig.engine.preparation import prepare
+    from accelcal_rig.store.read import load_campaign
+
+    stored = load_campaign(args.campaign)
+    procedure = args.procedure or Path(str(stored.attrs.get("procedure_path", "")))
+    if not procedure.is_file():
+        raise ConfigError(f"{args.campaign}: its procedure {procedure} is gone; pass --procedure with the same "
+                          "procedure")
+    prepared = prepare(procedure, args.config, args.faults, str(stored.attrs.get("chamber_profile", "")) or None)
+    return prepared, bool(stored.attrs.get("dry_run", False)), int(stored.attrs.get("seed", 0))
+
+
+def calibration_path(given: Path | None, output: Path) -> Path:
+    """The calibration file a run's fit writes: --calibration, else beside the campaign; its folder checked."""
+    calibration = given or output.with_suffix(".calibration.yaml")
+    if not calibration.parent.is_dir():
+        raise ConfigError(f"{calibration}: folder {calibration.parent} does not exist")
+    return calibration
+
+
+class _StopOnFirstSignal:
+    """SIGINT or SIGTERM stops the campaign through its safe state; later signals must not cut that short."""
+
+    def __init__(self) -> None:
+        self.stopping = False
+
+    def __call__(self, signum: int, frame: object) -> None:
+        if self.stopping:
+            LOGGER.warning("%s ignored: already stopping, the rig is being made safe", signal.Signals(signum).name)
+            return
+        self.stopping = True
+        stop_when_safe(KeyboardInterrupt() if signum == signal.SIGINT else TerminationRequested())
+
+
+@contextmanager
+def stop_on_first_signal() -> Iterator[None]:
+    """While a campaign runs: the first SIGINT or SIGTERM stops it when safe, later ones are logged and ignored."""
+    stop = _StopOnFirstSignal()
+    previous = {signum: signal.signal(signum, stop) for signum in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+@contextmanager
+def until_signalled() -> Iterator[threading.Event]:
+    """An event SIGINT or SIGTERM sets (`rig sim` serves until then)."""
+    stop = threading.Event()
+    previous = {signum: signal.signal(signum, lambda *_: stop.set()) for signum in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield stop
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+@contextmanager
+def campaign_session(prepared: PreparedCampaign, output: Path, *, verbose: bool, quiet: bool, dry_run: bool,
+                     overwrite: bool, resume: bool) -> Iterator[ProgressListener]:
+    """Around a run: the campaign locked before anything of it changes (the log included), a new campaign's
+    disk space checked, the console and the log file attached; yields the progress listener."""
+    from accelcal_rig.store.lock import campaign_lock
+
+    with campaign_lock(output, "rig resume" if resume else "rig run"):
+        if not resume:
+            check_free_space(prepared, output, dry_run, overwrite)
+        with campaign_logging(output, verbose, quiet, append=resume, real_clock=not dry_run) as progress:
+            yield progress
+
+
+def check_free_space(prepared: PreparedCampaign, output: Path, dry_run: bool, overwrite: bool) -> None:
+    """Refuse to start a campaign the disk cannot hold (with a margin), before anything is touched."""
+    from accelcal_rig.durable import free_bytes
+    from accelcal_rig.store.paths import journal_path
+    from accelcal_rig.store.space import START_MARGIN, megabytes
+
+    estimate = prepared.storage(dry_run)
+    replaced = sum(p.stat().st_size for p in (output, journal_path(output)) if overwrite and p.is_file())
+    free = free_bytes(output.parent) + replaced
+    needed = int(START_MARGIN * estimate.need_bytes)
+    if free < needed:
+        raise ConfigError(f"{output}: {megabytes(free)} free on {output.parent.resolve()}, the campaign needs about "
+                          f"{megabytes(needed)} ({START_MARGIN:g} × its estimated {megabytes(estimate.need_bytes)}): "
+                          "free some space or choose another -o")
+
+
+@contextmanager
+def campaign_logging(output: Path, verbose: bool, quiet: bool, append: bool,
+                     real_clock: bool) -> Iterator[ProgressListener]:
+    """Console on stderr at the chosen level (a live status line on a terminal, timestamped lines
+    otherwise), the full debug log with progress lines in a file beside the campaign file (appended to by
+    a resumed run); yields the progress listener. Everything is detached and closed when the run ends."""
+    from accelcal_rig.report.live import LogFileHandler, ProgressLines, StatusLine, TerminalHandler, listeners
+    from accelcal_rig.store.paths import log_path
+
+    status = StatusLine(sys.stderr, real_clock) if sys.stderr.isatty() and not quiet else None
+    console: logging.Handler
+    if status is not None:
+        console = TerminalHandler(status)
+        console.setFormatter(logging.Formatter("%(message)s"))
+    else:
+        console = logging.StreamHandler(sys.stderr)
+        console.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s", "%Y-%m-%d %H:%M:%S"))
+    console.setLevel(logging.DEBUG if verbose else logging.WARNING if quiet else logging.INFO)
+    try:
+        log_file = LogFileHandler(str(log_path(output)), mode="a" if append else "w")
+    except OSError as exc:
+        raise ConfigError(f"{log_path(output)}: cannot write the campaign's log: {exc.strerror}") from None
+    log_file.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s"))
+    LOGGER.setLevel(logging.DEBUG)
+    propagate, LOGGER.propagate = LOGGER.propagate, False
+    for handler in (console, log_file):
+        LOGGER.addHandler(handler)
+    lines = ProgressLines(real_clock)
+    try:
+        yield listeners(lines, status) if status is not None else lines
+    finally:
+        if status is not None:
+            status.close()
+        for handler in (console, log_file):
+            LOGGER.removeHandler(handler)
+            handler.close()
+        LOGGER.propagate = propagate
+
+
+def campaign_status(campaign: Path, calibration: Path | None) -> dict[str, Any]:
+    """`rig status --json`: the campaign's state and progress, and its DUTs' verdicts from its calibration."""
+    from accelcal_rig.fit.campaign_file import calibration_verdicts
+    from accelcal_rig.store.read import campaign_status as stored_status
+
+    return {**stored_status(campaign), **calibration_verdicts(campaign, calibration)}

@@ -1,0 +1,57 @@
+"""What `rig fit` and `rig fit-recording` print, as lines: a campaign fit's report (`FitOutcome.report`,
+as `rig fit --json` prints it) as a table, and a hand-held recording's fit (`RecordingFit.report`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from accelcal_rig.core.units import gravity_statement
+from accelcal_rig.fit.campaign_fit import summary_line
+
+
+def fit_lines(report: dict[str, Any], output: Path) -> list[str]:
+    """The table of every DUT's figures, the one-line summary naming the calibration file, the gravity."""
+    return [*fit_table(report), summary_line(report, output),
+            f"gravity: {gravity_statement(next(iter(report.values()))['gravity_m_s2'])}"]
+
+
+def fit_table(report: dict[str, Any]) -> list[str]:
+    """In-sample figures (the poses fitted) beside verification figures (poses the fit never saw)."""
+    lines = [f"{'':14s} {'raw':>8s} {'in-sample (the fitted poses)':^36s}  {'verification (never fitted)':^33s}".rstrip(),
+             f"{'sensor':14s} {'|g| mg':>8s} {'floor':>7s} {'expected':>8s} {'|g| mg':>7s} {'drift mg':>10s}  "
+             f"{'|g| mg':>7s} {'axis mg':>7s} {'tilt °':>7s} {'drift mg':>9s}  {'U k=2 mg':>8s}  verdict"]
+    for serial, r in report.items():
+        v = r.get("verification")
+        verification = (f"{v['rmse_mg']:7.4f} {v['max_axis_error_mg']:7.4f} {v['max_tilt_error_deg']:7.4f} "
+                        f"{max(v['drift_mg']):9.4f}" if v else f"{'none':>7s} {'':7s} {'':7s} {'':9s}")
+        lines.append(f"{serial:14s} {r['rmse_before_mg']:8.3f} {r['noise_floor_mg']:7.4f} {r['expected_fit_rmse_mg']:8.4f} "
+                     f"{r['rmse_after_mg']:7.4f} {max(r['drift_after_mg']):10.4f}  {verification}  "
+                     f"{max(r['expanded_uncertainty_mg']):8.4f}  {r['verdict']}")
+        lines += [f"  fails: {reason}" for reason in (r["verdict_reasons"] if r["verdict"] == "FAIL" else ())]
+        lines += [f"  warning: {warning}" for warning in r["warnings"]]
+    return lines
+
+
+def recording_lines(report: dict[str, Any], source: str, *, threshold_factor: float, init_s: float, output: Path,
+                    parameters: str) -> list[str]:
+    """The static intervals found (each with |g| before and after), the warnings, and the fit in one line."""
+    lines = [f"{len(report['intervals'])} static intervals in {source} ({report['samples']} samples at "
+             f"{report['rate_hz']:.4g} Hz; threshold {report['threshold_g2']:.3g} g², {threshold_factor:g} × the "
+             f"first {init_s:g} s)",
+             f"{'#':>3s} {'start s':>9s} {'end s':>9s} {'samples':>8s} {'mean x, y, z (g)':>29s} {'|g|−1 before':>13s} "
+             f"{'after (mg)':>11s}"]
+    for k, interval in enumerate(report["intervals"], start=1):
+        mean = " ".join(f"{v:+9.5f}" for v in interval["mean_g"])
+        lines.append(f"{k:3d} {interval['start_s']:9.2f} {interval['end_s']:9.2f} {interval['samples']:8d} {mean:>29s} "
+                     f"{interval['norm_before_mg']:13.3f} {interval['norm_after_mg']:11.4f}")
+    lines += [f"warning: {warning}" for warning in report["warnings"]]
+    chi2 = "n/a (no degrees of freedom left)" if report["chi2_reduced_before"] is None else (
+        f"{report['chi2_reduced_before']:.2f}" + (f" → {report['chi2_reduced']:.2f} with a scatter floor of "
+                                                   f"{report['scatter_floor_mg']:.4f} mg" if report["scatter_floor_mg"]
+                                                   else ""))
+    lines.append(f"calibration → {output}: norm-only, {parameters} parameters, |g| RMSE "
+                 f"{report['rmse_before_mg']:.3f} → {report['rmse_after_mg']:.4f} mg (noise floor "
+                 f"{report['noise_floor_mg']:.4f} mg) at {report['temperature_c']:.1f} °C; χ²_red {chi2}; outputs in "
+                 f"{report['units']}")
+    return lines

@@ -1,0 +1,104 @@
+"""`rig registry` as a person reads it: the registry's rows (as `Registry.calibrations` gives them) and its
+analyses (`registry.analysis`) as lines, and a row as JSON."""
+
+from __future__ import annotations
+
+from datetime import datetime
+from pathlib import Path
+from typing import Any
+
+
+def calibration_table(rows: list[dict[str, Any]]) -> list[str]:
+    """`rig registry list`: a header and one line per calibration (a sentence when none match)."""
+    if not rows:
+        return ["no calibrations match"]
+    lines = [f"{'id':>6}  {'serial':<16} {'part':<8} {'calibrated (UTC)':<19} {'verdict':<7} {'valid °C':<15} "
+             f"{'procedure':<22} source"]
+    for r in rows:
+        lines.append(f"{r['id']:>6}  {r['serial']:<16} {r['part']:<8} {r['calibrated_at']:%Y-%m-%d %H:%M:%S} "
+                     f"{r['verdict'] or '—':<7} {r['valid_from_c']:>6.1f}…{r['valid_to_c']:<7.1f} {r['procedure'][:22]:<22} "
+                     f"{Path(r['source_path']).name}{' (simulated)' if r['simulated'] else ''}")
+    return lines
+
+
+def sensor_lines(serial: str, current: dict[str, Any] | None, rows: list[dict[str, Any]], simulated: bool) -> list[str]:
+    """`rig registry show`: the sensor's valid calibration (or why it has none), then its history."""
+    lines = _current_lines(serial, current, rows, simulated) + [f"history ({len(rows)}):"]
+    for r in rows:
+        lines.append(f"  {r['id']:>6}  {r['calibrated_at']:%Y-%m-%d %H:%M}  {r['verdict'] or '—':<4}  "
+                     f"bias {triple(r['bias_mg'], 'mg')}  {Path(r['source_path']).name}"
+                     + (" (simulated)" if r["simulated"] else ""))
+    return lines
+
+
+def _current_lines(serial: str, current: dict[str, Any] | None, rows: list[dict[str, Any]],
+                   simulated: bool) -> list[str]:
+    if current is None:
+        newest = next((r for r in rows if simulated or not r["simulated"]), None)
+        why = ("its newest calibration failed its acceptance limits" if newest is not None
+               else "only dry runs (simulated) are recorded: --simulated shows them")
+        return [f"{serial}: no valid calibration ({why})"]
+    dry = " (SIMULATED: a dry run)" if current["simulated"] else ""
+    return [f"{serial} ({current['part']}): valid calibration {current['id']}{dry}, "
+            f"measured {current['calibrated_at']:%Y-%m-%d} "
+            f"by {current['procedure']} on {current['rig']}, {current['valid_from_c']:.1f}…{current['valid_to_c']:.1f} °C, "
+            f"verdict {current['verdict'] or 'none stated'}",
+            f"  at {current['reference_c']:g} °C: bias {triple(current['bias_mg'], 'mg', current['bias_uncertainty_mg'])}; "
+            f"scale error {triple(current['scale_error_ppm'], 'ppm', current['scale_uncertainty_ppm'], 0)}; "
+            f"non-orthogonality ≤ {current['nonorthogonality_mrad']:.3f} mrad",
+            f"  source {current['source_path']} (SHA-256 {current['source_sha256'][:16]}…), software "
+            f"{current['software_version']}"]
+
+
+def trend_lines(serial: str, calibrations: int, result: dict[str, Any]) -> list[str]:
+    """`rig registry trend`: each calibration's figures at the reference temperature, then the drift per year."""
+    lines = [f"{serial}: {calibrations} calibrations, figures at the reference temperature (± expanded, k = 2)"]
+    for point in result["calibrations"]:
+        lines.append(f"  {point['calibrated_at'][:10]}  bias {triple(point['bias_mg'], 'mg', point['bias_uncertainty_mg'])}"
+                     f"  scale {triple(point['scale_error_ppm'], 'ppm', point['scale_uncertainty_ppm'], 0)}")
+    for key, unit in (("bias_drift_mg_per_year", "mg"), ("scale_drift_ppm_per_year", "ppm")):
+        drift = result[key]
+        what = key.split("_drift")[0]
+        if drift is None:
+            lines.append(f"  {what} drift: needs two calibrations at different times")
+        else:
+            lines.append(f"  {what} drift per year: "
+                         + ", ".join(f"{axis} {_drift_text(d, unit)}" for axis, d in zip("xyz", drift)))
+    return lines
+
+
+def lot_lines(part: str, result: dict[str, Any]) -> list[str]:
+    """`rig registry stats`: the lot's yield, each figure's distribution per axis, the outliers."""
+    judged = f"{result['passed']} of {result['judged']} judged passed ({result['yield']:.1%})" if result["judged"] \
+        else "none judged against acceptance limits"
+    lines = [f"{part}: {result['sensors']} sensors ({result['calibrations']} calibrations), newest of each: {judged}"]
+    for name, columns in result["distributions"].items():
+        for axis, summary in zip("xyz" if len(columns) == 3 else " ", columns):
+            if summary is not None:
+                lines.append(f"  {name:<22} {axis}  median {summary['median']:+10.4g}  p5…p95 {summary['p5']:+.4g}…"
+                             f"{summary['p95']:+.4g}  std {summary['std']:.3g}  (n {summary['n']})")
+    for outlier in result["outliers"]:
+        lines.append(f"  outlier: {outlier['serial']} (calibration {outlier['id']}) {outlier['figure']} "
+                     f"{outlier['axis'] or ''} {outlier['value']:+.4g} (robust z {outlier['robust_z']:+.1f})")
+    return lines
+
+
+def _drift_text(drift: dict[str, float | None], unit: str) -> str:
+    """`+0.12 ± 0.03 mg`; without stated uncertainties (hand-held fits) the slope alone, said so."""
+    uncertainty = drift["expanded_uncertainty"]
+    spread = f" ± {uncertainty:.2g}" if uncertainty is not None else " (uncertainty not stated)"
+    return f"{drift['per_year']:+.4g}{spread} {unit}"
+
+
+def triple(values: list[float] | None, unit: str, uncertainty: list[float] | None = None, digits: int = 3) -> str:
+    """x/y/z of a figure (`+1.234/-0.500/+0.020 mg`), each with its uncertainty when given; `—` for none."""
+    if values is None:
+        return "—"
+    if uncertainty is None:
+        return "/".join(f"{v:+.{digits}f}" for v in values) + f" {unit}"
+    return "/".join(f"{v:+.{digits}f}±{u:.{digits}f}" for v, u in zip(values, uncertainty)) + f" {unit}"
+
+
+def public(row: dict[str, Any]) -> dict[str, Any]:
+    """A row as JSON: times as ISO 8601 UTC, the stored fit left out (`rig registry export` gives it)."""
+    return {k: (v.isoformat() + "Z" if isinstance(v, datetime) else v) for k, v in row.items() if k != "calibration"}

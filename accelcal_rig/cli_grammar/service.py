@@ -1,0 +1,40 @@
+"""The grammar of the commands that serve the operator's tools: `rig completion` and `rig serve`."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from accelcal_rig.cli_grammar.common import Commands, command, number, registry_option
+
+
+def add_completion_command(commands: Commands) -> None:
+    """`rig completion`: a shell completion script."""
+    completion = command(commands, "completion", "print a shell completion script",
+                         "Print a completion script for bash (commands, their actions and options; file names "
+                         "elsewhere). Load it now with eval \"$(rig completion bash)\", or for good: "
+                         "rig completion bash > ~/.local/share/bash-completion/completions/rig",
+                         "rig completion bash > ~/.local/share/bash-completion/completions/rig")
+    completion.add_argument("shell", choices=["bash"])
+
+
+def add_serve_command(commands: Commands) -> None:
+    """`rig serve`: the web dashboard."""
+    serve = command(commands, "serve", "a local web dashboard of campaigns and the registry",
+                    "Serve the dashboard: running and recent campaigns of the watched folders (state, phase, "
+                    "setpoint, temperatures, poses, time left, warnings, refreshed live), each campaign's "
+                    "temperature plot, report and certificates, and the registry (a serial's history and "
+                    "trend, a part's lot). Campaign files are only read, as rig status reads them. It listens "
+                    "on 127.0.0.1; another address needs --token (and TLS is advised: --tls-cert, --tls-key). "
+                    "Needs: pip install 'accelcal-rig[dashboard]'.",
+                    "rig serve --campaigns campaigns/ --port 8040")
+    serve.add_argument("--campaigns", type=Path, action="append", metavar="DIR",
+                       help="a folder of campaign files to show (repeatable; default: the current folder)")
+    registry_option(serve)
+    serve.add_argument("--config", type=Path, metavar="RIG", help="rig config whose registry: to use")
+    serve.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1)")
+    serve.add_argument("--port", type=number(0, 65535, integer=True), default=8040,
+                       help="port (default 8040; 0: any free one, printed)")
+    serve.add_argument("--token", help="a secret every request must carry (needed off 127.0.0.1; default "
+                                       "$ACCELCAL_DASHBOARD_TOKEN)")
+    serve.add_argument("--tls-cert", type=Path, help="TLS certificate (PEM), with --tls-key: serve HTTPS")
+    serve.add_argument("--tls-key", type=Path, help="its private key (PEM)")

@@ -1,0 +1,102 @@
+"""The work behind `rig serve`: the dashboard's options checked, its app made and its socket listening —
+before its address is printed, so whoever reads it can connect at once (and port 0 works) — then served."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import socket
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from accelcal_rig.errors import ConfigError
+
+
+@dataclass
+class Dashboard:
+    """A dashboard app and the socket it will be served on."""
+
+    app: Any
+    listening: socket.socket
+    host: str
+    token: str | None
+    tls_cert: Path | None
+    tls_key: Path | None
+
+    @property
+    def url(self) -> str:
+        """Where to open it: the port it listens on, the token in the query if it needs one."""
+        from urllib.parse import quote
+
+        scheme = "https" if self.tls_cert else "http"
+        port = self.listening.getsockname()[1]
+        return f"{scheme}://{self.host}:{port}/" + (f"?token={quote(self.token, safe='')}" if self.token else "")
+
+    def serve(self) -> None:
+        """Serve it until interrupted."""
+        import uvicorn
+
+        config = uvicorn.Config(self.app, log_level="warning", ssl_certfile=self.tls_cert, ssl_keyfile=self.tls_key)
+        uvicorn.Server(config).run(sockets=[self.listening])
+
+
+def open_dashboard(args: argparse.Namespace) -> Dashboard:
+    """The dashboard `rig serve`'s options describe, listening already; every mistake one line before then."""
+    from accelcal_rig.registry.location import configured, registry_url
+
+    try:
+        import uvicorn  # noqa: F401 - a missing extra is one line before anything else
+
+        from accelcal_rig.web.app import LOOPBACK_HOSTS, create_app
+    except ModuleNotFoundError as exc:
+        raise ConfigError(f"rig serve needs {exc.name}: pip install 'accelcal-rig[dashboard]'") from None
+    token = args.token or os.environ.get("ACCELCAL_DASHBOARD_TOKEN") or None
+    _check_access(args.host, token, args.tls_cert, args.tls_key)
+    folders = args.campaigns or [Path.cwd()]
+    missing = [folder for folder in folders if not folder.is_dir()]
+    if missing:
+        raise ConfigError(f"--campaigns {missing[0]}: not a folder")
+    from_config = None
+    if args.config is not None:
+        from accelcal_rig.config.load import load_rig
+
+        rig = load_rig(args.config)
+        from_config = configured(rig.model.registry, rig.path)
+    app = create_app(folders, registry_url(args.registry, from_config), token, tls=args.tls_cert is not None,
+                     hosts=[*LOOPBACK_HOSTS, args.host])
+    return Dashboard(app, _listen(args.host, args.port), args.host, token, args.tls_cert, args.tls_key)
+
+
+def _check_access(host: str, token: str | None, tls_cert: Path | None, tls_key: Path | None) -> None:
+    """Off the loopback a token; TLS files in pairs, and loadable."""
+    import ipaddress
+
+    try:
+        loopback = host == "localhost" or ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        loopback = False
+    if not loopback and token is None:
+        raise ConfigError(f"--host {host}: off 127.0.0.1 the dashboard needs --token (anyone on the network "
+                          "could read it otherwise)")
+    if (tls_cert is None) != (tls_key is None):
+        raise ConfigError("--tls-cert and --tls-key go together")
+    if tls_cert is not None:
+        import ssl
+
+        try:  # before anything is printed: a wrong file is one line naming it
+            ssl.create_default_context(ssl.Purpose.CLIENT_AUTH).load_cert_chain(tls_cert, tls_key)
+        except (OSError, ssl.SSLError) as exc:
+            raise ConfigError(f"--tls-cert {tls_cert} --tls-key {tls_key}: cannot load: {exc}") from None
+
+
+def _listen(host: str, port: int) -> socket.socket:
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    listening = socket.socket(family, socket.SOCK_STREAM)
+    listening.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        listening.bind((host, int(port)))
+    except OSError as exc:
+        raise ConfigError(f"--host {host} --port {port}: cannot listen there: {exc.strerror}") from None
+    listening.listen(128)
+    return listening
