@@ -4,6 +4,8 @@
 #include <stdbool.h>
 #include <string.h>
 
+#include "model_random.h"
+
 #define REG_COUNT 0x30u
 #define REG_STATUS 0x04u
 #define REG_FIFO_ENTRIES 0x05u
@@ -44,29 +46,6 @@ static struct {
     uint32_t temperature_stream;
     int tear_sign;
 } part;
-
-/* lowbias32 (a well-known 32-bit integer hash): the noise is a function of the entry index, not
- * of a stream's state, so a test can recompute any sample. */
-static uint32_t hash32(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7FEB352Du;
-    x ^= x >> 15;
-    x *= 0x846CA68Bu;
-    x ^= x >> 16;
-    return x;
-}
-
-/* xorshift32: the draws of tears and temperature noise, each its own stream. */
-static uint32_t next_random(uint32_t *state)
-{
-    uint32_t x = *state;
-    x ^= x << 13;
-    x ^= x >> 17;
-    x ^= x << 5;
-    *state = x;
-    return x;
-}
 
 static int64_t lsb_per_g(unsigned range_code)
 {

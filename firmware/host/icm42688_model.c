@@ -4,6 +4,8 @@
 #include <stdbool.h>
 #include <string.h>
 
+#include "model_random.h"
+
 #define REG_COUNT 0x80u
 #define REG_DEVICE_CONFIG 0x11u
 #define REG_TEMP_DATA1 0x1Du
@@ -37,27 +39,6 @@ static struct {
     uint64_t reset_done_us;
     uint32_t temperature_stream;
 } icm;
-
-/* lowbias32, as the ADXL355 model's noise: a function of the word's index, so a test recomputes it. */
-static uint32_t hash32(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7FEB352Du;
-    x ^= x >> 15;
-    x *= 0x846CA68Bu;
-    x ^= x >> 16;
-    return x;
-}
-
-static uint32_t next_random(uint32_t *state)
-{
-    uint32_t x = *state;
-    x ^= x << 13;
-    x ^= x >> 17;
-    x ^= x << 5;
-    *state = x;
-    return x;
-}
 
 int32_t icm_model_noise_lsb(uint32_t seed, uint64_t word, int32_t amplitude_lsb)
 {
