@@ -21,6 +21,7 @@ from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.geometry import fixture_to_dut
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
+from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, VerificationSeenByFit, compile_plan
 from accelcal_rig.plan.kinematics import UnreachablePose
 from accelcal_rig.store.space import StorageEstimate, estimate_storage
@@ -38,8 +39,10 @@ class PreparedCampaign:
     def storage(self, dry_run: bool) -> StorageEstimate:
         """The disk the campaign will take (a dry run also stores the simulation's truth)."""
         acquisition = self.procedure.model.acquisition
-        return estimate_storage(len(self.plan.pose_steps), len(self.rig.model.fixture.sensors),
-                                acquisition.samples_per_pose, len(self.plan.axis_names), dry_run)
+        sensors = self.rig.model.fixture.sensors
+        channels = [[(c.name, len(c.axes)) for c in part(s.part).channels] for s in sensors]
+        return estimate_storage(len(self.plan.pose_steps), len(sensors), acquisition.samples_per_pose,
+                                len(self.plan.axis_names), dry_run, channels)
 
 
 def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str | None = None,

@@ -3,6 +3,7 @@ the rest follows from what the files hold per pose and per event."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,11 +29,21 @@ _JOURNAL_FIXED_BYTES = 64 * 1024
 _CALIBRATION_BYTES = (32 * 1024, 24 * 1024)
 
 
-def pose_record_bytes(n_duts: int, samples_per_pose: int, n_axes: int, with_truth: bool) -> int:
-    """The journal bytes of one pose, encoded as the writer encodes it."""
+#: What a DUT measures, for the estimate: each channel's name and number of axes (an ADXL355: accel, 3).
+DutChannels = Sequence[tuple[str, int]]
+ACCELEROMETER: DutChannels = (("accel", 3),)
+
+
+def pose_record_bytes(n_duts: int, samples_per_pose: int, n_axes: int, with_truth: bool,
+                      dut_channels: Sequence[DutChannels] | None = None) -> int:
+    """The journal bytes of one pose, encoded as the writer encodes it (`dut_channels`: each DUT's channels;
+    by default every DUT an accelerometer)."""
     truth = {"parameters": np.zeros(12), "gravity_g": np.zeros(3), "temperature_c": np.asarray(0.0)}
-    accel = ChannelPoseRecord(np.zeros((samples_per_pose, 3), dtype="i4"), np.zeros(3), np.zeros(3), np.zeros(3))
-    duts = [DutPoseRecord(f"DUT-{k:04d}", {"accel": accel}, (0.0, 0.0), True, truth if with_truth else None)
+    channels = dut_channels if dut_channels is not None else [ACCELEROMETER] * n_duts
+    duts = [DutPoseRecord(f"DUT-{k:04d}", {name: ChannelPoseRecord(np.zeros((samples_per_pose, axes), dtype="i4"),
+                                                                   np.zeros(axes), np.zeros(axes), np.zeros(axes))
+                                           for name, axes in channels[k]},
+                          (0.0, 0.0), True, truth if with_truth else None)
             for k in range(n_duts)]
     pose = PoseRecord("T-100/pose0001", -100.0, 1, np.zeros(n_axes), np.zeros(n_axes), np.zeros(3), 0.0, 0.0,
                       (0.0, 0.0), duts)
@@ -66,8 +77,9 @@ class StorageEstimate:
         return poses_left * per_pose + self.file_bytes + self.calibration_bytes
 
 
-def estimate_storage(poses: int, n_duts: int, samples_per_pose: int, n_axes: int, with_truth: bool) -> StorageEstimate:
-    pose_bytes = pose_record_bytes(n_duts, samples_per_pose, n_axes, with_truth)
+def estimate_storage(poses: int, n_duts: int, samples_per_pose: int, n_axes: int, with_truth: bool,
+                     dut_channels: Sequence[DutChannels] | None = None) -> StorageEstimate:
+    pose_bytes = pose_record_bytes(n_duts, samples_per_pose, n_axes, with_truth, dut_channels)
     events = poses * _EVENTS_PER_POSE
     journal = _JOURNAL_FIXED_BYTES + poses * pose_bytes + events * _EVENT_JOURNAL_BYTES
     file = _FILE_FIXED_BYTES + int(1.05 * poses * pose_bytes) + events * _EVENT_FILE_BYTES
