@@ -264,7 +264,7 @@ class CampaignRunner:
             sensor.standby()
             sensor.configure(acquisition.ranges(), acquisition.odr_hz)
             sensor.start_measurement()
-            events.info("preflight", f"sensor {sensor.serial}: {sensor.part.label} rev {identity.revision} "
+            events.info("preflight", f"sensor {sensor.serial}: {identity.describe(sensor.part.label)} "
                                      f"({sensor.part.describe_identity(identity.registers)}), "
                                      f"{sensor.part.describe_ranges(acquisition.ranges())}, {acquisition.odr_hz:g} Hz")
 

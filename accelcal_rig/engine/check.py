@@ -31,7 +31,7 @@ def check_lines(instruments: SomeInstruments, rig: RigConfig) -> Iterator[str]:
         if wrong:
             raise InstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): {wrong}")
         ranges, odr_hz = sensor.read_settings()
-        yield (f"sensor {sensor.serial}  {sensor.endpoint}: {sensor.part.label} rev {identity.revision}, "
+        yield (f"sensor {sensor.serial}  {sensor.endpoint}: {identity.describe(sensor.part.label)}, "
                f"{sensor.part.describe_ranges(ranges)}, "
                f"{odr_hz:g} Hz, {sensor.read_temperature_c():.1f} °C")
 

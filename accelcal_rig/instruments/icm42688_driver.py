@@ -54,7 +54,7 @@ class Icm42688:
     def identify(self) -> DeviceIdentity:
         """WHO_AM_I (bank 0: selected first, whatever bank a previous user left)."""
         self._bus.write(regs.REG_BANK_SEL, 0)
-        return DeviceIdentity((self._bus.read(regs.REG_WHO_AM_I, 1)[0],), 0)
+        return DeviceIdentity((self._bus.read(regs.REG_WHO_AM_I, 1)[0],))  # no revision register
 
     def reset(self) -> None:
         """Soft reset (DEVICE_CONFIG), then wait with a deadline for INT_STATUS's RESET_DONE."""

@@ -14,10 +14,14 @@ from accelcal_rig.parts.part import Part
 @dataclass(frozen=True)
 class DeviceIdentity:
     """A DUT's identification registers (those its part names, e.g. DEVID_AD, DEVID_MST, PARTID of an ADXL355;
-    WHO_AM_I of an ICM-42688-P) and its silicon revision where it has one (0 where not)."""
+    WHO_AM_I of an ICM-42688-P) and its silicon revision where it has a register for it (None where not)."""
 
     registers: tuple[int, ...]
-    revision: int = 0
+    revision: int | None = None
+
+    def describe(self, label: str) -> str:
+        """"ADXL355 rev 1", or "ICM-42688-P" for a part that states no revision."""
+        return label if self.revision is None else f"{label} rev {self.revision}"
 
 
 @dataclass(frozen=True)

@@ -77,6 +77,7 @@ def test_identify_selects_bank_0_then_reads_who_am_i() -> None:
     driver, bus, _ = driver_on([("W", 0x76, 0x00), ("R", 0x75, 1, b"\x47")])
     identity = driver.identify()
     assert identity.registers == (0x47,) and ICM42688P.wrong_identity(identity.registers) is None
+    assert identity.revision is None and identity.describe(ICM42688P.label) == "ICM-42688-P"  # no revision register
     assert bus.done
 
 
