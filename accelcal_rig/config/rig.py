@@ -101,6 +101,19 @@ class TurntableAxis(StrictModel):
     max_deg: AngleDeg = 180.0
     continuous: bool = Field(False, description="endless axis: angles wrap into [min_deg, max_deg)")
     speed_deg_s: float = Field(10.0, ge=0.01, le=1000)
+    max_rate_dps: float | None = Field(None, gt=0, le=10000, description="rate mode: the highest rate (°/s, "
+                                       "either direction) the axis may be commanded; None: the axis has no rate mode")
+    max_acceleration_dps2: float | None = Field(None, gt=0, le=100000, description="rate mode: the highest "
+                                                "acceleration limit (°/s²) a rate may be commanded with")
+    slip_ring: bool = Field(False, description="the axis turns endlessly without winding a cable (a slip ring): "
+                            "constant-rate rotation needs one; default: true for a continuous axis")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _slip_ring_of_a_continuous_axis(cls, data: Any) -> Any:
+        if isinstance(data, dict) and "slip_ring" not in data:
+            return {**data, "slip_ring": bool(data.get("continuous", False))}
+        return data
 
     @field_validator("axis")
     @classmethod
@@ -116,7 +129,14 @@ class TurntableAxis(StrictModel):
             raise ValueError("min_deg must be below max_deg")
         if self.continuous and self.max_deg - self.min_deg != 360.0:
             raise ValueError("a continuous axis wraps over exactly 360°: set max_deg = min_deg + 360")
+        if (self.max_rate_dps is None) != (self.max_acceleration_dps2 is None):
+            raise ValueError("rate mode needs both max_rate_dps and max_acceleration_dps2 (or neither)")
         return self
+
+    @property
+    def has_rate_mode(self) -> bool:
+        """Whether the rig config gives the axis rate and acceleration limits (constant-rate rotation)."""
+        return self.max_rate_dps is not None and self.max_acceleration_dps2 is not None
 
     def allows(self, angle_deg: float) -> bool:
         """The one axis-limit rule: a continuous axis goes anywhere, any other stays within its limits."""
@@ -138,6 +158,10 @@ class TurntableConfig(StrictModel):
     position_tolerance_deg: float = Field(0.01, ge=1e-6, le=5)
     accuracy_arcsec: float = Field(3.0, ge=0, le=3600, description="angular position accuracy of each axis "
                                    "(spec sheet, ±): the fit's reference-mode uncertainty, the simulated table's error")
+    rate_accuracy_pct: float | None = Field(None, ge=0, le=10, description="rate mode: accuracy of a constant "
+                                            "rate (spec sheet, ± % of the rate): the simulated table's rate offset")
+    rate_stability_pct: float | None = Field(None, ge=0, le=10, description="rate mode: stability of a constant "
+                                             "rate (spec sheet, % of the rate, 1σ): the simulated rate's wobble")
 
     @field_validator("axes")
     @classmethod

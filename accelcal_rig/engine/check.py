@@ -7,7 +7,13 @@ from collections.abc import Iterator
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.humidity import dew_point_c
 from accelcal_rig.errors import InstrumentError
-from accelcal_rig.instruments.capabilities import AlarmReporting, controller_limits, has_purge, humidity_pct
+from accelcal_rig.instruments.capabilities import (
+    AlarmReporting,
+    ConstantRateRotation,
+    controller_limits,
+    has_purge,
+    humidity_pct,
+)
 from accelcal_rig.instruments.connect import SomeInstruments
 from accelcal_rig.instruments.interfaces import Chamber, Turntable
 
@@ -24,7 +30,7 @@ def check_lines(instruments: SomeInstruments, rig: RigConfig) -> Iterator[str]:
     if turntable is not None:
         angles = " ".join(f"{a:.3f}" for a in turntable.read_angles_deg())
         yield (f"turntable  {turntable.endpoint}: {turntable.identify()}, angles {angles}°, "
-               f"{'in position' if _at_rest(turntable) else 'moving'}")
+               f"{'in position' if _at_rest(turntable) else 'moving'}{_rates(turntable, rig)}")
     for sensor in instruments.sensors:
         identity = sensor.identify()
         wrong = sensor.part.wrong_identity(identity.registers)
@@ -34,6 +40,15 @@ def check_lines(instruments: SomeInstruments, rig: RigConfig) -> Iterator[str]:
         yield (f"sensor {sensor.serial}  {sensor.endpoint}: {identity.describe(sensor.part.label)}, "
                f"{sensor.part.describe_ranges(ranges)}, "
                f"{odr_hz:g} Hz, {sensor.read_temperature_c():.1f} °C")
+
+
+def _rates(turntable: Turntable, rig: RigConfig) -> str:
+    """The rates of the axes the rig config gives a rate mode, where the profile can read them; nothing else
+    (a table without rate mode, or a rig that states none, is not asked)."""
+    axes = [(index, axis.name) for index, axis in enumerate(rig.turntable.axes) if axis.max_rate_dps is not None]
+    if not axes or not isinstance(turntable, ConstantRateRotation):
+        return ""
+    return ", rates " + " ".join(f"{name} {turntable.read_rate_deg_s(index):.3f}" for index, name in axes) + " °/s"
 
 
 def _alarm(chamber: Chamber) -> str:

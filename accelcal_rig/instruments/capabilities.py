@@ -62,12 +62,15 @@ class SetpointResolution(Protocol):
 
 @runtime_checkable
 class ConstantRateRotation(Protocol):
-    """Turns an axis at a constant rate (a rate table: a gyroscope's reference). Declared for issue 26 (rate
-    tables), which implements it (ACUTROL rate mode, shared reference/instruments.md); no driver has it yet:
-    no turntable profile has a rate command to send."""
+    """Turns an axis at a constant rate (a rate table: a gyroscope's reference): `axis` is the index of the
+    rig config's axis (0 is the outermost). `rotate_at` reaches `rate_deg_s` (signed) at
+    `acceleration_deg_s2`; `read_rate_deg_s` is the controller's rate read-back; `hold` brings the axis to
+    rest at its acceleration limit and holds it (the next move returns it to position mode). The serial
+    driver has it where its profile has rate commands (`rotate`, `hold`, `rate`)."""
 
-    def rotate_at(self, axis: int, rate_deg_s: float) -> None: ...
+    def rotate_at(self, axis: int, rate_deg_s: float, acceleration_deg_s2: float) -> None: ...
     def read_rate_deg_s(self, axis: int) -> float: ...
+    def hold(self, axis: int) -> None: ...
 
 
 # ---------------------------------------------------------------------- sensors and links

@@ -15,6 +15,7 @@ import numpy as np
 
 from accelcal_rig.instruments.capabilities import (
     AlarmReporting,
+    ConstantRateRotation,
     ControllerLimits,
     HumiditySensing,
     Purging,
@@ -143,6 +144,19 @@ class PassTurntableReconnect(TurntableDelegate):
         cast(Reconnecting, self._turntable).reconnect()
 
 
-#: Every turntable capability a delegate passes on (ConstantRateRotation comes with its first driver).
-TURNTABLE_CAPABILITIES: Mapping[type, type[TurntableDelegate]] = {Reconnecting: PassTurntableReconnect}
+class PassRateRotation(TurntableDelegate):
+    def rotate_at(self, axis: int, rate_deg_s: float, acceleration_deg_s2: float) -> None:
+        self._through(lambda: cast(ConstantRateRotation, self._turntable).rotate_at(axis, rate_deg_s,
+                                                                                     acceleration_deg_s2))
+
+    def read_rate_deg_s(self, axis: int) -> float:
+        return self._through(lambda: cast(ConstantRateRotation, self._turntable).read_rate_deg_s(axis))
+
+    def hold(self, axis: int) -> None:
+        self._through(lambda: cast(ConstantRateRotation, self._turntable).hold(axis))
+
+
+#: Every turntable capability a delegate passes on, and how.
+TURNTABLE_CAPABILITIES: Mapping[type, type[TurntableDelegate]] = {Reconnecting: PassTurntableReconnect,
+                                                                  ConstantRateRotation: PassRateRotation}
 TurntableDelegate._passes_on = TURNTABLE_CAPABILITIES

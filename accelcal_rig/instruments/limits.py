@@ -9,12 +9,19 @@ import numpy as np
 from accelcal_rig.config.rig import ChamberConfig, TurntableConfig
 from accelcal_rig.errors import InstrumentError
 from accelcal_rig.instruments.capabilities import (
+    ConstantRateRotation,
     ControllerLimits,
     SetpointResolution,
     controller_limits,
     setpoint_decimals,
 )
-from accelcal_rig.instruments.delegates import CHAMBER_CAPABILITIES, ChamberDelegate, TurntableDelegate
+from accelcal_rig.instruments.delegates import (
+    CHAMBER_CAPABILITIES,
+    TURNTABLE_CAPABILITIES,
+    ChamberDelegate,
+    PassRateRotation,
+    TurntableDelegate,
+)
 from accelcal_rig.instruments.interfaces import Chamber, Turntable
 
 #: A setpoint read back further than this from what was written means the controller did not take it.
@@ -79,8 +86,9 @@ LimitedChamber._passes_on = {**CHAMBER_CAPABILITIES, ControllerLimits: _LimitsRe
 
 
 class LimitedTurntable(TurntableDelegate):
-    """Refuses moves outside the axis limits (continuous axes excepted) or with the wrong axis count; the rest
-    is passed on."""
+    """Refuses moves outside the axis limits (continuous axes excepted) or with the wrong axis count, and, on
+    a rate table, a rate or acceleration beyond the axis's rate limits or constant-rate rotation of an axis
+    without rate limits or without a slip ring; the rest is passed on."""
 
     def __init__(self, turntable: Turntable, config: TurntableConfig) -> None:
         super().__init__(turntable)
@@ -97,3 +105,26 @@ class LimitedTurntable(TurntableDelegate):
                     f"limits are {axis.min_deg:g}…{axis.max_deg:g}°"
                 )
         self._turntable.move_to(angles)
+
+
+class _LimitedRate(LimitedTurntable, PassRateRotation):
+    def rotate_at(self, axis: int, rate_deg_s: float, acceleration_deg_s2: float) -> None:
+        if not 0 <= axis < len(self._axes):
+            raise InstrumentError(f"turntable ({self.endpoint}): no axis {axis} (the rig has {len(self._axes)})")
+        limits = self._axes[axis]
+        refused = f"turntable ({self.endpoint}): axis {limits.name} at {rate_deg_s:g} °/s refused"
+        if limits.max_rate_dps is None or limits.max_acceleration_dps2 is None:
+            raise InstrumentError(f"{refused}: the rig config gives it no rate mode (max_rate_dps, "
+                                  "max_acceleration_dps2)")
+        if not limits.slip_ring:
+            raise InstrumentError(f"{refused}: it has no slip ring (slip_ring: false), so it cannot turn "
+                                  "continuously")
+        if not (math.isfinite(rate_deg_s) and abs(rate_deg_s) <= limits.max_rate_dps):
+            raise InstrumentError(f"{refused}: beyond its max_rate_dps {limits.max_rate_dps:g} °/s")
+        if not (math.isfinite(acceleration_deg_s2) and 0 < acceleration_deg_s2 <= limits.max_acceleration_dps2):
+            raise InstrumentError(f"{refused}: acceleration {acceleration_deg_s2:g} °/s² beyond its "
+                                  f"max_acceleration_dps2 {limits.max_acceleration_dps2:g} °/s²")
+        super().rotate_at(axis, rate_deg_s, acceleration_deg_s2)
+
+
+LimitedTurntable._passes_on = {**TURNTABLE_CAPABILITIES, ConstantRateRotation: _LimitedRate}

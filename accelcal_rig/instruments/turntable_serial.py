@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import re
 import time
+from typing import Self
 
 import numpy as np
 
 from accelcal_rig.config.rig import TurntableConfig
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.instruments.composition import composed, instance_of
 from accelcal_rig.instruments.definitions import TurntableDriver
 from accelcal_rig.instruments.line_port import LinePort, describe_endpoint
 from accelcal_rig.instruments.retrying import RetryCall
@@ -16,6 +18,13 @@ from accelcal_rig.protocols.turntable_line import Command, TurntableProtocol
 
 
 class SerialTurntable:
+    """A turntable of exactly the capabilities its profile has (constant-rate rotation where it has rate
+    commands: accelcal_rig.instruments.capabilities), whichever way it is made."""
+
+    def __new__(cls, line: LinePort, endpoint: str, protocol: TurntableProtocol, n_axes: int) -> Self:
+        mixins = [_RateTable] if protocol.rotate is not None else []
+        return instance_of(composed(cls, mixins) if cls is SerialTurntable else cls)
+
     def __init__(self, line: LinePort, endpoint: str, protocol: TurntableProtocol, n_axes: int) -> None:
         self._line = line
         self.endpoint = endpoint
@@ -25,6 +34,7 @@ class SerialTurntable:
         self._retry: RetryCall = lambda operation, reconnect: operation()
         self._set_up = False  # the profile's setup (interlock, mode) goes out before the first move
         self._polls_at_rest = 0
+        self._rate_axes: set[int] = set()  # axes a rate command left in rate mode (their interlock closed)
 
     @classmethod
     def open(cls, endpoint: str, protocol: TurntableProtocol, n_axes: int, baudrate: int = 9600,
@@ -75,6 +85,7 @@ class SerialTurntable:
         """Stop every axis; a profile's stop may leave another mode, so the next move sets it up again."""
         self._set_up = False
         self._each(self.protocol.stop)
+        self._rate_axes.clear()
 
     def close(self) -> None:
         self._line.close()
@@ -95,6 +106,7 @@ class SerialTurntable:
                 self._ask(command, axis=axis)
                 time.sleep(self.protocol.setup_pause_s)
         self._set_up = True
+        self._rate_axes.clear()  # the setup selects position mode
 
     def _each(self, command: Command | None) -> list[tuple[int | None, dict[str, str]]]:
         """A command sent once per axis if it names one (1-based axis numbers), else once (axis None)."""
@@ -119,6 +131,38 @@ class SerialTurntable:
         if match is None:
             raise TransientInstrumentError(f"turntable ({self.endpoint}): {request!r}: unexpected reply {reply!r}")
         return {k: v for k, v in match.groupdict().items() if v is not None}
+
+
+class _RateTable(SerialTurntable):
+    """Constant-rate rotation, composed in only for a profile with rate commands. Limits are the caller's
+    gate (LimitedTurntable)."""
+
+    def rotate_at(self, axis: int, rate_deg_s: float, acceleration_deg_s2: float) -> None:
+        """Turn one axis (0-based) at a rate; a profile's setup (interlock) goes out first unless an axis is
+        already in rate mode, and the next move sets position mode up again."""
+        number = self._axis_number(axis)
+        if not self._set_up and not self._rate_axes:
+            self._setup()
+        assert self.protocol.rotate is not None
+        self._ask(self.protocol.rotate, axis=number, rate=float(rate_deg_s), acceleration=float(acceleration_deg_s2),
+                  rate_limit=abs(float(rate_deg_s)))
+        self._rate_axes.add(axis)
+        self._set_up = False
+        self._polls_at_rest = 0
+
+    def read_rate_deg_s(self, axis: int) -> float:
+        assert self.protocol.rate is not None
+        return float(self._ask(self.protocol.rate, axis=self._axis_number(axis))["rate"])
+
+    def hold(self, axis: int) -> None:
+        assert self.protocol.hold is not None
+        self._ask(self.protocol.hold, axis=self._axis_number(axis))
+        self._polls_at_rest = 0
+
+    def _axis_number(self, axis: int) -> int:
+        if not 0 <= axis < self.n_axes:
+            raise InstrumentError(f"turntable ({self.endpoint}): no axis {axis} (it has {self.n_axes})")
+        return axis + 1
 
 
 def _is_fault(protocol: TurntableProtocol, reply: str) -> bool:

@@ -106,7 +106,15 @@ class VirtualLab:
             accuracy_deg=rig.turntable.accuracy_arcsec / 3600.0,
             settle_s=sim.turntable_settle_s,
             rng=self.rng,
+            # A rate table's error and wobble, each its own stream: a rig that never turns at a rate draws
+            # nothing more from the others.
+            rate_offsets=np.random.default_rng([seed, 1_000_007]).uniform(-1.0, 1.0, len(rig.turntable.axes))
+            * (rig.turntable.rate_accuracy_pct or 0.0) / 100.0,
+            rate_stability=(rig.turntable.rate_stability_pct or 0.0) / 100.0,
+            rate_rng=np.random.default_rng([seed, 1_000_009]),
         )
+        #: The acceleration of a rate command that names none (a profile setting it as a limit of its own).
+        self.rate_acceleration_deg_s2 = [a.max_acceleration_dps2 or 100.0 for a in rig.turntable.axes]
         self._gravity_angles_key = b""
         self._gravity_fixture = np.array([0.0, 0.0, 1.0])
         self._truth_coefficients = np.stack([d.truth.coefficients for d in self.duts]) if self.duts \

@@ -10,7 +10,7 @@ from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 
-_OPERATIONS = ("identify", "move", "position", "busy", "rate", "stop", "home", "fault")
+_OPERATIONS = ("identify", "move", "position", "busy", "rate", "rotate", "hold", "stop", "home", "fault")
 
 
 class SimulatedTurntableServer:
@@ -36,6 +36,8 @@ class SimulatedTurntableServer:
         #: ignores moves before it, as a table out of position mode does.
         self._set_up = [not protocol.setup] * n_axes
         self._setup_seen: list[set[str]] = [set() for _ in range(n_axes)]
+        #: Axes a rate command has put in rate mode (a profile with setup then ignores moves until it again).
+        self._rate_mode = [False] * n_axes
 
     @property
     def fault(self) -> str:
@@ -79,7 +81,7 @@ class SimulatedTurntableServer:
         for name, command, pattern in self._patterns:
             match = pattern.fullmatch(request)
             if match is not None:
-                if name in ("move", "stop", "home"):
+                if name in ("move", "stop", "home", "rotate", "hold"):
                     self.last_command = request
                 try:
                     answer = self._answer(name, command.answer or "", match.groupdict())
@@ -102,8 +104,17 @@ class SimulatedTurntableServer:
                 for a in axes:
                     self._setup_seen[a].add(name)
                     self._set_up[a] = len(self._setup_seen[a]) == len(self._protocol.setup)
+                    self._rate_mode[a] = self._rate_mode[a] and not self._set_up[a]
             elif name == "move" and not stalled and axis is not None and self._set_up[axis]:
                 motion.command_axis(now, axis, float(fields["angle"]))  # a stalled or unarmed table stays put
+            elif name == "rotate" and not stalled and axis is not None and (self._set_up[axis] or self._rate_mode[axis]):
+                motion.rotate(now, axis, float(fields["rate"]), float(fields["acceleration"])
+                              if "acceleration" in fields else self._lab.rate_acceleration_deg_s2[axis])
+                self._rate_mode[axis] = True
+                if self._protocol.setup:  # out of position mode: a move needs the setup again
+                    self._set_up[axis], self._setup_seen[axis] = False, set()
+            elif name == "hold" and axis is not None:
+                motion.hold(now, axis)
             elif name == "stop":
                 motion.stop(now)
                 for a in axes if self._protocol.setup else ():  # a stop leaves the mode a move needs
@@ -117,7 +128,7 @@ class SimulatedTurntableServer:
                 "identity": self._identity,
                 "angle": float(motion.position_deg(now)[shown]),
                 "busy": self._protocol.not_busy if motion.in_position(now, axis) else self._protocol.busy_values[0],
-                "rate": float(motion.rate_deg_s(now)[shown]),
+                "rate": motion.read_rate_deg_s(now, shown),
                 "fault": self.faults[shown],
             }
         return template.format(**values)

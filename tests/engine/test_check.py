@@ -40,3 +40,21 @@ def test_a_chamber_without_an_alarm_query_says_nothing_about_an_alarm(tmp_path: 
 @pytest.mark.parametrize(("driver", "profile"), [("line", "espec-p300"), ("modbus-tcp", "watlow-f4t")])
 def test_a_chamber_with_an_alarm_query_says_its_answer(tmp_path: Path, driver: str, profile: str) -> None:
     assert "°C), alarm clear; set point limits: the rig's" in chamber_line(tmp_path, driver, profile)
+
+
+def turntable_line(tmp_path: Path, **axis_settings: object) -> str:
+    """The line `rig check --dry-run --only turntable` prints, the rig's inner axis given `axis_settings`."""
+    config = yaml.safe_load(SIM_RIG.read_text())
+    config["turntable"]["axes"][2].update(axis_settings)
+    path = tmp_path / "rig.yaml"
+    path.write_text(yaml.safe_dump(config))
+    rig = load_rig(path)
+    with connected(rig, dry_run=True, only=frozenset({"turntable"})) as instruments:
+        (line,) = check_lines(instruments, rig.model)
+    return line
+
+
+def test_a_table_reads_the_rate_of_the_axes_its_rig_gives_a_rate_mode_and_no_others(tmp_path: Path) -> None:
+    assert "rate" not in turntable_line(tmp_path)  # the rig states no rate mode: nothing asked
+    line = turntable_line(tmp_path, max_rate_dps=1000, max_acceleration_dps2=500)
+    assert line.endswith("in position, rates inner 0.000 °/s")

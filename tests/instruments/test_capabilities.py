@@ -28,7 +28,7 @@ from accelcal_rig.instruments.interfaces import Chamber, Positioning, Turntable
 from accelcal_rig.instruments.turntable_serial import SerialTurntable
 from accelcal_rig.protocols.chamber_lines import LINE_PROFILES, line_protocol
 from accelcal_rig.protocols.chamber_registers import PROFILES, register_map
-from accelcal_rig.protocols.turntable_line import PROTOCOLS
+from accelcal_rig.protocols.turntable_line import PROTOCOLS, turntable_protocol
 from tests.instruments.expected_protocol import expected_protocol
 
 CHAMBER_CAPABILITIES = (AlarmReporting, ControllerLimits, HumiditySensing, Purging, SetpointResolution)
@@ -92,8 +92,17 @@ def test_the_helpers_answer_for_a_chamber_without_the_capability() -> None:
 
 
 @pytest.mark.parametrize("profile", sorted(PROTOCOLS))
-def test_every_turntable_positions_and_none_turns_at_a_constant_rate_yet(profile: str) -> None:
+def test_every_turntable_positions_and_turns_at_a_constant_rate_where_its_profile_can(profile: str) -> None:
     with expected_protocol([]) as line:
         table = SerialTurntable(line, "memory", PROTOCOLS[profile], 2)
     assert isinstance(table, Turntable) and isinstance(table, Positioning)
-    assert not isinstance(table, ConstantRateRotation)  # the rate-table issue brings the first
+    assert isinstance(table, ConstantRateRotation)  # both built-in profiles have rate commands
+    assert type(table).__name__ == "SerialTurntable"
+
+
+def test_a_profile_without_rate_commands_has_no_rate_mode() -> None:
+    positioning_only = turntable_protocol("accelcal-line", {"rotate": None, "hold": None})
+    with expected_protocol([]) as line:
+        table = SerialTurntable(line, "memory", positioning_only, 2)
+    assert isinstance(table, Positioning) and not isinstance(table, ConstantRateRotation)
+    assert not hasattr(table, "rotate_at")

@@ -10,7 +10,7 @@ from accelcal_rig.protocols.turntable_line import ACUTROL3000, PROTOCOLS, turnta
 
 
 @pytest.mark.parametrize(("overrides", "message"), [
-    ({"busy": None}, "needs a busy query or a rate query"),
+    ({"busy": None, "rate": None, "rotate": None, "hold": None}, "needs a busy query or a rate query"),
     ({"fault": {"send": "F?", "reply": "[0-9]+", "answer": "0"}}, r"fault: the reply pattern must capture \(fault\)"),
     ({"multi_axis_move": True, "move": {"send": "MOVEALL {angle}", "reply": "OK", "answer": "OK"}},
      "the move must name {axis}"),
