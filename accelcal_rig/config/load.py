@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Generic, TypeVar
@@ -36,11 +37,13 @@ class LoadedConfig(Generic[ModelT]):
         return ConfigError(f"{self.path}:{line}: {format_key(key_path)}: {message}")
 
 
-def load_validated(path: Path, model: type[ModelT], limits: YamlLimits = CONFIG_LIMITS) -> LoadedConfig[ModelT]:
+def load_validated(path: Path, model: type[ModelT], limits: YamlLimits = CONFIG_LIMITS,
+                   relocate: Callable[[KeyPath, dict[KeyPath, int]], KeyPath] | None = None) -> LoadedConfig[ModelT]:
     """Parse and validate any of the project's YAML files; an error is one line, `file:line: key: message`
-    for the first problem, with how many more there are (fix one, run again)."""
+    for the first problem, with how many more there are (fix one, run again). `relocate`: where in the file
+    a key of the model stands, for a model that reads an older layout into its own."""
     data, lines, text = load_yaml_with_lines(path, limits)
-    return _validated(path, model, data, lines, text)
+    return _validated(path, model, data, lines, text, relocate)
 
 
 #: What stands in for a section a rig config leaves out for `rig check --only`: never connected, only there
@@ -66,13 +69,15 @@ def load_rig_for_check(path: Path, only: frozenset[str]) -> LoadedConfig[RigConf
     return _validated(path, RigConfig, data, lines, text)
 
 
-def _validated(path: Path, model: type[ModelT], data: Any, lines: dict[KeyPath, int], text: str) -> LoadedConfig[ModelT]:
+def _validated(path: Path, model: type[ModelT], data: Any, lines: dict[KeyPath, int], text: str,
+               relocate: Callable[[KeyPath, dict[KeyPath, int]], KeyPath] | None = None) -> LoadedConfig[ModelT]:
     try:
         validated = model.model_validate(data)
     except ValidationError as exc:
         messages = []
         for err in exc.errors(include_url=False):
-            shown, line = locate(lines, tuple(err["loc"]))
+            key = tuple(err["loc"])
+            shown, line = locate(lines, relocate(key, lines) if relocate is not None else key)
             message = explained(model, data, err) or str(err["msg"]).removeprefix("Value error, ")
             messages.append(f"{path}:{line}: {format_key(shown)}: {message}")
         more = (f" (and {len(messages) - 1} more problem{'s' if len(messages) > 2 else ''})" if len(messages) > 1 else "")

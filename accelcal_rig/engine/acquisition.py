@@ -12,7 +12,7 @@ from functools import partial
 import numpy as np
 
 from accelcal_rig.core.clock import Clock
-from accelcal_rig.errors import TransientInstrumentError
+from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.capabilities import BlockCapturing
 from accelcal_rig.instruments.capture import capture_together
 from accelcal_rig.instruments.interfaces import SampleBlock, Sensor
@@ -39,6 +39,10 @@ def check_block(sensor: Sensor, block: SampleBlock, ranges: Mapping[str, float])
     saturated."""
     channels = sensor.part.channels
     for channel in channels:
+        if channel.name not in block.codes:
+            raise InstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): its block holds no {channel.name} codes "
+                                  f"(its driver reads {', '.join(block.codes) or 'none'}; its part has "
+                                  f"{', '.join(sensor.part.channel_names)})")
         codes = block.codes[channel.name]
         named = f"{channel.name} axis" if len(channels) > 1 else "axis"
         frozen = [axis for axis, values in zip(channel.axes, codes.T) if values.size > 1 and np.ptp(values) == 0]

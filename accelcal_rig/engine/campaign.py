@@ -160,11 +160,13 @@ class CampaignRunner:
     def _reach_safe_state(self, failure: BaseException | None) -> None:
         """Every way the measuring ends leads here: the state machine to SAFE, the rig safe, the audience told."""
         assert self.events is not None
-        if failure is None:
-            self.machine.go(State.SAFE, "campaign complete")
-        else:
-            self._go_safe(one_line_reason(failure))
-        safe = self._apply_safe_state()
+        try:
+            if failure is None:
+                self.machine.go(State.SAFE, "campaign complete")
+            else:
+                self._go_safe(one_line_reason(failure))
+        finally:  # the bookkeeping before it may fail (a full disk, a bug): never the rig's safe state
+            safe = self._apply_safe_state()
         if self.context is not None:
             note_purge_left_on(self.context)
         total = len(self.plan.pose_steps)

@@ -16,6 +16,7 @@ from accelcal_rig.engine.run_context import RunContext
 from accelcal_rig.engine.states import State
 from accelcal_rig.engine.step_handler import StepHandler
 from accelcal_rig.instruments.interfaces import SampleBlock
+from accelcal_rig.parts.part import Channel
 from accelcal_rig.plan.steps import Measurement
 from accelcal_rig.store.records import ChannelPoseRecord, DutPoseRecord, PoseRecord
 
@@ -92,7 +93,7 @@ def _dut_record(run: RunContext, index: int, block: SampleBlock, gravity_fixture
     for channel in sensor.part.channels:
         codes = block.codes[channel.name]
         lsb, n = channel.lsb(ranges[channel.name]), codes.shape[0]
-        reference = REFERENCES[channel.quantity](run, sensor.serial, gravity_fixture)
+        reference = REFERENCES[channel.quantity](run, sensor.serial, channel, gravity_fixture)
         channels[channel.name] = ChannelPoseRecord(codes, codes.mean(axis=0) * lsb,
                                                    codes.std(axis=0, ddof=1) * lsb / np.sqrt(n), reference)
     band = run.procedure.soak.band_c
@@ -107,19 +108,19 @@ def _dut_record(run: RunContext, index: int, block: SampleBlock, gravity_fixture
     )
 
 
-def _gravity_reference(run: RunContext, serial: str, gravity_fixture: np.ndarray) -> np.ndarray:
+def _gravity_reference(run: RunContext, serial: str, channel: Channel, gravity_fixture: np.ndarray) -> np.ndarray:
     """The site's gravity (in standard g) in the DUT's frame: the commanded pose, the nominal mount."""
     return run.rig.gravity_g * (run.fixture_to_dut[serial] @ gravity_fixture)
 
 
-def _rate_at_rest(run: RunContext, serial: str, gravity_fixture: np.ndarray) -> np.ndarray:
-    """The table's angular rate in the DUT's frame: zero, the table at rest through a pose (the Earth's
-    rotation, 0.004 °/s, is not included)."""
-    return np.zeros(3)
+def _rate_at_rest(run: RunContext, serial: str, channel: Channel, gravity_fixture: np.ndarray) -> np.ndarray:
+    """The table's angular rate in the DUT's frame: zero on each of the channel's axes, the table at rest
+    through a pose (the Earth's rotation, 0.004 °/s, is not included)."""
+    return np.zeros(len(channel.axes))
 
 
 #: What a channel should read at a pose, by the quantity it measures.
-REFERENCES: dict[str, Callable[[RunContext, str, np.ndarray], np.ndarray]] = {
+REFERENCES: dict[str, Callable[[RunContext, str, Channel, np.ndarray], np.ndarray]] = {
     "acceleration": _gravity_reference, "angular rate": _rate_at_rest}
 
 

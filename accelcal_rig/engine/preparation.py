@@ -20,6 +20,7 @@ from accelcal_rig.config.load import (
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.geometry import fixture_to_dut
+from accelcal_rig.engine.pose_steps import REFERENCES
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
 from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, VerificationSeenByFit, compile_plan
@@ -53,6 +54,7 @@ def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str 
     rig = with_chamber_profile(with_faults(load_rig(resolve_rig_path(procedure, rig_override)), faults),
                                chamber_profile)
     check_procedure_against_rig(procedure, rig)
+    _check_every_channel_has_a_reference(rig)
     try:
         plan = compile_plan(procedure.model, rig.model)
     except UnreachablePose as exc:
@@ -63,6 +65,17 @@ def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str 
         raise procedure.error(("verify", "schedule"), str(exc)) from None
     _check_design_identifies_fit(procedure, rig.model, plan)
     return PreparedCampaign(procedure, rig, plan, chamber_profile)
+
+
+def _check_every_channel_has_a_reference(rig: LoadedConfig[RigConfig]) -> None:
+    """Refuse, before anything moves, a part (a plug-in's) measuring a quantity no pose can say the reference
+    of: the first pose would otherwise stop the campaign after its first soak."""
+    for index, sensor in enumerate(rig.model.fixture.sensors):
+        for channel in part(sensor.part).channels:
+            if channel.quantity not in REFERENCES:
+                raise rig.error(("fixture", "sensors", index, "part"),
+                                f"the {part(sensor.part).label}'s {channel.name} channel measures {channel.quantity!r}, "
+                                f"which no pose has a reference for (known: {', '.join(sorted(REFERENCES))})")
 
 
 def _check_design_identifies_fit(procedure: LoadedConfig[Procedure], rig: RigConfig, plan: Plan) -> None:

@@ -198,10 +198,18 @@ def load_calibration(path: Path) -> CalibrationFile:
     certificates and its registry entries read the same file one after the other)."""
     key = _file_key(path)
     if key is None:  # missing or unreadable: the loader says so in its own words
-        return load_validated(path, CalibrationFile, CALIBRATION_LIMITS).model
+        return load_validated(path, CalibrationFile, CALIBRATION_LIMITS, _in_version_1).model
     if key not in _LOADED:
-        _remember(path, load_validated(path, CalibrationFile, CALIBRATION_LIMITS).model)
+        _remember(path, load_validated(path, CalibrationFile, CALIBRATION_LIMITS, _in_version_1).model)
     return _LOADED[key].model_copy(deep=True)
+
+
+def _in_version_1(key: tuple[str | int, ...], lines: dict[tuple[str | int, ...], int]) -> tuple[str | int, ...]:
+    """Where a key of a DUT's accel calibration stands in a version-1 file (`sensors.<serial>.…`), so that a
+    problem in one is reported at its own line."""
+    if len(key) >= 4 and key[0] == "duts" and key[2:4] == ("channels", ACCELERATION) and ("sensors", key[1]) in lines:
+        return ("sensors", key[1], *key[4:])
+    return key
 
 
 #: Calibrations read or written lately, by (path, inode, size, modification time): a changed file is read again.

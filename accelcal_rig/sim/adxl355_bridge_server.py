@@ -11,6 +11,7 @@ import numpy as np
 from accelcal_rig.config.rig import SensorConfig
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import BRIDGE_GREETING
+from accelcal_rig.sim.bridge_requests import register_request
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
@@ -219,11 +220,9 @@ class SimulatedBridgeServer:
                 if parts == ["?"]:
                     capture = f" capture={CAPTURE_CAPACITY_SAMPLES}" if self._version >= 2 else ""
                     return f"{BRIDGE_GREETING} {self._version}{capture} accelcal-rig simulated bridge"
-                if len(parts) == 3 and parts[0] == "R":
-                    return "=" + self.device.read(int(parts[1], 16), int(parts[2])).hex().upper()
-                if len(parts) == 3 and parts[0] == "W":
-                    self.device.write(int(parts[1], 16), int(parts[2], 16))
-                    return "="
+                reply = register_request(self.device, parts)
+                if reply is not None:
+                    return reply
                 if self._version >= 2 and len(parts) == 2 and parts[0] == "C":
                     return f"={self.device.start_capture(int(parts[1])):04X}"
                 if self._version >= 2 and len(parts) == 2 and parts[0] == "G":

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from accelcal_rig.config.rig import SensorConfig
 from accelcal_rig.instruments.adxl355_transport import BRIDGE_GREETING
+from accelcal_rig.sim.bridge_requests import register_request
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.icm42688_registers import SimulatedIcm42688
 from accelcal_rig.sim.lab import VirtualLab
@@ -39,11 +40,9 @@ class SimulatedIcm42688Bridge:
             with self._lab.lock:
                 if words == ["?"]:
                     return f"{BRIDGE_GREETING} {PROTOCOL_VERSION} part={self._part.name} accelcal-rig simulated bridge"
-                if len(words) == 3 and words[0] == "R":
-                    return "=" + self.device.read(int(words[1], 16), int(words[2])).hex().upper()
-                if len(words) == 3 and words[0] == "W":
-                    self.device.write(int(words[1], 16), int(words[2], 16))
-                    return "="
+                reply = register_request(self.device, words)
+                if reply is not None:
+                    return reply
         except ValueError as exc:
             return f"!{exc}"
         return f"!unknown request {request!r}"

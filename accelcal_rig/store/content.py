@@ -247,7 +247,7 @@ def _implausible_rows(campaign: Campaign, serial: str) -> list[int]:
         codes = campaign.channel_column(serial, info.name, "raw_codes")
         mean = campaign.channel_column(serial, info.name, "mean")
         bad |= ~np.any(codes != 0, axis=(1, 2)) | ~np.all(np.isfinite(mean), axis=1)
-        if info.name == "accel":
+        if info.quantity == "acceleration":  # gravity in standard g: a unit vector at standard gravity
             reference = campaign.channel_column(serial, info.name, "reference")
             with np.errstate(invalid="ignore"):
                 bad |= np.abs(np.linalg.norm(reference, axis=1) - 1.0) > 1e-6

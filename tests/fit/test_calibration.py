@@ -118,3 +118,16 @@ def test_the_documented_usage_snippet_runs(calibration, tmp_path: Path) -> None:
                             cwd=tmp_path, capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "(2, 3) (1, 3)"
+
+
+def test_a_problem_in_a_version_1_file_is_reported_at_its_own_key_and_line(calibration, tmp_path: Path) -> None:
+    path = tmp_path / "cal.yaml"
+    save_calibration(calibration, path)
+    data = yaml.safe_load(path.read_text())
+    sensors = {serial: dut["channels"]["accel"] for serial, dut in data["duts"].items()}
+    del sensors["ADX355-A002"]["lsb_g"]
+    version_1 = {**{k: v for k, v in data.items() if k != "duts"}, "format_version": 1, "sensors": sensors}
+    path.write_text(yaml.safe_dump(version_1, sort_keys=False))
+    line = path.read_text().splitlines().index("  ADX355-A002:") + 1
+    with pytest.raises(ConfigError, match=rf"cal.yaml:{line}: sensors.ADX355-A002.lsb_g: Field required"):
+        load_calibration(path)

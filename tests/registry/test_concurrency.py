@@ -4,6 +4,7 @@ calibrations of its own and 50 that both hold, at the same moment — every one 
 from __future__ import annotations
 
 import pickle
+import select
 import subprocess
 import sys
 from pathlib import Path
@@ -39,8 +40,10 @@ def test_two_writers_at_once_lose_nothing_and_duplicate_nothing(registry_url: st
         entries_file.write_bytes(pickle.dumps([*synthetic_entries(template, 100, prefix=f"RIG{rig}"), *shared]))
         writers.append(subprocess.Popen([sys.executable, "-c", WRITER, registry_url, str(entries_file), str(go)],
                                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True))
-    for writer in writers:  # both started, their registries open to be, and waiting for the word
-        assert writer.stdout is not None and writer.stdout.readline().strip() == "ready"
+    for writer in writers:  # both started, and waiting for the word (within a deadline: a stuck one fails)
+        assert writer.stdout is not None
+        assert select.select([writer.stdout], [], [], 60)[0], "a writer never said it was ready"
+        assert writer.stdout.readline().strip() == "ready"
     go.touch()
     results = [writer.communicate(timeout=120) for writer in writers]
     assert all(writer.returncode == 0 for writer in writers), [err for _, err in results]
