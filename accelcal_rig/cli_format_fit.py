@@ -1,5 +1,6 @@
 """What `rig fit` and `rig fit-recording` print, as lines: a campaign fit's report (`FitOutcome.report`,
-as `rig fit --json` prints it) as a table, and a hand-held recording's fit (`RecordingFit.report`)."""
+as `rig fit --json` prints it) as a table, and a hand-held recording's fit (`RecordingFit.report`, with its
+gyro's when it has one)."""
 
 from __future__ import annotations
 
@@ -54,4 +55,22 @@ def recording_lines(report: dict[str, Any], source: str, *, threshold_factor: fl
                  f"{report['rmse_before_mg']:.3f} → {report['rmse_after_mg']:.4f} mg (noise floor "
                  f"{report['noise_floor_mg']:.4f} mg) at {report['temperature_c']:.1f} °C; χ²_red {chi2}; outputs in "
                  f"{report['units']}")
+    if report.get("gyro"):
+        lines += gyro_lines(report["gyro"])
+    return lines
+
+
+def gyro_lines(gyro: dict[str, Any]) -> list[str]:
+    """The hand-held gyro fit (`HandheldGyroFit.report()`): bias and K with their 1σ, how the moves close."""
+    def row(values: list[float], sigmas: list[float], fmt: str) -> str:
+        return "  ".join(f"{v:{fmt}} ± {s:.2g}" for v, s in zip(values, sigmas))
+
+    lines = [f"gyro: {gyro['segments']} moves between static intervals, gravity misclosure RMS "
+             f"{gyro['residual_rms_before_deg']:.3f}° (K = I, bias from the still) → {gyro['residual_rms_after_deg']:.4f}°; "
+             f"rank {gyro['rank']} of 12, condition {gyro['condition']:.3g}",
+             f"  bias °/s   {row(gyro['bias_dps'], gyro['bias_sigma_dps'], '+.5f')}",
+             f"  scale      {row(gyro['scale'], gyro['scale_sigma'], '.5f')}"]
+    lines += [f"  K {'xyz'[i]}        {row(r, s, '+.5f')}" for i, (r, s) in enumerate(zip(gyro["matrix"],
+                                                                                            gyro["matrix_sigma"]))]
+    lines += [f"  note: {note}" for note in gyro["notes"]]
     return lines

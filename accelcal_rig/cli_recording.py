@@ -1,5 +1,6 @@
 """The work behind `rig fit-recording`: a hand-held recording (CSV, or a campaign file's raw samples) read,
-its static intervals found, the norm-only fit done and its calibration file written."""
+its static intervals found, the norm-only fit done (and the gyroscope's, with --gyro-columns) and its
+calibration file written."""
 
 from __future__ import annotations
 
@@ -40,8 +41,13 @@ def _read(args: argparse.Namespace) -> tuple[Recording, str]:
     from accelcal_rig.handheld.recording import CsvLayout, read_campaign_recording, read_csv_recording
 
     if args.recording.suffix in (".h5", ".hdf5"):
+        if args.gyro_columns:
+            raise ConfigError(f"{args.recording}: --gyro-columns: a campaign file's raw samples hold no turns between "
+                              "its poses (the turntable moves between them unrecorded): CSV recordings only")
         recording = read_campaign_recording(args.recording, args.serial, args.setpoint)
         return recording, recording.serial or args.recording.stem
-    layout = CsvLayout.parse_columns(args.columns, time_unit=args.time_unit, rate_hz=args.rate_hz,
-                                     units=args.units, counts_per_g=args.counts_per_g, zero_code=args.zero_code)
+    layout = CsvLayout.parse_columns(args.columns, gyro=args.gyro_columns, time_unit=args.time_unit,
+                                     rate_hz=args.rate_hz, units=args.units, counts_per_g=args.counts_per_g,
+                                     zero_code=args.zero_code, gyro_units=args.gyro_units,
+                                     counts_per_dps=args.counts_per_dps)
     return read_csv_recording(args.recording, layout), args.serial or args.recording.stem

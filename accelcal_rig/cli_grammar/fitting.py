@@ -43,9 +43,14 @@ def _add_fit_recording(commands: Commands) -> None:
         "its first, still seconds), fit the norm-only model (|g| = 1 in every interval) and write the same "
         "calibration file as rig fit, for one temperature. The recording is a CSV file (one row per sample) "
         "or a campaign file's raw samples of one sensor at one setpoint. Record at least 9 orientations "
-        "(12 or more, every axis up and down) for all 9 parameters, 6 for bias and scale alone.",
-        "rig fit-recording session.csv --columns samples,acc_x,acc_y,acc_z --time-unit samples --rate-hz 204.8 "
-        "--units counts --counts-per-g 2048 --parameters bias-scale -o imu.calibration.yaml")
+        "(12 or more, every axis up and down) for all 9 parameters, 6 for bias and scale alone. With "
+        "--gyro-columns, the gyroscope's bias (from the still intervals) and its scale and misalignment K (from "
+        "the turns between them, against the gravity directions) are fitted after and reported beside: turn the "
+        "sensor a quarter or half turn about tilted axes between poses (turns about the vertical, and full turns, "
+        "determine nothing).",
+        "rig fit-recording imu-session.csv --columns samples,ax,ay,az --time-unit samples --rate-hz 200 "
+        "--units counts --counts-per-g 2048 --gyro-columns gx,gy,gz --gyro-units counts --counts-per-dps 16.4 "
+        "-o imu.calibration.yaml")
     recording.add_argument("recording", type=Path, help="CSV file, or a campaign file (.h5)")
     recording.add_argument("-o", "--output", type=Path, required=True, help="calibration file to write (YAML)")
     _csv_layout_options(recording)
@@ -79,6 +84,14 @@ def _csv_layout_options(recording: argparse.ArgumentParser) -> None:
                                 "|reading| (the norm-only fit finds each axis's scale)")
     recording.add_argument("--zero-code", type=number(-1e12, 1e12), default=0.0,
                            help="code of 0 g: 0 for signed codes (default), 32768 for a 16-bit offset-binary ADC")
+    recording.add_argument("--gyro-columns", metavar="GX,GY,GZ",
+                           help="the gyroscope's x, y, z columns, named or numbered as --columns: calibrate it too "
+                                "(bias, scale and misalignment from the turns between the static intervals)")
+    recording.add_argument("--gyro-units", choices=["dps", "rad/s", "counts"], default="dps",
+                           help="of the gyro columns (default dps, °/s)")
+    recording.add_argument("--counts-per-dps", type=number(1e-6, 1e12),
+                           help="with --gyro-units counts (ICM-42688-P at ±2000 °/s: 16.4): the nominal sensitivity "
+                                "(the fit finds each axis's scale against it)")
 
 
 def _detector_options(recording: argparse.ArgumentParser) -> None:

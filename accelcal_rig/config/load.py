@@ -123,6 +123,10 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
         problem = dut_part.rate_problem(acquisition.odr_hz)
         if problem:
             raise procedure.error(("acquisition", "odr_hz"), f"{problem}: sensor {sensor.serial} of {rig.path}")
+        gyroscope_steps = [k for k in ("rates", "noise") if getattr(procedure.model, k) is not None]
+        if gyroscope_steps and not any(c.quantity == "angular rate" for c in dut_part.channels):
+            raise procedure.error((gyroscope_steps[0],), f"sensor {sensor.serial} of {rig.path} is an "
+                                                         f"{dut_part.label}, which has no gyroscope")
     for index, setpoint in enumerate(procedure.model.setpoints_c):
         if not chamber.min_setpoint_c <= setpoint <= chamber.max_setpoint_c:
             raise procedure.error(

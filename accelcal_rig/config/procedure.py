@@ -9,6 +9,7 @@ from pydantic import Field, field_validator, model_validator
 
 from accelcal_rig.config.acceptance import Acceptance, Verification
 from accelcal_rig.config.bounds import StrictModel, TemperatureC, TemperatureSpanC
+from accelcal_rig.config.rate_steps import NoiseRecord, RateSteps
 from accelcal_rig.config.schedule import MAX_SCHEDULE_POSES, Schedule
 
 #: Most temperature polls a campaign's ramp and soak deadlines allow (`rig plan` plays them all).
@@ -179,6 +180,35 @@ class Procedure(StrictModel):
     verify: Verification | None = Field(None, description="verification poses the fit never sees")
     acceptance: Acceptance = Acceptance()
     frost: Frost = Field(Frost(), description="dry-air purge and the dew point requirement")
+    rates: RateSteps | None = Field(None, description="a gyroscope's rate steps at every setpoint (a rate table)")
+    noise: NoiseRecord | None = Field(None, description="a still record at every setpoint (Allan deviation)")
+
+    @model_validator(mode="after")
+    def _gyroscope_steps_fit(self) -> Procedure:
+        if self.rates is None and self.noise is None:
+            return self
+        if self.method != "soak" or self.cooldown is not None:
+            raise ValueError("rates and noise are measured at rest at each setpoint: method: soak, no cool-down")
+        if self.acquisition.range_dps is None:
+            raise ValueError("rates and noise measure a gyroscope: set acquisition.range_dps")
+        if self.rates is not None:
+            beyond = [r for r in (*self.rates.rates_dps, *self.rates.verify_rates_dps) if r >= self.acquisition.range_dps]
+            if beyond:
+                raise ValueError(f"rates.rates_dps: {max(beyond):g} °/s is not inside the gyroscope's range "
+                                 f"(acquisition.range_dps ±{self.acquisition.range_dps:g} °/s)")
+            if self.rates.verify_rates_dps and self.verify is None:
+                raise ValueError("rates.verify_rates_dps are measured where the verification poses are: add a "
+                                 "verify: section")
+        if self.noise is not None and self.noise.pose > self.schedule.size:
+            raise ValueError(f"noise.pose: pose {self.noise.pose} asked for, the schedule has {self.schedule.size}")
+        return self
+
+    def noise_blocks(self) -> int:
+        """Blocks of `samples_per_pose` samples a noise record takes at each setpoint."""
+        if self.noise is None:
+            return 0
+        block_s = self.acquisition.samples_per_pose / self.acquisition.odr_hz
+        return max(1, int(np.ceil(self.noise.duration_s / block_s - 1e-9)))
 
     @model_validator(mode="after")
     def _ramp_fits(self) -> Procedure:
@@ -261,8 +291,10 @@ class Procedure(StrictModel):
         return self
 
     def schedule_size(self) -> int:
-        """Poses of the schedule at one setpoint."""
-        return self.schedule.size
+        """Records of one calibration setpoint: the schedule's poses, a gyroscope's rate steps and noise
+        record."""
+        rates = self.rates.steps_per_setpoint if self.rates is not None else 0
+        return self.schedule.size + rates + self.noise_blocks()
 
     def bands(self) -> int:
         """Setpoints whose poses are measured: each calibration setpoint, and a bidirectional ramp's way back
@@ -276,7 +308,8 @@ class Procedure(StrictModel):
         if verify is None:
             return 0
         setpoints = len(verify.setpoints_c) + (self.verified_bands() if verify.at_setpoints else 0)
-        return setpoints * verify.schedule.size
+        rates = self.rates.verification_steps if self.rates is not None else 0
+        return setpoints * (verify.schedule.size + rates)
 
     def verified_bands(self) -> int:
         """Bands whose verification poses `verify.at_setpoints` measures: all, or with `verify.on_ramp: false`

@@ -268,6 +268,10 @@ class SimulationConfig(StrictModel):
     noise_density_ug_per_rthz: float | None = Field(None, ge=0, le=100_000, description="every DUT's noise "
                                                     "density; unset: each part's own (its data sheet's)")
     turntable_settle_s: float = Field(0.5, ge=0, le=600)
+    latitude_deg: float = Field(48.0, ge=-90, le=90, description="the simulated site's latitude where the rig "
+                                "config states none (the Earth turns in every lab)")
+    heading_deg: float = Field(30.0, ge=-360, le=360, description="the simulated table's heading where the rig "
+                               "config states none")
     controller_limits_c: tuple[TemperatureC, TemperatureC] = Field(
         (-70.0, 180.0), description="the simulated controller's own set point limits (low, high), where its "
                                     "register map has them; it clamps set points to them as a real one does")
@@ -344,6 +348,12 @@ class RigConfig(StrictModel):
     gravity_uncertainty_m_s2: float = Field(0.0, ge=0.0, le=0.05, description="its standard uncertainty")
     registry: str | None = Field(None, max_length=4096, description="where finished calibrations are recorded: an "
                                  "SQLite file (relative to this file) or a postgresql:// URL")
+    latitude_deg: float | None = Field(None, ge=-90, le=90, description="the site's latitude: the Earth's rate "
+                                       "(15.04 °/h) is part of every gyroscope reference, its vertical component "
+                                       "sin(latitude) × 15.04 °/h; unset: left in the gyroscope's bias, said so")
+    heading_deg: float | None = Field(None, ge=-360, le=360, description="the azimuth of the table's x axis (world "
+                                      "x at zero angles), degrees east of true north: with latitude_deg, the Earth's "
+                                      "horizontal rate (cos(latitude) × 15.04 °/h) is part of the reference too")
 
     @model_validator(mode="after")
     def _cooling_floor_below_the_chamber(self) -> RigConfig:

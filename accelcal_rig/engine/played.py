@@ -113,6 +113,9 @@ class PlayedRig:
     table_deg: np.ndarray
     t_s: float = 0.0
     software_ramp: SoftwareRampPlayed | None = None
+    #: The rate axis's rate (°/s) and the pose it turns in (None: at rest).
+    rate_dps: float = 0.0
+    turning_in: tuple[float, ...] | None = None
     tally: SetpointTally = field(default_factory=lambda: SetpointTally(float("nan"), 0))
 
     @classmethod

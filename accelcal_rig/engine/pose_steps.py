@@ -5,10 +5,12 @@ its mount sees, the table's rate), and its temperatures against the band its soa
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
 
+from accelcal_rig.core.earth import earth_rate_world_dps
 from accelcal_rig.core.waits import MOVE_POLL_S, wait_until
 from accelcal_rig.engine.acquisition import acquire_together
 from accelcal_rig.engine.played import PlayedRig
@@ -17,7 +19,7 @@ from accelcal_rig.engine.states import State
 from accelcal_rig.engine.step_handler import StepHandler
 from accelcal_rig.instruments.interfaces import SampleBlock
 from accelcal_rig.parts.part import Channel
-from accelcal_rig.plan.steps import Measurement
+from accelcal_rig.plan.steps import Measurement, RateStep
 from accelcal_rig.store.records import ChannelPoseRecord, DutPoseRecord, PoseRecord
 
 #: A move's deadline is 1.5 × its travel time at the configured speeds plus this margin.
@@ -37,28 +39,36 @@ class MeasureStep:
 
 def measure(step: Measurement, run: RunContext) -> None:
     """Move, settle, acquire every DUT at once, store the pose."""
-    acquisition = run.procedure.acquisition
     if step.setpoint_c != run.table.setpoint_c:
         run.table.angles_deg, run.table.setpoint_c = None, step.setpoint_c
     commanded = np.array(step.pose.angles_deg)
     run.machine.go(State.MOVE, step.key)
-    _move(run, commanded)
+    move_to(run, commanded)
     run.machine.go(State.SETTLE, step.key)
-    run.clock.sleep(acquisition.settle_s)
+    run.clock.sleep(run.procedure.acquisition.settle_s)
+    acquire_and_store(step, run, commanded)
+
+
+def acquire_and_store(step: Measurement, run: RunContext, commanded: np.ndarray) -> None:
+    """Read the table's angles, acquire every DUT at once, store the record with each channel's reference."""
+    acquisition = run.procedure.acquisition
     run.machine.go(State.ACQUIRE, step.key)
-    measured = run.table.angles_deg = run.turntable.read_angles_deg()
+    measured = run.turntable.read_angles_deg()
+    # A turning axis: where it stands is a reading of the moment only.
+    run.table.angles_deg = None if any(step.rate_fixture_dps) else measured
     chamber_before = run.chamber.read_temperature_c()  # the alarm is checked once per pose, after it
     blocks = run.retrier.call(partial(acquire_together, run.sensors, acquisition.samples_per_pose, run.clock,
                                       acquisition.ranges()))
     chamber_after = run.read_chamber_c()
     run.machine.go(State.STORE, step.key)
     gravity_fixture = np.array(step.pose.gravity_fixture)
+    at = PoseInstant(step, measured, acquisition.samples_per_pose / acquisition.odr_hz)
     record = PoseRecord(
         step_key=step.key, setpoint_c=step.setpoint_c, pose_number=step.pose.number,
         commanded_angles_deg=commanded, measured_angles_deg=measured, gravity_fixture=gravity_fixture,
         t_start_s=min(b.t_start_s for b in blocks), t_end_s=max(b.t_end_s for b in blocks),
         chamber_temperature_c=(chamber_before, chamber_after),
-        duts=[_dut_record(run, i, block, gravity_fixture) for i, block in enumerate(blocks)],
+        duts=[_dut_record(run, i, block, at) for i, block in enumerate(blocks)],
     )
     run.writer.append_pose(record)
     run.report.pose_stored(chamber_after, tuple(float(np.mean(b.temperature_c)) for b in blocks))
@@ -66,7 +76,18 @@ def measure(step: Measurement, run: RunContext) -> None:
     run.report.publish(run.machine.state)
 
 
-def _move(run: RunContext, commanded: np.ndarray) -> None:
+@dataclass(frozen=True)
+class PoseInstant:
+    """Where the table was while a record's samples were taken: the step (its pose, its rate), the angles
+    read as the samples began, and how long they took."""
+
+    step: Measurement
+    measured_angles_deg: np.ndarray
+    duration_s: float
+
+
+def move_to(run: RunContext, commanded: np.ndarray) -> None:
+    """Move the table to `commanded` and wait until it is there, settled, within the position tolerance."""
     turntable = run.turntable
     current = turntable.read_angles_deg() if run.table.angles_deg is None else run.table.angles_deg
     speeds = np.array([a.speed_deg_s for a in run.rig.turntable.axes])
@@ -85,7 +106,7 @@ def _move(run: RunContext, commanded: np.ndarray) -> None:
                what=f"turntable ({turntable.endpoint}) reaching {np.round(commanded, 3).tolist()}°")
 
 
-def _dut_record(run: RunContext, index: int, block: SampleBlock, gravity_fixture: np.ndarray) -> DutPoseRecord:
+def _dut_record(run: RunContext, index: int, block: SampleBlock, at: PoseInstant) -> DutPoseRecord:
     """Each of the DUT's channels at the pose (its part's, in order), and its temperatures against the band."""
     sensor, settled_c = run.sensors[index], run.dut.settled_c[index]
     ranges = run.procedure.acquisition.ranges()
@@ -93,7 +114,7 @@ def _dut_record(run: RunContext, index: int, block: SampleBlock, gravity_fixture
     for channel in sensor.part.channels:
         codes = block.codes[channel.name]
         lsb, n = channel.lsb(ranges[channel.name]), codes.shape[0]
-        reference = REFERENCES[channel.quantity](run, sensor.serial, channel, gravity_fixture)
+        reference = REFERENCES[channel.quantity](run, sensor.serial, channel, at)
         channels[channel.name] = ChannelPoseRecord(codes, codes.mean(axis=0) * lsb,
                                                    codes.std(axis=0, ddof=1) * lsb / np.sqrt(n), reference)
     band = run.procedure.soak.band_c
@@ -108,20 +129,43 @@ def _dut_record(run: RunContext, index: int, block: SampleBlock, gravity_fixture
     )
 
 
-def _gravity_reference(run: RunContext, serial: str, channel: Channel, gravity_fixture: np.ndarray) -> np.ndarray:
-    """The site's gravity (in standard g) in the DUT's frame: the commanded pose, the nominal mount."""
-    return run.rig.gravity_g * (run.fixture_to_dut[serial] @ gravity_fixture)
+def _gravity_reference(run: RunContext, serial: str, channel: Channel, at: PoseInstant) -> np.ndarray:
+    """The site's gravity (in standard g) in the DUT's frame: the commanded pose, the nominal mount. A rate
+    step's turn about the vertical changes it not; the centripetal acceleration of a DUT off the rate axis is
+    not in it (its radius is not known): no accelerometer fit uses a rate step."""
+    return run.rig.gravity_g * (run.fixture_to_dut[serial] @ np.array(at.step.pose.gravity_fixture))
 
 
-def _rate_at_rest(run: RunContext, serial: str, channel: Channel, gravity_fixture: np.ndarray) -> np.ndarray:
-    """The table's angular rate in the DUT's frame: zero on each of the channel's axes, the table at rest
-    through a pose (the Earth's rotation, 0.004 °/s, is not included)."""
-    return np.zeros(len(channel.axes))
+def _rate_reference(run: RunContext, serial: str, channel: Channel, at: PoseInstant) -> np.ndarray:
+    """The true angular rate in the DUT's frame, °/s: the table's (zero through a pose, the commanded rate
+    about the fixture axis through a rate step) and the Earth's as far as the rig config places it."""
+    table = np.array(at.step.rate_fixture_dps)
+    return run.fixture_to_dut[serial] @ (table + _earth_rate_fixture_dps(run, at))
+
+
+#: Points over a record's samples at which a turning table's Earth rate is averaged.
+_EARTH_POINTS = 64
+
+
+def _earth_rate_fixture_dps(run: RunContext, at: PoseInstant) -> np.ndarray:
+    """The Earth's rate in the fixture frame over the record's samples: nothing where the rig config states no
+    latitude; its vertical component always, along "up" whatever turns about the vertical; its horizontal one
+    (with a heading) turns with a rate step's axis, averaged over the samples from the angles read as they
+    began."""
+    if run.rig.latitude_deg is None:
+        return np.zeros(3)
+    world = earth_rate_world_dps(run.rig.latitude_deg, run.rig.heading_deg)
+    angles = np.broadcast_to(np.asarray(at.measured_angles_deg, dtype=float),
+                             (_EARTH_POINTS, len(at.measured_angles_deg))).copy()
+    if isinstance(at.step, RateStep):
+        times = (np.arange(_EARTH_POINTS) + 0.5) / _EARTH_POINTS * at.duration_s
+        angles[:, at.step.rate_axis] += at.step.rate_dps * times
+    return run.kinematics.world_in_fixture(angles, world).mean(axis=0)
 
 
 #: What a channel should read at a pose, by the quantity it measures.
-REFERENCES: dict[str, Callable[[RunContext, str, Channel, np.ndarray], np.ndarray]] = {
-    "acceleration": _gravity_reference, "angular rate": _rate_at_rest}
+REFERENCES: dict[str, Callable[[RunContext, str, Channel, PoseInstant], np.ndarray]] = {
+    "acceleration": _gravity_reference, "angular rate": _rate_reference}
 
 
 def _angle_difference(a_deg: np.ndarray, b_deg: np.ndarray) -> np.ndarray:

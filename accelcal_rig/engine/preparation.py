@@ -24,6 +24,7 @@ from accelcal_rig.engine.pose_steps import REFERENCES
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
 from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, VerificationSeenByFit, compile_plan
+from accelcal_rig.plan.gyro_steps import NoRateAxis
 from accelcal_rig.plan.kinematics import UnreachablePose
 from accelcal_rig.store.space import StorageEstimate, estimate_storage
 
@@ -63,6 +64,8 @@ def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str 
         raise procedure.error(("cooldown", "pose"), str(exc)) from None
     except VerificationSeenByFit as exc:
         raise procedure.error(("verify", "schedule"), str(exc)) from None
+    except NoRateAxis as exc:
+        raise procedure.error(("rates",), f"{exc} ({rig.path})") from None
     _check_design_identifies_fit(procedure, rig.model, plan)
     return PreparedCampaign(procedure, rig, plan, chamber_profile)
 

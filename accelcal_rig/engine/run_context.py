@@ -20,6 +20,7 @@ from accelcal_rig.errors import InstrumentError
 from accelcal_rig.instruments.capabilities import alarm_active
 from accelcal_rig.instruments.interfaces import Chamber, RigInstruments, Sensor, TruthSource, Turntable
 from accelcal_rig.plan.compile import Plan
+from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.store.writer import CampaignWriter
 
 
@@ -65,6 +66,9 @@ class TableState:
 
     angles_deg: np.ndarray | None = None
     setpoint_c: float | None = None
+    #: The rate the rate axis turns at (°/s, signed) and the pose it turns in, None at rest.
+    rate_dps: float = 0.0
+    turning_in: tuple[float, ...] | None = None
 
 
 @dataclass
@@ -96,10 +100,12 @@ class RunContext:
     purge_on: bool | None = None
     #: Fixture frame → each DUT's frame, by serial.
     fixture_to_dut: dict[str, np.ndarray] = field(init=False)
+    kinematics: TurntableKinematics = field(init=False)
 
     def __post_init__(self) -> None:
         self.dut = DutThermalState(np.zeros(len(self.sensors)))
         self.fixture_to_dut = {s.serial: fixture_to_dut(s.mount_euler_deg) for s in self.rig.fixture.sensors}
+        self.kinematics = TurntableKinematics(self.rig.turntable.axes)
 
     @property
     def chamber(self) -> Chamber:

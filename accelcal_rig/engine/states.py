@@ -34,7 +34,8 @@ TRANSITIONS: dict[State, frozenset[State]] = {
     State.MOVE: frozenset({State.SETTLE}),
     State.SETTLE: frozenset({State.ACQUIRE}),
     State.ACQUIRE: frozenset({State.STORE}),
-    State.STORE: frozenset({State.MOVE, State.RAMP, State.SAFE, State.COOL}),
+    # SETTLE: the next rate step turning in the same pose; ACQUIRE: the next block of a noise record.
+    State.STORE: frozenset({State.MOVE, State.RAMP, State.SAFE, State.COOL, State.SETTLE, State.ACQUIRE}),
     State.COOL: frozenset({State.MOVE}),
     State.SAFE: frozenset({State.FIT, State.DONE, State.ABORTED}),
     State.FIT: frozenset({State.DONE}),

@@ -14,6 +14,7 @@ from typing import Any, assert_never
 from accelcal_rig.engine.cooldown_steps import COOLDOWN_RECORD
 from accelcal_rig.engine.frost_steps import AWAIT_DEW_POINT_MARGIN, SET_PURGE
 from accelcal_rig.engine.pose_steps import MEASURE
+from accelcal_rig.engine.rate_steps import NOISE_BLOCK, RATE_STEP, STOP_ROTATION
 from accelcal_rig.engine.step_handler import StepHandler
 from accelcal_rig.engine.thermal_steps import ADVANCE_RAMP, RAMP, RAMP_SEGMENT, SOAK, START_SOFTWARE_RAMP
 from accelcal_rig.plan.steps import (
@@ -21,13 +22,17 @@ from accelcal_rig.plan.steps import (
     AwaitDewPointMargin,
     CooldownRecord,
     MeasurePose,
+    NoiseBlock,
     Ramp,
     RampSegment,
+    RateStep,
     SetPurge,
     Soak,
     StartSoftwareRamp,
     Step,
+    StopRotation,
     VerifyPose,
+    VerifyRate,
 )
 
 
@@ -46,6 +51,12 @@ def handler_for(step: Step) -> StepHandler[Any]:
             return ADVANCE_RAMP
         case MeasurePose() | VerifyPose():
             return MEASURE
+        case RateStep() | VerifyRate():
+            return RATE_STEP
+        case StopRotation():
+            return STOP_ROTATION
+        case NoiseBlock():
+            return NOISE_BLOCK
         case CooldownRecord():
             return COOLDOWN_RECORD
         case SetPurge():

@@ -10,16 +10,17 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
 import yaml
-from pydantic import Field, field_validator, model_validator
+from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 
 from accelcal_rig.config.bounds import StrictModel, TemperatureC
 from accelcal_rig.config.load import load_validated
 from accelcal_rig.config.yaml_lines import CALIBRATION_LIMITS
 from accelcal_rig.durable import write_text_atomically
+from accelcal_rig.fit import gyro_model
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
 
 FORMAT_NAME = "accelcal-rig calibration"
@@ -27,6 +28,8 @@ FORMAT_VERSION = 2
 READABLE_VERSIONS = (1, 2)
 #: The channel every version-1 calibration is, and the one readers that handle a single channel take.
 ACCELERATION = "accel"
+#: A six-axis part's gyroscope channel.
+ANGULAR_RATE = "gyro"
 
 
 class CalibrationRangeWarning(UserWarning):
@@ -43,6 +46,9 @@ def _ordered(value: tuple[float, float]) -> tuple[float, float]:
 class PolynomialModel(StrictModel):
     """Each parameter's coefficients in x = (T − mid(domain)) / half-width(domain), increasing powers."""
 
+    #: The model's parameters, in its order: Eq. 1's.
+    NAMES: ClassVar[tuple[str, ...]] = PARAMETER_NAMES
+
     domain_c: tuple[TemperatureC, TemperatureC]
     degree: int = Field(ge=0, le=6)
     coefficients: dict[str, Annotated[list[Annotated[float, Field(ge=-1e6, le=1e6)]], Field(min_length=1, max_length=7)]]
@@ -50,15 +56,27 @@ class PolynomialModel(StrictModel):
     @field_validator("coefficients")
     @classmethod
     def _all_parameters(cls, value: dict[str, list[float]]) -> dict[str, list[float]]:
-        if set(value) != set(PARAMETER_NAMES):
-            raise ValueError(f"coefficients needed for exactly {', '.join(PARAMETER_NAMES)}")
+        if set(value) != set(cls.NAMES):
+            raise ValueError(f"coefficients needed for exactly {', '.join(cls.NAMES)}")
         return value
 
     _domain = field_validator("domain_c")(_ordered)
 
     def matrix(self) -> np.ndarray:
         width = max(len(c) for c in self.coefficients.values())
-        return np.array([self.coefficients[n] + [0.0] * (width - len(self.coefficients[n])) for n in PARAMETER_NAMES])
+        return np.array([self.coefficients[n] + [0.0] * (width - len(self.coefficients[n])) for n in self.NAMES])
+
+    def at(self, temperature_c: np.ndarray | float) -> np.ndarray:
+        """Every parameter (..., P) at each temperature, as the polynomials give it (no clamping here)."""
+        d_low, d_high = self.domain_c
+        x = (np.asarray(temperature_c, dtype=float) - 0.5 * (d_low + d_high)) / (0.5 * (d_high - d_low))
+        return np.moveaxis(np.polynomial.polynomial.polyval(x, self.matrix().T), 0, -1)
+
+
+class GyroPolynomialModel(PolynomialModel):
+    """The rate-table gyroscope model's 27 parameters (fit/gyro_model.py), each a polynomial."""
+
+    NAMES: ClassVar[tuple[str, ...]] = gyro_model.PARAMETER_NAMES
 
 
 class SetpointFit(StrictModel):
@@ -97,15 +115,59 @@ class SensorCalibration(StrictModel):
                 f"calibrated {low:g}…{high:g} °C"), stacklevel=3)
         if self.out_of_range == "clamp":
             temperature_c = np.clip(temperature_c, low, high)
-        d_low, d_high = self.polynomial.domain_c
-        x = (temperature_c - 0.5 * (d_low + d_high)) / (0.5 * (d_high - d_low))
-        return np.moveaxis(np.polynomial.polynomial.polyval(x, self.polynomial.matrix().T), 0, -1)
+        return self.polynomial.at(temperature_c)
+
+
+class GyroCalibration(StrictModel):
+    """A gyroscope's calibration on a rate table (fit/gyro_model.py): its 27 parameters as polynomials of its
+    own temperature, how the Earth's rate was taken out, and the gauge its misalignment is in."""
+
+    model: Literal["gyro-rate-table"] = "gyro-rate-table"
+    serial: str = Field(min_length=1, max_length=128)
+    range_dps: float = Field(gt=0, le=100_000, description="measuring range, ± °/s")
+    lsb_dps: float = Field(gt=0, le=100, description="°/s per code, for compensating raw codes")
+    validity_c: tuple[TemperatureC, TemperatureC]
+    out_of_range: Literal["clamp", "extrapolate"] = "clamp"
+    polynomial: GyroPolynomialModel
+    setpoints: list[SetpointFit]
+    earth_rate: str = Field(max_length=500, description="how the Earth's rate entered the references")
+    gauge: str = Field(max_length=500, description="the frame the sensitivity matrix is relative to")
+    metrics: dict[str, Any] = {}
+    warnings: list[str] = []
+    verdict: Literal["PASS", "FAIL"] | None = None
+    verdict_reasons: list[str] = []
+
+    def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:
+        """The model's 27 parameters (..., 27) at each temperature, as the file's `out_of_range` says outside it."""
+        temperature_c = np.asarray(temperature_c, dtype=float)
+        low, high = self.validity_c
+        outside = (temperature_c < low) | (temperature_c > high)
+        if np.any(outside):
+            action = "clamped to" if self.out_of_range == "clamp" else "extrapolated beyond"
+            warnings.warn(CalibrationRangeWarning(
+                f"gyroscope {self.serial}: {int(outside.sum())} of {outside.size} temperatures {action} the "
+                f"calibrated {low:g}…{high:g} °C"), stacklevel=3)
+        if self.out_of_range == "clamp":
+            temperature_c = np.clip(temperature_c, low, high)
+        return self.polynomial.at(temperature_c)
+
+
+def _channel_model(value: Any) -> str:
+    """Which model a channel's calibration is: its `model`, Eq. 1 for one that names none (every file before
+    gyroscopes)."""
+    model = value.get("model", "sfem-eq1") if isinstance(value, dict) else getattr(value, "model", "sfem-eq1")
+    return str(model)
+
+
+ChannelCalibration = Annotated[
+    Annotated[SensorCalibration, Tag("sfem-eq1")] | Annotated[GyroCalibration, Tag("gyro-rate-table")],
+    Discriminator(_channel_model)]
 
 
 class DutCalibration(StrictModel):
     """One DUT: a calibration per channel a channel model handles, and why each other channel has none."""
 
-    channels: dict[str, SensorCalibration] = Field(min_length=1, max_length=16)
+    channels: dict[str, ChannelCalibration] = Field(min_length=1, max_length=16)
     not_calibrated: dict[str, Annotated[str, Field(max_length=500)]] = Field({}, max_length=16)
 
 
@@ -147,10 +209,29 @@ class CalibrationFile(StrictModel):
     @property
     def sensors(self) -> dict[str, SensorCalibration]:
         """Each DUT's acceleration calibration by serial, for the readers that handle only that channel."""
-        return {serial: dut.channels[ACCELERATION] for serial, dut in self.duts.items() if ACCELERATION in dut.channels}
+        return {serial: calibration for serial, dut in self.duts.items()
+                if isinstance(calibration := dut.channels.get(ACCELERATION), SensorCalibration)}
 
-    def sensor(self, serial: str, channel: str = ACCELERATION) -> SensorCalibration:
-        """The calibration of one channel of one DUT; KeyError saying what the file has."""
+    @property
+    def gyroscopes(self) -> dict[str, GyroCalibration]:
+        """Each DUT's gyroscope calibration by serial, where it has one."""
+        return {serial: calibration for serial, dut in self.duts.items()
+                if isinstance(calibration := dut.channels.get(ANGULAR_RATE), GyroCalibration)}
+
+    def sensor(self, serial: str) -> SensorCalibration:
+        """The accelerometer calibration of one DUT; KeyError saying what the file has."""
+        calibration = self._channel(serial, ACCELERATION)
+        assert isinstance(calibration, SensorCalibration)
+        return calibration
+
+    def gyroscope(self, serial: str) -> GyroCalibration:
+        """The gyroscope calibration of one DUT; KeyError saying what the file has."""
+        calibration = self._channel(serial, ANGULAR_RATE)
+        if not isinstance(calibration, GyroCalibration):
+            raise KeyError(f"sensor {serial}: its {ANGULAR_RATE} channel is not a rate-table calibration")
+        return calibration
+
+    def _channel(self, serial: str, channel: str) -> SensorCalibration | GyroCalibration:
         if serial not in self.duts:
             raise KeyError(f"no calibration for sensor {serial} (file has {', '.join(self.duts)})")
         dut = self.duts[serial]
@@ -181,6 +262,15 @@ def apply(calibration: SensorCalibration, accel_g: np.ndarray, temperature_c: np
 def apply_codes(calibration: SensorCalibration, codes: np.ndarray, temperature_c: np.ndarray | float) -> np.ndarray:
     """As `apply`, from signed 20-bit ADXL355 codes at the calibration's range."""
     return apply(calibration, np.asarray(codes, dtype=float) * calibration.lsb_g, temperature_c)
+
+
+def apply_gyro(calibration: GyroCalibration, rate_dps: np.ndarray, force_g: np.ndarray,
+               temperature_c: np.ndarray | float) -> np.ndarray:
+    """Compensate raw gyroscope readings (..., 3) in °/s, taken at the sensor's own temperatures (...) while
+    it felt the specific force `force_g` (..., 3, in g: the compensated accelerometer's reading) → the angular
+    rate in the DUT frame, °/s."""
+    return gyro_model.correct_rate(np.asarray(rate_dps, dtype=float), np.asarray(force_g, dtype=float),
+                                   calibration.parameters_at(temperature_c))
 
 
 def save_calibration(calibration: CalibrationFile, path: Path) -> None:

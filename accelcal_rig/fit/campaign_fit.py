@@ -23,6 +23,7 @@ from accelcal_rig.fit.budget import (
 )
 from accelcal_rig.fit.calibration import (
     ACCELERATION,
+    ANGULAR_RATE,
     CalibrationFile,
     DutCalibration,
     PolynomialModel,
@@ -35,9 +36,11 @@ from accelcal_rig.fit.calibration import FORMAT_NAME as CALIBRATION_FORMAT
 from accelcal_rig.fit.calibration import FORMAT_VERSION as CALIBRATION_VERSION
 from accelcal_rig.fit.expected import expected_norm_rmse_mg, expected_reference_rmse_mg, thermal_jacobian
 from accelcal_rig.fit.fixture_pool import map_over_duts
+from accelcal_rig.fit.gyro_fit import GyroDesignError, GyroFitResult, fit_gyro, read_gyro_records, site_of
 from accelcal_rig.fit.joint import fit_joint
 from accelcal_rig.fit.lm import FitMode, FreeParameters, SfemFit, fit_sfem, norm_sigma
 from accelcal_rig.fit.metrics import drift_mg, noise_floor_mg, norm_rmse_mg
+from accelcal_rig.fit.noise_record import noise_allan
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, norm_only_gauge
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
 from accelcal_rig.fit.uncertainty import CoefficientCovariance
@@ -268,10 +271,13 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     limits = recorded_acceptance(campaign.header.procedure_yaml, source.get("campaign", "the campaign"))
     partial = partial_campaign(campaign, run_end)
     judged = {r.serial: judge(r.metrics, r.thermal, options.mode, limits, partial) for r in results}
-    uncalibrated = {serial: not_calibrated(campaign, serial) for serial in campaign.serials}
+    gyroscopes = {serial: fit_gyroscope(campaign, serial, options) for serial in campaign.serials}
+    uncalibrated = {serial: not_calibrated(campaign, serial, gyroscopes[serial]) for serial in campaign.serials}
     duts = {r.serial: DutCalibration(
         channels={ACCELERATION: r.calibration.model_copy(update={"verdict": judged[r.serial].verdict,
-                                                                 "verdict_reasons": judged[r.serial].reasons})},
+                                                                 "verdict_reasons": judged[r.serial].reasons}),
+                  **({ANGULAR_RATE: gyro.calibration} if isinstance(gyro := gyroscopes[r.serial], GyroFitResult)
+                     else {})},
         not_calibrated=uncalibrated[r.serial]) for r in results}
     calibration = CalibrationFile(
         format=CALIBRATION_FORMAT, format_version=CALIBRATION_VERSION, created=utc_now(),
@@ -279,20 +285,63 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     )
     report = {r.serial: {**plain(r.metrics), "warnings": r.thermal.warnings, "verdict": judged[r.serial].verdict,
                          "verdict_reasons": judged[r.serial].reasons,
+                         **_noise_figures(campaign, r.serial, ACCELERATION, "allan"),
+                         **({"gyro": {**gyro.metrics, "verdict": None,
+                                      **_noise_figures(campaign, r.serial, ANGULAR_RATE, "allan")}}
+                            if isinstance(gyro := gyroscopes[r.serial], GyroFitResult) else {}),
                          **({"not_calibrated": uncalibrated[r.serial]} if uncalibrated[r.serial] else {})}
               for r in results}
     return calibration, report
 
 
-#: The quantities a channel model calibrates: Eq. 1 against a reference vector, here gravity.
-CHANNEL_MODELS = {"acceleration": "Eq. 1 sensor-frame error model against gravity"}
+def _noise_figures(campaign: Campaign, serial: str, channel: str, key: str) -> dict[str, Any]:
+    """`{key: the channel's Allan figures}` where the campaign has noise records and the channel, else {}."""
+    odr_hz = float(campaign.header.duts[campaign.serials.index(serial)].get("odr_hz") or 0.0)
+    if odr_hz <= 0 or channel not in {c.name for c in campaign.header.dut_channels(serial)}:
+        return {}
+    figures = noise_allan(campaign, serial, channel, odr_hz)
+    return {key: figures} if figures is not None else {}
 
 
-def not_calibrated(campaign: Campaign, serial: str) -> dict[str, str]:
-    """The DUT's channels that no channel model calibrates yet, each with why (they are measured and stored)."""
-    return {channel.name: f"{channel.quantity} in {channel.unit}: measured and stored; no channel model "
-                          f"calibrates {channel.quantity} yet"
-            for channel in campaign.header.dut_channels(serial) if channel.quantity not in CHANNEL_MODELS}
+#: The quantities a channel model calibrates: Eq. 1 against gravity; the rate-table model against the table's
+#: rate and the Earth's.
+CHANNEL_MODELS = {"acceleration": "Eq. 1 sensor-frame error model against gravity",
+                  "angular rate": "rate-table gyroscope model (fit/gyro_model.py) against the table's rate"}
+
+
+def fit_gyroscope(campaign: Campaign, serial: str, options: FitOptions) -> GyroFitResult | str | None:
+    """The DUT's gyroscope fitted from the campaign's rate steps; why not (a line) where it has a gyroscope
+    but the campaign no rate steps or too few; None for a DUT without one."""
+    reason = _no_rate_steps(campaign, serial)
+    if reason is not None or ANGULAR_RATE not in {c.name for c in campaign.header.dut_channels(serial)}:
+        return reason
+    try:
+        return fit_gyro(read_gyro_records(campaign, serial), options.degree, options.out_of_range, site_of(campaign))
+    except GyroDesignError as exc:
+        return f"angular rate in dps: measured and stored; not calibrated: {exc}"
+
+
+def _no_rate_steps(campaign: Campaign, serial: str) -> str | None:
+    """Why the DUT's gyroscope cannot be calibrated from this campaign: it stores no rate step (None: it
+    does, or the DUT has no gyroscope)."""
+    if ANGULAR_RATE not in {c.name for c in campaign.header.dut_channels(serial)}:
+        return None
+    if campaign.header.plan.keys_of("rate") & campaign.stored_keys:
+        return None
+    return ("angular rate in dps: measured and stored; the campaign has no rate steps to calibrate it (a rate "
+            "table and a procedure with rates:)")
+
+
+def not_calibrated(campaign: Campaign, serial: str, gyro: GyroFitResult | str | None = None) -> dict[str, str]:
+    """The DUT's channels that no channel model calibrated, each with why (they are measured and stored): the
+    gyroscope's from its fit (`gyro`, a reason where it failed), else from whether the campaign has rate steps."""
+    reasons = {channel.name: f"{channel.quantity} in {channel.unit}: measured and stored; no channel model "
+                             f"calibrates {channel.quantity} yet"
+               for channel in campaign.header.dut_channels(serial) if channel.quantity not in CHANNEL_MODELS}
+    reason = gyro if isinstance(gyro, str) else _no_rate_steps(campaign, serial) if gyro is None else None
+    if reason is not None:
+        reasons[ANGULAR_RATE] = reason
+    return reasons
 
 
 #: Poses each direction of approach needs before the hysteresis term is fitted.

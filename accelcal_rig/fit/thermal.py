@@ -21,8 +21,8 @@ class ThermalModel:
     """`coefficients[k]` are parameter k's polynomial in x ∈ [−1, 1] over `domain_c`, increasing powers."""
 
     domain_c: tuple[float, float]
-    coefficients: np.ndarray              # (12, degree + 1); fixed parameters hold their constant value
-    residuals: np.ndarray                 # (n_temperatures, 12) per-temperature estimate minus polynomial
+    coefficients: np.ndarray              # (P, degree + 1); fixed parameters hold their constant value
+    residuals: np.ndarray                 # (n_temperatures, P) per-temperature estimate minus polynomial
     degree: int
     warnings: list[str] = field(default_factory=list)
 
@@ -31,7 +31,7 @@ class ThermalModel:
         return (np.asarray(temperature_c, dtype=float) - 0.5 * (low + high)) / (0.5 * (high - low))
 
     def parameters_at(self, temperature_c: np.ndarray | float, out_of_range: OutOfRange = "clamp") -> np.ndarray:
-        """Parameters (..., 12) at each temperature; outside the domain clamp to its edge or extrapolate."""
+        """Parameters (..., P) at each temperature; outside the domain clamp to its edge or extrapolate."""
         x = self.scaled(temperature_c)
         if out_of_range == "clamp":
             x = np.clip(x, -1.0, 1.0)
@@ -40,7 +40,8 @@ class ThermalModel:
 
 def fit_thermal(temperature_c: np.ndarray, parameters: np.ndarray, sigma: np.ndarray, free: np.ndarray,
                 degree: int) -> ThermalModel:
-    """Fit each free parameter's per-temperature estimates (n, 12) against temperature (n,)."""
+    """Fit each free parameter's per-temperature estimates (n, P) against temperature (n,): Eq. 1's twelve, or
+    any other channel model's."""
     temperature_c = np.asarray(temperature_c, dtype=float)
     n = temperature_c.size
     warnings = []
@@ -53,14 +54,15 @@ def fit_thermal(temperature_c: np.ndarray, parameters: np.ndarray, sigma: np.nda
     domain = (float(temperature_c.min()), float(temperature_c.max()))
     if domain[1] - domain[0] < 1e-9:
         domain = (domain[0] - 0.5, domain[0] + 0.5)  # one temperature: a constant over a nominal 1 °C
-    coefficients = np.zeros((12, degree + 1))
-    for k in range(12):
+    count = parameters.shape[1]
+    coefficients = np.zeros((count, degree + 1))
+    for k in range(count):
         if not free[k]:
             coefficients[k, 0] = parameters[0, k]
             continue
         weights = 1.0 / np.where(np.isfinite(sigma[:, k]) & (sigma[:, k] > 0), sigma[:, k], 1.0)
         polynomial = Polynomial.fit(temperature_c, parameters[:, k], used_degree, domain=list(domain), w=weights)
         coefficients[k, : used_degree + 1] = polynomial.coef
-    model = ThermalModel(domain, coefficients, np.empty((0, 12)), degree, warnings)
+    model = ThermalModel(domain, coefficients, np.empty((0, count)), degree, warnings)
     residuals = parameters - model.parameters_at(temperature_c, "extrapolate")
     return ThermalModel(domain, coefficients, residuals, degree, warnings)

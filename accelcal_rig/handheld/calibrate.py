@@ -1,5 +1,7 @@
 """A norm-only calibration from the static intervals of a recording, written as the same calibration
-file as `rig fit` (one temperature: every parameter a constant)."""
+file as `rig fit` (one temperature: every parameter a constant); and, when the recording has gyro columns,
+the gyroscope's bias and K from the moves between those intervals (handheld.gyro: in the report, not yet in
+the calibration file)."""
 
 from __future__ import annotations
 
@@ -10,7 +12,6 @@ import numpy as np
 
 from accelcal_rig import __version__
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
-from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import (
     ACCELERATION,
     FORMAT_NAME,
@@ -26,7 +27,8 @@ from accelcal_rig.fit.lm import DegenerateDesign, FreeParameters, SfemFit
 from accelcal_rig.fit.metrics import noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.robust import fit_norm_only_with_floor
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
-from accelcal_rig.handheld.recording import Recording
+from accelcal_rig.handheld.gyro import HandheldGyroFit, fit_handheld_gyro
+from accelcal_rig.handheld.recording import Recording, RecordingUnusable
 from accelcal_rig.handheld.static_intervals import Detection
 from accelcal_rig.store.records import utc_now
 
@@ -36,15 +38,12 @@ VISITED_G = 0.5
 NOMINAL_TEMPERATURE_C = 25.0
 
 
-class RecordingUnusable(ConfigError):
-    """Too few static intervals, or too poorly spread, for the fit asked for: bad input (exit code 2)."""
-
-
 @dataclass(frozen=True)
 class RecordingFit:
     fit: SfemFit
     calibration: CalibrationFile
     report: dict[str, Any]
+    gyro: HandheldGyroFit | None = None  # when the recording has gyro columns
 
 
 def missing_orientations(mean_g: np.ndarray) -> list[str]:
@@ -111,6 +110,9 @@ def fit_recording(recording: Recording, detection: Detection, free: FreeParamete
     if high - low < 1.0:
         low, high = temperature - 0.5, temperature + 0.5  # one temperature: valid within ±0.5 °C of it
     compensated = correct(mean, fit.parameters)
+    # The gyro after the accelerometer: its moves are judged against the compensated gravity directions.
+    gyro = (fit_handheld_gyro(recording, intervals, compensated, detection.rate_hz)
+            if recording.gyro_dps is not None else None)
     metrics = {
         "rmse_before_mg": norm_rmse_mg(mean, gravity_g), "rmse_after_mg": norm_rmse_mg(compensated, gravity_g),
         "gravity_m_s2": gravity_g * STANDARD_GRAVITY_M_S2, "units": "standard g (9.80665 m/s²)",
@@ -146,5 +148,6 @@ def fit_recording(recording: Recording, detection: Detection, free: FreeParamete
         "parameters": dict(zip(PARAMETER_NAMES, fit.parameters)),
         "sigma": dict(zip(PARAMETER_NAMES, fit.sigma)),
         **metrics, "warnings": warnings,
+        "gyro": gyro.report() if gyro is not None else None,
     })
-    return RecordingFit(fit, calibration_file, report)
+    return RecordingFit(fit, calibration_file, report, gyro)

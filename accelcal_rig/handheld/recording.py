@@ -1,4 +1,5 @@
-"""A continuous recording of one accelerometer, from a CSV file or from a campaign file's raw samples."""
+"""A continuous recording of one accelerometer (and of a gyroscope beside it, if the CSV has its columns), from
+a CSV file or from a campaign file's raw samples."""
 
 from __future__ import annotations
 
@@ -25,8 +26,17 @@ MAX_VALUE = 1e15
 MAX_CSV_BYTES = 512 << 20
 MAX_ACCEL_G = 1000.0
 MIN_TEMPERATURE_C, MAX_TEMPERATURE_C = -100.0, 300.0
+#: The largest rate (°/s, once scaled) taken for a gyroscope turned by hand: MEMS gyroscopes end at ±4000 °/s, and
+#: a column read in the wrong units (°/s read as rad/s: ×57) goes past it.
+MAX_GYRO_DPS = 5000.0
 Units = Literal["g", "counts", "m/s2"]
+GyroUnits = Literal["dps", "rad/s", "counts"]
 TimeUnit = Literal["s", "ms", "samples"]
+
+
+class RecordingUnusable(ConfigError):
+    """Too few static intervals, or too poorly spread, or turns that say too little, for the fit asked for: bad
+    input (exit code 2)."""
 
 
 @dataclass(frozen=True)
@@ -40,11 +50,13 @@ class Recording:
     notes: list[str] = field(default_factory=list)
     serial: str | None = None          # the sensor, when the source names it (a campaign file's DUT)
     gravity_m_s2: float | None = None  # the site's gravity, when the source states it (a campaign file)
+    gyro_dps: np.ndarray | None = None  # (n, 3) raw gyro readings in °/s (counts × gyro_lsb_dps), if recorded
+    gyro_lsb_dps: float | None = None   # °/s per count (for codes); 1.0 in °/s, 180/π in rad/s; None without a gyro
 
 
 @dataclass(frozen=True)
 class CsvLayout:
-    """Which CSV columns hold time, x, y, z (and temperature), and in what units."""
+    """Which CSV columns hold time, x, y, z (and temperature, and the gyroscope's x, y, z), and in what units."""
 
     time: str
     x: str
@@ -56,11 +68,14 @@ class CsvLayout:
     units: Units = "g"
     counts_per_g: float | None = None  # needed for counts
     zero_code: float = 0.0             # code of 0 g: 0 for signed codes, e.g. 32768 for 16-bit offset binary
+    gyro: tuple[str, str, str] | None = None  # the gyroscope's x, y, z columns, if it is to be read
+    gyro_units: GyroUnits = "dps"
+    counts_per_dps: float | None = None       # needed for gyro counts (the fit finds each axis's scale from it)
 
     @classmethod
-    def parse_columns(cls, spec: str, **options: object) -> CsvLayout:
-        """`time,x,y,z[,temperature]`: column names from the file's header, or column numbers counted from 1
-        (as cut and awk count) for a file with or without one."""
+    def parse_columns(cls, spec: str, gyro: str | None = None, **options: object) -> CsvLayout:
+        """`time,x,y,z[,temperature]` (and `gyro`: `gx,gy,gz`): column names from the file's header, or column
+        numbers counted from 1 (as cut and awk count) for a file with or without one."""
         names = [n.strip() for n in spec.split(",")]
         if len(names) not in (4, 5) or not all(names):
             raise ConfigError(f"--columns: {spec!r}: expected time,x,y,z or time,x,y,z,temperature column names "
@@ -70,11 +85,24 @@ class CsvLayout:
             raise ConfigError(f"--columns: {spec!r}: all names or all numbers, not both")
         if all(numbered) and min(int(n) for n in names) < 1:
             raise ConfigError(f"--columns: {spec!r}: column numbers count from 1")
+        gyro_names: tuple[str, str, str] | None = None
+        if gyro is not None:
+            split = [n.strip() for n in gyro.split(",")]
+            if len(split) != 3 or not all(split):
+                raise ConfigError(f"--gyro-columns: {gyro!r}: expected gx,gy,gz column names or numbers")
+            if any(n.isdigit() != all(numbered) for n in split):
+                raise ConfigError(f"--gyro-columns: {gyro!r}: by {'number' if all(numbered) else 'name'}, as --columns "
+                                  f"{spec!r}")
+            if all(numbered) and min(int(n) for n in split) < 1:
+                raise ConfigError(f"--gyro-columns: {gyro!r}: column numbers count from 1")
+            gyro_names = (split[0], split[1], split[2])
+        options["gyro"] = gyro_names
         return cls(*names[:4], names[4] if len(names) == 5 else None, **options)  # type: ignore[arg-type, call-arg]
 
     @property
     def wanted(self) -> list[str]:
-        return [self.time, self.x, self.y, self.z] + ([self.temperature] if self.temperature else [])
+        return ([self.time, self.x, self.y, self.z] + ([self.temperature] if self.temperature else [])
+                + list(self.gyro or ()))
 
     @property
     def numbered(self) -> bool:
@@ -112,9 +140,10 @@ def _column_index(path: Path, layout: CsvLayout, rows: list[list[str]]) -> tuple
     missing = [c for c in layout.wanted if c not in header]
     if missing:
         columns = repr(", ".join(header))[1:-1]
+        option = ("--gyro-columns gx,gy,gz" if set(missing) <= set(layout.gyro or ())
+                  else "--columns time,x,y,z[,temperature]")
         raise ConfigError(f"{path}: no column {', '.join(missing)} (columns: {columns[:120]}"
-                          f"{'…' if len(columns) > 120 else ''}); map them with --columns time,x,y,z[,temperature] "
-                          "(names, or numbers from 1)")
+                          f"{'…' if len(columns) > 120 else ''}); map them with {option} (names, or numbers from 1)")
     return [header.index(c) for c in layout.wanted], start + 1
 
 
@@ -123,6 +152,8 @@ def read_csv_recording(path: Path, layout: CsvLayout) -> Recording:
     number) or without (by number)."""
     if layout.time_unit == "samples" and not layout.rate_hz:
         raise ConfigError("--rate-hz is needed when the time column counts samples")
+    if layout.gyro and layout.gyro_units == "counts" and not layout.counts_per_dps:
+        raise ConfigError("--counts-per-dps is needed with --gyro-units counts (ICM-42688-P at ±2000 °/s: 16.4)")
     raw = read_regular_file(path, MAX_CSV_BYTES, "a recording")
     try:
         rows, delimiter = _split_rows(raw.decode("utf-8-sig", errors="replace"))
@@ -137,8 +168,7 @@ def read_csv_recording(path: Path, layout: CsvLayout) -> Recording:
         try:
             numbers = [float(row[i]) for i in index]
         except (ValueError, IndexError):
-            raise ConfigError(f"{path}:{line}: not a number in columns {', '.join(wanted)} (delimited by "
-                              f"{delimiter})") from None
+            _refuse_cell(path, line, layout, row, index, delimiter)
         if not all(math.isfinite(v) and abs(v) <= MAX_VALUE for v in numbers):
             raise ConfigError(f"{path}:{line}: not a finite number of at most {MAX_VALUE:g} in "
                               f"columns {', '.join(wanted)}")
@@ -174,7 +204,40 @@ def read_csv_recording(path: Path, layout: CsvLayout) -> Recording:
     if temperature is not None and not np.all((MIN_TEMPERATURE_C <= temperature) & (temperature <= MAX_TEMPERATURE_C)):
         raise ConfigError(f"{path}: column {layout.temperature}: temperatures outside {MIN_TEMPERATURE_C:g} … "
                           f"{MAX_TEMPERATURE_C:g} °C")
-    return Recording(str(path), t, accel_g, temperature, lsb_g, hashlib.sha256(raw).hexdigest(), notes)
+    gyro_dps, gyro_lsb_dps = _gyro_columns(path, layout, data)
+    return Recording(str(path), t, accel_g, temperature, lsb_g, hashlib.sha256(raw).hexdigest(), notes,
+                     gyro_dps=gyro_dps, gyro_lsb_dps=gyro_lsb_dps)
+
+
+def _refuse_cell(path: Path, line: int, layout: CsvLayout, row: list[str], index: list[int], delimiter: str) -> None:
+    """One line for a row with a cell that is not a number: a gyro column by its name (its option is a new one
+    to get wrong), the accelerometer's as the columns it was read with."""
+    for name, i in zip(layout.wanted, index):
+        try:
+            float(row[i])
+        except (ValueError, IndexError):
+            if name in (layout.gyro or ()):
+                cell = repr(row[i]) if i < len(row) else "missing"
+                raise ConfigError(f"{path}:{line}: column {name} (--gyro-columns): not a number ({cell}; delimited "
+                                  f"by {delimiter})") from None
+            break
+    raise ConfigError(f"{path}:{line}: not a number in columns {', '.join(layout.wanted)} (delimited by "
+                      f"{delimiter})")
+
+
+def _gyro_columns(path: Path, layout: CsvLayout, data: np.ndarray) -> tuple[np.ndarray | None, float | None]:
+    """The gyro columns in °/s (the last three read), and °/s per count; refused when a column reads faster
+    than any MEMS gyroscope turns, which is what a wrong --gyro-units or --counts-per-dps looks like."""
+    if not layout.gyro:
+        return None, None
+    lsb_dps = {"dps": 1.0, "rad/s": 180.0 / math.pi, "counts": 1.0 / (layout.counts_per_dps or 1.0)}[layout.gyro_units]
+    gyro_dps = data[:, -3:] * lsb_dps
+    largest = np.abs(gyro_dps).max(axis=0)
+    if largest.max() > MAX_GYRO_DPS:
+        name = layout.gyro[int(np.argmax(largest))]
+        raise ConfigError(f"{path}: column {name}: rates up to {largest.max():.3g} °/s once scaled ({layout.gyro_units}"
+                          f"): not a gyroscope turned by hand; check --gyro-units and --counts-per-dps")
+    return gyro_dps, lsb_dps
 
 
 def read_campaign_recording(path: Path, serial: str | None, setpoint_c: float | None) -> Recording:

@@ -18,6 +18,7 @@ from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.config.schedule import Schedule
 from accelcal_rig.plan import schedules
 from accelcal_rig.plan.frost import with_frost_steps
+from accelcal_rig.plan.gyro_steps import noise_blocks, rate_poses, rate_steps
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.plan.steps import (
     AdvanceRamp,
@@ -162,6 +163,7 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
     if checks:
         _check_verification_is_new(poses, checks)
     width = max(2, len(str(len(poses))))
+    spun = rate_poses(procedure.rates, rig, (checks or poses)[-1].angles_deg) if procedure.rates is not None else {}
     setpoints = tuple(procedure.setpoints_c)
     bidirectional = procedure.method == "ramp" and procedure.ramp is not None and procedure.ramp.bidirectional
     if bidirectional:  # and back, half-way between the setpoints
@@ -177,19 +179,36 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
         else:
             entry = restart = _ramp_and_soak(setpoint)
         at_rest = any(isinstance(step, Soak) for step in entry)
-        if verify is not None and verify.at_setpoints and (at_rest or verify.on_ramp):
+        verified = verify is not None and verify.at_setpoints and (at_rest or verify.on_ramp)
+        if verified:
             measure.extend(_verification(setpoint, checks))
         if procedure.method == "ramp":
             body: tuple[Step, ...] = tuple(step for m in measure for step in (AdvanceRamp(setpoint), m))
         else:
-            body = tuple(measure)
+            body = (*measure, *_gyroscope(procedure, rig, setpoint, spun, poses, calibrate=True, verify=verified))
         stages.append(Stage(setpoint, entry, body, restart))
         if verify is not None and index + 1 < len(setpoints):
             passed = _passed_between(setpoint, setpoints[index + 1], verify.setpoints_c, stages)
-            stages.extend(Stage(v, _ramp_and_soak(v), tuple(_verification(v, checks)), _ramp_and_soak(v))
+            stages.extend(Stage(v, _ramp_and_soak(v), (*_verification(v, checks),
+                                                       *_gyroscope(procedure, rig, v, spun, poses, False, True)),
+                                _ramp_and_soak(v))
                           for v in passed)
     stages = with_frost_steps(stages, procedure.frost)
     return Plan(tuple(s.setpoint_c for s in stages), poses, tuple(stages), names, checks)
+
+
+def _gyroscope(procedure: Procedure, rig: RigConfig, setpoint_c: float, spun: dict[str, Pose],
+               poses: tuple[Pose, ...], calibrate: bool, verify: bool) -> list[Step]:
+    """A gyroscope's steps after the poses: the rate steps (calibration, verification or both), then, at a
+    calibration setpoint, the still noise record."""
+    label = setpoint_label(setpoint_c)
+    steps: list[Step] = []
+    if procedure.rates is not None:
+        steps += rate_steps(label, setpoint_c, procedure.rates, rig, spun, calibrate, verify)
+    if procedure.noise is not None and calibrate:
+        held = next(p for p in poses if p.number == procedure.noise.pose)
+        steps += noise_blocks(label, setpoint_c, procedure, held)
+    return steps
 
 
 def _verification(setpoint_c: float, checks: tuple[Pose, ...]) -> list[VerifyPose]:

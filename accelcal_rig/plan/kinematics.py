@@ -44,6 +44,28 @@ class TurntableKinematics:
             chain = chain @ per_axis[:, k]
         return chain.reshape(angles.shape[:-1] + (3, 3))
 
+    def angular_velocity_in_fixture(self, angles_deg: np.ndarray, rates_deg_s: np.ndarray) -> np.ndarray:
+        """The fixture's angular velocity (°/s) in its own frame, shape (..., 3): each axis's rate about its
+        direction as its parents have turned it, ω_world = Σ_k rate_k · (R_1 ⋯ R_(k−1)) d_k, brought into
+        the fixture frame by Rᵀ."""
+        angles = np.deg2rad(np.asarray(angles_deg, dtype=float))
+        rates = np.asarray(rates_deg_s, dtype=float)
+        flat = angles.reshape(-1, len(self.axes))
+        per_axis = Rotation.from_rotvec((flat[:, :, None] * self._directions).reshape(-1, 3)).as_matrix()
+        per_axis = per_axis.reshape(flat.shape[0], len(self.axes), 3, 3)
+        flat_rates = np.broadcast_to(rates, angles.shape).reshape(-1, len(self.axes))
+        parents = np.broadcast_to(np.eye(3), (flat.shape[0], 3, 3))
+        omega_world = np.zeros((flat.shape[0], 3))
+        for k in range(len(self.axes)):
+            omega_world += flat_rates[:, k, None] * (parents @ self._directions[k])
+            parents = parents @ per_axis[:, k]
+        fixture = np.einsum("nji,nj->ni", parents, omega_world)  # parents is now the whole chain R
+        return fixture.reshape(angles.shape[:-1] + (3,))
+
+    def world_in_fixture(self, angles_deg: np.ndarray, vector_world: np.ndarray) -> np.ndarray:
+        """A world-frame vector in the fixture frame at these angles: Rᵀ·v, shape (..., 3)."""
+        return np.einsum("...ji,j->...i", self.chain_matrices(angles_deg), np.asarray(vector_world, dtype=float))
+
     def gravity_in_fixture(self, angles_deg: np.ndarray) -> np.ndarray:
         """Unit specific-force direction (+1 g up) in the fixture frame, shape (..., 3).
 

@@ -84,6 +84,11 @@ class Measurement:
     pose: Pose
     stored_kind: ClassVar[str] = "pose"
 
+    @property
+    def rate_fixture_dps(self) -> tuple[float, float, float]:
+        """The table's angular rate in the fixture frame while the samples are taken: at rest."""
+        return (0.0, 0.0, 0.0)
+
 
 @dataclass(frozen=True)
 class MeasurePose(Measurement):
@@ -105,8 +110,55 @@ class CooldownRecord(Measurement):
     number: int
 
 
+FIXTURE_AXES = "xyz"
+
+
+@dataclass(frozen=True)
+class RateStep(Measurement):
+    """Turn the table's rate axis at `rate_dps` (signed, right-handed about the fixture's `about` axis, which
+    the pose has brought to the rate axis), hold it, acquire, store. The table keeps turning after it: the
+    next rate step about the same axis starts from this rate, a StopRotation ends the run of them."""
+
+    about: str
+    rate_dps: float
+    rate_axis: int
+    stored_kind: ClassVar[str] = "rate"
+
+    @property
+    def rate_fixture_dps(self) -> tuple[float, float, float]:
+        rate = [0.0, 0.0, 0.0]
+        rate[FIXTURE_AXES.index(self.about)] = self.rate_dps
+        return (rate[0], rate[1], rate[2])
+
+
+@dataclass(frozen=True)
+class VerifyRate(RateStep):
+    """A verification rate step: turned like a calibration rate, stored apart, never seen by the fit."""
+
+    stored_kind: ClassVar[str] = "verify-rate"
+
+
+@dataclass(frozen=True)
+class StopRotation:
+    """Bring the turning rate axis to rest (at the acceleration of the last rate step) and wait until it is."""
+
+    setpoint_c: float
+    rate_axis: int
+    acceleration_dps2: float
+    from_rate_dps: float
+
+
+@dataclass(frozen=True)
+class NoiseBlock(Measurement):
+    """The `number`-th block of a still noise record at the pose it holds: the blocks follow one another with
+    nothing moving between them."""
+
+    number: int
+    stored_kind: ClassVar[str] = "noise"
+
+
 Step = (Ramp | Soak | SetPurge | AwaitDewPointMargin | StartSoftwareRamp | RampSegment | AdvanceRamp | MeasurePose
-        | VerifyPose | CooldownRecord)
+        | VerifyPose | CooldownRecord | RateStep | VerifyRate | StopRotation | NoiseBlock)
 #: The steps that store a record in the campaign (what its stored plan lists).
 Record = Soak | Measurement
 

@@ -8,6 +8,7 @@ from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.engine.estimate import DurationEstimate
 from accelcal_rig.engine.preparation import PreparedCampaign
 from accelcal_rig.plan.compile import setpoint_label
+from accelcal_rig.plan.steps import RateStep
 from accelcal_rig.store.space import START_MARGIN, megabytes
 
 
@@ -27,6 +28,7 @@ def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[s
         f"chamber within {soak.chamber_tolerance_c:g} °C; polled every {soak.poll_s:g} s; deadline "
         f"{soak.timeout_min:g} min ({soak.on_timeout})",
         _poses_line(prepared),
+        *_gyroscope_lines(prepared),
         *_verification_lines(prepared),
         *_method_lines(prepared),
         "fit        none: measured only" if procedure.fit.mode == "none" else
@@ -89,7 +91,37 @@ def _poses_line(prepared: PreparedCampaign) -> str:
     if cooldown is not None:
         return (f"records    {len(plan.pose_steps)} at pose {cooldown.pose} of the {procedure.schedule.kind} schedule, "
                 f"every {cooldown.record_every_s:g} s for {cooldown.duration_min:g} min; {samples}")
-    return f"poses      {len(plan.poses)} per setpoint ({procedure.schedule.kind}), {len(plan.pose_steps)} in all; {samples}"
+    static = sum(1 for s in plan.pose_steps if s.stored_kind == "pose")
+    return (f"poses      {len(plan.poses)} per setpoint ({procedure.schedule.kind}), {static} in all; {samples}"
+            + (f"; {len(plan.pose_steps)} records in all with the rate steps and noise blocks" if len(plan.pose_steps) > static + _checks(plan)
+               else ""))
+
+
+def _checks(plan: Any) -> int:
+    return sum(1 for s in plan.pose_steps if s.stored_kind == "verify")
+
+
+def _gyroscope_lines(prepared: PreparedCampaign) -> list[str]:
+    """The rate steps and the noise record, where the procedure has them."""
+    procedure, plan, rig = prepared.procedure.model, prepared.plan, prepared.rig.model
+    lines = []
+    rates = procedure.rates
+    if rates is not None:
+        turning = [s for s in plan.pose_steps if isinstance(s, RateStep)]
+        axis = rig.turntable.axes[turning[0].rate_axis] if turning else None
+        listed = ", ".join(f"±{r:g}" for r in rates.rates_dps)
+        checked = (f"; verification ±{', ±'.join(f'{r:g}' for r in rates.verify_rates_dps)} °/s, never fitted"
+                   if rates.verify_rates_dps else "")
+        acceleration = rates.acceleration_dps2 or (axis.max_acceleration_dps2 if axis else None)
+        lines.append(f"rates      {listed} °/s about fixture {', '.join(rates.about)} on table axis "
+                     f"{axis.name if axis else '?'} (reached at {acceleration:g} °/s², held {rates.settle_s:g} s): "
+                     f"{rates.steps_per_setpoint} per calibration setpoint, {len(turning)} in all{checked}")
+    if procedure.noise is not None:
+        blocks = procedure.noise_blocks()
+        block_s = procedure.acquisition.samples_per_pose / procedure.acquisition.odr_hz
+        lines.append(f"noise      {blocks * block_s:g} s still at pose {procedure.noise.pose} per calibration setpoint "
+                     f"({blocks} blocks of {procedure.acquisition.samples_per_pose} samples): the Allan deviation")
+    return lines
 
 
 def _verification_lines(prepared: PreparedCampaign) -> list[str]:

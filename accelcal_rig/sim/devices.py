@@ -15,6 +15,7 @@ from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.errors import InstrumentError
+from accelcal_rig.fit.gyro_model import PARAMETER_NAMES as GYRO_PARAMETER_NAMES
 from accelcal_rig.fit.sfem import PARAMETER_NAMES
 from accelcal_rig.instruments.interfaces import DeviceIdentity, RigInstruments, SampleBlock
 from accelcal_rig.sim.lab import VirtualLab
@@ -79,6 +80,15 @@ class SimulatedTurntable:
 
     def stop(self) -> None:
         self._lab.motion.stop(self._lab.clock.now())
+
+    def rotate_at(self, axis: int, rate_deg_s: float, acceleration_deg_s2: float) -> None:
+        self._lab.motion.rotate(self._lab.clock.now(), axis, rate_deg_s, acceleration_deg_s2)
+
+    def read_rate_deg_s(self, axis: int) -> float:
+        return self._lab.motion.read_rate_deg_s(self._lab.clock.now(), axis)
+
+    def hold(self, axis: int) -> None:
+        self._lab.motion.hold(self._lab.clock.now(), axis)
 
     def close(self) -> None:
         """Nothing to release: the lab lives in this process."""
@@ -164,7 +174,19 @@ class SimulationTruth:
             "half_range_c": HALF_RANGE_C,
             "fixture_time_constant_s": dut.tau_s,
             "noise_g_per_sample": self._lab.noise_g(self._index[serial], odr_hz),
+            **self._gyro(serial, odr_hz),
         }
+
+    def _gyro(self, serial: str, odr_hz: float) -> dict[str, np.ndarray | str | float]:
+        """A gyroscope's hidden model beside the accelerometer's (fit.gyro_model's parameters, the same cubics)."""
+        index = self._index[serial]
+        dut = self._lab.duts[index]
+        if dut.gyro_truth is None:
+            return {}
+        return {"gyro_polynomial_coefficients": dut.gyro_truth.coefficients,
+                "gyro_parameter_names": ",".join(GYRO_PARAMETER_NAMES),
+                "gyro_noise_dps_per_sample": self._lab.gyro_noise_dps(index, odr_hz),
+                "earth_rate_world_dps": np.asarray(self._lab.earth_rate_world_dps, dtype=float)}
 
     def block_truth(self, serial: str, block: SampleBlock) -> dict[str, np.ndarray]:
         return self._lab.truth_between(self._index[serial], block.t_start_s, block.t_end_s)

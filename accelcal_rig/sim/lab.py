@@ -12,10 +12,12 @@ import numpy as np
 from accelcal_rig.config.procedure import SimulatedEffects
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock
+from accelcal_rig.core.earth import earth_rate_world_dps
 from accelcal_rig.core.geometry import fixture_to_dut
 from accelcal_rig.core.humidity import relative_humidity_pct
 from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel
 from accelcal_rig.core.units import site_gravity_g
+from accelcal_rig.fit.gyro_model import distort_rate
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.parts.part import Part
 from accelcal_rig.parts.registry import part
@@ -125,6 +127,11 @@ class VirtualLab:
         #: uncertainty (its own stream, so a stated uncertainty of zero changes no other draw).
         draw = np.random.default_rng([seed, 1_000_003]).normal() if rig.gravity_uncertainty_m_s2 > 0 else 0.0
         self.site_gravity_g = site_gravity_g(rig.gravity_m_s2 + rig.gravity_uncertainty_m_s2 * draw)
+        #: The Earth's rate in the lab's world frame: at the rig config's site, else the simulation's (the
+        #: Earth turns in every lab, whether the rig config says where it is or not).
+        self.earth_rate_world_dps = earth_rate_world_dps(
+            sim.latitude_deg if rig.latitude_deg is None else rig.latitude_deg,
+            sim.heading_deg if rig.heading_deg is None else rig.heading_deg)
 
     def chamber_reading_c(self) -> float:
         """Chamber air as its controller reads it, with regulation noise."""
@@ -181,18 +188,24 @@ class VirtualLab:
         return density * float(np.sqrt(np.pi / 2 * odr_hz / 4))
 
     def true_rate_dps(self, index: int) -> np.ndarray:
-        """The DUT's true angular rate in its own frame: zero, the table at rest (samples are taken at rest)."""
-        return np.zeros(3)
+        """The DUT's true angular rate in its own frame now, °/s: the table's axes turning (a rate step, a
+        move) and the Earth's rotation."""
+        now = self.clock.now()
+        angles = self.motion.position_deg(now)
+        table = self.kinematics.angular_velocity_in_fixture(angles, self.motion.rate_deg_s(now))
+        earth = self.kinematics.world_in_fixture(angles, self.earth_rate_world_dps)
+        return self.duts[index].fixture_to_dut @ (table + earth)
 
     def dut_gyro_samples(self, index: int, t_start_s: float, n_samples: int, odr_hz: float,
                          range_dps: float) -> np.ndarray:
         """`n_samples` gyroscope codes (n, 3) of DUT `index` from `t_start_s` on: its hidden truth at its
-        temperature now applied to the true rate, white noise from its own stream, its part's codes."""
+        temperature now applied to the true rate and the specific force it feels, white noise from its own
+        stream, its part's codes."""
         dut, instant = self.duts[index], self._instant()
         if dut.gyro_truth is None:
             raise ValueError(f"{dut.serial}: the {dut.part.label} has no gyroscope")
         parameters = dut.gyro_truth.parameters_at(float(instant.temperature_c[index]))
-        reading = distort(self.true_rate_dps(index)[None, :], parameters[None, :])[0]
+        reading = distort_rate(self.true_rate_dps(index), instant.gravity_g[index], parameters)
         noise = self.gyro_rngs[index].normal(0.0, self.gyro_noise_dps(index, odr_hz), (n_samples, 3))
         return dut.part.channel("gyro").quantise(reading + noise, range_dps)
 

@@ -34,7 +34,8 @@ class DutTruth:
     coefficients: np.ndarray
 
     def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:
-        """Eq. 1 parameters (see fit.sfem.PARAMETER_NAMES) at each temperature, shape (..., 12)."""
+        """The model's parameters at each temperature, shape (..., P): Eq. 1's (fit.sfem.PARAMETER_NAMES) for an
+        accelerometer, the rate-table model's (fit.gyro_model.PARAMETER_NAMES) for a gyroscope."""
         x = (np.asarray(temperature_c, dtype=float) - T_REF_C) / HALF_RANGE_C
         return np.moveaxis(polynomial.polyval(x, self.coefficients.T), 0, -1)
 
@@ -60,24 +61,29 @@ def truth_for_serial(serial: str) -> DutTruth:
     return DutTruth(serial, coefficients)
 
 
-# A gyroscope's hidden truth: the same twelve-parameter model on angular rate (bias in °/s, scale,
-# non-orthogonality, misalignment), the same smooth cubics over temperature. Magnitudes of a consumer IMU's
-# gyroscope (an ICM-42688-P: zero-rate offset ±0.5 °/s, a few mdps/K): bias within ±0.5 °/s at 25 °C drifting
-# 0.1–0.5 °/s over −40…60 °C, scale within ±0.5 %, axes within a few tenths of a degree.
-_GYRO_HALF_WIDTH = np.repeat([0.5, 0.005, 0.3 * _DEG, 0.3 * _DEG], 3)
-_GYRO_DRIFT_LOW = np.repeat([0.1, 100e-6, 0.005 * _DEG, 0.005 * _DEG], 3)
-_GYRO_DRIFT_HIGH = np.repeat([0.5, 2000e-6, 0.02 * _DEG, 0.02 * _DEG], 3)
+# A gyroscope's hidden truth: the rate-table model's 27 parameters (fit/gyro_model.py), the same smooth cubics
+# over temperature. Magnitudes of a consumer IMU's gyroscope (an ICM-42688-P: zero-rate offset ±0.5 °/s, a few
+# mdps/K; sensitivity ±0.5 %, nonlinearity ±0.1 %, cross-axis ±2 %): bias within ±0.5 °/s at 25 °C drifting
+# 0.1–0.5 °/s over −40…60 °C, scale within ±0.5 %, cross-axis terms within a few tenths of a degree, ±
+# asymmetry and nonlinearity within 0.05 % and 0.1 %, g-sensitivity within ±0.05 °/s per g.
+_GYRO_GROUPS = (3, 3, 6, 3, 3, 9)
+_GYRO_CENTRE = np.repeat([0.0, 1.0, 0.0, 0.0, 0.0, 0.0], _GYRO_GROUPS)
+_GYRO_HALF_WIDTH = np.repeat([0.5, 0.005, 0.3 * _DEG, 5e-4, 1e-3, 0.05], _GYRO_GROUPS)
+_GYRO_DRIFT_LOW = np.repeat([0.1, 100e-6, 0.005 * _DEG, 20e-6, 20e-6, 0.002], _GYRO_GROUPS)
+_GYRO_DRIFT_HIGH = np.repeat([0.5, 2000e-6, 0.02 * _DEG, 100e-6, 200e-6, 0.01], _GYRO_GROUPS)
 
 
 def gyro_truth_for_serial(serial: str) -> DutTruth:
-    """The deterministic hidden truth of the gyroscope of the DUT with this serial number: its own seed, so
-    an accelerometer's truth (`truth_for_serial`) is the same with or without a gyroscope beside it."""
+    """The deterministic hidden truth of the gyroscope of the DUT with this serial number (fit.gyro_model's
+    parameters): its own seed, so an accelerometer's truth (`truth_for_serial`) is the same with or without a
+    gyroscope beside it."""
     seed = int.from_bytes(hashlib.sha256(f"gyro:{serial}".encode()).digest()[:8], "little")
     rng = np.random.default_rng(seed)
-    nominal = _NOMINAL_CENTRE + rng.uniform(-1, 1, 12) * _GYRO_HALF_WIDTH
-    drift = rng.uniform(_GYRO_DRIFT_LOW, _GYRO_DRIFT_HIGH) * rng.choice([-1.0, 1.0], 12)
-    shape = np.column_stack([np.ones(12), rng.uniform(-0.4, 0.4, (12, 2))])
+    count = len(_GYRO_CENTRE)
+    nominal = _GYRO_CENTRE + rng.uniform(-1, 1, count) * _GYRO_HALF_WIDTH
+    drift = rng.uniform(_GYRO_DRIFT_LOW, _GYRO_DRIFT_HIGH) * rng.choice([-1.0, 1.0], count)
+    shape = np.column_stack([np.ones(count), rng.uniform(-0.4, 0.4, (count, 2))])
     x = (np.linspace(*DRIFT_RANGE_C, 201) - T_REF_C) / HALF_RANGE_C
-    curves = polynomial.polyval(x, np.column_stack([np.zeros(12), shape]).T)
+    curves = polynomial.polyval(x, np.column_stack([np.zeros(count), shape]).T)
     span = curves.max(axis=1) - curves.min(axis=1)
     return DutTruth(serial, np.column_stack([nominal, shape * (drift / span)[:, None]]))

@@ -39,12 +39,15 @@ _UNUSABLE = (KeyError, ValueError, TypeError, IndexError, AttributeError, Overfl
 # ---------------------------------------------------------------------- encoding
 def encode_header(header: CampaignHeader) -> bytes:
     plan = header.plan
-    truth_attrs = {s: {k: plain_value(v) for k, v in d.items() if k != "polynomial_coefficients"}
+    truth_attrs = {s: {k: plain_value(v) for k, v in d.items() if not isinstance(v, np.ndarray)}
                    for s, d in header.truth.items()}
     arrays = {"plan_setpoint_c": plan.setpoint_c, "plan_pose_number": plan.pose_number,
               "plan_angles_deg": plan.angles_deg, "plan_gravity_fixture": plan.gravity_fixture}
     arrays.update({f"truth_coefficients/{s}": np.asarray(d["polynomial_coefficients"], dtype="f8")
                    for s, d in header.truth.items()})
+    # Any other array of a DUT's truth (a gyroscope's coefficients, the Earth's rate) under its own name.
+    arrays.update({f"truth_array/{s}/{k}": np.asarray(v, dtype="f8") for s, d in header.truth.items()
+                   for k, v in d.items() if isinstance(v, np.ndarray) and k != "polynomial_coefficients"})
     meta = {"campaign_id": header.campaign_id, "created": header.created, "software_version": header.software_version,
             "attrs": plain_value(header.attrs), "procedure_yaml": header.procedure_yaml, "rig_yaml": header.rig_yaml,
             "plan": {"step_key": list(plan.step_key), "kind": list(plan.kind), "fingerprint": plan.fingerprint,
@@ -122,7 +125,9 @@ def _header(record: Record) -> CampaignHeader:
     if not (len(plan.kind) == plan.setpoint_c.shape[0] == plan.pose_number.shape[0] == steps
             and plan.angles_deg.shape == (steps, len(plan.axis_names)) and plan.gravity_fixture.shape == (steps, 3)):
         raise ValueError("plan columns of different lengths")
-    truth = {s: {**_attributes(attrs), "polynomial_coefficients": arrays[f"truth_coefficients/{s}"]}
+    truth = {s: {**_attributes(attrs), "polynomial_coefficients": arrays[f"truth_coefficients/{s}"],
+                 **{name.split("/", 2)[2]: value for name, value in arrays.items()
+                    if name.startswith(f"truth_array/{s}/")}}
              for s, attrs in meta.get("truth", {}).items()}
     duts = [_attributes(d) for d in meta["duts"]]
     if not all(isinstance(d.get("serial"), str) for d in duts) or len({d["serial"] for d in duts}) != len(duts):

@@ -40,6 +40,8 @@ READABLE_VERSIONS = (1, 2, 3)
 TEXT = h5py.string_dtype("utf-8")
 #: Text columns are fixed-length UTF-8 (bytes per row; h5py returns bytes, `.decode()` them), longer text
 #: cut at a character boundary.
+#: A DUT's truth per pose in `simulation_truth/<serial>/` (the rest there describes its model).
+_TRUTH_COLUMNS = ("parameters", "gravity_g", "temperature_c")
 TEXT_BYTES = {"step_key": 64, "wall_time": 32, "level": 8, "kind": 16, "message": 1024}
 _UNITS = {"setpoint_c": "degC", "commanded_angles_deg": "deg", "measured_angles_deg": "deg", "gravity_fixture": "g",
           "t_start_s": "s", "t_end_s": "s", "chamber_temperature_c": "degC", "raw_codes": "LSB", "mean_g": "g",
@@ -141,8 +143,10 @@ def _image(campaign: Campaign, journal_bytes: int) -> bytes:
             truth.attrs["note"] = "SIMULATION TRUTH: hidden parameters of simulated DUTs, not measured data"
             for serial, description in header.truth.items():
                 group = truth.create_group(serial)
-                _dataset(group, "polynomial_coefficients", description["polynomial_coefficients"])
-                group.attrs.update({k: v for k, v in description.items() if k != "polynomial_coefficients"})
+                for name, value in description.items():  # the coefficients, and any other array of the truth
+                    if isinstance(value, np.ndarray):
+                        _dataset(group, name, value)
+                group.attrs.update({k: v for k, v in description.items() if not isinstance(v, np.ndarray)})
                 for name in ("parameters", "gravity_g", "temperature_c"):
                     _dataset(group, name, campaign.truth_column(serial, name))
         file.flush()
@@ -153,7 +157,7 @@ def _write_plan(group: h5py.Group, plan: StoredPlan) -> None:
     group.attrs["fingerprint"] = plan.fingerprint
     group.attrs["axis_names"] = list(plan.axis_names)
     _dataset(group, "step_key", _fixed_text("step_key", list(plan.step_key)))
-    _dataset(group, "kind", _fixed_text("level", list(plan.kind)))
+    _dataset(group, "kind", _fixed_text("kind", list(plan.kind)))
     _dataset(group, "setpoint_c", plan.setpoint_c)
     _dataset(group, "pose_number", plan.pose_number)
     _dataset(group, "angles_deg", plan.angles_deg)
@@ -353,7 +357,10 @@ def _read_header(reader: _Reader) -> CampaignHeader:
         for serial, group in reader.node("simulation_truth", h5py.Group).items():
             if serial in {d["serial"] for d in duts} and isinstance(group, h5py.Group):
                 truth[serial] = {**{k: plain_value(v) for k, v in group.attrs.items()},
-                                 "polynomial_coefficients": reader.matrix(f"simulation_truth/{serial}/polynomial_coefficients")}
+                                 "polynomial_coefficients": reader.matrix(f"simulation_truth/{serial}/polynomial_coefficients"),
+                                 **{name: np.asarray(node[()], dtype=float) for name, node in group.items()
+                                    if name not in _TRUTH_COLUMNS and name != "polynomial_coefficients"
+                                    and isinstance(node, h5py.Dataset) and node.dtype.kind == "f" and node.size <= 4096}}
     poses_group = reader.node("poses", h5py.Group)
     return CampaignHeader(
         campaign_id=_text(file.attrs.get("campaign_id", "")), created=_text(file.attrs.get("started", "")),

@@ -27,6 +27,7 @@ from accelcal_rig.store.content import Campaign, take_what_the_file_kept
 from accelcal_rig.store.hdf5_file import DamagedFile, read_campaign_file
 from accelcal_rig.store.journal import read_journal
 from accelcal_rig.store.paths import journal_path, progress_path
+from accelcal_rig.store.records import STATIC_KINDS
 
 
 def _first_line(exc: BaseException) -> str:
@@ -265,8 +266,12 @@ def dut_description(campaign: Campaign, serial: str) -> dict[str, Any]:
 
 
 def read_dut_poses(campaign: Campaign, serial: str) -> DutPoses:
+    """The DUT's accelerometer poses: those taken at rest, the table standing (a rate step's turning table
+    and a noise record's blocks are a gyroscope's)."""
     dut = dut_description(campaign, serial)
-    return DutPoses(
+    keys = campaign.pose_column("step_key")
+    static = np.isin(keys, list(campaign.header.plan.keys_of(*STATIC_KINDS))) if len(keys) else np.zeros(0, bool)
+    poses = DutPoses(
         serial=serial,
         range_g=float(dut["range_g"]),
         lsb_g=float(dut["lsb_g"]),
@@ -283,6 +288,7 @@ def read_dut_poses(campaign: Campaign, serial: str) -> DutPoses:
         gravity_uncertainty_g=site_gravity_g(float(campaign.attrs.get("gravity_uncertainty_m_s2", 0.0))),
         truth_gravity_g=campaign.truth_column(serial, "gravity_g"),
     )
+    return poses if static.all() else poses.subset(static)
 
 
 def rows_at_setpoint(path: Path, campaign: Campaign, setpoint_c: float | None) -> tuple[float, np.ndarray]:

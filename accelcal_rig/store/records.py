@@ -150,8 +150,13 @@ class StoredEvent:
     message: str
 
 
-#: The plan kinds of steps that store a pose: a calibration pose, a verification pose.
-MEASUREMENT_KINDS = ("pose", "verify")
+#: The plan kinds of steps that store a pose: a calibration pose, a verification pose, a rate step (a gyroscope's
+#: calibration) and its verification, a block of a still noise record.
+MEASUREMENT_KINDS = ("pose", "verify", "rate", "verify-rate", "noise")
+#: The kinds whose samples are taken at rest, the table standing at the pose (an accelerometer's poses).
+STATIC_KINDS = ("pose", "verify")
+#: The kinds never fitted: every figure of how good a calibration is comes from them.
+VERIFICATION_KINDS = ("verify", "verify-rate")
 
 
 @dataclass(frozen=True)
@@ -159,7 +164,7 @@ class StoredPlan:
     """The compiled plan as the campaign keeps it: one row per step."""
 
     step_key: tuple[str, ...]
-    kind: tuple[str, ...]             # "soak" | "pose" | "verify" (a verification pose, never fitted)
+    kind: tuple[str, ...]             # "soak" | MEASUREMENT_KINDS ("verify", "verify-rate": never fitted)
     setpoint_c: np.ndarray            # (S,)
     pose_number: np.ndarray           # (S,) 1-based, 0 for soaks
     angles_deg: np.ndarray            # (S, A) commanded angles, NaN for soaks
@@ -174,7 +179,11 @@ class StoredPlan:
 
     @property
     def verification_keys(self) -> frozenset[str]:
-        return frozenset(k for k, kind in zip(self.step_key, self.kind) if kind == "verify")
+        return frozenset(k for k, kind in zip(self.step_key, self.kind) if kind in VERIFICATION_KINDS)
+
+    def keys_of(self, *kinds: str) -> frozenset[str]:
+        """The keys of the steps of these kinds."""
+        return frozenset(k for k, kind in zip(self.step_key, self.kind) if kind in kinds)
 
 
 @dataclass(frozen=True)

@@ -87,7 +87,7 @@ def test_a_version_1_file_reads_as_each_duts_acceleration_channel(calibration, t
                  "sensors": {serial: dut["channels"]["accel"] for serial, dut in data["duts"].items()}}
     path.write_text(yaml.safe_dump(version_1, sort_keys=False))
     read = load_calibration(path)
-    assert read.sensors == calibration.sensors and read.sensor("ADX355-A001", "accel") == calibration.sensor("ADX355-A001")
+    assert read.sensors == calibration.sensors and read.sensor("ADX355-A001") == calibration.sensor("ADX355-A001")
     assert read.not_calibrated() == {}
 
 
@@ -95,7 +95,7 @@ def test_a_channel_no_model_calibrates_is_named_with_why(calibration) -> None:
     dut = calibration.duts["ADX355-A001"].model_copy(update={"not_calibrated": {"gyro": "angular rate: no model yet"}})
     with_gyro = calibration.model_copy(update={"duts": {**calibration.duts, "ADX355-A001": dut}})
     with pytest.raises(KeyError, match=r"ADX355-A001: no calibration of its gyro channel \(angular rate: no model yet\)"):
-        with_gyro.sensor("ADX355-A001", "gyro")
+        with_gyro.gyroscope("ADX355-A001")
     assert with_gyro.not_calibrated() == {"ADX355-A001": {"gyro": "angular rate: no model yet"}}
 
 

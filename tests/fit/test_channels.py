@@ -74,11 +74,11 @@ def test_the_fit_calibrates_the_accelerometer_and_names_the_gyroscope_with_why(w
     calibration, report = fit_and_save(load_campaign(with_gyro), with_gyro, tmp_path / "cal.yaml", FitOptions())
     for serial, dut in calibration.duts.items():
         assert set(dut.channels) == {"accel"} and set(dut.not_calibrated) == {"gyro"}
-        assert "angular rate" in dut.not_calibrated["gyro"] and "no channel model" in dut.not_calibrated["gyro"]
+        assert "angular rate" in dut.not_calibrated["gyro"] and "no rate steps" in dut.not_calibrated["gyro"]
         assert report[serial]["not_calibrated"] == dut.not_calibrated
     assert summary_line(report, tmp_path / "cal.yaml").endswith("not calibrated (measured and stored): gyro")
     with pytest.raises(KeyError, match="no calibration of its gyro channel"):
-        calibration.sensor("ADX355-A001", "gyro")
+        calibration.gyroscope("ADX355-A001")
 
 
 @pytest.mark.parametrize("format_name", ["json", "csv", "c-header", "px4-params"])

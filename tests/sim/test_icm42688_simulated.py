@@ -8,7 +8,10 @@ import pytest
 
 from accelcal_rig.config.load import load_rig
 from accelcal_rig.core.clock import VirtualClock
+from accelcal_rig.core.earth import EARTH_RATE_DPS
 from accelcal_rig.errors import InstrumentError
+from accelcal_rig.fit.gyro_model import PARAMETER_NAMES as GYRO_PARAMETER_NAMES
+from accelcal_rig.fit.gyro_model import distort_rate
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.instruments import icm42688 as regs
 from accelcal_rig.instruments.adxl355_transport import SerialBridge
@@ -29,7 +32,9 @@ def imu_lab(seed: int = 5) -> tuple[VirtualLab, VirtualClock]:
 
 
 def test_the_gyro_truth_has_its_own_seed_and_an_adxl_lab_draws_nothing_for_it() -> None:
-    assert not np.allclose(gyro_truth_for_serial("IMU-A001").coefficients, truth_for_serial("IMU-A001").coefficients)
+    gyro, accel = gyro_truth_for_serial("IMU-A001").coefficients, truth_for_serial("IMU-A001").coefficients
+    assert gyro.shape == (len(GYRO_PARAMETER_NAMES), 4) and accel.shape == (12, 4)
+    assert not np.allclose(gyro[:3], accel[:3])
     np.testing.assert_array_equal(gyro_truth_for_serial("IMU-A001").coefficients,
                                   gyro_truth_for_serial("IMU-A001").coefficients)
     adxl_lab = VirtualLab(load_rig(SIM_RIG).model, VirtualClock(), 5)
@@ -108,9 +113,14 @@ def test_the_driver_through_a_version_3_bridge_reads_both_sensors_truth() -> Non
     expected_g = distort(lab.gravity_in_dut(0), dut.truth.parameters_at(temperature))
     assert accel.mean(axis=0) / 16384 == pytest.approx(expected_g, abs=3e-4)
     assert accel.std(axis=0, ddof=1).mean() / 16384 == pytest.approx(70e-6 * np.sqrt(np.pi / 2 * 25), rel=0.25)
-    # The gyroscope at rest reads its hidden bias, in its own range's codes.
-    bias_dps = dut.gyro_truth.parameters_at(temperature)[:3]
-    assert gyro.mean(axis=0) / 16.4 == pytest.approx(bias_dps, abs=0.01)
+    # The gyroscope at rest reads its hidden bias, the Earth's rate and its g-sensitivity to gravity through its
+    # own truth, in its own range's codes (noise 2.8 mdps/√Hz × √(π/2·25 Hz) and the 0.061 °/s code: ≤ 0.01 °/s).
+    parameters = dut.gyro_truth.parameters_at(temperature)
+    bias_dps = parameters[:3]
+    earth_dps = lab.true_rate_dps(0)
+    assert np.linalg.norm(earth_dps) == pytest.approx(EARTH_RATE_DPS, rel=1e-9)   # the table at rest
+    expected_dps = distort_rate(earth_dps, lab.gravity_in_dut(0), parameters)
+    assert gyro.mean(axis=0) / 16.4 == pytest.approx(expected_dps, abs=0.01)
     assert np.all(np.abs(bias_dps) < 1.0) and np.any(np.abs(bias_dps) > 0.05)
     assert block.temperature_c[0] == pytest.approx(temperature, abs=0.2)
 

@@ -1,0 +1,288 @@
+"""Fit a DUT's gyroscope from a campaign's rate steps and static poses: the rate-table model
+(fit/gyro_model.py) by Levenberg–Marquardt at each setpoint, each parameter's polynomial over temperature,
+the figures before and after, on the rate steps the fit never saw, and against the simulation's truth.
+
+Each record's reference is the true angular rate in the DUT frame the rig recorded with it: the table's
+commanded rate about the fixture axis and the Earth's rate as far as the rig config placed it (its vertical
+component from `latitude_deg`, its horizontal one with `heading_deg`). The specific force each record was
+taken at is the accelerometer channel's reference (gravity at the commanded pose): the g-sensitivity is fitted
+against it. The table's rate accuracy is a systematic error of every rate: a common relative error of K,
+stated beside each scale factor's 1σ, never a weight.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import yaml
+from numpy.polynomial import polynomial
+from scipy.optimize import least_squares
+from scipy.stats import chi2
+
+from accelcal_rig.fit import gyro_model
+from accelcal_rig.fit.calibration import GyroCalibration, GyroPolynomialModel, SetpointFit, plain
+from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
+from accelcal_rig.store.content import Campaign
+from accelcal_rig.store.records import ChannelInfo
+
+#: The kinds of record the gyroscope fit uses: the static poses (bias, g-sensitivity) and the rate steps.
+CALIBRATION_KINDS = ("pose", "rate")
+VERIFICATION_KINDS = ("verify", "verify-rate")
+#: A record's standard error is never taken below this (°/s): a block of identical codes is not exact.
+STDERR_FLOOR_DPS = 1e-5
+#: Normalised Jacobian columns whose smallest/largest singular value falls below this are not identified.
+CONDITION_LIMIT = 1e-9
+
+
+class GyroDesignError(ValueError):
+    """The records cannot determine the gyroscope's model (no rate steps, too few axes)."""
+
+
+@dataclass(frozen=True)
+class GyroRecords:
+    """One DUT's gyroscope records as arrays, row i of the campaign's stored poses."""
+
+    serial: str
+    info: ChannelInfo
+    kind: np.ndarray                  # (N,) the plan's kind of each record
+    setpoint_c: np.ndarray            # (N,)
+    t_s: np.ndarray                   # (N,)
+    temperature_c: np.ndarray         # (N,) the DUT's own sensor, mean of before and after
+    mean_dps: np.ndarray              # (N, 3)
+    stderr_dps: np.ndarray            # (N, 3)
+    reference_dps: np.ndarray         # (N, 3) the true rate the rig recorded (table and Earth)
+    force_g: np.ndarray               # (N, 3) the specific force (gravity at the commanded pose)
+    truth_parameters: np.ndarray | None  # (N, 27) the simulation's, at each record's true temperature
+
+    def rows(self, *kinds: str) -> np.ndarray:
+        return np.isin(self.kind, kinds)
+
+
+def read_gyro_records(campaign: Campaign, serial: str, channel: str = "gyro") -> GyroRecords:
+    """The DUT's gyroscope channel over every stored record, with the acceleration reference beside it."""
+    keys = campaign.pose_column("step_key")
+    plan = campaign.header.plan
+    kinds = dict(zip(plan.step_key, plan.kind))
+    truth = None
+    described = campaign.header.truth.get(serial, {})
+    temperature = campaign.truth_column(serial, "temperature_c")
+    if "gyro_polynomial_coefficients" in described and temperature is not None:
+        coefficients = np.asarray(described["gyro_polynomial_coefficients"], dtype=float)
+        x = (temperature - float(described["t_ref_c"])) / float(described["half_range_c"])
+        truth = np.moveaxis(polynomial.polyval(x, coefficients.T), 0, -1)
+    return GyroRecords(
+        serial=serial, info=campaign.channel_info(serial, channel),
+        kind=np.array([kinds.get(str(k), "") for k in keys]),
+        setpoint_c=campaign.pose_column("setpoint_c"), t_s=campaign.pose_column("t_start_s"),
+        temperature_c=campaign.dut_column(serial, "temperature_c").mean(axis=1),
+        mean_dps=campaign.channel_column(serial, channel, "mean"),
+        stderr_dps=campaign.channel_column(serial, channel, "stderr"),
+        reference_dps=campaign.channel_column(serial, channel, "reference"),
+        force_g=campaign.channel_column(serial, "accel", "reference"),
+        truth_parameters=truth,
+    )
+
+
+@dataclass(frozen=True)
+class GyroSetpointFit:
+    parameters: np.ndarray            # (27,)
+    sigma: np.ndarray                 # (27,) 1σ, widened by √χ²_red when χ² exceeds its 99 % quantile
+    chi2_reduced: float
+    n_records: int
+
+
+def fit_gyro_setpoint(mean_dps: np.ndarray, stderr_dps: np.ndarray, reference_dps: np.ndarray,
+                      force_g: np.ndarray) -> GyroSetpointFit:
+    """The model at one temperature: readings (n, 3) against the true rates and specific forces, each weighted
+    by its standard error. Refused (GyroDesignError) when the records leave a parameter undetermined."""
+    sigma = np.maximum(np.asarray(stderr_dps, dtype=float), STDERR_FLOOR_DPS)
+    n = len(mean_dps)
+    if 3 * n <= gyro_model.N_PARAMETERS:
+        raise GyroDesignError(f"{n} records give {3 * n} equations for {gyro_model.N_PARAMETERS} parameters")
+
+    def residuals(theta: np.ndarray) -> np.ndarray:
+        return ((gyro_model.distort_rate(reference_dps, force_g, theta) - mean_dps) / sigma).ravel()
+
+    def derivatives(theta: np.ndarray) -> np.ndarray:
+        jacobian = gyro_model.distort_jacobian(reference_dps, force_g, theta)
+        return (jacobian / sigma[:, :, None]).reshape(-1, gyro_model.N_PARAMETERS)
+
+    start = gyro_model.IDENTITY_PARAMETERS.copy()
+    result = least_squares(residuals, start, jac=derivatives, method="lm", xtol=1e-12, ftol=1e-12)
+    jacobian = result.jac
+    _check_identified(jacobian, n)
+    dof = 3 * n - gyro_model.N_PARAMETERS
+    chi2_reduced = float(result.fun @ result.fun / dof)
+    covariance = np.linalg.inv(jacobian.T @ jacobian)
+    if chi2_reduced > chi2.ppf(0.99, dof) / dof:
+        covariance *= chi2_reduced  # more scatter than the standard errors allow: widen, never hide
+    return GyroSetpointFit(result.x, np.sqrt(np.diag(covariance)), chi2_reduced, n)
+
+
+def _check_identified(jacobian: np.ndarray, n_records: int) -> None:
+    norms = np.linalg.norm(jacobian, axis=0)
+    blind = [name for name, norm in zip(gyro_model.PARAMETER_NAMES, norms) if norm == 0]
+    if blind:
+        raise GyroDesignError(f"the {n_records} records do not constrain {', '.join(blind)}: rate steps about each "
+                              "axis in both directions at two or more rates, and static poses over the sphere")
+    _, singular, vt = np.linalg.svd(jacobian / norms, full_matrices=False)
+    if singular[-1] < CONDITION_LIMIT * singular[0]:
+        weakest = np.abs(vt[-1])
+        involved = [gyro_model.PARAMETER_NAMES[i] for i in np.argsort(weakest)[::-1] if weakest[i] > 0.3]
+        raise GyroDesignError(f"the {n_records} records cannot separate {', '.join(involved)}")
+
+
+@dataclass(frozen=True)
+class GyroFitResult:
+    serial: str
+    calibration: GyroCalibration
+    metrics: dict[str, Any]           # what `rig fit --json` prints under `gyro`
+
+
+def site_of(campaign: Campaign) -> dict[str, Any]:
+    """The rig config's latitude, heading and table rate accuracy as the campaign recorded its rig."""
+    try:
+        rig = yaml.safe_load(campaign.header.rig_yaml) or {}
+    except yaml.YAMLError:
+        rig = {}
+    turntable = rig.get("turntable") or {}
+    return {"latitude_deg": rig.get("latitude_deg"), "heading_deg": rig.get("heading_deg"),
+            "rate_accuracy_pct": float(turntable.get("rate_accuracy_pct") or 0.0),
+            "accuracy_arcsec": float(campaign.header.turntable_accuracy_arcsec)}
+
+
+def earth_rate_statement(site: dict[str, Any]) -> str:
+    if site["latitude_deg"] is None:
+        return ("not taken out: the rig config states no latitude_deg, so the Earth's rate (up to 0.0042 °/s) "
+                "is left in the fitted bias")
+    if site["heading_deg"] is None:
+        return (f"vertical component at latitude {site['latitude_deg']:g}° taken out; the horizontal one "
+                "(cos(latitude) × 0.0042 °/s) is left in the fitted bias: the rig config states no heading_deg")
+    return (f"taken out at latitude {site['latitude_deg']:g}° and table heading {site['heading_deg']:g}° (its "
+            "vertical component exactly; the horizontal one at rate steps averaged over each block's turn)")
+
+
+GAUGE = ("the fixture frame as the rate table realises it: turning about each fixture axis defines all nine "
+         "entries of K (scale on the diagonal, cross-axis terms off it), the DUT's nominal mount taken out")
+
+
+def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: dict[str, Any]) -> GyroFitResult:
+    """Fit each setpoint, the polynomials over temperature, and the figures of the calibration."""
+    calibrating = records.rows(*CALIBRATION_KINDS)
+    if not records.rows("rate").any():
+        raise GyroDesignError(f"sensor {records.serial}: no rate steps stored, the gyroscope cannot be calibrated")
+    setpoints = np.array(list(dict.fromkeys(records.setpoint_c[calibrating].tolist())))
+    groups = [np.flatnonzero(calibrating & (records.setpoint_c == s)) for s in setpoints]
+    temperatures = np.array([records.temperature_c[g].mean() for g in groups])
+    fits = []
+    for setpoint, group in zip(setpoints, groups):
+        try:
+            fits.append(fit_gyro_setpoint(records.mean_dps[group], records.stderr_dps[group],
+                                          records.reference_dps[group], records.force_g[group]))
+        except (GyroDesignError, np.linalg.LinAlgError) as exc:
+            raise GyroDesignError(f"sensor {records.serial} gyroscope at {setpoint:g} °C: {exc}") from None
+    estimates, sigmas = np.array([f.parameters for f in fits]), np.array([f.sigma for f in fits])
+    thermal = fit_thermal(temperatures, estimates, sigmas, np.ones(gyro_model.N_PARAMETERS, dtype=bool), degree)
+    metrics = _figures(records, thermal, out_of_range, calibrating)
+    metrics["chi2_reduced"] = [f.chi2_reduced for f in fits]
+    metrics["temperature_range_c"] = [float(temperatures.min()), float(temperatures.max())]
+    metrics["earth_rate"] = earth_rate_statement(site)
+    systematic = _systematic_sigma(site)
+    metrics["table_systematics_1sigma"] = {"scale_relative": systematic["scale"], "cross_rad": systematic["cross"]}
+    if records.truth_parameters is not None:
+        metrics["truth_error"] = _truth_error(records, setpoints, groups, fits, systematic)
+    calibration = GyroCalibration(
+        serial=records.serial, range_dps=records.info.range, lsb_dps=records.info.lsb,
+        validity_c=thermal.domain_c, out_of_range=out_of_range,
+        polynomial=GyroPolynomialModel(domain_c=thermal.domain_c, degree=degree,
+                                       coefficients={n: plain(c) for n, c in
+                                                     zip(gyro_model.PARAMETER_NAMES, thermal.coefficients)}),
+        setpoints=[SetpointFit(setpoint_c=float(s), temperature_c=float(t), n_poses=f.n_records,
+                               chi2_reduced=plain(f.chi2_reduced),
+                               parameters=dict(zip(gyro_model.PARAMETER_NAMES, plain(f.parameters))),
+                               sigma=dict(zip(gyro_model.PARAMETER_NAMES, plain(f.sigma))))
+                   for s, t, f in zip(setpoints, temperatures, fits)],
+        earth_rate=metrics["earth_rate"], gauge=GAUGE,
+        metrics={k: plain(v) for k, v in metrics.items() if k != "truth_error"}, warnings=thermal.warnings,
+    )
+    return GyroFitResult(records.serial, calibration, plain(metrics))
+
+
+def _figures(records: GyroRecords, thermal: ThermalModel, out_of_range: OutOfRange,
+             calibrating: np.ndarray) -> dict[str, Any]:
+    """RMS error of the rate steps against their references before (raw) and after compensation, in-sample and
+    on the verification records, and the bias left at rest."""
+    compensated = gyro_model.correct_rate(records.mean_dps, records.force_g,
+                                          thermal.parameters_at(records.temperature_c, out_of_range))
+    before, after = records.mean_dps - records.reference_dps, compensated - records.reference_dps
+    turning = records.rows("rate")
+    figures: dict[str, Any] = {
+        "rmse_before_dps": _rms(before[turning]), "rmse_after_dps": _rms(after[turning]),
+        "rest_error_before_dps": _rms(before[records.rows("pose")]),
+        "rest_error_after_dps": _rms(after[records.rows("pose")]),
+        "noise_floor_dps": _rms(records.stderr_dps[calibrating]),
+    }
+    checks = records.rows("verify-rate")
+    if checks.any() or records.rows("verify").any():
+        rest = records.rows("verify")
+        figures["verification"] = {
+            "rate_steps": int(checks.sum()), "rmse_before_dps": _rms(before[checks]),
+            "rmse_dps": _rms(after[checks]), "max_axis_error_dps": _max(after[checks]),
+            "scale_error_ppm": _scale_error_ppm(records, compensated, checks),
+            "rest_error_dps": _rms(after[rest]), "noise_floor_dps": _rms(records.stderr_dps[checks | rest]),
+            "temperatures_c": sorted({round(float(t), 2) for t in records.setpoint_c[checks | rest]}),
+        }
+    return figures
+
+
+def _scale_error_ppm(records: GyroRecords, compensated: np.ndarray, rows: np.ndarray) -> float | None:
+    """The largest relative error along the turning axis at the verification rates, ppm."""
+    if not rows.any():
+        return None
+    reference = records.reference_dps[rows]
+    along = np.argmax(np.abs(reference), axis=1)
+    index = np.arange(len(along))
+    return float(1e6 * np.max(np.abs(compensated[rows][index, along] / reference[index, along] - 1.0)))
+
+
+def _rms(values: np.ndarray) -> float | None:
+    return float(np.sqrt(np.mean(values**2))) if values.size else None
+
+
+def _max(values: np.ndarray) -> float | None:
+    return float(np.max(np.abs(values))) if values.size else None
+
+
+def _systematic_sigma(site: dict[str, Any]) -> dict[str, float]:
+    """The table's systematic errors as 1σ of the parameters they shift: its rate accuracy (± uniform, a common
+    relative error of every rate) on the scale factors; its position accuracy (± uniform per axis: the fixture
+    axis a rate step turns about is tilted by it, the same for every rate of the step's pose) on the cross-axis
+    terms."""
+    return {"scale": site["rate_accuracy_pct"] / 100.0 / np.sqrt(3.0),
+            "cross": float(np.radians(site["accuracy_arcsec"] / 3600.0)) / np.sqrt(3.0)}
+
+
+def _with_systematics(fit: GyroSetpointFit, systematic: dict[str, float]) -> np.ndarray:
+    """A setpoint fit's 1σ with the table's systematic errors combined in."""
+    sigma = fit.sigma.copy()
+    sigma[gyro_model.SCALE] = np.hypot(sigma[gyro_model.SCALE], fit.parameters[gyro_model.SCALE] * systematic["scale"])
+    sigma[gyro_model.CROSS] = np.hypot(sigma[gyro_model.CROSS], systematic["cross"])
+    return sigma
+
+
+def _truth_error(records: GyroRecords, setpoints: np.ndarray, groups: list[np.ndarray], fits: list[GyroSetpointFit],
+                 systematic: dict[str, float]) -> list[dict[str, Any]]:
+    """Estimate minus truth for every parameter at every setpoint, with its 1σ (the table's systematic errors
+    combined in) and z."""
+    assert records.truth_parameters is not None
+    out = []
+    for setpoint, group, fit in zip(setpoints, groups, fits):
+        true = records.truth_parameters[group].mean(axis=0)
+        sigma = _with_systematics(fit, systematic)
+        for k, name in enumerate(gyro_model.PARAMETER_NAMES):
+            error = float(fit.parameters[k] - true[k])
+            out.append({"parameter": name, "setpoint_c": float(setpoint), "error": error, "sigma": float(sigma[k]),
+                        "z": error / float(sigma[k])})
+    return out

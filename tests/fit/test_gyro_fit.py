@@ -1,0 +1,167 @@
+"""A six-axis IMU's gyroscope over temperature on the simulated rate table: the plan turns each fixture axis
+both ways at every rate, the rig records the table's and the Earth's rate as the reference, and the fit
+recovers each DUT's hidden model within its stated uncertainty, compensates rates it never saw, and reads
+the noise record's Allan figures. Bad input gets one line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from accelcal_rig.assembly import run_campaign
+from accelcal_rig.engine.preparation import prepare
+from accelcal_rig.errors import ConfigError
+from accelcal_rig.fit.calibration import apply_gyro, load_calibration
+from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save
+from accelcal_rig.fit.gyro_fit import read_gyro_records
+from accelcal_rig.plan.steps import RateStep, StopRotation, VerifyRate
+from accelcal_rig.store.read import load_campaign, read_dut_poses
+from tests.conftest import REPO
+
+RIG = REPO / "configs" / "sim-imu.yaml"
+PROCEDURE = {
+    "name": "imu-small", "rig": str(RIG), "setpoints_c": [0, 40],
+    "soak": {"criterion": "settling", "min_dwell_min": 10, "window_min": 10, "poll_s": 60},
+    "schedule": {"kind": "paper-24"},
+    "acquisition": {"samples_per_pose": 100, "range_g": 2, "range_dps": 2000, "odr_hz": 100, "settle_s": 1},
+    "rates": {"rates_dps": [10, 100, 1000], "settle_s": 1, "verify_rates_dps": [30, 500]},
+    "noise": {"duration_s": 20},
+    "fit": {"mode": "reference", "polynomial_degree": 1},
+    "verify": {"schedule": {"kind": "sphere", "count": 6}, "at_setpoints": False, "setpoints_c": [20]},
+}
+
+
+def _procedure(folder: Path, **changes: object) -> Path:
+    path = folder / "imu.yaml"
+    path.write_text(yaml.safe_dump({**PROCEDURE, **changes}, sort_keys=False))
+    return path
+
+
+@pytest.fixture(scope="module")
+def campaign_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("imu")
+    path = folder / "imu.h5"
+    run_campaign(prepare(_procedure(folder)), path, dry_run=True, seed=3, overwrite=False)
+    return path
+
+
+@pytest.fixture(scope="module")
+def fitted(campaign_path: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict]:
+    output = tmp_path_factory.mktemp("fit") / "cal.yaml"
+    _, report = fit_and_save(load_campaign(campaign_path), campaign_path, output, FitOptions(degree=1))
+    return output, report
+
+
+def test_the_plan_turns_each_fixture_axis_both_ways_at_every_rate(tmp_path: Path) -> None:
+    plan = prepare(_procedure(tmp_path)).plan
+    stage = plan.stages[0]
+    turning = [s for s in stage.body if isinstance(s, RateStep) and not isinstance(s, VerifyRate)]
+    assert sorted({(s.about, s.rate_dps) for s in turning}) == sorted(
+        (axis, sign * rate) for axis in "xyz" for rate in (10, 100, 1000) for sign in (-1, 1))
+    assert [s for s in stage.body if isinstance(s, VerifyRate)] == []          # verified at 20 °C only
+    assert sum(isinstance(s, StopRotation) for s in stage.body) == 3
+    for step in turning:   # the pose puts "up" along the fixture axis the vertical rate axis turns about
+        axis = "xyz".index(step.about)
+        assert step.pose.gravity_fixture[axis] == pytest.approx(1.0)
+        assert step.rate_fixture_dps[axis] == step.rate_dps
+    checks = [s for stage in plan.stages if stage.setpoint_c == 20 for s in stage.body if isinstance(s, VerifyRate)]
+    assert sorted({abs(s.rate_dps) for s in checks}) == [30, 500] and len(checks) == 12
+
+
+def test_the_accelerometer_fit_sees_only_the_poses_taken_at_rest(campaign_path: Path) -> None:
+    campaign = load_campaign(campaign_path)
+    kinds = set(campaign.header.plan.kind)
+    assert {"rate", "verify-rate", "noise"} <= kinds                            # stored as written, whole
+    poses = read_dut_poses(campaign, campaign.serials[0])
+    assert len(poses.setpoint_c) == 2 * 24 + 6
+
+
+def test_every_gyroscope_reference_holds_the_table_and_the_earth(campaign_path: Path) -> None:
+    campaign = load_campaign(campaign_path)
+    records = read_gyro_records(campaign, campaign.serials[0])
+    at_rest = records.rows("pose")
+    earth = np.linalg.norm(records.reference_dps[at_rest], axis=1)
+    assert earth == pytest.approx(np.degrees(7.292115e-5), rel=1e-6)   # latitude and heading given: all of it
+    turning = records.rows("rate")
+    assert np.sort(np.unique(np.round(np.abs(records.reference_dps[turning]).max(axis=1)))).tolist() == [10, 100, 1000]
+
+
+def test_the_fit_recovers_the_hidden_gyroscope_within_its_uncertainty(fitted: tuple[Path, dict]) -> None:
+    _, report = fitted
+    z = np.array([t["z"] for r in report.values() for t in r["gyro"]["truth_error"]])
+    assert len(z) == 4 * 2 * 27
+    assert np.max(np.abs(z)) < 4.5                      # 216 values: 4.5σ is one in 3 × 10⁴ for each
+    assert 0.6 < np.std(z) < 1.5                        # the quoted σ is the scatter, neither much more nor less
+    for serial, dut in report.items():
+        gyro = dut["gyro"]
+        assert gyro["rmse_after_dps"] < gyro["rmse_before_dps"] / 100, serial
+        assert "latitude 48.14" in gyro["earth_rate"] and "heading 30" in gyro["earth_rate"]
+
+
+def test_rates_the_fit_never_saw_are_compensated(fitted: tuple[Path, dict], campaign_path: Path) -> None:
+    path, report = fitted
+    calibration = load_calibration(path)
+    campaign = load_campaign(campaign_path)
+    for serial in campaign.serials:
+        verification = report[serial]["gyro"]["verification"]
+        assert verification["rate_steps"] == 12
+        assert verification["rmse_dps"] < verification["rmse_before_dps"] / 50
+        # Compensated with the calibration file, as firmware would: the same figure.
+        records = read_gyro_records(campaign, serial)
+        rows = records.rows("verify-rate")
+        rate = apply_gyro(calibration.gyroscope(serial), records.mean_dps[rows], records.force_g[rows],
+                          records.temperature_c[rows])
+        rms = float(np.sqrt(np.mean((rate - records.reference_dps[rows]) ** 2)))
+        assert rms == pytest.approx(verification["rmse_dps"], rel=1e-6)
+        assert calibration.duts[serial].not_calibrated == {}
+
+
+def test_the_noise_record_gives_each_axis_its_random_walk(fitted: tuple[Path, dict], campaign_path: Path) -> None:
+    """The simulated gyroscope's white noise and its 0.061 °/s codes: the angle random walk lies between the
+    noise's alone and with the worst rounding (a code's quarter, squared)."""
+    _, report = fitted
+    campaign = load_campaign(campaign_path)
+    for serial, dut in report.items():
+        allan = dut["gyro"]["allan"]
+        truth = campaign.header.truth[serial]
+        sigma, lsb = float(truth["gyro_noise_dps_per_sample"]), campaign.channel_info(serial, "gyro").lsb
+        low, high = sigma / 10.0 * 60.0, np.sqrt(sigma**2 + lsb**2 / 4) / 10.0 * 60.0
+        for axis in allan["arw_deg_per_rthr"]:
+            assert axis["low"] < axis["value"] < axis["high"]
+            assert 0.9 * low < axis["value"] < 1.1 * high
+        assert allan["samples"] == 2000 and allan["gaps_share"] < 0.05
+        assert len(allan["by_setpoint"]) == 2 and "vrw_m_s_per_rthr" in dut["allan"]
+
+
+@pytest.mark.parametrize(("changes", "key", "message"), [
+    ({"rates": {"rates_dps": [2500]}}, "rates", "not inside the gyroscope's range"),
+    ({"rates": {"rates_dps": [1400, 1600]}, "acquisition": {**PROCEDURE["acquisition"], "range_dps": 2000}},
+     "rates", "beyond turntable axis outer's max_rate_dps 1500"),
+    ({"rates": {"rates_dps": [10], "verify_rates_dps": [10]}}, "rates", "is a calibration rate"),
+])
+def test_a_rate_the_part_or_the_table_cannot_take_is_one_line(tmp_path: Path, changes: dict, key: str,
+                                                              message: str) -> None:
+    with pytest.raises(ConfigError) as caught:
+        prepare(_procedure(tmp_path, **changes))
+    text = str(caught.value)
+    assert message in text and key in text and "\n" not in text.strip()
+
+
+def test_a_rate_step_on_a_table_without_a_rate_mode_is_one_line(tmp_path: Path) -> None:
+    rig = yaml.safe_load(RIG.read_text())
+    for axis in rig["turntable"]["axes"]:
+        axis.pop("max_rate_dps", None)
+        axis.pop("max_acceleration_dps2", None)
+    (tmp_path / "rig.yaml").write_text(yaml.safe_dump(rig))
+    with pytest.raises(ConfigError, match="no turntable axis has a rate mode") as caught:
+        prepare(_procedure(tmp_path, rig=str(tmp_path / "rig.yaml")))
+    assert "\n" not in str(caught.value).strip()
+
+
+def test_rates_on_a_fixture_without_gyroscopes_are_one_line(tmp_path: Path) -> None:
+    acquisition = {**PROCEDURE["acquisition"], "odr_hz": 125}   # an ADXL355's rate: only the gyroscope is missing
+    with pytest.raises(ConfigError, match=r"rates: sensor ADX355-A001 of .*sim.yaml is an ADXL355, which has no gyroscope"):
+        prepare(_procedure(tmp_path, rig=str(REPO / "configs" / "sim.yaml"), acquisition=acquisition))
