@@ -13,8 +13,28 @@ from accelcal_rig.fit.campaign_fit import summary_line
 
 def fit_lines(report: dict[str, Any], output: Path) -> list[str]:
     """The table of every DUT's figures, the one-line summary naming the calibration file, the gravity."""
-    return [*fit_table(report), summary_line(report, output),
+    return [*fit_table(report), *gyro_table(report), summary_line(report, output),
             f"gravity: {gravity_statement(next(iter(report.values()))['gravity_m_s2'])}"]
+
+
+def gyro_table(report: dict[str, Any]) -> list[str]:
+    """Each calibrated gyroscope's figures: its rate steps before and after, the rates and poses it never saw."""
+    gyros = {serial: r["gyro"] for serial, r in report.items() if "gyro" in r}
+    if not gyros:
+        return []
+    lines = [f"{'gyroscope':14s} {'raw':>8s} {'in-sample':>9s} {'verification (never fitted)':^37s}  "
+             f"{'U k=2':>7s}  verdict",
+             f"{'':14s} {'rms °/s':>8s} {'rms °/s':>9s} {'rms °/s':>8s} {'axis °/s':>9s} {'scale ppm':>9s} "
+             f"{'rest °/s':>8s}  {'°/s':>7s}"]
+    for serial, g in gyros.items():
+        v = g.get("verification") or {}
+        cells = [v.get("rmse_dps"), v.get("max_axis_error_dps"), v.get("scale_error_ppm"), v.get("rest_error_dps")]
+        shown = [f"{c:{w}.{d}f}" if c is not None else f"{'none':>{w}s}" for c, w, d in
+                 zip(cells, (8, 9, 9, 8), (4, 4, 0, 4))]
+        lines.append(f"{serial:14s} {g['rmse_before_dps']:8.3f} {g['rmse_after_dps']:9.4f} {' '.join(shown)}  "
+                     f"{max(g['expanded_uncertainty_dps']):7.4f}  {g['verdict']}")
+        lines += [f"  fails: {reason}" for reason in (g["verdict_reasons"] if g["verdict"] == "FAIL" else ())]
+    return lines
 
 
 def fit_table(report: dict[str, Any]) -> list[str]:

@@ -12,66 +12,109 @@ def calibration_table(rows: list[dict[str, Any]]) -> list[str]:
     """`rig registry list`: a header and one line per calibration (a sentence when none match)."""
     if not rows:
         return ["no calibrations match"]
-    lines = [f"{'id':>6}  {'serial':<16} {'part':<8} {'calibrated (UTC)':<19} {'verdict':<7} {'valid °C':<15} "
-             f"{'procedure':<22} source"]
+    lines = [f"{'id':>6}  {'serial':<16} {'channel':<7} {'part':<8} {'calibrated (UTC)':<19} {'verdict':<7} "
+             f"{'valid °C':<15} {'procedure':<22} source"]
     for r in rows:
-        lines.append(f"{r['id']:>6}  {r['serial']:<16} {r['part']:<8} {r['calibrated_at']:%Y-%m-%d %H:%M:%S} "
+        lines.append(f"{r['id']:>6}  {r['serial']:<16} {_channel(r):<7} {r['part']:<8} {r['calibrated_at']:%Y-%m-%d %H:%M:%S} "
                      f"{r['verdict'] or '—':<7} {r['valid_from_c']:>6.1f}…{r['valid_to_c']:<7.1f} {r['procedure'][:22]:<22} "
                      f"{Path(r['source_path']).name}{' (simulated)' if r['simulated'] else ''}")
     return lines
 
 
-def sensor_lines(serial: str, current: dict[str, Any] | None, rows: list[dict[str, Any]], simulated: bool) -> list[str]:
-    """`rig registry show`: the sensor's valid calibration (or why it has none), then its history."""
-    lines = _current_lines(serial, current, rows, simulated) + [f"history ({len(rows)}):"]
+def _channel(row: dict[str, Any]) -> str:
+    return str(row.get("channel") or "accel")
+
+
+def sensor_lines(serial: str, current: dict[str, dict[str, Any] | None], rows: list[dict[str, Any]],
+                 simulated: bool) -> list[str]:
+    """`rig registry show`: the sensor's valid calibration of each channel (or why it has none), then its
+    history; each channel named where the sensor has more than its accelerometer."""
+    labelled = set(current) != {"accel"}
+    lines = []
+    for channel, valid in current.items():
+        lines += _current_lines(serial, valid, [r for r in rows if _channel(r) == channel], simulated,
+                                f" {channel}" if labelled else "")
+    lines.append(f"history ({len(rows)}):")
     for r in rows:
+        bias = triple(r["bias_dps"], "°/s", digits=4) if _channel(r) == "gyro" else triple(r["bias_mg"], "mg")
         lines.append(f"  {r['id']:>6}  {r['calibrated_at']:%Y-%m-%d %H:%M}  {r['verdict'] or '—':<4}  "
-                     f"bias {triple(r['bias_mg'], 'mg')}  {Path(r['source_path']).name}"
-                     + (" (simulated)" if r["simulated"] else ""))
+                     + (f"{_channel(r):<5}  " if labelled else "")
+                     + f"bias {bias}  {Path(r['source_path']).name}" + (" (simulated)" if r["simulated"] else ""))
     return lines
 
 
 def _current_lines(serial: str, current: dict[str, Any] | None, rows: list[dict[str, Any]],
-                   simulated: bool) -> list[str]:
+                   simulated: bool, label: str = "") -> list[str]:
     if current is None:
         newest = next((r for r in rows if simulated or not r["simulated"]), None)
         why = ("its newest calibration failed its acceptance limits" if newest is not None
                else "only dry runs (simulated) are recorded: --simulated shows them")
-        return [f"{serial}: no valid calibration ({why})"]
+        return [f"{serial}{label}: no valid calibration ({why})"]
     dry = " (SIMULATED: a dry run)" if current["simulated"] else ""
-    return [f"{serial} ({current['part']}): valid calibration {current['id']}{dry}, "
+    figures = _gyro_figures(current) if _channel(current) == "gyro" else [
+        f"  at {current['reference_c']:g} °C: bias {triple(current['bias_mg'], 'mg', current['bias_uncertainty_mg'])}; "
+        f"scale error {triple(current['scale_error_ppm'], 'ppm', current['scale_uncertainty_ppm'], 0)}; "
+        f"non-orthogonality ≤ {current['nonorthogonality_mrad']:.3f} mrad"
+        + _noise(current, "vrw_m_s_per_rthr", "VRW", "m/s/√h", "bias_instability_ug", "µg")]
+    return [f"{serial}{label} ({current['part']}): valid calibration {current['id']}{dry}, "
             f"measured {current['calibrated_at']:%Y-%m-%d} "
             f"by {current['procedure']} on {current['rig']}, {current['valid_from_c']:.1f}…{current['valid_to_c']:.1f} °C, "
             f"verdict {current['verdict'] or 'none stated'}",
-            f"  at {current['reference_c']:g} °C: bias {triple(current['bias_mg'], 'mg', current['bias_uncertainty_mg'])}; "
-            f"scale error {triple(current['scale_error_ppm'], 'ppm', current['scale_uncertainty_ppm'], 0)}; "
-            f"non-orthogonality ≤ {current['nonorthogonality_mrad']:.3f} mrad",
+            *figures,
             f"  source {current['source_path']} (SHA-256 {current['source_sha256'][:16]}…), software "
             f"{current['software_version']}"]
 
 
-def trend_lines(serial: str, calibrations: int, result: dict[str, Any]) -> list[str]:
-    """`rig registry trend`: each calibration's figures at the reference temperature, then the drift per year."""
-    lines = [f"{serial}: {calibrations} calibrations, figures at the reference temperature (± expanded, k = 2)"]
+def _gyro_figures(row: dict[str, Any]) -> list[str]:
+    """A gyroscope's figures: bias and scale error at the reference temperature, the expanded uncertainty at the
+    largest calibrated rate, the verification RMS error, its noise."""
+    expanded = row["expanded_uncertainty_dps"]
+    rmse = row["verification_rmse_dps"]
+    return [f"  at {row['reference_c']:g} °C: bias {triple(row['bias_dps'], '°/s', row['bias_uncertainty_dps'], 4)}; "
+            f"scale error {triple(row['scale_error_ppm'], 'ppm', row['scale_uncertainty_ppm'], 0)}",
+            f"  expanded uncertainty (k = 2) at the largest calibrated rate {triple(expanded, '°/s', digits=4)}; "
+            f"verification RMS error {f'{rmse:.4f} °/s' if rmse is not None else '— (no verification rate steps)'}"
+            + _noise(row, "arw_deg_per_rthr", "ARW", "°/√h", "bias_instability_dph", "°/h")]
+
+
+def _noise(row: dict[str, Any], walk: str, walk_name: str, walk_unit: str, instability: str, unit: str) -> str:
+    """`; ARW 0.127/0.162/0.180 °/√h, bias instability 3.4/0.0/6.7 °/h` where the row has them, else ""."""
+    if row.get(walk) is None:
+        return ""
+    text = f"; {walk_name} " + "/".join(f"{v:.4g}" for v in row[walk]) + f" {walk_unit}"
+    if row.get(instability) is not None:
+        text += ", bias instability " + "/".join(f"{v:.3g}" for v in row[instability]) + f" {unit}"
+    return text
+
+
+def trend_lines(serial: str, calibrations: int, result: dict[str, Any], channel: str = "accel") -> list[str]:
+    """`rig registry trend`: each calibration's figures at the reference temperature, then the drift per year
+    (one channel's: an accelerometer's bias in mg, a gyroscope's in °/s)."""
+    unit, shown, digits = ("dps", "°/s", 4) if channel == "gyro" else ("mg", "mg", 3)
+    label = f" {channel}" if channel != "accel" else ""
+    lines = [f"{serial}{label}: {calibrations} calibrations, figures at the reference temperature (± expanded, k = 2)"]
     for point in result["calibrations"]:
-        lines.append(f"  {point['calibrated_at'][:10]}  bias {triple(point['bias_mg'], 'mg', point['bias_uncertainty_mg'])}"
+        lines.append(f"  {point['calibrated_at'][:10]}  bias "
+                     f"{triple(point[f'bias_{unit}'], shown, point[f'bias_uncertainty_{unit}'], digits)}"
                      f"  scale {triple(point['scale_error_ppm'], 'ppm', point['scale_uncertainty_ppm'], 0)}")
-    for key, unit in (("bias_drift_mg_per_year", "mg"), ("scale_drift_ppm_per_year", "ppm")):
+    for key, drift_unit in ((f"bias_drift_{unit}_per_year", shown), ("scale_drift_ppm_per_year", "ppm")):
         drift = result[key]
         what = key.split("_drift")[0]
         if drift is None:
             lines.append(f"  {what} drift: needs two calibrations at different times")
         else:
             lines.append(f"  {what} drift per year: "
-                         + ", ".join(f"{axis} {_drift_text(d, unit)}" for axis, d in zip("xyz", drift)))
+                         + ", ".join(f"{axis} {_drift_text(d, drift_unit)}" for axis, d in zip("xyz", drift)))
     return lines
 
 
-def lot_lines(part: str, result: dict[str, Any]) -> list[str]:
-    """`rig registry stats`: the lot's yield, each figure's distribution per axis, the outliers."""
+def lot_lines(part: str, result: dict[str, Any], channel: str = "accel") -> list[str]:
+    """`rig registry stats`: the lot's yield, each figure's distribution per axis, the outliers (one channel's)."""
     judged = f"{result['passed']} of {result['judged']} judged passed ({result['yield']:.1%})" if result["judged"] \
         else "none judged against acceptance limits"
-    lines = [f"{part}: {result['sensors']} sensors ({result['calibrations']} calibrations), newest of each: {judged}"]
+    label = f" {channel}" if channel != "accel" else ""
+    lines = [f"{part}{label}: {result['sensors']} sensors ({result['calibrations']} calibrations), newest of each: "
+             f"{judged}"]
     for name, columns in result["distributions"].items():
         for axis, summary in zip("xyz" if len(columns) == 3 else " ", columns):
             if summary is not None:

@@ -92,19 +92,23 @@ def _add(args: argparse.Namespace) -> int:
 def _list(args: argparse.Namespace) -> int:
     since = _since(args.since) if args.since else None
     rows = open_registry(args).calibrations(serial=args.serial, part=args.part, since=since, verdict=args.verdict,
-                                            limit=args.limit)
+                                            limit=args.limit, channel=args.channel)
     print(json.dumps([public(r) for r in rows], indent=2) if args.json else "\n".join(calibration_table(rows)))
     return 0
 
 
 def _show(args: argparse.Namespace) -> int:
+    from accelcal_rig.registry.analysis import by_channel
+
     registry = open_registry(args)
-    rows = registry.calibrations(serial=args.serial)
+    rows = registry.calibrations(serial=args.serial, channel=args.channel)
     if not rows:
-        raise ConfigError(f"serial {args.serial}: no calibration in the registry")
-    current = registry.current(args.serial, simulated=args.simulated)
+        raise ConfigError(f"serial {args.serial}: no calibration{_of_channel(args)} in the registry")
+    current = {channel: registry.current(args.serial, simulated=args.simulated, channel=channel)
+               for channel in by_channel(rows)}
     if args.json:
-        print(json.dumps({"serial": args.serial, "current": public(current) if current else None,
+        print(json.dumps({"serial": args.serial,
+                          "current": {channel: public(row) if row else None for channel, row in current.items()},
                           "history": [public(r) for r in rows]}, indent=2))
     else:
         print("\n".join(sensor_lines(args.serial, current, rows, args.simulated)))
@@ -112,27 +116,31 @@ def _show(args: argparse.Namespace) -> int:
 
 
 def _trend(args: argparse.Namespace) -> int:
-    from accelcal_rig.registry.analysis import trend
+    from accelcal_rig.registry.analysis import by_channel, trend
 
-    rows = _real_unless(args, open_registry(args).calibrations(serial=args.serial))
+    rows = _real_unless(args, open_registry(args).calibrations(serial=args.serial, channel=args.channel))
     if not rows:
-        raise ConfigError(f"serial {args.serial}: no calibration in the registry" + _simulated_hint(args))
-    result = trend(rows)
+        raise ConfigError(f"serial {args.serial}: no calibration{_of_channel(args)} in the registry"
+                          + _simulated_hint(args))
+    results = {channel: (len(of), trend(of, channel)) for channel, of in by_channel(rows).items()}
     if args.json:
-        print(json.dumps({"serial": args.serial, **result}, indent=2))
+        print(json.dumps({"serial": args.serial, "channels": {c: r for c, (_, r) in results.items()}}, indent=2))
     else:
-        print("\n".join(trend_lines(args.serial, len(rows), result)))
+        print("\n".join(line for channel, (n, result) in results.items()
+                        for line in trend_lines(args.serial, n, result, channel)))
     return 0
 
 
 def _stats(args: argparse.Namespace) -> int:
-    from accelcal_rig.registry.analysis import lot_statistics
+    from accelcal_rig.registry.analysis import by_channel, lot_statistics
 
-    rows = _real_unless(args, open_registry(args).calibrations(part=args.part))
+    rows = _real_unless(args, open_registry(args).calibrations(part=args.part, channel=args.channel))
     if not rows:
-        raise ConfigError(f"part {args.part}: no calibration in the registry" + _simulated_hint(args))
-    result = lot_statistics(rows)
-    print(json.dumps({"part": args.part, **result}, indent=2) if args.json else "\n".join(lot_lines(args.part, result)))
+        raise ConfigError(f"part {args.part}: no calibration{_of_channel(args)} in the registry"
+                          + _simulated_hint(args))
+    results = {channel: lot_statistics(of, channel) for channel, of in by_channel(rows).items()}
+    print(json.dumps({"part": args.part, "channels": results}, indent=2) if args.json else
+          "\n".join(line for channel, result in results.items() for line in lot_lines(args.part, result, channel)))
     return 0
 
 
@@ -161,6 +169,10 @@ def _export(args: argparse.Namespace) -> int:
 def _real_unless(args: argparse.Namespace, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Dry runs are rehearsals, not calibrations: left out unless --simulated."""
     return rows if args.simulated else [r for r in rows if not r["simulated"]]
+
+
+def _of_channel(args: argparse.Namespace) -> str:
+    return f" of the {args.channel} channel" if getattr(args, "channel", None) else ""
 
 
 def _simulated_hint(args: argparse.Namespace) -> str:

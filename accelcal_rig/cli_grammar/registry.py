@@ -44,12 +44,14 @@ def _add_list(actions: Commands) -> None:
     listing.add_argument("--since", metavar="DATE", help="only those calibrated on or after this date (YYYY-MM-DD)")
     listing.add_argument("--verdict", choices=["PASS", "FAIL"], help="only those with this verdict")
     listing.add_argument("--limit", type=number(1, 10_000_000, integer=True), help="at most this many")
+    _channel_option(listing)
     listing.add_argument("--json", action="store_true", help="one JSON list")
 
 
 def _add_show(actions: Commands) -> None:
     show = _action(actions, "show", "a sensor's valid calibration and its history", "rig registry show ADX355-A001")
     show.add_argument("serial")
+    _channel_option(show)
     show.add_argument("--json", action="store_true", help="one JSON object")
     _simulated_option(show)
 
@@ -71,6 +73,7 @@ def _add_trend(actions: Commands) -> None:
     trend = _action(actions, "trend", "bias and scale at the reference temperature across recalibrations: ageing drift",
                     "rig registry trend ADX355-A001")
     trend.add_argument("serial")
+    _channel_option(trend)
     trend.add_argument("--json", action="store_true", help="one JSON object")
     _simulated_option(trend)
 
@@ -79,8 +82,14 @@ def _add_stats(actions: Commands) -> None:
     stats = _action(actions, "stats", "a part's lot: yield, distributions of bias, scale and non-orthogonality, outliers",
                     "rig registry stats --part adxl355")
     stats.add_argument("--part", required=True)
+    _channel_option(stats)
     stats.add_argument("--json", action="store_true", help="one JSON object")
     _simulated_option(stats)
+
+
+def _channel_option(action: argparse.ArgumentParser) -> None:
+    action.add_argument("--channel", choices=["accel", "gyro"],
+                        help="only this channel of the DUTs (default: every channel, each named)")
 
 
 def _simulated_option(action: argparse.ArgumentParser) -> None:

@@ -51,6 +51,37 @@ class ParameterLimits(StrictModel):
                                                                               "mode only)")
 
 
+class GyroParameterLimits(StrictModel):
+    """Limits on a gyroscope's calibration at `at_c` (a data sheet's figures); a limit left out is not judged."""
+
+    at_c: TemperatureC = Field(25.0, description="temperature the parameters are judged at (inside the "
+                                                 "calibrated range)")
+    bias_dps: float | None = Field(None, gt=0, le=1000, description="|bias| of each axis, the Earth's rate taken "
+                                                                   "out as the calibration states")
+    scale_error_ppm: float | None = Field(None, gt=0, le=1e6, description="|scale − 1| of each axis")
+    cross_axis_mrad: float | None = Field(None, gt=0, le=1000, description="|each cross-axis term| of K")
+    gsens_dps_per_g: float | None = Field(None, gt=0, le=1000, description="|each g-sensitivity term|")
+
+
+class GyroAcceptance(StrictModel):
+    """What a DUT's gyroscope must meet to PASS; the verification limits are judged on the rate steps and
+    poses the fit never saw (`rates.verify_rates_dps`, `verify:`)."""
+
+    max_verification_rmse_dps: float | None = Field(None, gt=0, le=10_000, description="RMS axis error of the "
+                                                    "compensated verification rate steps against their references")
+    max_axis_error_dps: float | None = Field(None, gt=0, le=10_000, description="largest axis error of a "
+                                             "compensated verification rate step")
+    max_scale_error_ppm: float | None = Field(None, gt=0, le=1e6, description="largest relative error along the "
+                                              "turning axis at the verification rates")
+    max_rest_error_dps: float | None = Field(None, gt=0, le=10_000, description="RMS axis error of the compensated "
+                                             "verification poses (at rest: the bias left)")
+    parameters: GyroParameterLimits | None = None
+
+    def verification_limits(self) -> list[str]:
+        names = ["max_verification_rmse_dps", "max_axis_error_dps", "max_scale_error_ppm", "max_rest_error_dps"]
+        return [n for n in names if getattr(self, n) is not None]
+
+
 class Acceptance(StrictModel):
     """What a DUT's calibration must meet to PASS; each limit left out is not judged. The verification
     limits are judged on the verification poses (a `verify:` section is needed for them)."""
@@ -62,6 +93,7 @@ class Acceptance(StrictModel):
                                        "the verification temperatures (max − min)")
     max_tilt_error_deg: float | None = Field(None, gt=0, le=90, description="largest Eq. 10 pitch or roll error")
     parameters: ParameterLimits | None = None
+    gyro: GyroAcceptance | None = Field(None, description="a gyroscope's limits (a procedure with rates:)")
     allow_partial: bool = Field(False, description="a campaign that stopped before its last pose may pass")
 
     def verification_limits(self) -> list[str]:

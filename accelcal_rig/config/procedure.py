@@ -185,7 +185,7 @@ class Procedure(StrictModel):
 
     @model_validator(mode="after")
     def _gyroscope_steps_fit(self) -> Procedure:
-        if self.rates is None and self.noise is None:
+        if self.rates is None and self.noise is None and self.acceptance.gyro is None:
             return self
         if self.method != "soak" or self.cooldown is not None:
             raise ValueError("rates and noise are measured at rest at each setpoint: method: soak, no cool-down")
@@ -199,6 +199,20 @@ class Procedure(StrictModel):
             if self.rates.verify_rates_dps and self.verify is None:
                 raise ValueError("rates.verify_rates_dps are measured where the verification poses are: add a "
                                  "verify: section")
+        gyro = self.acceptance.gyro
+        if gyro is not None:
+            if self.rates is None:
+                raise ValueError("acceptance.gyro judges a gyroscope's calibration: add rates:")
+            on_rates = [n for n in gyro.verification_limits() if n != "max_rest_error_dps"]
+            if on_rates and not self.rates.verify_rates_dps:
+                raise ValueError(f"acceptance.gyro.{on_rates[0]} is judged on verification rate steps: add "
+                                 "rates.verify_rates_dps")
+            if gyro.max_rest_error_dps is not None and self.verify is None:
+                raise ValueError("acceptance.gyro.max_rest_error_dps is judged on verification poses: add a verify: "
+                                 "section")
+            if gyro.parameters is not None and not min(self.setpoints_c) <= gyro.parameters.at_c <= max(self.setpoints_c):
+                raise ValueError(f"acceptance.gyro.parameters.at_c: {gyro.parameters.at_c:g} °C is outside the "
+                                 "calibrated range")
         if self.noise is not None and self.noise.pose > self.schedule.size:
             raise ValueError(f"noise.pose: pose {self.noise.pose} asked for, the schedule has {self.schedule.size}")
         return self

@@ -272,6 +272,8 @@ class SimulationConfig(StrictModel):
                                 "config states none (the Earth turns in every lab)")
     heading_deg: float = Field(30.0, ge=-360, le=360, description="the simulated table's heading where the rig "
                                "config states none")
+    gyro_bias_instability_dph: float = Field(0.0, ge=0, le=10_000, description="every simulated gyroscope's bias "
+                                             "instability (a flicker floor of its Allan deviation over 1…1000 s), °/h")
     controller_limits_c: tuple[TemperatureC, TemperatureC] = Field(
         (-70.0, 180.0), description="the simulated controller's own set point limits (low, high), where its "
                                     "register map has them; it clamps set points to them as a real one does")

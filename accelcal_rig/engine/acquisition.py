@@ -16,6 +16,7 @@ from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.capabilities import BlockCapturing
 from accelcal_rig.instruments.capture import capture_together
 from accelcal_rig.instruments.interfaces import SampleBlock, Sensor
+from accelcal_rig.parts.part import Channel
 
 
 def acquire_together(sensors: Sequence[Sensor], n_samples: int, clock: Clock,
@@ -35,7 +36,9 @@ def acquire_together(sensors: Sequence[Sensor], n_samples: int, clock: Clock,
 
 def check_block(sensor: Sensor, block: SampleBlock, ranges: Mapping[str, float]) -> None:
     """Watchdog on the data, each channel of the part: an axis whose every sample is the same code has
-    stopped (real noise moves it by many LSB at any data rate), and a code at either end of the ADC range is
+    stopped where the part's noise moves it by a code or more; a channel whose noise is finer than its code
+    (an ICM-42688-P's gyroscope at ±2000 °/s: 0.3 code) holds one code for a whole block now and then, so
+    there only every axis frozen at once is a stopped sensor; a code at either end of the ADC range is
     saturated."""
     channels = sensor.part.channels
     for channel in channels:
@@ -46,9 +49,18 @@ def check_block(sensor: Sensor, block: SampleBlock, ranges: Mapping[str, float])
         codes = block.codes[channel.name]
         named = f"{channel.name} axis" if len(channels) > 1 else "axis"
         frozen = [axis for axis, values in zip(channel.axes, codes.T) if values.size > 1 and np.ptp(values) == 0]
-        if frozen:
+        if frozen and (len(frozen) == len(channel.axes) or _noise_codes(channel, block, ranges[channel.name]) >= 1.0):
             raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): data stuck: every one of "
                                            f"{len(codes)} samples of {named} {','.join(frozen)} reads the same code")
         if np.any(codes >= channel.code_max) or np.any(codes <= channel.code_min):
             raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): saturated at "
                                            f"±{ranges[channel.name]} {channel.unit} (a code at the end of the ADC range)")
+
+
+def _noise_codes(channel: Channel, block: SampleBlock, range_: float) -> float:
+    """The channel's per-sample noise in codes at the block's data rate: its density over the bandwidth of an
+    ODR/4 low-pass (×π/2), over its code at the range."""
+    n = max(len(block.codes[channel.name]) - 1, 1)
+    span_s = block.t_end_s - block.t_start_s
+    rate_hz = n / span_s if span_s > 0 else 1.0
+    return 1e-6 * channel.noise_density_micro_per_rthz * float(np.sqrt(np.pi / 2 * rate_hz / 4)) / channel.lsb(range_)

@@ -1,15 +1,85 @@
 """A self-contained C header for firmware: every sensor's polynomial coefficients and the functions that
-evaluate them and apply Eq. 1, U_SF = M · C · S · (U − b), exactly as `fit.calibration.apply` does.
+evaluate them and apply Eq. 1, U_SF = M · C · S · (U − b), exactly as `fit.calibration.apply` does; where DUTs
+have a calibrated gyroscope, its 27 polynomials and `accelcal_apply_gyro`, which inverts the rate-table model
+exactly as `fit.calibration.apply_gyro` (`fit.gyro_model.correct_rate`) does.
 
-C99, no allocation, <math.h> only (sqrt, sin, cos). `ACCELCAL_REAL` selects double (default) or float.
+C99, no allocation, <math.h> only (sqrt, sin, cos, fabs). `ACCELCAL_REAL` selects double (default) or float.
 """
 
 from __future__ import annotations
 
 import re
 
-from accelcal_rig.fit.calibration import CalibrationFile
+from accelcal_rig.fit import gyro_model
+from accelcal_rig.fit.calibration import CalibrationFile, GyroCalibration
 from accelcal_rig.fit.sfem import PARAMETER_NAMES
+
+#: Newton steps on each axis's scale curve: as many as `gyro_model.correct_rate` takes.
+_GYRO_NEWTON_STEPS = gyro_model._INVERSE_STEPS  # noqa: SLF001 - the same count, so the same result
+
+_GYRO_FUNCTIONS = r"""
+/* The gyroscope model's 27 parameters at its own temperature (deg C), as accelcal_parameters. */
+static inline void accelcal_gyro_parameters(const accelcal_gyro *g, ACCELCAL_REAL temperature_c,
+                                            ACCELCAL_REAL p[ACCELCAL_GYRO_N_PARAMETERS])
+{
+    ACCELCAL_REAL t = temperature_c;
+    if (g->clamp) {
+        if (t < g->t_min_c) t = g->t_min_c;
+        if (t > g->t_max_c) t = g->t_max_c;
+    }
+    const ACCELCAL_REAL x = (t - g->t_mid_c) / g->t_half_range_c;
+    for (int k = 0; k < ACCELCAL_GYRO_N_PARAMETERS; ++k) {
+        ACCELCAL_REAL value = 0;
+        for (int j = ACCELCAL_GYRO_DEGREE; j >= 0; --j) value = value * x + g->coefficients[k][j];
+        p[k] = value;
+    }
+}
+
+/* Compensate one raw gyroscope reading (deg/s, codes x lsb_dps) taken at the gyroscope's temperature (deg C)
+ * while it felt the specific force force_g (g, the compensated accelerometer's reading): the model
+ * raw = b + u + a|u| + n u (u/1000)^2 + G f, u = K w, solved for the true rate w (deg/s). Bias and
+ * g-sensitivity come off, each axis's scale curve is inverted by Newton's method, then K. */
+static inline void accelcal_apply_gyro(const accelcal_gyro *g, ACCELCAL_REAL temperature_c,
+                                       const ACCELCAL_REAL raw_dps[3], const ACCELCAL_REAL force_g[3],
+                                       ACCELCAL_REAL out_dps[3])
+{
+    ACCELCAL_REAL p[ACCELCAL_GYRO_N_PARAMETERS], u[3];
+    accelcal_gyro_parameters(g, temperature_c, p);
+    for (int i = 0; i < 3; ++i) {
+        const ACCELCAL_REAL *gs = &p[18 + 3 * i];
+        const ACCELCAL_REAL target = raw_dps[i] - p[i] - (gs[0] * force_g[0] + gs[1] * force_g[1] + gs[2] * force_g[2]);
+        const ACCELCAL_REAL a = p[12 + i], n = p[15 + i];
+        ACCELCAL_REAL v = target;
+        for (int step = 0; step < ACCELCAL_GYRO_NEWTON_STEPS; ++step) {
+            const ACCELCAL_REAL r = v / ACCELCAL_GYRO_NONLINEARITY_RATE_DPS;
+            const ACCELCAL_REAL sign = (ACCELCAL_REAL)((v > 0) - (v < 0));
+            const ACCELCAL_REAL curve = v + a * fabs(v) + n * v * r * r;
+            v = v - (curve - target) / (1 + a * sign + 3 * n * r * r);
+        }
+        u[i] = v;
+    }
+    /* K: scale factors on the diagonal, cross terms xy, xz, yx, yz, zx, zy off it; out = K^-1 u (adjugate). */
+    const ACCELCAL_REAL k[3][3] = {{p[3], p[6], p[7]}, {p[8], p[4], p[9]}, {p[10], p[11], p[5]}};
+    const ACCELCAL_REAL c00 = k[1][1] * k[2][2] - k[1][2] * k[2][1];
+    const ACCELCAL_REAL c01 = k[1][2] * k[2][0] - k[1][0] * k[2][2];
+    const ACCELCAL_REAL c02 = k[1][0] * k[2][1] - k[1][1] * k[2][0];
+    const ACCELCAL_REAL det = k[0][0] * c00 + k[0][1] * c01 + k[0][2] * c02;
+    const ACCELCAL_REAL inv[3][3] = {
+        {c00, k[0][2] * k[2][1] - k[0][1] * k[2][2], k[0][1] * k[1][2] - k[0][2] * k[1][1]},
+        {c01, k[0][0] * k[2][2] - k[0][2] * k[2][0], k[0][2] * k[1][0] - k[0][0] * k[1][2]},
+        {c02, k[0][1] * k[2][0] - k[0][0] * k[2][1], k[0][0] * k[1][1] - k[0][1] * k[1][0]}};
+    for (int i = 0; i < 3; ++i) out_dps[i] = (inv[i][0] * u[0] + inv[i][1] * u[1] + inv[i][2] * u[2]) / det;
+}
+
+/* As accelcal_apply_gyro, from signed gyroscope codes at the calibrated range. */
+static inline void accelcal_apply_gyro_codes(const accelcal_gyro *g, ACCELCAL_REAL temperature_c,
+                                             const int32_t codes[3], const ACCELCAL_REAL force_g[3],
+                                             ACCELCAL_REAL out_dps[3])
+{
+    const ACCELCAL_REAL raw_dps[3] = {codes[0] * g->lsb_dps, codes[1] * g->lsb_dps, codes[2] * g->lsb_dps};
+    accelcal_apply_gyro(g, temperature_c, raw_dps, force_g, out_dps);
+}
+"""
 
 _FUNCTIONS = r"""
 /* Eq. 1 parameters at the sensor's own temperature (deg C): p[k] = sum_j c[k][j] * x^j (Horner),
@@ -131,5 +201,54 @@ def to_c_header(calibration: CalibrationFile, guard: str = "ACCELCAL_CALIBRATION
             values = [*map(float, row), *([0.0] * (degree + 1 - len(row)))]
             lines.append(f"            {{{', '.join(repr(v) for v in values)}}}, /* {name} */")
         lines += ["        },", "    },"]
-    lines += ["};", _FUNCTIONS, f"#endif /* {guard} */", ""]
+    lines += ["};", _FUNCTIONS]
+    gyros = list(calibration.gyroscopes.values())
+    if gyros:
+        lines += _gyro_section(gyros)
+    lines += [f"#endif /* {guard} */", ""]
     return "\n".join(lines)
+
+
+def _gyro_section(gyros: list[GyroCalibration]) -> list[str]:
+    """The gyroscopes' type, coefficients (indexed by ACCELCAL_GYRO_<SERIAL>) and functions."""
+    assert list(gyro_model.PARAMETER_NAMES[12:18]) == [f"{t}_{a}" for t in ("asymmetry", "nonlinearity")
+                                                       for a in "xyz"]  # the offsets the C code uses
+    degree = max(g.polynomial.degree for g in gyros)
+    lines = [
+        "/* Gyroscopes calibrated on a rate table (model gyro-rate-table, fit/gyro_model.py), per temperature:",
+        " * raw = b + u + a|u| + n u (u/1000)^2 + G f, u = K w. Parameter order: "
+        + ", ".join(gyro_model.PARAMETER_NAMES) + ".",
+        " * Usage: accelcal_apply_gyro(&ACCELCAL_GYROS[ACCELCAL_GYRO_<SERIAL>], temperature_c, raw_dps, force_g,"
+        " out_dps); */",
+        f"#define ACCELCAL_GYRO_N_PARAMETERS {gyro_model.N_PARAMETERS}",
+        f"#define ACCELCAL_GYRO_DEGREE {degree}",
+        f"#define ACCELCAL_N_GYROS {len(gyros)}",
+        f"#define ACCELCAL_GYRO_NEWTON_STEPS {_GYRO_NEWTON_STEPS}",
+        f"#define ACCELCAL_GYRO_NONLINEARITY_RATE_DPS {gyro_model.NONLINEARITY_RATE_DPS!r}",
+        "",
+        "typedef struct {",
+        "    const char *serial;",
+        "    ACCELCAL_REAL lsb_dps;               /* deg/s per code at the calibrated range */",
+        "    ACCELCAL_REAL t_mid_c, t_half_range_c; /* x = (T - t_mid_c) / t_half_range_c */",
+        "    ACCELCAL_REAL t_min_c, t_max_c;      /* calibrated temperature range */",
+        "    int clamp;                           /* 1: T clamped to the range; 0: extrapolated */",
+        "    ACCELCAL_REAL coefficients[ACCELCAL_GYRO_N_PARAMETERS][ACCELCAL_GYRO_DEGREE + 1]; /* increasing powers */",
+        "} accelcal_gyro;",
+        "",
+    ]
+    lines += [f"#define ACCELCAL_GYRO_{c_identifier(g.serial)} {i}" for i, g in enumerate(gyros)]
+    lines += ["", "static const accelcal_gyro ACCELCAL_GYROS[ACCELCAL_N_GYROS] = {"]
+    for gyro in gyros:
+        low, high = gyro.polynomial.domain_c
+        lines += [
+            "    {",
+            f"        \"{gyro.serial}\", {gyro.lsb_dps!r}, {0.5 * (low + high)!r}, {0.5 * (high - low)!r},",
+            f"        {gyro.validity_c[0]!r}, {gyro.validity_c[1]!r}, {int(gyro.out_of_range == 'clamp')},",
+            "        {",
+        ]
+        for name, row in zip(gyro_model.PARAMETER_NAMES, gyro.polynomial.matrix()):
+            values = [*map(float, row), *([0.0] * (degree + 1 - len(row)))]
+            lines.append(f"            {{{', '.join(repr(v) for v in values)}}}, /* {name} */")
+        lines += ["        },", "    },"]
+    lines += ["};", _GYRO_FUNCTIONS]
+    return lines

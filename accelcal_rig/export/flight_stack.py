@@ -1,9 +1,11 @@
-"""What the PX4 and ArduPilot exports share: one sensor's bias as the cubic in (T - T_ref) both stacks hold,
-in m/s², and the statements of what else the calibration holds that an offset-only thermal model cannot.
+"""What the PX4 and ArduPilot exports share: one sensor's bias as the cubic in (T - T_ref) both stacks hold
+(the accelerometer's in m/s², the gyroscope's in rad/s), and the statements of what else the calibration holds
+that an offset-only thermal model cannot.
 
 Both stacks subtract a per-axis offset polynomial of the sensor temperature from the raw reading, clipped to a
 temperature range, and nothing else that changes with temperature: scale factors and cross-axis terms (Eq. 1's
-S, C and M) have no place, so every export says how large they are for the sensor it is for.
+S, C and M; the gyroscope model's K, asymmetry, nonlinearity and g-sensitivity) have no place, so every export
+says how large they are for the sensor it is for.
 """
 
 from __future__ import annotations
@@ -17,7 +19,8 @@ from numpy.polynomial import Polynomial
 
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.fit.calibration import CalibrationFile, SensorCalibration
+from accelcal_rig.fit import gyro_model
+from accelcal_rig.fit.calibration import CalibrationFile, GyroCalibration, SensorCalibration
 from accelcal_rig.fit.sfem import error_matrix
 
 #: Both stacks hold the offset as a cubic in the temperature difference.
@@ -26,6 +29,10 @@ STACK_DEGREE = 3
 _GRID_POINTS = 401
 #: Significant digits written: 9 carry a float32 (what both stacks store) exactly.
 _DIGITS = 9
+#: Both stacks take angular rates in rad/s.
+RAD_PER_DEG = float(np.pi / 180.0)
+#: Directions of the true rate over which what a gyroscope's offset-only compensation leaves is searched.
+_DIRECTIONS = 2000
 
 
 #: The exported axes are the sensor's own; a stack applies its terms in the axes its driver publishes.
@@ -46,16 +53,17 @@ class StackOptions:
 
 @dataclass(frozen=True)
 class OffsetCubic:
-    """Per axis (rows x, y, z), offset(T) = Σ_k coefficients_m_s2[axis, k] · (T - t_ref_c)^k in m/s², for T
-    within t_min_c…t_max_c. `refit_error_mg`: how far it strays from the calibration's own bias over that
-    range: 0 when the calibration's polynomial (of `source_degree`) has degree ≤ 3, re-expanded exactly."""
+    """Per axis (rows x, y, z), offset(T) = Σ_k coefficients[axis, k] · (T - t_ref_c)^k in the stack's unit
+    (m/s² for an accelerometer, rad/s for a gyroscope), for T within t_min_c…t_max_c. `refit_error`: how far
+    it strays from the calibration's own bias over that range, in the same unit: 0 when the calibration's
+    polynomial (of `source_degree`) has degree ≤ 3, re-expanded exactly."""
 
     t_ref_c: float
     t_min_c: float
     t_max_c: float
-    coefficients_m_s2: np.ndarray
+    coefficients: np.ndarray
     source_degree: int
-    refit_error_mg: float
+    refit_error: float
 
 
 @dataclass(frozen=True)
@@ -94,24 +102,36 @@ def instance_index(options: StackOptions, low: int, high: int, default: int, par
 
 
 def offset_cubic(sensor: SensorCalibration, t_ref_c: float) -> OffsetCubic:
-    """The sensor's bias (Eq. 1's b, in g over x = (T - mid) / half-width) as a cubic in (T - t_ref_c) in m/s².
+    """The accelerometer's bias (Eq. 1's b, in g over x = (T - mid) / half-width) as a cubic in (T - t_ref_c)
+    in m/s². Up to degree 3 this is the same polynomial written about another point (exact but for rounding);
+    above, the least-squares cubic over the calibrated range, and how far it strays is part of the result."""
+    return _bias_cubic(sensor.polynomial.matrix()[:3] * STANDARD_GRAVITY_M_S2, sensor.polynomial.domain_c,
+                       sensor.validity_c, t_ref_c)
 
-    Up to degree 3 this is the same polynomial written about another point (exact but for rounding); above,
-    the least-squares cubic over the calibrated range, and how far it strays is part of the result."""
-    low, high = sensor.validity_c
+
+def gyro_offset_cubic(gyro: GyroCalibration, t_ref_c: float) -> OffsetCubic:
+    """The gyroscope's bias (`bias_*_dps`, in °/s over x) as a cubic in (T - t_ref_c) in rad/s, as
+    `offset_cubic` makes the accelerometer's."""
+    return _bias_cubic(gyro.polynomial.matrix()[:3] * RAD_PER_DEG, gyro.polynomial.domain_c, gyro.validity_c,
+                       t_ref_c)
+
+
+def _bias_cubic(bias: np.ndarray, domain_c: tuple[float, float], validity_c: tuple[float, float],
+                t_ref_c: float) -> OffsetCubic:
+    """Rows of coefficients over the scaled temperature (already in the stack's unit) as cubics about t_ref_c."""
+    low, high = validity_c
     grid = np.linspace(low, high, _GRID_POINTS)
-    bias = sensor.polynomial.matrix()[:3]
     degree = bias.shape[1] - 1
     rows, worst = [], 0.0
-    for bias_g in bias:
-        own = Polynomial(bias_g * STANDARD_GRAVITY_M_S2, domain=list(sensor.polynomial.domain_c), window=[-1.0, 1.0])
+    for row in bias:
+        own = Polynomial(row, domain=list(domain_c), window=[-1.0, 1.0])
         if degree > STACK_DEGREE:
             cubic = _about(Polynomial.fit(grid, own(grid), STACK_DEGREE), t_ref_c)
             worst = max(worst, float(np.max(np.abs(cubic(grid) - own(grid)))))
         else:
             cubic = _about(own, t_ref_c)
         rows.append(np.pad(cubic.coef, (0, STACK_DEGREE + 1 - len(cubic.coef))))
-    return OffsetCubic(t_ref_c, low, high, np.array(rows), degree, worst / STANDARD_GRAVITY_M_S2 * 1e3)
+    return OffsetCubic(t_ref_c, low, high, np.array(rows), degree, worst)
 
 
 def _about(polynomial: Polynomial, t_ref_c: float) -> Polynomial:
@@ -122,14 +142,20 @@ def _about(polynomial: Polynomial, t_ref_c: float) -> Polynomial:
 def offset_at(cubic: OffsetCubic, temperature_c: float) -> np.ndarray:
     """The cubic's offset per axis (m/s²) at one temperature, clipped to its range as the stacks clip it."""
     u = float(np.clip(temperature_c, cubic.t_min_c, cubic.t_max_c)) - cubic.t_ref_c
-    return np.asarray(cubic.coefficients_m_s2 @ u ** np.arange(STACK_DEGREE + 1), dtype=float)
+    return np.asarray(cubic.coefficients @ u ** np.arange(STACK_DEGREE + 1), dtype=float)
+
+
+def steepest_slope(cubic: OffsetCubic) -> float:
+    """The largest |d offset / dT| of any axis over the range, in the stack's unit per °C: what a stale
+    temperature costs."""
+    u = np.linspace(cubic.t_min_c, cubic.t_max_c, _GRID_POINTS) - cubic.t_ref_c
+    slopes = [Polynomial(row).deriv()(u) for row in cubic.coefficients]
+    return float(np.max(np.abs(slopes)))
 
 
 def steepest_slope_mg_per_c(cubic: OffsetCubic) -> float:
-    """The largest |d offset / dT| of any axis over the range, mg/°C: what a stale temperature costs."""
-    u = np.linspace(cubic.t_min_c, cubic.t_max_c, _GRID_POINTS) - cubic.t_ref_c
-    slopes = [Polynomial(row).deriv()(u) for row in cubic.coefficients_m_s2]
-    return float(np.max(np.abs(slopes))) / STANDARD_GRAVITY_M_S2 * 1e3
+    """`steepest_slope` of an accelerometer's cubic (m/s²), in mg/°C."""
+    return steepest_slope(cubic) / STANDARD_GRAVITY_M_S2 * 1e3
 
 
 def not_exported(sensor: SensorCalibration, stack: str) -> str:
@@ -152,33 +178,97 @@ def not_exported(sensor: SensorCalibration, stack: str) -> str:
             f"{_spread(cross_mrad):.3f} mrad; together up to {left_mg:.3f} mg at 1 g left uncorrected")
 
 
+def gyro_not_exported(gyro: GyroCalibration, stack: str) -> str:
+    """The gyroscope model's terms an offset-only thermal model cannot hold, over the calibrated range, and what
+    leaving them out costs at full scale.
+
+    With the bias alone removed the stack outputs u + a|u| + n u (u/1000)² + G·f for u = K·ω: the error left is
+    that minus ω. "Together" bounds it at |ω| = the range and |f| = 1 g: the largest error of the rate terms
+    over directions of ω and temperatures, plus the largest ‖G‖₂."""
+    low, high = gyro.validity_c
+    parameters = gyro.parameters_at(np.linspace(low, high, _GRID_POINTS))
+    scale_ppm = (parameters[:, gyro_model.SCALE] - 1.0) * 1e6
+    cross_mrad = parameters[:, gyro_model.CROSS] * 1e3
+    asymmetry_ppm = parameters[:, gyro_model.ASYMMETRY] * 1e6
+    nonlinearity_ppm = parameters[:, gyro_model.NONLINEARITY] * 1e6
+    gsens = gyro_model.gsensitivity_matrix(parameters)
+    gsens_norm = np.linalg.norm(gsens, ord=2, axis=(1, 2))
+    rate_dps = gyro.range_dps * _sphere(_DIRECTIONS)
+    left = [np.linalg.norm(_rate_terms_left(p, rate_dps), axis=1).max() for p in parameters[:: _GRID_POINTS // 40]]
+    together = float(max(left)) + float(gsens_norm.max())
+    return (f"not exported ({stack} holds gyro offsets only): scale error up to {np.max(np.abs(scale_ppm)):.0f} ppm, "
+            f"changing by up to {_spread(scale_ppm):.0f} ppm over {low:.2f} to {high:.2f} degC; cross-axis "
+            f"sensitivity (misalignment and non-orthogonality) up to {np.max(np.abs(cross_mrad)):.3f} mrad, changing "
+            f"by up to {_spread(cross_mrad):.3f} mrad; +/- asymmetry up to {np.max(np.abs(asymmetry_ppm)):.0f} ppm; "
+            f"cubic nonlinearity up to {np.max(np.abs(nonlinearity_ppm)):.0f} ppm at 1000 deg/s; g-sensitivity up "
+            f"to {gsens_norm.max():.4f} deg/s per g, changing by up to {_spread(gsens.reshape(len(gsens), 9)):.4f} "
+            f"deg/s per g; together up to {together:.3f} deg/s at full scale ({gyro.range_dps:g} deg/s) and 1 g "
+            "left uncorrected")
+
+
+def _rate_terms_left(params: np.ndarray, rate_dps: np.ndarray) -> np.ndarray:
+    """What a gyroscope with `params` reads for each true rate, bias and g-sensitivity taken off, minus the rate."""
+    no_bias_no_g = np.array(params, dtype=float)
+    no_bias_no_g[gyro_model.BIAS] = 0.0
+    no_bias_no_g[gyro_model.GSENS] = 0.0
+    return gyro_model.distort_rate(rate_dps, np.zeros(3), no_bias_no_g) - rate_dps
+
+
+def _sphere(n: int) -> np.ndarray:
+    """n directions spread evenly over the unit sphere (a Fibonacci lattice), and the six axes both ways."""
+    k = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * k / n
+    phi = np.pi * (1.0 + 5.0**0.5) * k
+    r = np.sqrt(1.0 - z * z)
+    return np.concatenate([np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1), np.eye(3), -np.eye(3)])
+
+
 def _spread(values: np.ndarray) -> float:
     """The largest change of any one column over the rows (temperatures)."""
     return float(np.max(values.max(axis=0) - values.min(axis=0)))
 
 
-def range_note(sensor: SensorCalibration, cubic: OffsetCubic, stack: str, names: str) -> str:
+def range_note(sensor: SensorCalibration | GyroCalibration, cubic: OffsetCubic, stack: str, names: str) -> str:
     """The calibrated range against the clipping range written (the same), and what each does beyond it."""
     low, high = sensor.validity_c
     beyond = "clamps" if sensor.out_of_range == "clamp" else "extrapolates"
-    return (f"temperature: calibrated {low:.2f} to {high:.2f} degC (beyond it the calibration {beyond}); {names} "
+    label = "gyro temperature" if isinstance(sensor, GyroCalibration) else "temperature"
+    return (f"{label}: calibrated {low:.2f} to {high:.2f} degC (beyond it the calibration {beyond}); {names} "
             f"written {cubic.t_min_c:.2f} to {cubic.t_max_c:.2f} degC: {stack} clips the temperature to them, so "
             "beyond them it holds the offset of the nearer end")
 
 
-def refit_note(cubic: OffsetCubic, stack: str, since: str = "") -> list[str]:
+def refit_note(cubic: OffsetCubic, stack: str, since: str = "", what: str = "bias") -> list[str]:
     """A statement only when the calibration's polynomial is above the stack's degree and was refitted; `since`:
-    the temperature a stack takes the cubic's change from, which doubles what the change may stray."""
+    the temperature a stack takes the cubic's change from, which doubles what the change may stray. `what`:
+    "bias" (an accelerometer's cubic, m/s², stated in mg) or "gyro bias" (rad/s, stated in deg/s)."""
     if cubic.source_degree <= STACK_DEGREE:
         return []
     change = f" (its change since {since}, which {stack} subtracts, up to twice that)" if since else ""
-    return [f"the calibration's degree-{cubic.source_degree} bias polynomial refitted as {stack}'s cubic: "
-            f"up to {cubic.refit_error_mg:.4f} mg from it over the calibrated range{change}"]
+    size = (f"{cubic.refit_error / STANDARD_GRAVITY_M_S2 * 1e3:.4f} mg" if what == "bias"
+            else f"{cubic.refit_error / RAD_PER_DEG:.5f} deg/s")
+    return [f"the calibration's degree-{cubic.source_degree} {what} polynomial refitted as {stack}'s cubic: "
+            f"up to {size} from it over the calibrated range{change}"]
 
 
 def mg(values_m_s2: np.ndarray) -> str:
     """x, y, z in mg for a note."""
     return ", ".join(f"{v:.3f}" for v in np.asarray(values_m_s2) / STANDARD_GRAVITY_M_S2 * 1e3)
+
+
+def dps(values_rad_s: np.ndarray) -> str:
+    """x, y, z in deg/s for a note."""
+    return ", ".join(f"{v:.5f}" for v in np.asarray(values_rad_s) / RAD_PER_DEG)
+
+
+def gyro_of(calibration: CalibrationFile, serial: str) -> GyroCalibration | None:
+    """The DUT's gyroscope calibration, where it has one: a flight stack's file then carries it too."""
+    return calibration.gyroscopes.get(serial)
+
+
+GYRO_AXES_NOTE = ("the gyro coefficients are in the gyroscope's own x, y, z as calibrated (its sensitivity matrix "
+                  "is relative to the fixture frame): permute and re-sign them as the accelerometer's where the "
+                  "driver publishes the gyroscope rotated")
 
 
 def number(value: float) -> str:

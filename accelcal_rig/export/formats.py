@@ -31,19 +31,33 @@ def export(calibration: CalibrationFile, format_name: str, options: StackOptions
     stacks = {"px4-params": to_px4_params, "ardupilot-params": to_ardupilot_params}
     if format_name in stacks:
         exported = stacks[format_name](calibration, options)
-        left = not_exported(calibration, [exported.serial])
+        left = not_exported(calibration, [exported.serial], format_name)
         return Exported(exported.text, f"sensor {exported.serial}", (*exported.notes, *left))
     if (options.serial, options.instance, options.device_id) != (None, None, None):
         raise ConfigError(f"--serial, --instance and --device-id are for px4-params and ardupilot-params, not {format_name}")
     text = {"json": to_json, "csv": to_csv, "c-header": to_c_header}[format_name](calibration)
-    return Exported(text, f"{len(calibration.sensors)} sensors", tuple(not_exported(calibration, calibration.sensors)))
+    return Exported(text, f"{len(calibration.sensors)} sensors",
+                    tuple(not_exported(calibration, calibration.sensors, format_name)))
 
 
-def not_exported(calibration: CalibrationFile, serials: Iterable[str]) -> list[str]:
-    """The channels of these DUTs an export leaves out, each with why: every export holds the accel channel."""
+#: The formats that leave a calibrated gyroscope out (every other one carries it beside the accelerometer).
+WITHOUT_GYRO = {"csv": "the json export and the c-header carry it"}
+
+
+def not_exported(calibration: CalibrationFile, serials: Iterable[str], format_name: str = "") -> list[str]:
+    """The channels of these DUTs an export leaves out, each with why: every export holds the accel channel, and
+    every one but csv a calibrated gyro channel; a channel no model calibrated is in none."""
     uncalibrated = calibration.not_calibrated()
-    return [f"sensor {serial}: its {channel} channel is not in this export: not calibrated ({why})"
-            for serial in serials for channel, why in uncalibrated.get(serial, {}).items()]
+    gyroscopes = calibration.gyroscopes
+    notes = []
+    for serial in serials:
+        notes += [f"sensor {serial}: its {channel} channel is not in this export: not calibrated ({why})"
+                  for channel, why in uncalibrated.get(serial, {}).items()
+                  if channel not in calibration.duts[serial].channels]
+        if serial in gyroscopes and format_name in WITHOUT_GYRO:
+            notes.append(f"sensor {serial}: its gyro channel (calibrated, model gyro-rate-table) is not in this "
+                         f"{format_name} export: {WITHOUT_GYRO[format_name]}")
+    return notes
 
 
 def write_export(exported: Exported, format_name: str, output: Path | None) -> int:

@@ -1,4 +1,5 @@
-"""JSON (the calibration file's own structure) and CSV (one row per sensor and parameter)."""
+"""JSON (the calibration file's own structure, every channel) and CSV (one row per sensor and accelerometer
+parameter: a calibrated gyroscope is left out, and `formats.not_exported` says so)."""
 
 from __future__ import annotations
 

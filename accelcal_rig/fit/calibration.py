@@ -124,6 +124,10 @@ class GyroCalibration(StrictModel):
 
     model: Literal["gyro-rate-table"] = "gyro-rate-table"
     serial: str = Field(min_length=1, max_length=128)
+    mode: Literal["rate-table", "hand-held"] = Field("rate-table", description="rate steps on a rate table, or "
+                                                     "the turns between a hand-held recording's still intervals")
+    free_parameters: list[str] = Field(list(gyro_model.PARAMETER_NAMES), max_length=27, description="the "
+                                       "parameters the data determined; the others hold their nominal values")
     range_dps: float = Field(gt=0, le=100_000, description="measuring range, ± °/s")
     lsb_dps: float = Field(gt=0, le=100, description="°/s per code, for compensating raw codes")
     validity_c: tuple[TemperatureC, TemperatureC]

@@ -11,7 +11,7 @@ import numpy as np
 
 from accelcal_rig import __version__
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
-from accelcal_rig.fit.acceptance import judge, recorded_acceptance
+from accelcal_rig.fit.acceptance import Judgement, judge, recorded_acceptance
 from accelcal_rig.fit.approach import approach_directions, temperature_rates_c_per_min
 from accelcal_rig.fit.budget import (
     budget,
@@ -26,6 +26,7 @@ from accelcal_rig.fit.calibration import (
     ANGULAR_RATE,
     CalibrationFile,
     DutCalibration,
+    GyroCalibration,
     PolynomialModel,
     SensorCalibration,
     SetpointFit,
@@ -36,6 +37,7 @@ from accelcal_rig.fit.calibration import FORMAT_NAME as CALIBRATION_FORMAT
 from accelcal_rig.fit.calibration import FORMAT_VERSION as CALIBRATION_VERSION
 from accelcal_rig.fit.expected import expected_norm_rmse_mg, expected_reference_rmse_mg, thermal_jacobian
 from accelcal_rig.fit.fixture_pool import map_over_duts
+from accelcal_rig.fit.gyro_acceptance import judge_gyro
 from accelcal_rig.fit.gyro_fit import GyroDesignError, GyroFitResult, fit_gyro, read_gyro_records, site_of
 from accelcal_rig.fit.joint import fit_joint
 from accelcal_rig.fit.lm import FitMode, FreeParameters, SfemFit, fit_sfem, norm_sigma
@@ -271,36 +273,65 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     limits = recorded_acceptance(campaign.header.procedure_yaml, source.get("campaign", "the campaign"))
     partial = partial_campaign(campaign, run_end)
     judged = {r.serial: judge(r.metrics, r.thermal, options.mode, limits, partial) for r in results}
-    gyroscopes = {serial: fit_gyroscope(campaign, serial, options) for serial in campaign.serials}
+    noise = {serial: {channel: figures for channel in (ACCELERATION, ANGULAR_RATE)
+                      if (figures := _noise_figures(campaign, serial, channel)) is not None}
+             for serial in campaign.serials}
+    gyroscopes = {serial: fit_gyroscope(campaign, serial, options, noise[serial].get(ANGULAR_RATE))
+                  for serial in campaign.serials}
+    gyro_verdicts = {serial: judge_gyro(gyro.metrics, gyro.thermal, limits.gyro, partial, limits.allow_partial)
+                     for serial, gyro in gyroscopes.items() if isinstance(gyro, GyroFitResult)}
     uncalibrated = {serial: not_calibrated(campaign, serial, gyroscopes[serial]) for serial in campaign.serials}
-    duts = {r.serial: DutCalibration(
-        channels={ACCELERATION: r.calibration.model_copy(update={"verdict": judged[r.serial].verdict,
-                                                                 "verdict_reasons": judged[r.serial].reasons}),
-                  **({ANGULAR_RATE: gyro.calibration} if isinstance(gyro := gyroscopes[r.serial], GyroFitResult)
-                     else {})},
-        not_calibrated=uncalibrated[r.serial]) for r in results}
+    duts = {}
+    for r in results:
+        accel = r.calibration.model_copy(update={
+            "verdict": judged[r.serial].verdict, "verdict_reasons": judged[r.serial].reasons,
+            "metrics": {**r.calibration.metrics, **_allan(noise[r.serial], ACCELERATION)}})
+        channels: dict[str, SensorCalibration | GyroCalibration] = {ACCELERATION: accel}
+        gyro = gyroscopes[r.serial]
+        if isinstance(gyro, GyroFitResult):
+            verdict = gyro_verdicts[r.serial]
+            channels[ANGULAR_RATE] = gyro.calibration.model_copy(update={
+                "verdict": verdict.verdict, "verdict_reasons": verdict.reasons,
+                "metrics": {**gyro.calibration.metrics, **_allan(noise[r.serial], ANGULAR_RATE)}})
+        duts[r.serial] = DutCalibration(channels=channels, not_calibrated=uncalibrated[r.serial])
     calibration = CalibrationFile(
         format=CALIBRATION_FORMAT, format_version=CALIBRATION_VERSION, created=utc_now(),
         software_version=__version__, source={**source, **({"partial": partial} if partial else {})}, duts=duts,
     )
-    report = {r.serial: {**plain(r.metrics), "warnings": r.thermal.warnings, "verdict": judged[r.serial].verdict,
-                         "verdict_reasons": judged[r.serial].reasons,
-                         **_noise_figures(campaign, r.serial, ACCELERATION, "allan"),
-                         **({"gyro": {**gyro.metrics, "verdict": None,
-                                      **_noise_figures(campaign, r.serial, ANGULAR_RATE, "allan")}}
+    overall = {serial: dut_verdict(judged[serial], gyro_verdicts.get(serial)) for serial in judged}
+    report = {r.serial: {**plain(r.metrics), "warnings": r.thermal.warnings, "verdict": overall[r.serial].verdict,
+                         "verdict_reasons": overall[r.serial].reasons,
+                         **_allan(noise[r.serial], ACCELERATION),
+                         **({"gyro": {**gyro.metrics, "verdict": gyro_verdicts[r.serial].verdict,
+                                      "verdict_reasons": gyro_verdicts[r.serial].reasons,
+                                      **_allan(noise[r.serial], ANGULAR_RATE)}}
                             if isinstance(gyro := gyroscopes[r.serial], GyroFitResult) else {}),
                          **({"not_calibrated": uncalibrated[r.serial]} if uncalibrated[r.serial] else {})}
               for r in results}
     return calibration, report
 
 
-def _noise_figures(campaign: Campaign, serial: str, channel: str, key: str) -> dict[str, Any]:
-    """`{key: the channel's Allan figures}` where the campaign has noise records and the channel, else {}."""
+def dut_verdict(accelerometer: Judgement, gyroscope: Judgement | None) -> Judgement:
+    """A DUT's verdict: FAIL when either of its sensors fails; the gyroscope's reasons follow the
+    accelerometer's, each marked."""
+    if gyroscope is None:
+        return accelerometer
+    failed = "FAIL" in (accelerometer.verdict, gyroscope.verdict)
+    pick = (lambda j: [r for r in j.reasons] if j.verdict == "FAIL" else []) if failed else (lambda j: list(j.reasons))
+    return Judgement("FAIL" if failed else "PASS", pick(accelerometer) + [f"gyro: {r}" for r in pick(gyroscope)])
+
+
+def _noise_figures(campaign: Campaign, serial: str, channel: str) -> dict[str, Any] | None:
+    """The channel's Allan figures where the campaign has noise records and the DUT the channel, else None."""
     odr_hz = float(campaign.header.duts[campaign.serials.index(serial)].get("odr_hz") or 0.0)
     if odr_hz <= 0 or channel not in {c.name for c in campaign.header.dut_channels(serial)}:
-        return {}
-    figures = noise_allan(campaign, serial, channel, odr_hz)
-    return {key: figures} if figures is not None else {}
+        return None
+    return noise_allan(campaign, serial, channel, odr_hz)
+
+
+def _allan(noise: dict[str, dict[str, Any]], channel: str) -> dict[str, Any]:
+    """`{"allan": figures}` of a channel that has them, else {}."""
+    return {"allan": plain(noise[channel])} if channel in noise else {}
 
 
 #: The quantities a channel model calibrates: Eq. 1 against gravity; the rate-table model against the table's
@@ -309,14 +340,16 @@ CHANNEL_MODELS = {"acceleration": "Eq. 1 sensor-frame error model against gravit
                   "angular rate": "rate-table gyroscope model (fit/gyro_model.py) against the table's rate"}
 
 
-def fit_gyroscope(campaign: Campaign, serial: str, options: FitOptions) -> GyroFitResult | str | None:
+def fit_gyroscope(campaign: Campaign, serial: str, options: FitOptions,
+                  allan: dict[str, Any] | None = None) -> GyroFitResult | str | None:
     """The DUT's gyroscope fitted from the campaign's rate steps; why not (a line) where it has a gyroscope
     but the campaign no rate steps or too few; None for a DUT without one."""
     reason = _no_rate_steps(campaign, serial)
     if reason is not None or ANGULAR_RATE not in {c.name for c in campaign.header.dut_channels(serial)}:
         return reason
     try:
-        return fit_gyro(read_gyro_records(campaign, serial), options.degree, options.out_of_range, site_of(campaign))
+        return fit_gyro(read_gyro_records(campaign, serial), options.degree, options.out_of_range, site_of(campaign),
+                        allan)
     except GyroDesignError as exc:
         return f"angular rate in dps: measured and stored; not calibrated: {exc}"
 
@@ -414,6 +447,16 @@ def summary_line(report: dict[str, Any], calibration_path: Path) -> str:
         drift = max(max(r["drift_after_mg"]) for r in report.values())
         figures = (f"|g| RMSE {before:.2f} → {after:.4f} mg in-sample, no verification poses (noise floor "
                    f"{floor:.4f} mg), offset drift after ≤ {drift:.4f} mg")
+    gyros = [r["gyro"] for r in report.values() if "gyro" in r]
+    if gyros:
+        checked = all("verification" in g and g["verification"]["rmse_dps"] is not None for g in gyros)
+        key = "verification" if checked else None
+        before = max((g[key] if key else g)["rmse_before_dps"] for g in gyros)
+        after = max(g[key]["rmse_dps"] if key else g["rmse_after_dps"] for g in gyros)
+        figures += (f"; gyro rate RMS {before:.3f} → {after:.4f} °/s "
+                    f"{'at verification rates' if checked else 'in-sample, no verification rates'}, expanded "
+                    f"uncertainty ≤ {max(max(g['expanded_uncertainty_dps']) for g in gyros):.4f} °/s at "
+                    f"{gyros[0]['uncertainty_budget']['largest_rate_dps']:g} °/s")
     failed = [serial for serial, r in report.items() if r.get("verdict") == "FAIL"]
     verdicts = (f"{len(report) - len(failed)} PASS, {len(failed)} FAIL ({', '.join(failed)})" if failed
                 else f"{len(report)} PASS")

@@ -21,8 +21,11 @@ from numpy.polynomial import polynomial
 from scipy.optimize import least_squares
 from scipy.stats import chi2
 
+from accelcal_rig.core.earth import EARTH_RATE_DPS
 from accelcal_rig.fit import gyro_model
+from accelcal_rig.fit.allan import FLICKER_FLOOR
 from accelcal_rig.fit.calibration import GyroCalibration, GyroPolynomialModel, SetpointFit, plain
+from accelcal_rig.fit.gyro_budget import gyro_budget, truth_coverage
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.records import ChannelInfo
@@ -91,6 +94,7 @@ class GyroSetpointFit:
     sigma: np.ndarray                 # (27,) 1σ, widened by √χ²_red when χ² exceeds its 99 % quantile
     chi2_reduced: float
     n_records: int
+    covariance: np.ndarray            # (27, 27), widened as sigma
 
 
 def fit_gyro_setpoint(mean_dps: np.ndarray, stderr_dps: np.ndarray, reference_dps: np.ndarray,
@@ -118,7 +122,7 @@ def fit_gyro_setpoint(mean_dps: np.ndarray, stderr_dps: np.ndarray, reference_dp
     covariance = np.linalg.inv(jacobian.T @ jacobian)
     if chi2_reduced > chi2.ppf(0.99, dof) / dof:
         covariance *= chi2_reduced  # more scatter than the standard errors allow: widen, never hide
-    return GyroSetpointFit(result.x, np.sqrt(np.diag(covariance)), chi2_reduced, n)
+    return GyroSetpointFit(result.x, np.sqrt(np.diag(covariance)), chi2_reduced, n, covariance)
 
 
 def _check_identified(jacobian: np.ndarray, n_records: int) -> None:
@@ -139,6 +143,7 @@ class GyroFitResult:
     serial: str
     calibration: GyroCalibration
     metrics: dict[str, Any]           # what `rig fit --json` prints under `gyro`
+    thermal: ThermalModel
 
 
 def site_of(campaign: Campaign) -> dict[str, Any]:
@@ -168,8 +173,10 @@ GAUGE = ("the fixture frame as the rate table realises it: turning about each fi
          "entries of K (scale on the diagonal, cross-axis terms off it), the DUT's nominal mount taken out")
 
 
-def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: dict[str, Any]) -> GyroFitResult:
-    """Fit each setpoint, the polynomials over temperature, and the figures of the calibration."""
+def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: dict[str, Any],
+             allan: dict[str, Any] | None = None) -> GyroFitResult:
+    """Fit each setpoint, the polynomials over temperature, and the figures of the calibration. `allan`: the
+    noise record's figures (fit/noise_record.py), whose bias instability bounds how well a bias holds."""
     calibrating = records.rows(*CALIBRATION_KINDS)
     if not records.rows("rate").any():
         raise GyroDesignError(f"sensor {records.serial}: no rate steps stored, the gyroscope cannot be calibrated")
@@ -189,10 +196,26 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
     metrics["chi2_reduced"] = [f.chi2_reduced for f in fits]
     metrics["temperature_range_c"] = [float(temperatures.min()), float(temperatures.max())]
     metrics["earth_rate"] = earth_rate_statement(site)
-    systematic = _systematic_sigma(site)
-    metrics["table_systematics_1sigma"] = {"scale_relative": systematic["scale"], "cross_rad": systematic["cross"]}
+    wander = _bias_wander_dps(allan)
+    systematic: dict[str, Any] = {**_systematic_sigma(site), "bias_instability_dps": wander}
+    metrics["table_systematics_1sigma"] = {"scale_relative": systematic["scale"], "cross_rad": systematic["cross"],
+                                           "earth_dps": systematic["earth_dps"]}
+    metrics["bias_instability_1sigma_dps"] = (wander.tolist() if allan is not None
+                                              else "not measured: the campaign has no noise record")
+    covariances = np.array([f.covariance for f in fits])
+    temperature_u_c = _temperature_scatter_c(records, groups)
+    largest = float(np.max(np.abs(records.reference_dps[records.rows("rate")])))
+    metrics["uncertainty_budget"] = gyro_budget(thermal, temperatures, covariances, sigmas, temperature_u_c,
+                                                systematic, round(largest))
+    metrics["expanded_uncertainty_dps"] = metrics["uncertainty_budget"]["at_largest_rate"]["expanded_dps"]
     if records.truth_parameters is not None:
         metrics["truth_error"] = _truth_error(records, setpoints, groups, fits, systematic)
+        checks = records.rows(*VERIFICATION_KINDS)
+        if checks.any():
+            metrics["truth_coverage_k2"] = truth_coverage(
+                records.mean_dps[checks], records.force_g[checks], records.reference_dps[checks],
+                records.temperature_c[checks], records.truth_parameters[checks], thermal, temperatures, covariances,
+                sigmas, temperature_u_c, systematic, out_of_range)
     calibration = GyroCalibration(
         serial=records.serial, range_dps=records.info.range, lsb_dps=records.info.lsb,
         validity_c=thermal.domain_c, out_of_range=out_of_range,
@@ -207,7 +230,7 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
         earth_rate=metrics["earth_rate"], gauge=GAUGE,
         metrics={k: plain(v) for k, v in metrics.items() if k != "truth_error"}, warnings=thermal.warnings,
     )
-    return GyroFitResult(records.serial, calibration, plain(metrics))
+    return GyroFitResult(records.serial, calibration, plain(metrics), thermal)
 
 
 def _figures(records: GyroRecords, thermal: ThermalModel, out_of_range: OutOfRange,
@@ -256,24 +279,58 @@ def _max(values: np.ndarray) -> float | None:
 
 
 def _systematic_sigma(site: dict[str, Any]) -> dict[str, float]:
-    """The table's systematic errors as 1σ of the parameters they shift: its rate accuracy (± uniform, a common
-    relative error of every rate) on the scale factors; its position accuracy (± uniform per axis: the fixture
-    axis a rate step turns about is tilted by it, the same for every rate of the step's pose) on the cross-axis
-    terms."""
+    """The systematic errors as 1σ of what they shift: the table's rate accuracy (± uniform, a common relative
+    error of every rate) the scale factors; its position accuracy (± uniform per axis: the fixture axis a rate
+    step turns about is tilted by it, the same for every rate of the step's pose) the cross-axis terms; the
+    Earth's rate the rig config does not place (± uniform, its size) the bias."""
+    if site["latitude_deg"] is None:
+        earth = EARTH_RATE_DPS
+    elif site["heading_deg"] is None:
+        earth = EARTH_RATE_DPS * float(np.cos(np.radians(site["latitude_deg"])))
+    else:
+        earth = 0.0
     return {"scale": site["rate_accuracy_pct"] / 100.0 / np.sqrt(3.0),
-            "cross": float(np.radians(site["accuracy_arcsec"] / 3600.0)) / np.sqrt(3.0)}
+            "cross": float(np.radians(site["accuracy_arcsec"] / 3600.0)) / np.sqrt(3.0),
+            "earth_dps": earth / np.sqrt(3.0)}
 
 
-def _with_systematics(fit: GyroSetpointFit, systematic: dict[str, float]) -> np.ndarray:
-    """A setpoint fit's 1σ with the table's systematic errors combined in."""
+def _temperature_scatter_c(records: GyroRecords, groups: list[np.ndarray]) -> float:
+    """A record's temperature reading's scatter about its setpoint's line in time: the uncertainty of the
+    temperature a compensation is evaluated at."""
+    residuals, fitted = [], 0
+    for group in groups:
+        t, temperature = records.t_s[group], records.temperature_c[group]
+        if len(group) >= 3 and np.ptp(t) > 0:
+            line = np.polynomial.Polynomial.fit(t, temperature, 1)
+            residuals.append(temperature - line(t))
+            fitted += 2
+        else:
+            residuals.append(temperature - temperature.mean())
+            fitted += 1
+    pooled = np.concatenate(residuals)
+    return float(np.sqrt(np.sum(pooled**2) / max(len(pooled) - fitted, 1)))
+
+
+def _bias_wander_dps(allan: dict[str, Any] | None) -> np.ndarray:
+    """How far a bias wanders between when it is measured and when it is used, 1σ per axis: the flicker floor
+    of the Allan deviation, 0.664 × the bias instability the noise record measured (its upper bound where the
+    record could not resolve it); zero without a noise record (then said so)."""
+    if allan is None or "bias_instability_dph" not in allan:
+        return np.zeros(3)
+    return np.array([FLICKER_FLOOR * (a["value"] or a["high"]) / 3600.0 for a in allan["bias_instability_dph"]])
+
+
+def _with_systematics(fit: GyroSetpointFit, systematic: dict[str, Any]) -> np.ndarray:
+    """A setpoint fit's 1σ with the systematic errors combined in."""
     sigma = fit.sigma.copy()
+    sigma[gyro_model.BIAS] = np.hypot(sigma[gyro_model.BIAS], systematic["bias_instability_dps"])
     sigma[gyro_model.SCALE] = np.hypot(sigma[gyro_model.SCALE], fit.parameters[gyro_model.SCALE] * systematic["scale"])
     sigma[gyro_model.CROSS] = np.hypot(sigma[gyro_model.CROSS], systematic["cross"])
     return sigma
 
 
 def _truth_error(records: GyroRecords, setpoints: np.ndarray, groups: list[np.ndarray], fits: list[GyroSetpointFit],
-                 systematic: dict[str, float]) -> list[dict[str, Any]]:
+                 systematic: dict[str, Any]) -> list[dict[str, Any]]:
     """Estimate minus truth for every parameter at every setpoint, with its 1σ (the table's systematic errors
     combined in) and z."""
     assert records.truth_parameters is not None

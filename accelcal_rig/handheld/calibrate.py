@@ -12,12 +12,16 @@ import numpy as np
 
 from accelcal_rig import __version__
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
+from accelcal_rig.fit import gyro_model
 from accelcal_rig.fit.calibration import (
     ACCELERATION,
+    ANGULAR_RATE,
     FORMAT_NAME,
     FORMAT_VERSION,
     CalibrationFile,
     DutCalibration,
+    GyroCalibration,
+    GyroPolynomialModel,
     PolynomialModel,
     SensorCalibration,
     SetpointFit,
@@ -56,6 +60,42 @@ def missing_orientations(mean_g: np.ndarray) -> list[str]:
         if not np.any(direction[:, axis] <= -VISITED_G):
             missing.append(f"{name} down")
     return missing
+
+
+#: A hand-held recording determines the gyroscope's bias and K; the rest of the model holds its nominal value.
+HANDHELD_GYRO_PARAMETERS = tuple(gyro_model.PARAMETER_NAMES[i] for i in range(gyro_model.CROSS.stop))
+
+
+def gyro_calibration(gyro: HandheldGyroFit, recording: Recording, serial: str, temperature_c: float,
+                     validity_c: tuple[float, float]) -> GyroCalibration:
+    """The hand-held gyroscope fit as the calibration file's `gyro` channel: bias and K constant over the
+    recording's temperature, every other term of the rate-table model at its nominal value (not determined)."""
+    parameters = gyro_model.IDENTITY_PARAMETERS.copy()
+    sigma = np.full(gyro_model.N_PARAMETERS, np.nan)
+    parameters[gyro_model.BIAS], sigma[gyro_model.BIAS] = gyro.bias_dps, gyro.bias_sigma_dps
+    parameters[gyro_model.SCALE], sigma[gyro_model.SCALE] = np.diag(gyro.matrix), np.diag(gyro.matrix_sigma)
+    for column, (i, j) in enumerate(gyro_model.CROSS_TERMS):
+        parameters[gyro_model.CROSS.start + column] = gyro.matrix[i, j]
+        sigma[gyro_model.CROSS.start + column] = gyro.matrix_sigma[i, j]
+    names = gyro_model.PARAMETER_NAMES
+    assert recording.gyro_dps is not None
+    return GyroCalibration(
+        serial=serial, mode="hand-held", free_parameters=list(HANDHELD_GYRO_PARAMETERS),
+        range_dps=max(250.0, float(np.ceil(np.abs(recording.gyro_dps).max()))), lsb_dps=recording.gyro_lsb_dps or 1.0,
+        validity_c=validity_c, out_of_range="clamp",
+        polynomial=GyroPolynomialModel(domain_c=validity_c, degree=0,
+                                       coefficients={n: [float(p)] for n, p in zip(names, parameters)}),
+        setpoints=[SetpointFit(setpoint_c=temperature_c, temperature_c=temperature_c, n_poses=gyro.segments,
+                               chi2_reduced=plain(gyro.chi2_reduced), parameters=dict(zip(names, plain(parameters))),
+                               sigma=dict(zip(names, plain(sigma))))],
+        earth_rate="not taken out: a hand-held recording leaves the Earth's rate (up to 0.0042 °/s) in the bias",
+        gauge="the accelerometer's calibrated frame (its norm-only gauge): the turns between still intervals define "
+              "K relative to the gravity directions it measures; asymmetry, nonlinearity and g-sensitivity are not "
+              "determined (held at zero)",
+        metrics=plain({"residual_rms_before_deg": float(np.sqrt(np.mean(gyro.residual_before_deg ** 2))),
+                       "residual_rms_after_deg": float(np.sqrt(np.mean(gyro.residual_after_deg ** 2))),
+                       "segments": gyro.segments, "rank": gyro.rank, "condition": gyro.condition}),
+        warnings=list(gyro.notes))
 
 
 def fit_recording(recording: Recording, detection: Detection, free: FreeParameters, serial: str,
@@ -132,11 +172,14 @@ def fit_recording(recording: Recording, detection: Detection, free: FreeParamete
                                sigma=dict(zip(PARAMETER_NAMES, plain(fit.sigma))))],
         metrics=plain(metrics), warnings=warnings,
     )
+    channels: dict[str, SensorCalibration | GyroCalibration] = {ACCELERATION: calibration}
+    if gyro is not None:
+        channels[ANGULAR_RATE] = gyro_calibration(gyro, recording, serial, temperature, (low, high))
     calibration_file = CalibrationFile(
         format=FORMAT_NAME, format_version=FORMAT_VERSION, created=utc_now(), software_version=__version__,
         source={"recording": recording.source, "measurements_sha256": recording.sha256,
                 "procedure": "hand-held recording, norm-only"},
-        duts={serial: DutCalibration(channels={ACCELERATION: calibration})},
+        duts={serial: DutCalibration(channels=channels)},
     )
     report = plain({
         "source": recording.source, "rate_hz": detection.rate_hz, "samples": len(recording.t_s),

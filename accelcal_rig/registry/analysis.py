@@ -10,24 +10,39 @@ import numpy as np
 _SECONDS_PER_YEAR = 365.25 * 86400.0
 #: The reason of a PASS that no limits judged: not counted in a yield.
 UNJUDGED = "no acceptance limits stated"
+UNJUDGED_GYRO = "no gyroscope acceptance limits stated"
 #: A figure further than this from its lot's median, in robust z (0.6745 · deviation / MAD), is an outlier
 #: (Iglewicz & Hoaglin, "How to Detect and Handle Outliers", 1993).
 OUTLIER_Z = 3.5
+#: Each channel's bias column and its unit: an accelerometer's in mg, a gyroscope's in °/s.
+BIAS = {"accel": ("bias_mg", "mg"), "gyro": ("bias_dps", "dps")}
+#: Each channel's figures in a lot's statistics: (column, per axis).
+LOT_FIGURES = {"accel": (("bias_mg", True), ("scale_error_ppm", True), ("nonorthogonality_mrad", False)),
+               "gyro": (("bias_dps", True), ("scale_error_ppm", True), ("verification_rmse_dps", False),
+                        ("arw_deg_per_rthr", True), ("bias_instability_dph", True))}
 
 
-def trend(rows: list[dict[str, Any]]) -> dict[str, Any]:
-    """Bias and scale error at the reference temperature across one serial's calibrations, oldest first,
-    and their drift per year: a weighted straight line through them (weights from the stated uncertainties;
-    unweighted where a calibration states none)."""
-    rows = sorted(rows, key=lambda r: (r["calibrated_at"], r["id"]))
-    points = [{"id": r["id"], "calibrated_at": r["calibrated_at"].isoformat(), "verdict": r["verdict"],
-               "reference_c": r["reference_c"], "bias_mg": r["bias_mg"], "bias_uncertainty_mg": r["bias_uncertainty_mg"],
+def by_channel(rows: list[dict[str, Any]]) -> dict[str, list[dict[str, Any]]]:
+    """Rows of every channel split by channel, `accel` first (their order kept)."""
+    channels = sorted({r.get("channel") or "accel" for r in rows}, key=lambda c: (c != "accel", c))
+    return {c: [r for r in rows if (r.get("channel") or "accel") == c] for c in channels}
+
+
+def trend(rows: list[dict[str, Any]], channel: str = "accel") -> dict[str, Any]:
+    """Bias and scale error at the reference temperature across one serial's calibrations of one channel,
+    oldest first, and their drift per year: a weighted straight line through them (weights from the stated
+    uncertainties; unweighted where a calibration states none). An accelerometer's bias is in mg, a
+    gyroscope's in °/s (`bias_dps`, its drift `bias_drift_dps_per_year`)."""
+    bias, unit = BIAS.get(channel, BIAS["accel"])
+    rows = sorted((r for r in rows if (r.get("channel") or "accel") == channel), key=lambda r: (r["calibrated_at"], r["id"]))
+    points = [{"id": r["id"], "channel": channel, "calibrated_at": r["calibrated_at"].isoformat(), "verdict": r["verdict"],
+               "reference_c": r["reference_c"], bias: r[bias], f"bias_uncertainty_{unit}": r[f"bias_uncertainty_{unit}"],
                "scale_error_ppm": r["scale_error_ppm"], "scale_uncertainty_ppm": r["scale_uncertainty_ppm"]}
               for r in rows]
     years = np.array([(r["calibrated_at"] - rows[0]["calibrated_at"]).total_seconds() / _SECONDS_PER_YEAR
                       for r in rows]) if rows else np.array([])
     return {"calibrations": points,
-            "bias_drift_mg_per_year": _drift(years, rows, "bias_mg", "bias_uncertainty_mg"),
+            f"bias_drift_{unit}_per_year": _drift(years, rows, bias, f"bias_uncertainty_{unit}"),
             "scale_drift_ppm_per_year": _drift(years, rows, "scale_error_ppm", "scale_uncertainty_ppm")}
 
 
@@ -55,17 +70,21 @@ def _drift(years: np.ndarray, rows: list[dict[str, Any]], key: str,
     return result
 
 
-def lot_statistics(rows: list[dict[str, Any]]) -> dict[str, Any]:
-    """A part's lot: each serial's newest calibration; yield against the acceptance limits, the spread of
-    bias, scale error and non-orthogonality, and the serials whose figures stand out."""
+def lot_statistics(rows: list[dict[str, Any]], channel: str = "accel") -> dict[str, Any]:
+    """A part's lot, one channel of it: each serial's newest calibration; yield against the acceptance limits,
+    the spread of its figures (an accelerometer's bias, scale error and non-orthogonality; a gyroscope's bias,
+    scale error, verification RMS error and noise), and the serials whose figures stand out."""
     newest: dict[str, dict[str, Any]] = {}
     for row in sorted(rows, key=lambda r: (r["calibrated_at"], r["id"])):
-        newest[row["serial"]] = row
+        if (row.get("channel") or "accel") == channel:
+            newest[row["serial"]] = row
     latest = list(newest.values())
-    judged = [r for r in latest if r["verdict"] in ("PASS", "FAIL") and list(r["verdict_reasons"]) != [UNJUDGED]]
+    rows = [r for r in rows if (r.get("channel") or "accel") == channel]
+    judged = [r for r in latest if r["verdict"] in ("PASS", "FAIL")
+              and list(r["verdict_reasons"]) not in ([UNJUDGED], [UNJUDGED_GYRO])]
     passed = sum(r["verdict"] == "PASS" for r in judged)
-    figures = {"bias_mg": _per_axis(latest, "bias_mg"), "scale_error_ppm": _per_axis(latest, "scale_error_ppm"),
-               "nonorthogonality_mrad": _scalar(latest, "nonorthogonality_mrad")}
+    figures = {name: (_per_axis(latest, name) if per_axis else _scalar(latest, name))
+               for name, per_axis in LOT_FIGURES.get(channel, LOT_FIGURES["accel"])}
     return {
         "sensors": len(latest), "calibrations": len(rows), "judged": len(judged), "passed": passed,
         "yield": passed / len(judged) if judged else None,

@@ -128,8 +128,10 @@ class Registry:
 
     # ------------------------------------------------------------------ reading
     def calibrations(self, serial: str | None = None, part: str | None = None, since: datetime | None = None,
-                     verdict: str | None = None, limit: int | None = None) -> list[dict[str, Any]]:
-        """Rows, newest calibration first, filtered as given; without the stored fit (`calibration(id)` has it:
+                     verdict: str | None = None, limit: int | None = None,
+                     channel: str | None = None) -> list[dict[str, Any]]:
+        """Rows, newest calibration first, filtered as given (`channel`: only that channel's, else every
+        channel's, each row saying which); without the stored fit (`calibration(id)` has it:
         a lot of thousands of sensors is listed without reading thousands of fits)."""
         listed = [column for column in calibrations.columns if column.name != "calibration"]
         query = sa.select(*listed).order_by(calibrations.c.calibrated_at.desc(), calibrations.c.id.desc())
@@ -141,6 +143,8 @@ class Registry:
             query = query.where(calibrations.c.calibrated_at >= since)
         if verdict is not None:
             query = query.where(calibrations.c.verdict == verdict)
+        if channel is not None:
+            query = query.where(calibrations.c.channel == channel)
         if limit is not None:
             query = query.limit(limit)
         with self.engine.connect() as connection:
@@ -154,11 +158,19 @@ class Registry:
             raise ConfigError(f"registry {described(self.url)}: no calibration {row_id}")
         return dict(row._mapping)
 
-    def current(self, serial: str, simulated: bool = False) -> dict[str, Any] | None:
-        """The valid calibration of a serial: its newest measured, unless that failed its acceptance limits
-        (then none is valid: the sensor is out of tolerance now). Dry runs count only when asked."""
-        rows = [r for r in self.calibrations(serial=serial) if simulated or not r["simulated"]]
+    def current(self, serial: str, simulated: bool = False, channel: str = "accel") -> dict[str, Any] | None:
+        """The valid calibration of a serial's channel: its newest measured, unless that failed its acceptance
+        limits (then none is valid: the sensor is out of tolerance now). Dry runs count only when asked."""
+        rows = [r for r in self.calibrations(serial=serial, channel=channel) if simulated or not r["simulated"]]
         return rows[0] if rows and rows[0]["verdict"] != "FAIL" else None
+
+    def channels(self, serial: str | None = None) -> list[str]:
+        """Every channel with a calibration recorded (of one serial, if given): `accel` first."""
+        query = sa.select(calibrations.c.channel).distinct()
+        if serial is not None:
+            query = query.where(calibrations.c.serial == serial)
+        with self.engine.connect() as connection:
+            return sorted(connection.execute(query).scalars(), key=lambda c: (c != "accel", c))
 
     def parts(self) -> list[str]:
         """Every part with a calibration recorded."""

@@ -16,10 +16,11 @@ from accelcal_rig.fit.calibration import (
     ACCELERATION,
     FORMAT_VERSION,
     CalibrationFile,
+    GyroCalibration,
     SensorCalibration,
     load_calibration,
 )
-from accelcal_rig.registry.figures import reference_figures
+from accelcal_rig.registry.figures import channel_figures
 from accelcal_rig.store.content import measurements_sha256
 from accelcal_rig.store.read import load_campaign
 
@@ -36,8 +37,8 @@ def file_sha256(path: Path) -> str:
 
 
 def campaign_entries(campaign_path: Path, calibration_path: Path | None = None) -> list[dict[str, Any]]:
-    """One entry per DUT of a campaign file and its calibration (by default the one `rig run`/`rig fit`
-    writes beside it, FILE.calibration.yaml)."""
+    """One entry per calibrated channel of each DUT of a campaign file and its calibration (by default the one
+    `rig run`/`rig fit` writes beside it, FILE.calibration.yaml): an IMU's accelerometer and its gyroscope."""
     calibration_path = calibration_path or campaign_path.with_suffix(".calibration.yaml")
     if not calibration_path.is_file():
         raise ConfigError(f"{campaign_path}: no calibration beside it ({calibration_path.name}): fit it first "
@@ -54,7 +55,8 @@ def campaign_entries(campaign_path: Path, calibration_path: Path | None = None) 
               "procedure": str(campaign.attrs.get("procedure_name", "")), "rig": str(campaign.attrs.get("rig_name", "")),
               "simulated": bool(campaign.attrs.get("dry_run", False)),
               "measured": campaign.finished or campaign.header.created}
-    return [_entry(calibration, sensor, parts.get(serial, "unknown"), source) for serial, sensor in calibration.sensors.items()]
+    return [_entry(calibration, channel, sensor, parts.get(serial, "unknown"), source)
+            for serial, dut in calibration.duts.items() for channel, sensor in dut.channels.items()]
 
 
 def recording_entries(recording_path: Path, calibration: CalibrationFile, part: str) -> list[dict[str, Any]]:
@@ -62,18 +64,19 @@ def recording_entries(recording_path: Path, calibration: CalibrationFile, part: 
     measured = datetime.fromtimestamp(recording_path.stat().st_mtime, UTC).isoformat()  # when it was recorded
     source = {"kind": "recording", "path": str(recording_path.resolve()), "sha256": file_sha256(recording_path),
               "procedure": "hand-held", "rig": "hand-held", "simulated": False, "measured": measured}
-    return [_entry(calibration, sensor, part, source) for sensor in calibration.sensors.values()]
+    return [_entry(calibration, ACCELERATION, sensor, part, source) for sensor in calibration.sensors.values()]
 
 
-def _entry(calibration: CalibrationFile, sensor: SensorCalibration, part: str, source: dict[str, Any]) -> dict[str, Any]:
+def _entry(calibration: CalibrationFile, channel: str, sensor: SensorCalibration | GyroCalibration, part: str,
+           source: dict[str, Any]) -> dict[str, Any]:
     stored = {"file": {"format": calibration.format, "format_version": calibration.format_version,
                        "model": calibration.model, "created": calibration.created,
                        "software_version": calibration.software_version, "source": calibration.source},
               "sensor": json.loads(sensor.model_dump_json())}
     verification = sensor.metrics.get("verification") if isinstance(sensor.metrics.get("verification"), dict) else {}
-    rmse = verification.get("rmse_mg") if verification else None
+    rmse = verification.get("rmse_mg") if verification and channel == ACCELERATION else None
     return {
-        "serial": sensor.serial, "channel": ACCELERATION, "part": part, "source_kind": source["kind"],
+        "serial": sensor.serial, "channel": channel, "part": part, "source_kind": source["kind"],
         "source_path": source["path"],
         "source_sha256": source["sha256"],
         "fit_sha256": hashlib.sha256(json.dumps(stored["sensor"], sort_keys=True).encode()).hexdigest(),
@@ -83,7 +86,7 @@ def _entry(calibration: CalibrationFile, sensor: SensorCalibration, part: str, s
         "valid_from_c": float(sensor.validity_c[0]), "valid_to_c": float(sensor.validity_c[1]),
         "verdict": sensor.verdict, "verdict_reasons": list(sensor.verdict_reasons),
         "verification_rmse_mg": float(rmse) if rmse is not None else None,
-        "calibration": stored, **reference_figures(stored),
+        "calibration": stored, **channel_figures(stored, channel),
     }
 
 

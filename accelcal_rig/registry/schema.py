@@ -1,7 +1,8 @@
 """The registry's tables as the current migration leaves them (accelcal_rig/registry/migrations): one row
-per calibration of one DUT. What identifies a calibration is its source file's SHA-256, the DUT's serial
-and the fit's own digest: registering the same file again adds nothing; a refit of it with other options
-is another calibration."""
+per calibration of one channel of one DUT (an IMU's accelerometer and gyroscope are two rows). What
+identifies a calibration is its source file's SHA-256, the DUT's serial and the fit's own digest (each
+channel's fit its own): registering the same file again adds nothing; a refit of it with other options is
+another calibration."""
 
 from __future__ import annotations
 
@@ -41,6 +42,16 @@ calibrations = sa.Table(
     sa.Column("nonorthogonality_mrad", sa.Float, nullable=True),            # the largest of the three
     # Added by migration 0003: which channel of its DUT the calibration is.
     sa.Column("channel", sa.String(16), nullable=False, server_default="accel"),
+    # Added by migration 0004: a gyroscope's figures (°/s; its scale error is in scale_error_ppm) and each
+    # channel's noise from the campaign's still record (Allan deviation), per axis.
+    sa.Column("bias_dps", sa.JSON, nullable=True),                          # [x, y, z]
+    sa.Column("bias_uncertainty_dps", sa.JSON, nullable=True),              # [x, y, z], k = 2, at rest
+    sa.Column("expanded_uncertainty_dps", sa.JSON, nullable=True),          # [x, y, z], k = 2, at the largest rate
+    sa.Column("verification_rmse_dps", sa.Float, nullable=True),
+    sa.Column("arw_deg_per_rthr", sa.JSON, nullable=True),                  # [x, y, z]
+    sa.Column("bias_instability_dph", sa.JSON, nullable=True),              # [x, y, z]
+    sa.Column("vrw_m_s_per_rthr", sa.JSON, nullable=True),                  # [x, y, z]
+    sa.Column("bias_instability_ug", sa.JSON, nullable=True),               # [x, y, z]
     sa.Index("calibrations_serial_channel", "serial", "channel"),
     sa.UniqueConstraint("source_sha256", "serial", "fit_sha256", name="one_calibration_per_fit"),
 )

@@ -2,8 +2,9 @@
 `certificate` extra) its PDF, from a campaign file and the calibration fitted to it.
 
 A certificate states only what the two files hold: the item and its identity as read at preflight, the
-campaign and its instruments, the calibration, its verification, its uncertainty budget and its verdict;
-fields for the signatures of who performed and who approved it. A dry run's certificate says on every
+campaign and its instruments, the calibration, its verification, its uncertainty budget and its verdict (an
+IMU's both sensors: the gyroscope's, and the noise of each, in certificate_gyro.py); fields for the signatures
+of who performed and who approved it. A dry run's certificate says on every
 page that no physical sensor was calibrated; a partial campaign's says it was partial.
 """
 
@@ -22,7 +23,8 @@ from accelcal_rig import __version__
 from accelcal_rig.core.units import gravity_statement
 from accelcal_rig.durable import write_atomically, write_text_atomically
 from accelcal_rig.errors import ConfigError, RigError
-from accelcal_rig.fit.calibration import CalibrationFile, SensorCalibration, load_calibration
+from accelcal_rig.fit.calibration import CalibrationFile, GyroCalibration, SensorCalibration, load_calibration
+from accelcal_rig.report import certificate_gyro
 from accelcal_rig.store.content import Campaign, measurements_sha256
 from accelcal_rig.store.read import dut_description, usable_campaign
 from accelcal_rig.store.records import utc_now
@@ -68,7 +70,9 @@ def write_certificates(campaign_path: Path, calibration_path: Path, folder: Path
     if calibration.source.get("measurements_sha256") != measurements_sha256(campaign):
         raise ConfigError(f"{calibration_path}: fitted to other measurements than {campaign_path} holds now: fit it "
                           "again (rig fit) before certifying")
-    old = [s for s, c in calibration.sensors.items() if "uncertainty_budget" not in c.metrics or c.verdict is None]
+    judged: list[tuple[str, SensorCalibration | GyroCalibration]] = [*calibration.sensors.items(),
+                                                                     *calibration.gyroscopes.items()]
+    old = [s for s, c in judged if "uncertainty_budget" not in c.metrics or c.verdict is None]
     if old:
         raise ConfigError(f"{calibration_path}: sensor {old[0]} has no uncertainty budget or verdict (written by an "
                           "earlier accelcal-rig): fit it again (rig fit) before certifying")
@@ -138,12 +142,16 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
     if calibration.source.get("partial"):
         banners.append(f"PARTIAL: {calibration.source['partial']}.")
     uncalibrated = calibration.duts[serial].not_calibrated if serial in calibration.duts else {}
-    banners += [f"NOT CALIBRATED: its {channel} channel ({why}). This certificate covers its accel channel only."
+    gyro = calibration.gyroscopes.get(serial)
+    covered = "accel and gyro channels" if gyro is not None else "accel channel"
+    banners += [f"NOT CALIBRATED: its {channel} channel ({why}). This certificate covers its {covered} only."
                 for channel, why in uncalibrated.items()]
-    style = STYLE + (DRY_RUN_PAGES if attrs.get("dry_run") else "")
+    style = STYLE + (DRY_RUN_PAGES if attrs.get("dry_run") else "") + (GYRO_STYLE if gyro is not None else "")
+    item = ("MEMS IMU: accelerometer and gyroscope" if gyro is not None
+            else f"MEMS accelerometer{' channel' if uncalibrated else ''}")
     parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Calibration certificate {_e(number)}"
              f"</title><style>{style}</style></head><body>",
-             f"<h1>Calibration certificate: MEMS accelerometer{' channel' if uncalibrated else ''}</h1>",
+             f"<h1>Calibration certificate: {item}</h1>",
              f"<p>Certificate <b class='number'>{_e(number)}</b> — issued {_e(utc_now())} by accelcal-rig "
              f"{_e(__version__)}</p>",
              *(f"<div class='banner'>{_e(b)}</div>" for b in banners)]
@@ -171,13 +179,17 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
         ("gravity", gravity_statement(float(metrics.get("gravity_m_s2", 9.80665)))),
         ("performed by", operator or "—"),
     ])]
-    parts += ["<section>", "<h2>Results</h2>", _results(sensor), "</section>"]
-    parts += ["<section>", "<h2>Verification (poses the calibration never saw)</h2>", _verification(metrics), "</section>"]
-    parts += ["<section>", "<h2>Uncertainty of a compensated reading</h2>", _uncertainty(metrics), "</section>"]
-    verdict = sensor.verdict or "NOT JUDGED"
-    reasons = "".join(f"<li>{_e(r)}</li>" for r in sensor.verdict_reasons)
-    parts += ["<section><h2>Verdict against the procedure's acceptance limits</h2>",
-              f"<p><span class='verdict {_e(verdict)}'>{_e(verdict)}</span></p><ul>{reasons}</ul></section>"]
+    accel = " (accelerometer)" if gyro is not None else ""
+    parts += ["<section>", f"<h2>Results{accel}</h2>", _results(sensor), "</section>"]
+    parts += ["<section>", f"<h2>Verification{accel} (poses the calibration never saw)</h2>", _verification(metrics),
+              "</section>"]
+    parts += ["<section>", f"<h2>Uncertainty of a compensated reading{accel}</h2>", _uncertainty(metrics), "</section>"]
+    if gyro is not None:
+        parts += _gyro_sections(gyro)
+    noise = certificate_gyro.noise(sensor, gyro)
+    if noise:
+        parts += ["<section>", "<h2>Noise (Allan deviation)</h2>", noise, "</section>"]
+    parts += _verdict_section(sensor, gyro)
     parts += ["<section><h2>Signatures</h2>",
               "<table class='signatures'><tr><th class='text'></th><th class='text'>name</th><th class='text'>date"
               "</th><th class='text'>signature</th></tr>"
@@ -188,6 +200,38 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
               f"it the calibration {'is clamped to its edge' if sensor.out_of_range == 'clamp' else 'extrapolates'}."
               "</p></body></html>"]
     return "\n".join(parts)
+
+
+#: An IMU's certificate states two sensors on at most two pages: its tables a little tighter.
+GYRO_STYLE = """
+body { font-size: 7.5pt; } h1 { font-size: 13pt; } h2 { font-size: 9.5pt; margin: 2.5mm 0 0.8mm 0; }
+th, td { padding: 0.3pt 3pt; } p { margin: 0.8mm 0; } ul { margin: 0.5mm 0; } .signatures td { height: 10mm; }
+"""
+
+
+def _gyro_sections(gyro: GyroCalibration) -> list[str]:
+    """The gyroscope's results, verification, uncertainty and the statements of how it was referenced."""
+    return ["<section>", "<h2>Results (gyroscope)</h2>", certificate_gyro.gyro_results(gyro),
+            certificate_gyro.gyro_statements(gyro), "</section>",
+            "<section>", "<h2>Verification (gyroscope: rate steps the calibration never saw)</h2>",
+            certificate_gyro.gyro_verification(gyro), "</section>",
+            "<section>", "<h2>Uncertainty of a compensated rate (gyroscope)</h2>", certificate_gyro.gyro_uncertainty(gyro),
+            "</section>"]
+
+
+def _verdict_section(sensor: SensorCalibration, gyro: GyroCalibration | None) -> list[str]:
+    """The DUT's verdict (an IMU's: FAIL when either sensor fails), and each sensor's with its reasons."""
+    verdict = certificate_gyro.overall_verdict(sensor, gyro) if gyro is not None else sensor.verdict or "NOT JUDGED"
+    judged: list[tuple[str, SensorCalibration | GyroCalibration]] = (
+        [("", sensor)] if gyro is None else [("accelerometer", sensor), ("gyroscope", gyro)])
+    lists = []
+    for label, calibration in judged:
+        reasons = "".join(f"<li>{_e(r)}</li>" for r in calibration.verdict_reasons)
+        head = f"<p>{_e(label)}: <b class='{_e(calibration.verdict or '')}'>{_e(calibration.verdict or 'NOT JUDGED')}" \
+               "</b></p>" if label else ""
+        lists.append(f"{head}<ul>{reasons}</ul>")
+    return ["<section><h2>Verdict against the procedure's acceptance limits</h2>",
+            f"<p><span class='verdict {_e(verdict)}'>{_e(verdict)}</span></p>{''.join(lists)}</section>"]
 
 
 def _identity(campaign: Campaign, serial: str) -> str:

@@ -295,3 +295,91 @@ def soak_traces(data: CampaignData, band_c: float, path: Path) -> Path:
                      "over the window)", fontsize=10)
     figure.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=[top, bottom], label="setpoint (°C)", shrink=0.6)
     return save(figure, path)
+
+
+def gyro_parameters(data: CampaignData, path: Path) -> Path:
+    """Each calibrated gyroscope's scale error (ppm) and bias (°/s) per axis over temperature: each setpoint's
+    estimate ±1σ and the polynomial through them."""
+    plt = pyplot()
+    figure, axes = plt.subplots(2, 3, figsize=(13, 7), sharex=True, squeeze=False)
+    colours = plt.get_cmap("tab10")
+    for index, (serial, gyro) in enumerate(data.gyros.items()):
+        colour = colours(index % 10)
+        low, high = gyro.validity_c
+        curve_t = np.linspace(low, high, 100)
+        curve = gyro.polynomial.at(curve_t)
+        names = list(gyro.polynomial.NAMES)
+        setpoints_t = np.array([s.temperature_c for s in gyro.setpoints])
+        for column, axis in enumerate("xyz"):
+            for row, (name, factor, offset) in enumerate(((f"scale_{axis}", 1e6, -1.0), (f"bias_{axis}_dps", 1.0, 0.0))):
+                k = names.index(name)
+                ax = axes[row, column]
+                ax.plot(curve_t, (curve[:, k] + offset) * factor, color=colour, lw=1.2,
+                        label=serial if (row, column) == (0, 0) else None)
+                values = np.array([(s.parameters[name] + offset) * factor for s in gyro.setpoints])
+                sigmas = np.array([(s.sigma.get(name) or 0.0) * factor for s in gyro.setpoints])
+                ax.errorbar(setpoints_t, values, yerr=sigmas, fmt="o", ms=4, color=colour, capsize=3)
+    for column, axis in enumerate("xyz"):
+        axes[0, column].set_title(f"gyro {axis}")
+        axes[0, column].set_ylabel(f"scale error {axis} (ppm)")
+        axes[1, column].set_ylabel(f"bias {axis} (°/s)")
+        axes[1, column].set_xlabel("sensor temperature (°C)")
+        for row in range(2):
+            axes[row, column].grid(alpha=0.3)
+    if data.gyros:
+        axes[0, 0].legend(fontsize=8)
+    figure.suptitle("Gyroscope scale error and bias over temperature: each setpoint's fit (±1σ) and the polynomial")
+    figure.tight_layout()
+    return save(figure, path)
+
+
+#: σ(τ) of flicker noise of bias instability B on its flat part, as a factor of B (fit/allan.py).
+_FLICKER_FLOOR = float(np.sqrt(2.0 * np.log(2.0) / np.pi))
+#: Per channel: (panel title, unit shown, factor from the data's unit, random walk key and its factor to the
+#: data's unit per √Hz, bias instability key and its factor to the data's unit).
+_ALLAN_PANELS = {
+    "gyro": ("gyroscope", "°/h", 3600.0, "arw_deg_per_rthr", 1 / 60.0, "bias_instability_dph", 1 / 3600.0),
+    "accel": ("accelerometer", "µg", 1e6, "vrw_m_s_per_rthr", 1 / (60.0 * 9.80665), "bias_instability_ug", 1e-6),
+}
+
+
+def allan(data: CampaignData, path: Path) -> Path:
+    """The overlapping Allan deviation of each DUT's still record per axis, log-log, both sensors; the fitted
+    random walk marked where it is read off (σ(1 s) = N on the −½ slope, dashed) and the bias instability at its
+    averaging time (0.664·B, a triangle)."""
+    plt = pyplot()
+    channels = [c for c in ("gyro", "accel") if any(n.channel == c for curves in data.noise.values() for n in curves)]
+    figure, axes = plt.subplots(1, max(len(channels), 1), figsize=(7 * max(len(channels), 1), 5.5), squeeze=False)
+    colours = plt.get_cmap("tab10")
+    styles = ("-", "--", ":")
+    for column, channel in enumerate(channels):
+        title, unit, factor, walk, walk_factor, instability, instability_factor = _ALLAN_PANELS[channel]
+        ax = axes[0, column]
+        for index, (serial, records) in enumerate(data.noise.items()):
+            colour = colours(index % 10)
+            for record in records:
+                if record.channel != channel:
+                    continue
+                for k, (axis, curve) in enumerate(zip("xyz", record.curves)):
+                    ax.loglog(curve.tau_s, curve.deviation * factor, styles[k], color=colour, lw=1.0,
+                              label=f"{serial} {axis}")
+                    walks = record.figures.get(walk)
+                    if isinstance(walks, list) and k < len(walks):
+                        n = walks[k]["value"] * walk_factor
+                        tau = curve.tau_s[[0, -1]]
+                        ax.loglog(tau, n / np.sqrt(tau) * factor, color=colour, lw=0.6, alpha=0.5, ls=(0, (4, 3)))
+                        ax.plot([1.0], [n * factor], "o", color=colour, ms=4)
+                    bis = record.figures.get(instability)
+                    if isinstance(bis, list) and k < len(bis) and bis[k]["value"] > 0:
+                        ax.plot([bis[k]["tau_s"]], [_FLICKER_FLOOR * bis[k]["value"] * instability_factor * factor], "^",
+                                color=colour, ms=6)
+        setpoint = next((r.setpoint_c for records in data.noise.values() for r in records), None)
+        ax.set_title(f"{title}: overlapping Allan deviation" + (f" at {setpoint:g} °C" if setpoint is not None else ""))
+        ax.set_xlabel("averaging time τ (s)")
+        ax.set_ylabel(f"σ(τ) ({unit})")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=6, ncol=2)
+    figure.suptitle("Allan deviation of the still record per axis: dots, the random walk N at τ = 1 s (dashed, N/√τ); "
+                    "triangles, 0.664 × the bias instability where it is read")
+    figure.tight_layout()
+    return save(figure, path)

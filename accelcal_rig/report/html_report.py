@@ -40,6 +40,8 @@ FIGURES = {
     "drift": "drift.png",
     "soaks": "soak_traces.png",
 }
+#: Drawn only where the campaign has them: a calibrated gyroscope, a still noise record.
+GYRO_FIGURES = {"gyro_parameters": "gyro_parameters.png", "allan": "allan_deviation.png"}
 
 
 def _e(value: object) -> str:
@@ -61,7 +63,8 @@ def _table(header: list[str], rows: Sequence[Sequence[object]], text_columns: in
 
 
 def _figure(name: str, caption: str) -> str:
-    return f'<figure><img src="figures/{FIGURES[name]}" alt="{_e(caption)}"><figcaption class="note">{_e(caption)}' \
+    file = FIGURES.get(name) or GYRO_FIGURES[name]
+    return f'<figure><img src="figures/{file}" alt="{_e(caption)}"><figcaption class="note">{_e(caption)}' \
            "</figcaption></figure>"
 
 
@@ -78,6 +81,10 @@ def write_report(campaign: Path, output: Path) -> Path:
     figures.parameters(data, folder / FIGURES["parameters"])
     figures.drift(data, folder / FIGURES["drift"])
     figures.soak_traces(data, data.soak_band_c, folder / FIGURES["soaks"])
+    if data.gyros:
+        figures.gyro_parameters(data, folder / GYRO_FIGURES["gyro_parameters"])
+    if data.noise:
+        figures.allan(data, folder / GYRO_FIGURES["allan"])
     page = output / "index.html"
     write_text_atomically(page, _page(data), "the report")
     return page
@@ -112,6 +119,15 @@ def _page(data: CampaignData) -> str:
               _figure("drift", "Zero-g offset per axis over temperature: the raw bias (top), and what the "
                                "compensation makes of the raw zero-g reading (bottom). Paper Fig. 11."),
               _drift_table(data)]
+    if data.gyros:
+        parts += _gyro_section(data)
+    if data.noise:
+        parts += ["<h2>Noise: Allan deviation</h2>",
+                  _figure("allan", "Overlapping Allan deviation of each DUT's still record per axis, log-log, both "
+                                   "sensors; dots: the fitted random walk N at τ = 1 s (the dashed line N/√τ through "
+                                   "it); triangles: 0.664 × the bias instability B at the averaging time it is read "
+                                   "at (none where B is zero)."),
+                  _noise_table(data)]
     parts += ["<h2>Soaks</h2>", _figure("soaks", "Temperature traces of every soak."), _soak_table(data)]
     if any(d.fit is not None and "truth_error" in d.fit.metrics for d in data.duts.values()):
         parts += ["<h2>Against the simulated truth</h2>", _truth_table(data)]
@@ -174,6 +190,61 @@ def _summary(data: CampaignData) -> list[str]:
             f"({_e(', '.join(_having(data, channel)))}): {_e(why)}; its raw codes are in the campaign file "
             f"(duts/&lt;serial&gt;/{_e(channel)}/).</p>" for channel, why in left]
     return out
+
+
+def _gyro_section(data: CampaignData) -> list[str]:
+    """The gyroscopes: rmse before and after, verification figures, expanded uncertainty and verdict per DUT, and
+    their scale error and bias over temperature."""
+    rows, classes = [], []
+    for serial, gyro in data.gyros.items():
+        m = gyro.metrics
+        v: dict = m["verification"] if isinstance(m.get("verification"), dict) else {}
+        budget = m.get("uncertainty_budget") or {}
+
+        def dps(value: object, digits: int = 4) -> str:
+            return "—" if value is None else f"{float(value):.{digits}f}"  # type: ignore[arg-type]
+
+        expanded = m.get("expanded_uncertainty_dps")
+        rows.append([serial, gyro.verdict or "—", "; ".join(gyro.verdict_reasons), dps(m.get("rmse_before_dps"), 3),
+                     dps(m.get("rmse_after_dps")), v.get("rate_steps", "—"), dps(v.get("rmse_dps")),
+                     dps(v.get("max_axis_error_dps")), dps(v.get("scale_error_ppm"), 0), dps(v.get("rest_error_dps")),
+                     " / ".join(f"{u:.4f}" for u in expanded) if expanded else "—",
+                     f"{float(budget['largest_rate_dps']):g}" if "largest_rate_dps" in budget else "—"])
+        classes.append("" if gyro.verdict == "PASS" else "warning")
+    earth = sorted({g.earth_rate for g in data.gyros.values()})
+    return ["<h2>Gyroscope calibration</h2>",
+            _table(["DUT", "verdict", "reasons", "rate RMS before (°/s)", "after, in-sample (°/s)",
+                    "verification rate steps", "verification RMS (°/s)", "largest axis error (°/s)",
+                    "scale error (ppm)", "error at rest (°/s)", "expanded uncertainty x/y/z (k = 2, °/s)",
+                    "at rate (°/s)"], rows, text_columns=3, row_classes=classes),
+            f"<p class='note'>From {_e(data.gyro_source)}. Rate RMS: every calibration rate step's axes against its "
+            "reference (the table's rate and the Earth's), raw and compensated; verification: the rate steps and poses "
+            "the fit never saw, compensated as the calibration file would; the expanded uncertainty is the "
+            "calibration's share at the largest calibrated rate about each axis, the worst over the range. Earth's "
+            f"rate: {_e('; '.join(earth))}.</p>",
+            "<h2>Gyroscope parameters over temperature</h2>",
+            _figure("gyro_parameters", "Each gyroscope's scale error and bias per axis fitted at each setpoint (±1σ) "
+                                       "and its polynomial over the sensor temperature.")]
+
+
+def _noise_table(data: CampaignData) -> str:
+    """Per DUT and channel: the random walk and bias instability per axis with their 68 % intervals."""
+    keys = {"gyro": (("arw_deg_per_rthr", "ARW (°/√h)", ".4f"), ("bias_instability_dph", "bias instability (°/h)", ".2f")),
+            "accel": (("vrw_m_s_per_rthr", "VRW (m/s/√h)", ".5f"), ("bias_instability_ug", "bias instability (µg)", ".1f"))}
+    rows = []
+    for serial, records in data.noise.items():
+        for record in records:
+            for key, label, spec in keys[record.channel]:
+                values = record.figures.get(key)
+                if isinstance(values, list):
+                    rows.append([serial, record.channel, label, f"{record.setpoint_c:g}",
+                                 *(f"{format(e['value'], spec)} [{format(e['low'], spec)}, {format(e['high'], spec)}]"
+                                   for e in values)])
+    if not rows:
+        return ""
+    return (_table(["DUT", "channel", "figure", "record at (°C)", "x", "y", "z"], rows, text_columns=3)
+            + "<p class='note'>Read off the Allan deviation by a non-negative fit of its white, flicker and random-walk "
+              "terms (docs/calibration.md, Noise); [68 % interval].</p>")
 
 
 def _having(data: CampaignData, channel: str) -> list[str]:

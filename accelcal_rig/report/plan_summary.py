@@ -144,6 +144,13 @@ def _verification_lines(prepared: PreparedCampaign) -> list[str]:
         judged += [f"{name} {getattr(p, name):g} at {p.at_c:g} °C" for name in
                    ("bias_mg", "scale_error_ppm", "nonorthogonality_mrad", "misalignment_mrad")
                    if getattr(p, name) is not None]
+    gyro = limits.gyro
+    if gyro is not None:
+        judged += [f"gyro {name} {getattr(gyro, name):g}" for name in gyro.verification_limits()]
+        if gyro.parameters is not None:
+            judged += [f"gyro {name} {getattr(gyro.parameters, name):g} at {gyro.parameters.at_c:g} °C" for name in
+                       ("bias_dps", "scale_error_ppm", "cross_axis_mrad", "gsens_dps_per_g")
+                       if getattr(gyro.parameters, name) is not None]
     lines.append("accept     " + ("; ".join(judged) if judged else "no limits: every DUT passes") +
                  ("" if limits.allow_partial else "; a partial campaign fails"))
     return lines

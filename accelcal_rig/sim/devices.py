@@ -186,6 +186,8 @@ class SimulationTruth:
         return {"gyro_polynomial_coefficients": dut.gyro_truth.coefficients,
                 "gyro_parameter_names": ",".join(GYRO_PARAMETER_NAMES),
                 "gyro_noise_dps_per_sample": self._lab.gyro_noise_dps(index, odr_hz),
+                "gyro_bias_instability_dph": 3600.0 * float(self._lab.bias_wander[index].sigma > 0)
+                * self._lab.gyro_bias_instability_dps,
                 "earth_rate_world_dps": np.asarray(self._lab.earth_rate_world_dps, dtype=float)}
 
     def block_truth(self, serial: str, block: SampleBlock) -> dict[str, np.ndarray]:

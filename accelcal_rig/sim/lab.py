@@ -22,6 +22,7 @@ from accelcal_rig.fit.sfem import distort
 from accelcal_rig.parts.part import Part
 from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.kinematics import TurntableKinematics
+from accelcal_rig.sim.bias_wander import BiasWander
 from accelcal_rig.sim.moisture import ChamberMoisture
 from accelcal_rig.sim.truth import DutTruth, fixture_parameters_at, gyro_truth_for_serial, truth_for_serial
 from accelcal_rig.sim.turntable_motion import TurntableMotion
@@ -77,6 +78,10 @@ class VirtualLab:
         #: A gyroscope's noise its own stream, so a six-axis part's acceleration draws are those of its accelerometer
         #: alone, and a rig without gyroscopes draws nothing more.
         self.gyro_rngs = [np.random.default_rng([seed, index, 2]) for index in range(len(rig.fixture.sensors))]
+        self.gyro_bias_instability_dps = sim.gyro_bias_instability_dph / 3600.0
+        #: Each gyroscope's bias wander (its bias instability), from a stream of its own.
+        self.bias_wander = [BiasWander(sim.gyro_bias_instability_dph / 3600.0, np.random.default_rng([seed, index, 3]))
+                            for index in range(len(rig.fixture.sensors))]
         self.chamber_noise_c = sim.chamber_noise_c
         self.controller_limits_c = sim.controller_limits_c
         self.kinematics = TurntableKinematics(rig.turntable.axes)
@@ -199,15 +204,16 @@ class VirtualLab:
     def dut_gyro_samples(self, index: int, t_start_s: float, n_samples: int, odr_hz: float,
                          range_dps: float) -> np.ndarray:
         """`n_samples` gyroscope codes (n, 3) of DUT `index` from `t_start_s` on: its hidden truth at its
-        temperature now applied to the true rate and the specific force it feels, white noise from its own
-        stream, its part's codes."""
+        temperature now applied to the true rate and the specific force it feels, white noise and the bias's
+        wander from streams of its own, its part's codes."""
         dut, instant = self.duts[index], self._instant()
         if dut.gyro_truth is None:
             raise ValueError(f"{dut.serial}: the {dut.part.label} has no gyroscope")
         parameters = dut.gyro_truth.parameters_at(float(instant.temperature_c[index]))
         reading = distort_rate(self.true_rate_dps(index), instant.gravity_g[index], parameters)
         noise = self.gyro_rngs[index].normal(0.0, self.gyro_noise_dps(index, odr_hz), (n_samples, 3))
-        return dut.part.channel("gyro").quantise(reading + noise, range_dps)
+        wander = self.bias_wander[index].at(t_start_s + np.arange(n_samples) / odr_hz)
+        return dut.part.channel("gyro").quantise(reading + noise + wander, range_dps)
 
     def _instant(self) -> _Instant:
         """Every DUT's truth at the clock's time, evaluated for the whole fixture at once: all its sensors are

@@ -125,18 +125,23 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
         rows = real or every  # a serial only dry runs know is shown as such, marked simulated
         result = trend(rows)
         points = result["calibrations"]
-        times = [(r["calibrated_at"] - rows[-1]["calibrated_at"]).total_seconds() / 86400.0 for r in reversed(rows)]
+        accel = [r for r in rows if r["channel"] == "accel"]  # the plot and trend are the accelerometer's
+        times = [(r["calibrated_at"] - accel[-1]["calibrated_at"]).total_seconds() / 86400.0 for r in reversed(accel)]
         plot = line_plot(times, {f"bias {axis}": [p["bias_mg"][k] for p in points] for k, axis in enumerate("xyz")},
                          "days since the first calibration", "bias at the reference temperature (mg)")
+        gyro = trend(rows, "gyro") if any(r["channel"] == "gyro" for r in rows) else None
         return page("serial.html", serial=serial, rows=every, current=reg.current(serial, simulated=not real),
-                    trend=result, plot=plot, only_simulated=not real)
+                    trend=result, plot=plot, only_simulated=not real, gyro_trend=gyro,
+                    gyro_current=reg.current(serial, simulated=not real, channel="gyro") if gyro else None)
 
     def part_page(request: Request) -> Response:
         part = request.path_params["part"]
         every = registry.get().calibrations(part=part)
         real = [r for r in every if not r["simulated"]]
         rows = real or every
-        return page("part.html", part=part, stats=lot_statistics(rows) if rows else None, only_simulated=not real)
+        gyro = [r for r in rows if r["channel"] == "gyro"]
+        return page("part.html", part=part, stats=lot_statistics(rows) if rows else None, only_simulated=not real,
+                    gyro_stats=lot_statistics(gyro, "gyro") if gyro else None)
 
     def serial_json(request: Request) -> Response:
         rows = registry.get().calibrations(serial=request.path_params["serial"])

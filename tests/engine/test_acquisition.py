@@ -23,8 +23,8 @@ class Dut:
     endpoint: str = "memory"
 
 
-def block(**codes: np.ndarray) -> SampleBlock:
-    return SampleBlock(codes, 0.0, 1.0, (25.0, 25.0))
+def block(duration_s: float = 1.0, **codes: np.ndarray) -> SampleBlock:
+    return SampleBlock(codes, 0.0, duration_s, (25.0, 25.0))
 
 
 def noisy(n: int = 20) -> np.ndarray:
@@ -36,10 +36,22 @@ def test_a_block_with_every_channel_moving_within_range_passes() -> None:
 
 
 def test_a_stuck_gyroscope_axis_is_named_with_its_channel() -> None:
+    """At ±250 °/s and 200 Hz the gyroscope's noise (2.8 mdps/√Hz) is 3 codes: one frozen axis has stopped."""
     gyro = noisy()
     gyro[:, 1] = 7
     with pytest.raises(TransientInstrumentError, match="samples of gyro axis y reads the same code"):
-        check_block(Dut(ICM42688P), block(accel=noisy(), gyro=gyro), {"accel": 2, "gyro": 2000})  # type: ignore[arg-type]
+        check_block(Dut(ICM42688P), block(0.1, accel=noisy(), gyro=gyro), {"accel": 2, "gyro": 250})  # type: ignore[arg-type]
+
+
+def test_a_channel_coarser_than_its_noise_is_stuck_only_when_every_axis_is() -> None:
+    """At ±2000 °/s (0.061 °/s a code) the same noise is 0.3 code: a still axis may hold one code a whole
+    block; every axis frozen at once is a sensor that stopped."""
+    gyro = noisy()
+    gyro[:, 1] = 7
+    check_block(Dut(ICM42688P), block(0.1, accel=noisy(), gyro=gyro), {"accel": 2, "gyro": 2000})  # type: ignore[arg-type]
+    gyro[:, :] = 7
+    with pytest.raises(TransientInstrumentError, match="samples of gyro axis x,y,z reads the same code"):
+        check_block(Dut(ICM42688P), block(0.1, accel=noisy(), gyro=gyro), {"accel": 2, "gyro": 2000})  # type: ignore[arg-type]
 
 
 def test_a_saturated_code_names_the_range_in_the_channels_unit() -> None:

@@ -25,7 +25,7 @@ def read_qgc_params(path: Path) -> dict[str, float]:
             continue
         vehicle, component, name, value, kind = line.split("\t")
         assert (vehicle, component) == ("1", "1"), line
-        integer = name == "TC_A_ENABLE" or name.endswith("_ID")
+        integer = name.endswith(("_ENABLE", "_ID"))
         assert int(kind) == (INT32 if integer else REAL32), line
         values[name] = float(value)
     return values

@@ -14,6 +14,7 @@ from scipy.spatial.transform import Rotation
 
 from accelcal_rig.cli import main
 from accelcal_rig.errors import ConfigError
+from accelcal_rig.fit.calibration import apply_gyro, load_calibration
 from accelcal_rig.fit.sfem import distort, norm_only_gauge
 from accelcal_rig.handheld.calibrate import fit_recording
 from accelcal_rig.handheld.gyro import EARTH_RATE_DPS, fit_handheld_gyro, still_gyro_bias
@@ -142,9 +143,15 @@ def test_the_command_reports_the_gyro_and_keeps_the_calibration_file(tmp_path: P
     np.testing.assert_allclose(gyro["scale"], np.diag(gyro["matrix"]))
     assert abs(gyro["scale"][0] - TRUE_MATRIX[0, 0]) < 3 * gyro["scale_sigma"][0]
     assert gyro["residual_rms_after_deg"] < gyro["residual_rms_before_deg"] / 10
-    # The calibration file holds the accelerometer alone, as before (the gyro channel is wired elsewhere).
-    with_gyro = (tmp_path / "cal.yaml").read_text()
-    assert "gyro" not in with_gyro and len(with_gyro.splitlines()) == len(without.splitlines())
+    # The calibration file holds the gyroscope as its DUT's gyro channel: bias and K as fitted, the rest of the
+    # rate-table model nominal and said to be undetermined; compensating with it is what the fit does.
+    assert "gyro" not in without
+    calibration = load_calibration(tmp_path / "cal.yaml").gyroscope("s")   # the recording names the sensor
+    assert calibration.mode == "hand-held" and len(calibration.free_parameters) == 12
+    raw = TRUE_MATRIX @ np.array([[10.0, -20.0, 30.0], [-200.0, 5.0, 90.0]]).T + TRUE_BIAS_DPS[:, None]
+    expected = (raw.T - np.array(gyro["bias_dps"])) @ np.linalg.inv(np.array(gyro["matrix"])).T
+    np.testing.assert_allclose(apply_gyro(calibration, raw.T, np.zeros((2, 3)), 25.0), expected, rtol=1e-9)
+    assert "not taken out" in calibration.earth_rate and "not determined" in calibration.gauge
     assert main([*argv, "--gyro-columns", GYRO_COLUMNS]) == 0
     out = capsys.readouterr().out
     assert "gyro: 15 moves between static intervals" in out and "Earth's rate" in out

@@ -50,9 +50,9 @@ def test_list_show_trend_stats_and_export(tmp_path: Path, capsys) -> None:
     assert shown.startswith("ADX355-A002 (adxl355): valid calibration") and "(SIMULATED: a dry run)" in shown
     assert "history (2):" in shown
     assert rig("registry", "trend", "ADX355-A002", "--json", "--simulated", "--registry", registry) == 0
-    assert len(json.loads(capsys.readouterr().out)["calibrations"]) == 2
+    assert len(json.loads(capsys.readouterr().out)["channels"]["accel"]["calibrations"]) == 2
     assert rig("registry", "stats", "--part", "adxl355", "--json", "--simulated", "--registry", registry) == 0
-    stats = json.loads(capsys.readouterr().out)
+    stats = json.loads(capsys.readouterr().out)["channels"]["accel"]
     assert stats["sensors"] == 4 and stats["calibrations"] == 8
     header = tmp_path / "accel.h"
     assert rig("registry", "export", "ADX355-A002", "--format", "c-header", "-o", header, "--registry", registry) == 2

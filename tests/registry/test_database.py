@@ -17,7 +17,7 @@ from accelcal_rig.registry.figures import reference_figures
 
 def test_first_use_creates_the_schema_at_its_current_version(registry_url: str) -> None:
     registry = Registry.open(registry_url)
-    assert registry.revision() == head_revision() == "0003"
+    assert registry.revision() == head_revision() == "0004"
     assert registry.count() == 0
     assert Registry.open(registry_url).revision() == head_revision()  # opening again changes nothing
 
@@ -108,7 +108,7 @@ def test_a_schema_newer_than_this_software_is_one_line(registry_url: str) -> Non
     registry = Registry.open(registry_url)
     with registry.engine.begin() as connection:
         connection.execute(sa.text("UPDATE alembic_version SET version_num = '0099'"))
-    with pytest.raises(ConfigError, match="schema 0099 is newer than this software's 0003: upgrade accelcal-rig"):
+    with pytest.raises(ConfigError, match="schema 0099 is newer than this software's 0004: upgrade accelcal-rig"):
         Registry.open(registry_url)
 
 
@@ -120,7 +120,7 @@ def test_readers_do_not_migrate_but_create_a_new_registry(registry_url: str) -> 
 
     with Registry.open(registry_url).engine.begin() as connection:
         connection.execute(sa.text("UPDATE alembic_version SET version_num = '0001'"))
-    with pytest.raises(ConfigError, match="schema 0001 is older than this software's 0003: a recording command"):
+    with pytest.raises(ConfigError, match="schema 0001 is older than this software's 0004: a recording command"):
         Registry.open(registry_url, upgrade=False)
 
 

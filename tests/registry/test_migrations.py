@@ -11,6 +11,8 @@ from accelcal_rig.registry.entries import campaign_entries
 from accelcal_rig.registry.figures import reference_figures
 from tests.registry.conftest import synthetic_entries
 
+_ADDED_BY_0004 = ("bias_dps", "bias_uncertainty_dps", "expanded_uncertainty_dps", "verification_rmse_dps",
+                  "arw_deg_per_rthr", "bias_instability_dph", "vrw_m_s_per_rthr", "bias_instability_ug")
 _ADDED_BY_0003 = ("channel",)
 _ADDED_BY_0002 = ("fitted_at", "reference_c", "bias_mg", "bias_uncertainty_mg", "scale_error_ppm", "scale_uncertainty_ppm",
                   "nonorthogonality_mrad")
@@ -21,7 +23,7 @@ def test_a_first_version_database_upgrades_with_its_records_and_their_figures(re
     registry = Registry(_engine_of(registry_url), registry_url)
     registry.upgrade("0001")
     assert registry.revision() == "0001"
-    version_1 = [{k: v for k, v in e.items() if k not in _ADDED_BY_0002 + _ADDED_BY_0003}
+    version_1 = [{k: v for k, v in e.items() if k not in _ADDED_BY_0002 + _ADDED_BY_0003 + _ADDED_BY_0004}
                  for e in [*campaign_entries(campaign, calibration),
                            *synthetic_entries(campaign_entries(campaign, calibration)[0], 3)]]
     table = sa.Table("calibrations", sa.MetaData(), autoload_with=registry.engine)
@@ -48,13 +50,14 @@ def test_a_second_version_database_upgrades_and_its_calibrations_are_acceleratio
     campaign, calibration = quick_campaign
     registry = Registry(_engine_of(registry_url), registry_url)
     registry.upgrade("0002")
-    version_2 = [{k: v for k, v in e.items() if k not in _ADDED_BY_0003} for e in campaign_entries(campaign, calibration)]
+    version_2 = [{k: v for k, v in e.items() if k not in _ADDED_BY_0003 + _ADDED_BY_0004}
+                 for e in campaign_entries(campaign, calibration)]
     table = sa.Table("calibrations", sa.MetaData(), autoload_with=registry.engine)
     assert "channel" not in {c.name for c in table.columns}
     with registry.engine.begin() as connection:
         connection.execute(table.insert(), version_2)
     upgraded = Registry.open(registry_url)
-    assert upgraded.revision() == head_revision() == "0003"
+    assert upgraded.revision() == head_revision() == "0004"
     rows = [upgraded.calibration(listed["id"]) for listed in upgraded.calibrations()]
     assert len(rows) == 4 and {row["channel"] for row in rows} == {"accel"}
     indexes = sa.inspect(upgraded.engine).get_indexes("calibrations")
