@@ -20,9 +20,10 @@ from accelcal_rig.parts.part import Channel
 
 
 def acquire_together(sensors: Sequence[Sensor], n_samples: int, clock: Clock,
-                     ranges: Mapping[str, float]) -> list[SampleBlock]:
+                     ranges: Mapping[str, float], may_saturate: frozenset[str] = frozenset()) -> list[SampleBlock]:
     """One gap-free block of `n_samples` from each sensor, over the same instants, each checked by the
-    data watchdog (a transient failure: the caller's retry takes a new block)."""
+    data watchdog (a transient failure: the caller's retry takes a new block); the channels named in
+    `may_saturate` are not judged saturated (an accelerometer on a turning table: no fit uses it there)."""
     capturing = [sensor for sensor in sensors
                  if 0 < n_samples <= sensor.capture_capacity_samples and isinstance(sensor, BlockCapturing)]
     if len(capturing) == len(sensors):
@@ -30,11 +31,12 @@ def acquire_together(sensors: Sequence[Sensor], n_samples: int, clock: Clock,
     else:
         blocks = clock.run_concurrently([partial(sensor.acquire, n_samples) for sensor in sensors])
     for sensor, block in zip(sensors, blocks):
-        check_block(sensor, block, ranges)
+        check_block(sensor, block, ranges, may_saturate)
     return blocks
 
 
-def check_block(sensor: Sensor, block: SampleBlock, ranges: Mapping[str, float]) -> None:
+def check_block(sensor: Sensor, block: SampleBlock, ranges: Mapping[str, float],
+                may_saturate: frozenset[str] = frozenset()) -> None:
     """Watchdog on the data, each channel of the part: an axis whose every sample is the same code has
     stopped where the part's noise moves it by a code or more; a channel whose noise is finer than its code
     (an ICM-42688-P's gyroscope at ±2000 °/s: 0.3 code) holds one code for a whole block now and then, so
@@ -52,7 +54,7 @@ def check_block(sensor: Sensor, block: SampleBlock, ranges: Mapping[str, float])
         if frozen and (len(frozen) == len(channel.axes) or _noise_codes(channel, block, ranges[channel.name]) >= 1.0):
             raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): data stuck: every one of "
                                            f"{len(codes)} samples of {named} {','.join(frozen)} reads the same code")
-        if np.any(codes >= channel.code_max) or np.any(codes <= channel.code_min):
+        if channel.name not in may_saturate and (np.any(codes >= channel.code_max) or np.any(codes <= channel.code_min)):
             raise TransientInstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): saturated at "
                                            f"±{ranges[channel.name]} {channel.unit} (a code at the end of the ADC range)")
 

@@ -29,6 +29,7 @@ from accelcal_rig.engine.audience import Audience, Reporter
 from accelcal_rig.engine.connection import ConnectedRig
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.frost_steps import frost_preflight, note_purge_left_on
+from accelcal_rig.engine.rate_steps import bring_rate_axes_to_rest
 from accelcal_rig.engine.resume import ResumePoint
 from accelcal_rig.engine.run_context import RunContext
 from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
@@ -259,6 +260,7 @@ class CampaignRunner:
         self._check_controller_limits(run)
         frost_preflight(run)
         events.info("preflight", f"turntable: {run.turntable.identify()} ({run.turntable.endpoint})")
+        bring_rate_axes_to_rest(run)
         acquisition = self.procedure.acquisition
         for sensor in run.sensors:
             identity = run.retrier.call(partial(_checked_identity, sensor))

@@ -99,6 +99,25 @@ def stop_turning(run: RunContext, axis: int, acceleration_dps2: float) -> None:
     run.table.rate_dps, run.table.turning_in, run.table.angles_deg = 0.0, None, None
 
 
+def bring_rate_axes_to_rest(run: RunContext) -> None:
+    """Before anything moves, every run: each axis the rig gives a rate mode read back, and one still turning
+    (a run that stopped mid-step whose safe state could not reach the table, a controller left turning by
+    hand) held until it is at rest, said in the event log. The run's bookkeeping starts from rest."""
+    turntable = run.turntable
+    if not isinstance(turntable, ConstantRateRotation):
+        return
+    for index, axis in enumerate(run.rig.turntable.axes):
+        if axis.max_acceleration_dps2 is None:
+            continue
+        rate = turntable.read_rate_deg_s(index)
+        if abs(rate) > RATE_FLOOR_DPS:
+            run.events.warning("preflight", f"turntable ({turntable.endpoint}) axis {axis.name} turning at {rate:g} °/s "
+                                            "before the run: brought to rest first")
+            run.table.rate_dps = rate
+            stop_turning(run, index, axis.max_acceleration_dps2)
+    run.table.rate_dps, run.table.turning_in = 0.0, None
+
+
 class StopRotationHandler:
     def run(self, step: StopRotation, run: RunContext) -> None:
         if run.table.rate_dps or run.table.turning_in is not None:

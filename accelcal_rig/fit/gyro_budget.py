@@ -5,10 +5,13 @@ the verification records' errors against the simulation truth fall inside the ex
 Sources: the fit (each setpoint's parameter covariance, carried through the thermal polynomials); the
 thermal model (each parameter's scatter about its polynomial beyond its setpoints' 1σ); the temperature (a
 reading's temperature uncertainty times the parameters' slope); the table's rate accuracy (± uniform, a
-common relative error of every rate); its position accuracy (± uniform per axis: the turning axis tilted,
-a cross-axis error); the Earth's rate where the rig config does not place it (± uniform, its size); the
-bias's wander between its measurement and its use (the noise record's bias instability at its flicker floor). A
-compensated reading's own noise is not in it: it is stated for the calibration, what averaging cannot remove.
+common relative error of every rate); its position accuracy (± uniform per axis: the turning axis tilted
+anew at each setpoint, a cross-axis error the polynomials average over the setpoints); the Earth's rate
+where the rig config does not place it (± uniform, its size); the bias's wander between its measurement and
+its use (the noise record's bias instability at its flicker floor). The thermal model's term is the scatter
+beyond what scatters the setpoints and has a source here (pointing, the bias's wander): nothing counts
+twice. A compensated reading's own noise is not in it: it is stated for the calibration, what averaging
+cannot remove.
 """
 
 from __future__ import annotations
@@ -60,11 +63,26 @@ def _slope_per_c(thermal: ThermalModel, temperature_c: np.ndarray) -> np.ndarray
     return np.moveaxis(np.polynomial.polynomial.polyval(x, derivative), 0, -1)
 
 
-def thermal_model_variance(thermal: ThermalModel, sigmas: np.ndarray) -> np.ndarray:
-    """(27,) each parameter's scatter about its polynomial beyond what its setpoints' 1σ explain, where that
-    scatter is evidently more than they explain (its χ² beyond the 99 % quantile, the rule the setpoint fits
-    widen by: a scatter within it is noise, and counting its excess anyway would only ever add); zero where
-    the polynomial interpolates (no degrees of freedom left: said by fit_thermal's warning)."""
+def between_setpoints_sigma(systematic: dict[str, Any]) -> np.ndarray:
+    """(27,) what makes each parameter's estimates scatter from setpoint to setpoint besides their fits' 1σ, and
+    has a source of its own in the budget: the table's pointing (each setpoint's moves tilt the axes anew) on
+    the cross-axis terms, the bias's wander on the bias. The thermal model's term is the scatter beyond these,
+    so nothing is counted twice."""
+    sigma = np.zeros(gyro_model.N_PARAMETERS)
+    sigma[gyro_model.CROSS] = systematic["cross"]
+    sigma[gyro_model.BIAS] = np.asarray(systematic.get("bias_instability_dps", np.zeros(3)), dtype=float)
+    return sigma
+
+
+def thermal_model_variance(thermal: ThermalModel, sigmas: np.ndarray,
+                           between: np.ndarray | None = None) -> np.ndarray:
+    """(27,) each parameter's scatter about its polynomial beyond what its setpoints' 1σ (and `between`: what
+    scatters them that the budget counts elsewhere) explain, where that scatter is evidently more (its χ²
+    beyond the 99 % quantile, the rule the setpoint fits widen by: a scatter within it is noise, and counting
+    its excess anyway would only ever add); zero where the polynomial interpolates (no degrees of freedom
+    left: said by fit_thermal's warning)."""
+    if between is not None:
+        sigmas = np.sqrt(sigmas**2 + between**2)
     n = len(thermal.residuals)
     dof = n - (min(thermal.degree, n - 1) + 1)
     if dof <= 0:
@@ -86,16 +104,20 @@ def sources_dps(true_dps: np.ndarray, force_g: np.ndarray, temperature_c: np.nda
     jacobian = rate_jacobian(true_dps, force_g, params)
     weights = polynomial_weights(thermal, setpoint_temperatures_c, sigmas, temperature_c)                # (m, P, K)
     fit_cov = np.einsum("mpk,kpq,mqk->mpq", weights, covariances, weights)
-    thermal_var = thermal_model_variance(thermal, sigmas)
+    thermal_var = thermal_model_variance(thermal, sigmas, between_setpoints_sigma(systematic))
     slope = _slope_per_c(thermal, temperature_c)
     magnitude = np.abs(true_dps)
-    across = np.sqrt(np.maximum(np.sum(true_dps**2, axis=1, keepdims=True) - true_dps**2, 0.0))
+    # Each setpoint's moves tilt the turning axis anew: its cross-axis estimates carry their own pointing
+    # error, which the polynomials average as they average the setpoints.
+    pointing = np.zeros(gyro_model.N_PARAMETERS)
+    pointing[gyro_model.CROSS] = systematic["cross"] ** 2
+    pointing_var = np.einsum("mpk,p->mp", weights**2, pointing)
     return {
         "fit": np.sqrt(np.einsum("mip,mpq,miq->mi", jacobian, fit_cov, jacobian)),
         "thermal model": np.sqrt(np.einsum("mip,p->mi", jacobian**2, thermal_var)),
         "temperature": np.abs(np.einsum("mip,mp->mi", jacobian, slope)) * temperature_u_c,
         "table rate": magnitude * systematic["scale"],
-        "table pointing": across * systematic["cross"],
+        "table pointing": np.sqrt(np.einsum("mip,mp->mi", jacobian**2, pointing_var)),
         "earth rate": np.full_like(magnitude, systematic["earth_dps"]),
         "bias instability": np.broadcast_to(np.asarray(systematic.get("bias_instability_dps", np.zeros(3)), dtype=float),
                                             magnitude.shape).copy(),

@@ -180,18 +180,26 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
     calibrating = records.rows(*CALIBRATION_KINDS)
     if not records.rows("rate").any():
         raise GyroDesignError(f"sensor {records.serial}: no rate steps stored, the gyroscope cannot be calibrated")
-    setpoints = np.array(list(dict.fromkeys(records.setpoint_c[calibrating].tolist())))
-    groups = [np.flatnonzero(calibrating & (records.setpoint_c == s)) for s in setpoints]
-    temperatures = np.array([records.temperature_c[g].mean() for g in groups])
-    fits = []
-    for setpoint, group in zip(setpoints, groups):
+    fits, kept, skipped = [], [], []
+    for setpoint in dict.fromkeys(records.setpoint_c[calibrating].tolist()):
+        group = np.flatnonzero(calibrating & (records.setpoint_c == setpoint))
         try:
             fits.append(fit_gyro_setpoint(records.mean_dps[group], records.stderr_dps[group],
                                           records.reference_dps[group], records.force_g[group]))
+            kept.append((setpoint, group))
         except (GyroDesignError, np.linalg.LinAlgError) as exc:
-            raise GyroDesignError(f"sensor {records.serial} gyroscope at {setpoint:g} °C: {exc}") from None
+            skipped.append(f"{setpoint:g} °C: {exc}")
+    if not fits:
+        raise GyroDesignError(f"sensor {records.serial} gyroscope: no setpoint's records determine it "
+                              f"({'; '.join(skipped)})")
+    setpoints = np.array([s for s, _ in kept])
+    groups = [g for _, g in kept]
+    temperatures = np.array([records.temperature_c[g].mean() for g in groups])
     estimates, sigmas = np.array([f.parameters for f in fits]), np.array([f.sigma for f in fits])
     thermal = fit_thermal(temperatures, estimates, sigmas, np.ones(gyro_model.N_PARAMETERS, dtype=bool), degree)
+    # A setpoint whose records do not determine the model (a campaign stopped in its rate steps) is left out,
+    # said so: the others still calibrate the gyroscope over their range.
+    thermal.warnings.extend(f"gyroscope setpoint left out: {why}" for why in skipped)
     metrics = _figures(records, thermal, out_of_range, calibrating)
     metrics["chi2_reduced"] = [f.chi2_reduced for f in fits]
     metrics["temperature_range_c"] = [float(temperatures.min()), float(temperatures.max())]
@@ -261,13 +269,23 @@ def _figures(records: GyroRecords, thermal: ThermalModel, out_of_range: OutOfRan
 
 
 def _scale_error_ppm(records: GyroRecords, compensated: np.ndarray, rows: np.ndarray) -> float | None:
-    """The largest relative error along the turning axis at the verification rates, ppm."""
+    """The largest scale error at the verification rates, ppm: of each pair of steps turned both ways at one
+    rate about one axis at one setpoint, the compensated difference along the turning axis over the
+    reference's (a bias left over cancels in it, as it would not in one step's ratio at a low rate)."""
     if not rows.any():
         return None
-    reference = records.reference_dps[rows]
-    along = np.argmax(np.abs(reference), axis=1)
-    index = np.arange(len(along))
-    return float(1e6 * np.max(np.abs(compensated[rows][index, along] / reference[index, along] - 1.0)))
+    index = np.flatnonzero(rows)
+    along = np.argmax(np.abs(records.reference_dps[index]), axis=1)
+    reference = records.reference_dps[index, along]
+    measured = compensated[index, along]
+    errors = []
+    for i in range(len(index)):
+        for j in range(len(index)):
+            if (reference[i] > 0 > reference[j] and along[i] == along[j]
+                    and records.setpoint_c[index[i]] == records.setpoint_c[index[j]]
+                    and abs(reference[i] + reference[j]) < 1e-3 * abs(reference[i])):
+                errors.append((measured[i] - measured[j]) / (reference[i] - reference[j]) - 1.0)
+    return float(1e6 * np.max(np.abs(errors))) if errors else None
 
 
 def _rms(values: np.ndarray) -> float | None:

@@ -18,6 +18,7 @@ from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.durable import read_regular_file
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.store.read import dut_description, rows_at_setpoint, usable_campaign
+from accelcal_rig.store.records import STATIC_KINDS
 
 #: The largest number a recording's CSV may hold, and the largest reading (in g, once scaled) and
 #: temperature range taken for a recording of an accelerometer turned by hand.
@@ -250,7 +251,9 @@ def read_campaign_recording(path: Path, serial: str | None, setpoint_c: float | 
     if serial not in serials:
         raise ConfigError(f"{path}: no sensor {serial} (the file has {', '.join(serials)})")
     setpoint_c, mask = rows_at_setpoint(path, campaign, setpoint_c)
-    rows = np.flatnonzero(mask)
+    # The poses at rest: a rate step's turning table adds a centripetal acceleration no static interval has.
+    rows = np.flatnonzero(mask & np.isin(campaign.pose_column("step_key"),
+                                         list(campaign.header.plan.keys_of(*STATIC_KINDS))))
     dut = dut_description(campaign, serial)
     lsb_g, odr_hz = float(dut["lsb_g"]), float(dut["odr_hz"])
     codes = campaign.dut_column(serial, "raw_codes")[rows]

@@ -14,7 +14,7 @@ import numpy as np
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rate_steps import RateSteps
 from accelcal_rig.config.rig import RigConfig
-from accelcal_rig.plan.kinematics import TurntableKinematics
+from accelcal_rig.plan.kinematics import TurntableKinematics, UnreachablePose
 from accelcal_rig.plan.steps import FIXTURE_AXES, NoiseBlock, Pose, RateStep, Step, StopRotation, VerifyRate
 
 
@@ -74,7 +74,11 @@ def rate_poses(rates: RateSteps, rig: RigConfig, start_deg: tuple[float, ...]) -
     for about in rates.about:
         up = np.zeros(3)
         up[FIXTURE_AXES.index(about)] = sign  # the rate axis along `about`: up is along it (or against it)
-        current = kinematics.solve(up, current)
+        try:
+            current = kinematics.solve(up, current)
+        except UnreachablePose as exc:
+            raise NoRateAxis(f"rates.about {about}: the fixture's {about} axis cannot be brought to the rate axis: "
+                             f"{exc}") from None
         poses[about] = Pose(FIXTURE_AXES.index(about) + 1, tuple(round(float(a), 9) + 0.0 for a in current),
                             (float(up[0]), float(up[1]), float(up[2])))
     return poses

@@ -96,7 +96,7 @@ class SimulatedTurntable:
 
 class SimulatedAccelerometer:
     """A DUT (of its rig config's part) whose samples come from its hidden truth, the table's true angles and
-    white noise."""
+    white noise: its accelerometer, and its gyroscope where the part has one (the test double's IMU)."""
 
     endpoint = ENDPOINT
     capture_capacity_samples = 0  # read one thread per DUT, as a host draining FIFOs would
@@ -107,6 +107,7 @@ class SimulatedAccelerometer:
         self.serial = lab.duts[index].serial
         self.part = lab.duts[index].part
         self._range_g: float = self.part.channel("accel").ranges[0]
+        self._ranges: dict[str, float] = {c.name: c.ranges[0] for c in self.part.channels}
         self._odr_hz = 125.0
         self._measuring = False
 
@@ -121,11 +122,13 @@ class SimulatedAccelerometer:
     def reset(self) -> None:
         self._measuring = False
         self._range_g, self._odr_hz = self.part.channel("accel").ranges[0], self.part.output_data_rates_hz[0]  # the reset state
+        self._ranges = {c.name: c.ranges[0] for c in self.part.channels}
 
     def configure(self, ranges: Mapping[str, float], odr_hz: float) -> None:
         if self._measuring:
             raise InstrumentError(f"sensor {self.serial}: range and filter can only change in standby")
         self._range_g = ranges["accel"]
+        self._ranges = {c.name: ranges[c.name] for c in self.part.channels}
         self._odr_hz = odr_hz
 
     def start_measurement(self) -> None:
@@ -135,7 +138,7 @@ class SimulatedAccelerometer:
         self._measuring = False
 
     def read_settings(self) -> tuple[dict[str, float], float]:
-        return {"accel": self._range_g}, self._odr_hz
+        return dict(self._ranges), self._odr_hz
 
     def read_temperature_c(self) -> float:
         return self._lab.dut_reading_c(self._index)
@@ -150,8 +153,11 @@ class SimulatedAccelerometer:
         temperature_before = self.read_temperature_c()
         t_start = clock.now()
         clock.sleep(n_samples / self._odr_hz)
-        codes = self._lab.dut_samples(self._index, t_start, n_samples, self._odr_hz, self._range_g)
-        return SampleBlock({"accel": codes}, t_start, t_start + (n_samples - 1) / self._odr_hz,
+        codes = {"accel": self._lab.dut_samples(self._index, t_start, n_samples, self._odr_hz, self._range_g)}
+        if "gyro" in self._ranges:  # the table's rate at the end of the block: a rate step holds it constant
+            codes["gyro"] = self._lab.dut_gyro_samples(self._index, t_start, n_samples, self._odr_hz,
+                                                       self._ranges["gyro"])
+        return SampleBlock(codes, t_start, t_start + (n_samples - 1) / self._odr_hz,
                            (temperature_before, self.read_temperature_c()))
 
     def close(self) -> None:

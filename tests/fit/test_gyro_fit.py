@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
+from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.config.acceptance import GyroAcceptance
 from accelcal_rig.engine.preparation import prepare
@@ -19,7 +20,9 @@ from accelcal_rig.fit.calibration import apply_gyro, load_calibration
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save
 from accelcal_rig.fit.gyro_acceptance import judge_gyro
 from accelcal_rig.fit.gyro_fit import fit_gyro, read_gyro_records, site_of
+from accelcal_rig.handheld.recording import read_campaign_recording
 from accelcal_rig.plan.steps import RateStep, StopRotation, VerifyRate
+from accelcal_rig.sim.devices import build_simulated_rig
 from accelcal_rig.store.read import load_campaign, read_dut_poses
 from tests.conftest import REPO
 
@@ -83,6 +86,15 @@ def test_the_accelerometer_fit_sees_only_the_poses_taken_at_rest(campaign_path: 
     assert {"rate", "verify-rate", "noise"} <= kinds                            # stored as written, whole
     poses = read_dut_poses(campaign, campaign.serials[0])
     assert len(poses.setpoint_c) == 3 * 24 + 2 * 6
+
+
+def test_the_analyses_and_hand_held_readers_take_the_poses_at_rest_only(campaign_path: Path) -> None:
+    """A rate step's turning table (centripetal acceleration) and a noise record are no static poses."""
+    setpoint, duts, numbers = poses_at_setpoint(campaign_path, 20.0)
+    assert setpoint == 20.0 and sorted(numbers.tolist()) == list(range(1, 25))
+    assert all(len(poses.setpoint_c) == 24 for poses in duts.values())
+    recording = read_campaign_recording(campaign_path, None, 20.0)
+    assert len(recording.t_s) == 24 * PROCEDURE["acquisition"]["samples_per_pose"]
 
 
 def test_every_gyroscope_reference_holds_the_table_and_the_earth(campaign_path: Path) -> None:
@@ -219,3 +231,28 @@ def test_the_budget_covers_the_truth_as_its_coverage_factor_says(fitted: tuple[P
                                                                  budget["at_rest"]["expanded_dps"]))
         assert dut["gyro"]["expanded_uncertainty_dps"] == budget["at_largest_rate"]["expanded_dps"]
         assert budget["at_largest_rate"]["sources_dps"]["earth rate"] == [0.0, 0.0, 0.0]   # placed: taken out
+
+
+def test_a_table_left_turning_is_brought_to_rest_before_anything_moves(tmp_path: Path) -> None:
+    """A run that finds the rate axis turning (a safe state that could not reach the table, a controller
+    left turning by hand) holds it first, and says so."""
+    turning: list[float] = []
+
+    def left_turning(rig, procedure, clock, seed):
+        instruments = build_simulated_rig(rig, procedure, clock, seed)
+        instruments.turntable.rotate_at(0, 300.0, 500.0)           # type: ignore[attr-defined]
+        clock.sleep(2.0)
+        turning.append(instruments.turntable.read_rate_deg_s(0))  # type: ignore[attr-defined]
+        return instruments
+
+    small = {**PROCEDURE, "setpoints_c": [20], "rates": {"rates_dps": [10]}, "noise": None, "verify": None,
+             "acceptance": {}, "fit": {"mode": "none"}, "schedule": {"kind": "six-position"}}
+    path = tmp_path / "small.yaml"
+    path.write_text(yaml.safe_dump({k: v for k, v in small.items() if v is not None}))
+    run_campaign(prepare(path), tmp_path / "c.h5", dry_run=True, seed=1, overwrite=False,
+                 build_instruments=left_turning)
+    campaign = load_campaign(tmp_path / "c.h5")
+    assert turning and abs(turning[0]) > 299
+    warned = [e.message for e in campaign.events if e.kind == "preflight" and "turning at" in e.message]
+    assert len(warned) == 1 and "brought to rest first" in warned[0]
+    assert campaign.state == "done" and {"rate", "pose"} <= set(campaign.header.plan.kind)
