@@ -12,11 +12,11 @@ def calibration_table(rows: list[dict[str, Any]]) -> list[str]:
     """`rig registry list`: a header and one line per calibration (a sentence when none match)."""
     if not rows:
         return ["no calibrations match"]
-    lines = [f"{'id':>6}  {'serial':<16} {'channel':<7} {'part':<8} {'calibrated (UTC)':<19} {'verdict':<7} "
+    lines = [f"{'id':>6}  {'serial':<16} {'channel':<7} {'part':<8} {'calibrated (UTC)':<19} {'verdict':<10} "
              f"{'valid °C':<15} {'procedure':<22} source"]
     for r in rows:
         lines.append(f"{r['id']:>6}  {r['serial']:<16} {_channel(r):<7} {r['part']:<8} {r['calibrated_at']:%Y-%m-%d %H:%M:%S} "
-                     f"{r['verdict'] or '—':<7} {r['valid_from_c']:>6.1f}…{r['valid_to_c']:<7.1f} {r['procedure'][:22]:<22} "
+                     f"{r['verdict'] or 'NOT JUDGED':<10} {r['valid_from_c']:>6.1f}…{r['valid_to_c']:<7.1f} {r['procedure'][:22]:<22} "
                      f"{Path(r['source_path']).name}{' (simulated)' if r['simulated'] else ''}")
     return lines
 
@@ -37,7 +37,7 @@ def sensor_lines(serial: str, current: dict[str, dict[str, Any] | None], rows: l
     lines.append(f"history ({len(rows)}):")
     for r in rows:
         bias = triple(r["bias_dps"], "°/s", digits=4) if _channel(r) == "gyro" else triple(r["bias_mg"], "mg")
-        lines.append(f"  {r['id']:>6}  {r['calibrated_at']:%Y-%m-%d %H:%M}  {r['verdict'] or '—':<4}  "
+        lines.append(f"  {r['id']:>6}  {r['calibrated_at']:%Y-%m-%d %H:%M}  {r['verdict'] or 'NOT JUDGED':<10}  "
                      + (f"{_channel(r):<5}  " if labelled else "")
                      + f"bias {bias}  {Path(r['source_path']).name}" + (" (simulated)" if r["simulated"] else ""))
     return lines
@@ -59,7 +59,7 @@ def _current_lines(serial: str, current: dict[str, Any] | None, rows: list[dict[
     return [f"{serial}{label} ({current['part']}): valid calibration {current['id']}{dry}, "
             f"measured {current['calibrated_at']:%Y-%m-%d} "
             f"by {current['procedure']} on {current['rig']}, {current['valid_from_c']:.1f}…{current['valid_to_c']:.1f} °C, "
-            f"verdict {current['verdict'] or 'none stated'}",
+            f"verdict {current['verdict'] or 'NOT JUDGED (no acceptance limits stated)'}",
             *figures,
             f"  source {current['source_path']} (SHA-256 {current['source_sha256'][:16]}…), software "
             f"{current['software_version']}"]

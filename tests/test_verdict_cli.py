@@ -89,3 +89,28 @@ def test_resuming_a_complete_rejected_campaign_again_still_fails_on_reject(write
     capsys.readouterr()
     assert main(["resume", str(campaign), "-q", "--fail-on-reject"]) == 3  # its calibration already judged it
     assert capsys.readouterr().out.count("  verdict    ") == 4
+
+
+def test_without_limits_nothing_is_judged_and_nothing_is_stated_as_conformity(write, workdir: Path, capsys) -> None:
+    """No acceptance limits, no specification: NOT JUDGED in the summary, `rig status`, `rig fit --json`, the
+    calibration file and the registry (no verdict, no yield); the certificate states no conformity."""
+    procedure = write("unlimited.yaml", VERIFIED.split("acceptance:")[0])
+    campaign, registry = workdir / "c.h5", workdir / "registry.sqlite"
+    assert main(["run", str(procedure), "--dry-run", "-o", str(campaign), "-q", "--fail-on-reject",
+                 "--registry", str(registry)]) == 0
+    out = capsys.readouterr().out
+    assert "4 NOT JUDGED (no acceptance limits stated)" in out and "PASS" not in out
+    assert main(["status", str(campaign), "--json"]) == 0
+    verdicts = json.loads(capsys.readouterr().out)["verdicts"]
+    assert {v["verdict"] for v in verdicts.values()} == {"NOT JUDGED"}
+    assert main(["fit", str(campaign), "-o", str(workdir / "cal.yaml"), "--json", "--registry", str(registry)]) == 0
+    assert {r["verdict"] for r in json.loads(capsys.readouterr().out).values()} == {"NOT JUDGED"}
+    assert {s.verdict for s in load_calibration(workdir / "cal.yaml").sensors.values()} == {"NOT JUDGED"}
+    page = next((workdir / "c.certificates").glob("*.html")).read_text(encoding="utf-8")
+    assert "Statement of conformity" in page and "class='verdict" not in page and "None: the procedure" in page
+    assert main(["registry", "list", "--registry", str(registry)]) == 0
+    listed = capsys.readouterr().out
+    assert listed.count("NOT JUDGED") == 4 and " PASS " not in listed
+    assert main(["registry", "stats", "--part", "adxl355", "--registry", str(registry), "--json", "--simulated"]) == 0
+    stats = json.loads(capsys.readouterr().out)["channels"]["accel"]
+    assert (stats["calibrations"], stats["judged"], stats["passed"], stats["yield"]) == (4, 0, 0, None)

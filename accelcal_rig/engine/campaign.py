@@ -234,7 +234,7 @@ class CampaignRunner:
         for warning in outcome.warnings:
             self.events.warning("fit", warning)
         for serial, (verdict, reasons) in outcome.verdicts.items():
-            log = self.events.info if verdict == "PASS" else self.events.warning
+            log = self.events.warning if verdict == "FAIL" else self.events.info
             log("verdict", f"{serial}: {verdict}: {'; '.join(reasons)}")
         return outcome
 

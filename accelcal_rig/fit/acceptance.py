@@ -1,5 +1,6 @@
 """The verdict on one DUT's calibration: PASS when it meets every acceptance limit the procedure states,
-FAIL with the reasons otherwise.
+FAIL with the reasons otherwise, NOT JUDGED when the procedure states none (no specification, no statement
+of conformity: the results and their uncertainties are all there is to say).
 
 Verification limits are judged on the verification poses only; parameter limits on the calibration at the
 limits' temperature; a campaign that stopped before its last pose fails unless the procedure allows it.
@@ -19,13 +20,16 @@ from accelcal_rig.config.yaml_lines import parse_yaml_text
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.thermal import ThermalModel
 
-Verdict = Literal["PASS", "FAIL"]
+Verdict = Literal["PASS", "FAIL", "NOT JUDGED"]
+#: The reason of a calibration that no limits judged.
+NO_LIMITS = "no acceptance limits stated"
+NOT_JUDGED: Verdict = "NOT JUDGED"
 
 
 @dataclass(frozen=True)
 class Judgement:
     verdict: Verdict
-    #: FAIL: every limit not met; PASS: every limit met (or that none was stated). One line each.
+    #: FAIL: every limit not met; PASS: every limit met; NOT JUDGED: that none was stated. One line each.
     reasons: list[str]
 
 
@@ -55,11 +59,12 @@ def judge(metrics: dict[str, Any], thermal: ThermalModel, mode: str, limits: Acc
             checks.append(_within(f"verification drift of {'xyz'[axis]}", float(drift[axis]), limits.max_drift_mg, "mg"))
     if limits.parameters is not None:
         checks.extend(_parameter_checks(thermal, mode, limits))
+    judged_any = bool(checks)
     if partial:
         checks.append((limits.allow_partial, f"{partial}" + (" (acceptance.allow_partial)" if limits.allow_partial
                                                             else ": a partial campaign fails")))
-    if not checks:
-        return Judgement("PASS", ["no acceptance limits stated"])
+    if not judged_any and all(ok for ok, _ in checks):  # no limit stated: no conformity to state
+        return Judgement(NOT_JUDGED, [NO_LIMITS, *(text for _, text in checks)])
     failed = [text for ok, text in checks if not ok]
     return Judgement("FAIL", failed) if failed else Judgement("PASS", [text for _, text in checks])
 

@@ -100,7 +100,8 @@ class SensorCalibration(StrictModel):
     setpoints: list[SetpointFit]
     metrics: dict[str, Any] = {}
     warnings: list[str] = []
-    verdict: Literal["PASS", "FAIL"] | None = Field(None, description="against the procedure's acceptance limits")
+    verdict: Literal["PASS", "FAIL", "NOT JUDGED"] | None = Field(None, description="against the procedure's "
+                                                                   "acceptance limits (NOT JUDGED: it states none)")
     verdict_reasons: list[str] = []
 
     def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:
@@ -138,7 +139,7 @@ class GyroCalibration(StrictModel):
     gauge: str = Field(max_length=500, description="the frame the sensitivity matrix is relative to")
     metrics: dict[str, Any] = {}
     warnings: list[str] = []
-    verdict: Literal["PASS", "FAIL"] | None = None
+    verdict: Literal["PASS", "FAIL", "NOT JUDGED"] | None = None
     verdict_reasons: list[str] = []
 
     def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:

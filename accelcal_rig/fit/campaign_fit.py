@@ -11,7 +11,7 @@ import numpy as np
 
 from accelcal_rig import __version__
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
-from accelcal_rig.fit.acceptance import Judgement, judge, recorded_acceptance
+from accelcal_rig.fit.acceptance import NOT_JUDGED, Judgement, Verdict, judge, recorded_acceptance
 from accelcal_rig.fit.approach import approach_directions, temperature_rates_c_per_min
 from accelcal_rig.fit.budget import (
     budget,
@@ -312,13 +312,16 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
 
 
 def dut_verdict(accelerometer: Judgement, gyroscope: Judgement | None) -> Judgement:
-    """A DUT's verdict: FAIL when either of its sensors fails; the gyroscope's reasons follow the
+    """A DUT's verdict: FAIL when either of its sensors fails, PASS when both pass, NOT JUDGED otherwise (a
+    sensor without limits: no statement of conformity for the DUT); the gyroscope's reasons follow the
     accelerometer's, each marked."""
     if gyroscope is None:
         return accelerometer
-    failed = "FAIL" in (accelerometer.verdict, gyroscope.verdict)
+    verdicts = (accelerometer.verdict, gyroscope.verdict)
+    failed = "FAIL" in verdicts
     pick = (lambda j: [r for r in j.reasons] if j.verdict == "FAIL" else []) if failed else (lambda j: list(j.reasons))
-    return Judgement("FAIL" if failed else "PASS", pick(accelerometer) + [f"gyro: {r}" for r in pick(gyroscope)])
+    verdict: Verdict = "FAIL" if failed else "PASS" if verdicts == ("PASS", "PASS") else NOT_JUDGED
+    return Judgement(verdict, pick(accelerometer) + [f"gyro: {r}" for r in pick(gyroscope)])
 
 
 def _noise_figures(campaign: Campaign, serial: str, channel: str) -> dict[str, Any] | None:
@@ -458,8 +461,12 @@ def summary_line(report: dict[str, Any], calibration_path: Path) -> str:
                     f"uncertainty ≤ {max(max(g['expanded_uncertainty_dps']) for g in gyros):.4f} °/s at "
                     f"{gyros[0]['uncertainty_budget']['largest_rate_dps']:g} °/s")
     failed = [serial for serial, r in report.items() if r.get("verdict") == "FAIL"]
-    verdicts = (f"{len(report) - len(failed)} PASS, {len(failed)} FAIL ({', '.join(failed)})" if failed
-                else f"{len(report)} PASS")
+    unjudged = sum(r.get("verdict") == NOT_JUDGED for r in report.values())
+    passed = len(report) - len(failed) - unjudged
+    verdicts = (f"{passed} PASS, {len(failed)} FAIL ({', '.join(failed)})" if failed else f"{passed} PASS")
+    if unjudged:
+        verdicts = (f"{unjudged} NOT JUDGED (no acceptance limits stated)" if unjudged == len(report)
+                    else f"{verdicts}, {unjudged} NOT JUDGED")
     uncalibrated = sorted({channel for r in report.values() for channel in r.get("not_calibrated", {})})
     left = f"; not calibrated (measured and stored): {', '.join(uncalibrated)}" if uncalibrated else ""
     return f"calibration → {calibration_path}: {figures}, {len(report)} DUTs (worst of each); {verdicts}{left}"

@@ -1,5 +1,5 @@
 """The verdict on a DUT's gyroscope: PASS when its calibration meets every limit of `acceptance.gyro`, FAIL
-with the reasons otherwise. Verification limits are judged on the rate steps and poses the fit never saw,
+with the reasons otherwise, NOT JUDGED without limits. Verification limits are judged on the rate steps and poses the fit never saw,
 parameter limits on the calibration at the limits' temperature, each value against its limit (simple
 acceptance, as the accelerometer's)."""
 
@@ -11,14 +11,17 @@ import numpy as np
 
 from accelcal_rig.config.acceptance import GyroAcceptance
 from accelcal_rig.fit import gyro_model
-from accelcal_rig.fit.acceptance import Judgement, _within
+from accelcal_rig.fit.acceptance import NOT_JUDGED, Judgement, _within
 from accelcal_rig.fit.thermal import ThermalModel
+
+NO_GYRO_LIMITS = "no gyroscope acceptance limits stated"
 
 
 def judge_gyro(metrics: dict[str, Any], thermal: ThermalModel, limits: GyroAcceptance | None,
                partial: str = "", allow_partial: bool = False) -> Judgement:
-    if limits is None:
-        return Judgement("PASS", ["no gyroscope acceptance limits stated"])
+    if limits is None and not partial:
+        return Judgement(NOT_JUDGED, [NO_GYRO_LIMITS])
+    limits = limits or GyroAcceptance()
     checks: list[tuple[bool, str]] = []
     verification = metrics.get("verification")
     figures = [("max_verification_rmse_dps", "verification rate RMS error", "rmse_dps", "°/s"),
@@ -47,10 +50,11 @@ def judge_gyro(metrics: dict[str, Any], thermal: ThermalModel, limits: GyroAccep
             if limit is not None:
                 worst = int(np.argmax(values))
                 checks.append(_within(f"gyro {label} {names[worst]} at {p.at_c:g} °C", float(values[worst]), limit, unit))
+    judged_any = bool(checks)
     if partial:
         checks.append((allow_partial, partial + (" (acceptance.allow_partial)" if allow_partial
                                                  else ": a partial campaign fails")))
-    if not checks:
-        return Judgement("PASS", ["no gyroscope acceptance limits stated"])
+    if not judged_any and all(ok for ok, _ in checks):
+        return Judgement(NOT_JUDGED, [NO_GYRO_LIMITS, *(text for _, text in checks)])
     failed = [text for ok, text in checks if not ok]
     return Judgement("FAIL", failed) if failed else Judgement("PASS", [text for _, text in checks])

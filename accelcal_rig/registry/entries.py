@@ -84,7 +84,9 @@ def _entry(calibration: CalibrationFile, channel: str, sensor: SensorCalibration
         "software_version": calibration.software_version, "calibrated_at": _utc(source["measured"]),
         "fitted_at": _utc(calibration.created), "registered_at": datetime.now(UTC).replace(tzinfo=None),
         "valid_from_c": float(sensor.validity_c[0]), "valid_to_c": float(sensor.validity_c[1]),
-        "verdict": sensor.verdict, "verdict_reasons": list(sensor.verdict_reasons),
+        # NOT JUDGED (no limits stated) is stored as no verdict: counted in no yield.
+        "verdict": sensor.verdict if sensor.verdict in ("PASS", "FAIL") else None,
+        "verdict_reasons": list(sensor.verdict_reasons),
         "verification_rmse_mg": float(rmse) if rmse is not None else None,
         "calibration": stored, **channel_figures(stored, channel),
     }

@@ -222,6 +222,10 @@ def _gyro_sections(gyro: GyroCalibration) -> list[str]:
 def _verdict_section(sensor: SensorCalibration, gyro: GyroCalibration | None) -> list[str]:
     """The DUT's verdict (an IMU's: FAIL when either sensor fails), and each sensor's with its reasons."""
     verdict = certificate_gyro.overall_verdict(sensor, gyro) if gyro is not None else sensor.verdict or "NOT JUDGED"
+    sensors = [sensor] + ([gyro] if gyro is not None else [])
+    if all(c.verdict in (None, "NOT JUDGED") for c in sensors):  # no specification: no conformity statement
+        return ["<section><h2>Statement of conformity</h2><p>None: the procedure states no acceptance limits (no "
+                "specification to judge against). The results above are stated with their uncertainties.</p></section>"]
     judged: list[tuple[str, SensorCalibration | GyroCalibration]] = (
         [("", sensor)] if gyro is None else [("accelerometer", sensor), ("gyroscope", gyro)])
     lists = []

@@ -169,7 +169,7 @@ def _summary(data: CampaignData) -> list[str]:
             v["n_poses"], f"{v['rmse_mg']:.4f}", f"{v['rmse_mg'] / v['noise_floor_mg']:.2f}",
             f"{v['max_axis_error_mg']:.4f}", f"{v['max_tilt_error_deg']:.4f}",
             " / ".join(f"{d * 1e3:.1f}" for d in v["drift_mg"])])])
-        classes.append("" if verdict == "PASS" else "warning")
+        classes.append("warning" if verdict == "FAIL" else "")
     out += ["<h2>Calibration: verification (poses the fit never saw)</h2>",
             _table(["DUT", "verdict", "reasons", "poses", "|g| RMSE (mg)", "÷ noise floor", "largest axis error (mg)",
                     "largest tilt error (°)", "residual drift x/y/z (µg)"], verified, text_columns=3,
@@ -210,7 +210,7 @@ def _gyro_section(data: CampaignData) -> list[str]:
                      dps(v.get("max_axis_error_dps")), dps(v.get("scale_error_ppm"), 0), dps(v.get("rest_error_dps")),
                      " / ".join(f"{u:.4f}" for u in expanded) if expanded else "—",
                      f"{float(budget['largest_rate_dps']):g}" if "largest_rate_dps" in budget else "—"])
-        classes.append("" if gyro.verdict == "PASS" else "warning")
+        classes.append("warning" if gyro.verdict == "FAIL" else "")
     earth = sorted({g.earth_rate for g in data.gyros.values()})
     return ["<h2>Gyroscope calibration</h2>",
             _table(["DUT", "verdict", "reasons", "rate RMS before (°/s)", "after, in-sample (°/s)",

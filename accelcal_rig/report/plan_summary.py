@@ -151,7 +151,7 @@ def _verification_lines(prepared: PreparedCampaign) -> list[str]:
             judged += [f"gyro {name} {getattr(gyro.parameters, name):g} at {gyro.parameters.at_c:g} °C" for name in
                        ("bias_dps", "scale_error_ppm", "cross_axis_mrad", "gsens_dps_per_g")
                        if getattr(gyro.parameters, name) is not None]
-    lines.append("accept     " + ("; ".join(judged) if judged else "no limits: every DUT passes") +
+    lines.append("accept     " + ("; ".join(judged) if judged else "no limits: every DUT NOT JUDGED (no statement of conformity)") +
                  ("" if limits.allow_partial else "; a partial campaign fails"))
     return lines
 

@@ -46,11 +46,15 @@ def test_a_partial_campaign_fails_unless_allowed() -> None:
     partial = "partial campaign: 100 of 264 poses stored (state aborted)"
     assert judge(VERIFIED, BIASED, "reference", Acceptance(), partial).verdict == "FAIL"
     allowed = judge(VERIFIED, BIASED, "reference", Acceptance(allow_partial=True), partial)
-    assert allowed.verdict == "PASS" and allowed.reasons == [partial + " (acceptance.allow_partial)"]
+    assert allowed.verdict == "NOT JUDGED"      # allowed, and no limit stated: nothing to conform to
+    assert allowed.reasons == ["no acceptance limits stated", partial + " (acceptance.allow_partial)"]
+    limited = Acceptance(allow_partial=True, parameters=ParameterLimits(bias_mg=1000))
+    assert judge(VERIFIED, BIASED, "reference", limited, partial).verdict == "PASS"
 
 
-def test_no_limits_pass_and_say_so_and_norm_only_is_not_judged_on_misalignment() -> None:
-    assert judge(VERIFIED, BIASED, "reference", Acceptance()).reasons == ["no acceptance limits stated"]
+def test_no_limits_no_verdict_and_norm_only_is_not_judged_on_misalignment() -> None:
+    unjudged = judge(VERIFIED, BIASED, "reference", Acceptance())
+    assert unjudged.verdict == "NOT JUDGED" and unjudged.reasons == ["no acceptance limits stated"]
     turned = constant(np.concatenate([IDENTITY_PARAMETERS[:9], [0.01, 0.0, 0.0]]))
     limits = Acceptance(parameters=ParameterLimits(misalignment_mrad=1))
     assert judge(VERIFIED, turned, "reference", limits).verdict == "FAIL"

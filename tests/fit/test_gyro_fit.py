@@ -36,7 +36,8 @@ PROCEDURE = {
     "noise": {"duration_s": 20},
     "fit": {"mode": "reference", "polynomial_degree": 1},
     "verify": {"schedule": {"kind": "sphere", "count": 6}, "at_setpoints": False, "setpoints_c": [10, 30]},
-    "acceptance": {"gyro": {"max_verification_rmse_dps": 0.5, "max_rest_error_dps": 0.1,
+    "acceptance": {"max_verification_rmse_mg": 1.0,
+                   "gyro": {"max_verification_rmse_dps": 0.5, "max_rest_error_dps": 0.1,
                             "parameters": {"at_c": 20, "bias_dps": 1.0}}},
 }
 #: The rate limits' tests change only the rates.
