@@ -88,6 +88,23 @@ class SetpointFit(StrictModel):
     sigma: dict[str, float | None]
 
 
+def _within_validity(polynomial: PolynomialModel, validity_c: tuple[float, float], out_of_range: str, who: str,
+                     temperature_c: np.ndarray | float) -> np.ndarray:
+    """Every channel model's parameters at each temperature, as its file's `out_of_range` says outside its
+    validity (clamped or extrapolated, warned either way)."""
+    temperature_c = np.asarray(temperature_c, dtype=float)
+    low, high = validity_c
+    outside = (temperature_c < low) | (temperature_c > high)
+    if np.any(outside):
+        action = "clamped to" if out_of_range == "clamp" else "extrapolated beyond"
+        warnings.warn(CalibrationRangeWarning(
+            f"{who}: {int(outside.sum())} of {outside.size} temperatures {action} the calibrated {low:g}…{high:g} °C"),
+            stacklevel=4)
+    if out_of_range == "clamp":
+        temperature_c = np.clip(temperature_c, low, high)
+    return polynomial.at(temperature_c)
+
+
 class SensorCalibration(StrictModel):
     serial: str = Field(min_length=1, max_length=128)
     mode: Literal["reference", "norm-only"]
@@ -106,17 +123,8 @@ class SensorCalibration(StrictModel):
 
     def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:
         """Eq. 1 parameters (..., 12) at each temperature, as the file's `out_of_range` says outside it."""
-        temperature_c = np.asarray(temperature_c, dtype=float)
-        low, high = self.validity_c
-        outside = (temperature_c < low) | (temperature_c > high)
-        if np.any(outside):
-            action = "clamped to" if self.out_of_range == "clamp" else "extrapolated beyond"
-            warnings.warn(CalibrationRangeWarning(
-                f"sensor {self.serial}: {int(outside.sum())} of {outside.size} temperatures {action} the "
-                f"calibrated {low:g}…{high:g} °C"), stacklevel=3)
-        if self.out_of_range == "clamp":
-            temperature_c = np.clip(temperature_c, low, high)
-        return self.polynomial.at(temperature_c)
+        return _within_validity(self.polynomial, self.validity_c, self.out_of_range, f"sensor {self.serial}",
+                                temperature_c)
 
 
 class GyroCalibration(StrictModel):
@@ -144,17 +152,8 @@ class GyroCalibration(StrictModel):
 
     def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:
         """The model's 27 parameters (..., 27) at each temperature, as the file's `out_of_range` says outside it."""
-        temperature_c = np.asarray(temperature_c, dtype=float)
-        low, high = self.validity_c
-        outside = (temperature_c < low) | (temperature_c > high)
-        if np.any(outside):
-            action = "clamped to" if self.out_of_range == "clamp" else "extrapolated beyond"
-            warnings.warn(CalibrationRangeWarning(
-                f"gyroscope {self.serial}: {int(outside.sum())} of {outside.size} temperatures {action} the "
-                f"calibrated {low:g}…{high:g} °C"), stacklevel=3)
-        if self.out_of_range == "clamp":
-            temperature_c = np.clip(temperature_c, low, high)
-        return self.polynomial.at(temperature_c)
+        return _within_validity(self.polynomial, self.validity_c, self.out_of_range, f"gyroscope {self.serial}",
+                                temperature_c)
 
 
 def _channel_model(value: Any) -> str:
