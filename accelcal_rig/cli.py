@@ -7,6 +7,7 @@ cli_recording, cli_serve, cli_registry, cli_analyze, the assembly, the engine)."
 from __future__ import annotations
 
 import argparse
+import datetime as dt
 import json
 import logging
 import os
@@ -35,6 +36,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from accelcal_rig.cli_campaign import prepare_run
 
     prepared, resume = prepare_run(args)
+    _warn_of_references(prepared, args)
     return _execute(prepared, args.output, args, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite,
                     resume=resume)
 
@@ -45,6 +47,7 @@ def _cmd_plan(args: argparse.Namespace) -> int:
     from accelcal_rig.report.plan_summary import plan_json, plan_lines
 
     prepared = prepare(args.procedure, args.config)
+    _warn_of_references(prepared, args)
     estimate = estimate_duration(prepared.procedure.model, prepared.rig.model, prepared.plan)
     if args.json:
         print(json.dumps(plan_json(prepared, estimate)))
@@ -57,7 +60,17 @@ def _cmd_resume(args: argparse.Namespace) -> int:
     from accelcal_rig.cli_campaign import prepare_resume
 
     prepared, dry_run, seed = prepare_resume(args)
+    _warn_of_references(prepared, args)
     return _execute(prepared, args.campaign, args, dry_run=dry_run, seed=seed, overwrite=False, resume=True)
+
+
+def _warn_of_references(prepared: PreparedCampaign, args: argparse.Namespace) -> None:
+    """A line on stderr for each of the rig's references past its due date (refused instead, in one line, when
+    the rig config says `references_overdue: refuse`), before anything moves."""
+    from accelcal_rig.config.traceability import reference_warnings
+
+    for line in reference_warnings(prepared.rig, args.today()):
+        print(f"rig: warning: {line}", file=sys.stderr)
 
 
 def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace, *, dry_run: bool, seed: int,
@@ -138,17 +151,16 @@ def _complete_campaign_verdicts(done: NothingToResume, output: Path, calibration
 
 def _record(flag: str | None, configured: str | None, source: Path, entries: Callable[[], list],
             json_output: bool = False, later: str | None = None) -> None:
-    """Record a finished fit in the registry; a registry that cannot take it is a warning naming how to
-    record it later, never a loss: the calibration file is written already. Beside a JSON report the line
-    goes to stderr, so stdout stays one JSON object."""
+    """Record a finished fit in the registry (a dry run's in the dry runs' own); a registry that cannot take it
+    is a warning naming how to record it later, never a loss: the calibration file is written already. Beside
+    a JSON report the line goes to stderr, so stdout stays one JSON object."""
     from alembic.util.exc import CommandError
     from sqlalchemy.exc import SQLAlchemyError
 
     from accelcal_rig.cli_registry import register
-    from accelcal_rig.registry.location import registry_url
 
     try:
-        print(register(registry_url(flag, configured), entries()), file=sys.stderr if json_output else sys.stdout)
+        print(register(flag, configured, entries()), file=sys.stderr if json_output else sys.stdout)
     except (RigError, SQLAlchemyError, OSError, CommandError) as exc:
         print(f"rig: warning: not recorded in the registry: {_one_line(exc)} (record it later: "
               f"{later or f'rig registry add {source}'})", file=sys.stderr)
@@ -253,7 +265,8 @@ def _cmd_fit_recording(args: argparse.Namespace) -> int:
     print(json.dumps(result.report) if args.json else "\n".join(recording_lines(
         result.report, recording.source, threshold_factor=args.threshold_factor, init_s=args.init_s,
         output=args.output, parameters=args.parameters)))
-    _record(args.registry, None, args.recording, lambda: recording_entries(args.recording, result.calibration, args.part),
+    _record(args.registry, None, args.recording,
+            lambda: recording_entries(args.recording, result.calibration, args.part, recording.simulated),
             json_output=args.json, later="run this rig fit-recording again once the registry is reachable")
     return 0
 
@@ -278,6 +291,12 @@ def _cmd_registry(args: argparse.Namespace) -> int:
     from accelcal_rig.cli_registry import registry_command
 
     return registry_command(args)
+
+
+def _cmd_approve(args: argparse.Namespace) -> int:
+    from accelcal_rig.cli_approval import approve_command
+
+    return approve_command(args)
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
@@ -329,6 +348,8 @@ def _certify(campaign: Path, calibration: Path, folder: Path, operator: str, pdf
         print(f"rig: warning: {warning}", file=sys.stderr)
     for w in written:
         print(certificate_line(w))
+    if written:  # a draft until a person approves it
+        print(f"certificates are drafts until approved: rig approve {campaign} --as USER")
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
@@ -373,8 +394,10 @@ def run_program() -> None:
     raise SystemExit(code)
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(argv: list[str] | None = None, today: Callable[[], dt.date] = dt.date.today) -> int:
+    """`today`: the calendar the references' due dates are judged by (a test passes its own)."""
     args = build_parser().parse_args(argv)
+    args.today = today
     # Driver libraries log their own view of a failure; ours is the one line that names the instrument.
     logging.getLogger("pymodbus").addHandler(logging.NullHandler())
     logging.getLogger("pymodbus").propagate = False
@@ -382,7 +405,7 @@ def main(argv: list[str] | None = None) -> int:
                "fit": _cmd_fit, "check": _cmd_check,
                "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export, "certificate": _cmd_certificate,
                "fit-recording": _cmd_fit_recording, "analyze": _cmd_analyze, "registry": _cmd_registry,
-               "serve": _cmd_serve, "completion": _cmd_completion}[args.command]
+               "serve": _cmd_serve, "completion": _cmd_completion, "approve": _cmd_approve}[args.command]
     try:
         return handler(args)
     except CampaignAborted as exc:

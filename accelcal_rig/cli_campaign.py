@@ -11,6 +11,7 @@ import sys
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -19,6 +20,7 @@ from accelcal_rig.core.signals import TerminationRequested, stop_when_safe
 from accelcal_rig.errors import ConfigError
 
 if TYPE_CHECKING:
+    from accelcal_rig.config.lab import Receipt
     from accelcal_rig.engine.preparation import PreparedCampaign
     from accelcal_rig.engine.progress import ProgressListener
 
@@ -38,13 +40,27 @@ def prepare_run(args: argparse.Namespace) -> tuple[PreparedCampaign, bool]:
         from accelcal_rig.store.read import load_campaign
 
         profile = str(load_campaign(args.output).attrs.get("chamber_profile", "")) or None
-    prepared = prepare(args.procedure, args.config, args.faults, profile)
+    prepared = replace(prepare(args.procedure, args.config, args.faults, profile), receipt=_receipt(args))
     if exists and not (args.overwrite or args.resume):
         raise ConfigError(f"{args.output}: campaign file exists; continue it with --resume, or choose another -o "
                           "or pass --overwrite")
     if not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
     return prepared, args.resume and exists
+
+
+def _receipt(args: argparse.Namespace) -> Receipt:
+    """`rig run --customer/--received/--condition`: what a new campaign records of the DUTs that state none."""
+    from accelcal_rig.config.lab import Receipt, iso_date
+
+    try:
+        received = iso_date(args.received) if args.received else None
+    except ValueError as exc:
+        raise ConfigError(f"--received: {exc}") from None
+    for option, text, longest in (("--customer", args.customer, 200), ("--condition", args.condition, 500)):
+        if len(text) > longest or any(ord(c) < 32 or ord(c) == 127 for c in text):
+            raise ConfigError(f"{option}: not one line of at most {longest} characters")
+    return Receipt(args.customer, received, args.condition)
 
 
 def prepare_resume(args: argparse.Namespace) -> tuple[PreparedCampaign, bool, int]:

@@ -44,8 +44,8 @@ def warning_lines(warnings: Iterable[str]) -> list[str]:
 
 
 def verdict_lines(verdicts: dict[str, tuple[str, tuple[str, ...]]]) -> list[str]:
-    """Each DUT's verdict, with the reasons of a FAIL."""
-    return [f"  verdict    {serial} {verdict}" + (f": {'; '.join(reasons)}" if verdict == "FAIL" else "")
+    """Each DUT's verdict, with the reasons of a FAIL or a CONDITIONAL (the figures inside their guard band)."""
+    return [f"  verdict    {serial} {verdict}" + (f": {'; '.join(reasons)}" if verdict in ("FAIL", "CONDITIONAL") else "")
             for serial, (verdict, reasons) in verdicts.items()]
 
 

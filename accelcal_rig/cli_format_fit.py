@@ -33,7 +33,7 @@ def gyro_table(report: dict[str, Any]) -> list[str]:
                  zip(cells, (8, 9, 9, 8), (4, 4, 0, 4))]
         lines.append(f"{serial:14s} {g['rmse_before_dps']:8.3f} {g['rmse_after_dps']:9.4f} {' '.join(shown)}  "
                      f"{max(g['expanded_uncertainty_dps']):7.4f}  {g['verdict']}")
-        lines += [f"  fails: {reason}" for reason in (g["verdict_reasons"] if g["verdict"] == "FAIL" else ())]
+        lines += _reasons(g)
     return lines
 
 
@@ -49,7 +49,7 @@ def fit_table(report: dict[str, Any]) -> list[str]:
         lines.append(f"{serial:14s} {r['rmse_before_mg']:8.3f} {r['noise_floor_mg']:7.4f} {r['expected_fit_rmse_mg']:8.4f} "
                      f"{r['rmse_after_mg']:7.4f} {max(r['drift_after_mg']):10.4f}  {verification}  "
                      f"{max(r['expanded_uncertainty_mg']):8.4f}  {r['verdict']}")
-        lines += [f"  fails: {reason}" for reason in (r["verdict_reasons"] if r["verdict"] == "FAIL" else ())]
+        lines += _reasons(r)
         lines += [f"  warning: {warning}" for warning in r["warnings"]]
     return lines
 
@@ -94,3 +94,12 @@ def gyro_lines(gyro: dict[str, Any]) -> list[str]:
                                                                                             gyro["matrix_sigma"]))]
     lines += [f"  note: {note}" for note in gyro["notes"]]
     return lines
+
+
+def _reasons(judged: dict[str, Any]) -> list[str]:
+    """Why a sensor failed, or which figures its decision rule left inside their guard band."""
+    if judged["verdict"] == "FAIL":
+        return [f"  fails: {reason}" for reason in judged["verdict_reasons"]]
+    if judged["verdict"] == "CONDITIONAL":
+        return [f"  conditional: {reason}" for reason in judged["verdict_reasons"] if "conditional" in reason]
+    return []

@@ -8,16 +8,19 @@ from pathlib import Path
 from typing import Any
 
 
-def calibration_table(rows: list[dict[str, Any]]) -> list[str]:
-    """`rig registry list`: a header and one line per calibration (a sentence when none match)."""
+def calibration_table(rows: list[dict[str, Any]], dry_runs: str | None = None) -> list[str]:
+    """`rig registry list`: a header and one line per calibration, a dry run's `dry run` in the `made` column (a
+    sentence when none match, naming the dry runs' registry `dry_runs` if given: they are recorded there)."""
     if not rows:
-        return ["no calibrations match"]
-    lines = [f"{'id':>6}  {'serial':<16} {'channel':<7} {'part':<8} {'calibrated (UTC)':<19} {'verdict':<10} "
-             f"{'valid °C':<15} {'procedure':<22} source"]
+        return ["no calibrations match" + (f" (dry runs are recorded apart, in {dry_runs}: --registry names it)"
+                                           if dry_runs else "")]
+    lines = [f"{'id':>6}  {'serial':<16} {'channel':<7} {'part':<8} {'calibrated (UTC)':<19} {'verdict':<11} "
+             f"{'made':<7} {'valid °C':<15} {'procedure':<22} source"]
     for r in rows:
         lines.append(f"{r['id']:>6}  {r['serial']:<16} {_channel(r):<7} {r['part']:<8} {r['calibrated_at']:%Y-%m-%d %H:%M:%S} "
-                     f"{r['verdict'] or 'NOT JUDGED':<10} {r['valid_from_c']:>6.1f}…{r['valid_to_c']:<7.1f} {r['procedure'][:22]:<22} "
-                     f"{Path(r['source_path']).name}{' (simulated)' if r['simulated'] else ''}")
+                     f"{r['verdict'] or 'NOT JUDGED':<11} {'dry run' if r['simulated'] else 'real':<7} "
+                     f"{r['valid_from_c']:>6.1f}…{r['valid_to_c']:<7.1f} {r['procedure'][:22]:<22} "
+                     f"{Path(r['source_path']).name}")
     return lines
 
 
@@ -26,14 +29,14 @@ def _channel(row: dict[str, Any]) -> str:
 
 
 def sensor_lines(serial: str, current: dict[str, dict[str, Any] | None], rows: list[dict[str, Any]],
-                 simulated: bool) -> list[str]:
+                 simulated: bool, why: dict[str, str] | None = None) -> list[str]:
     """`rig registry show`: the sensor's valid calibration of each channel (or why it has none), then its
     history; each channel named where the sensor has more than its accelerometer."""
     labelled = set(current) != {"accel"}
     lines = []
     for channel, valid in current.items():
         lines += _current_lines(serial, valid, [r for r in rows if _channel(r) == channel], simulated,
-                                f" {channel}" if labelled else "")
+                                f" {channel}" if labelled else "", (why or {}).get(channel, ""))
     lines.append(f"history ({len(rows)}):")
     for r in rows:
         bias = triple(r["bias_dps"], "°/s", digits=4) if _channel(r) == "gyro" else triple(r["bias_mg"], "mg")
@@ -44,12 +47,9 @@ def sensor_lines(serial: str, current: dict[str, dict[str, Any] | None], rows: l
 
 
 def _current_lines(serial: str, current: dict[str, Any] | None, rows: list[dict[str, Any]],
-                   simulated: bool, label: str = "") -> list[str]:
+                   simulated: bool, label: str = "", why: str = "") -> list[str]:
     if current is None:
-        newest = next((r for r in rows if simulated or not r["simulated"]), None)
-        why = ("its newest calibration failed its acceptance limits" if newest is not None
-               else "only dry runs (simulated) are recorded: --simulated shows them")
-        return [f"{serial}{label}: no valid calibration ({why})"]
+        return [f"{serial}{label}: no valid calibration ({why or 'its newest calibration failed its acceptance limits'})"]
     dry = " (SIMULATED: a dry run)" if current["simulated"] else ""
     figures = _gyro_figures(current) if _channel(current) == "gyro" else [
         f"  at {current['reference_c']:g} °C: bias {triple(current['bias_mg'], 'mg', current['bias_uncertainty_mg'])}; "
@@ -97,11 +97,15 @@ def trend_lines(serial: str, calibrations: int, result: dict[str, Any], channel:
         lines.append(f"  {point['calibrated_at'][:10]}  bias "
                      f"{triple(point[f'bias_{unit}'], shown, point[f'bias_uncertainty_{unit}'], digits)}"
                      f"  scale {triple(point['scale_error_ppm'], 'ppm', point['scale_uncertainty_ppm'], 0)}")
+    withheld = result.get("drift_not_stated")
+    if withheld:
+        option = " (--min-span-days sets it)" if 0 < result["span_days"] < result["min_span_days"] else ""
+        return [*lines, f"  drift per year: not stated: {withheld}{option}"]
     for key, drift_unit in ((f"bias_drift_{unit}_per_year", shown), ("scale_drift_ppm_per_year", "ppm")):
         drift = result[key]
         what = key.split("_drift")[0]
         if drift is None:
-            lines.append(f"  {what} drift: needs two calibrations at different times")
+            lines.append(f"  {what} drift: needs two calibrations at different times with its figures")
         else:
             lines.append(f"  {what} drift per year: "
                          + ", ".join(f"{axis} {_drift_text(d, drift_unit)}" for axis, d in zip("xyz", drift)))
@@ -110,8 +114,12 @@ def trend_lines(serial: str, calibrations: int, result: dict[str, Any], channel:
 
 def lot_lines(part: str, result: dict[str, Any], channel: str = "accel") -> list[str]:
     """`rig registry stats`: the lot's yield, each figure's distribution per axis, the outliers (one channel's)."""
-    judged = f"{result['passed']} of {result['judged']} judged passed ({result['yield']:.1%})" if result["judged"] \
-        else "none judged against acceptance limits"
+    judged = "none judged against acceptance limits"
+    if result["judged"]:
+        conditional = result.get("conditional", 0)
+        judged = (f"{result['passed']} of {result['judged']} judged passed ({result['yield']:.1%})"
+                  + (f", {conditional} conditional (inside a guard band: neither passed nor failed)" if conditional
+                     else ""))
     label = f" {channel}" if channel != "accel" else ""
     lines = [f"{part}{label}: {result['sensors']} sensors ({result['calibrations']} calibrations), newest of each: "
              f"{judged}"]

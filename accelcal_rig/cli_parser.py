@@ -10,6 +10,7 @@ import argparse
 
 from accelcal_rig import __version__
 from accelcal_rig.cli_grammar.analysis import add_analysis_commands
+from accelcal_rig.cli_grammar.approval import add_approve_command
 from accelcal_rig.cli_grammar.campaign import add_campaign_commands
 from accelcal_rig.cli_grammar.common import Parser
 from accelcal_rig.cli_grammar.documents import add_document_commands
@@ -26,6 +27,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_fit_commands(commands)          # fit, fit-recording
     add_analysis_commands(commands)     # analyze
     add_registry_commands(commands)     # registry
+    add_approve_command(commands)       # approve
     add_completion_command(commands)
     add_serve_command(commands)
     add_document_commands(commands)     # report, certificate, export

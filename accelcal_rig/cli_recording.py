@@ -39,6 +39,7 @@ def calibrate_recording(args: argparse.Namespace) -> tuple[Recording, RecordingF
 def _read(args: argparse.Namespace) -> tuple[Recording, str]:
     """The recording, and the serial its calibration names (--serial, else the source's or the file's name)."""
     from accelcal_rig.handheld.recording import CsvLayout, read_campaign_recording, read_csv_recording
+    from accelcal_rig.handheld.time_base import check_time_base
 
     if args.recording.suffix in (".h5", ".hdf5"):
         if args.gyro_columns:
@@ -50,4 +51,6 @@ def _read(args: argparse.Namespace) -> tuple[Recording, str]:
                                      rate_hz=args.rate_hz, units=args.units, counts_per_g=args.counts_per_g,
                                      zero_code=args.zero_code, gyro_units=args.gyro_units,
                                      counts_per_dps=args.counts_per_dps)
-    return read_csv_recording(args.recording, layout), args.serial or args.recording.stem
+    recording = read_csv_recording(args.recording, layout)
+    check_time_base(recording.source, layout.time, layout.time_unit, recording.t_s, args.part)
+    return recording, args.serial or args.recording.stem

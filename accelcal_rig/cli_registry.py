@@ -18,33 +18,47 @@ if TYPE_CHECKING:
 
 
 def registry_command(args: argparse.Namespace) -> int:
+    from accelcal_rig.cli_approval import audit_command, certificate_command, user_command
+
     return {"add": _add, "list": _list, "show": _show, "trend": _trend, "stats": _stats,
-            "export": _export}[args.registry_command](args)
+            "export": _export, "user": user_command, "audit": audit_command,
+            "certificate": certificate_command}[args.registry_command](args)
 
 
 def open_registry(args: argparse.Namespace, upgrade: bool = False):  # noqa: ANN201 - imported late (SQLAlchemy)
     """The registry the command names: --registry, else the rig config's (--config), else the environment's,
     else the default file. Only a recording command (`upgrade`) migrates an older schema."""
     from accelcal_rig.registry.database import Registry
-    from accelcal_rig.registry.location import configured, registry_url
+    from accelcal_rig.registry.location import registry_url
 
-    from_config = None
-    if getattr(args, "config", None) is not None:
-        from accelcal_rig.config.load import load_rig
-
-        rig = load_rig(args.config)
-        from_config = configured(rig.model.registry, rig.path)
-    return Registry.open(registry_url(args.registry, from_config), upgrade=upgrade)
+    return Registry.open(registry_url(args.registry, _from_config(args)), upgrade=upgrade)
 
 
-def register(url: str, entries: list[dict[str, Any]]) -> str:
-    """Record entries in the registry at `url`; one line saying what happened (for `rig run`/`rig fit`)."""
+def _from_config(args: argparse.Namespace) -> str | None:
+    """The `registry:` of the rig config `--config` names, if it does."""
+    if getattr(args, "config", None) is None:
+        return None
+    from accelcal_rig.config.load import load_rig
+    from accelcal_rig.registry.location import configured
+
+    rig = load_rig(args.config)
+    return configured(rig.model.registry, rig.path)
+
+
+def register(flag: str | None, configured: str | None, entries: list[dict[str, Any]]) -> str:
+    """Record entries in the registry they belong to: the one `--registry` (`flag`) names, else a dry run's in
+    the dry runs' own and a real one's in the rig config's (`configured`) or the lab's; one line saying what
+    happened (for `rig run`/`rig fit`/`rig fit-recording`)."""
     from accelcal_rig.registry.database import Registry
-    from accelcal_rig.registry.location import described
+    from accelcal_rig.registry.location import described, recording_url
 
+    simulated = any(entry["simulated"] for entry in entries)
+    url = recording_url(flag, configured, simulated)
     added, already = Registry.open(url, upgrade=True).add(entries)
     tail = f", {already} registered already" if already else ""
-    return f"registry   {len(added)} calibration{'s' if len(added) != 1 else ''} recorded in {described(url)}{tail}"
+    apart = " (a dry run: kept apart from the lab's registry)" if simulated and flag is None else ""
+    return (f"registry   {len(added)} calibration{'s' if len(added) != 1 else ''} recorded in {described(url)}"
+            f"{tail}{apart}")
 
 
 def campaign_entries(campaign: Path, calibration: Path | None) -> list[dict[str, Any]]:
@@ -54,11 +68,12 @@ def campaign_entries(campaign: Path, calibration: Path | None) -> list[dict[str,
     return entries(campaign, calibration)
 
 
-def recording_entries(recording: Path, calibration: CalibrationFile, part: str) -> list[dict[str, Any]]:
-    """What the registry records of a hand-held recording's fit."""
+def recording_entries(recording: Path, calibration: CalibrationFile, part: str,
+                      simulated: bool = False) -> list[dict[str, Any]]:
+    """What the registry records of a hand-held recording's fit (`simulated`: of a dry run's campaign file)."""
     from accelcal_rig.registry.entries import recording_entries as entries
 
-    return entries(recording, calibration, part)
+    return entries(recording, calibration, part, simulated)
 
 
 def rig_registry(value: str | None, rig_path: Path) -> str | None:
@@ -82,18 +97,36 @@ def stored_rig_registry(campaign: Path) -> str | None:
 def _add(args: argparse.Namespace) -> int:
     if args.calibration is not None and len(args.files) != 1:
         raise ConfigError("--calibration names the calibration of one campaign file: give one FILE with it")
-    registry = open_registry(args, upgrade=True)
+    from accelcal_rig.registry.database import Registry
+    from accelcal_rig.registry.location import described, recording_url
+
+    named = args.registry or _from_config(args)  # a registry named here takes dry runs too
+    opened: dict[str, Registry] = {}
     for path in args.files:
-        added, already = registry.add(campaign_entries(path, args.calibration))
-        print(f"{path}: {len(added)} added" + (f", {already} registered already" if already else ""))
+        entries = campaign_entries(path, args.calibration)
+        simulated = any(entry["simulated"] for entry in entries)
+        url = recording_url(named, None, simulated)
+        if url not in opened:
+            opened[url] = Registry.open(url, upgrade=True)
+        added, already = opened[url].add(entries)
+        print(f"{path}: {len(added)} added" + (f", {already} registered already" if already else "")
+              + (f" (a dry run: in {described(url)}, apart from the lab's registry)" if simulated and not named else ""))
     return 0
 
 
 def _list(args: argparse.Namespace) -> int:
+    from accelcal_rig.registry.location import described, recording_url
+
     since = _since(args.since) if args.since else None
-    rows = open_registry(args).calibrations(serial=args.serial, part=args.part, since=since, verdict=args.verdict,
-                                            limit=args.limit, channel=args.channel)
-    print(json.dumps([public(r) for r in rows], indent=2) if args.json else "\n".join(calibration_table(rows)))
+    registry = open_registry(args)
+    rows = registry.calibrations(serial=args.serial, part=args.part, since=since, verdict=args.verdict,
+                                 limit=args.limit, channel=args.channel, simulated=args.made)
+    if args.json:
+        print(json.dumps([public(r) for r in rows], indent=2))
+        return 0
+    dry_runs = recording_url(None, None, simulated=True)
+    elsewhere = None if rows or args.made is False or registry.url == dry_runs else described(dry_runs)
+    print("\n".join(calibration_table(rows, elsewhere)))
     return 0
 
 
@@ -111,18 +144,21 @@ def _show(args: argparse.Namespace) -> int:
                           "current": {channel: public(row) if row else None for channel, row in current.items()},
                           "history": [public(r) for r in rows]}, indent=2))
     else:
-        print("\n".join(sensor_lines(args.serial, current, rows, args.simulated)))
+        why = {channel: ("" if args.simulated else registry.why_not_valid(args.serial, channel))
+               for channel, row in current.items() if row is None}
+        print("\n".join(sensor_lines(args.serial, current, rows, args.simulated, why)))
     return 0
 
 
 def _trend(args: argparse.Namespace) -> int:
-    from accelcal_rig.registry.analysis import by_channel, trend
+    from accelcal_rig.registry.analysis import MIN_SPAN_DAYS, by_channel, trend
 
     rows = _real_unless(args, open_registry(args).calibrations(serial=args.serial, channel=args.channel))
     if not rows:
         raise ConfigError(f"serial {args.serial}: no calibration{_of_channel(args)} in the registry"
                           + _simulated_hint(args))
-    results = {channel: (len(of), trend(of, channel)) for channel, of in by_channel(rows).items()}
+    span = MIN_SPAN_DAYS if args.min_span_days is None else args.min_span_days
+    results = {channel: (len(of), trend(of, channel, span)) for channel, of in by_channel(rows).items()}
     if args.json:
         print(json.dumps({"serial": args.serial, "channels": {c: r for c, (_, r) in results.items()}}, indent=2))
     else:
@@ -157,7 +193,9 @@ def _export(args: argparse.Namespace) -> int:
     else:
         found = registry.current(args.serial, simulated=args.simulated)
         if found is None:
-            raise ConfigError(f"serial {args.serial}: no valid calibration in the registry" + _simulated_hint(args))
+            raise ConfigError(f"serial {args.serial}: no valid calibration in the registry" + (
+                f" ({registry.why_not_valid(args.serial)})" if not args.simulated and registry.calibrations(
+                    serial=args.serial, simulated=False) else _simulated_hint(args)))
         row = registry.calibration(found["id"])
     if args.output is not None and not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")

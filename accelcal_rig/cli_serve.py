@@ -53,6 +53,9 @@ def open_dashboard(args: argparse.Namespace) -> Dashboard:
         raise ConfigError(f"rig serve needs {exc.name}: pip install 'accelcal-rig[dashboard]'") from None
     token = args.token or os.environ.get("ACCELCAL_DASHBOARD_TOKEN") or None
     _check_access(args.host, token, args.tls_cert, args.tls_key)
+    if args.user_header and token is None:
+        raise ConfigError(f"--user-header {args.user_header}: needs --token, which the reverse proxy sends "
+                          "(Authorization: Bearer TOKEN) and its users never see: only the proxy may name a user")
     folders = args.campaigns or [Path.cwd()]
     missing = [folder for folder in folders if not folder.is_dir()]
     if missing:
@@ -64,7 +67,7 @@ def open_dashboard(args: argparse.Namespace) -> Dashboard:
         rig = load_rig(args.config)
         from_config = configured(rig.model.registry, rig.path)
     app = create_app(folders, registry_url(args.registry, from_config), token, tls=args.tls_cert is not None,
-                     hosts=[*LOOPBACK_HOSTS, args.host])
+                     hosts=[*LOOPBACK_HOSTS, args.host], user_header=args.user_header)
     return Dashboard(app, _listen(args.host, args.port), args.host, token, args.tls_cert, args.tls_key)
 
 

@@ -37,7 +37,7 @@ def status_lines(status: dict[str, Any]) -> list[str]:
     if status.get("calibration"):
         lines.append(f"fit        {status['calibration']}")
     for serial, judged in (status.get("verdicts") or {}).items():
-        reasons = f": {'; '.join(judged['reasons'])}" if judged["verdict"] == "FAIL" else ""
+        reasons = f": {'; '.join(judged['reasons'])}" if judged["verdict"] in ("FAIL", "CONDITIONAL") else ""
         lines.append(f"verdict    {serial} {judged['verdict'] or 'not judged'}{reasons}")
     hint = _next_step(status)
     if hint:

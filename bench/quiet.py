@@ -24,3 +24,4 @@ def throwaway_registry() -> None:
     folder = tempfile.mkdtemp(prefix="accelcal-bench-registry-")
     atexit.register(shutil.rmtree, folder, ignore_errors=True)
     os.environ["ACCELCAL_REGISTRY"] = os.path.join(folder, "registry.sqlite")
+    os.environ["ACCELCAL_DRY_RUN_REGISTRY"] = os.path.join(folder, "dry-runs.sqlite")

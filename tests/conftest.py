@@ -23,11 +23,12 @@ acquisition: {samples_per_pose: 20, range_g: 2, odr_hz: 125, settle_s: 1}
 @pytest.fixture(scope="session", autouse=True)
 def test_registry(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """Every finished fit in the tests (and in the processes they start) is recorded in a registry of the
-    session's own, never in the user's."""
+    session's own, never in the user's: a dry run's in the session's dry runs' registry beside it."""
     import os
 
     path = tmp_path_factory.mktemp("registry") / "registry.sqlite"
     os.environ["ACCELCAL_REGISTRY"] = str(path)
+    os.environ["ACCELCAL_DRY_RUN_REGISTRY"] = str(path.with_name("dry-runs.sqlite"))
     return path
 
 

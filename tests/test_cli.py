@@ -319,7 +319,7 @@ def test_rig_plan_shows_verification_limits_and_warns_of_too_few_setpoints(write
     assert main(["plan", str(write("tiny.yaml", text))]) == 0
     out = capsys.readouterr().out
     assert "verify     8 poses (sphere, listed as v1…) at every calibration setpoint and at 30 °C: 24 in all" in out
-    assert "accept     max_drift_mg 0.2; a partial campaign fails" in out
+    assert "accept     max_drift_mg 0.2; simple acceptance (no decision_rule stated); a partial campaign fails" in out
     assert "warning    2 calibration setpoints cannot fix a degree-2 polynomial: the fit will use degree 1" in out
     assert len([line for line in out.splitlines() if re.match(r"^\s+v[1-8]\s+-?\d", line)]) == 8
 

@@ -24,6 +24,6 @@ def test_bash_completes_commands_actions_and_options() -> None:
     script = subprocess.run([RIG, "completion", "bash"], capture_output=True, text=True, check=True).stdout
     assert complete(script, "re") == ["registry", "repair", "report", "resume"]
     assert complete(script, "registry", "s") == ["show", "stats"]
-    assert complete(script, "registry", "list", "--s") == ["--serial", "--since"]
+    assert complete(script, "registry", "list", "--s") == ["--serial", "--simulated", "--since"]
     assert "--chamber-profile" in complete(script, "run", "--c")
     assert complete(script, "analyze", "t") == ["tilt"]

@@ -27,7 +27,7 @@ def test_a_dut_beyond_its_limits_fails_and_fail_on_reject_exits_3(write, workdir
     assert main(["run", str(procedure), "--dry-run", "-o", str(campaign), "-q", "--fail-on-reject"]) == 3
     out, err = capsys.readouterr()
     assert "4 PASS" not in out and "0 PASS, 4 FAIL" in out
-    assert out.count("  verdict    ") == 4 and "FAIL: verification |g| RMSE" in out and "> 0.001 mg" in out
+    assert out.count("  verdict    ") == 4 and "FAIL: verification |g| RMSE" in out and "limit ≤ 0.001 mg: fail" in out
     assert "4 DUT(s) failed their acceptance limits" in err
 
     assert main(["status", str(campaign), "--json"]) == 0
@@ -114,3 +114,33 @@ def test_without_limits_nothing_is_judged_and_nothing_is_stated_as_conformity(wr
     assert main(["registry", "stats", "--part", "adxl355", "--registry", str(registry), "--json", "--simulated"]) == 0
     stats = json.loads(capsys.readouterr().out)["channels"]["accel"]
     assert (stats["calibrations"], stats["judged"], stats["passed"], stats["yield"]) == (4, 0, 0, None)
+
+
+def test_a_limit_inside_the_guard_band_is_conditional_under_guarded_and_pass_under_simple_acceptance(
+        write, workdir: Path, capsys) -> None:
+    """The same simulated campaign three times (its seed fixed): once to learn each DUT's bias at 30 °C and its
+    expanded uncertainty, then with a bias limit half a U beyond the largest, judged by each rule."""
+    def run(name: str, acceptance: str) -> dict:
+        procedure = write(f"{name}.yaml", VERIFIED.split("acceptance:")[0] + f"acceptance: {acceptance}\n")
+        campaign = workdir / f"{name}.h5"
+        assert main(["run", str(procedure), "--dry-run", "-o", str(campaign), "-q", "--no-pdf"]) == 0
+        capsys.readouterr()
+        assert main(["fit", str(campaign), "-o", str(workdir / f"{name}.yaml.cal"), "--json"]) == 0
+        return json.loads(capsys.readouterr().out)
+
+    learned = run("learn", "{decision_rule: guarded, parameters: {at_c: 30, bias_mg: 1000}}")
+    biases = [(serial, c) for serial, sensor in learned.items() for c in sensor["decision"]["limits"]]
+    assert {c["limit_key"] for _, c in biases} == {"parameters.bias_mg"} and len(biases) == 3 * len(learned)
+    assert all(c["outcome"] == "pass" and c["expanded_u"] > 0 for _, c in biases)
+    serial, largest = max(biases, key=lambda b: abs(b[1]["value"]))
+    limit = abs(largest["value"]) + 0.5 * largest["expanded_u"]
+
+    guarded = run("guarded", f"{{decision_rule: guarded, parameters: {{at_c: 30, bias_mg: {limit!r}}}}}")
+    simple = run("simple", f"{{decision_rule: simple, parameters: {{at_c: 30, bias_mg: {limit!r}}}}}")
+    same = next(c for c in guarded[serial]["decision"]["limits"] if c["label"] == largest["label"])
+    assert same["value"] == largest["value"]                       # the same measurements, judged again
+    assert guarded[serial]["verdict"] == "CONDITIONAL" and same["outcome"] == "conditional pass"
+    assert "guarded acceptance" in guarded[serial]["decision"]["decision_rule"]
+    assert simple[serial]["verdict"] == "PASS" and "simple acceptance" in simple[serial]["decision"]["decision_rule"]
+    assert any("conditional pass" in r for r in guarded[serial]["verdict_reasons"])
+    assert load_calibration(workdir / "guarded.yaml.cal").sensor(serial).verdict == "CONDITIONAL"

@@ -39,6 +39,13 @@ def _add_run(commands: Commands) -> None:
     run.add_argument("--resume", action="store_true",
                      help="continue the campaign in the output file if it exists (after a crash, a fault or "
                           "Ctrl-C), else start it")
+    run.add_argument("--customer", metavar="NAME", default="",
+                     help="whose DUTs they are, for every DUT whose fixture entry names no customer (recorded in the "
+                          "campaign file, stated on the certificates)")
+    run.add_argument("--received", metavar="YYYY-MM-DD", default="",
+                     help="when the DUTs were received, for every DUT whose fixture entry has no received_date")
+    run.add_argument("--condition", metavar="TEXT", default="",
+                     help="the DUTs' condition on receipt, for every DUT whose fixture entry states none")
     campaign_output_options(run)
 
 

@@ -13,7 +13,8 @@ FAULTS_HELP = ("fault injection into the simulators, e.g. rate=0.05,kinds=drop+c
                "chamber_stall_after_min=60 (keys of simulation.faults)")
 
 REGISTRY_HELP = ("the registry: a postgresql:// URL or an SQLite file (default: the rig config's registry:, "
-                 "else $ACCELCAL_REGISTRY, else ~/.local/share/accelcal-rig/registry.sqlite)")
+                 "else $ACCELCAL_REGISTRY, else ~/.local/share/accelcal-rig/registry.sqlite; a dry run's "
+                 "calibrations: $ACCELCAL_DRY_RUN_REGISTRY, else dry-runs.sqlite beside that file)")
 
 #: The built-in chamber profiles a dry run or `rig sim` may swap in (accelcal_rig.protocols.chamber_registers).
 CHAMBER_PROFILE_HELP = ("simulate a chamber of this built-in profile instead of the rig's (watlow-f4, watlow-f4t, "

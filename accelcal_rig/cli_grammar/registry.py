@@ -5,11 +5,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from accelcal_rig.cli_grammar.approval import add_approval_actions
 from accelcal_rig.cli_grammar.common import Commands, command, number, registry_option
 
 
 def add_registry_commands(commands: Commands) -> None:
-    """`rig registry add | list | show | export | trend | stats`."""
+    """`rig registry add | list | show | export | trend | stats | user | audit | certificate`."""
     registry = command(commands, "registry", "the lab's calibrations by serial number: add, list, show, export, "
                        "trend, stats",
                        "Every finished fit is recorded by DUT serial: rig run, rig fit and rig fit-recording do it "
@@ -20,6 +21,7 @@ def add_registry_commands(commands: Commands) -> None:
     actions = registry.add_subparsers(dest="registry_command", required=True, metavar="ACTION")
     for add in (_add_add, _add_list, _add_show, _add_export, _add_trend, _add_stats):
         add(actions)
+    add_approval_actions(actions)   # user, audit, certificate
 
 
 def _action(actions: Commands, name: str, summary: str, example: str) -> argparse.ArgumentParser:
@@ -42,9 +44,16 @@ def _add_list(actions: Commands) -> None:
     listing.add_argument("--serial", help="only this DUT")
     listing.add_argument("--part", help="only this part (adxl355, adxl357, …)")
     listing.add_argument("--since", metavar="DATE", help="only those calibrated on or after this date (YYYY-MM-DD)")
-    listing.add_argument("--verdict", choices=["PASS", "FAIL"], help="only those with this verdict")
+    listing.add_argument("--verdict", choices=["PASS", "FAIL", "CONDITIONAL", "NOT JUDGED"],
+                         help="only those with this verdict (CONDITIONAL: inside a guard band; NOT JUDGED: no "
+                              "acceptance limits stated)")
     listing.add_argument("--limit", type=number(1, 10_000_000, integer=True), help="at most this many")
     _channel_option(listing)
+    made = listing.add_mutually_exclusive_group()
+    made.add_argument("--simulated", dest="made", action="store_const", const=True,
+                      help="only dry runs (simulated campaigns)")
+    made.add_argument("--real", dest="made", action="store_const", const=False,
+                      help="only calibrations measured on a real rig")
     listing.add_argument("--json", action="store_true", help="one JSON list")
 
 
@@ -74,6 +83,8 @@ def _add_trend(actions: Commands) -> None:
                     "rig registry trend ADX355-A001")
     trend.add_argument("serial")
     _channel_option(trend)
+    trend.add_argument("--min-span-days", type=number(0, 36525, "days"), metavar="DAYS",
+                       help="state a drift per year only from calibrations spanning at least this long (default 30)")
     trend.add_argument("--json", action="store_true", help="one JSON object")
     _simulated_option(trend)
 

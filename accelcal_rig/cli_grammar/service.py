@@ -38,3 +38,8 @@ def add_serve_command(commands: Commands) -> None:
                                        "$ACCELCAL_DASHBOARD_TOKEN)")
     serve.add_argument("--tls-cert", type=Path, help="TLS certificate (PEM), with --tls-key: serve HTTPS")
     serve.add_argument("--tls-key", type=Path, help="its private key (PEM)")
+    serve.add_argument("--user-header", metavar="HEADER",
+                       help="the lab's reverse proxy authenticates users and names them in this header (e.g. "
+                            "X-Remote-User): approvers are those the registry gives the approver role. Use only "
+                            "behind a proxy that sets it and strips it from what clients send; without it, "
+                            "approvers log in with their registry password")

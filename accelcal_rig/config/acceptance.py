@@ -3,6 +3,8 @@ pass."""
 
 from __future__ import annotations
 
+from typing import Literal
+
 from pydantic import Field, field_validator, model_validator
 
 from accelcal_rig.config.bounds import StrictModel, TemperatureC
@@ -95,6 +97,22 @@ class Acceptance(StrictModel):
     parameters: ParameterLimits | None = None
     gyro: GyroAcceptance | None = Field(None, description="a gyroscope's limits (a procedure with rates:)")
     allow_partial: bool = Field(False, description="a campaign that stopped before its last pose may pass")
+    decision_rule: Literal["simple", "guarded"] | None = Field(
+        None, description="how each figure's expanded uncertainty is taken into its verdict (ILAC-G8:09/2019): "
+                          "simple acceptance, or guarded acceptance with a guard band of guard_band_factor × U; "
+                          "stated on the certificate (none stated: simple, and said so)")
+    guard_band_factor: float = Field(1.0, gt=0, le=3, description="guarded acceptance: the guard band in "
+                                                                  "expanded uncertainties (k = 2)")
+
+    @model_validator(mode="after")
+    def _guard_band_guards(self) -> Acceptance:
+        if self.guard_band_factor != 1.0 and self.decision_rule != "guarded":
+            raise ValueError("acceptance.guard_band_factor is the guard band of decision_rule: guarded")
+        return self
+
+    def states_limits(self) -> bool:
+        """Whether any limit is stated (a rule without one judges nothing)."""
+        return bool(self.verification_limits()) or self.parameters is not None or self.gyro is not None
 
     def verification_limits(self) -> list[str]:
         """The keys of the limits that need verification poses."""

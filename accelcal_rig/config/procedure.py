@@ -164,6 +164,9 @@ class Procedure(StrictModel):
     """A whole campaign. Setpoints run in the order given."""
 
     name: str = Field(min_length=1, max_length=128, pattern=r"^[A-Za-z0-9_.-]+$")
+    version: str = Field("", max_length=32, pattern=r"^[A-Za-z0-9_.+-]*$", description="the procedure's version "
+                         "(its revision under the lab's document control), quoted text; empty: certificates say it "
+                         "is not stated")
     description: str = Field("", max_length=10_000)
     rig: str = Field(min_length=1, max_length=4096, pattern=r"^[^\x00]+$",
                      description="rig config path, relative to this file")
@@ -331,6 +334,14 @@ class Procedure(StrictModel):
         if self.verify is None or self.ramp is None or self.verify.on_ramp:
             return self.bands()
         return 2
+
+    @field_validator("version", mode="before")
+    @classmethod
+    def _version_as_written(cls, value: object) -> object:
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            raise ValueError(f"write it as quoted text, version: \"{value}\" (a bare number loses what a version "
+                             "means: 1.10 would read 1.1)")
+        return value
 
     @field_validator("setpoints_c", mode="before")
     @classmethod

@@ -9,6 +9,7 @@ import numpy as np
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from accelcal_rig.config.bounds import AngleDeg, Baudrate, StrictModel, TemperatureC, TimeoutS
+from accelcal_rig.config.lab import ONE_LINE, InstrumentIdentity, IsoDate, LabConfig, References
 from accelcal_rig.core.thermal import dut_time_constant_s
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
 from accelcal_rig.parts.registry import DEFAULT_PART, part
@@ -37,8 +38,9 @@ def _known_driver(kind: Kind) -> classmethod:
 ChamberProfile = Literal["watlow-f4", "watlow-f4t", "espec-p300", "thermotron-8800", "simserv", "watlow-f4t-scpi"]
 
 
-class ChamberConfig(StrictModel):
-    """Thermal chamber: how to reach its controller, its register map, limits and dynamics."""
+class ChamberConfig(InstrumentIdentity):
+    """Thermal chamber: what it is (make, model, serial), how to reach its controller, its register map, limits
+    and dynamics."""
 
     driver: str = Field("modbus-tcp", max_length=64, description="a chamber driver (accelcal_rig.plugins)")
     _driver = _known_driver("chamber")
@@ -143,8 +145,9 @@ class TurntableAxis(StrictModel):
         return self.continuous or self.min_deg <= angle_deg <= self.max_deg
 
 
-class TurntableConfig(StrictModel):
-    """A chain of rotary axes, outermost first; the fixture sits on the innermost axis."""
+class TurntableConfig(InstrumentIdentity):
+    """What the table is (make, model, serial) and its chain of rotary axes, outermost first; the fixture sits on
+    the innermost axis."""
 
     driver: str = Field("serial", max_length=64, description="a turntable driver (accelcal_rig.plugins)")
     _driver = _known_driver("turntable")
@@ -194,6 +197,12 @@ class SensorConfig(StrictModel):
     spi_speed_hz: int = Field(5_000_000, ge=1000, le=10_000_000)
     timeout_s: TimeoutS = 1.0
     mount_euler_deg: tuple[AngleDeg, AngleDeg, AngleDeg] = (0.0, 0.0, 0.0)
+    customer: str = Field("", max_length=200, pattern=ONE_LINE, description="whose item it is (its certificate states "
+                          "it); empty: rig run --customer's, else not stated")
+    received_date: IsoDate | None = Field(None, description="when the laboratory received the item (YYYY-MM-DD); "
+                                          "unset: rig run --received's, else not stated")
+    condition: str = Field("", max_length=500, pattern=ONE_LINE, description="the item's condition on receipt (e.g. "
+                           "'no visible damage'); empty: rig run --condition's, else not stated")
 
     @field_validator("part")
     @classmethod
@@ -356,6 +365,12 @@ class RigConfig(StrictModel):
     heading_deg: float | None = Field(None, ge=-360, le=360, description="the azimuth of the table's x axis (world "
                                       "x at zero angles), degrees east of true north: with latitude_deg, the Earth's "
                                       "horizontal rate (cos(latitude) × 15.04 °/h) is part of the reference too")
+    lab: LabConfig | None = Field(None, description="the laboratory and the place of calibration its certificates "
+                                  "state; unset: they say it is not stated")
+    references: References = Field(References(), description="each reference's certificate, issuer and due date "
+                                   "(the certificates' traceability)")
+    references_overdue: Literal["warn", "refuse"] = Field("warn", description="a reference past its due date: rig "
+                                                          "plan and rig run warn, or refuse to run")
 
     @model_validator(mode="after")
     def _cooling_floor_below_the_chamber(self) -> RigConfig:

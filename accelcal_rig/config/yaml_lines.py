@@ -25,6 +25,14 @@ MAX_DEPTH = 32
 MAX_NODES = 100_000
 
 
+class PersonLoader(yaml.SafeLoader):
+    """A person's file: a date is read as its text, so the model validating it names the key and line of a bad
+    one (`due_date: 2025-13-01`) instead of the YAML parser failing on it at line 1."""
+
+
+PersonLoader.add_constructor("tag:yaml.org,2002:timestamp", PersonLoader.construct_yaml_str)
+
+
 @dataclass(frozen=True)
 class YamlLimits:
     """How large a file of one kind may be: what a person writes (procedures, rig configs) or what the
@@ -38,7 +46,7 @@ class YamlLimits:
 
     @property
     def loader(self) -> type:
-        return getattr(yaml, "CSafeLoader", yaml.SafeLoader) if self.machine_written else yaml.SafeLoader
+        return getattr(yaml, "CSafeLoader", yaml.SafeLoader) if self.machine_written else PersonLoader
 
 
 CONFIG_LIMITS = YamlLimits(MAX_FILE_BYTES, MAX_NODES)

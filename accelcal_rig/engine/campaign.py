@@ -40,6 +40,7 @@ from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, Tran
 from accelcal_rig.instruments.capabilities import controller_limits
 from accelcal_rig.instruments.interfaces import DeviceIdentity, Sensor
 from accelcal_rig.plan.compile import Plan, setpoint_label
+from accelcal_rig.plan.composition import plan_composition
 from accelcal_rig.plan.steps import Measurement
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.writer import CampaignWriter
@@ -142,9 +143,9 @@ class CampaignRunner:
         self.context = RunContext(self.procedure, self.rig, self.plan, guarded.instruments, guarded.retrier,
                                   self.clock, events, self.writer, self.machine, self.report)
         self.writer.set_state("running")
-        events.info("plan", f"{len(self.plan.setpoints_c)} setpoints × {len(self.plan.poses)} poses = "
-                            f"{len(self.plan.pose_steps)} poses, {len(self.context.sensors)} DUTs, "
-                            f"{self.procedure.acquisition.samples_per_pose} samples per pose")
+        events.info("plan", f"{len(self.plan.setpoints_c)} setpoints; {plan_composition(self.plan)}; "
+                            f"{len(self.context.sensors)} DUTs, {self.procedure.acquisition.samples_per_pose} samples "
+                            "per pose")
         run = f" (run {self.resume.run}, resuming after {self.report.poses_done} stored poses)" if self.resume else ""
         estimate = (f", about {format_duration(self.report.remaining_s(self.machine.state) or 0.0)}"
                     if self.report.audience.estimate else "")

@@ -1,6 +1,8 @@
 """What a new campaign file records about itself before the first step: the procedure and rig as written,
-the plan, the DUTs and their parts, the instruments, the fit options, and in a dry run the simulation's
-truth."""
+the plan, the DUTs and their parts (whose each is, when it arrived and in what condition), the instruments by
+make, model and serial, the laboratory, the references and their certificates, the fit options, and in a dry
+run the simulation's truth: what a certificate states, read from the campaign rather than from today's
+config files."""
 
 from __future__ import annotations
 
@@ -8,7 +10,10 @@ from pathlib import Path
 
 import numpy as np
 
+from accelcal_rig.config.lab import Receipt, ReferenceConfig
 from accelcal_rig.config.procedure import Procedure
+from accelcal_rig.config.rig import RigConfig, SensorConfig
+from accelcal_rig.config.traceability import expected_references
 from accelcal_rig.engine.connection import ConnectedRig
 from accelcal_rig.engine.preparation import PreparedCampaign
 from accelcal_rig.fit.recorded_options import options_attrs
@@ -19,11 +24,35 @@ from accelcal_rig.store.records import ChannelInfo, StoredPlan
 from accelcal_rig.store.writer import CampaignWriter
 
 
-def instrument_info(instruments: RigInstruments) -> dict[str, dict[str, str]]:
+def instrument_info(instruments: RigInstruments, rig: RigConfig) -> dict[str, dict[str, str]]:
+    """Each instrument as the run reached it (driver, endpoint: for the lab) and as the rig config names it
+    (make, model, serial: for a certificate)."""
     return {
-        "chamber": {"driver": type(instruments.chamber).__name__, "endpoint": instruments.chamber.endpoint},
-        "turntable": {"driver": type(instruments.turntable).__name__, "endpoint": instruments.turntable.endpoint},
+        name: {"driver": type(reached).__name__, "endpoint": reached.endpoint,
+               "make": config.make, "model": config.model, "serial": config.serial}
+        for name, reached, config in (("chamber", instruments.chamber, rig.chamber),
+                                      ("turntable", instruments.turntable, rig.turntable))
     }
+
+
+def reference_info(rig: RigConfig) -> dict[str, dict[str, str]]:
+    """Each reference the rig's campaigns rely on, as its certificate states it ({}: not stated in the rig config)."""
+    def info(reference: ReferenceConfig | None) -> dict[str, str]:
+        if reference is None:
+            return {}
+        return {"certificate": reference.certificate, "issuer": reference.issuer,
+                "due_date": reference.due_date.isoformat(), "make": reference.make, "model": reference.model,
+                "serial": reference.serial}
+
+    return {key: info(getattr(rig.references, key)) for key in expected_references(rig)}
+
+
+def receipt_info(sensor: SensorConfig, default: Receipt) -> dict[str, str]:
+    """Whose the DUT is, when it was received and in what condition: its fixture entry's, else the campaign's
+    (`rig run --customer` …); "" for what neither states."""
+    received = sensor.received_date or default.received_date
+    return {"customer": sensor.customer or default.customer, "received_date": received.isoformat() if received else "",
+            "condition": sensor.condition or default.condition}
 
 
 def create_campaign_file(prepared: PreparedCampaign, output: Path, connected: ConnectedRig, *,
@@ -36,7 +65,7 @@ def create_campaign_file(prepared: PreparedCampaign, output: Path, connected: Co
         {"serial": s.serial, "name": mounts[s.serial].name, "mount_euler_deg": list(mounts[s.serial].mount_euler_deg),
          "part": s.part.name, "range_g": acquisition.range_g, "odr_hz": acquisition.odr_hz,
          "lsb_g": s.part.channel("accel").lsb(acquisition.range_g),
-         "driver": type(s).__name__, "endpoint": s.endpoint}
+         "driver": type(s).__name__, "endpoint": s.endpoint, **receipt_info(mounts[s.serial], prepared.receipt)}
         for s in instruments.sensors
     ]
     ranges = acquisition.ranges()
@@ -44,15 +73,20 @@ def create_campaign_file(prepared: PreparedCampaign, output: Path, connected: Co
                                 for c in s.part.channels) for s in instruments.sensors}
     truth = ({s.serial: instruments.truth.describe(s.serial, acquisition.odr_hz) for s in instruments.sensors}
              if instruments.truth is not None else {})
-    attrs = {"procedure_name": procedure.name, "procedure_path": str(prepared.procedure.path.resolve()),
+    lab = rig.model.lab
+    attrs = {"procedure_name": procedure.name, "procedure_version": procedure.version,
+             "procedure_path": str(prepared.procedure.path.resolve()),
              "rig_name": rig.model.name, "rig_path": str(rig.path.resolve()), "dry_run": dry_run, "seed": seed,
              "clock": clock.kind, "samples_per_pose": acquisition.samples_per_pose,
              "gravity_m_s2": rig.model.gravity_m_s2, "gravity_uncertainty_m_s2": rig.model.gravity_uncertainty_m_s2,
              "chamber_profile": prepared.chamber_profile or "",
+             "lab_name": lab.name if lab else "", "lab_address": lab.address if lab else "",
+             "place_of_calibration": lab.place_of_calibration if lab else "",
              **fit_attrs(procedure)}
     return CampaignWriter.create(
         output, {"attrs": attrs, "procedure_yaml": prepared.procedure.text, "rig_yaml": rig.text,
-                 "plan": stored_plan(prepared.plan), "duts": duts, "instruments": instrument_info(instruments),
+                 "plan": stored_plan(prepared.plan), "duts": duts, "instruments": instrument_info(instruments, rig.model),
+                 "references": reference_info(rig.model),
                  "turntable_accuracy_arcsec": rig.model.turntable.accuracy_arcsec, "truth": truth,
                  "channels": channels},
         overwrite=overwrite, storage=prepared.storage(dry_run))

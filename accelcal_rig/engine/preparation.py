@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from accelcal_rig.config.lab import Receipt
 from accelcal_rig.config.load import (
     LoadedConfig,
     check_procedure_against_rig,
@@ -37,6 +38,9 @@ class PreparedCampaign:
     rig: LoadedConfig[RigConfig]
     plan: Plan
     chamber_profile: str | None = None   # `--chamber-profile`: the rig's chamber swapped for this profile's
+    #: `rig run --customer/--received/--condition`: what the campaign file records of every DUT whose fixture entry
+    #: states none of its own.
+    receipt: Receipt = Receipt()
 
     def storage(self, dry_run: bool) -> StorageEstimate:
         """The disk the campaign will take (a dry run also stores the simulation's truth)."""

@@ -91,7 +91,7 @@ def resume_campaign(prepared: PreparedCampaign, output: Path, connect: RigConnec
         # Noise of a resumed dry run is new noise (the same sensors, not a replay of the first run).
         seed = int(stored.attrs.get("seed", 0)) + 1000 * (reopened.run - 1)
         with connect(seed, reopened.clock_now_s) as rig:
-            writer.record_instruments(instrument_info(rig.instruments))
+            writer.record_instruments(instrument_info(rig.instruments, prepared.rig.model))
             point = ResumePoint(frozenset(writer.stored_step_keys()), reopened.previous_state in ("created", "running"),
                                 reopened.run)
             events = EventLog(rig.clock, writer)

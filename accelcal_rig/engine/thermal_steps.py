@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from accelcal_rig.config.procedure import SoakCriterion
-from accelcal_rig.core.formatting import format_duration
+from accelcal_rig.core.formatting import format_duration, format_fixed
 from accelcal_rig.core.waits import wait_until
 from accelcal_rig.engine.played import EstimateEnds, PlayedRig, SoftwareRampPlayed
 from accelcal_rig.engine.run_context import RunContext, SoftwareRamp
@@ -37,7 +37,7 @@ class RampStep:
         chamber.write_setpoint_c(setpoint_c)
         ramp_s = abs(setpoint_c - start_c) / (run.rig.chamber.ramp_rate_c_per_min / 60.0)
         timeout_s = soak.ramp_timeout_factor * ramp_s + soak.ramp_timeout_margin_min * 60.0
-        run.events.info("ramp", f"ramp {start_c:.1f} → {setpoint_c:g} °C (deadline {format_duration(timeout_s)})")
+        run.events.info("ramp", f"ramp {format_fixed(start_c)} → {setpoint_c:g} °C (deadline {format_duration(timeout_s)})")
 
         def reached() -> bool:
             within = abs(run.read_chamber_c() - setpoint_c) <= soak.chamber_tolerance_c

@@ -9,6 +9,7 @@ temperature read as the poses' were (once at its start and once at its end).
 
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -24,6 +25,7 @@ from accelcal_rig.fit.uncertainty import (
     coefficient_covariance,
     combined,
     joint_map,
+    model_variance,
     output_uncertainty,
     two_stage_map,
 )
@@ -40,21 +42,61 @@ def fitted_powers(thermal: ThermalModel, n_setpoints: int, joint: bool) -> int:
     return thermal.coefficients.shape[1] if joint else min(thermal.degree, n_setpoints - 1) + 1
 
 
+@dataclass(frozen=True)
+class FittedTerms:
+    """What a joint fit took off each calibration pose's reading beside Eq. 1 (fit_joint, `fit.hysteresis`):
+    a bias of ±h by the direction the pose's temperature was approached from and one of c × its rate of
+    temperature change."""
+
+    approach: np.ndarray              # (N,) +1 warming, −1 cooling, of the calibration poses
+    hysteresis_g: np.ndarray          # (3,) h per axis, g
+    rate_c_per_min: np.ndarray        # (N,) each calibration pose's rate of temperature change
+    rate_g: np.ndarray                # (3,) c per axis, g per °C/min
+
+    def shift_g(self) -> np.ndarray:
+        """(N, 3) what the terms add to each pose's reading."""
+        return self.approach[:, None] * self.hysteresis_g + self.rate_c_per_min[:, None] * self.rate_g
+
+
 def calibration_covariance(poses: DutPoses, groups: list[np.ndarray], fits: list[SfemFit], thermal: ThermalModel,
                            temperatures: np.ndarray, pose_temperatures: np.ndarray, mode: FitMode,
-                           joint: bool) -> CoefficientCovariance:
-    """The coefficients' covariance by source, for the estimator the fit used."""
+                           joint: bool, terms: FittedTerms | None = None) -> CoefficientCovariance:
+    """The coefficients' covariance by source, for the estimator the fit used.
+
+    `terms`: what a joint fit took off the readings beside the thermal model (its hysteresis and rate). The
+    residuals are then those of the fit as fitted (a term fitted is no scatter beyond the noise); the map to
+    the coefficients is the fit's own, the terms' columns in it (estimating h and c beside the bias costs
+    the bias what they share with it); and the hysteresis becomes a source (hysteresis_u_g).
+
+    The thermal model's term of a joint fit (which has no per-setpoint estimates about a polynomial to
+    check): each band's offset about the model, as a bias (band_misfit), where it is (model_variance), at
+    the band's mean temperature. Its size comes from the calibration poses' own residuals. Readings taken
+    while the temperature moves (its rate, a hysteresis swinging after a turn and relaxing) leave a misfit
+    common to a band's poses, which χ² (`scatter_beyond_noise`) spreads over every pose as if it were
+    independent from pose to pose, and so averages away. Not counted twice: `scatter_beyond_noise` is what
+    that misfit costs the coefficients' estimate, `thermal_model` what it costs a reading the model does not
+    describe (the two parts of a prediction's uncertainty); and the terms' own share is taken off first."""
     free = fits[0].free
     n_powers = fitted_powers(thermal, len(groups), joint)
     sigmas = np.array([f.sigma for f in fits])
     rows = np.concatenate(groups)
+    per_pose_rows = 3 if mode == "reference" else 1
+    shift = terms.shift_g() if terms is not None else np.zeros((len(poses.mean_g), 3))
+    n_coefficients = int(np.sum(free)) * n_powers
     if joint:
         powers = [np.vander(thermal.scaled(pose_temperatures[g]), n_powers, increasing=True) for g in groups]
-        mapping = joint_map(thermal_jacobian([f.jacobian for f in fits], powers, 3 if mode == "reference" else 1))
+        jacobian = thermal_jacobian([f.jacobian for f in fits], powers, per_pose_rows)
+        if terms is not None:  # a term shifts the reading as the bias does: its column is the bias's × its factor
+            bias = np.vstack([f.jacobian[:, 0:3] for f in fits])
+            jacobian = np.hstack([jacobian] + [np.repeat(factor[rows], per_pose_rows)[:, None] * bias
+                                               for factor in (terms.approach, terms.rate_c_per_min)])
+        mapping = joint_map(jacobian)
+        residual_model = np.zeros((len(groups), 12))  # no per-setpoint estimates to compare: band_misfit
     else:
         mapping = two_stage_map([f.jacobian for f in fits], thermal.scaled(temperatures), sigmas, free, n_powers)
+        residual_model = thermal.residuals if len(thermal.residuals) else np.zeros((0, 12))
     accuracy = np.radians(poses.reference_accuracy_arcsec / 3600)
-    compensated = correct(poses.mean_g[rows], thermal.parameters_at(pose_temperatures[rows], "extrapolate"))
+    compensated = correct(poses.mean_g[rows] - shift[rows], thermal.parameters_at(pose_temperatures[rows], "extrapolate"))
     if mode == "reference":
         reference = poses.reference_g[rows]
         sigma = reference_sigma_g(np.maximum(poses.stderr_g[rows], 1e-9), reference, accuracy)
@@ -63,9 +105,56 @@ def calibration_covariance(poses: DutPoses, groups: list[np.ndarray], fits: list
         reference = None
         residuals = (np.linalg.norm(compensated, axis=1) - poses.gravity_g) / norm_sigma(poses.mean_g[rows],
                                                                                           poses.stderr_g[rows])
-    residual_model = thermal.residuals if len(thermal.residuals) else np.zeros((0, 12))
-    return coefficient_covariance(mapping, reference, poses.stderr_g[rows], accuracy, free, n_powers, residuals,
-                                  residual_model, sigmas)
+    found = coefficient_covariance(mapping, reference, poses.stderr_g[rows], accuracy, free, n_powers, residuals,
+                                   residual_model, sigmas, temperatures)
+    if joint:  # the bands' own biases about the model: the polynomial's and the terms' coefficients fitted per axis
+        offsets, offset_sigma, left = band_misfit(residuals, jacobian, [f.jacobian[:, 0:3] for f in fits])
+        bias = np.zeros(12, dtype=bool)
+        bias[0:3] = True
+        variance, local = model_variance(offsets, offset_sigma, bias, n_powers + (2 if terms is not None else 0),
+                                         left)
+        found = replace(found, model_variance=variance, model_temperatures_c=np.asarray(temperatures, dtype=float),
+                        model_variance_by_temperature=local)
+    if mapping.shape[0] == n_coefficients:
+        return found
+    coefficients = slice(0, n_coefficients)
+    total = found.noise + found.pointing + found.excess
+    h_variance = np.diagonal(total)[n_coefficients:n_coefficients + 3]
+    assert terms is not None
+    return replace(found, noise=found.noise[coefficients, coefficients],
+                   pointing=found.pointing[coefficients, coefficients], excess=found.excess[coefficients, coefficients],
+                   hysteresis=hysteresis_u_g(terms.hysteresis_g, h_variance))
+
+
+def band_misfit(residuals: np.ndarray, jacobian: np.ndarray,
+                bias_jacobians: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A joint fit's misfit common to a band's poses, as a bias: each band's whitened residuals (in the order
+    of `bias_jacobians`, each band's rows of ∂residual/∂bias; `jacobian` the whole fit's) fitted by a bias
+    of its own. (K, 12) each: the offsets δ on the bias parameters (zero on the others), their 1σ were they
+    free, and the 1σ noise alone leaves in them after the fit (one on the others): model_variance's
+    residuals, sigma and residual_sigma, as it takes the per-setpoint estimates about their polynomial."""
+    q, _ = np.linalg.qr(jacobian)
+    count = len(bias_jacobians)
+    offsets, sigma, left = np.zeros((count, 12)), np.ones((count, 12)), np.ones((count, 12))
+    start = 0
+    for k, bias in enumerate(bias_jacobians):
+        rows = slice(start, start + len(bias))
+        start += len(bias)
+        inverse = np.linalg.inv(bias.T @ bias)
+        offsets[k, 0:3] = inverse @ bias.T @ residuals[rows]
+        sigma[k, 0:3] = np.sqrt(np.diagonal(inverse))
+        shared = q[rows].T @ bias                                  # what the fit's own coefficients take of it
+        left[k, 0:3] = np.sqrt(np.maximum(np.diagonal(inverse @ (bias.T @ bias - shared.T @ shared) @ inverse), 0.0))
+    return offsets, sigma, left
+
+
+def hysteresis_u_g(h_g: np.ndarray, h_variance_g2: np.ndarray) -> np.ndarray:
+    """(3,) The standard uncertainty of a reading's hysteresis, per axis, in g: a reading at rest after its
+    temperature moved lies on one branch, ±h from the calibration (a bidirectional fit's, the mean of both
+    branches), the side unknown to whoever applies it: a two-valued error of standard deviation h. With h
+    known only as its estimate ĥ ± u(ĥ), the expectation of h² is ĥ² + u(ĥ)². A reading long at rest, its
+    hysteresis relaxed, is nearer the middle: the term is then an upper bound."""
+    return np.sqrt(np.asarray(h_g, dtype=float) ** 2 + np.maximum(np.asarray(h_variance_g2, dtype=float), 0.0))
 
 
 def temperature_scatter_c(poses: DutPoses, pose_temperatures: np.ndarray, n_groups: int) -> float:
@@ -121,15 +210,46 @@ def budget(poses: DutPoses, covariance: CoefficientCovariance, thermal: ThermalM
         "expanded_mg": [COVERAGE_FACTOR * u for u in worst(standard, everywhere)],
         "worst_at_c": grid[np.argmax(per_temperature, axis=0)].tolist(),
         "by_temperature": rows,
+        "not_included": not_included(poses, covariance),
     }
 
 
-def truth_coverage(checks: DutPoses, covariance: CoefficientCovariance, thermal: ThermalModel,
-                   compensated_g: np.ndarray, temperature_c: np.ndarray, temperature_u_c: np.ndarray,
-                   mode: FitMode, out_of_range: OutOfRange) -> float | None:
-    """Dry runs: the fraction of verification-pose axis errors against the simulation truth inside each pose's
-    expanded uncertainty. The truth is what the true parameters, in the fit's gauge, make of the noiseless
-    reading: the true gravity itself in reference mode."""
+#: Poses whose temperature moved faster than this were taken on a ramp (the loosest shipped soak criterion,
+#: fast-bidirectional-ramp's `max_rate_c_per_min`, lets a soaked DUT move this much).
+MOVING_C_PER_MIN = 0.1
+
+
+def not_included(poses: DutPoses, covariance: CoefficientCovariance) -> dict[str, str]:
+    """What the budget leaves out because this calibration cannot measure it, each with why: the
+    hysteresis where no fit measured it; the bias by the rate of temperature change where the calibration
+    poses were taken while it moved and no fit measured it."""
+    if covariance.hysteresis is not None:
+        return {}
+    missing = {"hysteresis": "not measured: a calibration that approaches each temperature from one side "
+                             "cannot tell it from the bias (a bidirectional ramp's fit measures it); a reading "
+                             "at rest that came to its temperature from the other side may differ by as much "
+                             "as the sensor's hysteresis"}
+    rates = []
+    for setpoint in dict.fromkeys(poses.setpoint_c.tolist()):
+        group = poses.setpoint_c == setpoint
+        if group.sum() >= 3 and np.ptp(poses.t_s[group]) > 0:
+            rates.append(60.0 * np.polyfit(poses.t_s[group], poses.temperature_c[group], 1)[0])
+    rate = float(np.median(np.abs(rates))) if rates else 0.0
+    if rate > MOVING_C_PER_MIN:
+        missing["rate_of_change"] = (
+            f"not measured: the calibration poses were taken while the temperature moved ({rate:.2f} °C/min, "
+            "median), and a bias per °C/min cannot be told from the bias at one rate (a bidirectional ramp's fit "
+            "measures it); a reading at rest differs by it times that rate")
+    return missing
+
+
+def truth_errors(checks: DutPoses, covariance: CoefficientCovariance, thermal: ThermalModel,
+                 compensated_g: np.ndarray, temperature_c: np.ndarray, temperature_u_c: np.ndarray,
+                 mode: FitMode, out_of_range: OutOfRange) -> tuple[np.ndarray, dict[str, np.ndarray]] | None:
+    """Dry runs: each verification pose's axis errors (n, 3) in g against the simulation truth, and the
+    budget's sources of its standard uncertainty (output_uncertainty); None without a truth. The truth is
+    what the true parameters, in the fit's gauge, make of the noiseless reading: the true gravity itself in
+    reference mode."""
     if checks.truth_parameters is None or checks.truth_gravity_g is None:
         return None
     truth = checks.truth_parameters
@@ -137,5 +257,17 @@ def truth_coverage(checks: DutPoses, covariance: CoefficientCovariance, thermal:
     expected = correct(distort(checks.truth_gravity_g, truth), gauge)
     sources = output_uncertainty(checks.mean_g, temperature_c, thermal, covariance, checks.stderr_g, temperature_u_c,
                                  checks.gravity_uncertainty_g / checks.gravity_g, out_of_range)
-    inside = np.abs(compensated_g - expected) <= COVERAGE_FACTOR * combined(sources)
-    return float(np.mean(inside))
+    return compensated_g - expected, sources
+
+
+def truth_coverage(checks: DutPoses, covariance: CoefficientCovariance, thermal: ThermalModel,
+                   compensated_g: np.ndarray, temperature_c: np.ndarray, temperature_u_c: np.ndarray,
+                   mode: FitMode, out_of_range: OutOfRange) -> float | None:
+    """Dry runs: the fraction of verification-pose axis errors against the simulation truth (truth_errors)
+    inside each pose's expanded uncertainty."""
+    found = truth_errors(checks, covariance, thermal, compensated_g, temperature_c, temperature_u_c, mode,
+                         out_of_range)
+    if found is None:
+        return None
+    errors, sources = found
+    return float(np.mean(np.abs(errors) <= COVERAGE_FACTOR * combined(sources)))

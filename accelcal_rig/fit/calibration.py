@@ -105,6 +105,10 @@ def _within_validity(polynomial: PolynomialModel, validity_c: tuple[float, float
     return polynomial.at(temperature_c)
 
 
+#: A sensor's verdict: CONDITIONAL where guarded acceptance leaves a figure inside its guard band.
+VerdictName = Literal["PASS", "FAIL", "CONDITIONAL", "NOT JUDGED"]
+
+
 class SensorCalibration(StrictModel):
     serial: str = Field(min_length=1, max_length=128)
     mode: Literal["reference", "norm-only"]
@@ -117,9 +121,11 @@ class SensorCalibration(StrictModel):
     setpoints: list[SetpointFit]
     metrics: dict[str, Any] = {}
     warnings: list[str] = []
-    verdict: Literal["PASS", "FAIL", "NOT JUDGED"] | None = Field(None, description="against the procedure's "
-                                                                   "acceptance limits (NOT JUDGED: it states none)")
+    verdict: VerdictName | None = Field(None, description="against the procedure's acceptance limits under its "
+                                                          "decision rule (NOT JUDGED: it states none)")
     verdict_reasons: list[str] = []
+    decision: dict[str, Any] = Field({}, description="the decision rule as stated and every figure judged: its "
+                                                     "value, expanded uncertainty, limit and outcome")
 
     def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:
         """Eq. 1 parameters (..., 12) at each temperature, as the file's `out_of_range` says outside it."""
@@ -147,8 +153,9 @@ class GyroCalibration(StrictModel):
     gauge: str = Field(max_length=500, description="the frame the sensitivity matrix is relative to")
     metrics: dict[str, Any] = {}
     warnings: list[str] = []
-    verdict: Literal["PASS", "FAIL", "NOT JUDGED"] | None = None
+    verdict: VerdictName | None = None
     verdict_reasons: list[str] = []
+    decision: dict[str, Any] = {}
 
     def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:
         """The model's 27 parameters (..., 27) at each temperature, as the file's `out_of_range` says outside it."""

@@ -11,9 +11,10 @@ import numpy as np
 
 from accelcal_rig import __version__
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
-from accelcal_rig.fit.acceptance import NOT_JUDGED, Judgement, Verdict, judge, recorded_acceptance
+from accelcal_rig.fit.acceptance import NOT_JUDGED, Judgement, combined_verdict, judge, recorded_acceptance
 from accelcal_rig.fit.approach import approach_directions, temperature_rates_c_per_min
 from accelcal_rig.fit.budget import (
+    FittedTerms,
     budget,
     calibration_covariance,
     fitted_powers,
@@ -43,10 +44,11 @@ from accelcal_rig.fit.joint import fit_joint
 from accelcal_rig.fit.lm import FitMode, FreeParameters, SfemFit, fit_sfem, norm_sigma
 from accelcal_rig.fit.metrics import drift_mg, noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.noise_record import noise_allan
+from accelcal_rig.fit.parameter_uncertainty import ParameterUncertainty, certificate_temperatures, of_sensor
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, norm_only_gauge
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
 from accelcal_rig.fit.uncertainty import CoefficientCovariance
-from accelcal_rig.fit.verification import pose_figures
+from accelcal_rig.fit.verification import ReferenceUncertainty, pose_figures
 from accelcal_rig.store.content import Campaign, measurements_sha256
 from accelcal_rig.store.read import DutPoses, read_dut_poses
 from accelcal_rig.store.records import utc_now
@@ -75,6 +77,7 @@ class DutFitResult:
     compensated_g: np.ndarray         # (N, 3) every pose compensated with the polynomial model
     metrics: dict[str, Any]
     calibration: SensorCalibration
+    parameter_u: ParameterUncertainty  # each parameter's own uncertainty at a temperature (limits judge with it)
 
 
 def smoothed_temperatures(poses: DutPoses, groups: list[np.ndarray]) -> np.ndarray:
@@ -144,11 +147,15 @@ def fit_dut(stored: DutPoses, options: FitOptions) -> DutFitResult:
     metrics["in_sample"] = pose_figures(compensated, poses.reference_g, poses.stderr_g, poses.setpoint_c,
                                         pose_temperatures, align, poses.gravity_g)
     joint = options.temperature_model == "joint"
+    terms = FittedTerms(approach, hysteresis_g, rate, rate_g) if approach is not None and rate is not None else None
     covariance = calibration_covariance(poses, groups, fits, thermal, temperatures, pose_temperatures, options.mode,
-                                        joint)
+                                        joint, terms)
     scatter_c = temperature_scatter_c(poses, pose_temperatures, len(groups))
     metrics["uncertainty_budget"] = budget(poses, covariance, thermal, temperatures, scatter_c)
     metrics["expanded_uncertainty_mg"] = metrics["uncertainty_budget"]["expanded_mg"]
+    parameter_u = of_sensor(thermal, covariance, poses.gravity_uncertainty_g / poses.gravity_g)
+    metrics["parameter_uncertainty"] = parameter_u.expanded_table(certificate_temperatures(thermal.domain_c),
+                                                                  list(PARAMETER_NAMES))
     if stored.verification.any():
         checks = stored.subset(stored.verification)
         metrics["verification"], coverage = _verification(checks, thermal, options, covariance, scatter_c)
@@ -171,7 +178,8 @@ def fit_dut(stored: DutPoses, options: FitOptions) -> DutFitResult:
         metrics=_file_metrics(plain(metrics)),
         warnings=thermal.warnings,
     )
-    return DutFitResult(poses.serial, setpoints, temperatures, fits, thermal, compensated, metrics, calibration)
+    return DutFitResult(poses.serial, setpoints, temperatures, fits, thermal, compensated, metrics, calibration,
+                        parameter_u)
 
 
 def _file_metrics(metrics: dict[str, Any]) -> dict[str, Any]:
@@ -208,8 +216,10 @@ def _verification(checks: DutPoses, thermal: ThermalModel, options: FitOptions, 
     groups = [np.flatnonzero(checks.setpoint_c == s) for s in dict.fromkeys(checks.setpoint_c.tolist())]
     temperatures = smoothed_temperatures(checks, groups)
     compensated = correct(checks.mean_g, thermal.parameters_at(temperatures, options.out_of_range))
+    references = ReferenceUncertainty(np.radians(checks.reference_accuracy_arcsec / 3600),
+                                      checks.gravity_uncertainty_g / checks.gravity_g)
     figures = pose_figures(compensated, checks.reference_g, checks.stderr_g, checks.setpoint_c, temperatures,
-                           options.mode == "norm-only", checks.gravity_g)
+                           options.mode == "norm-only", checks.gravity_g, references)
     coverage = truth_coverage(checks, covariance, thermal, compensated, temperatures,
                               smoothed_temperature_u_c(checks.t_s, groups, scatter_c), options.mode, options.out_of_range)
     return figures, coverage
@@ -272,26 +282,27 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     results = map_over_duts(bind(fit_dut, options=options), stored)
     limits = recorded_acceptance(campaign.header.procedure_yaml, source.get("campaign", "the campaign"))
     partial = partial_campaign(campaign, run_end)
-    judged = {r.serial: judge(r.metrics, r.thermal, options.mode, limits, partial) for r in results}
+    judged = {r.serial: judge(r.metrics, r.thermal, options.mode, limits, partial, r.parameter_u) for r in results}
     noise = {serial: {channel: figures for channel in (ACCELERATION, ANGULAR_RATE)
                       if (figures := _noise_figures(campaign, serial, channel)) is not None}
              for serial in campaign.serials}
     gyroscopes = {serial: fit_gyroscope(campaign, serial, options, noise[serial].get(ANGULAR_RATE))
                   for serial in campaign.serials}
-    gyro_verdicts = {serial: judge_gyro(gyro.metrics, gyro.thermal, limits.gyro, partial, limits.allow_partial)
+    gyro_verdicts = {serial: judge_gyro(gyro.metrics, gyro.thermal, limits, partial, gyro.parameter_u)
                      for serial, gyro in gyroscopes.items() if isinstance(gyro, GyroFitResult)}
     uncalibrated = {serial: not_calibrated(campaign, serial, gyroscopes[serial]) for serial in campaign.serials}
     duts = {}
     for r in results:
         accel = r.calibration.model_copy(update={
             "verdict": judged[r.serial].verdict, "verdict_reasons": judged[r.serial].reasons,
+            "decision": judged[r.serial].plain(),
             "metrics": {**r.calibration.metrics, **_allan(noise[r.serial], ACCELERATION)}})
         channels: dict[str, SensorCalibration | GyroCalibration] = {ACCELERATION: accel}
         gyro = gyroscopes[r.serial]
         if isinstance(gyro, GyroFitResult):
             verdict = gyro_verdicts[r.serial]
             channels[ANGULAR_RATE] = gyro.calibration.model_copy(update={
-                "verdict": verdict.verdict, "verdict_reasons": verdict.reasons,
+                "verdict": verdict.verdict, "verdict_reasons": verdict.reasons, "decision": verdict.plain(),
                 "metrics": {**gyro.calibration.metrics, **_allan(noise[r.serial], ANGULAR_RATE)}})
         duts[r.serial] = DutCalibration(channels=channels, not_calibrated=uncalibrated[r.serial])
     calibration = CalibrationFile(
@@ -300,10 +311,11 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     )
     overall = {serial: dut_verdict(judged[serial], gyro_verdicts.get(serial)) for serial in judged}
     report = {r.serial: {**plain(r.metrics), "warnings": r.thermal.warnings, "verdict": overall[r.serial].verdict,
-                         "verdict_reasons": overall[r.serial].reasons,
+                         "verdict_reasons": overall[r.serial].reasons, "decision": judged[r.serial].plain(),
                          **_allan(noise[r.serial], ACCELERATION),
                          **({"gyro": {**gyro.metrics, "verdict": gyro_verdicts[r.serial].verdict,
                                       "verdict_reasons": gyro_verdicts[r.serial].reasons,
+                                      "decision": gyro_verdicts[r.serial].plain(),
                                       **_allan(noise[r.serial], ANGULAR_RATE)}}
                             if isinstance(gyro := gyroscopes[r.serial], GyroFitResult) else {}),
                          **({"not_calibrated": uncalibrated[r.serial]} if uncalibrated[r.serial] else {})}
@@ -312,16 +324,14 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
 
 
 def dut_verdict(accelerometer: Judgement, gyroscope: Judgement | None) -> Judgement:
-    """A DUT's verdict: FAIL when either of its sensors fails, PASS when both pass, NOT JUDGED otherwise (a
-    sensor without limits: no statement of conformity for the DUT); the gyroscope's reasons follow the
-    accelerometer's, each marked."""
+    """A DUT's verdict from its sensors' (combined_verdict); the gyroscope's reasons follow the accelerometer's,
+    each marked."""
     if gyroscope is None:
         return accelerometer
     verdicts = (accelerometer.verdict, gyroscope.verdict)
     failed = "FAIL" in verdicts
     pick = (lambda j: [r for r in j.reasons] if j.verdict == "FAIL" else []) if failed else (lambda j: list(j.reasons))
-    verdict: Verdict = "FAIL" if failed else "PASS" if verdicts == ("PASS", "PASS") else NOT_JUDGED
-    return Judgement(verdict, pick(accelerometer) + [f"gyro: {r}" for r in pick(gyroscope)])
+    return Judgement(combined_verdict(list(verdicts)), pick(accelerometer) + [f"gyro: {r}" for r in pick(gyroscope)])
 
 
 def _noise_figures(campaign: Campaign, serial: str, channel: str) -> dict[str, Any] | None:
@@ -462,8 +472,11 @@ def summary_line(report: dict[str, Any], calibration_path: Path) -> str:
                     f"{gyros[0]['uncertainty_budget']['largest_rate_dps']:g} °/s")
     failed = [serial for serial, r in report.items() if r.get("verdict") == "FAIL"]
     unjudged = sum(r.get("verdict") == NOT_JUDGED for r in report.values())
-    passed = len(report) - len(failed) - unjudged
+    conditional = [serial for serial, r in report.items() if r.get("verdict") == "CONDITIONAL"]
+    passed = len(report) - len(failed) - unjudged - len(conditional)
     verdicts = (f"{passed} PASS, {len(failed)} FAIL ({', '.join(failed)})" if failed else f"{passed} PASS")
+    if conditional:  # inside a guard band: the procedure's decision rule states neither pass nor fail
+        verdicts += f", {len(conditional)} CONDITIONAL ({', '.join(conditional)})"
     if unjudged:
         verdicts = (f"{unjudged} NOT JUDGED (no acceptance limits stated)" if unjudged == len(report)
                     else f"{verdicts}, {unjudged} NOT JUDGED")

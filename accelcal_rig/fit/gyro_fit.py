@@ -26,7 +26,9 @@ from accelcal_rig.fit import gyro_model
 from accelcal_rig.fit.allan import FLICKER_FLOOR
 from accelcal_rig.fit.calibration import GyroCalibration, GyroPolynomialModel, SetpointFit, plain
 from accelcal_rig.fit.gyro_budget import gyro_budget, truth_coverage
+from accelcal_rig.fit.parameter_uncertainty import ParameterUncertainty, certificate_temperatures, of_gyro
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
+from accelcal_rig.fit.uncertainty import COVERAGE_FACTOR
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.records import ChannelInfo
 
@@ -144,6 +146,7 @@ class GyroFitResult:
     calibration: GyroCalibration
     metrics: dict[str, Any]           # what `rig fit --json` prints under `gyro`
     thermal: ThermalModel
+    parameter_u: ParameterUncertainty  # each parameter's own uncertainty at a temperature (limits judge with it)
 
 
 def site_of(campaign: Campaign) -> dict[str, Any]:
@@ -211,6 +214,15 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
     metrics["bias_instability_1sigma_dps"] = (wander.tolist() if allan is not None
                                               else "not measured: the campaign has no noise record")
     covariances = np.array([f.covariance for f in fits])
+    if "verification" in metrics:
+        compensated = gyro_model.correct_rate(records.mean_dps, records.force_g,
+                                              thermal.parameters_at(records.temperature_c, out_of_range))
+        scale = _scale_error_ppm(records, compensated, records.rows("verify-rate"))
+        metrics["verification"]["expanded_u"] = verification_uncertainty(records, compensated, systematic,
+                                                                         None if scale is None else scale[1])
+    parameter_u = of_gyro(thermal, temperatures, covariances, sigmas, systematic)
+    metrics["parameter_uncertainty"] = parameter_u.expanded_table(certificate_temperatures(thermal.domain_c),
+                                                                  list(gyro_model.PARAMETER_NAMES))
     temperature_u_c = _temperature_scatter_c(records, groups)
     largest = float(np.max(np.abs(records.reference_dps[records.rows("rate")])))
     metrics["uncertainty_budget"] = gyro_budget(thermal, temperatures, covariances, sigmas, temperature_u_c,
@@ -238,7 +250,7 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
         earth_rate=metrics["earth_rate"], gauge=GAUGE,
         metrics={k: plain(v) for k, v in metrics.items() if k != "truth_error"}, warnings=thermal.warnings,
     )
-    return GyroFitResult(records.serial, calibration, plain(metrics), thermal)
+    return GyroFitResult(records.serial, calibration, plain(metrics), thermal, parameter_u)
 
 
 def _figures(records: GyroRecords, thermal: ThermalModel, out_of_range: OutOfRange,
@@ -258,34 +270,65 @@ def _figures(records: GyroRecords, thermal: ThermalModel, out_of_range: OutOfRan
     checks = records.rows("verify-rate")
     if checks.any() or records.rows("verify").any():
         rest = records.rows("verify")
+        scale = _scale_error_ppm(records, compensated, checks)
         figures["verification"] = {
             "rate_steps": int(checks.sum()), "rmse_before_dps": _rms(before[checks]),
             "rmse_dps": _rms(after[checks]), "max_axis_error_dps": _max(after[checks]),
-            "scale_error_ppm": _scale_error_ppm(records, compensated, checks),
+            "scale_error_ppm": None if scale is None else scale[0],
             "rest_error_dps": _rms(after[rest]), "noise_floor_dps": _rms(records.stderr_dps[checks | rest]),
             "temperatures_c": sorted({round(float(t), 2) for t in records.setpoint_c[checks | rest]}),
         }
     return figures
 
 
-def _scale_error_ppm(records: GyroRecords, compensated: np.ndarray, rows: np.ndarray) -> float | None:
-    """The largest scale error at the verification rates, ppm: of each pair of steps turned both ways at one
-    rate about one axis at one setpoint, the compensated difference along the turning axis over the
-    reference's (a bias left over cancels in it, as it would not in one step's ratio at a low rate)."""
+def _scale_error_ppm(records: GyroRecords, compensated: np.ndarray, rows: np.ndarray) -> tuple[float, float] | None:
+    """The largest scale error at the verification rates, ppm, and its pair's noise (1σ, ppm): of each pair of
+    steps turned both ways at one rate about one axis at one setpoint, the compensated difference along the
+    turning axis over the reference's (a bias left over cancels in it, as it would not in one step's ratio
+    at a low rate)."""
     if not rows.any():
         return None
     index = np.flatnonzero(rows)
     along = np.argmax(np.abs(records.reference_dps[index]), axis=1)
     reference = records.reference_dps[index, along]
     measured = compensated[index, along]
-    errors = []
+    noise = records.stderr_dps[index, along]
+    errors, noises = [], []
     for i in range(len(index)):
         for j in range(len(index)):
             if (reference[i] > 0 > reference[j] and along[i] == along[j]
                     and records.setpoint_c[index[i]] == records.setpoint_c[index[j]]
                     and abs(reference[i] + reference[j]) < 1e-3 * abs(reference[i])):
                 errors.append((measured[i] - measured[j]) / (reference[i] - reference[j]) - 1.0)
-    return float(1e6 * np.max(np.abs(errors))) if errors else None
+                noises.append(np.hypot(noise[i], noise[j]) / (reference[i] - reference[j]))
+    if not errors:
+        return None
+    worst = int(np.argmax(np.abs(errors)))
+    return float(1e6 * abs(errors[worst])), float(1e6 * noises[worst])
+
+
+def verification_uncertainty(records: GyroRecords, compensated: np.ndarray, systematic: dict[str, Any],
+                             scale_noise_ppm: float | None) -> dict[str, Any]:
+    """U (k = 2) of each verification figure as a measurement of the compensated gyroscope's error: the
+    reading's noise and the reference's errors — the table's rate accuracy along the turning axis, its
+    pointing across it, the Earth's rate where the rig does not place it (the calibration's own uncertainty
+    is what the figure measures). A root mean square is known to the root mean square of its terms'
+    uncertainties, a largest value to its record's."""
+    reference = records.reference_dps
+    magnitude2 = np.sum(reference**2, axis=1, keepdims=True)
+    u = np.sqrt(records.stderr_dps**2 + (reference * systematic["scale"]) ** 2
+                + (magnitude2 - reference**2) * systematic["cross"] ** 2 + systematic["earth_dps"] ** 2)
+    steps, rest = records.rows("verify-rate"), records.rows("verify")
+    out: dict[str, Any] = {"coverage_factor": COVERAGE_FACTOR}
+    if steps.any():
+        error = np.abs(compensated[steps] - reference[steps])
+        out["rmse_dps"] = COVERAGE_FACTOR * float(np.sqrt(np.mean(u[steps] ** 2)))
+        out["max_axis_error_dps"] = COVERAGE_FACTOR * float(u[steps].ravel()[np.argmax(error)])
+    if scale_noise_ppm is not None:
+        out["scale_error_ppm"] = COVERAGE_FACTOR * float(np.hypot(1e6 * systematic["scale"], scale_noise_ppm))
+    if rest.any():
+        out["rest_error_dps"] = COVERAGE_FACTOR * float(np.sqrt(np.mean(u[rest] ** 2)))
+    return out
 
 
 def _rms(values: np.ndarray) -> float | None:

@@ -7,8 +7,13 @@ Sources:
 - `turntable_pointing`: the table's pointing accuracy, through the fitted coefficients (reference mode);
 - `scatter_beyond_noise`: residual scatter the first two do not explain (the fit's χ²_red, when it is
   significantly above 1 at the 99 % level), through the coefficients;
-- `thermal_model`: the per-setpoint estimates' scatter about the polynomial beyond their own 1σ (when
-  significant at the 95 % level);
+- `thermal_model`: what Eq. 1 × a polynomial in temperature does not describe: the per-setpoint
+  estimates' scatter about the polynomial beyond their own 1σ (when significant at the 95 % level), at
+  each setpoint its own, interpolated between them; for a joint fit, each band's poses' common offset
+  about the model, as a bias (budget.band_misfit);
+- `hysteresis`: a reading at rest lies on one of its two branches, ±h from the calibration (the mean of
+  both), h measured by a bidirectional ramp's joint fit (budget.hysteresis_u_g); absent where no fit
+  measured it (a method that approaches each temperature from one side cannot: budget.not_included);
 - `temperature`: the uncertainty of the temperature the reading is compensated at;
 - `gravity`: the site's gravity value (every output is relative to it).
 
@@ -21,7 +26,7 @@ covariances of each pose propagate separately, so the budget can say what each c
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.stats import chi2
@@ -45,6 +50,23 @@ class CoefficientCovariance:
     pointing: np.ndarray              # (P, P) from the turntable's pointing accuracy
     excess: np.ndarray                # (P, P) from scatter beyond both (zero unless significant)
     model_variance: np.ndarray        # (12,) the thermal model's excess variance per parameter (zero if none)
+    #: (3,) per axis, the standard uncertainty of a reading's hysteresis in g, as a bias of the raw reading,
+    #: where the fit measured it (a bidirectional ramp's joint fit: budget.hysteresis_u_g); None: not measured
+    hysteresis: np.ndarray | None = None
+    #: (K,) and (K, 12): the thermal model's excess variance at each setpoint (model_variance), where the
+    #: calibration measured it; empty: `model_variance` over the whole range
+    model_temperatures_c: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    model_variance_by_temperature: np.ndarray = field(default_factory=lambda: np.zeros((0, 12)))
+
+    def model_variance_at(self, temperature_c: np.ndarray) -> np.ndarray:
+        """(n, 12) the thermal model's excess variance at each temperature: linear between the setpoints
+        it was measured at, the nearest one's beyond them; `model_variance` where none are known."""
+        temperature_c = np.atleast_1d(np.asarray(temperature_c, dtype=float))
+        if not len(self.model_temperatures_c):
+            return np.broadcast_to(self.model_variance, (len(temperature_c), 12))
+        order = np.argsort(self.model_temperatures_c, kind="stable")
+        known, variance = self.model_temperatures_c[order], self.model_variance_by_temperature[order]
+        return np.stack([np.interp(temperature_c, known, variance[:, k]) for k in range(12)], axis=1)
 
 
 def joint_map(jacobian: np.ndarray) -> np.ndarray:
@@ -72,10 +94,15 @@ def two_stage_map(setpoint_jacobians: list[np.ndarray], scaled_temperatures: np.
 
 def coefficient_covariance(mapping: np.ndarray, reference_g: np.ndarray | None, stderr_g: np.ndarray,
                            accuracy_rad: float, free: np.ndarray, n_powers: int, residuals: np.ndarray,
-                           thermal_residuals: np.ndarray, setpoint_sigma: np.ndarray) -> CoefficientCovariance:
+                           thermal_residuals: np.ndarray, setpoint_sigma: np.ndarray,
+                           setpoint_temperatures_c: np.ndarray | None = None) -> CoefficientCovariance:
     """`mapping` (P, R): from every calibration pose's whitened residuals (pose by pose, as the fit weighs
     them) to the coefficients; `residuals`: those residuals at the solution (for χ²); `thermal_residuals`
-    (K, 12) and `setpoint_sigma` (K, 12): the per-setpoint estimates about the polynomial and their 1σ."""
+    (K, 12) and `setpoint_sigma` (K, 12): the per-setpoint estimates about the polynomial and their 1σ, at
+    `setpoint_temperatures_c` (K,) (without them the thermal model's term is one figure for the whole
+    range). Rows of `mapping` beyond the coefficients are other quantities the same fit estimated
+    (budget.calibration_covariance: a joint fit's hysteresis and rate terms): their covariances come out
+    alongside, in the same matrices."""
     a = mapping
     n_poses = len(stderr_g)
     if reference_g is None:                                             # norm-only: |g| residuals, noise only
@@ -94,22 +121,53 @@ def coefficient_covariance(mapping: np.ndarray, reference_g: np.ndarray | None, 
     excess = np.zeros_like(noise)
     if dof > 0 and chi2_total > chi2.ppf(0.99, dof):
         excess = (chi2_total / dof - 1.0) * (a @ a.T)
-    return CoefficientCovariance(free, n_powers, noise, pointing, excess,
-                                 _model_variance(thermal_residuals, setpoint_sigma, free, n_powers))
+    if setpoint_temperatures_c is None or len(thermal_residuals) <= n_powers:
+        variance, local = model_variance(thermal_residuals, setpoint_sigma, free, n_powers)
+        return CoefficientCovariance(free, n_powers, noise, pointing, excess, variance)
+    variance, local = model_variance(thermal_residuals, setpoint_sigma, free, n_powers,
+                                     residual_sigma(setpoint_temperatures_c, setpoint_sigma, n_powers))
+    return CoefficientCovariance(free, n_powers, noise, pointing, excess, variance,
+                                 model_temperatures_c=np.asarray(setpoint_temperatures_c, dtype=float),
+                                 model_variance_by_temperature=local)
 
 
-def _model_variance(residuals: np.ndarray, sigma: np.ndarray, free: np.ndarray, n_powers: int) -> np.ndarray:
+def model_variance(residuals: np.ndarray, sigma: np.ndarray, free: np.ndarray, n_fitted: int,
+                   residual_sigma: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Per parameter, the variance of the per-setpoint estimates about the polynomial beyond their 1σ, when
-    their χ² is significant at the 95 % level; zero otherwise, and when there is nothing left to check."""
-    variance = np.zeros(12)
-    dof = len(residuals) - n_powers
+    their χ² is significant at the 95 % level (K − `n_fitted` degrees of freedom); zero otherwise, and when
+    there is nothing left to check: (12,) over the whole range, and (K, 12) at each setpoint.
+
+    At a setpoint it is that setpoint's own residual squared less what its noise alone leaves in it
+    (`residual_sigma`², the residual's variance: σ²(1 − leverage), the polynomial having been fitted
+    through it), not below zero: the misfit where it is, not spread over the range (a polynomial that
+    cannot follow one end misses there, not everywhere)."""
+    variance, local = np.zeros(12), np.zeros((len(residuals), 12))
+    dof = len(residuals) - n_fitted
     if dof <= 0:
-        return variance
+        return variance, local
+    residual_sigma = sigma if residual_sigma is None else residual_sigma
     for k in np.flatnonzero(free):
         statistic = float(np.sum((residuals[:, k] / sigma[:, k]) ** 2))
         if statistic > chi2.ppf(0.95, dof):
             variance[k] = (statistic / dof - 1.0) * float(np.mean(sigma[:, k] ** 2))
-    return variance
+            local[:, k] = np.maximum(residuals[:, k] ** 2 - residual_sigma[:, k] ** 2, 0.0)
+    return variance, local
+
+
+def residual_sigma(temperatures_c: np.ndarray, sigma: np.ndarray, n_powers: int) -> np.ndarray:
+    """(K, 12) the 1σ that noise alone leaves in each per-setpoint estimate's residual about its weighted
+    polynomial (fit_thermal's): σ·√(1 − leverage)."""
+    t = np.asarray(temperatures_c, dtype=float)
+    x = (t - t.mean()) / max(float(np.ptp(t)), 1e-9)                   # leverage is the same in any scale of T
+    powers = np.vander(x, n_powers, increasing=True)
+    out = np.array(sigma, dtype=float, copy=True)
+    for k in range(sigma.shape[1]):
+        if not np.all(np.isfinite(sigma[:, k]) & (sigma[:, k] > 0)):
+            continue
+        weights = 1.0 / sigma[:, k] ** 2
+        hat = powers @ np.linalg.solve(powers.T @ (weights[:, None] * powers), powers.T * weights)
+        out[:, k] = sigma[:, k] * np.sqrt(np.clip(1.0 - np.diagonal(hat), 0.0, 1.0))
+    return out
 
 
 def output_uncertainty(raw_g: np.ndarray, temperature_c: np.ndarray, model: ThermalModel,
@@ -140,16 +198,20 @@ def output_uncertainty(raw_g: np.ndarray, temperature_c: np.ndarray, model: Ther
     warmer = correct(raw_g, model.parameters_at(temperature_c + _STEP_C, out_of_range))
     cooler = correct(raw_g, model.parameters_at(temperature_c - _STEP_C, out_of_range))
     by_temperature = (warmer - cooler) / (2 * _STEP_C)
-    model_u = np.sqrt(np.einsum("nap,p,nap->na", by_parameter, covariance.model_variance, by_parameter))
-    return {
+    model_u = np.sqrt(np.einsum("nap,np,nap->na", by_parameter, covariance.model_variance_at(temperature_c),
+                                by_parameter))
+    sources = {
         "reading_noise": reading,
         "calibration_noise": through(covariance.noise),
         "turntable_pointing": through(covariance.pointing),
         "scatter_beyond_noise": through(covariance.excess),
         "thermal_model": model_u,
-        "temperature": np.abs(by_temperature) * np.asarray(temperature_u_c, dtype=float)[:, None],
-        "gravity": np.abs(output) * gravity_relative_u,
     }
+    if covariance.hysteresis is not None:  # not measured is not zero: budget.not_included says so
+        sources["hysteresis"] = np.sqrt(np.einsum("nab,b,nab->na", gain, covariance.hysteresis**2, gain))
+    sources["temperature"] = np.abs(by_temperature) * np.asarray(temperature_u_c, dtype=float)[:, None]
+    sources["gravity"] = np.abs(output) * gravity_relative_u
+    return sources
 
 
 def combined(sources: dict[str, np.ndarray]) -> np.ndarray:

@@ -8,12 +8,15 @@ Arrays in, a plain dict out.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from accelcal_rig.fit.lm import pointing_covariance_g2
 from accelcal_rig.fit.metrics import noise_floor_mg, norm_rmse_mg, tilt_angles_deg
+from accelcal_rig.fit.uncertainty import COVERAGE_FACTOR
 
 #: Roll (Eq. 10) is judged only where gravity has at least this much in the x–z plane, in g: near ±90° of
 #: pitch roll is undefined and any error in it is meaningless.
@@ -21,12 +24,15 @@ ROLL_DEFINED_G = 0.5
 
 
 def pose_figures(compensated_g: np.ndarray, reference_g: np.ndarray, stderr_g: np.ndarray, setpoint_c: np.ndarray,
-                 temperature_c: np.ndarray, align: bool, gravity_g: float = 1.0) -> dict[str, Any]:
+                 temperature_c: np.ndarray, align: bool, gravity_g: float = 1.0,
+                 reference_u: ReferenceUncertainty | None = None) -> dict[str, Any]:
     """The figures of merit of compensated readings (N, 3) against the gravity each pose expects (N, 3).
 
     `align`: a norm-only fit fixes no rotation of the sensor frame, so its output is first turned by the one
     rotation that best aligns it with the references (per-axis and tilt errors are then those of a sensor
     mounted as the fit found it). `gravity_g`: the site's gravity in standard g, what |g| is judged against.
+    `reference_u`: the references' uncertainty, to state each figure's own (`expanded_u`, what a limit on it
+    is judged with).
     """
     compensated_g = np.asarray(compensated_g, dtype=float)
     reference_g = np.asarray(reference_g, dtype=float)
@@ -42,7 +48,7 @@ def pose_figures(compensated_g: np.ndarray, reference_g: np.ndarray, stderr_g: n
         "offset_mg": zero_g_offset_mg(error_mg[g], reference_g[g]).tolist(),
     } for g in groups]
     offsets = np.array([row["offset_mg"] for row in by_setpoint])
-    return {
+    figures = {
         "n_poses": int(len(compensated_g)),
         "rmse_mg": norm_rmse_mg(compensated_g, gravity_g),
         "noise_floor_mg": noise_floor_mg(compensated_g, stderr_g),
@@ -53,6 +59,61 @@ def pose_figures(compensated_g: np.ndarray, reference_g: np.ndarray, stderr_g: n
         "frame": "best rotation onto the references (norm-only fits fix none)" if align else "fixture",
         "by_setpoint": by_setpoint,
     }
+    if reference_u is not None:
+        figures["expanded_u"] = figure_uncertainty(compensated_g, reference_g, stderr_g, groups, offsets, reference_u)
+    return figures
+
+
+@dataclass(frozen=True)
+class ReferenceUncertainty:
+    """What a verification pose's reference is known to: the table's pointing (± per axis, uniform) and the
+    site's gravity (relative standard uncertainty)."""
+
+    accuracy_rad: float
+    gravity_relative_u: float
+
+
+def figure_uncertainty(compensated_g: np.ndarray, reference_g: np.ndarray, stderr_g: np.ndarray,
+                       groups: list[np.ndarray], offsets_mg: np.ndarray, reference_u: ReferenceUncertainty
+                       ) -> dict[str, Any]:
+    """U (k = 2) of each figure as a measurement of the compensated DUT's error: the reference's uncertainty and
+    the reading's noise (the calibration's own uncertainty is what the figure measures, not an error of it).
+    A root mean square is known to the root mean square of its terms' uncertainties (the triangle
+    inequality); a largest value to its pose's; a drift to its two setpoints' zero-g offsets, whose pointing
+    errors repeat (the same table angles) and cancel."""
+    stderr_g = np.maximum(np.asarray(stderr_g, dtype=float), 0.0)
+    pointing = np.diagonal(pointing_covariance_g2(reference_g, reference_u.accuracy_rad), axis1=1, axis2=2)
+    axis_u = np.sqrt(stderr_g**2 + pointing + (reference_g * reference_u.gravity_relative_u) ** 2)
+    direction = compensated_g / np.linalg.norm(compensated_g, axis=1, keepdims=True)
+    norm_u = np.sqrt(np.sum((direction * stderr_g) ** 2, axis=1)
+                     + (np.linalg.norm(reference_g, axis=1) * reference_u.gravity_relative_u) ** 2)
+    error = np.abs(compensated_g - reference_g)
+    worst_pose, worst_axis = np.unravel_index(np.argmax(error), error.shape)
+    # A reading's noise turns pitch by noise / |g|, roll by noise / |g in the x–z plane| (judged only where
+    # that is at least ROLL_DEFINED_G): the more sensitive of the two bounds it.
+    lever_g = np.minimum(np.linalg.norm(reference_g, axis=1),
+                         np.maximum(np.hypot(reference_g[:, 0], reference_g[:, 2]), ROLL_DEFINED_G))
+    tilt_u_rad = np.sqrt(reference_u.accuracy_rad**2 / 3.0 + (np.max(stderr_g, axis=1) / lever_g) ** 2)
+    tilted = int(np.argmax(tilt_errors_deg(compensated_g, reference_g)))
+    offset_u = np.array([_offset_u_g(stderr_g[g], reference_g[g]) for g in groups])                   # (K, 3)
+    high, low = np.argmax(offsets_mg, axis=0), np.argmin(offsets_mg, axis=0)
+    drift_u = np.sqrt(offset_u[high, range(3)] ** 2 + offset_u[low, range(3)] ** 2)
+    return {"coverage_factor": COVERAGE_FACTOR,
+            "rmse_mg": COVERAGE_FACTOR * 1e3 * float(np.sqrt(np.mean(norm_u**2))),
+            "max_axis_error_mg": COVERAGE_FACTOR * 1e3 * float(axis_u[worst_pose, worst_axis]),
+            "max_tilt_error_deg": COVERAGE_FACTOR * float(np.degrees(tilt_u_rad[tilted])),
+            "drift_mg": (COVERAGE_FACTOR * 1e3 * drift_u).tolist()}
+
+
+def _offset_u_g(stderr_g: np.ndarray, reference_g: np.ndarray) -> np.ndarray:
+    """(3,) the standard uncertainty of zero_g_offset_mg's intercept (in g) from the poses' noise."""
+    n = len(stderr_g)
+    rms = np.sqrt(np.mean(stderr_g**2, axis=0))
+    if n < 3:
+        return rms / np.sqrt(n)
+    spread = np.sum((reference_g - reference_g.mean(axis=0)) ** 2, axis=0)
+    leverage = np.divide(reference_g.mean(axis=0) ** 2, spread, out=np.zeros(3), where=spread > 1e-12)
+    return rms * np.sqrt(1.0 / n + leverage)
 
 
 def zero_g_offset_mg(error_mg: np.ndarray, reference_g: np.ndarray) -> np.ndarray:

@@ -40,6 +40,10 @@ from accelcal_rig.store.records import utc_now
 VISITED_G = 0.5
 #: Temperature assumed when a recording has none (and none is given).
 NOMINAL_TEMPERATURE_C = 25.0
+#: Beyond this χ²_red (the intervals against their own standard errors, before any scatter floor) a fit is
+#: implausible: the intervals scatter ten times more than their noise explains, so they were not still or the
+#: time base is wrong. Hand-held recordings held still reach a few (the real session of tests/data: 4 at most).
+MAX_CHI2_REDUCED = 100.0
 
 
 @dataclass(frozen=True)
@@ -98,6 +102,16 @@ def gyro_calibration(gyro: HandheldGyroFit, recording: Recording, serial: str, t
         warnings=list(gyro.notes))
 
 
+def _refuse_implausible(recording: Recording, intervals: int, chi2_reduced: float | None) -> None:
+    """A fit its own figures call implausible is refused (not written, not registered), in one line."""
+    if chi2_reduced is None or not chi2_reduced > MAX_CHI2_REDUCED:  # NaN: no degrees of freedom left to judge by
+        return
+    raise RecordingUnusable(f"{recording.source}: implausible fit: its {intervals} static intervals scatter "
+                            f"{np.sqrt(chi2_reduced):.0f} times more than their standard errors say (χ²_red "
+                            f"{chi2_reduced:.0f}, above {MAX_CHI2_REDUCED:g}): they were not still, or the time base "
+                            "is wrong (--time-unit, --rate-hz); no calibration written")
+
+
 def fit_recording(recording: Recording, detection: Detection, free: FreeParameters, serial: str,
                   temperature_c: float | None = None, gravity_m_s2: float | None = None) -> RecordingFit:
     """A norm-only fit of the static intervals: |U_SF| fitted to the site's gravity (`gravity_m_s2`, else the
@@ -123,6 +137,7 @@ def fit_recording(recording: Recording, detection: Detection, free: FreeParamete
     except DegenerateDesign as exc:
         raise RecordingUnusable(f"{recording.source}: {exc}") from None
     fit = robust.fit
+    _refuse_implausible(recording, len(intervals), robust.chi2_reduced_before)
     if robust.scatter_floor_g > 0:
         recording_notes = [f"the intervals scatter more than their standard errors say (χ²_red "
                            f"{robust.chi2_reduced_before:.2f}): each weighed with a scatter floor of "

@@ -53,6 +53,7 @@ class Recording:
     gravity_m_s2: float | None = None  # the site's gravity, when the source states it (a campaign file)
     gyro_dps: np.ndarray | None = None  # (n, 3) raw gyro readings in °/s (counts × gyro_lsb_dps), if recorded
     gyro_lsb_dps: float | None = None   # °/s per count (for codes); 1.0 in °/s, 180/π in rad/s; None without a gyro
+    simulated: bool = False             # a dry run's campaign file: a rehearsal, recorded apart from the lab's
 
 
 @dataclass(frozen=True)
@@ -265,4 +266,5 @@ def read_campaign_recording(path: Path, serial: str | None, setpoint_c: float | 
     digest = hashlib.sha256(np.ascontiguousarray(codes).tobytes()).hexdigest()
     gravity = campaign.attrs.get("gravity_m_s2")
     return Recording(f"{path} sensor {serial} at {setpoint_c:g} °C", t, accel_g, np.repeat(pose_temperature, n), lsb_g,
-                     digest, serial=serial, gravity_m_s2=float(gravity) if gravity is not None else None)
+                     digest, serial=serial, gravity_m_s2=float(gravity) if gravity is not None else None,
+                     simulated=bool(campaign.attrs.get("dry_run", False)))

@@ -8,9 +8,15 @@ from typing import Any
 import numpy as np
 
 _SECONDS_PER_YEAR = 365.25 * 86400.0
+#: The shortest span of calibrations a drift per year is stated from (`rig registry trend --min-span-days`):
+#: calibrations minutes apart measure the noise of the two calibrations, not ageing.
+MIN_SPAN_DAYS = 30.0
 #: The reason of a PASS that no limits judged: not counted in a yield.
 UNJUDGED = "no acceptance limits stated"
 UNJUDGED_GYRO = "no gyroscope acceptance limits stated"
+#: The verdicts judged against acceptance limits: a CONDITIONAL one (inside a guard band) is judged, and counts
+#: in a yield as neither passed nor failed.
+JUDGED = ("PASS", "FAIL", "CONDITIONAL")
 #: A figure further than this from its lot's median, in robust z (0.6745 · deviation / MAD), is an outlier
 #: (Iglewicz & Hoaglin, "How to Detect and Handle Outliers", 1993).
 OUTLIER_Z = 3.5
@@ -28,11 +34,12 @@ def by_channel(rows: list[dict[str, Any]]) -> dict[str, list[dict[str, Any]]]:
     return {c: [r for r in rows if (r.get("channel") or "accel") == c] for c in channels}
 
 
-def trend(rows: list[dict[str, Any]], channel: str = "accel") -> dict[str, Any]:
+def trend(rows: list[dict[str, Any]], channel: str = "accel", min_span_days: float = MIN_SPAN_DAYS) -> dict[str, Any]:
     """Bias and scale error at the reference temperature across one serial's calibrations of one channel,
     oldest first, and their drift per year: a weighted straight line through them (weights from the stated
-    uncertainties; unweighted where a calibration states none). An accelerometer's bias is in mg, a
-    gyroscope's in °/s (`bias_dps`, its drift `bias_drift_dps_per_year`)."""
+    uncertainties; unweighted where a calibration states none), stated only when the calibrations span at least
+    `min_span_days` (`drift_not_stated` says why not). An accelerometer's bias is in mg, a gyroscope's in °/s
+    (`bias_dps`, its drift `bias_drift_dps_per_year`)."""
     bias, unit = BIAS.get(channel, BIAS["accel"])
     rows = sorted((r for r in rows if (r.get("channel") or "accel") == channel), key=lambda r: (r["calibrated_at"], r["id"]))
     points = [{"id": r["id"], "channel": channel, "calibrated_at": r["calibrated_at"].isoformat(), "verdict": r["verdict"],
@@ -41,9 +48,31 @@ def trend(rows: list[dict[str, Any]], channel: str = "accel") -> dict[str, Any]:
               for r in rows]
     years = np.array([(r["calibrated_at"] - rows[0]["calibrated_at"]).total_seconds() / _SECONDS_PER_YEAR
                       for r in rows]) if rows else np.array([])
-    return {"calibrations": points,
-            f"bias_drift_{unit}_per_year": _drift(years, rows, bias, f"bias_uncertainty_{unit}"),
-            "scale_drift_ppm_per_year": _drift(years, rows, "scale_error_ppm", "scale_uncertainty_ppm")}
+    span_days = float(years.max() - years.min()) * _SECONDS_PER_YEAR / 86400.0 if len(years) else 0.0
+    withheld = _withheld(len(rows), span_days, min_span_days)
+    return {"calibrations": points, "span_days": span_days, "min_span_days": min_span_days,
+            "drift_not_stated": withheld,
+            f"bias_drift_{unit}_per_year": None if withheld else _drift(years, rows, bias, f"bias_uncertainty_{unit}"),
+            "scale_drift_ppm_per_year": None if withheld else _drift(years, rows, "scale_error_ppm",
+                                                                     "scale_uncertainty_ppm")}
+
+
+def _withheld(calibrations: int, span_days: float, min_span_days: float) -> str | None:
+    """Why no drift per year is stated, or None when one may be."""
+    if calibrations < 2 or span_days == 0.0:
+        return "needs two calibrations at different times"
+    if span_days < min_span_days:
+        return f"the calibrations span {_span_text(span_days)}, under the {min_span_days:g} days a drift per year needs"
+    return None
+
+
+def _span_text(days: float) -> str:
+    """`12 minutes`, `5.2 hours`, `3.5 days`."""
+    if days < 1.0 / 24.0:
+        return f"{days * 1440.0:.0f} minutes"
+    if days < 1.0:
+        return f"{days * 24.0:.1f} hours"
+    return f"{days:.1f} days"
 
 
 def _drift(years: np.ndarray, rows: list[dict[str, Any]], key: str,
@@ -80,13 +109,15 @@ def lot_statistics(rows: list[dict[str, Any]], channel: str = "accel") -> dict[s
             newest[row["serial"]] = row
     latest = list(newest.values())
     rows = [r for r in rows if (r.get("channel") or "accel") == channel]
-    judged = [r for r in latest if r["verdict"] in ("PASS", "FAIL")
+    judged = [r for r in latest if r["verdict"] in JUDGED
               and list(r["verdict_reasons"]) not in ([UNJUDGED], [UNJUDGED_GYRO])]
     passed = sum(r["verdict"] == "PASS" for r in judged)
+    conditional = sum(r["verdict"] == "CONDITIONAL" for r in judged)
     figures = {name: (_per_axis(latest, name) if per_axis else _scalar(latest, name))
                for name, per_axis in LOT_FIGURES.get(channel, LOT_FIGURES["accel"])}
     return {
         "sensors": len(latest), "calibrations": len(rows), "judged": len(judged), "passed": passed,
+        "conditional": conditional, "failed": len(judged) - passed - conditional,
         "yield": passed / len(judged) if judged else None,
         "distributions": {name: [_summary(column) for column in columns] for name, columns in figures.items()},
         "outliers": _outliers(latest, figures),

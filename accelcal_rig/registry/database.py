@@ -23,7 +23,7 @@ from sqlalchemy.engine import Connection, Engine
 
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.registry.location import described
-from accelcal_rig.registry.schema import calibrations
+from accelcal_rig.registry.schema import approvals, calibrations
 
 _MIGRATIONS = Path(__file__).parent / "migrations"
 #: A PostgreSQL advisory lock key for schema migrations (any constant the lab's other users do not take).
@@ -34,6 +34,8 @@ _OPEN_ATTEMPTS = 20
 _BATCH = 500
 #: SQLite waits this long for another writer's lock before giving up.
 _SQLITE_BUSY_S = 60.0
+#: The verdict of a calibration no acceptance limits judged: stored as none (NULL), counted in no yield.
+NOT_JUDGED = "NOT JUDGED"
 
 
 def migration_config() -> Config:
@@ -129,10 +131,11 @@ class Registry:
     # ------------------------------------------------------------------ reading
     def calibrations(self, serial: str | None = None, part: str | None = None, since: datetime | None = None,
                      verdict: str | None = None, limit: int | None = None,
-                     channel: str | None = None) -> list[dict[str, Any]]:
+                     channel: str | None = None, simulated: bool | None = None) -> list[dict[str, Any]]:
         """Rows, newest calibration first, filtered as given (`channel`: only that channel's, else every
-        channel's, each row saying which); without the stored fit (`calibration(id)` has it:
-        a lot of thousands of sensors is listed without reading thousands of fits)."""
+        channel's, each row saying which; `verdict` NOT JUDGED: those stored with none; `simulated`: only dry
+        runs, or only real calibrations); without the stored fit (`calibration(id)` has it: a lot of thousands
+        of sensors is listed without reading thousands of fits)."""
         listed = [column for column in calibrations.columns if column.name != "calibration"]
         query = sa.select(*listed).order_by(calibrations.c.calibrated_at.desc(), calibrations.c.id.desc())
         if serial is not None:
@@ -141,8 +144,12 @@ class Registry:
             query = query.where(calibrations.c.part == part)
         if since is not None:
             query = query.where(calibrations.c.calibrated_at >= since)
-        if verdict is not None:
+        if verdict == NOT_JUDGED:
+            query = query.where(calibrations.c.verdict.is_(None))
+        elif verdict is not None:
             query = query.where(calibrations.c.verdict == verdict)
+        if simulated is not None:
+            query = query.where(calibrations.c.simulated if simulated else sa.not_(calibrations.c.simulated))
         if channel is not None:
             query = query.where(calibrations.c.channel == channel)
         if limit is not None:
@@ -159,10 +166,56 @@ class Registry:
         return dict(row._mapping)
 
     def current(self, serial: str, simulated: bool = False, channel: str = "accel") -> dict[str, Any] | None:
-        """The valid calibration of a serial's channel: its newest measured, unless that failed its acceptance
-        limits (then none is valid: the sensor is out of tolerance now). Dry runs count only when asked."""
+        """The valid calibration of a serial's channel: its newest approved real calibration, unless a newer
+        one failed its acceptance limits and was not rejected (the sensor is out of tolerance now: none is
+        valid; an approved FAIL confirms it). A calibration awaiting approval is not valid yet; a rejected one
+        never. Dry runs, only when
+        asked, count as their newest unless failed: they are never a lab's valid calibration."""
         rows = [r for r in self.calibrations(serial=serial, channel=channel) if simulated or not r["simulated"]]
-        return rows[0] if rows and rows[0]["verdict"] != "FAIL" else None
+        if simulated:
+            return rows[0] if rows and rows[0]["verdict"] != "FAIL" else None
+        decided = self.last_actions([r["id"] for r in rows])
+        for row in rows:
+            action = decided.get(row["id"])
+            if row["verdict"] == "FAIL" and action != "reject":  # approved or not, the sensor failed
+                return None
+            if action in ("approve", "reissue"):
+                return row
+        return None
+
+    def why_not_valid(self, serial: str, channel: str = "accel") -> str:
+        """Why a serial's channel has no valid calibration (current() is None), in a few words."""
+        rows = [r for r in self.calibrations(serial=serial, channel=channel) if not r["simulated"]]
+        if not rows:
+            return "only dry runs (simulated) are recorded: --simulated shows them"
+        decided = self.last_actions([r["id"] for r in rows])
+        failed = next((r for r in rows if r["verdict"] == "FAIL" and decided.get(r["id"]) != "reject"), None)
+        approved = next((r for r in rows if decided.get(r["id"]) in ("approve", "reissue")), None)
+        if failed is not None and (approved is None or failed["calibrated_at"] >= approved["calibrated_at"]):
+            return (f"calibration {failed['id']} failed its acceptance limits and is the newest not rejected: the "
+                    "sensor is out of tolerance")
+        return "none approved: a calibration awaiting approval or rejected is not valid (rig approve)"
+
+    def ids_of(self, entries: list[dict[str, Any]]) -> dict[str, int]:
+        """Of recorded entries (registry/entries.py), each serial's first row: its DUT's calibration's lead.
+        A serial whose entries are not all recorded is left out."""
+        found: dict[str, list[int | None]] = {}
+        with self.engine.connect() as connection:
+            for entry in entries:
+                row_id = connection.execute(sa.select(calibrations.c.id).where(
+                    calibrations.c.source_sha256 == entry["source_sha256"], calibrations.c.serial == entry["serial"],
+                    calibrations.c.fit_sha256 == entry["fit_sha256"])).scalar()
+                found.setdefault(entry["serial"], []).append(row_id)
+        return {serial: min(i for i in ids if i is not None) for serial, ids in found.items() if None not in ids}
+
+    def last_actions(self, ids: list[int]) -> dict[int, str]:
+        """The latest approval action (approve, reject, reissue) recorded on each of these rows that has one."""
+        if not ids:
+            return {}
+        query = (sa.select(approvals.c.calibration_id, approvals.c.action)
+                 .where(approvals.c.calibration_id.in_(ids)).order_by(approvals.c.id))
+        with self.engine.connect() as connection:
+            return {int(i): str(action) for i, action in connection.execute(query)}
 
     def channels(self, serial: str | None = None) -> list[str]:
         """Every channel with a calibration recorded (of one serial, if given): `accel` first."""
@@ -216,6 +269,7 @@ def _engine(url: str) -> Engine:
             cursor = dbapi_connection.cursor()
             cursor.execute("PRAGMA journal_mode=WAL")  # readers never block the writer, nor it them
             cursor.execute(f"PRAGMA busy_timeout={int(_SQLITE_BUSY_S * 1000)}")
+            cursor.execute("PRAGMA foreign_keys=ON")  # a decision names a calibration that exists
             cursor.close()
 
         @sa.event.listens_for(engine, "begin")

@@ -26,6 +26,9 @@ from accelcal_rig.store.read import load_campaign
 
 #: Campaign states whose fit is final: a running campaign's file is still being written.
 FINISHED_STATES = ("done", "aborted")
+#: The verdicts stored as they are (CONDITIONAL: a limit met or missed inside its guard band under guarded
+#: acceptance); any other (NOT JUDGED: no limits stated) is stored as none, counted in no yield.
+STORED_VERDICTS = ("PASS", "FAIL", "CONDITIONAL")
 
 
 def file_sha256(path: Path) -> str:
@@ -59,11 +62,12 @@ def campaign_entries(campaign_path: Path, calibration_path: Path | None = None) 
             for serial, dut in calibration.duts.items() for channel, sensor in dut.channels.items()]
 
 
-def recording_entries(recording_path: Path, calibration: CalibrationFile, part: str) -> list[dict[str, Any]]:
-    """The entry of a hand-held fit: its recording is the source."""
+def recording_entries(recording_path: Path, calibration: CalibrationFile, part: str,
+                      simulated: bool = False) -> list[dict[str, Any]]:
+    """The entry of a hand-held fit: its recording is the source (`simulated`: a dry run's campaign file)."""
     measured = datetime.fromtimestamp(recording_path.stat().st_mtime, UTC).isoformat()  # when it was recorded
     source = {"kind": "recording", "path": str(recording_path.resolve()), "sha256": file_sha256(recording_path),
-              "procedure": "hand-held", "rig": "hand-held", "simulated": False, "measured": measured}
+              "procedure": "hand-held", "rig": "hand-held", "simulated": simulated, "measured": measured}
     return [_entry(calibration, ACCELERATION, sensor, part, source) for sensor in calibration.sensors.values()]
 
 
@@ -84,8 +88,7 @@ def _entry(calibration: CalibrationFile, channel: str, sensor: SensorCalibration
         "software_version": calibration.software_version, "calibrated_at": _utc(source["measured"]),
         "fitted_at": _utc(calibration.created), "registered_at": datetime.now(UTC).replace(tzinfo=None),
         "valid_from_c": float(sensor.validity_c[0]), "valid_to_c": float(sensor.validity_c[1]),
-        # NOT JUDGED (no limits stated) is stored as no verdict: counted in no yield.
-        "verdict": sensor.verdict if sensor.verdict in ("PASS", "FAIL") else None,
+        "verdict": sensor.verdict if sensor.verdict in STORED_VERDICTS else None,
         "verdict_reasons": list(sensor.verdict_reasons),
         "verification_rmse_mg": float(rmse) if rmse is not None else None,
         "calibration": stored, **channel_figures(stored, channel),

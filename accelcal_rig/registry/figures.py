@@ -23,18 +23,37 @@ def reference_figures(calibration: dict[str, Any]) -> dict[str, Any]:
     low, high = sensor["validity_c"]
     reference = float(np.clip(REFERENCE_C, low, high))
     values = _parameters_at(sensor["polynomial"], reference)
-    expanded = sensor.get("metrics", {}).get("expanded_uncertainty_mg")
-    sigma = _nearest_setpoint_sigma(sensor.get("setpoints", []), reference)
-    scale_sigma = [float(s) for axis in "xyz" if (s := sigma.get(f"scale_{axis}")) is not None]
+    own = _parameter_expanded(sensor.get("metrics", {}), reference)
+    if own is not None:   # each parameter's own expanded uncertainty there, as the fit stated it
+        bias_u: list[float] | None = [1e3 * own[f"bias_{axis}_g"] for axis in "xyz"]
+        scale_u: list[float] | None = [1e6 * own[f"scale_{axis}"] for axis in "xyz"]
+    else:                 # a fit from before: the reading's budget and the nearest setpoint's 2σ
+        expanded = sensor.get("metrics", {}).get("expanded_uncertainty_mg")
+        bias_u = [float(u) for u in expanded] if expanded else None
+        sigma = _nearest_setpoint_sigma(sensor.get("setpoints", []), reference)
+        scale_sigma = [float(s) for axis in "xyz" if (s := sigma.get(f"scale_{axis}")) is not None]
+        scale_u = [2e6 * s for s in scale_sigma] if len(scale_sigma) == 3 else None
     return {
         "reference_c": reference,
         "bias_mg": [1e3 * values[f"bias_{axis}_g"] for axis in "xyz"],
-        "bias_uncertainty_mg": [float(u) for u in expanded] if expanded else None,
+        "bias_uncertainty_mg": bias_u,
         "scale_error_ppm": [1e6 * (values[f"scale_{axis}"] - 1.0) for axis in "xyz"],
-        "scale_uncertainty_ppm": [2e6 * s for s in scale_sigma] if len(scale_sigma) == 3 else None,
+        "scale_uncertainty_ppm": scale_u,
         "nonorthogonality_mrad": 1e3 * max(abs(values[n]) for n in ("nonorth_yx_rad", "nonorth_zx_rad",
                                                                     "nonorth_zy_rad")),
     }
+
+
+def _parameter_expanded(metrics: dict[str, Any], temperature_c: float) -> dict[str, float] | None:
+    """Each parameter's expanded uncertainty (k = 2) at a temperature the fit stated it at, if it did."""
+    table = metrics.get("parameter_uncertainty")
+    if not isinstance(table, dict):
+        return None
+    temperatures = [float(t) for t in table.get("temperatures_c", [])]
+    at = [i for i, t in enumerate(temperatures) if abs(t - temperature_c) < 1e-6]
+    if not at:
+        return None
+    return {name: float(values[at[0]]) for name, values in table.get("expanded", {}).items()}
 
 
 def _parameters_at(polynomial: dict[str, Any], temperature_c: float) -> dict[str, float]:
@@ -69,9 +88,9 @@ def noise_figures(calibration: dict[str, Any]) -> dict[str, Any]:
 
 
 def gyro_figures(calibration: dict[str, Any]) -> dict[str, Any]:
-    """Figures of a stored gyroscope calibration at the reference temperature: bias (°/s, with the expanded
-    uncertainty of a compensated rate at rest) and scale error with the scale's expanded uncertainty (twice the
-    1σ of the setpoint fit nearest it), the expanded uncertainty of a compensated rate at the largest calibrated
+    """Figures of a stored gyroscope calibration at the reference temperature: bias and scale error, each with
+    its own expanded uncertainty (a fit from before they were stated: the bias's of a compensated rate at rest,
+    the scale's twice the 1σ of the setpoint fit nearest it), the expanded uncertainty of a compensated rate at the largest calibrated
     rate, the verification rate steps' RMS error, and its noise."""
     sensor = calibration["sensor"]
     low, high = sensor["validity_c"]
@@ -88,12 +107,15 @@ def gyro_figures(calibration: dict[str, Any]) -> dict[str, Any]:
     rmse = verification.get("rmse_dps")
     at_rest = (metrics.get("uncertainty_budget") or {}).get("at_rest") or {}
     noise = noise_figures(calibration)
+    own = _parameter_expanded(metrics, reference)  # each parameter's own, where the fit stated them
     return {
         "reference_c": reference,
         "bias_dps": [values[f"bias_{axis}_dps"] for axis in "xyz"],
         "scale_error_ppm": [1e6 * (values[f"scale_{axis}"] - 1.0) for axis in "xyz"],
-        "scale_uncertainty_ppm": [2e6 * s for s in scale_sigma] if len(scale_sigma) == 3 else None,
-        "bias_uncertainty_dps": [float(u) for u in at_rest["expanded_dps"]] if at_rest.get("expanded_dps") else None,
+        "scale_uncertainty_ppm": ([1e6 * own[f"scale_{axis}"] for axis in "xyz"] if own is not None
+                                  else [2e6 * s for s in scale_sigma] if len(scale_sigma) == 3 else None),
+        "bias_uncertainty_dps": ([own[f"bias_{axis}_dps"] for axis in "xyz"] if own is not None
+                                 else [float(u) for u in at_rest["expanded_dps"]] if at_rest.get("expanded_dps") else None),
         "expanded_uncertainty_dps": [float(u) for u in expanded] if expanded else None,
         "verification_rmse_dps": float(rmse) if rmse is not None else None,
         "arw_deg_per_rthr": noise["arw_deg_per_rthr"], "bias_instability_dph": noise["bias_instability_dph"],

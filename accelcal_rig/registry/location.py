@@ -1,5 +1,8 @@
 """Which registry: `--registry URL`, else the rig config's `registry:`, else the ACCELCAL_REGISTRY
-environment variable, else an SQLite file in the user's data folder (created on first use)."""
+environment variable, else an SQLite file in the user's data folder (created on first use). A dry run's
+calibrations are rehearsals: they go to a registry of their own (`--registry URL`, else the
+ACCELCAL_DRY_RUN_REGISTRY environment variable, else `dry-runs.sqlite` beside the default), never to the
+lab's."""
 
 from __future__ import annotations
 
@@ -10,6 +13,7 @@ from pathlib import Path
 from accelcal_rig.errors import ConfigError
 
 ENVIRONMENT_VARIABLE = "ACCELCAL_REGISTRY"
+DRY_RUN_ENVIRONMENT_VARIABLE = "ACCELCAL_DRY_RUN_REGISTRY"
 
 
 def default_path() -> Path:
@@ -18,11 +22,25 @@ def default_path() -> Path:
     return Path(data) / "accelcal-rig" / "registry.sqlite"
 
 
+def default_dry_run_path() -> Path:
+    """`dry-runs.sqlite` beside the default registry: where dry runs are recorded unless told otherwise."""
+    return default_path().with_name("dry-runs.sqlite")
+
+
 def registry_url(flag: str | None = None, configured: str | None = None) -> str:
     """The first given of the flag, the rig config's value and the environment, else the default file; as a
     SQLAlchemy URL (a bare path is an SQLite file, `postgresql://` is spoken with psycopg)."""
     chosen = flag or configured or os.environ.get(ENVIRONMENT_VARIABLE) or str(default_path())
     return normalised(chosen)
+
+
+def recording_url(flag: str | None, configured: str | None, simulated: bool) -> str:
+    """Where a fit is recorded: a real calibration as `registry_url` chooses; a dry run's in the dry runs'
+    registry (the flag, else ACCELCAL_DRY_RUN_REGISTRY, else the default beside the lab's), never in the
+    rig config's or the environment's registry, which are the lab's."""
+    if not simulated:
+        return registry_url(flag, configured)
+    return normalised(flag or os.environ.get(DRY_RUN_ENVIRONMENT_VARIABLE) or str(default_dry_run_path()))
 
 
 def configured(value: str | None, config_path: Path) -> str | None:

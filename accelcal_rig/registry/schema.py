@@ -27,7 +27,7 @@ calibrations = sa.Table(
     sa.Column("registered_at", sa.DateTime, nullable=False),               # UTC
     sa.Column("valid_from_c", sa.Float, nullable=False),
     sa.Column("valid_to_c", sa.Float, nullable=False),
-    sa.Column("verdict", sa.String(8), nullable=True),                      # PASS | FAIL | none stated
+    sa.Column("verdict", sa.String(16), nullable=True),                     # PASS | FAIL | CONDITIONAL | none (NOT JUDGED); 0005 widened it
     sa.Column("verdict_reasons", sa.JSON, nullable=False),
     sa.Column("verification_rmse_mg", sa.Float, nullable=True),
     sa.Column("calibration", sa.JSON, nullable=False),                      # the whole fit, to export again
@@ -57,3 +57,44 @@ calibrations = sa.Table(
 )
 
 COLUMNS = tuple(column.name for column in calibrations.columns)
+
+# Added by migration 0006: the lab's users, the append-only record of approvals, and every certificate
+# revision issued (the database refuses to change or delete the last two).
+users = sa.Table(
+    "users", metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("name", sa.String(64), nullable=False, unique=True),
+    sa.Column("full_name", sa.String(128), nullable=False),
+    sa.Column("role", sa.String(16), nullable=False),                 # approver | viewer
+    sa.Column("password_hash", sa.String(256), nullable=True),        # argon2id; none: a reverse proxy's user
+    sa.Column("disabled", sa.Boolean, nullable=False, server_default=sa.false()),
+    sa.Column("created_at", sa.DateTime, nullable=False),
+)
+
+approvals = sa.Table(
+    "approvals", metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("calibration_id", sa.Integer, sa.ForeignKey("calibrations.id"), nullable=False, index=True),
+    sa.Column("action", sa.String(16), nullable=False),               # approve | reject | reissue
+    sa.Column("user_name", sa.String(64), nullable=False),
+    sa.Column("full_name", sa.String(128), nullable=False),
+    sa.Column("authority", sa.String(128), nullable=False),
+    sa.Column("reason", sa.Text, nullable=False, server_default=""),
+    sa.Column("revision", sa.Integer, nullable=True),
+    sa.Column("at", sa.DateTime, nullable=False),
+)
+
+certificate_revisions = sa.Table(
+    "certificate_revisions", metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("calibration_id", sa.Integer, sa.ForeignKey("calibrations.id"), nullable=False),
+    sa.Column("revision", sa.Integer, nullable=False),
+    sa.Column("number", sa.String(128), nullable=False),
+    sa.Column("approver", sa.String(128), nullable=False),
+    sa.Column("issued_at", sa.DateTime, nullable=False),
+    sa.Column("reason", sa.Text, nullable=False, server_default=""),
+    sa.Column("html", sa.Text, nullable=False),
+    sa.Column("pdf", sa.LargeBinary, nullable=True),
+    sa.Column("sha256", sa.String(64), nullable=False),
+    sa.UniqueConstraint("calibration_id", "revision", name="one_certificate_per_revision"),
+)

@@ -58,6 +58,7 @@ class DutReport:
     fit: DutFitResult | None
     truth_by_setpoint: np.ndarray | None   # (K, 12) simulation truth averaged per setpoint, dry runs only
     judgement: Judgement | None = None     # against the procedure's acceptance limits
+    verification: DutPoses | None = None   # the verification poses (never fitted), at every setpoint they were taken
 
 
 @dataclass(frozen=True)
@@ -123,12 +124,13 @@ def read_campaign_data(path: Path) -> CampaignData:
         elif len(poses.setpoint_c):
             try:
                 fit = fit_dut(stored, options)
-                judgement = judge(fit.metrics, fit.thermal, options.mode, limits, partial)
+                judgement = judge(fit.metrics, fit.thermal, options.mode, limits, partial, fit.parameter_u)
             except (ValueError, np.linalg.LinAlgError) as exc:
                 reasons.append(str(exc))
         else:
             reasons.append("no poses stored")
-        duts[serial] = DutReport(poses, pose_numbers[~stored.verification], fit, _truth_by_setpoint(poses), judgement)
+        duts[serial] = DutReport(poses, pose_numbers[~stored.verification], fit, _truth_by_setpoint(poses), judgement,
+                                 stored.subset(stored.verification))
     soaks = [SoakRecord(name, s.setpoint_c, s.outcome, s.t_s, s.chamber_c, s.dut_c, s.t_reached_s, s.t_stable_s)
              for name, s in zip(campaign.soak_names(), campaign.soaks)]
     events = list(campaign.events)
@@ -166,7 +168,7 @@ def _gyroscopes(path: Path, campaign: Campaign, options: FitOptions, limits: Acc
             continue
         if not isinstance(fitted, GyroFitResult):
             continue
-        verdict = judge_gyro(fitted.metrics, fitted.thermal, limits.gyro, partial, limits.allow_partial)
+        verdict = judge_gyro(fitted.metrics, fitted.thermal, limits, partial, fitted.parameter_u)
         odr_hz = float(campaign.header.duts[campaign.serials.index(serial)].get("odr_hz") or 0.0)
         allan = noise_allan(campaign, serial, ANGULAR_RATE, odr_hz) if odr_hz > 0 else None
         gyros[serial] = fitted.calibration.model_copy(update={

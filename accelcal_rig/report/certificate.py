@@ -24,7 +24,8 @@ from accelcal_rig.core.units import gravity_statement
 from accelcal_rig.durable import write_atomically, write_text_atomically
 from accelcal_rig.errors import ConfigError, RigError
 from accelcal_rig.fit.calibration import CalibrationFile, GyroCalibration, SensorCalibration, load_calibration
-from accelcal_rig.report import certificate_gyro
+from accelcal_rig.fit.sfem import PARAMETER_NAMES
+from accelcal_rig.report import certificate_decision, certificate_gyro, certificate_lab
 from accelcal_rig.store.content import Campaign, measurements_sha256
 from accelcal_rig.store.read import dut_description, usable_campaign
 from accelcal_rig.store.records import utc_now
@@ -47,10 +48,9 @@ table { border-collapse: collapse; width: 100%; margin: 1mm 0; }
 th, td { border: 0.4pt solid #bbb; padding: 1pt 4pt; text-align: right; vertical-align: top; }
 th { background: #eee; } td.text, th.text { text-align: left; } td.key { text-align: left; width: 34%; color: #333; }
 .verdict { font-size: 14pt; font-weight: bold; padding: 2mm 4mm; display: inline-block; border: 1.2pt solid; }
-.PASS { color: #0a5a0a; } .FAIL { color: #a00000; }
 .banner { border: 1.2pt solid #a00000; color: #a00000; font-weight: bold; padding: 1.5mm 3mm; margin: 2mm 0; }
 .note { color: #444; font-size: 8pt; }
-.signatures td { height: 14mm; vertical-align: bottom; text-align: left; }
+.signatures td { height: 10mm; vertical-align: bottom; text-align: left; }
 """
 
 
@@ -63,19 +63,10 @@ class Written:
 
 def write_certificates(campaign_path: Path, calibration_path: Path, folder: Path, operator: str = "",
                        pdf: bool = True) -> tuple[list[Written], list[str]]:
-    """One certificate per DUT of the calibration into `folder` (created); (what was written, warnings).
+    """One draft certificate per DUT of the calibration into `folder` (created): every page says it is not
+    issued until a person approves it (rig approve issues it as a revision); (what was written, warnings).
     Refused in one line when the calibration was fitted to other measurements than the campaign's."""
-    campaign = usable_campaign(campaign_path)
-    calibration = load_calibration(calibration_path)
-    if calibration.source.get("measurements_sha256") != measurements_sha256(campaign):
-        raise ConfigError(f"{calibration_path}: fitted to other measurements than {campaign_path} holds now: fit it "
-                          "again (rig fit) before certifying")
-    judged: list[tuple[str, SensorCalibration | GyroCalibration]] = [*calibration.sensors.items(),
-                                                                     *calibration.gyroscopes.items()]
-    old = [s for s, c in judged if "uncertainty_budget" not in c.metrics or c.verdict is None]
-    if old:
-        raise ConfigError(f"{calibration_path}: sensor {old[0]} has no uncertainty budget or verdict (written by an "
-                          "earlier accelcal-rig): fit it again (rig fit) before certifying")
+    campaign, calibration = _certifiable(campaign_path, calibration_path)
     folder.mkdir(parents=True, exist_ok=True)
     render = _pdf_renderer() if pdf else None
     warnings = [] if render is not None or not pdf else [
@@ -91,13 +82,64 @@ def write_certificates(campaign_path: Path, calibration_path: Path, folder: Path
         pdf_path = None
         if render is not None:
             pdf_path = folder / f"{name}.pdf"
-            try:
-                pdf_bytes = render(page)
-            except Exception as exc:  # noqa: BLE001 - a renderer's failure is one line naming the file
-                raise RigError(f"{pdf_path}: the PDF could not be rendered: {str(exc).splitlines()[0]}") from None
-            write_atomically(pdf_path, pdf_bytes, "the certificate")
+            write_atomically(pdf_path, _rendered_pdf(render, page, pdf_path), "the certificate")
         written.append(Written(serial, html_path, pdf_path))
     return written, warnings
+
+
+@dataclass(frozen=True)
+class Approval:
+    """Who approved the certificate revision being issued, and when (UTC date); a reissue's reason."""
+
+    approver: str
+    date: str
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class Rendered:
+    number: str
+    html: str
+    pdf: bytes | None
+
+
+def render_certificate(campaign_path: Path, calibration_path: Path, serial: str, revision: int, approver: str,
+                       pdf: bool = True, reason: str = "", operator: str = "") -> Rendered:
+    """One DUT's certificate issued as `revision`, approved by `approver` today: what an approval keeps."""
+    campaign, calibration = _certifiable(campaign_path, calibration_path)
+    sensor = calibration.sensors.get(serial)
+    if sensor is None:
+        raise ConfigError(f"{calibration_path}: no sensor {serial}")
+    approval = Approval(approver, utc_now()[:10], reason)
+    page = certificate_html(campaign, campaign_path, calibration, calibration_path, serial, sensor, operator, revision,
+                            approval)
+    render = _pdf_renderer() if pdf else None
+    number = certificate_number(campaign, sensor, calibration, revision).base
+    return Rendered(number, page, None if render is None else _rendered_pdf(render, page, calibration_path))
+
+
+def _certifiable(campaign_path: Path, calibration_path: Path) -> tuple[Campaign, CalibrationFile]:
+    """The campaign and its calibration, refused in one line when the calibration was fitted to other
+    measurements than the campaign holds, or before budgets and verdicts were stated."""
+    campaign = usable_campaign(campaign_path)
+    calibration = load_calibration(calibration_path)
+    if calibration.source.get("measurements_sha256") != measurements_sha256(campaign):
+        raise ConfigError(f"{calibration_path}: fitted to other measurements than {campaign_path} holds now: fit it "
+                          "again (rig fit) before certifying")
+    judged: list[tuple[str, SensorCalibration | GyroCalibration]] = [*calibration.sensors.items(),
+                                                                     *calibration.gyroscopes.items()]
+    old = [s for s, c in judged if "uncertainty_budget" not in c.metrics or c.verdict is None]
+    if old:
+        raise ConfigError(f"{calibration_path}: sensor {old[0]} has no uncertainty budget or verdict (written by an "
+                          "earlier accelcal-rig): fit it again (rig fit) before certifying")
+    return campaign, calibration
+
+
+def _rendered_pdf(render: Any, page: str, where: Path) -> bytes:
+    try:
+        return bytes(render(page))
+    except Exception as exc:  # noqa: BLE001 - a renderer's failure is one line naming the file
+        raise RigError(f"{where}: the PDF could not be rendered: {str(exc).splitlines()[0]}") from None
 
 
 def _pdf_renderer() -> Any:
@@ -126,17 +168,21 @@ def _grid(header: list[str], rows: Sequence[Sequence[object]], text_columns: int
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
-def certificate_number(campaign: Campaign, sensor: SensorCalibration, calibration: CalibrationFile) -> str:
-    """Unique to the DUT and the measurements: its serial and the measured data's SHA-256."""
-    return f"{sensor.serial}-{str(calibration.source.get('measurements_sha256', ''))[:12]}"
+def certificate_number(campaign: Campaign, sensor: SensorCalibration, calibration: CalibrationFile,
+                       revision: int = 1) -> certificate_lab.CertificateNumber:
+    """Unique to the DUT, its measurements and their fit, with its revision (certificate_lab)."""
+    return certificate_lab.certificate_number(sensor.serial, calibration, revision)
 
 
 def certificate_html(campaign: Campaign, campaign_path: Path, calibration: CalibrationFile, calibration_path: Path,
-                     serial: str, sensor: SensorCalibration, operator: str = "") -> str:
+                     serial: str, sensor: SensorCalibration, operator: str = "", revision: int = 1,
+                     approval: Approval | None = None) -> str:
+    """The certificate's page; without `approval` a draft, every page saying it is not issued yet."""
     dut = dut_description(campaign, serial)
     attrs, metrics = campaign.attrs, sensor.metrics
-    number = certificate_number(campaign, sensor, calibration)
-    banners = []
+    number = certificate_number(campaign, sensor, calibration, revision)
+    banners = [] if approval is not None else [
+        "DRAFT: not issued until a person approves it (rig approve, or the dashboard)."]
     if attrs.get("dry_run"):
         banners.append("SIMULATED: a dry run against simulated instruments. No physical sensor was calibrated.")
     if calibration.source.get("partial"):
@@ -146,39 +192,33 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
     covered = "accel and gyro channels" if gyro is not None else "accel channel"
     banners += [f"NOT CALIBRATED: its {channel} channel ({why}). This certificate covers its {covered} only."
                 for channel, why in uncalibrated.items()]
-    style = STYLE + (DRY_RUN_PAGES if attrs.get("dry_run") else "") + (GYRO_STYLE if gyro is not None else "")
+    style = STYLE + certificate_decision.STYLE + (DRY_RUN_PAGES if attrs.get("dry_run") else "") + (GYRO_STYLE if gyro is not None else "")
     item = ("MEMS IMU: accelerometer and gyroscope" if gyro is not None
             else f"MEMS accelerometer{' channel' if uncalibrated else ''}")
     parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Calibration certificate {_e(number)}"
-             f"</title><style>{style}</style></head><body>",
+             f"</title><style>{style}</style><style>{certificate_lab.LAB_STYLE}</style></head><body>",
+             certificate_lab.header_html(campaign),
              f"<h1>Calibration certificate: {item}</h1>",
-             f"<p>Certificate <b class='number'>{_e(number)}</b> — issued {_e(utc_now())} by accelcal-rig "
+             f"<p>Certificate <b class='number'>{_e(number)}</b> — "
+             f"{'issued ' + _e(approval.date) if approval else 'draft of ' + _e(utc_now()[:10])} by accelcal-rig "
              f"{_e(__version__)}</p>",
              *(f"<div class='banner'>{_e(b)}</div>" for b in banners)]
-    parts += ["<h2>Item calibrated</h2>", _rows([
+    parts += ["<div class='front'>", "<h2>Item calibrated</h2>", _rows([
         ("serial", serial),
         ("part", f"{dut.get('part', '?')}: {_identity(campaign, serial)}"),
         ("configured", f"±{dut.get('range_g', '?')} g, {dut.get('odr_hz', '?')} Hz, {float(dut.get('lsb_g', 0)) * 1e6:.4g} µg "
                        "per code"),
-        ("interface", f"{dut.get('driver', '?')} at {dut.get('endpoint', '?')}"),
         ("mount on the fixture", f"{dut.get('name', '')} ({', '.join(f'{a:g}' for a in dut.get('mount_euler_deg', []))}° "
                                  "xyz Euler)"),
+        *certificate_lab.item_rows(campaign, serial),
     ])]
-    instruments = campaign.header.instruments
     parts += ["<h2>Calibration</h2>", _rows([
-        ("procedure", f"{attrs.get('procedure_name', '')} ({attrs.get('procedure_path', '')})"),
-        ("rig", str(attrs.get("rig_name", ""))),
-        ("instruments", "; ".join(f"{name}: {i.get('driver', '?')} at {i.get('endpoint', '?')}"
-                                  for name, i in instruments.items()) or "—"),
-        ("campaign", f"{campaign_path} — started {campaign.header.created}, finished {campaign.finished or '—'}, "
-                     f"state {campaign.state}"),
-        ("measured data (SHA-256)", str(calibration.source.get("measurements_sha256", ""))),
-        ("calibration file", f"{calibration_path} (accelcal-rig {calibration.software_version}, {calibration.created})"),
-        ("method", f"Eq. 1 error model, {sensor.mode} fit of {len(sensor.free_parameters)} parameters, "
-                   f"polynomial degree {sensor.polynomial.degree} in temperature; {len(sensor.setpoints)} setpoints"),
+        *certificate_lab.calibration_rows(campaign, campaign_path.name, calibration, calibration_path.name, sensor,
+                                          gyro is not None),
         ("gravity", gravity_statement(float(metrics.get("gravity_m_s2", 9.80665)))),
+        *certificate_lab.environment_rows(campaign, serial),
         ("performed by", operator or "—"),
-    ])]
+    ]), certificate_lab.traceability_html(campaign), "</div>"]
     accel = " (accelerometer)" if gyro is not None else ""
     parts += ["<section>", f"<h2>Results{accel}</h2>", _results(sensor), "</section>"]
     parts += ["<section>", f"<h2>Verification{accel} (poses the calibration never saw)</h2>", _verification(metrics),
@@ -189,16 +229,19 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
     noise = certificate_gyro.noise(sensor, gyro)
     if noise:
         parts += ["<section>", "<h2>Noise (Allan deviation)</h2>", noise, "</section>"]
-    parts += _verdict_section(sensor, gyro)
+    parts += certificate_decision.conformity_section(sensor, gyro)
     parts += ["<section><h2>Signatures</h2>",
               "<table class='signatures'><tr><th class='text'></th><th class='text'>name</th><th class='text'>date"
               "</th><th class='text'>signature</th></tr>"
               f"<tr><td>performed by</td><td>{_e(operator)}</td><td></td><td></td></tr>"
-              "<tr><td>approved by</td><td></td><td></td><td></td></tr></table></section>",
+              f"<tr><td>approved by</td><td>{_e(approval.approver if approval else '')}</td>"
+              f"<td>{_e(approval.date if approval else '')}</td><td></td></tr></table>",
+              *([f"<p>Revision {revision} replaces revision {revision - 1}: {_e(approval.reason)}</p>"]
+                if approval is not None and revision > 1 and approval.reason else []),
               "<p class='note'>The results refer only to the item calibrated, under the conditions stated, within "
               f"the calibrated temperature range {sensor.validity_c[0]:.2f} … {sensor.validity_c[1]:.2f} °C. Outside "
               f"it the calibration {'is clamped to its edge' if sensor.out_of_range == 'clamp' else 'extrapolates'}."
-              "</p></body></html>"]
+              "</p>", certificate_lab.end_html(number), "</section></body></html>"]
     return "\n".join(parts)
 
 
@@ -217,25 +260,6 @@ def _gyro_sections(gyro: GyroCalibration) -> list[str]:
             certificate_gyro.gyro_verification(gyro), "</section>",
             "<section>", "<h2>Uncertainty of a compensated rate (gyroscope)</h2>", certificate_gyro.gyro_uncertainty(gyro),
             "</section>"]
-
-
-def _verdict_section(sensor: SensorCalibration, gyro: GyroCalibration | None) -> list[str]:
-    """The DUT's verdict (an IMU's: FAIL when either sensor fails), and each sensor's with its reasons."""
-    verdict = certificate_gyro.overall_verdict(sensor, gyro) if gyro is not None else sensor.verdict or "NOT JUDGED"
-    sensors = [sensor] + ([gyro] if gyro is not None else [])
-    if all(c.verdict in (None, "NOT JUDGED") for c in sensors):  # no specification: no conformity statement
-        return ["<section><h2>Statement of conformity</h2><p>None: the procedure states no acceptance limits (no "
-                "specification to judge against). The results above are stated with their uncertainties.</p></section>"]
-    judged: list[tuple[str, SensorCalibration | GyroCalibration]] = (
-        [("", sensor)] if gyro is None else [("accelerometer", sensor), ("gyroscope", gyro)])
-    lists = []
-    for label, calibration in judged:
-        reasons = "".join(f"<li>{_e(r)}</li>" for r in calibration.verdict_reasons)
-        head = f"<p>{_e(label)}: <b class='{_e(calibration.verdict or '')}'>{_e(calibration.verdict or 'NOT JUDGED')}" \
-               "</b></p>" if label else ""
-        lists.append(f"{head}<ul>{reasons}</ul>")
-    return ["<section><h2>Verdict against the procedure's acceptance limits</h2>",
-            f"<p><span class='verdict {_e(verdict)}'>{_e(verdict)}</span></p>{''.join(lists)}</section>"]
 
 
 def _identity(campaign: Campaign, serial: str) -> str:
@@ -258,11 +282,19 @@ def _results(sensor: SensorCalibration) -> str:
     low, high = sensor.validity_c
     temperatures = np.array([low, 0.5 * (low + high), high])
     values = sensor.parameters_at(temperatures)              # (3, 12)
-    rows = [[label, *(format((values[i, k] + offset) * factor, spec) for i in range(3))]
+
+    def cell(i: int, k: int, factor: float, offset: float, spec: str) -> str:
+        u = certificate_decision.expanded_at(sensor.metrics, PARAMETER_NAMES[k], float(temperatures[i]))
+        text = format((values[i, k] + offset) * factor, spec)
+        return text if u is None else f"{text} ± {format(u * factor, spec.lstrip('+'))}"
+
+    rows = [[label, *(cell(i, k, factor, offset, spec) for i in range(3))]
             for label, k, factor, offset, spec in _RESULT_ROWS + (_MISALIGNMENT_ROWS if sensor.mode == "reference" else [])]
     return (f"<p>Calibrated range {low:.2f} … {high:.2f} °C (the DUT's own temperature sensor). Parameters of Eq. 1, "
-            "U<sub>SF</sub> = M·C·S·(U − b), at the ends and the middle of the range; the full polynomials are in the "
-            "calibration file.</p>" + _grid(["parameter", *(f"at {t:.2f} °C" for t in temperatures)], rows))
+            "U<sub>SF</sub> = M·C·S·(U − b), at the ends and the middle of the range, each ± its expanded uncertainty "
+            "(k = 2: the fit's, carried through its polynomial, the thermal model's scatter and, for the scale "
+            "factors, the site's gravity); the full polynomials are in the calibration file.</p>"
+            + _grid(["parameter", *(f"at {t:.2f} °C" for t in temperatures)], rows))
 
 
 def _verification(metrics: dict[str, Any]) -> str:
@@ -270,13 +302,21 @@ def _verification(metrics: dict[str, Any]) -> str:
     if v is None:
         return "<p><b>No verification poses:</b> the calibration was not checked on poses it was not fitted to.</p>"
     temperatures = ", ".join(f"{r['setpoint_c']:g}" for r in v["by_setpoint"])
+    expanded = v.get("expanded_u", {})
+
+    def u(key: str, spec: str = ".4f") -> str:
+        return f" ± {format(expanded[key], spec)}" if key in expanded else ""
+
+    drift_u = expanded.get("drift_mg")
+    drift = ", ".join(f"{d * 1e3:.1f}" + (f" ± {drift_u[a] * 1e3:.1f}" if drift_u else "") for a, d in enumerate(v["drift_mg"]))
     return _rows([
         ("poses", f"{v['n_poses']} at {temperatures} °C"),
-        ("|g| RMSE (Eq. 9)", f"{v['rmse_mg']:.4f} mg (their noise floor {v['noise_floor_mg']:.4f} mg)"),
-        ("largest axis error", f"{v['max_axis_error_mg']:.4f} mg ({v['frame']})"),
-        ("largest tilt error (Eq. 10)", f"{v['max_tilt_error_deg']:.4f}°"),
-        ("residual zero-g drift x, y, z", ", ".join(f"{d * 1e3:.1f}" for d in v["drift_mg"]) + " µg over the range"),
-    ])
+        ("|g| RMSE (Eq. 9)", f"{v['rmse_mg']:.4f}{u('rmse_mg')} mg (their noise floor {v['noise_floor_mg']:.4f} mg)"),
+        ("largest axis error", f"{v['max_axis_error_mg']:.4f}{u('max_axis_error_mg')} mg ({v['frame']})"),
+        ("largest tilt error (Eq. 10)", f"{v['max_tilt_error_deg']:.4f}{u('max_tilt_error_deg')}°"),
+        ("residual zero-g drift x, y, z", drift + " µg over the range"),
+    ]) + ("<p class='note'>± the figure's expanded uncertainty (k = 2) as a measurement of the calibrated DUT's "
+          "error: the table's pointing, the site's gravity and the reading's noise.</p>" if expanded else "")
 
 
 def _uncertainty(metrics: dict[str, Any]) -> str:

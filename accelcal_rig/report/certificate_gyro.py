@@ -12,10 +12,10 @@ from typing import Any
 import numpy as np
 
 from accelcal_rig.fit import gyro_model
+from accelcal_rig.fit.acceptance import combined_verdict
 from accelcal_rig.fit.calibration import GyroCalibration, SensorCalibration
-
-#: The temperature the gyroscope's parameters are stated at: 25 °C, or the calibrated temperature nearest it.
-REFERENCE_C = 25.0
+from accelcal_rig.fit.parameter_uncertainty import REFERENCE_C
+from accelcal_rig.report.certificate_decision import expanded_at
 
 
 def _e(value: object) -> str:
@@ -41,29 +41,20 @@ def reference_c(gyro: GyroCalibration) -> float:
     return float(np.clip(REFERENCE_C, low, high))
 
 
-def _sigma_at(gyro: GyroCalibration, temperature_c: float) -> dict[str, float | None]:
-    """The 1σ of the setpoint fit nearest the temperature (the polynomial's own, where it has no setpoints)."""
-    if not gyro.setpoints:
-        return {}
-    return dict(min(gyro.setpoints, key=lambda s: abs(s.temperature_c - temperature_c)).sigma)
-
-
-def _with_sigma(value: float, sigma: float | None, factor: float, spec: str) -> str:
+def _with_u(value: float, expanded: float | None, factor: float, spec: str) -> str:
     text = format(value * factor, spec)
-    return text if sigma is None else f"{text} ± {format(abs(sigma) * factor, spec.lstrip('+'))}"
+    return text if expanded is None else f"{text} ± {format(abs(expanded) * factor, spec.lstrip('+'))}"
 
 
 def gyro_results(gyro: GyroCalibration) -> str:
-    """The model's parameters at the reference temperature, a row per kind and a column per gyro axis, each ± the
-    1σ of the setpoint fit nearest it."""
+    """The model's parameters at the reference temperature, a row per kind and a column per gyro axis, each ± its
+    expanded uncertainty there."""
     at = reference_c(gyro)
     values = dict(zip(gyro_model.PARAMETER_NAMES, gyro.parameters_at(at).tolist()))
-    sigma = _sigma_at(gyro, at)
-    nearest = min((s.temperature_c for s in gyro.setpoints), key=lambda t: abs(t - at), default=at)
     axes = gyro_model.AXES
 
     def row(label: str, names: list[str], factor: float, offset: float, spec: str) -> list[str]:
-        return [label, *(_with_sigma(values[n] + offset, sigma.get(n), factor, spec) for n in names)]
+        return [label, *(_with_u(values[n] + offset, expanded_at(gyro.metrics, n, at), factor, spec) for n in names)]
 
     others = [[b for b in axes if b != a] for a in axes]
     rows = [row("bias (°/s)", [f"bias_{a}_dps" for a in axes], 1.0, 0.0, "+.4f"),
@@ -77,7 +68,8 @@ def gyro_results(gyro: GyroCalibration) -> str:
     low, high = gyro.validity_c
     return (f"<p>Calibrated range {low:.2f} … {high:.2f} °C (the DUT's own temperature sensor), ±{gyro.range_dps:g} °/s. "
             "Parameters of the rate-table model ω<sub>raw</sub> = b + u + a⊙|u| + n⊙u⊙(u/1000 °/s)² + G·f, u = K·ω, "
-            f"at {at:.2f} °C, each ± the 1σ of the setpoint fit nearest it ({nearest:.2f} °C); the full polynomials "
+            f"at {at:.2f} °C, each ± its expanded uncertainty (k = 2: the fit's through the polynomials, the table's "
+            "rate and pointing accuracy, the Earth's rate where unplaced, the bias's wander); the full polynomials "
             "are in the calibration file.</p>"
             + _grid(["parameter", "gyro x", "gyro y", "gyro z"], rows))
 
@@ -89,13 +81,17 @@ def gyro_verification(gyro: GyroCalibration) -> str:
                 "not fitted to.</p>")
     temperatures = ", ".join(f"{t:g}" for t in v.get("temperatures_c", []))
 
+    expanded = v.get("expanded_u", {})
+
     def dps(key: str) -> str:
-        return "—" if v.get(key) is None else f"{v[key]:.4f} °/s"
+        u = f" ± {expanded[key]:.4f}" if key in expanded else ""
+        return "—" if v.get(key) is None else f"{v[key]:.4f}{u} °/s"
 
     rms = dps("rmse_dps") + (f" (before calibration {v['rmse_before_dps']:.4f} °/s; their noise floor "
                              f"{v['noise_floor_dps']:.4f} °/s)" if v.get("rmse_before_dps") is not None
                              and v.get("noise_floor_dps") is not None else "")
-    scale = "—" if v.get("scale_error_ppm") is None else f"{v['scale_error_ppm']:.0f} ppm"
+    scale_u = f" ± {expanded['scale_error_ppm']:.0f}" if "scale_error_ppm" in expanded else ""
+    scale = "—" if v.get("scale_error_ppm") is None else f"{v['scale_error_ppm']:.0f}{scale_u} ppm"
     return _rows([
         ("rate steps", f"{v.get('rate_steps', 0)} at {temperatures} °C"),
         ("RMS axis error", rms),
@@ -166,8 +162,5 @@ def noise(sensor: SensorCalibration, gyro: GyroCalibration | None) -> str:
 
 
 def overall_verdict(sensor: SensorCalibration, gyro: GyroCalibration | None) -> str:
-    """The DUT's verdict: FAIL when either sensor fails, NOT JUDGED when a sensor has no verdict, else PASS."""
-    verdicts = [sensor.verdict] + ([gyro.verdict] if gyro is not None else [])
-    if "FAIL" in verdicts:
-        return "FAIL"
-    return "PASS" if all(v == "PASS" for v in verdicts) else "NOT JUDGED"
+    """The DUT's verdict from its sensors' (combined_verdict)."""
+    return combined_verdict([sensor.verdict] + ([gyro.verdict] if gyro is not None else []))

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.durable import write_atomically
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, distort, norm_only_gauge
@@ -91,9 +92,17 @@ def norm_deviation(data: CampaignData, path: Path) -> Path:
     axes[0, 0].set_ylabel("|g| − g before (mg)")
     axes[1, 0].set_ylabel("|g| − g after (mg)")
     figure.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=axes, label="setpoint (°C)", shrink=0.8)
-    figure.suptitle("Norm of gravity at each calibration pose, before and after calibration (paper Fig. 6); g: the "
-                    "site's gravity")
+    figure.suptitle("Norm of gravity at each calibration pose, before and after calibration (paper Fig. 6); g: "
+                    + gravity_used(data.gravity_m_s2))
     return save(figure, path)
+
+
+def gravity_used(gravity_m_s2: float) -> str:
+    """Which gravity |g| is compared with: the site's as the rig config states it, or the standard value in its
+    place (said so: the figure then shows the site's difference from it too)."""
+    if gravity_m_s2 == STANDARD_GRAVITY_M_S2:
+        return f"the standard {STANDARD_GRAVITY_M_S2} m/s² (the site's was not stated)"
+    return f"the site's {gravity_m_s2:.6g} m/s²"
 
 
 def _sphere_grid(n: int = 24) -> np.ndarray:
@@ -279,8 +288,13 @@ def soak_traces(data: CampaignData, band_c: float, path: Path) -> Path:
                         color=cmap(norm(soak.setpoint_c)))
     for dut in data.duts.values():
         top.plot(dut.poses.t_s / 3600.0, dut.poses.temperature_c, ".", ms=2, color="tab:green")
+        if dut.verification is not None and len(dut.verification.t_s):
+            top.plot(dut.verification.t_s / 3600.0, dut.verification.temperature_c, "o", ms=3, mfc="none", mew=0.6,
+                     color="tab:purple")
     top.plot([], [], "-", color="k", label="chamber air")
-    top.plot([], [], ".", color="tab:green", label="DUTs during poses")
+    top.plot([], [], ".", color="tab:green", label="DUTs during calibration poses")
+    if any(d.verification is not None and len(d.verification.t_s) for d in data.duts.values()):
+        top.plot([], [], "o", ms=3, mfc="none", mew=0.6, color="tab:purple", label="DUTs during verification poses")
     top.plot([], [], ":", color="0.6", label="soak criterion met")
     top.legend(fontsize=8)
     top.set_xlabel("campaign time (h)")

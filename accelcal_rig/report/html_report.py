@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from accelcal_rig import __version__
-from accelcal_rig.core.formatting import format_duration
+from accelcal_rig.core.formatting import format_duration, format_fixed
 from accelcal_rig.core.units import gravity_statement
 from accelcal_rig.durable import write_text_atomically
 from accelcal_rig.errors import ConfigError
@@ -27,8 +27,9 @@ body { font-family: sans-serif; margin: 2em auto; max-width: 1200px; color: #222
 h1 { font-size: 1.5em; } h2 { font-size: 1.2em; margin-top: 2em; border-bottom: 1px solid #ccc; }
 table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0; }
 th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: right; }
-th { background: #f0f0f0; } td.text, th.text { text-align: left; }
+th { background: #f0f0f0; } td.text, th.text { text-align: left; } td.unbroken { white-space: nowrap; }
 tr.warning td { background: #fff6d5; } tr.error td { background: #fde0e0; } tr.total td { font-weight: bold; }
+tr.conditional td { background: #ffe2a8; }
 img { max-width: 100%; border: 1px solid #eee; } .note { color: #555; font-size: 0.9em; }
 .state-done { color: #106010; } .state-aborted, .state-running { color: #a01010; }
 """
@@ -42,24 +43,29 @@ FIGURES = {
 }
 #: Drawn only where the campaign has them: a calibrated gyroscope, a still noise record.
 GYRO_FIGURES = {"gyro_parameters": "gyro_parameters.png", "allan": "allan_deviation.png"}
+#: A verdict's row style: a failed DUT highlighted, a CONDITIONAL one (inside a guard band) in amber.
+_VERDICT_ROWS = {"FAIL": "warning", "CONDITIONAL": "conditional"}
 
 
 def _e(value: object) -> str:
     return html.escape(str(value))
 
 
-def _table(header: list[str], rows: Sequence[Sequence[object]], text_columns: int = 1,
-           row_classes: list[str] | None = None) -> str:
+def _table(header: list[str] | None, rows: Sequence[Sequence[object]], text_columns: int = 1,
+           row_classes: list[str] | None = None, unbroken: tuple[int, ...] = ()) -> str:
+    """`header` None: no header row (a table of named facts); `unbroken`: columns never wrapped inside a value
+    (timestamps)."""
     def cell(tag: str, index: int, value: object) -> str:
-        css = ' class="text"' if index < text_columns else ""
+        classes = " ".join(c for c, on in (("text", index < text_columns), ("unbroken", index in unbroken)) if on)
+        css = f' class="{classes}"' if classes else ""
         return f"<{tag}{css}>{_e(value)}</{tag}>"
 
-    head = "".join(cell("th", i, h) for i, h in enumerate(header))
+    head = "" if header is None else "<tr>" + "".join(cell("th", i, h) for i, h in enumerate(header)) + "</tr>"
     body = []
     for r, row in enumerate(rows):
         css = f' class="{row_classes[r]}"' if row_classes and row_classes[r] else ""
         body.append(f"<tr{css}>" + "".join(cell("td", i, v) for i, v in enumerate(row)) + "</tr>")
-    return f"<table><tr>{head}</tr>{''.join(body)}</table>"
+    return f"<table>{head}{''.join(body)}</table>"
 
 
 def _figure(name: str, caption: str) -> str:
@@ -144,14 +150,14 @@ def _summary(data: CampaignData) -> list[str]:
         ["rig", data.rig_name + (" — simulated (dry run)" if s.get("dry_run") else "")],
         ["poses", f"{s.get('poses_done')} of {s.get('poses_total')} × {len(data.duts)} DUTs × "
                   f"{s.get('samples_per_pose')} samples"],
-        ["setpoints (°C)", ", ".join(f"{t:g}" for t in s.get("setpoints_c", []))],
+        ["setpoints (°C)", ", ".join(f"{t + 0.0:g}" for t in s.get("setpoints_c", []))],
         ["started / finished", f"{s.get('started')} / {s.get('finished') or '—'}"],
         ["campaign time", format_duration(float(data.pose_t_s.max())) if len(data.pose_t_s) else "—"],
         ["fit", _fit_description(data.options)],
         ["gravity", gravity_statement(data.gravity_m_s2)],
         ["integrity", s.get("integrity", "?")],
     ]
-    out = ["<h2>Campaign</h2>", _table(["", ""], rows, text_columns=2)]
+    out = ["<h2>Campaign</h2>", _table(None, rows, text_columns=2)]
     sensors, verified, classes = [], [], []
     for serial, dut in data.duts.items():
         if dut.fit is None:
@@ -169,7 +175,7 @@ def _summary(data: CampaignData) -> list[str]:
             v["n_poses"], f"{v['rmse_mg']:.4f}", f"{v['rmse_mg'] / v['noise_floor_mg']:.2f}",
             f"{v['max_axis_error_mg']:.4f}", f"{v['max_tilt_error_deg']:.4f}",
             " / ".join(f"{d * 1e3:.1f}" for d in v["drift_mg"])])])
-        classes.append("warning" if verdict == "FAIL" else "")
+        classes.append(_VERDICT_ROWS.get(verdict, ""))
     out += ["<h2>Calibration: verification (poses the fit never saw)</h2>",
             _table(["DUT", "verdict", "reasons", "poses", "|g| RMSE (mg)", "÷ noise floor", "largest axis error (mg)",
                     "largest tilt error (°)", "residual drift x/y/z (µg)"], verified, text_columns=3,
@@ -210,7 +216,7 @@ def _gyro_section(data: CampaignData) -> list[str]:
                      dps(v.get("max_axis_error_dps")), dps(v.get("scale_error_ppm"), 0), dps(v.get("rest_error_dps")),
                      " / ".join(f"{u:.4f}" for u in expanded) if expanded else "—",
                      f"{float(budget['largest_rate_dps']):g}" if "largest_rate_dps" in budget else "—"])
-        classes.append("warning" if gyro.verdict == "FAIL" else "")
+        classes.append(_VERDICT_ROWS.get(gyro.verdict or "", ""))
     earth = sorted({g.earth_rate for g in data.gyros.values()})
     return ["<h2>Gyroscope calibration</h2>",
             _table(["DUT", "verdict", "reasons", "rate RMS before (°/s)", "after, in-sample (°/s)",
@@ -237,7 +243,7 @@ def _noise_table(data: CampaignData) -> str:
             for key, label, spec in keys[record.channel]:
                 values = record.figures.get(key)
                 if isinstance(values, list):
-                    rows.append([serial, record.channel, label, f"{record.setpoint_c:g}",
+                    rows.append([serial, record.channel, label, f"{record.setpoint_c + 0.0:g}",
                                  *(f"{format(e['value'], spec)} [{format(e['low'], spec)}, {format(e['high'], spec)}]"
                                    for e in values)])
     if not rows:
@@ -273,7 +279,7 @@ def _rmse_table(data: CampaignData) -> str:
 
 def _uncertainty_table(data: CampaignData) -> str:
     """Per DUT, each source's standard uncertainty and the expanded one, worst case over the range."""
-    rows, classes, notes = [], [], []
+    rows, classes, notes, budgets = [], [], [], []
     for serial, dut in data.duts.items():
         if dut.fit is None:
             continue
@@ -288,14 +294,32 @@ def _uncertainty_table(data: CampaignData) -> str:
         if coverage is not None:
             notes.append(f"{serial}: {coverage * 100:.1f} % of its verification axis errors against the simulation "
                          "truth lie inside their expanded uncertainty")
-        reading = budget["reading"]
+        budgets.append(budget)
     if not rows:
         return "<p>No fit.</p>"
     return (_table(["DUT", "source", "x (µg)", "y (µg)", "z (µg)"], rows, text_columns=2, row_classes=classes)
             + f"<p class='note'>Standard uncertainties of a compensated reading, each source's largest over every "
-              f"orientation and the calibrated range (GUM; sources uncorrelated): {_e(reading)}. Calibration noise "
-              "and turntable pointing reach the reading through the fitted coefficients.</p>"
+              f"orientation and the calibrated range (GUM; sources uncorrelated): {_e(_reading_of(budgets))}. "
+              "Calibration noise and turntable pointing reach the reading through the fitted coefficients.</p>"
             + "".join(f"<p class='note'>{_e(n)} (a dry run; about 95 % is what k = 2 promises).</p>" for n in notes))
+
+
+def _reading_of(budgets: list[dict]) -> str:
+    """The reading the budgets are of, its figures as the range over the DUTs (one DUT's own where there is
+    one): a reading averaged like a calibration pose, its temperature read like a pose's."""
+    stderr = [value for b in budgets for value in b.get("reading_stderr_mg", [])]
+    temperature = [float(b["temperature_u_c"]) for b in budgets if "temperature_u_c" in b]
+    if not stderr or not temperature:
+        return "; ".join(dict.fromkeys(str(b["reading"]) for b in budgets))
+    whose = f" (the range over the {len(budgets)} DUTs)" if len(budgets) > 1 else ""
+    return (f"a reading averaged like a calibration pose (standard error {_span(stderr, 4)} mg per axis), its "
+            f"temperature read like a pose's (±{_span(temperature, 3)} °C){whose}")
+
+
+def _span(values: list[float], digits: int) -> str:
+    """`0.0123 … 0.0125`, or the one value when all round alike."""
+    low, high = format_fixed(min(values), digits), format_fixed(max(values), digits)
+    return low if low == high else f"{low} … {high}"
 
 
 def _parameter_table(data: CampaignData) -> str:
@@ -313,7 +337,7 @@ def _parameter_table(data: CampaignData) -> str:
         datasheet = data.zero_g_offset_mg.get(serial)
         bias = np.abs(p[0:3]) * 1e3
         outside = datasheet is not None and bool(np.any(bias > datasheet))
-        rows.append([serial, f"{t:.1f}", *(f"{v:+.3f}" for v in p[0:3] * 1e3), f"±{datasheet:g}" if datasheet else "—",
+        rows.append([serial, format_fixed(t), *(f"{v:+.3f}" for v in p[0:3] * 1e3), f"±{datasheet:g}" if datasheet else "—",
                      *(f"{v:+.0f}" for v in (p[3:6] - 1.0) * 1e6), *(f"{v:+.3f}" for v in p[6:9] * 1e3)])
         classes.append("warning" if outside else "")
     if not rows:
@@ -339,7 +363,8 @@ def _drift_table(data: CampaignData) -> str:
         interpolates = len(dut.fit.fits) <= min(dut.fit.thermal.degree, len(dut.fit.fits) - 1) + 1
         after = (["0 by construction (the polynomial interpolates)"] + ["—"] * 2 if interpolates and len(dut.fit.fits) > 1
                  else [f"{v * 1e3:.1f}" for v in m["drift_after_mg"]])
-        rows.append([serial, f"{low:.1f} … {high:.1f}", *(f"{v:.3f}" for v in m["drift_before_mg"]), *after])
+        rows.append([serial, f"{format_fixed(low)} … {format_fixed(high)}", *(f"{v:.3f}" for v in m["drift_before_mg"]),
+                     *after])
     return _table(["DUT", "range (°C)", "before x (mg)", "before y (mg)", "before z (mg)", "after x (µg)",
                    "after y (µg)", "after z (µg)"], rows, text_columns=2) if rows else ""
 
@@ -349,8 +374,8 @@ def _soak_table(data: CampaignData) -> str:
     for soak in data.soaks:
         to_stable = format_duration(soak.t_stable_s - soak.t_reached_s) if np.isfinite(soak.t_stable_s) else "—"
         settled = soak.dut_c[-1] if soak.dut_c.ndim == 2 and len(soak.dut_c) else []
-        rows.append([soak.label, f"{soak.setpoint_c:g}", soak.outcome, format_duration(soak.t_reached_s), to_stable,
-                     ", ".join(f"{v:.2f}" for v in settled)])
+        rows.append([soak.label, f"{soak.setpoint_c + 0.0:g}", soak.outcome, format_duration(soak.t_reached_s),
+                     to_stable, ", ".join(format_fixed(v, 2) for v in settled)])
         classes.append("" if soak.outcome == "stable" else "warning")
     return _table(["soak", "setpoint (°C)", "outcome", "reached at", "stable after", "last DUT readings (°C)"],
                   rows, text_columns=1, row_classes=classes)
@@ -377,7 +402,7 @@ def _event_table(data: CampaignData) -> str:
     summary = ", ".join(f"{n} {level}" for level, n in sorted(counts.items()))
     return (f"<p class='note'>{_e(summary)} events; debug events (transitions, each pose) are in the file and "
             "its log, not shown here.</p>" + _table(["campaign time", "wall time", "level", "kind", "message"], rows,
-                                                    text_columns=5, row_classes=classes))
+                                                    text_columns=5, row_classes=classes, unbroken=(0, 1)))
 
 
 def _fit_description(options: FitOptions | None) -> str:

@@ -151,8 +151,11 @@ def _verification_lines(prepared: PreparedCampaign) -> list[str]:
             judged += [f"gyro {name} {getattr(gyro.parameters, name):g} at {gyro.parameters.at_c:g} °C" for name in
                        ("bias_dps", "scale_error_ppm", "cross_axis_mrad", "gsens_dps_per_g")
                        if getattr(gyro.parameters, name) is not None]
+    rule = ("" if not judged else f"; {limits.decision_rule} acceptance" + (
+        f", guard band {limits.guard_band_factor:g} × U" if limits.decision_rule == "guarded" else "")
+        if limits.decision_rule else "; simple acceptance (no decision_rule stated)")
     lines.append("accept     " + ("; ".join(judged) if judged else "no limits: every DUT NOT JUDGED (no statement of conformity)") +
-                 ("" if limits.allow_partial else "; a partial campaign fails"))
+                 rule + ("" if limits.allow_partial else "; a partial campaign fails"))
     return lines
 
 

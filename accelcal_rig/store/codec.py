@@ -54,7 +54,8 @@ def encode_header(header: CampaignHeader) -> bytes:
                      "axis_names": list(plan.axis_names)},
             "duts": plain_value(header.duts), "instruments": header.instruments,
             "turntable_accuracy_arcsec": float(header.turntable_accuracy_arcsec), "truth": truth_attrs,
-            "channels": {serial: {c.name: c.attrs() for c in channels} for serial, channels in header.channels.items()}}
+            "channels": {serial: {c.name: c.attrs() for c in channels} for serial, channels in header.channels.items()},
+            "references": header.references}
     return encode_record("header", meta, arrays)
 
 
@@ -138,9 +139,14 @@ def _header(record: Record) -> CampaignHeader:
                 for serial, by_name in meta.get("channels", {}).items()}  # absent before parts declared channels
     if not set(channels) <= {d["serial"] for d in duts} or not all(channels.values()):
         raise ValueError("channels of sensors not in the campaign, or a sensor without channels")
+    stated = meta.get("references", {})  # absent before campaigns recorded them
+    if not isinstance(stated, dict):
+        raise ValueError("references that are not a mapping")
+    references = {str(key): {str(k): str(v) for k, v in _attributes(info).items()} for key, info in stated.items()}
     return CampaignHeader(str(meta["campaign_id"]), str(meta["created"]), str(meta["software_version"]),
                           dict(meta["attrs"]), str(meta["procedure_yaml"]), str(meta["rig_yaml"]), plan, duts,
-                          dict(meta["instruments"]), float(meta["turntable_accuracy_arcsec"]), truth, channels)
+                          dict(meta["instruments"]), float(meta["turntable_accuracy_arcsec"]), truth, channels,
+                          references)
 
 
 def _attributes(value: object) -> dict[str, object]:

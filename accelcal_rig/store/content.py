@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
 from accelcal_rig.store.records import CampaignHeader, ChannelInfo, PoseRecord, RunStart, SoakTrace, StoredEvent
 
 #: The acceleration channel's fields under their names in formats 1 and 2.
@@ -237,20 +238,21 @@ def measurements_sha256(campaign: Campaign) -> str:
 
 
 def _implausible_rows(campaign: Campaign, serial: str) -> list[int]:
-    """Rows no real measurement produces: a reference gravity that is not a unit vector, a block of codes
+    """Rows no real measurement produces: a reference gravity not as long as the site's, a block of codes
     all zero in any channel, or a non-finite mean or temperature."""
     if not campaign.poses:
         return []
     temperature = campaign.dut_column(serial, "temperature_c")
     bad = ~np.all(np.isfinite(temperature), axis=1)
+    site = site_gravity_g(float(campaign.attrs.get("gravity_m_s2", STANDARD_GRAVITY_M_S2)))
     for info in campaign.header.dut_channels(serial):
         codes = campaign.channel_column(serial, info.name, "raw_codes")
         mean = campaign.channel_column(serial, info.name, "mean")
         bad |= ~np.any(codes != 0, axis=(1, 2)) | ~np.all(np.isfinite(mean), axis=1)
-        if info.quantity == "acceleration":  # gravity in standard g: a unit vector at standard gravity
+        if info.quantity == "acceleration":  # gravity in standard g: the site's gravity's length
             reference = campaign.channel_column(serial, info.name, "reference")
             with np.errstate(invalid="ignore"):
-                bad |= np.abs(np.linalg.norm(reference, axis=1) - 1.0) > 1e-6
+                bad |= np.abs(np.linalg.norm(reference, axis=1) - site) > 1e-6
     return np.flatnonzero(bad).tolist()
 
 

@@ -127,6 +127,9 @@ def _image(campaign: Campaign, journal_bytes: int) -> bytes:
         instruments = file.create_group("instruments")
         for name, info in campaign.instruments.items():
             instruments.create_group(name).attrs.update(info)
+        references = file.create_group("references")
+        for name, info in header.references.items():
+            references.create_group(name).attrs.update(info)
         soaks = file.create_group("soaks")
         for name, soak in zip(campaign.soak_names(), campaign.soaks):
             group = soaks.create_group(name)
@@ -319,7 +322,8 @@ def _dut_columns(header: CampaignHeader, serial: str, version: int,
     return found
 
 
-_HEADER_ATTRS = ("procedure_name", "procedure_path", "rig_name", "rig_path", "dry_run", "seed", "clock",
+_HEADER_ATTRS = ("procedure_name", "procedure_version", "procedure_path", "rig_name", "rig_path", "dry_run", "seed",
+                 "clock", "lab_name", "lab_address", "place_of_calibration",
                  "samples_per_pose", "fit_mode", "polynomial_degree", "fit_parameters", "fit_out_of_range",
                  "fit_temperature_model")
 
@@ -361,13 +365,16 @@ def _read_header(reader: _Reader) -> CampaignHeader:
                                  **{name: np.asarray(node[()], dtype=float) for name, node in group.items()
                                     if name not in _TRUTH_COLUMNS and name != "polynomial_coefficients"
                                     and isinstance(node, h5py.Dataset) and node.dtype.kind == "f" and node.size <= 4096}}
+    references = {name: {k: _text(v) for k, v in group.attrs.items()}
+                  for name, group in (reader.node("references", h5py.Group).items() if "references" in file else ())
+                  if isinstance(group, h5py.Group)}  # absent before campaigns recorded them
     poses_group = reader.node("poses", h5py.Group)
     return CampaignHeader(
         campaign_id=_text(file.attrs.get("campaign_id", "")), created=_text(file.attrs.get("started", "")),
         software_version=_text(file.attrs.get("software_version", "")), attrs=attrs,
         procedure_yaml=reader.text("config/procedure_yaml"), rig_yaml=rig_yaml, plan=plan,
         duts=duts, instruments={}, turntable_accuracy_arcsec=float(poses_group.attrs.get("turntable_accuracy_arcsec", 0.0)),
-        truth=truth, channels=channels)
+        truth=truth, channels=channels, references=references)
 
 
 def _read_channels(group: h5py.Group) -> tuple[ChannelInfo, ...]:

@@ -198,13 +198,18 @@ class CampaignHeader:
     procedure_yaml: str
     rig_yaml: str
     plan: StoredPlan
-    duts: list[dict[str, Any]]        # per DUT: serial, name, mount_euler_deg, range_g, odr_hz, lsb_g, driver, endpoint
-    instruments: dict[str, dict[str, str]]
+    duts: list[dict[str, Any]]        # per DUT: serial, name, mount_euler_deg, range_g, odr_hz, lsb_g, driver, endpoint,
+                                      # customer, received_date, condition (the last three "" when not stated)
+    instruments: dict[str, dict[str, str]]  # chamber, turntable: driver, endpoint, make, model, serial
     turntable_accuracy_arcsec: float
     #: Dry runs: each simulated DUT's hidden model (attributes and `polynomial_coefficients`).
     truth: dict[str, dict[str, Any]] = field(default_factory=dict)
     #: Each DUT's channels by serial (absent: formats 1 and 2, whose DUTs measured acceleration only).
     channels: dict[str, tuple[ChannelInfo, ...]] = field(default_factory=dict)
+    #: The references the rig config named when the campaign was created, by key (`turntable_angle`, …): each
+    #: its certificate, issuer, due_date (ISO), make, model and serial; {} for one the rig config did not state.
+    #: Absent before campaigns recorded them.
+    references: dict[str, dict[str, str]] = field(default_factory=dict)
 
     @property
     def serials(self) -> list[str]:

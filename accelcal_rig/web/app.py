@@ -6,6 +6,7 @@ JSON endpoints with the bundled script. With a token, every request must carry i
 from __future__ import annotations
 
 import hmac
+import secrets
 from pathlib import Path
 from typing import Any
 from urllib.parse import quote
@@ -14,6 +15,7 @@ from jinja2 import Environment, PackageLoader, select_autoescape
 from starlette.applications import Starlette
 from starlette.middleware import Middleware
 from starlette.middleware.base import BaseHTTPMiddleware, RequestResponseEndpoint
+from starlette.middleware.sessions import SessionMiddleware
 from starlette.middleware.trustedhost import TrustedHostMiddleware
 from starlette.requests import Request
 from starlette.responses import FileResponse, HTMLResponse, JSONResponse, PlainTextResponse, RedirectResponse, Response
@@ -23,10 +25,13 @@ from starlette.staticfiles import StaticFiles
 from accelcal_rig.registry.analysis import lot_statistics, trend
 from accelcal_rig.registry.database import Registry
 from accelcal_rig.registry.location import described
+from accelcal_rig.web.approval import BEARER_SCOPE_KEY, ApprovalSettings, approval_routes
 from accelcal_rig.web.campaigns import CampaignFolders
 from accelcal_rig.web.svg import line_plot
 
 _STATIC = Path(__file__).parent / "static"
+#: The registry page's filter (`?made=`): every calibration, only real ones, only dry runs.
+_MADE: dict[str, bool | None] = {"": None, "real": False, "dry-run": True}
 _TOKEN_COOKIE = "accelcal_token"
 
 
@@ -43,6 +48,9 @@ class _TokenRequired(BaseHTTPMiddleware):
                  or request.headers.get("authorization", "").removeprefix("Bearer ").strip())
         if not given or not hmac.compare_digest(given.encode(), self._token):  # bytes: any text compares
             return PlainTextResponse("a token is needed: open the address rig serve printed", status_code=401)
+        # Sent as a header, the token is the lab's reverse proxy's (its users never see it): only such a
+        # request may name its user in the proxy's header (web/approval.py).
+        request.scope[BEARER_SCOPE_KEY] = request.headers.get("authorization", "").startswith("Bearer ")
         response = await call_next(request)
         if request.query_params.get("token"):
             response.set_cookie(_TOKEN_COOKIE, self._token.decode(), httponly=True, samesite="strict",
@@ -56,15 +64,19 @@ LOOPBACK_HOSTS = ["127.0.0.1", "localhost", "::1", "[::1]"]
 
 
 def create_app(campaign_folders: list[Path], registry_url: str | None, token: str | None = None,
-               tls: bool = False, hosts: list[str] | None = None) -> Starlette:
-    """`hosts`: the Host names answered without a token (default LOOPBACK_HOSTS); with a token, any."""
+               tls: bool = False, hosts: list[str] | None = None, user_header: str | None = None) -> Starlette:
+    """`hosts`: the Host names answered without a token (default LOOPBACK_HOSTS); with a token, any.
+    `user_header`: the reverse proxy's header naming the authenticated user (web/approval.py); it needs a
+    token, which the proxy sends as `Authorization: Bearer`."""
+    if user_header and not token:
+        raise ValueError("a user header needs a token: the proxy sends it, so only the proxy names a user")
     campaigns = CampaignFolders(campaign_folders)
     registry = _LazyRegistry(registry_url)
     templates = Environment(loader=PackageLoader("accelcal_rig.web", "templates"),
                             autoescape=select_autoescape(["html"]))
 
-    def page(name: str, **values: Any) -> HTMLResponse:
-        return HTMLResponse(templates.get_template(name).render(registry=registry.label, **values))
+    def page(name: str, status: int = 200, **values: Any) -> HTMLResponse:
+        return HTMLResponse(templates.get_template(name).render(registry=registry.label, **values), status_code=status)
 
     def front(request: Request) -> Response:
         return page("front.html", campaigns=campaigns.summaries(), folders=campaigns.folders)
@@ -111,16 +123,18 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
         if serial:
             return RedirectResponse(f"/registry/serials/{quote(serial, safe='')}", status_code=303)
         reg = registry.get()
-        rows = reg.calibrations(limit=50)
-        parts = reg.parts()
-        return page("registry.html", rows=rows, parts=parts)
+        made = request.query_params.get("made", "")
+        if made not in _MADE:
+            return PlainTextResponse(f"made={made}: not one of real, dry-run", status_code=400)
+        rows = reg.calibrations(limit=50, simulated=_MADE[made])
+        return page("registry.html", rows=rows, parts=reg.parts(), made_filter=made)
 
     def serial_page(request: Request) -> Response:
         serial = request.path_params["serial"]
         reg = registry.get()
         every = reg.calibrations(serial=serial)
         if not every:
-            return page("registry.html", rows=[], parts=[], missing=serial)
+            return page("registry.html", rows=[], parts=[], missing=serial, made_filter="")
         real = [r for r in every if not r["simulated"]]
         rows = real or every  # a serial only dry runs know is shown as such, marked simulated
         result = trend(rows)
@@ -130,7 +144,11 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
         plot = line_plot(times, {f"bias {axis}": [p["bias_mg"][k] for p in points] for k, axis in enumerate("xyz")},
                          "days since the first calibration", "bias at the reference temperature (mg)")
         gyro = trend(rows, "gyro") if any(r["channel"] == "gyro" for r in rows) else None
+        decided = {i: {"approve": "approved", "reissue": "approved", "reject": "rejected"}[a]
+                   for i, a in reg.last_actions([r["id"] for r in every]).items()}
         return page("serial.html", serial=serial, rows=every, current=reg.current(serial, simulated=not real),
+                    why_not_valid=reg.why_not_valid(serial), decisions=decided,
+                    gyro_why_not_valid=reg.why_not_valid(serial, "gyro") if gyro else "",
                     trend=result, plot=plot, only_simulated=not real, gyro_trend=gyro,
                     gyro_current=reg.current(serial, simulated=not real, channel="gyro") if gyro else None)
 
@@ -149,7 +167,12 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
 
     middleware = ([Middleware(_TokenRequired, token=token, secure=tls)] if token
                   else [Middleware(TrustedHostMiddleware, allowed_hosts=hosts or LOOPBACK_HOSTS)])
+    # The approver's session: signed with a key made now (a restart logs everyone out), never sent to
+    # another site (SameSite=Strict), unreadable by scripts (HttpOnly), HTTPS-only when served over TLS.
+    middleware.append(Middleware(SessionMiddleware, secret_key=secrets.token_urlsafe(32), session_cookie="accelcal_session",
+                                 same_site="strict", https_only=tls, max_age=8 * 3600))
     return Starlette(routes=[
+        *approval_routes(registry, page, ApprovalSettings(user_header)),
         Route("/", front), Route("/api/campaigns", campaigns_json),
         Route("/campaigns/{name}", campaign), Route("/api/campaigns/{name}", campaign_json),
         Route("/campaigns/{name}/{kind}/{file:path}", campaign_file),

@@ -34,6 +34,7 @@ def test_a_site_with_stronger_gravity_reads_more_than_1_g_and_is_fitted_to_it(wr
     truths = np.linalg.norm(campaign.truth_column(campaign.serials[0], "gravity_g"), axis=1)
     np.testing.assert_allclose(references, site_g, rtol=1e-12)
     np.testing.assert_allclose(truths, site_g, rtol=1e-9)  # no uncertainty stated: the site is as stated
+    assert campaign.unusable_reasons() == []  # references as long as the site's gravity are plausible, not damage
     free = "all" if mode == "reference" else "bias-scale"  # six poses: norm-only sees bias and scale only
     _, report = fit_campaign(campaign, FitOptions(mode=mode, degree=0, free=free), {"campaign": str(output)})
     for r in report.values():  # 0.29 mg of |g| would remain if the fit aimed at 1 g

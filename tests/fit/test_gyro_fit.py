@@ -13,7 +13,7 @@ import yaml
 
 from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
 from accelcal_rig.assembly import run_campaign
-from accelcal_rig.config.acceptance import GyroAcceptance
+from accelcal_rig.config.acceptance import Acceptance, GyroAcceptance
 from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import apply_gyro, load_calibration
@@ -200,7 +200,8 @@ def test_each_gyroscope_is_judged_against_its_limits(fitted: tuple[Path, dict], 
     calibration = load_calibration(path)
     for serial, dut in report.items():
         assert dut["gyro"]["verdict"] == "PASS" == calibration.gyroscope(serial).verdict
-        assert any("verification rate RMS error" in r and "≤ 0.5 °/s" in r for r in dut["gyro"]["verdict_reasons"])
+        assert any("verification rate RMS error" in r and "limit ≤ 0.5 °/s: pass" in r
+                   for r in dut["gyro"]["verdict_reasons"])
     # The same figures against limits they cannot meet: FAIL, each reason naming its figure.
     campaign = load_campaign(campaign_path)
     serial = campaign.serials[0]
@@ -208,9 +209,15 @@ def test_each_gyroscope_is_judged_against_its_limits(fitted: tuple[Path, dict], 
     assert fit.metrics["verification"]["rmse_dps"] == report[serial]["gyro"]["verification"]["rmse_dps"]
     tight = GyroAcceptance.model_validate({"max_verification_rmse_dps": 1e-6, "max_scale_error_ppm": 1e-3,
                                            "parameters": {"at_c": 20, "gsens_dps_per_g": 1e-6}})
-    judged = judge_gyro(fit.metrics, fit.thermal, tight)
+    judged = judge_gyro(fit.metrics, fit.thermal, Acceptance(gyro=tight), parameter_u=fit.parameter_u)
     assert judged.verdict == "FAIL" and len(judged.reasons) == 3
-    assert any(r.startswith("gyro g-sensitivity") and "> 1e-06 °/s/g" in r for r in judged.reasons)
+    assert any(r.startswith("gyro g-sensitivity") and "limit ±1e-06 °/s/g: fail" in r for r in judged.reasons)
+    # Each figure judged carries its own expanded uncertainty: the verification's from the table's rate
+    # accuracy and the noise, each parameter's from the fit through its polynomial.
+    assert all(c.expanded_u is not None and c.expanded_u > 0 for c in judged.checks)
+    scale = next(c for c in judged.checks if c.limit_key == "gyro.max_scale_error_ppm")
+    accuracy_ppm = 1e4 * site_of(campaign)["rate_accuracy_pct"] / np.sqrt(3)     # ± uniform, 1σ
+    assert accuracy_ppm > 0 and scale.expanded_u >= 2 * accuracy_ppm
 
 
 def test_the_budget_covers_the_truth_as_its_coverage_factor_says(fitted: tuple[Path, dict]) -> None:

@@ -68,3 +68,26 @@ def test_lot_statistics_count_the_newest_calibration_of_each_sensor_and_name_the
     flagged = {(o["serial"], o["figure"], o["axis"]) for o in result["outliers"]}
     assert ("L-ODD", "bias_mg", "x") in flagged
     assert result["outliers"][0]["serial"] == "L-ODD"
+
+
+@pytest.mark.parametrize("apart_days, said", [(12 / 1440, "12 minutes"), (5 / 24, "5.0 hours"), (29.5, "29.5 days")])
+def test_calibrations_closer_than_the_minimum_span_state_no_drift_per_year(apart_days: float, said: str) -> None:
+    rows = [row(1, "S", 0, [1.0, 2.0, 3.0], [0, 0, 0], u_bias=[0.1] * 3),
+            row(2, "S", apart_days, [1.5, 2.0, 3.0], [10, 0, 0], u_bias=[0.1] * 3)]
+    result = trend(rows)
+    assert result["bias_drift_mg_per_year"] is None and result["scale_drift_ppm_per_year"] is None
+    assert result["drift_not_stated"] == f"the calibrations span {said}, under the 30 days a drift per year needs"
+    assert result["span_days"] == pytest.approx(apart_days)
+    stated = trend(rows, min_span_days=apart_days)  # the same calibrations, a span the caller accepts
+    assert stated["drift_not_stated"] is None
+    assert stated["bias_drift_mg_per_year"][0]["per_year"] == pytest.approx(0.5 / (apart_days / 365.25))
+
+
+def test_a_conditional_verdict_is_judged_and_neither_passed_nor_failed() -> None:
+    verdicts = ["PASS", "PASS", "CONDITIONAL", "FAIL", None]
+    rows = [row(k, f"S{k}", 0, [0, 0, 0], [0, 0, 0], verdict=v) for k, v in enumerate(verdicts)]
+    result = lot_statistics(rows)
+    judged = [v for v in verdicts if v is not None]
+    assert (result["judged"], result["passed"], result["conditional"], result["failed"]) == (
+        len(judged), judged.count("PASS"), judged.count("CONDITIONAL"), judged.count("FAIL"))
+    assert result["yield"] == pytest.approx(judged.count("PASS") / len(judged))

@@ -104,7 +104,7 @@ def test_a_0003_database_with_records_upgrades_to_0004(registry_url: str, imu: t
     with registry.engine.begin() as connection:
         connection.execute(table.insert(), version_3)
     upgraded = Registry.open(registry_url)
-    assert upgraded.revision() == head_revision() == "0004"
+    assert upgraded.revision() == head_revision()
     rows = [upgraded.calibration(listed["id"]) for listed in upgraded.calibrations()]
     assert len(rows) == 4 and {r["channel"] for r in rows} == {"accel"}
     for row in rows:  # the noise of the records already there, filled from their stored fits

@@ -68,24 +68,50 @@ def test_list_show_trend_stats_and_export(tmp_path: Path, capsys) -> None:
     assert "rig: warning:" in capsys.readouterr().err  # what PX4 cannot hold (scale, cross-axis) is said
 
 
-def test_which_registry_flag_rig_config_environment(tmp_path: Path, capsys, monkeypatch) -> None:
+def test_which_registry_flag_rig_config_environment_and_dry_runs_apart(tmp_path: Path, capsys, monkeypatch) -> None:
     procedure_dir = tmp_path / "lab"
     procedure_dir.mkdir()
     shutil.copy(REPO / "configs" / "sim.yaml", procedure_dir / "sim.yaml")
     (procedure_dir / "sim.yaml").write_text((procedure_dir / "sim.yaml").read_text() + "\nregistry: rig-registry.sqlite\n")
     procedure = procedure_dir / "quick.yaml"
     procedure.write_text((REPO / "procedures" / "quick-6pos.yaml").read_text().replace("../configs/sim.yaml", "sim.yaml"))
+    monkeypatch.setenv("ACCELCAL_DRY_RUN_REGISTRY", str(tmp_path / "dry-runs.sqlite"))
     assert rig("run", procedure, "--dry-run", "-o", tmp_path / "a.h5", "-q", "--no-pdf") == 0
-    assert (procedure_dir / "rig-registry.sqlite").is_file()  # the rig config's, relative to it, over the environment
+    assert "(a dry run: kept apart from the lab's registry)" in capsys.readouterr().out
+    # A dry run is no calibration of the lab's: not in the rig config's registry, nor the environment's.
+    assert not (procedure_dir / "rig-registry.sqlite").exists()
+    assert Registry.open(normalised(str(tmp_path / "dry-runs.sqlite"))).count() == 4
     assert rig("run", procedure, "--dry-run", "-o", tmp_path / "b.h5", "-q", "--no-pdf", "--registry",
                tmp_path / "flag.sqlite") == 0
-    assert (tmp_path / "flag.sqlite").is_file()  # the flag over the rig config
-    monkeypatch.setenv("ACCELCAL_REGISTRY", str(tmp_path / "environment.sqlite"))
+    assert Registry.open(normalised(str(tmp_path / "flag.sqlite"))).count() == 4  # the flag over all
     capsys.readouterr()
+    # Told to, `add` records a dry run in the registry --config names (relative to the rig config).
+    assert rig("registry", "add", tmp_path / "a.h5", "--config", procedure_dir / "sim.yaml") == 0
+    assert capsys.readouterr().out.strip() == f"{tmp_path / 'a.h5'}: 4 added"
+    monkeypatch.setenv("ACCELCAL_REGISTRY", str(tmp_path / "environment.sqlite"))
     assert rig("registry", "list", "--json") == 0  # no flag, no config: the environment's
     assert json.loads(capsys.readouterr().out) == [] and (tmp_path / "environment.sqlite").is_file()
+    assert rig("registry", "list") == 0  # an empty lab registry says where dry runs went
+    assert f"dry runs are recorded apart, in sqlite:///{tmp_path / 'dry-runs.sqlite'}" in capsys.readouterr().out
     assert rig("registry", "list", "--config", procedure_dir / "sim.yaml", "--json") == 0
     assert len(json.loads(capsys.readouterr().out)) == 4
+
+
+def test_a_dry_run_without_a_registry_named_goes_to_the_dry_runs_default(tmp_path: Path, capsys, monkeypatch) -> None:
+    """Neither flag nor ACCELCAL_DRY_RUN_REGISTRY: dry-runs.sqlite beside the default registry, not the lab's
+    (the environment's); `rig registry add` of a dry run's campaign goes there too."""
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "data"))
+    monkeypatch.delenv("ACCELCAL_DRY_RUN_REGISTRY")
+    monkeypatch.setenv("ACCELCAL_REGISTRY", str(tmp_path / "lab.sqlite"))
+    campaign = tmp_path / "quick.h5"
+    assert rig("run", REPO / "procedures" / "quick-6pos.yaml", "--dry-run", "-o", campaign, "-q", "--no-pdf") == 0
+    default = tmp_path / "data" / "accelcal-rig" / "dry-runs.sqlite"
+    assert f"recorded in sqlite:///{default}" in capsys.readouterr().out
+    assert Registry.open(normalised(str(default))).count() == 4 and not (tmp_path / "lab.sqlite").exists()
+    assert rig("registry", "add", campaign) == 0
+    assert capsys.readouterr().out.strip() == (f"{campaign}: 0 added, 4 registered already (a dry run: in "
+                                               f"sqlite:///{default}, apart from the lab's registry)")
+    assert not (tmp_path / "lab.sqlite").exists()
 
 
 def test_hand_held_fits_are_recorded_with_their_part(tmp_path: Path, capsys) -> None:
@@ -154,3 +180,37 @@ def test_a_trend_of_fits_without_stated_uncertainty_is_printed_not_a_crash(tmp_p
     page = TestClient(base_url="http://127.0.0.1", app=create_app([tmp_path], registry)).get(
         f"/registry/serials/{serial}")
     assert page.status_code == 200 and "uncertainty not stated" in page.text
+
+
+def test_a_trend_of_calibrations_minutes_apart_states_no_drift(tmp_path: Path, quick_campaign, capsys) -> None:
+    """A second calibration 12 minutes after the first: the two are listed, the drift per year is not stated,
+    in one line, and the command succeeds; asked for a shorter span it is stated."""
+    from datetime import timedelta
+
+    from accelcal_rig.registry.entries import campaign_entries
+
+    registry = normalised(str(tmp_path / "lab.sqlite"))
+    first = campaign_entries(*quick_campaign)[0] | {"simulated": False}
+    later = first | {"fit_sha256": "e" * 64, "calibrated_at": first["calibrated_at"] + timedelta(minutes=12),
+                     "bias_mg": [b + 0.5 for b in first["bias_mg"]]}
+    Registry.open(registry).add([first, later])
+    assert rig("registry", "trend", first["serial"], "--registry", registry) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == 4 and out[-1] == ("  drift per year: not stated: the calibrations span 12 minutes, under the "
+                                         "30 days a drift per year needs (--min-span-days sets it)")
+    assert rig("registry", "trend", first["serial"], "--min-span-days", "0.001", "--json", "--registry", registry) == 0
+    drift = json.loads(capsys.readouterr().out)["channels"]["accel"]["bias_drift_mg_per_year"]
+    minutes_per_year = 365.25 * 1440
+    assert drift[0]["per_year"] == pytest.approx(0.5 * minutes_per_year / 12)
+
+
+def test_a_hand_held_fit_of_a_dry_runs_campaign_is_a_dry_run_too(tmp_path: Path, quick_campaign, capsys,
+                                                                  monkeypatch) -> None:
+    monkeypatch.setenv("ACCELCAL_DRY_RUN_REGISTRY", str(tmp_path / "dry-runs.sqlite"))
+    monkeypatch.setenv("ACCELCAL_REGISTRY", str(tmp_path / "lab.sqlite"))
+    campaign, _ = quick_campaign
+    assert rig("fit-recording", campaign, "--setpoint", "15", "--parameters", "bias-scale", "-o", tmp_path / "hand.yaml") == 0
+    assert "(a dry run: kept apart from the lab's registry)" in capsys.readouterr().out
+    rows = Registry.open(normalised(str(tmp_path / "dry-runs.sqlite"))).calibrations()
+    assert [(r["source_kind"], r["simulated"]) for r in rows] == [("recording", True)]
+    assert not (tmp_path / "lab.sqlite").exists()

@@ -42,31 +42,36 @@ def test_an_imu_certificate_states_its_gyroscope_as_its_calibration_holds_it(imu
         gyro = calibration.gyroscope(w.serial)
         v, budget = gyro.metrics["verification"], gyro.metrics["uncertainty_budget"]
         assert "NOT CALIBRATED" not in page and "MEMS IMU: accelerometer and gyroscope" in page
-        assert f"<td class='text'>{v['rmse_dps']:.4f} °/s (before calibration {v['rmse_before_dps']:.4f} °/s" in page
-        assert f"{v['max_axis_error_dps']:.4f} °/s" in page and f"{v['scale_error_ppm']:.0f} ppm" in page
+        assert (f"<td class='text'>{v['rmse_dps']:.4f} ± {v['expanded_u']['rmse_dps']:.4f} °/s (before calibration "
+                f"{v['rmse_before_dps']:.4f} °/s") in page
+        u = v["expanded_u"]
+        assert f"{v['max_axis_error_dps']:.4f} ± {u['max_axis_error_dps']:.4f} °/s" in page
+        assert f"{v['scale_error_ppm']:.0f} ± {u['scale_error_ppm']:.0f} ppm" in page
         assert f"{v['rate_steps']} at {', '.join(f'{t:g}' for t in v['temperatures_c'])} °C" in page
         for value in (*budget["at_rest"]["expanded_dps"], *budget["at_largest_rate"]["expanded_dps"]):
             assert f"<td>{value:.5f}</td>" in page
         assert "table pointing" in page and "at ±1000 °/s" in page
         assert gyro.earth_rate in page.replace("&#x27;", "'") and "the fixture frame as the rate table realises it" in page
         bias_x = gyro.parameters_at(25.0)[0]
-        assert f"{bias_x:+.4f} ± " in page  # the bias at the reference temperature with its 1σ
+        assert f"{bias_x:+.4f} ± " in page  # the bias at the reference temperature with its expanded uncertainty
         arw = gyro.metrics["allan"]["arw_deg_per_rthr"][0]["value"]
         vrw = calibration.sensor(w.serial).metrics["allan"]["vrw_m_s_per_rthr"][0]["value"]
         assert f"{arw:.4f} [" in page and f"{vrw:.5f} [" in page and "angle random walk" in page
-        assert page.count("class='verdict PASS'") == 1 and "gyroscope: <b class='PASS'>PASS</b>" in page
+        assert page.count("class='verdict PASS'") == 1 and "Gyroscope: <b class='PASS'>PASS</b>" in page
 
 
-def test_an_imu_certificate_fits_on_two_pages(imu: tuple[Path, Path], tmp_path: Path) -> None:
+def test_an_imu_certificate_fits_on_three_pages_and_ends_on_its_last(imu: tuple[Path, Path], tmp_path: Path) -> None:
     pytest.importorskip("weasyprint")
-    from weasyprint import HTML
+    from pypdf import PdfReader
 
     campaign, calibration = imu
     written, warnings = write_certificates(campaign, calibration, tmp_path / "certs")
     assert warnings == []
     for w in written:
         assert w.pdf is not None and w.pdf.read_bytes().startswith(b"%PDF")
-        assert 1 <= len(HTML(string=w.html.read_text(encoding="utf-8")).render().pages) <= 2
+        pages = PdfReader(w.pdf).pages           # two sensors and ISO/IEC 17025's contents: at most three
+        assert 1 <= len(pages) <= 3 and "End of certificate" in pages[-1].extract_text()
+        assert all("End of certificate" not in page.extract_text() for page in pages[:-1])
 
 
 def test_a_failing_gyroscope_fails_the_imu(imu: tuple[Path, Path], tmp_path: Path) -> None:
@@ -81,7 +86,7 @@ def test_a_failing_gyroscope_fails_the_imu(imu: tuple[Path, Path], tmp_path: Pat
     pages = {w.serial: w.html.read_text(encoding="utf-8") for w in written}
     failed = pages["IMU-A002"]
     assert failed.count("class='verdict FAIL'") == 1 and "class='verdict PASS'" not in failed
-    assert "accelerometer: <b class='PASS'>PASS</b>" in failed and "gyroscope: <b class='FAIL'>FAIL</b>" in failed
+    assert "Accelerometer: <b class='PASS'>PASS</b>" in failed and "Gyroscope: <b class='FAIL'>FAIL</b>" in failed
     assert reason in failed
     assert all(page.count("class='verdict PASS'") == 1 for serial, page in pages.items() if serial != "IMU-A002")
 

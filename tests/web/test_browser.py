@@ -120,7 +120,7 @@ def test_a_running_campaign_advances_on_the_page_and_a_serial_has_its_history(br
     shutil.copy(SIM_RIG, folder / "sim.yaml")
     (folder / "live.yaml").write_text(LIVE_PROCEDURE)
     registry = str(tmp_path / "registry.sqlite")
-    env = {**os.environ, "ACCELCAL_REGISTRY": registry}
+    env = {**os.environ, "ACCELCAL_REGISTRY": registry, "ACCELCAL_DRY_RUN_REGISTRY": registry}  # the dry run's shown
     server, found = _started([RIG, "serve", "--campaigns", str(folder), "--port", "0"],
                              r"dashboard on (http://\S+)", env)
     base = found.group(1).rstrip("/")

@@ -1,0 +1,200 @@
+"""`rig approve` and `rig registry user | audit | certificate`: a person's decision on each DUT's calibration,
+recorded append-only with who, how and when; the certificate revision an approval issues, kept in the
+registry and written beside the campaign."""
+
+from __future__ import annotations
+
+import argparse
+import getpass
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from accelcal_rig.errors import ConfigError
+
+
+def approve_command(args: argparse.Namespace) -> int:
+    from accelcal_rig.cli_registry import campaign_entries, open_registry
+    from accelcal_rig.registry.approvals import Approvals, IssuedCertificate
+    from accelcal_rig.report.certificate import render_certificate
+
+    campaign = args.campaign
+    calibration = args.calibration or campaign.with_suffix(".calibration.yaml")
+    registry = open_registry(args, upgrade=True)
+    approvals = Approvals(registry)
+    user = _authenticated(approvals, args.user, args.password_stdin)
+    authority = f"rig approve, password of registry user {user.name} (operating-system user {_os_user()})"
+    entries = campaign_entries(campaign, calibration)
+    serials = list(dict.fromkeys(e["serial"] for e in entries))
+    unknown = [s for s in (args.serial or []) if s not in serials]
+    if unknown:
+        raise ConfigError(f"{campaign}: no DUT {unknown[0]} in its calibration (DUTs: {', '.join(serials)})")
+    ids = registry.ids_of(entries)
+    for serial in args.serial or serials:
+        if serial not in ids:
+            raise ConfigError(f"{campaign}: DUT {serial}'s calibration is not in the registry {registry.url}: record it "
+                              "first (rig registry add)")
+        lead = ids[serial]
+        decision = approvals.decision(lead)
+        if args.action == "approve" and decision.state == "approved":
+            print(f"{serial}: approved already (revision {decision.revision}, by {decision.by}); a new revision needs "
+                  "--reissue --reason")
+            continue
+        issued = None
+        if args.action != "reject":
+            revision = approvals.next_revision(lead)
+            rendered = render_certificate(campaign, calibration, serial, revision, user.full_name,
+                                          pdf=not args.no_pdf, reason=args.reason, operator=args.operator)
+            issued = IssuedCertificate(revision, rendered.number, rendered.html, rendered.pdf)
+        revision_issued = approvals.record(lead, args.action, user, authority, args.reason, issued)
+        if issued is not None:
+            written = _write_beside(campaign, serial, issued)
+            print(f"{serial}: {args.action}d by {user.full_name}; certificate {issued.number} revision "
+                  f"{revision_issued} → {', '.join(str(p) for p in written)}")
+        else:
+            print(f"{serial}: rejected by {user.full_name}: {args.reason}")
+    return 0
+
+
+def _authenticated(approvals: Any, name: str, from_stdin: bool) -> Any:
+    """The approver, by their password (asked for, or one line on standard input)."""
+    user = approvals.user(name)
+    if user is None:
+        raise ConfigError(f"registry {approvals.registry.url}: no user {name} (rig registry user add)")
+    if not user.may_approve:
+        raise ConfigError(f"user {name} may not approve (role {user.role}{', disabled' if user.disabled else ''})")
+    password = _password(from_stdin, f"password of {name}: ")
+    found = approvals.authenticate(name, password)
+    if found is None:
+        raise ConfigError(f"user {name}: wrong password (or no password here: a reverse proxy's user approves "
+                          "on the dashboard)")
+    return found
+
+
+def _password(from_stdin: bool, prompt: str) -> str:
+    if from_stdin:
+        return sys.stdin.readline().rstrip("\n")
+    if not sys.stdin.isatty():
+        raise ConfigError("a password is needed: run in a terminal, or give it with --password-stdin")
+    return getpass.getpass(prompt)
+
+
+def _os_user() -> str:
+    try:
+        return getpass.getuser()
+    except (KeyError, OSError):
+        return "unknown"
+
+
+def _write_beside(campaign: Path, serial: str, issued: Any) -> list[Path]:
+    """The revision beside the campaign: CAMPAIGN.certificates/SERIAL.rN.html (and .pdf); earlier revisions
+    stay."""
+    import re
+
+    from accelcal_rig.durable import write_atomically, write_text_atomically
+
+    folder = campaign.with_suffix(".certificates")
+    folder.mkdir(parents=True, exist_ok=True)
+    stem = f"{re.sub(r'[^A-Za-z0-9_.-]', '_', serial)}.r{issued.revision}"
+    written = [folder / f"{stem}.html"]
+    write_text_atomically(written[0], issued.html, "the certificate")
+    if issued.pdf is not None:
+        written.append(folder / f"{stem}.pdf")
+        write_atomically(written[1], issued.pdf, "the certificate")
+    return written
+
+
+def user_command(args: argparse.Namespace) -> int:
+    from accelcal_rig.cli_registry import open_registry
+    from accelcal_rig.registry.approvals import Approvals
+
+    approvals = Approvals(open_registry(args, upgrade=True))
+    if args.user_action == "list":
+        for user in approvals.users():
+            print(f"{user.name:<20} {user.role:<9} {'disabled ' if user.disabled else ''}{user.full_name}")
+        return 0
+    if not args.name:
+        raise ConfigError(f"rig registry user {args.user_action}: name the user")
+    _admitted(approvals, args)
+    if args.user_action == "add":
+        if not args.full_name:
+            raise ConfigError("rig registry user add: --full-name is needed (as certificates name the person)")
+        password = None if args.no_password else _new_password(args.password_stdin, args.name)
+        approvals.add_user(args.name, args.full_name, args.role, password)
+        print(f"user {args.name} ({args.full_name}) added as {args.role}"
+              + (", no password here: the reverse proxy authenticates them" if password is None else ""))
+    elif args.user_action == "password":
+        approvals.set_password(args.name, _new_password(args.password_stdin, args.name))
+        print(f"user {args.name}: password changed")
+    else:
+        approvals.set_disabled(args.name, args.user_action == "disable")
+        print(f"user {args.name} {args.user_action}d")
+    return 0
+
+
+def _admitted(approvals: Any, args: argparse.Namespace) -> None:
+    """Once the lab has an approver, only an approver changes its users: `--by NAME` with their password (the
+    first line on standard input with --password-stdin). The first approver is added freely. (Whoever may
+    write the registry's tables directly is beyond this: the database's own privileges decide that.)"""
+    if not any(u.may_approve for u in approvals.users()):
+        return
+    if not args.by:
+        raise ConfigError(f"rig registry user {args.user_action}: the lab has approvers: --by APPROVER (with "
+                          "their password) is needed to change its users")
+    user = _authenticated(approvals, args.by, args.password_stdin)
+    if not user.may_approve:
+        raise ConfigError(f"user {args.by} may not change users (role {user.role})")
+
+
+def _new_password(from_stdin: bool, name: str) -> str:
+    password = _password(from_stdin, f"new password of {name}: ")
+    if not from_stdin and getpass.getpass("again: ") != password:
+        raise ConfigError(f"user {name}: the two passwords differ")
+    return password
+
+
+def audit_command(args: argparse.Namespace) -> int:
+    from accelcal_rig.cli_registry import open_registry
+    from accelcal_rig.registry.approvals import Approvals
+
+    trail = Approvals(open_registry(args)).trail(serial=args.serial)
+    if args.json:
+        print(json.dumps([{**row, "at": row["at"].isoformat() + "Z"} for row in trail], indent=1))
+        return 0
+    if not trail:
+        print("no decisions recorded" + (f" for {args.serial}" if args.serial else ""))
+    for row in trail:
+        revision = f" revision {row['revision']}" if row["revision"] is not None else ""
+        reason = f": {row['reason']}" if row["reason"] else ""
+        print(f"{row['at']:%Y-%m-%d %H:%M:%S}Z  {row['serial']:<16} calibration {row['calibration_id']:>5}  "
+              f"{row['action']}{revision} by {row['full_name']} ({row['authority']}){reason}")
+    return 0
+
+
+def certificate_command(args: argparse.Namespace) -> int:
+    from accelcal_rig.cli_registry import open_registry
+    from accelcal_rig.durable import write_atomically
+    from accelcal_rig.registry.approvals import Approvals
+
+    approvals = Approvals(open_registry(args))
+    if args.revision is None:
+        issued = approvals.certificates(args.id)
+        if not issued:
+            print(f"calibration {args.id}: no certificate issued (it is {approvals.decision(args.id).state})")
+        for row in issued:
+            print(f"revision {row['revision']}  {row['number']}  issued {row['issued_at']:%Y-%m-%d %H:%M}Z by "
+                  f"{row['approver']}  sha256 {row['sha256'][:16]}…" + (f"  ({row['reason']})" if row["reason"] else ""))
+        return 0
+    row = approvals.certificate(args.id, args.revision)
+    if args.output is None:
+        sys.stdout.write(row["html"])
+        return 0
+    if args.output.suffix.lower() == ".pdf":
+        if row["pdf"] is None:
+            raise ConfigError(f"calibration {args.id} revision {args.revision}: issued as HTML only (no PDF kept)")
+        write_atomically(args.output, bytes(row["pdf"]), "the certificate")
+    else:
+        write_atomically(args.output, row["html"].encode(), "the certificate")
+    print(f"certificate {row['number']} revision {args.revision} → {args.output}")
+    return 0

@@ -1,0 +1,235 @@
+"""The dashboard's approval: a calibration's page (its decision, the record of decisions, every certificate
+revision issued) and, for an authenticated approver, approve, reject and reissue.
+
+Who is an approver: a registry user with the approver role, known by their password (a login form; a
+session cookie signed with a key made at each start, HttpOnly, SameSite=Strict) or by the lab's reverse
+proxy (`rig serve --user-header NAME`: the proxy authenticated them and names them in that header; the proxy
+must strip it from what clients send). Every state-changing request is a POST that carries the session's
+token and comes from the dashboard's own origin (Origin, else Referer): a page elsewhere cannot approve in
+the approver's name. Everything else on the dashboard is read-only as before.
+"""
+
+from __future__ import annotations
+
+import hmac
+import secrets
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+from urllib.parse import parse_qs, urlsplit
+
+from starlette.requests import Request
+from starlette.responses import HTMLResponse, PlainTextResponse, RedirectResponse, Response
+from starlette.routing import Route
+
+from accelcal_rig.errors import RigError
+from accelcal_rig.registry.approvals import Approvals, IssuedCertificate, User
+
+#: A login or decision form is a few hundred bytes; anything much longer is refused unread.
+MAX_FORM_BYTES = 16_384
+SESSION_USER = "user"
+#: Set by the token middleware when the token came as an Authorization header: the reverse proxy's request.
+BEARER_SCOPE_KEY = "accelcal.bearer"
+#: The largest row id a database holds (a longer number in a path is no calibration).
+MAX_ID = 2**63 - 1
+SESSION_TOKEN = "csrf"
+
+
+class ApprovalSettings:
+    def __init__(self, user_header: str | None) -> None:
+        self.user_header = user_header
+
+    def authority(self, user: User, via_header: bool) -> str:
+        return (f"dashboard, reverse proxy header {self.user_header}" if via_header
+                else f"dashboard, password of registry user {user.name}")
+
+
+def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: ApprovalSettings) -> list[Route]:
+    """`registry`: the dashboard's lazily opened registry (its `get()`)."""
+
+    def approvals() -> Approvals:
+        return Approvals(registry.get())
+
+    def current_user(request: Request) -> tuple[User | None, bool]:
+        """The approver this request is from, and whether the reverse proxy named them."""
+        if settings.user_header:  # only the proxy, known by the token it sends as a header, names a user
+            name = request.headers.get(settings.user_header, "") if request.scope.get(BEARER_SCOPE_KEY) else ""
+            user = approvals().user(name) if name else None
+            return (user if user is not None and not user.disabled else None), True
+        remembered = request.session.get(SESSION_USER)
+        user = approvals().user(remembered) if isinstance(remembered, str) else None
+        return (user if user is not None and not user.disabled else None), False
+
+    def token(request: Request) -> str:
+        if SESSION_TOKEN not in request.session:
+            request.session[SESSION_TOKEN] = secrets.token_urlsafe(32)
+        return str(request.session[SESSION_TOKEN])
+
+    async def form(request: Request) -> dict[str, str] | Response:
+        """The posted form, once its origin and token are checked; else the refusal."""
+        if not same_origin(request):
+            return PlainTextResponse("refused: a request from another site (Origin)", status_code=403)
+        body = b""
+        async for chunk in request.stream():
+            body += chunk
+            if len(body) > MAX_FORM_BYTES:
+                return PlainTextResponse("refused: form too large", status_code=413)
+        try:
+            fields = {k: v[0] for k, v in parse_qs(body.decode("utf-8"), strict_parsing=False).items()}
+        except UnicodeDecodeError:
+            return PlainTextResponse("refused: a form that is not UTF-8", status_code=400)
+        if any("\x00" in k or "\x00" in v for k, v in fields.items()):
+            return PlainTextResponse("refused: a form with a NUL character", status_code=400)
+        expected = request.session.get(SESSION_TOKEN)
+        if not isinstance(expected, str) or not hmac.compare_digest(fields.get("csrf", "").encode(), expected.encode()):
+            return PlainTextResponse("refused: the form's token is missing or stale: reload the page", status_code=403)
+        return fields
+
+    def login_page(request: Request) -> Response:
+        target = request.query_params.get("next", "/registry")
+        return page("login.html", csrf=token(request), error="", proxy=settings.user_header,
+                    next=target if _local(target) else "/registry")
+
+    async def login(request: Request) -> Response:
+        if settings.user_header:
+            return PlainTextResponse("the reverse proxy authenticates users here", status_code=404)
+        fields = await form(request)
+        if isinstance(fields, Response):
+            return fields
+        user = approvals().authenticate(fields.get("name", ""), fields.get("password", ""))
+        if user is None:
+            return page("login.html", csrf=token(request), error="unknown user or wrong password", proxy=None,
+                        next=fields.get("next", "/registry"), status=401)
+        request.session.clear()  # a new session for the person: no fixation of an earlier one
+        request.session[SESSION_USER] = user.name
+        request.session[SESSION_TOKEN] = secrets.token_urlsafe(32)
+        target = fields.get("next", "/registry")
+        return RedirectResponse(target if _local(target) else "/registry", status_code=303)
+
+    async def logout(request: Request) -> Response:
+        fields = await form(request)
+        if isinstance(fields, Response):
+            return fields
+        request.session.clear()
+        return RedirectResponse("/registry", status_code=303)
+
+    def calibration_page(request: Request) -> Response:
+        row_id = int(request.path_params["id"])
+        if row_id > MAX_ID:
+            return PlainTextResponse(f"no calibration {row_id} in the registry", status_code=404)
+        reg = registry.get()
+        try:
+            row = reg.calibration(row_id)
+        except RigError:
+            return PlainTextResponse(f"no calibration {row_id} in the registry", status_code=404)
+        book = approvals()
+        user, via_header = current_user(request)
+        return page("calibration.html", row=row, decision=book.decision(row_id), trail=book.trail(calibration_id=row_id),
+                    certificates=book.certificates(row_id), user=user, via_header=via_header,
+                    csrf=token(request), campaign_here=_campaign_of(row) is not None,
+                    message=request.query_params.get("message", ""))
+
+    async def decide(request: Request) -> Response:
+        row_id = int(request.path_params["id"])
+        if row_id > MAX_ID:
+            return PlainTextResponse(f"no calibration {row_id} in the registry", status_code=404)
+        fields = await form(request)
+        if isinstance(fields, Response):
+            return fields
+        user, via_header = current_user(request)
+        if user is None or not user.may_approve:
+            return PlainTextResponse("refused: log in as an approver", status_code=403)
+        action = fields.get("action", "")
+        if action not in ("approve", "reject", "reissue"):
+            return PlainTextResponse(f"action {action!r}: not one of approve, reject, reissue", status_code=400)
+        from starlette.concurrency import run_in_threadpool
+
+        try:
+            message = await run_in_threadpool(_decide, registry.get(), row_id, action, user,
+                                              settings.authority(user, via_header), fields.get("reason", ""))
+        except RigError as exc:
+            return PlainTextResponse(f"refused: {exc}", status_code=409)
+        return RedirectResponse(f"/registry/calibrations/{row_id}?message={_quote(message)}", status_code=303)
+
+    def certificate_file(request: Request) -> Response:
+        row_id, revision, kind = (int(request.path_params["id"]), int(request.path_params["revision"]),
+                                  request.path_params["kind"])
+        if row_id > MAX_ID or revision > MAX_ID:
+            return PlainTextResponse("no such certificate revision", status_code=404)
+        try:
+            row = approvals().certificate(row_id, revision)
+        except RigError:
+            return PlainTextResponse("no such certificate revision", status_code=404)
+        if kind == "pdf":
+            if row["pdf"] is None:
+                return PlainTextResponse("issued as HTML only", status_code=404)
+            return Response(bytes(row["pdf"]), media_type="application/pdf")
+        if kind == "html":
+            return HTMLResponse(row["html"])
+        return PlainTextResponse("no such certificate file", status_code=404)
+
+    return [Route("/login", login_page, methods=["GET"]), Route("/login", login, methods=["POST"]),
+            Route("/logout", logout, methods=["POST"]),
+            Route("/registry/calibrations/{id:int}", calibration_page, methods=["GET"]),
+            Route("/registry/calibrations/{id:int}/decision", decide, methods=["POST"]),
+            Route("/registry/calibrations/{id:int}/certificates/{revision:int}.{kind}", certificate_file)]
+
+
+def same_origin(request: Request) -> bool:
+    """Whether a state-changing request comes from the dashboard's own pages: its Origin (else its Referer)
+    names the scheme, host and port the request was sent to."""
+    claimed = request.headers.get("origin") or request.headers.get("referer")
+    if not claimed or claimed == "null":
+        return False
+    parts = urlsplit(claimed)
+    own = urlsplit(str(request.base_url))
+    return (parts.scheme, parts.netloc) == (own.scheme, own.netloc)
+
+
+def _local(target: str) -> bool:
+    """A redirect target on this dashboard (a path, not another site's address)."""
+    return target.startswith("/") and not target.startswith("//") and "\\" not in target
+
+
+def _quote(text: str) -> str:
+    from urllib.parse import quote
+
+    return quote(text[:300], safe="")
+
+
+def _campaign_of(row: dict[str, Any]) -> tuple[Path, Path] | None:
+    """The campaign file and its calibration file on this computer, as recorded, if both are here."""
+    if row["source_kind"] != "campaign":
+        return None
+    campaign = Path(row["source_path"])
+    calibration = campaign.with_suffix(".calibration.yaml")
+    return (campaign, calibration) if campaign.is_file() and calibration.is_file() else None
+
+
+def _decide(reg: Any, row_id: int, action: str, user: User, authority: str, reason: str) -> str:
+    """Record the decision; an approval or a reissue renders the certificate revision from the campaign."""
+    from accelcal_rig.registry.entries import campaign_entries
+    from accelcal_rig.report.certificate import render_certificate
+
+    book = Approvals(reg)
+    row = reg.calibration(row_id)
+    issued = None
+    if action != "reject":
+        found = _campaign_of(row)
+        if found is None:
+            raise RigError(f"the campaign file {row['source_path']} (and its calibration beside it) is not on this "
+                           "computer: approve with rig approve where it is")
+        if action == "approve" and book.decision(row_id).state == "approved":
+            raise RigError("approved already: a new revision is a reissue, with a reason")
+        # The certificate must be of the fit decided on: the campaign and the calibration beside it now make
+        # the same registry rows, or the files have changed (a refit) since it was recorded.
+        lead = book.rows_of(row_id)[0]
+        if reg.ids_of(campaign_entries(*found)).get(row["serial"]) != lead["id"]:
+            raise RigError(f"{found[1].name} beside the campaign is not the fit of calibration {lead['id']} (refitted "
+                           "since?): approve the calibration it is, or fit again and record it")
+        revision = book.next_revision(row_id)
+        rendered = render_certificate(found[0], found[1], row["serial"], revision, user.full_name, reason=reason)
+        issued = IssuedCertificate(revision, rendered.number, rendered.html, rendered.pdf)
+    revision_issued = book.record(row_id, action, user, authority, reason, issued)  # type: ignore[arg-type]
+    return (f"{action}d by {user.full_name}" + (f": certificate revision {revision_issued} issued"
+                                                 if revision_issued else ""))

@@ -1,0 +1,95 @@
+"""`rig approve` end to end: a registry user with the approver role, known by their password, approves a
+DUT's calibration; its certificate is issued as revision 1 naming them, beside the campaign and in the
+registry; a reissue is revision 2 with its reason, revision 1 still retrievable; every decision is in the
+audit; a wrong password, a viewer, a missing reason are each one line and exit 2."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import pytest
+from pypdf import PdfReader
+
+from accelcal_rig.cli import main
+from accelcal_rig.registry.location import normalised
+from tests.conftest import REPO
+
+SERIAL = "ADX355-A002"
+PASSWORD = "a long enough secret"
+
+
+@pytest.fixture(scope="module")
+def fitted(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    folder = tmp_path_factory.mktemp("approve")
+    registry = normalised(str(folder / "registry.sqlite"))
+    assert main(["run", str(REPO / "procedures" / "quick-6pos.yaml"), "--dry-run", "-o", str(folder / "c.h5"), "-q",
+                 "--no-pdf", "--registry", registry]) == 0
+    return folder / "c.h5", registry
+
+
+def rig(monkeypatch: pytest.MonkeyPatch, *argv: str, stdin: str = "") -> int:
+    monkeypatch.setattr("sys.stdin", io.StringIO(stdin))
+    return main(list(argv))
+
+
+def test_an_approver_issues_revisions_and_every_decision_is_audited(fitted, monkeypatch, capsys, tmp_path) -> None:
+    campaign, registry = fitted
+    folder = campaign.with_suffix(".certificates")
+    assert "DRAFT: not issued" in (folder / f"{SERIAL}.html").read_text()     # the run's certificate is a draft
+    assert rig(monkeypatch, "registry", "user", "add", "jdoe", "--full-name", "Jane Doe", "--role", "approver",
+               "--password-stdin", "--registry", registry, stdin=PASSWORD + "\n") == 0
+    assert rig(monkeypatch, "registry", "user", "add", "vic", "--full-name", "Vic Viewer", "--password-stdin",
+               "--registry", registry, stdin=PASSWORD + "\n") == 2            # the lab has an approver now
+    assert "--by APPROVER (with their password) is needed" in capsys.readouterr().err
+    assert rig(monkeypatch, "registry", "user", "add", "vic", "--full-name", "Vic Viewer", "--by", "jdoe",
+               "--password-stdin", "--registry", registry, stdin="not her password\n" + PASSWORD + "\n") == 2
+    assert "user jdoe: wrong password" in capsys.readouterr().err
+    assert rig(monkeypatch, "registry", "user", "add", "vic", "--full-name", "Vic Viewer", "--by", "jdoe",
+               "--password-stdin", "--registry", registry, stdin=PASSWORD + "\n" + PASSWORD + "\n") == 0
+    capsys.readouterr()
+
+    assert rig(monkeypatch, "approve", str(campaign), "--as", "jdoe", "--serial", SERIAL, "--password-stdin",
+               "--registry", registry, stdin="wrong password\n") == 2
+    assert "user jdoe: wrong password" in capsys.readouterr().err
+    assert rig(monkeypatch, "approve", str(campaign), "--as", "vic", "--password-stdin", "--registry", registry,
+               stdin=PASSWORD + "\n") == 2
+    assert "user vic may not approve (role viewer)" in capsys.readouterr().err
+
+    assert rig(monkeypatch, "approve", str(campaign), "--as", "jdoe", "--serial", SERIAL, "--password-stdin",
+               "--registry", registry, "--operator", "A. Smith", stdin=PASSWORD + "\n") == 0
+    out = capsys.readouterr().out
+    assert f"{SERIAL}: approved by Jane Doe; certificate" in out and "revision 1 →" in out
+    text = " ".join(page.extract_text() for page in PdfReader(folder / f"{SERIAL}.r1.pdf").pages)
+    assert "Jane Doe" in text and "revision 1" in text and "DRAFT" not in text and "A. Smith" in text
+    assert rig(monkeypatch, "approve", str(campaign), "--as", "jdoe", "--serial", SERIAL, "--password-stdin",
+               "--registry", registry, stdin=PASSWORD + "\n") == 0
+    assert "approved already (revision 1, by Jane Doe)" in capsys.readouterr().out
+
+    assert rig(monkeypatch, "approve", str(campaign), "--as", "jdoe", "--serial", SERIAL, "--reissue",
+               "--password-stdin", "--no-pdf", "--registry", registry, stdin=PASSWORD + "\n") == 2
+    assert "a reissue needs a reason" in capsys.readouterr().err
+    assert rig(monkeypatch, "approve", str(campaign), "--as", "jdoe", "--serial", SERIAL, "--reissue", "--reason",
+               "customer's address corrected", "--password-stdin", "--no-pdf", "--registry", registry,
+               stdin=PASSWORD + "\n") == 0
+    assert "revision 2 →" in capsys.readouterr().out
+    second = (folder / f"{SERIAL}.r2.html").read_text()
+    assert "Revision 2 replaces revision 1: customer&#x27;s address corrected" in second
+    assert (folder / f"{SERIAL}.r1.pdf").is_file()                    # the earlier revision stays
+
+    assert rig(monkeypatch, "registry", "list", "--serial", SERIAL, "--json", "--registry", registry) == 0
+    import json
+
+    (row,) = json.loads(capsys.readouterr().out)
+    copy = tmp_path / "r1.pdf"
+    assert rig(monkeypatch, "registry", "certificate", str(row["id"]), "--revision", "1", "-o", str(copy),
+               "--registry", registry) == 0
+    assert copy.read_bytes() == (folder / f"{SERIAL}.r1.pdf").read_bytes()   # as issued, from the registry
+    assert rig(monkeypatch, "registry", "certificate", str(row["id"]), "--registry", registry) == 0
+    listed = capsys.readouterr().out
+    assert "revision 1" in listed and "revision 2" in listed and "customer's address corrected" in listed
+
+    assert rig(monkeypatch, "registry", "audit", SERIAL, "--registry", registry) == 0
+    audit = capsys.readouterr().out.splitlines()
+    assert [line.split()[5] for line in audit] == ["approve", "reissue"]
+    assert all("by Jane Doe (rig approve, password of registry user jdoe" in line for line in audit)
