@@ -38,8 +38,14 @@ def approve_command(args: argparse.Namespace) -> int:
         lead = ids[serial]
         decision = approvals.decision(lead)
         if args.action == "approve" and decision.state == "approved":
+            # A kill after the registry recorded it, before the files were written: they come from the registry.
+            kept = approvals.certificate(lead, decision.revision) if decision.revision else None
+            restored = _write_beside(campaign, serial, IssuedCertificate(
+                int(kept["revision"]), kept["number"], kept["html"], None if kept["pdf"] is None else bytes(kept["pdf"])),
+                only_missing=True) if kept else []
             print(f"{serial}: approved already (revision {decision.revision}, by {decision.by}); a new revision needs "
-                  "--reissue --reason")
+                  "--reissue --reason" + (f"; its certificate written again → {', '.join(map(str, restored))}"
+                                          if restored else ""))
             continue
         issued = None
         if args.action != "reject":
@@ -87,9 +93,9 @@ def _os_user() -> str:
         return "unknown"
 
 
-def _write_beside(campaign: Path, serial: str, issued: Any) -> list[Path]:
+def _write_beside(campaign: Path, serial: str, issued: Any, only_missing: bool = False) -> list[Path]:
     """The revision beside the campaign: CAMPAIGN.certificates/SERIAL.rN.html (and .pdf); earlier revisions
-    stay."""
+    stay. `only_missing`: write only what is not there (what was written, either way)."""
     import re
 
     from accelcal_rig.durable import write_atomically, write_text_atomically
@@ -97,11 +103,13 @@ def _write_beside(campaign: Path, serial: str, issued: Any) -> list[Path]:
     folder = campaign.with_suffix(".certificates")
     folder.mkdir(parents=True, exist_ok=True)
     stem = f"{re.sub(r'[^A-Za-z0-9_.-]', '_', serial)}.r{issued.revision}"
-    written = [folder / f"{stem}.html"]
-    write_text_atomically(written[0], issued.html, "the certificate")
-    if issued.pdf is not None:
+    written = []
+    if not (only_missing and (folder / f"{stem}.html").is_file()):
+        written.append(folder / f"{stem}.html")
+        write_text_atomically(written[-1], issued.html, "the certificate")
+    if issued.pdf is not None and not (only_missing and (folder / f"{stem}.pdf").is_file()):
         written.append(folder / f"{stem}.pdf")
-        write_atomically(written[1], issued.pdf, "the certificate")
+        write_atomically(written[-1], issued.pdf, "the certificate")
     return written
 
 

@@ -65,6 +65,12 @@ def test_an_approver_issues_revisions_and_every_decision_is_audited(fitted, monk
     assert rig(monkeypatch, "approve", str(campaign), "--as", "jdoe", "--serial", SERIAL, "--password-stdin",
                "--registry", registry, stdin=PASSWORD + "\n") == 0
     assert "approved already (revision 1, by Jane Doe)" in capsys.readouterr().out
+    issued_pdf = (folder / f"{SERIAL}.r1.pdf").read_bytes()
+    (folder / f"{SERIAL}.r1.pdf").unlink()           # as a kill after the registry recorded it leaves it
+    assert rig(monkeypatch, "approve", str(campaign), "--as", "jdoe", "--serial", SERIAL, "--password-stdin",
+               "--registry", registry, stdin=PASSWORD + "\n") == 0
+    assert "its certificate written again" in capsys.readouterr().out
+    assert (folder / f"{SERIAL}.r1.pdf").read_bytes() == issued_pdf      # as issued, from the registry
 
     assert rig(monkeypatch, "approve", str(campaign), "--as", "jdoe", "--serial", SERIAL, "--reissue",
                "--password-stdin", "--no-pdf", "--registry", registry, stdin=PASSWORD + "\n") == 2

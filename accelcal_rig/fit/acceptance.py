@@ -130,30 +130,44 @@ def _partial(partial: str, allowed: bool) -> tuple[bool, str] | None:
     return allowed, partial + (" (acceptance.allow_partial)" if allowed else ": a partial campaign fails")
 
 
-def _parameter_checks(thermal: ThermalModel, mode: str, limits: Acceptance, rule: DecisionRule,
-                      parameter_u: ParameterUncertainty | None) -> list[LimitCheck]:
-    assert limits.parameters is not None
-    p = limits.parameters
-    at = thermal.parameters_at(p.at_c, "clamp")
+#: One parameter limit: (procedure key, label, limit, the parameters it judges, unit factor, offset, unit, names).
+ParameterLimit = tuple[str, str, "float | None", Any, float, float, str, Sequence[str]]
+
+
+def parameter_checks(thermal: ThermalModel, at_c: float, parameter_u: ParameterUncertainty | None,
+                     limits: list[ParameterLimit], rule: DecisionRule, prefix: str = "") -> list[LimitCheck]:
+    """Every stated parameter limit of any channel's model against its parameters at `at_c`, each with its own
+    expanded uncertainty there: (value + offset) × factor, signed. Outside the DUTs' own range the range's
+    nearest edge is judged, and said so."""
+    at = thermal.parameters_at(at_c, "clamp")
     low, high = thermal.domain_c
-    used_c = min(max(p.at_c, low), high)   # outside the DUTs' own range: its nearest edge, and said so
-    where = f"{p.at_c:g} °C" if used_c == p.at_c else f"{used_c:.2f} °C (the calibrated range's edge nearest {p.at_c:g} °C)"
-    u = (COVERAGE_FACTOR * parameter_u.standard(p.at_c)[0]) if parameter_u is not None else np.full(len(at), np.nan)
-    rows = [("bias_mg", "bias", p.bias_mg, at[0:3] * 1e3, u[0:3] * 1e3, "mg", "xyz"),
-            ("scale_error_ppm", "scale error", p.scale_error_ppm, (at[3:6] - 1.0) * 1e6, u[3:6] * 1e6, "ppm", "xyz"),
-            ("nonorthogonality_mrad", "non-orthogonality", p.nonorthogonality_mrad, at[6:9] * 1e3, u[6:9] * 1e3,
-             "mrad", ("yx", "zx", "zy"))]
-    if mode == "reference":
-        rows.append(("misalignment_mrad", "misalignment", p.misalignment_mrad, at[9:12] * 1e3, u[9:12] * 1e3, "mrad",
-                     "xyz"))
+    used_c = min(max(at_c, low), high)
+    where = f"{at_c:g} °C" if used_c == at_c else f"{used_c:.2f} °C (the calibrated range's edge nearest {at_c:g} °C)"
+    u = COVERAGE_FACTOR * parameter_u.standard(at_c)[0] if parameter_u is not None else np.full(len(at), np.nan)
     checks = []
-    for key, label, limit, values, expanded, unit, names in rows:
+    for key, label, limit, index, factor, offset, unit, names in limits:
         if limit is None:
             continue
-        checks += [check(f"parameters.{key}", f"{label} {name} at {where}", float(v),
-                         None if np.isnan(e) else float(e), limit, unit, rule, signed=True)
+        values, expanded = (np.atleast_1d(at[index]) + offset) * factor, np.atleast_1d(u[index]) * factor
+        checks += [check(f"{prefix}parameters.{key}", f"{prefix.rstrip('.') + ' ' if prefix else ''}{label} {name} at "
+                         f"{where}", float(v), None if np.isnan(e) else float(e), limit, unit, rule, signed=True)
                    for name, v, e in zip(names, values, expanded)]
     return checks
+
+
+def _parameter_checks(thermal: ThermalModel, mode: str, limits: Acceptance, rule: DecisionRule,
+                      parameter_u: ParameterUncertainty | None) -> list[LimitCheck]:
+    """Eq. 1's limits (misalignment only where a reference fit determines it)."""
+    assert limits.parameters is not None
+    p = limits.parameters
+    rows: list[ParameterLimit] = [
+        ("bias_mg", "bias", p.bias_mg, slice(0, 3), 1e3, 0.0, "mg", "xyz"),
+        ("scale_error_ppm", "scale error", p.scale_error_ppm, slice(3, 6), 1e6, -1.0, "ppm", "xyz"),
+        ("nonorthogonality_mrad", "non-orthogonality", p.nonorthogonality_mrad, slice(6, 9), 1e3, 0.0, "mrad",
+         ("yx", "zx", "zy"))]
+    if mode == "reference":
+        rows.append(("misalignment_mrad", "misalignment", p.misalignment_mrad, slice(9, 12), 1e3, 0.0, "mrad", "xyz"))
+    return parameter_checks(thermal, p.at_c, parameter_u, rows, rule)
 
 
 def recorded_acceptance(procedure_yaml: str, where: str) -> Acceptance:

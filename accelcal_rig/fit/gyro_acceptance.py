@@ -7,15 +7,20 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from accelcal_rig.config.acceptance import Acceptance, GyroAcceptance
 from accelcal_rig.fit import gyro_model
-from accelcal_rig.fit.acceptance import NOT_JUDGED, Judgement, _partial, rule_of, verdict_of
+from accelcal_rig.fit.acceptance import (
+    NOT_JUDGED,
+    Judgement,
+    ParameterLimit,
+    _partial,
+    parameter_checks,
+    rule_of,
+    verdict_of,
+)
 from accelcal_rig.fit.decision import DecisionRule, LimitCheck, check
 from accelcal_rig.fit.parameter_uncertainty import ParameterUncertainty
 from accelcal_rig.fit.thermal import ThermalModel
-from accelcal_rig.fit.uncertainty import COVERAGE_FACTOR
 
 NO_GYRO_LIMITS = "no gyroscope acceptance limits stated"
 
@@ -55,26 +60,15 @@ def judge_gyro(metrics: dict[str, Any], thermal: ThermalModel, acceptance: Accep
 
 def _parameter_checks(thermal: ThermalModel, limits: GyroAcceptance, rule: DecisionRule,
                       parameter_u: ParameterUncertainty | None) -> list[LimitCheck]:
+    """The rate-table model's limits (fit/gyro_model.py's parameters)."""
     assert limits.parameters is not None
     p = limits.parameters
-    at = thermal.parameters_at(p.at_c, "clamp")
-    low, high = thermal.domain_c
-    used_c = min(max(p.at_c, low), high)   # outside the DUTs' own range: its nearest edge, and said so
-    where = f"{p.at_c:g} °C" if used_c == p.at_c else f"{used_c:.2f} °C (the calibrated range's edge nearest {p.at_c:g} °C)"
-    u = COVERAGE_FACTOR * parameter_u.standard(p.at_c)[0] if parameter_u is not None else np.full(len(at), np.nan)
+    axes = list(gyro_model.AXES)
     crosses = [f"{gyro_model.AXES[i]}{gyro_model.AXES[j]}" for i, j in gyro_model.CROSS_TERMS]
-    rows = [("bias_dps", "bias", p.bias_dps, at[gyro_model.BIAS], u[gyro_model.BIAS], "°/s", list(gyro_model.AXES)),
-            ("scale_error_ppm", "scale error", p.scale_error_ppm, (at[gyro_model.SCALE] - 1.0) * 1e6,
-             u[gyro_model.SCALE] * 1e6, "ppm", list(gyro_model.AXES)),
-            ("cross_axis_mrad", "cross-axis", p.cross_axis_mrad, at[gyro_model.CROSS] * 1e3, u[gyro_model.CROSS] * 1e3,
-             "mrad", crosses),
-            ("gsens_dps_per_g", "g-sensitivity", p.gsens_dps_per_g, at[gyro_model.GSENS], u[gyro_model.GSENS], "°/s/g",
-             [f"{a}{b}" for a in gyro_model.AXES for b in gyro_model.AXES])]
-    checks = []
-    for key, label, limit, values, expanded, unit, names in rows:
-        if limit is None:
-            continue
-        checks += [check(f"gyro.parameters.{key}", f"gyro {label} {name} at {where}", float(v),
-                         None if np.isnan(e) else float(e), limit, unit, rule, signed=True)
-                   for name, v, e in zip(names, np.atleast_1d(values), np.atleast_1d(expanded))]
-    return checks
+    rows: list[ParameterLimit] = [
+        ("bias_dps", "bias", p.bias_dps, gyro_model.BIAS, 1.0, 0.0, "°/s", axes),
+        ("scale_error_ppm", "scale error", p.scale_error_ppm, gyro_model.SCALE, 1e6, -1.0, "ppm", axes),
+        ("cross_axis_mrad", "cross-axis", p.cross_axis_mrad, gyro_model.CROSS, 1e3, 0.0, "mrad", crosses),
+        ("gsens_dps_per_g", "g-sensitivity", p.gsens_dps_per_g, gyro_model.GSENS, 1.0, 0.0, "°/s/g",
+         [f"{a}{b}" for a in axes for b in axes])]
+    return parameter_checks(thermal, p.at_c, parameter_u, rows, rule, prefix="gyro.")

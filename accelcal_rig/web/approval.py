@@ -149,6 +149,8 @@ def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: 
                                               settings.authority(user, via_header), fields.get("reason", ""))
         except RigError as exc:
             return PlainTextResponse(f"refused: {exc}", status_code=409)
+        except OSError as exc:  # the campaign or its calibration unreadable here: one line, nothing recorded
+            return PlainTextResponse(f"refused: {exc.filename or 'a file'}: {exc.strerror or exc}", status_code=409)
         return RedirectResponse(f"/registry/calibrations/{row_id}?message={_quote(message)}", status_code=303)
 
     def certificate_file(request: Request) -> Response:
