@@ -14,6 +14,7 @@ import os
 import signal
 import sys
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -24,6 +25,7 @@ from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
 if TYPE_CHECKING:
     from accelcal_rig.engine.preparation import PreparedCampaign
     from accelcal_rig.engine.session import NothingToResume, RunResult
+    from accelcal_rig.follow_up import FollowUp
 
 EXIT_INTERRUPTED = 130
 #: A failure the program did not foresee (a bug): one line, and this code.
@@ -76,35 +78,32 @@ def _warn_of_references(prepared: PreparedCampaign, args: argparse.Namespace) ->
 def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace, *, dry_run: bool, seed: int,
              overwrite: bool, resume: bool) -> int:
     """Run or resume under the CLI's signal handling and logging, the campaign locked before anything of it
-    changes (the log included); print the summary."""
+    changes (the log included); print the summary, then finish the campaign's follow-up."""
     from accelcal_rig.assembly import run_campaign
-    from accelcal_rig.cli_campaign import calibration_path, campaign_session, stop_on_first_signal
+    from accelcal_rig.cli_campaign import campaign_session, follow_up_of, stop_on_first_signal
     from accelcal_rig.engine.session import NothingToResume
 
-    calibration = calibration_path(args.calibration, output)
+    follow_up = follow_up_of(args, output, resume and not overwrite)
+    prepared = replace(prepared, follow_up=follow_up.to_json())
     with stop_on_first_signal():
         try:
             with campaign_session(prepared, output, verbose=args.verbose, quiet=args.quiet, dry_run=dry_run,
                                   overwrite=overwrite, resume=resume) as progress:
                 result = run_campaign(prepared, output, dry_run=dry_run, seed=seed, overwrite=overwrite,
-                                      calibration=calibration, resume=resume, progress=progress)
+                                      calibration=follow_up.calibration, resume=resume, progress=progress)
         except NothingToResume as done:
             print(done)
-            return _complete_campaign_verdicts(done, output, calibration, args)
-    return _after_campaign(prepared, result, output, calibration, args, dry_run)
+            return _complete_campaign_verdicts(done, output, follow_up, args)
+    return _after_campaign(prepared, result, output, follow_up, args, dry_run)
 
 
-def _after_campaign(prepared: PreparedCampaign, result: RunResult, output: Path, calibration: Path,
+def _after_campaign(prepared: PreparedCampaign, result: RunResult, output: Path, follow_up: FollowUp,
                     args: argparse.Namespace, dry_run: bool) -> int:
     """The summary; after a fit, the certificates and the registry. A signal now only cuts the printing short."""
-    from accelcal_rig.cli_registry import campaign_entries, rig_registry
-
     try:
         code = _print_summary(prepared, result, dry_run, args.fail_on_reject)
         if result.summary.fit and not result.summary.fit_failed:
-            code = max(code, _certify_after_run(output, calibration, args))
-            _record(args.registry, rig_registry(prepared.rig.model.registry, prepared.rig.path), output,
-                    lambda: campaign_entries(output, calibration))
+            code = max(code, _finish_follow_up(output, follow_up))
         return code
     except (KeyboardInterrupt, TerminationRequested):
         print(f"rig: interrupted after the campaign ended ({result.summary.state}); {result.output} holds all of it",
@@ -126,27 +125,47 @@ def _print_summary(prepared: PreparedCampaign, result: RunResult, dry_run: bool,
     return _rejected_exit(summary.rejected, fail_on_reject)
 
 
-def _complete_campaign_verdicts(done: NothingToResume, output: Path, calibration: Path,
+def _complete_campaign_verdicts(done: NothingToResume, output: Path, follow_up: FollowUp,
                                 args: argparse.Namespace) -> int:
-    """A complete campaign resumed: the verdicts of the fit this resume did (and its certificates and
-    warnings), else those of its calibration file; `--fail-on-reject` either way."""
+    """A complete campaign resumed: the verdicts of the fit this resume did (and its warnings), else those of
+    its calibration file; then whatever of its certificates and registry rows is missing; `--fail-on-reject`
+    either way."""
     from accelcal_rig.cli_format_campaign import verdict_lines, warning_lines
     from accelcal_rig.fit.campaign_file import calibration_verdicts
 
-    code = 0
     fit = done.fit
     if fit is not None:
         verdicts = fit.verdicts
         for line in warning_lines(fit.warnings):
             print(line)
-        code = _certify_after_run(output, calibration, args)
     else:
-        judged = calibration_verdicts(output, calibration)["verdicts"] or {}
+        judged = calibration_verdicts(output, follow_up.calibration)["verdicts"] or {}
         verdicts = {serial: (str(v["verdict"]), tuple(v["reasons"])) for serial, v in judged.items()}
     for line in verdict_lines(verdicts):
         print(line)
+    code = _finish_follow_up(output, follow_up) if follow_up.calibration.is_file() else 0
     rejected = [serial for serial, (verdict, _) in verdicts.items() if verdict == "FAIL"]
     return max(code, _rejected_exit(rejected, args.fail_on_reject))
+
+
+def _finish_follow_up(output: Path, follow_up: FollowUp) -> int:
+    """The certificates and the registry rows of a fitted campaign, each written only if it is not there and
+    current (follow_up.state): a run's, or what a kill left undone of one."""
+    from accelcal_rig import follow_up as follow
+    from accelcal_rig.cli_registry import campaign_entries
+    from accelcal_rig.registry.location import campaign_rig_registry
+
+    parts = {p.part: p for p in follow.state(output, follow_up)}
+    code = 0
+    if parts["certificates"].state != follow.DONE:
+        code = _certify_after_run(output, follow_up)
+    if parts["registry"].state == follow.DONE:
+        print(f"registry   {parts['registry'].detail} already")
+    else:
+        _record(follow_up.registry, campaign_rig_registry(output), output,
+                lambda: campaign_entries(output, follow_up.calibration),
+                later=f"rig resume {output}, or rig registry add {output}")
+    return code
 
 
 def _record(flag: str | None, configured: str | None, source: Path, entries: Callable[[], list],
@@ -328,11 +347,10 @@ def _cmd_certificate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _certify_after_run(output: Path, calibration: Path, args: argparse.Namespace) -> int:
+def _certify_after_run(output: Path, follow_up: FollowUp) -> int:
     """The certificates at the end of a run; one that cannot be written is one line, the campaign stands."""
     try:
-        _certify(output, calibration, args.certificates or output.with_suffix(".certificates"), args.operator,
-                 not args.no_pdf)
+        _certify(output, follow_up.calibration, follow_up.certificates, follow_up.operator, follow_up.pdf)
     except (RigError, OSError) as exc:
         print(f"rig: error: campaign done, but no certificates: {_one_line(exc)}", file=sys.stderr)
         return 1

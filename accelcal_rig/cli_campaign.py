@@ -23,6 +23,7 @@ if TYPE_CHECKING:
     from accelcal_rig.config.lab import Receipt
     from accelcal_rig.engine.preparation import PreparedCampaign
     from accelcal_rig.engine.progress import ProgressListener
+    from accelcal_rig.follow_up import FollowUp
 
 
 def prepare_run(args: argparse.Namespace) -> tuple[PreparedCampaign, bool]:
@@ -83,6 +84,21 @@ def calibration_path(given: Path | None, output: Path) -> Path:
     if not calibration.parent.is_dir():
         raise ConfigError(f"{calibration}: folder {calibration.parent} does not exist")
     return calibration
+
+
+def follow_up_of(args: argparse.Namespace, output: Path, continuing: bool) -> FollowUp:
+    """Where this command writes the campaign's follow-up: a new campaign's from its flags (recorded in it), a
+    continued one's as its `rig run` recorded, each part a flag names now instead."""
+    from accelcal_rig import follow_up
+    from accelcal_rig.store.paths import journal_path
+    from accelcal_rig.store.read import load_campaign
+
+    calibration_path(args.calibration, output)  # a folder named and missing: refused before anything moves
+    if continuing and (output.exists() or journal_path(output).exists()):
+        found = follow_up.of_campaign(load_campaign(output).attrs, output, args)
+        calibration_path(found.calibration, output)
+        return found
+    return follow_up.of_run(args, output, calibration_path(args.calibration, output))
 
 
 class _StopOnFirstSignal:
@@ -193,8 +209,17 @@ def campaign_logging(output: Path, verbose: bool, quiet: bool, append: bool,
 
 
 def campaign_status(campaign: Path, calibration: Path | None) -> dict[str, Any]:
-    """`rig status --json`: the campaign's state and progress, and its DUTs' verdicts from its calibration."""
+    """`rig status --json`: the campaign's state and progress, its DUTs' verdicts from its calibration, and
+    each part of its follow-up (calibration, certificates, registry) with what is missing."""
+    from accelcal_rig import follow_up
     from accelcal_rig.fit.campaign_file import calibration_verdicts
+    from accelcal_rig.fit.recorded_options import NO_FIT, requested_mode
     from accelcal_rig.store.read import campaign_status as stored_status
+    from accelcal_rig.store.read import load_campaign
 
-    return {**stored_status(campaign), **calibration_verdicts(campaign, calibration)}
+    stored = load_campaign(campaign)
+    found = follow_up.of_campaign(stored.attrs, campaign, argparse.Namespace(calibration=calibration))
+    fit_due = requested_mode(stored.attrs) != NO_FIT
+    parts = follow_up.state(campaign, found, fit_due)
+    return {**stored_status(campaign, stored), **calibration_verdicts(campaign, found.calibration),
+            "follow_up": [p.as_dict() for p in parts]}

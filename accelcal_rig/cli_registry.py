@@ -85,13 +85,9 @@ def rig_registry(value: str | None, rig_path: Path) -> str | None:
 
 def stored_rig_registry(campaign: Path) -> str | None:
     """The `registry:` of the rig config a campaign was run with (as it stored it)."""
-    import yaml
+    from accelcal_rig.registry.location import campaign_rig_registry
 
-    from accelcal_rig.store.read import load_campaign
-
-    stored = load_campaign(campaign)
-    value = (yaml.safe_load(stored.header.rig_yaml) or {}).get("registry")
-    return rig_registry(value, Path(str(stored.attrs.get("rig_path", campaign)))) if value else None
+    return campaign_rig_registry(campaign)
 
 
 def _add(args: argparse.Namespace) -> int:

@@ -36,6 +36,9 @@ def status_lines(status: dict[str, Any]) -> list[str]:
         lines.append(f"file       {status['campaign_file']}")
     if status.get("calibration"):
         lines.append(f"fit        {status['calibration']}")
+    for part in status.get("follow_up") or []:
+        if part["state"] != "not due" and not (part["part"] == "calibration" and part["state"] == "done"):
+            lines.append(f"{part['part']:<10} {part['state']}: {part['detail']}")
     for serial, judged in (status.get("verdicts") or {}).items():
         reasons = f": {'; '.join(judged['reasons'])}" if judged["verdict"] in ("FAIL", "CONDITIONAL") else ""
         lines.append(f"verdict    {serial} {judged['verdict'] or 'not judged'}{reasons}")
@@ -53,10 +56,13 @@ def _state(status: dict[str, Any]) -> str:
 
 
 def _next_step(status: dict[str, Any]) -> str:
-    """What to do about it: continue a campaign that stopped."""
+    """What to do about it: continue a campaign that stopped, or finish what a complete one lacks."""
     state, writer = status["state"], status.get("writer") or ""
     if state == "aborted" or (state in ("created", "running") and writer.startswith("gone")):
         return f"rig resume {status['file']}  (continues with the poses not stored)"
+    unfinished = [p["part"] for p in status.get("follow_up") or [] if p["state"] in ("missing", "stale", "unknown")]
+    if state == "done" and unfinished:
+        return f"rig resume {status['file']}  (writes what is missing: {', '.join(unfinished)})"
     return ""
 
 

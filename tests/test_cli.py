@@ -277,7 +277,7 @@ def test_resume_of_a_complete_campaign_says_so_and_exits_0(write, capsys) -> Non
     assert main(["run", str(path), "--dry-run", "-o", str(output), "-q"]) == 0
     capsys.readouterr()
     assert main(["resume", str(output), "-q"]) == 0
-    assert "the campaign is complete: nothing to resume" in capsys.readouterr().out
+    assert "the campaign is complete: every pose is stored" in capsys.readouterr().out
 
 
 def test_rig_plan_prints_every_pose_and_an_estimate_without_touching_instruments(write, workdir: Path, capsys) -> None:
@@ -448,4 +448,4 @@ def test_resume_finds_the_procedure_from_any_folder(tmp_path: Path) -> None:
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     resumed = rig("resume", str(tmp_path / "c.h5"), cwd=elsewhere)
-    assert resumed.returncode == 0 and "the campaign is complete: nothing to resume" in resumed.stdout, resumed.stderr
+    assert resumed.returncode == 0 and "the campaign is complete: every pose is stored" in resumed.stdout, resumed.stderr

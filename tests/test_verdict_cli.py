@@ -77,7 +77,7 @@ def test_resuming_a_complete_campaign_whose_fit_is_missing_fits_judges_and_certi
         certificate.unlink()
     assert main(["resume", str(campaign), "-q", "--no-pdf", "--fail-on-reject"]) == 3
     out = capsys.readouterr().out
-    assert "nothing to resume" in out and out.count("  verdict    ") == 4 and "FAIL: verification |g| RMSE" in out
+    assert "every pose is stored" in out and out.count("  verdict    ") == 4 and "FAIL: verification |g| RMSE" in out
     assert campaign.with_suffix(".calibration.yaml").exists()
     assert len(list(campaign.with_suffix(".certificates").glob("*.html"))) == 4
 

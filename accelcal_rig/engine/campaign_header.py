@@ -82,7 +82,7 @@ def create_campaign_file(prepared: PreparedCampaign, output: Path, connected: Co
              "chamber_profile": prepared.chamber_profile or "",
              "lab_name": lab.name if lab else "", "lab_address": lab.address if lab else "",
              "place_of_calibration": lab.place_of_calibration if lab else "",
-             **fit_attrs(procedure)}
+             "follow_up": prepared.follow_up, **fit_attrs(procedure)}
     return CampaignWriter.create(
         output, {"attrs": attrs, "procedure_yaml": prepared.procedure.text, "rig_yaml": rig.text,
                  "plan": stored_plan(prepared.plan), "duts": duts, "instruments": instrument_info(instruments, rig.model),

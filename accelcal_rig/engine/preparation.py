@@ -41,6 +41,9 @@ class PreparedCampaign:
     #: `rig run --customer/--received/--condition`: what the campaign file records of every DUT whose fixture entry
     #: states none of its own.
     receipt: Receipt = Receipt()
+    #: Where the command that starts the campaign writes its follow-up (the calibration, certificates, registry),
+    #: recorded in the campaign for its resume: JSON the engine stores and does not read.
+    follow_up: str = ""
 
     def storage(self, dry_run: bool) -> StorageEstimate:
         """The disk the campaign will take (a dry run also stores the simulation's truth)."""

@@ -23,7 +23,7 @@ from accelcal_rig.engine.preparation import PreparedCampaign
 from accelcal_rig.engine.progress import ProgressListener
 from accelcal_rig.engine.progress_file import ProgressFile
 from accelcal_rig.engine.resume import ResumePoint, check_same_campaign
-from accelcal_rig.errors import RigError
+from accelcal_rig.errors import ConfigError, RigError
 from accelcal_rig.fit.campaign_fit import fit_and_save, summary_line
 from accelcal_rig.fit.fixture_pool import warm_up_workers
 from accelcal_rig.fit.recorded_options import recorded_options
@@ -85,7 +85,7 @@ def resume_campaign(prepared: PreparedCampaign, output: Path, connect: RigConnec
     check_same_campaign(output, stored, prepared.procedure, prepared.rig, prepared.plan, dry_run)
     if stored.state == "done" and stored.poses_planned == len(stored.poses):
         done, fit = _finish_complete(prepared, output, stored, calibration)
-        raise NothingToResume("; ".join([f"{output}: the campaign is complete: nothing to resume", *done]), fit)
+        raise NothingToResume("; ".join([f"{output}: the campaign is complete: every pose is stored", *done]), fit)
     writer, reopened = CampaignWriter.reopen(output, prepared.storage(dry_run))
     try:
         # Noise of a resumed dry run is new noise (the same sensors, not a replay of the first run).
@@ -114,13 +114,28 @@ def _finish_complete(prepared: PreparedCampaign, output: Path, stored: Campaign,
         if file_currency(output, stored, writing=False) != "current":
             repair_campaign(output)
             done.append(f"{output.name} brought up to date from its journal")
-        if calibration is not None and not calibration.exists() and prepared.procedure.model.fit.mode != "none":
+        if calibration is not None and prepared.procedure.model.fit.mode != "none" and not _fitted_to(calibration, output):
             try:
                 fit = _fit_stage(prepared.procedure.model, output, calibration)(load_campaign(output))
             except (ValueError, KeyError, OSError, np.linalg.LinAlgError) as exc:
                 raise RigError(f"{output}: the campaign is complete, but its fit failed: {exc}") from None
             done.append(fit.summary)
     return done, fit
+
+
+def _fitted_to(calibration: Path, output: Path) -> bool:
+    """Whether the calibration file is there, readable and fitted to the campaign's measurements now (else a
+    complete campaign's resume fits it again: the file is derived, like the campaign file)."""
+    from accelcal_rig.fit.calibration import load_calibration
+    from accelcal_rig.store.content import measurements_sha256
+
+    if not calibration.is_file():
+        return False
+    try:
+        fitted = load_calibration(calibration).source.get("measurements_sha256")
+    except ConfigError:
+        return False
+    return fitted == measurements_sha256(load_campaign(output))
 
 
 def _close(writer: CampaignWriter) -> tuple[str, ...]:

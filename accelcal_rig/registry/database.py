@@ -60,10 +60,13 @@ class Registry:
         self.url = url
 
     @classmethod
-    def open(cls, url: str, upgrade: bool = True) -> Registry:
-        """Connect. A new, empty database is created at the current schema; an older one is migrated when
-        `upgrade` (the commands that record), else refused in one line (readers do not change a schema);
-        one newer than this software is refused either way."""
+    def open(cls, url: str, upgrade: bool = True, create: bool = True) -> Registry:
+        """Connect. A new, empty database is created at the current schema when `create` (the commands that
+        record; a reader is refused in one line instead); an older one is migrated when `upgrade`, else
+        refused in one line (readers do not change a schema); one newer than this software is refused
+        either way."""
+        if not create and url.startswith("sqlite:///") and not Path(url.removeprefix("sqlite:///")).is_file():
+            raise ConfigError(f"registry {described(url)}: does not exist (nothing recorded in it yet)")
         engine = _engine(url)
         registry = cls(engine, url)
         for attempt in range(_OPEN_ATTEMPTS):

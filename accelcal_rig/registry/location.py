@@ -69,3 +69,14 @@ def described(url: str) -> str:
         user = credentials.split(":", 1)[0]
         rest = f"{user}@{where}" if user else where
     return f"{scheme}://{rest}"
+
+
+def campaign_rig_registry(campaign: Path) -> str | None:
+    """The `registry:` of the rig config a campaign was run with (as the campaign stored it)."""
+    import yaml
+
+    from accelcal_rig.store.read import load_campaign
+
+    stored = load_campaign(campaign)
+    value = (yaml.safe_load(stored.header.rig_yaml) or {}).get("registry")
+    return configured(value, Path(str(stored.attrs.get("rig_path", campaign)))) if value else None

@@ -65,26 +65,54 @@ def write_certificates(campaign_path: Path, calibration_path: Path, folder: Path
                        pdf: bool = True) -> tuple[list[Written], list[str]]:
     """One draft certificate per DUT of the calibration into `folder` (created): every page says it is not
     issued until a person approves it (rig approve issues it as a revision); (what was written, warnings).
-    Refused in one line when the calibration was fitted to other measurements than the campaign's."""
+    Refused in one line when the calibration was fitted to other measurements than the campaign's. Each DUT's
+    PDF is written before its HTML page: a page that names the calibration's certificate number marks a
+    certificate written whole (certificate_current)."""
     campaign, calibration = _certifiable(campaign_path, calibration_path)
     folder.mkdir(parents=True, exist_ok=True)
     render = _pdf_renderer() if pdf else None
     warnings = [] if render is not None or not pdf else [
         "PDFs need WeasyPrint: pip install 'accelcal-rig[certificate]' (HTML certificates written)"]
     written: list[Written] = []
-    for serial, sensor in calibration.sensors.items():
+    for serial, name in certificate_names(list(calibration.sensors)).items():
+        sensor = calibration.sensors[serial]
         page = certificate_html(campaign, campaign_path, calibration, calibration_path, serial, sensor, operator)
-        name = re.sub(r"[^A-Za-z0-9_.-]", "_", serial)
-        if any(w.html.stem == name for w in written):  # two serials that differ only in what a file name drops
-            name += f"-{len(written) + 1}"
-        html_path = folder / f"{name}.html"
-        write_text_atomically(html_path, page, "the certificate")
         pdf_path = None
         if render is not None:
             pdf_path = folder / f"{name}.pdf"
             write_atomically(pdf_path, _rendered_pdf(render, page, pdf_path), "the certificate")
+        html_path = folder / f"{name}.html"
+        write_text_atomically(html_path, page, "the certificate")
         written.append(Written(serial, html_path, pdf_path))
     return written, warnings
+
+
+def certificate_names(serials: Sequence[str]) -> dict[str, str]:
+    """Each serial's certificate file name (without suffix): the serial with what a file name cannot hold
+    replaced, numbered where two serials would otherwise share one."""
+    names: dict[str, str] = {}
+    for serial in serials:
+        name = re.sub(r"[^A-Za-z0-9_.-]", "_", serial)
+        if name in names.values():
+            name += f"-{len(names) + 1}"
+        names[serial] = name
+    return names
+
+
+def certificate_current(page: Path, pdf: Path | None, calibration: CalibrationFile, serial: str) -> bool:
+    """Whether the draft certificate in `page` (and `pdf`, when one is due) was written from `calibration`:
+    the page names its certificate number, and the PDF, written just before it, is there."""
+    try:
+        text = page.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return False
+    number = certificate_number_of(serial, calibration)
+    return number in text and (pdf is None or pdf.is_file())
+
+
+def certificate_number_of(serial: str, calibration: CalibrationFile) -> str:
+    """The draft certificate number of a DUT of a calibration (revision 1's base)."""
+    return certificate_lab.certificate_number(serial, calibration).base
 
 
 @dataclass(frozen=True)
@@ -140,6 +168,11 @@ def _rendered_pdf(render: Any, page: str, where: Path) -> bytes:
         return bytes(render(page))
     except Exception as exc:  # noqa: BLE001 - a renderer's failure is one line naming the file
         raise RigError(f"{where}: the PDF could not be rendered: {str(exc).splitlines()[0]}") from None
+
+
+def pdf_renderer_available() -> bool:
+    """Whether PDFs can be written here (WeasyPrint and its system libraries)."""
+    return _pdf_renderer() is not None
 
 
 def _pdf_renderer() -> Any:
