@@ -247,15 +247,21 @@ def _cmd_check(args: argparse.Namespace) -> int:
 def _cmd_sim(args: argparse.Namespace) -> int:
     from accelcal_rig.assembly import served_rig
     from accelcal_rig.cli_campaign import until_signalled
+    from accelcal_rig.cli_format_campaign import sim_stopped_line
     from accelcal_rig.config.load import load_rig, with_chamber_profile, with_faults
     from accelcal_rig.core.clock import RealClock
 
-    rig = with_chamber_profile(with_faults(load_rig(args.rig), args.faults), args.chamber_profile)
-    with until_signalled() as stop, served_rig(rig.model, RealClock(), args.seed) as simulated:
-        print(json.dumps(simulated.describe()), flush=True)
-        while not stop.wait(0.5):
-            pass
-    print("rig sim: stopped", file=sys.stderr)
+    described = None
+    try:
+        rig = with_chamber_profile(with_faults(load_rig(args.rig), args.faults), args.chamber_profile)
+        with until_signalled() as stop, served_rig(rig.model, RealClock(), args.seed) as simulated:
+            described = simulated.describe()
+            print(json.dumps(described), flush=True)
+            while not stop.wait(0.5):
+                pass
+    except (KeyboardInterrupt, TerminationRequested):
+        pass  # a signal before the simulators took it over: stopped as well
+    print(sim_stopped_line(args.rig, described), file=sys.stderr)
     return 0
 
 
@@ -298,11 +304,16 @@ def _cmd_completion(args: argparse.Namespace) -> int:
 
 
 def _cmd_serve(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_serve import open_dashboard
+    from accelcal_rig.cli_serve import open_dashboard, stopped_line
 
-    dashboard = open_dashboard(args)
-    print(f"dashboard on {dashboard.url}", flush=True)
-    dashboard.serve()
+    dashboard = None
+    try:
+        dashboard = open_dashboard(args)
+        print(f"dashboard on {dashboard.url}", flush=True)
+        dashboard.serve()
+    except (KeyboardInterrupt, TerminationRequested):
+        pass  # SIGINT or SIGTERM: how a dashboard is meant to end
+    print(stopped_line(dashboard), file=sys.stderr)
     return 0
 
 
@@ -397,8 +408,14 @@ def run_program() -> None:
     """The `rig` executable: run the command, then exit without letting a late signal crash the exit.
 
     By the time a command returns, its campaign is recorded (done, or aborted and safe); a second
-    Ctrl-C arriving while the interpreter shuts down must not turn that into a kill by signal.
+    Ctrl-C arriving while the interpreter shuts down must not turn that into a kill by signal. SIGTERM is Ctrl-C
+    from the start, as the `rig` script (accelcal_rig.entry) makes it, under `python -m accelcal_rig` too.
     """
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+        signal.signal(signal.SIGTERM, interrupt)
     try:
         code = main()
     except KeyboardInterrupt:  # a signal between start and the command's own handling

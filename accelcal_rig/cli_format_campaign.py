@@ -1,15 +1,17 @@
-"""What `rig run`, `rig resume`, `rig check` and `rig certificate` print about a campaign, its rig and its
-DUTs, as lines: a run's summary (from the engine's RunResult), each DUT's verdict, each certificate written."""
+"""What `rig run`, `rig resume`, `rig check`, `rig sim` and `rig certificate` print about a campaign, its rig and
+its DUTs, as lines: a run's summary (from the engine's RunResult), each DUT's verdict, each certificate written."""
 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.core.units import gravity_statement
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from accelcal_rig.engine.preparation import PreparedCampaign
     from accelcal_rig.engine.session import RunResult
     from accelcal_rig.report.certificate import Written
@@ -58,3 +60,13 @@ def check_closing_line(rig_name: str, only: frozenset[str] | None) -> str:
     if only:
         return f"rig {rig_name}: the {' and '.join(sorted(only))} answered as configured (only those checked)"
     return f"rig {rig_name}: every instrument answered as configured"
+
+
+def sim_stopped_line(rig_path: Path, described: dict[str, Any] | None) -> str:
+    """What `rig sim` says as SIGINT or SIGTERM ends it: the simulators it closed (as its first line named
+    them), or that none was serving yet."""
+    if described is None:
+        return f"rig sim: stopped before the simulators of {rig_path} were serving"
+    chamber, turntable, sensors = described["chamber"], described["turntable"], described["sensors"]
+    return (f"rig sim: stopped (simulators of {rig_path} closed: chamber {chamber['endpoint']}, turntable "
+            f"{turntable['device']}, {len(sensors)} sensor bridge{'s' if len(sensors) != 1 else ''})")

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import os
 import socket
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -23,22 +23,38 @@ class Dashboard:
     token: str | None
     tls_cert: Path | None
     tls_key: Path | None
+    #: The port it listens on, kept: the server closes the socket as it stops.
+    port: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.port = self.listening.getsockname()[1]
+
+    @property
+    def address(self) -> str:
+        """Where it is served, without the token (fit for a log line)."""
+        return f"{'https' if self.tls_cert else 'http'}://{self.host}:{self.port}"
 
     @property
     def url(self) -> str:
-        """Where to open it: the port it listens on, the token in the query if it needs one."""
+        """Where to open it: its address, the token in the query if it needs one."""
         from urllib.parse import quote
 
-        scheme = "https" if self.tls_cert else "http"
-        port = self.listening.getsockname()[1]
-        return f"{scheme}://{self.host}:{port}/" + (f"?token={quote(self.token, safe='')}" if self.token else "")
+        return f"{self.address}/" + (f"?token={quote(self.token, safe='')}" if self.token else "")
 
     def serve(self) -> None:
-        """Serve it until interrupted."""
+        """Serve it until SIGINT or SIGTERM: uvicorn closes its connections, then raises the signal again with
+        the handler it found (the `rig` program's: KeyboardInterrupt), for the caller to end on."""
         import uvicorn
 
         config = uvicorn.Config(self.app, log_level="warning", ssl_certfile=self.tls_cert, ssl_keyfile=self.tls_key)
         uvicorn.Server(config).run(sockets=[self.listening])
+
+
+def stopped_line(dashboard: Dashboard | None) -> str:
+    """What `rig serve` says as SIGINT or SIGTERM ends it: what it stopped (never the token)."""
+    if dashboard is None:
+        return "rig serve: stopped before the dashboard was listening"
+    return f"rig serve: stopped (dashboard on {dashboard.address} closed)"
 
 
 def open_dashboard(args: argparse.Namespace) -> Dashboard:

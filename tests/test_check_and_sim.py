@@ -14,6 +14,7 @@ import yaml
 from accelcal_rig.config.load import load_rig
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 from tests.conftest import REPO, SIM_RIG
+from tests.test_cli_serve import DEADLINE_S, first_line
 
 RIG = str(Path(sys.executable).parent / "rig")
 
@@ -143,3 +144,18 @@ def test_rig_check_of_a_line_chamber_says_what_frost_settings_can_count_on(tmp_p
     assert line.startswith(f"chamber    tcp {chamber['host']}:{chamber['port']}: accelcal-rig simulated simserv")
     assert "the rig's -55…100 °C, the controller's -70…180 °C" in line
     assert "% RH (dew point 12.0 °C); dry-air purge output" in line
+
+
+@pytest.mark.parametrize("stop", [signal.SIGTERM, signal.SIGINT], ids=["sigterm", "ctrl-c"])
+def test_rig_sim_says_which_simulators_it_stopped_and_exits_0(stop: signal.Signals) -> None:
+    process = subprocess.Popen([RIG, "sim", str(SIM_RIG)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        endpoints = json.loads(first_line(process, DEADLINE_S))  # serving from here on
+        process.send_signal(stop)
+        _, err = process.communicate(timeout=DEADLINE_S)
+    finally:
+        process.kill()
+    assert process.returncode == 0, err.decode()
+    assert err.decode().strip().splitlines()[-1] == (
+        f"rig sim: stopped (simulators of {SIM_RIG} closed: chamber {endpoints['chamber']['endpoint']}, "
+        f"turntable {endpoints['turntable']['device']}, 4 sensor bridges)")

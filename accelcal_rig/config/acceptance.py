@@ -7,7 +7,7 @@ from typing import Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from accelcal_rig.config.bounds import StrictModel, TemperatureC
+from accelcal_rig.config.bounds import Real, StrictModel, TemperatureC
 from accelcal_rig.config.schedule import Schedule
 
 
@@ -46,11 +46,11 @@ class ParameterLimits(StrictModel):
 
     at_c: TemperatureC = Field(25.0, description="temperature the parameters are judged at (inside the "
                                                  "calibrated range)")
-    bias_mg: float | None = Field(None, gt=0, le=1000, description="|bias| of each axis")
-    scale_error_ppm: float | None = Field(None, gt=0, le=1e6, description="|scale − 1| of each axis")
-    nonorthogonality_mrad: float | None = Field(None, gt=0, le=1000, description="|each non-orthogonality|")
-    misalignment_mrad: float | None = Field(None, gt=0, le=1000, description="|each misalignment| (reference "
-                                                                              "mode only)")
+    bias_mg: Real | None = Field(None, gt=0, le=1000, description="|bias| of each axis")
+    scale_error_ppm: Real | None = Field(None, gt=0, le=1e6, description="|scale − 1| of each axis")
+    nonorthogonality_mrad: Real | None = Field(None, gt=0, le=1000, description="|each non-orthogonality|")
+    misalignment_mrad: Real | None = Field(None, gt=0, le=1000, description="|each misalignment| (reference "
+                                                                             "mode only)")
 
 
 class GyroParameterLimits(StrictModel):
@@ -58,25 +58,25 @@ class GyroParameterLimits(StrictModel):
 
     at_c: TemperatureC = Field(25.0, description="temperature the parameters are judged at (inside the "
                                                  "calibrated range)")
-    bias_dps: float | None = Field(None, gt=0, le=1000, description="|bias| of each axis, the Earth's rate taken "
-                                                                   "out as the calibration states")
-    scale_error_ppm: float | None = Field(None, gt=0, le=1e6, description="|scale − 1| of each axis")
-    cross_axis_mrad: float | None = Field(None, gt=0, le=1000, description="|each cross-axis term| of K")
-    gsens_dps_per_g: float | None = Field(None, gt=0, le=1000, description="|each g-sensitivity term|")
+    bias_dps: Real | None = Field(None, gt=0, le=1000, description="|bias| of each axis, the Earth's rate taken "
+                                                                  "out as the calibration states")
+    scale_error_ppm: Real | None = Field(None, gt=0, le=1e6, description="|scale − 1| of each axis")
+    cross_axis_mrad: Real | None = Field(None, gt=0, le=1000, description="|each cross-axis term| of K")
+    gsens_dps_per_g: Real | None = Field(None, gt=0, le=1000, description="|each g-sensitivity term|")
 
 
 class GyroAcceptance(StrictModel):
     """What a DUT's gyroscope must meet to PASS; the verification limits are judged on the rate steps and
     poses the fit never saw (`rates.verify_rates_dps`, `verify:`)."""
 
-    max_verification_rmse_dps: float | None = Field(None, gt=0, le=10_000, description="RMS axis error of the "
-                                                    "compensated verification rate steps against their references")
-    max_axis_error_dps: float | None = Field(None, gt=0, le=10_000, description="largest axis error of a "
-                                             "compensated verification rate step")
-    max_scale_error_ppm: float | None = Field(None, gt=0, le=1e6, description="largest relative error along the "
-                                              "turning axis at the verification rates")
-    max_rest_error_dps: float | None = Field(None, gt=0, le=10_000, description="RMS axis error of the compensated "
-                                             "verification poses (at rest: the bias left)")
+    max_verification_rmse_dps: Real | None = Field(None, gt=0, le=10_000, description="RMS axis error of the "
+                                                   "compensated verification rate steps against their references")
+    max_axis_error_dps: Real | None = Field(None, gt=0, le=10_000, description="largest axis error of a "
+                                            "compensated verification rate step")
+    max_scale_error_ppm: Real | None = Field(None, gt=0, le=1e6, description="largest relative error along the "
+                                             "turning axis at the verification rates")
+    max_rest_error_dps: Real | None = Field(None, gt=0, le=10_000, description="RMS axis error of the compensated "
+                                            "verification poses (at rest: the bias left)")
     parameters: GyroParameterLimits | None = None
 
     def verification_limits(self) -> list[str]:
@@ -88,12 +88,12 @@ class Acceptance(StrictModel):
     """What a DUT's calibration must meet to PASS; each limit left out is not judged. The verification
     limits are judged on the verification poses (a `verify:` section is needed for them)."""
 
-    max_verification_rmse_mg: float | None = Field(None, gt=0, le=1000, description="Eq. 9 |g| RMSE")
-    max_axis_error_mg: float | None = Field(None, gt=0, le=1000, description="largest per-axis error of the "
-                                            "compensated vector against the reference gravity")
-    max_drift_mg: float | None = Field(None, gt=0, le=1000, description="residual zero-g drift per axis over "
-                                       "the verification temperatures (max − min)")
-    max_tilt_error_deg: float | None = Field(None, gt=0, le=90, description="largest Eq. 10 pitch or roll error")
+    max_verification_rmse_mg: Real | None = Field(None, gt=0, le=1000, description="Eq. 9 |g| RMSE")
+    max_axis_error_mg: Real | None = Field(None, gt=0, le=1000, description="largest per-axis error of the "
+                                           "compensated vector against the reference gravity")
+    max_drift_mg: Real | None = Field(None, gt=0, le=1000, description="residual zero-g drift per axis over "
+                                      "the verification temperatures (max − min)")
+    max_tilt_error_deg: Real | None = Field(None, gt=0, le=90, description="largest Eq. 10 pitch or roll error")
     parameters: ParameterLimits | None = None
     gyro: GyroAcceptance | None = Field(None, description="a gyroscope's limits (a procedure with rates:)")
     allow_partial: bool = Field(False, description="a campaign that stopped before its last pose may pass")
@@ -101,8 +101,8 @@ class Acceptance(StrictModel):
         None, description="how each figure's expanded uncertainty is taken into its verdict (ILAC-G8:09/2019): "
                           "simple acceptance, or guarded acceptance with a guard band of guard_band_factor × U; "
                           "stated on the certificate (none stated: simple, and said so)")
-    guard_band_factor: float = Field(1.0, gt=0, le=3, description="guarded acceptance: the guard band in "
-                                                                  "expanded uncertainties (k = 2)")
+    guard_band_factor: Real = Field(1.0, gt=0, le=3, description="guarded acceptance: the guard band in "
+                                                                 "expanded uncertainties (k = 2)")
 
     @model_validator(mode="after")
     def _guard_band_guards(self) -> Acceptance:

@@ -9,6 +9,7 @@ from typing import Any, Generic, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
+from accelcal_rig.config.bounds import NUMBERS_FROM_TEXT
 from accelcal_rig.config.procedure import MAX_POLLS, Procedure
 from accelcal_rig.config.rig import FaultInjection, RigConfig
 from accelcal_rig.config.schedule import Schedule
@@ -213,8 +214,8 @@ def with_faults(rig: LoadedConfig[RigConfig], spec: str | None) -> LoadedConfig[
         if not sep or key not in faults:
             raise ConfigError(f"--faults: {item.strip()!r}: expected key=value with key one of {', '.join(faults)}")
         faults[key] = value.split("+") if key == "kinds" else (None if value in ("", "none") else value)
-    try:
-        validated = FaultInjection.model_validate(faults)
+    try:  # the command line's values are text: its numbers are read from it (a file's must be numbers)
+        validated = FaultInjection.model_validate(faults, context={NUMBERS_FROM_TEXT: True})
     except ValidationError as exc:
         err = exc.errors(include_url=False)[0]
         raise ConfigError(f"--faults: {format_key(tuple(err['loc']))}: {err['msg']}") from None

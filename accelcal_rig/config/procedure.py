@@ -8,7 +8,7 @@ import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from accelcal_rig.config.acceptance import Acceptance, Verification
-from accelcal_rig.config.bounds import StrictModel, TemperatureC, TemperatureSpanC
+from accelcal_rig.config.bounds import Real, StrictModel, TemperatureC, TemperatureSpanC, Whole
 from accelcal_rig.config.rate_steps import NoiseRecord, RateSteps
 from accelcal_rig.config.schedule import MAX_SCHEDULE_POSES, Schedule
 
@@ -31,25 +31,25 @@ class SoakCriterion(StrictModel):
 
     criterion: Literal["band", "settling"] = Field("band", description="band: readings within band_c over "
                                                    "the window; settling: a fitted settling curve's prediction")
-    min_dwell_min: float = Field(30.0, ge=0, le=2880, description="least time at setpoint before stability counts")
-    window_min: float = Field(10.0, gt=0, le=1440, description="trailing window over which stability is judged")
+    min_dwell_min: Real = Field(30.0, ge=0, le=2880, description="least time at setpoint before stability counts")
+    window_min: Real = Field(10.0, gt=0, le=1440, description="trailing window over which stability is judged")
     band_c: TemperatureSpanC = Field(0.3, description="max−min of each DUT's own temperature over the window")
     chamber_tolerance_c: TemperatureSpanC = Field(1.0, description="chamber air within this of the setpoint")
-    settle_c: float = Field(0.1, gt=0, le=10, description="criterion settling: most change still to come (k = 2) "
-                                                          "of each DUT's temperature")
-    max_rate_c_per_min: float = Field(0.02, gt=0, le=10, description="criterion settling: fastest each DUT's "
-                                      "temperature may still move (k = 2), °C/min")
-    time_constant_max_min: float = Field(60.0, gt=0, le=1440, description="criterion settling: the slowest "
-                                         "settling time constant fitted (the fixture's, with margin)")
-    poll_s: float = Field(10.0, ge=1, le=600, description="temperature polling interval")
-    timeout_min: float = Field(240.0, gt=0, le=2880, description="soak deadline, counted from reaching the setpoint")
+    settle_c: Real = Field(0.1, gt=0, le=10, description="criterion settling: most change still to come (k = 2) "
+                                                         "of each DUT's temperature")
+    max_rate_c_per_min: Real = Field(0.02, gt=0, le=10, description="criterion settling: fastest each DUT's "
+                                     "temperature may still move (k = 2), °C/min")
+    time_constant_max_min: Real = Field(60.0, gt=0, le=1440, description="criterion settling: the slowest "
+                                        "settling time constant fitted (the fixture's, with margin)")
+    poll_s: Real = Field(10.0, ge=1, le=600, description="temperature polling interval")
+    timeout_min: Real = Field(240.0, gt=0, le=2880, description="soak deadline, counted from reaching the setpoint")
     on_timeout: Literal["abort", "skip", "proceed"] = Field(
         "abort", description="a soak not stable by its deadline: abort the campaign, skip the setpoint "
                              "(recorded; a resume tries it again), or measure its poses anyway with a warning")
-    ramp_timeout_factor: float = Field(
+    ramp_timeout_factor: Real = Field(
         2.0, ge=1, le=10, description="ramp deadline = factor × |Δ| / rig ramp rate + ramp_timeout_margin_min"
     )
-    ramp_timeout_margin_min: float = Field(15.0, ge=0, le=1440)
+    ramp_timeout_margin_min: Real = Field(15.0, ge=0, le=1440)
 
     @model_validator(mode="after")
     def _fits_in_timeout(self) -> SoakCriterion:
@@ -67,12 +67,12 @@ class SoakCriterion(StrictModel):
 class Acquisition(StrictModel):
     """How each pose is measured."""
 
-    samples_per_pose: int = Field(200, ge=2, le=100_000)
-    range_g: int = Field(2, ge=1, le=1000, description="± full scale in g, one of every DUT part's ranges")
-    odr_hz: float = Field(125.0, gt=0, le=100_000, description="output data rate, one of every DUT part's")
-    settle_s: float = Field(5.0, ge=0, le=3600, description="wait after the turntable is in position")
-    range_dps: float | None = Field(None, gt=0, le=100_000, description="± full scale in °/s of every DUT part's "
-                                    "gyroscope, one of its ranges; needed where a part has one")
+    samples_per_pose: Whole = Field(200, ge=2, le=100_000)
+    range_g: Whole = Field(2, ge=1, le=1000, description="± full scale in g, one of every DUT part's ranges")
+    odr_hz: Real = Field(125.0, gt=0, le=100_000, description="output data rate, one of every DUT part's")
+    settle_s: Real = Field(5.0, ge=0, le=3600, description="wait after the turntable is in position")
+    range_dps: Real | None = Field(None, gt=0, le=100_000, description="± full scale in °/s of every DUT part's "
+                                   "gyroscope, one of its ranges; needed where a part has one")
 
     def ranges(self) -> dict[str, float]:
         """The ± full scale asked of each channel, by the channel's name (a gyroscope's only when given)."""
@@ -93,7 +93,7 @@ class FitOptions(StrictModel):
                                     "polynomials fitted to every pose at its own temperature (the ramp method)")
     mode: Literal["reference", "norm-only", "none"] = Field(
         "reference", description="none: measure only (a tilt check, a cool-down), no calibration at the end")
-    polynomial_degree: int = Field(3, ge=0, le=6)
+    polynomial_degree: Whole = Field(3, ge=0, le=6)
     parameters: Literal["all", "bias-scale"] = "all"
     out_of_range: Literal["clamp", "extrapolate"] = "clamp"
     hysteresis: bool = Field(False, description="joint fit of a bidirectional ramp: a bias ±h per axis by the "
@@ -107,30 +107,30 @@ class SimulatedEffects(StrictModel):
     They show how the fit copes with reality: a calibration on such a sensor cannot reach the noise floor.
     """
 
-    hysteresis_mg: float = Field(0.0, ge=0, le=50, description="bias difference between approaching a "
-                                 "temperature from below and from above")
-    hysteresis_span_c: float = Field(0.0, ge=0, le=100, description="the travel over which the hysteresis swings "
-                                     "from one side to the other (0: at once)")
-    hysteresis_time_constant_h: float | None = Field(None, gt=0, le=1000, description="the hysteresis relaxes "
-                                                     "towards none with this time constant (unset: never)")
-    rate_bias_mg_per_c_per_min: float = Field(0.0, ge=0, le=50, description="bias per °C/min of the DUT's own "
-                                              "temperature change (package stress in a ramp), ± per axis and DUT")
-    rate_scale_ppm_per_c_per_min: float = Field(0.0, ge=0, le=10_000, description="scale factor change per "
-                                                "°C/min, ± per axis and DUT")
-    nonlinearity_mg_per_g2: float = Field(0.0, ge=0, le=50, description="square-law term per axis, ± per DUT")
+    hysteresis_mg: Real = Field(0.0, ge=0, le=50, description="bias difference between approaching a "
+                                "temperature from below and from above")
+    hysteresis_span_c: Real = Field(0.0, ge=0, le=100, description="the travel over which the hysteresis swings "
+                                    "from one side to the other (0: at once)")
+    hysteresis_time_constant_h: Real | None = Field(None, gt=0, le=1000, description="the hysteresis relaxes "
+                                                    "towards none with this time constant (unset: never)")
+    rate_bias_mg_per_c_per_min: Real = Field(0.0, ge=0, le=50, description="bias per °C/min of the DUT's own "
+                                             "temperature change (package stress in a ramp), ± per axis and DUT")
+    rate_scale_ppm_per_c_per_min: Real = Field(0.0, ge=0, le=10_000, description="scale factor change per "
+                                               "°C/min, ± per axis and DUT")
+    nonlinearity_mg_per_g2: Real = Field(0.0, ge=0, le=50, description="square-law term per axis, ± per DUT")
 
 
 class Cooldown(StrictModel):
     """Free cool-down validation (paper §4.3, Fig. 11): after the soak at the procedure's one setpoint,
     hold one pose, let the chamber go (switched off, or set to ambient) and record while the DUTs cool."""
 
-    pose: int = Field(1, ge=1, le=MAX_SCHEDULE_POSES, description="pose number of the schedule to hold")
+    pose: Whole = Field(1, ge=1, le=MAX_SCHEDULE_POSES, description="pose number of the schedule to hold")
     chamber: Literal["power-off", "ambient"] = Field(
         "power-off", description="power-off: the chamber switched off (its power event); ambient: its set point "
                                  "to ambient_c")
     ambient_c: TemperatureC = Field(23.0, description="set point for chamber: ambient")
-    record_every_s: float = Field(60.0, gt=0, le=3600, description="one block of samples this often")
-    duration_min: float = Field(240.0, gt=0, le=7 * 24 * 60, description="how long to record")
+    record_every_s: Real = Field(60.0, gt=0, le=3600, description="one block of samples this often")
+    duration_min: Real = Field(240.0, gt=0, le=7 * 24 * 60, description="how long to record")
 
 
 class RampMethod(StrictModel):
@@ -138,8 +138,8 @@ class RampMethod(StrictModel):
     both methods). After a soak at the first setpoint the chamber setpoint moves at `rate_c_per_min`
     towards the last; each setpoint's poses start once the ramp is half-way from the previous setpoint."""
 
-    rate_c_per_min: float = Field(ge=0.01, le=10, description="the software ramp of the chamber setpoint")
-    update_s: float = Field(30.0, ge=1, le=600, description="how often the chamber setpoint is moved on")
+    rate_c_per_min: Real = Field(ge=0.01, le=10, description="the software ramp of the chamber setpoint")
+    update_s: Real = Field(30.0, ge=1, le=600, description="how often the chamber setpoint is moved on")
     bidirectional: bool = Field(False, description="after a soak at the last setpoint, ramp back towards the "
                                 "first, the poses taken again half-way between the setpoints: every band "
                                 "measured warming and cooling, so rate and lag errors cancel in the joint fit "
@@ -155,9 +155,9 @@ class Frost(StrictModel):
 
     purge_below_c: TemperatureC | None = Field(None, description="hold the chamber's dry-air purge on while the "
                                                "setpoint is below this (off at and above it)")
-    dew_point_margin_c: float | None = Field(None, ge=0, le=50, description="after a warming step, poses wait "
-                                             "until every DUT is this far above the chamber air's dew point")
-    dew_point_timeout_min: float = Field(60.0, gt=0, le=1440, description="longest wait for that margin")
+    dew_point_margin_c: Real | None = Field(None, ge=0, le=50, description="after a warming step, poses wait "
+                                            "until every DUT is this far above the chamber air's dew point")
+    dew_point_timeout_min: Real = Field(60.0, gt=0, le=1440, description="longest wait for that margin")
 
 
 class Procedure(StrictModel):
@@ -353,10 +353,10 @@ class Procedure(StrictModel):
         missing = {"from_c", "to_c", "step_c"} - set(value)
         if unknown or missing:
             raise ValueError("a setpoint range needs exactly the keys from_c, to_c and step_c")
-        try:
-            start, stop, step = (float(value[k]) for k in ("from_c", "to_c", "step_c"))
-        except (TypeError, ValueError):
-            raise ValueError("from_c, to_c and step_c must be numbers") from None
+        given = [value[k] for k in ("from_c", "to_c", "step_c")]
+        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in given):
+            raise ValueError("from_c, to_c and step_c must be numbers, written without quotes")
+        start, stop, step = (float(v) for v in given)
         if not all(np.isfinite([start, stop, step])) or max(abs(start), abs(stop)) > 1000:
             raise ValueError("from_c, to_c and step_c must be finite temperatures")
         if abs(step) < 1e-3 or (stop - start) / step < 0:

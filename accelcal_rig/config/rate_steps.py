@@ -7,10 +7,10 @@ from typing import Annotated, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from accelcal_rig.config.bounds import StrictModel
+from accelcal_rig.config.bounds import Real, StrictModel, Whole
 
 FixtureAxis = Literal["x", "y", "z"]
-RateDps = Annotated[float, Field(gt=0, le=10_000)]
+RateDps = Annotated[Real, Field(gt=0, le=10_000)]
 
 
 class RateSteps(StrictModel):
@@ -24,9 +24,9 @@ class RateSteps(StrictModel):
                                      description="the fixture axes brought to the table's rate axis")
     axis: str | None = Field(None, max_length=32, description="the table axis that turns (default: the outermost "
                                                               "with a rate mode)")
-    acceleration_dps2: float | None = Field(None, gt=0, le=100_000, description="how fast each rate is reached "
-                                            "(default: the axis's max_acceleration_dps2)")
-    settle_s: float = Field(1.0, ge=0, le=600, description="hold each rate this long before the samples")
+    acceleration_dps2: Real | None = Field(None, gt=0, le=100_000, description="how fast each rate is reached "
+                                           "(default: the axis's max_acceleration_dps2)")
+    settle_s: Real = Field(1.0, ge=0, le=600, description="hold each rate this long before the samples")
     verify_rates_dps: list[RateDps] = Field([], max_length=32, description="rates the fit never sees, turned "
                                             "both ways about each axis wherever the verification poses are taken")
 
@@ -65,5 +65,5 @@ class NoiseRecord(StrictModel):
     """A still record at every calibration setpoint, for the Allan deviation: consecutive blocks of
     `acquisition.samples_per_pose` samples at one pose of the schedule, nothing moving."""
 
-    duration_s: float = Field(gt=0, le=86_400, description="how long (rounded up to whole blocks)")
-    pose: int = Field(1, ge=1, le=10_000, description="the schedule's pose it is taken at")
+    duration_s: Real = Field(gt=0, le=86_400, description="how long (rounded up to whole blocks)")
+    pose: Whole = Field(1, ge=1, le=10_000, description="the schedule's pose it is taken at")

@@ -6,9 +6,18 @@ from collections.abc import Callable
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import Field, ValidationError, field_validator, model_validator
+from pydantic import BeforeValidator, Field, ValidationError, field_validator, model_validator
 
-from accelcal_rig.config.bounds import AngleDeg, Baudrate, StrictModel, TemperatureC, TimeoutS
+from accelcal_rig.config.bounds import (
+    AngleDeg,
+    Baudrate,
+    Real,
+    StrictModel,
+    TemperatureC,
+    TimeoutS,
+    Whole,
+    whole_number,
+)
 from accelcal_rig.config.lab import ONE_LINE, InstrumentIdentity, IsoDate, LabConfig, References
 from accelcal_rig.core.thermal import dut_time_constant_s
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
@@ -48,7 +57,7 @@ class ChamberConfig(InstrumentIdentity):
     options: dict[str, Any] = Field({}, description="settings a plug-in chamber driver reads")
     endpoint: str | None = Field(None, max_length=1024, description="modbus-tcp: host:port; modbus-rtu: serial "
                                  "device or URL; line: host:port (TCP) or a serial device or URL")
-    device_id: int = Field(1, ge=0, le=247)
+    device_id: Whole = Field(1, ge=0, le=247)
     profile: ChamberProfile = Field("watlow-f4t", description="register map (modbus drivers) or line protocol "
                                     "(line driver)")
     registers: dict[str, Any] = Field({}, description="fields of the profile's register map to override")
@@ -56,11 +65,11 @@ class ChamberConfig(InstrumentIdentity):
     timeout_s: TimeoutS = 1.0
     baudrate: Baudrate = 9600
     parity: Literal["N", "E", "O"] = "N"
-    stopbits: Literal[1, 2] = 1
+    stopbits: Annotated[Literal[1, 2], BeforeValidator(whole_number)] = 1
     min_setpoint_c: TemperatureC = -55.0
     max_setpoint_c: TemperatureC = 100.0
     safe_setpoint_c: TemperatureC = 23.0
-    ramp_rate_c_per_min: float = Field(3.0, ge=0.1, le=50)
+    ramp_rate_c_per_min: Real = Field(3.0, ge=0.1, le=50)
     dew_point_c: TemperatureC | None = Field(None, description="the chamber air's dew point to assume (used "
                                              "instead of any humidity reading: a temperature-only chamber, or a "
                                              "conservative value); a procedure's frost check needs this or a "
@@ -97,16 +106,16 @@ class TurntableAxis(StrictModel):
     """One rotary axis of the kinematic chain, its direction given in its parent's frame at zero angles."""
 
     name: str = Field(min_length=1, max_length=32, pattern=r"^[A-Za-z0-9_.-]+$")
-    axis: tuple[Annotated[float, Field(ge=-1e6, le=1e6)], Annotated[float, Field(ge=-1e6, le=1e6)],
-                Annotated[float, Field(ge=-1e6, le=1e6)]]
+    axis: tuple[Annotated[Real, Field(ge=-1e6, le=1e6)], Annotated[Real, Field(ge=-1e6, le=1e6)],
+                Annotated[Real, Field(ge=-1e6, le=1e6)]]
     min_deg: AngleDeg = -180.0
     max_deg: AngleDeg = 180.0
     continuous: bool = Field(False, description="endless axis: angles wrap into [min_deg, max_deg)")
-    speed_deg_s: float = Field(10.0, ge=0.01, le=1000)
-    max_rate_dps: float | None = Field(None, gt=0, le=10000, description="rate mode: the highest rate (°/s, "
-                                       "either direction) the axis may be commanded; None: the axis has no rate mode")
-    max_acceleration_dps2: float | None = Field(None, gt=0, le=100000, description="rate mode: the highest "
-                                                "acceleration limit (°/s²) a rate may be commanded with")
+    speed_deg_s: Real = Field(10.0, ge=0.01, le=1000)
+    max_rate_dps: Real | None = Field(None, gt=0, le=10000, description="rate mode: the highest rate (°/s, "
+                                      "either direction) the axis may be commanded; None: the axis has no rate mode")
+    max_acceleration_dps2: Real | None = Field(None, gt=0, le=100000, description="rate mode: the highest "
+                                               "acceleration limit (°/s²) a rate may be commanded with")
     slip_ring: bool = Field(False, description="the axis turns endlessly without winding a cable (a slip ring): "
                             "constant-rate rotation needs one; default: true for a continuous axis")
 
@@ -158,13 +167,13 @@ class TurntableConfig(InstrumentIdentity):
     protocol_overrides: dict[str, Any] = Field({}, description="fields of the line protocol to override")
     timeout_s: TimeoutS = 2.0
     axes: list[TurntableAxis] = Field(min_length=1, max_length=6)
-    position_tolerance_deg: float = Field(0.01, ge=1e-6, le=5)
-    accuracy_arcsec: float = Field(3.0, ge=0, le=3600, description="angular position accuracy of each axis "
-                                   "(spec sheet, ±): the fit's reference-mode uncertainty, the simulated table's error")
-    rate_accuracy_pct: float | None = Field(None, ge=0, le=10, description="rate mode: accuracy of a constant "
-                                            "rate (spec sheet, ± % of the rate): the simulated table's rate offset")
-    rate_stability_pct: float | None = Field(None, ge=0, le=10, description="rate mode: stability of a constant "
-                                             "rate (spec sheet, % of the rate, 1σ): the simulated rate's wobble")
+    position_tolerance_deg: Real = Field(0.01, ge=1e-6, le=5)
+    accuracy_arcsec: Real = Field(3.0, ge=0, le=3600, description="angular position accuracy of each axis "
+                                  "(spec sheet, ±): the fit's reference-mode uncertainty, the simulated table's error")
+    rate_accuracy_pct: Real | None = Field(None, ge=0, le=10, description="rate mode: accuracy of a constant "
+                                           "rate (spec sheet, ± % of the rate): the simulated table's rate offset")
+    rate_stability_pct: Real | None = Field(None, ge=0, le=10, description="rate mode: stability of a constant "
+                                            "rate (spec sheet, % of the rate, 1σ): the simulated rate's wobble")
 
     @field_validator("axes")
     @classmethod
@@ -194,7 +203,7 @@ class SensorConfig(StrictModel):
     endpoint: str | None = Field(None, max_length=1024, description="serial-bridge: device or URL; spidev: "
                                  "bus.chip_select")
     baudrate: Baudrate = 921600
-    spi_speed_hz: int = Field(5_000_000, ge=1000, le=10_000_000)
+    spi_speed_hz: Whole = Field(5_000_000, ge=1000, le=10_000_000)
     timeout_s: TimeoutS = 1.0
     mount_euler_deg: tuple[AngleDeg, AngleDeg, AngleDeg] = (0.0, 0.0, 0.0)
     customer: str = Field("", max_length=200, pattern=ONE_LINE, description="whose item it is (its certificate states "
@@ -248,18 +257,18 @@ class FaultInjection(StrictModel):
     switch on after a time on the campaign's clock (None: never).
     """
 
-    rate: float = Field(0.0, ge=0, le=1, description="share of replies hit by a transient fault")
+    rate: Real = Field(0.0, ge=0, le=1, description="share of replies hit by a transient fault")
     kinds: list[Literal["drop", "delay", "corrupt", "disconnect", "busy"]] = ["drop", "delay", "corrupt", "disconnect"]
-    delay_s: float = Field(0.05, ge=0, le=10, description="wall-clock delay of a delayed reply")
-    disconnect_s: float = Field(2.0, ge=0, le=3600, description="campaign time a disconnected line stays dead")
-    seed: int = Field(0, ge=0, le=2**32 - 1)
-    chamber_stall_after_min: float | None = Field(None, ge=0, le=_YEAR_MIN,
-                                                  description="the chamber stops following its setpoint")
-    turntable_stall_after_min: float | None = Field(None, ge=0, le=_YEAR_MIN, description="the turntable stops moving")
+    delay_s: Real = Field(0.05, ge=0, le=10, description="wall-clock delay of a delayed reply")
+    disconnect_s: Real = Field(2.0, ge=0, le=3600, description="campaign time a disconnected line stays dead")
+    seed: Whole = Field(0, ge=0, le=2**32 - 1)
+    chamber_stall_after_min: Real | None = Field(None, ge=0, le=_YEAR_MIN,
+                                                 description="the chamber stops following its setpoint")
+    turntable_stall_after_min: Real | None = Field(None, ge=0, le=_YEAR_MIN, description="the turntable stops moving")
     sensor_wrong_id: str | None = Field(None, max_length=64, description="serial of a DUT whose part ID reads wrong")
     sensor_stuck: str | None = Field(None, max_length=64, description="serial of a DUT whose samples freeze")
-    sensor_stuck_after_min: float = Field(0.0, ge=0, le=_YEAR_MIN, description="when that DUT's samples freeze")
-    sensor_temperature_tear_rate: float = Field(
+    sensor_stuck_after_min: Real = Field(0.0, ge=0, le=_YEAR_MIN, description="when that DUT's samples freeze")
+    sensor_temperature_tear_rate: Real = Field(
         0.0, ge=0, le=1, description="share of every DUT's TEMP2/TEMP1 reads that straddle an update of the high "
                                      "nibble (not double-buffered on a real ADXL355): off by 256 LSB, about 28 °C")
 
@@ -268,39 +277,39 @@ class SimulationConfig(StrictModel):
     """Physics of the virtual lab used by `--dry-run` (docs/procedures.md, "The simulated rig")."""
 
     ambient_c: TemperatureC = 23.0
-    chamber_time_constant_min: float = Field(3.0, ge=0.01, le=1440)
-    chamber_noise_c: float = Field(0.05, ge=0, le=10)
-    fixture_time_constant_min: float = Field(10.0, ge=0.01, le=1440)
-    free_cooling_time_constant_min: float = Field(45.0, ge=0.01, le=10080, description="chamber switched off: its "
-                                                  "air relaxes to ambient with this time constant")
-    self_heating_c: float = Field(0.2, ge=0, le=20)
-    noise_density_ug_per_rthz: float | None = Field(None, ge=0, le=100_000, description="every DUT's noise "
-                                                    "density; unset: each part's own (its data sheet's)")
-    turntable_settle_s: float = Field(0.5, ge=0, le=600)
-    latitude_deg: float = Field(48.0, ge=-90, le=90, description="the simulated site's latitude where the rig "
-                                "config states none (the Earth turns in every lab)")
-    heading_deg: float = Field(30.0, ge=-360, le=360, description="the simulated table's heading where the rig "
-                               "config states none")
-    gyro_bias_instability_dph: float = Field(0.0, ge=0, le=10_000, description="every simulated gyroscope's bias "
-                                             "instability (a flicker floor of its Allan deviation over 1…1000 s), °/h")
+    chamber_time_constant_min: Real = Field(3.0, ge=0.01, le=1440)
+    chamber_noise_c: Real = Field(0.05, ge=0, le=10)
+    fixture_time_constant_min: Real = Field(10.0, ge=0.01, le=1440)
+    free_cooling_time_constant_min: Real = Field(45.0, ge=0.01, le=10080, description="chamber switched off: its "
+                                                 "air relaxes to ambient with this time constant")
+    self_heating_c: Real = Field(0.2, ge=0, le=20)
+    noise_density_ug_per_rthz: Real | None = Field(None, ge=0, le=100_000, description="every DUT's noise "
+                                                   "density; unset: each part's own (its data sheet's)")
+    turntable_settle_s: Real = Field(0.5, ge=0, le=600)
+    latitude_deg: Real = Field(48.0, ge=-90, le=90, description="the simulated site's latitude where the rig "
+                               "config states none (the Earth turns in every lab)")
+    heading_deg: Real = Field(30.0, ge=-360, le=360, description="the simulated table's heading where the rig "
+                              "config states none")
+    gyro_bias_instability_dph: Real = Field(0.0, ge=0, le=10_000, description="every simulated gyroscope's bias "
+                                            "instability (a flicker floor of its Allan deviation over 1…1000 s), °/h")
     controller_limits_c: tuple[TemperatureC, TemperatureC] = Field(
         (-70.0, 180.0), description="the simulated controller's own set point limits (low, high), where its "
                                     "register map has them; it clamps set points to them as a real one does")
     room_dew_point_c: TemperatureC = Field(12.0, description="the room's air, which a chamber without purge "
                                            "takes in (23 °C at 50 % RH has a dew point near 12 °C)")
     purge_dew_point_c: TemperatureC = Field(-40.0, description="the dry-air purge's dew point (instrument air)")
-    moisture_time_constant_min: float = Field(5.0, ge=0.01, le=1440, description="the air's dew point follows "
-                                              "its target with this time constant")
-    chamber_overshoot_pct: float = Field(0.0, ge=0, le=50, description="the air overshoots a set point by this "
-                                         "share of the step, peaking three chamber time constants after the ramp arrives")
+    moisture_time_constant_min: Real = Field(5.0, ge=0.01, le=1440, description="the air's dew point follows "
+                                             "its target with this time constant")
+    chamber_overshoot_pct: Real = Field(0.0, ge=0, le=50, description="the air overshoots a set point by this "
+                                        "share of the step, peaking three chamber time constants after the ramp arrives")
     cooling_floor_c: TemperatureC | None = Field(None, description="cooling slows towards this temperature (the "
                                                  "compressor's floor): at T, the ramp rate × (T − floor)/(ambient − floor)")
-    slot_gradient_c: float = Field(0.0, ge=0, le=20, description="at 60 °C from ambient, the last slot's air is "
-                                   "this much nearer ambient than the first's (the slot at the air inlet leads)")
-    slot_lead_pct: float = Field(0.0, ge=0, le=90, description="the first slot's time constant is this much "
-                                 "shorter than the last's, linearly between")
-    time_constant_per_dut_min: float = Field(0.0, ge=0, le=60, description="each DUT (its board and socket) adds "
-                                             "this to fixture_time_constant_min: a fuller fixture lags more")
+    slot_gradient_c: Real = Field(0.0, ge=0, le=20, description="at 60 °C from ambient, the last slot's air is "
+                                  "this much nearer ambient than the first's (the slot at the air inlet leads)")
+    slot_lead_pct: Real = Field(0.0, ge=0, le=90, description="the first slot's time constant is this much "
+                                "shorter than the last's, linearly between")
+    time_constant_per_dut_min: Real = Field(0.0, ge=0, le=60, description="each DUT (its board and socket) adds "
+                                            "this to fixture_time_constant_min: a fuller fixture lags more")
     faults: FaultInjection = FaultInjection()
 
     def fixture_time_constants_s(self, serials: list[str]) -> list[float]:
@@ -324,9 +333,9 @@ def _slot_positions(n_duts: int) -> list[float]:
 class RetryPolicy(StrictModel):
     """Transient communication failures (no reply, garbled reply, a port gone) are retried this way."""
 
-    attempts: int = Field(5, ge=1, le=20, description="tries in all, the first included")
-    first_backoff_s: float = Field(0.5, ge=0, le=600, description="wait before the second try; doubles each time")
-    max_backoff_s: float = Field(8.0, ge=0, le=3600, description="longest wait between tries")
+    attempts: Whole = Field(5, ge=1, le=20, description="tries in all, the first included")
+    first_backoff_s: Real = Field(0.5, ge=0, le=600, description="wait before the second try; doubles each time")
+    max_backoff_s: Real = Field(8.0, ge=0, le=3600, description="longest wait between tries")
 
 
 NotifyEvent = Literal["start", "soak", "fault", "safe", "finish"]
@@ -341,7 +350,7 @@ class NotifyConfig(StrictModel):
                                                                   description="program and arguments to run for each event")
     events: list[NotifyEvent] = Field(["start", "soak", "fault", "safe", "finish"],
                                       description="which events to send")
-    timeout_s: float = Field(10.0, gt=0, le=120, description="longest one delivery may take")
+    timeout_s: Real = Field(10.0, gt=0, le=120, description="longest one delivery may take")
 
 
 class RigConfig(StrictModel):
@@ -353,18 +362,18 @@ class RigConfig(StrictModel):
     retry: RetryPolicy = RetryPolicy()
     notify: NotifyConfig = NotifyConfig()
     simulation: SimulationConfig = SimulationConfig()
-    gravity_m_s2: float = Field(STANDARD_GRAVITY_M_S2, ge=9.7, le=9.9,
-                                description="the site's gravity (a survey or a gravity model); the standard value "
-                                            "by default, said so in reports")
-    gravity_uncertainty_m_s2: float = Field(0.0, ge=0.0, le=0.05, description="its standard uncertainty")
+    gravity_m_s2: Real = Field(STANDARD_GRAVITY_M_S2, ge=9.7, le=9.9,
+                               description="the site's gravity (a survey or a gravity model); the standard value "
+                                           "by default, said so in reports")
+    gravity_uncertainty_m_s2: Real = Field(0.0, ge=0.0, le=0.05, description="its standard uncertainty")
     registry: str | None = Field(None, max_length=4096, description="where finished calibrations are recorded: an "
                                  "SQLite file (relative to this file) or a postgresql:// URL")
-    latitude_deg: float | None = Field(None, ge=-90, le=90, description="the site's latitude: the Earth's rate "
-                                       "(15.04 °/h) is part of every gyroscope reference, its vertical component "
-                                       "sin(latitude) × 15.04 °/h; unset: left in the gyroscope's bias, said so")
-    heading_deg: float | None = Field(None, ge=-360, le=360, description="the azimuth of the table's x axis (world "
-                                      "x at zero angles), degrees east of true north: with latitude_deg, the Earth's "
-                                      "horizontal rate (cos(latitude) × 15.04 °/h) is part of the reference too")
+    latitude_deg: Real | None = Field(None, ge=-90, le=90, description="the site's latitude: the Earth's rate "
+                                      "(15.04 °/h) is part of every gyroscope reference, its vertical component "
+                                      "sin(latitude) × 15.04 °/h; unset: left in the gyroscope's bias, said so")
+    heading_deg: Real | None = Field(None, ge=-360, le=360, description="the azimuth of the table's x axis (world "
+                                     "x at zero angles), degrees east of true north: with latitude_deg, the Earth's "
+                                     "horizontal rate (cos(latitude) × 15.04 °/h) is part of the reference too")
     lab: LabConfig | None = Field(None, description="the laboratory and the place of calibration its certificates "
                                   "state; unset: they say it is not stated")
     references: References = Field(References(), description="each reference's certificate, issuer and due date "

@@ -7,7 +7,7 @@ from typing import Annotated, ClassVar, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from accelcal_rig.config.bounds import AngleDeg, StrictModel
+from accelcal_rig.config.bounds import AngleDeg, Real, StrictModel, Whole
 
 #: Most orientations a schedule may list (each is solved for the turntable's angles when the plan compiles).
 MAX_SCHEDULE_POSES = 2_000
@@ -53,7 +53,7 @@ class SphereSchedule(GeneratedSchedule):
     """`count` gravity directions spread evenly over the sphere (Fibonacci lattice)."""
 
     kind: Literal["sphere"]
-    count: int = Field(ge=6, le=MAX_SCHEDULE_POSES)
+    count: Whole = Field(ge=6, le=MAX_SCHEDULE_POSES)
 
     @property
     def size(self) -> int:
@@ -65,7 +65,7 @@ class TiltSchedule(GeneratedSchedule):
     y axis up, roll tilts the x axis down; (0, 0) is level with z up."""
 
     kind: Literal["tilt"]
-    pitch_roll_deg: list[tuple[float, float]] = Field(min_length=1, max_length=MAX_SCHEDULE_POSES)
+    pitch_roll_deg: list[tuple[Real, Real]] = Field(min_length=1, max_length=MAX_SCHEDULE_POSES)
 
     @property
     def size(self) -> int:

@@ -27,9 +27,38 @@ MAX_NODES = 100_000
 
 class PersonLoader(yaml.SafeLoader):
     """A person's file: a date is read as its text, so the model validating it names the key and line of a bad
-    one (`due_date: 2025-13-01`) instead of the YAML parser failing on it at line 1."""
+    one (`due_date: 2025-13-01`) instead of the YAML parser failing on it at line 1; and a number is read as
+    YAML 1.2 (and JSON, and every calculator) reads one, not as PyYAML's YAML 1.1 does (docs/procedures.md,
+    "Numbers")."""
 
 
+_INT = "tag:yaml.org,2002:int"
+_FLOAT = "tag:yaml.org,2002:float"
+#: YAML 1.2 core schema integers: decimal (a leading zero is still decimal: 010 is ten, where YAML 1.1
+#: reads octal eight), 0o octal, 0x hexadecimal. No `2_0` (YAML 1.1: 20) and no base 60 (`1:30`, YAML 1.1:
+#: 90): those stay text, which a number's key refuses.
+YAML12_INT = re.compile(r"^(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)$")
+#: YAML 1.2 core schema floats: an exponent needs neither a point nor a sign (`1e3`, `1.0e3`, which YAML 1.1
+#: reads as text), and .inf/.nan (which the models refuse by name).
+YAML12_FLOAT = re.compile(r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+                          r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$")
+
+
+def _construct_int(loader: yaml.SafeLoader, node: yaml.ScalarNode) -> int:
+    """A YAML 1.2 integer (PyYAML's own constructor would read 010 as octal)."""
+    text = str(loader.construct_scalar(node))
+    if text.startswith(("0x", "0o")):
+        return int(text[2:], 16 if text[1] == "x" else 8)
+    return int(text, 10)
+
+
+PersonLoader.yaml_implicit_resolvers = {
+    first: [(tag, pattern) for tag, pattern in resolvers if tag not in (_INT, _FLOAT)]
+    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
+}
+PersonLoader.add_implicit_resolver(_INT, YAML12_INT, list("-+0123456789"))
+PersonLoader.add_implicit_resolver(_FLOAT, YAML12_FLOAT, list("-+0123456789."))
+PersonLoader.add_constructor(_INT, _construct_int)
 PersonLoader.add_constructor("tag:yaml.org,2002:timestamp", PersonLoader.construct_yaml_str)
 
 

@@ -15,7 +15,7 @@ from accelcal_rig.config.rig import ChamberConfig, is_host_port
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.composition import composed, instance_of
 from accelcal_rig.instruments.definitions import ChamberDriver
-from accelcal_rig.instruments.limits import plausible_c
+from accelcal_rig.instruments.limits import plausible_c, refuse_non_finite
 from accelcal_rig.instruments.line_port import LinePort
 from accelcal_rig.instruments.retrying import RetryCall
 from accelcal_rig.protocols.chamber_lines import ChamberLineProtocol, Operation
@@ -64,7 +64,9 @@ class LineChamber:
         return self._temperature("read_setpoint", "sp", "set point")
 
     def write_setpoint_c(self, setpoint_c: float) -> None:
-        """Limits are the caller's gate (LimitedChamber), which also reads the set point back."""
+        """Limits are the caller's gate (LimitedChamber), which also reads the set point back; a NaN is refused
+        here too (`TEMP, Snan` would reach the controller)."""
+        refuse_non_finite(f"chamber ({self.endpoint})", "setpoint", setpoint_c, " °C")
         self._ask("write_setpoint", value=float(setpoint_c))
 
     def set_power(self, on: bool) -> None:

@@ -18,7 +18,7 @@ from accelcal_rig.config.rig import ChamberConfig
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.composition import composed, instance_of
 from accelcal_rig.instruments.definitions import ChamberDriver
-from accelcal_rig.instruments.limits import plausible_c
+from accelcal_rig.instruments.limits import plausible_c, refuse_non_finite
 from accelcal_rig.instruments.retrying import RetryCall
 from accelcal_rig.protocols.chamber_registers import ChamberRegisterMap
 
@@ -91,7 +91,9 @@ class ModbusChamber:
         return self._plausible(self._read_temperature(self.registers.setpoint), "set point")
 
     def write_setpoint_c(self, setpoint_c: float) -> None:
-        """Write the static set point (both float words in one request). Limits are the caller's gate."""
+        """Write the static set point (both float words in one request). Limits are the caller's gate; a NaN
+        is refused here too (it encodes as a float32 NaN, and fails round() as a scaled integer)."""
+        refuse_non_finite(f"chamber ({self.endpoint})", "setpoint", setpoint_c, " °C")
         self._write(self.registers.setpoint, self._encode(setpoint_c))
 
     def set_power(self, on: bool) -> None:

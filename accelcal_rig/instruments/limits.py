@@ -35,6 +35,14 @@ def plausible_c(value: float) -> bool:
     return math.isfinite(value) and PLAUSIBLE_C[0] <= value <= PLAUSIBLE_C[1]
 
 
+def refuse_non_finite(instrument: str, what: str, value: float, unit: str) -> None:
+    """A NaN or an infinity is never sent (a controller would take it as garbage, or as its own idea of a
+    limit): one line naming the instrument, before the wire. Every driver's writes call it, so a driver used
+    without the limits in front of it (a plug-in's test, a script) is as safe."""
+    if not math.isfinite(value):
+        raise InstrumentError(f"{instrument}: {what} {value:g}{unit} refused: not a finite number (nothing was sent)")
+
+
 class LimitedChamber(ChamberDelegate):
     """Refuses setpoints outside the rig's chamber limits, and outside the controller's own where it exposes
     them (read once, at connect: a controller clamps silently what it will not take); verifies each write by
@@ -49,6 +57,7 @@ class LimitedChamber(ChamberDelegate):
         self._decimals = setpoint_decimals(chamber)
 
     def write_setpoint_c(self, setpoint_c: float) -> None:
+        refuse_non_finite(f"chamber ({self.endpoint})", "setpoint", setpoint_c, " °C")
         if self._decimals is not None:
             setpoint_c = round(setpoint_c, self._decimals)
         low, high = self._limits.min_setpoint_c, self._limits.max_setpoint_c
@@ -99,6 +108,7 @@ class LimitedTurntable(TurntableDelegate):
         if angles.shape != (len(self._axes),):
             raise InstrumentError(f"turntable ({self.endpoint}): {angles.size} angles for {len(self._axes)} axes")
         for axis, angle in zip(self._axes, angles):
+            refuse_non_finite(f"turntable ({self.endpoint})", f"axis {axis.name} to", angle, "°")
             if not axis.allows(angle):
                 raise InstrumentError(
                     f"turntable ({self.endpoint}): axis {axis.name} to {angle:g}° refused, "

@@ -12,6 +12,7 @@ from accelcal_rig.config.rig import TurntableConfig
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.composition import composed, instance_of
 from accelcal_rig.instruments.definitions import TurntableDriver
+from accelcal_rig.instruments.limits import refuse_non_finite
 from accelcal_rig.instruments.line_port import LinePort, describe_endpoint
 from accelcal_rig.instruments.retrying import RetryCall
 from accelcal_rig.protocols.turntable_line import Command, TurntableProtocol
@@ -50,10 +51,12 @@ class SerialTurntable:
     def move_to(self, angles_deg: np.ndarray) -> None:
         """Command every axis (in one line where the profile moves them together); limits are the caller's
         gate (LimitedTurntable)."""
+        moves = [(axis, float(angle)) for axis, angle in enumerate(np.asarray(angles_deg, dtype=float), start=1)]
+        for axis, angle in moves:  # a NaN is refused before anything, the setup included, is sent
+            refuse_non_finite(f"turntable ({self.endpoint})", f"axis {axis} to", angle, "°")
         if not self._set_up:
             self._setup()
         p = self.protocol
-        moves = [(axis, float(angle)) for axis, angle in enumerate(np.asarray(angles_deg, dtype=float), start=1)]
         self._polls_at_rest = 0
         if p.multi_axis_move:
             line = p.move_separator.join(p.move.send.format(axis=axis, angle=angle) for axis, angle in moves)
@@ -141,6 +144,8 @@ class _RateTable(SerialTurntable):
         """Turn one axis (0-based) at a rate; a profile's setup (interlock) goes out first unless an axis is
         already in rate mode, and the next move sets position mode up again."""
         number = self._axis_number(axis)
+        refuse_non_finite(f"turntable ({self.endpoint})", f"axis {number} at", rate_deg_s, " °/s")
+        refuse_non_finite(f"turntable ({self.endpoint})", f"axis {number} acceleration", acceleration_deg_s2, " °/s²")
         if not self._set_up and not self._rate_axes:
             self._setup()
         assert self.protocol.rotate is not None

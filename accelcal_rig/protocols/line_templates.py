@@ -3,6 +3,7 @@ as a pattern (so that a simulator generated from a profile recognises the reques
 
 from __future__ import annotations
 
+import math
 import re
 import string
 from collections.abc import Mapping
@@ -12,6 +13,18 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 
 #: A decimal number as controllers print them (sign, decimals, exponent optional).
 NUMBER = r"[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?"
+
+
+def finite_number(text: str) -> float:
+    """A request's number as a controller reads it: digits as NUMBER writes them (not Python's `nan`, `inf`,
+    `1_0` or blanks, which float() would take) and finite (not `1e400`); ValueError otherwise, which a
+    simulator answers with its profile's error."""
+    if not re.fullmatch(NUMBER, text, re.ASCII):
+        raise ValueError(f"not a number: {text!r}")
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(f"not a finite number: {text!r}")
+    return value
 
 
 def regular_expression(value: str) -> str:

@@ -11,7 +11,7 @@ import numpy as np
 from accelcal_rig.config.rig import SensorConfig
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import BRIDGE_GREETING
-from accelcal_rig.sim.bridge_requests import register_request
+from accelcal_rig.sim.bridge_requests import overlong_request, register_request
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
@@ -198,7 +198,8 @@ class SimulatedBridgeServer:
         self._lab = lab
         self._version = protocol_version
         self.device = SimulatedAdxl355(lab, index, wrong_part_id, stuck_after_s, temperature_tear_rate)
-        self._server = PtyLineServer(self._handle, b"\n", f"simulated-bridge-{lab.duts[index].serial}", faults)
+        self._server = PtyLineServer(self._handle, b"\n", f"simulated-bridge-{lab.duts[index].serial}", faults,
+                                     overlong=overlong_request)
         self.path = self.endpoint = self._server.path
 
     @property

@@ -20,3 +20,9 @@ def register_request(device: RegisterDevice, words: list[str]) -> str | None:
         device.write(int(words[1], 16), int(words[2], 16))
         return "="
     return None
+
+
+def overlong_request(head: str) -> str:
+    """The answer to a line longer than any request, whatever it began with: the reference firmware's
+    (firmware/src/bridge.c, `answer_line`), which drops such a line and reads the next."""
+    return "!request too long"

@@ -9,6 +9,7 @@ from typing import Literal
 
 from accelcal_rig.config.rig import ChamberConfig
 from accelcal_rig.protocols.chamber_lines import ChamberLineProtocol, Operation
+from accelcal_rig.protocols.line_templates import finite_number
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
@@ -36,12 +37,23 @@ class SimulatedLineChamberServer:
         replies_end = protocol.read_terminator.encode(protocol.encoding)
         server = TcpLineServer if transport == "tcp" else PtyLineServer
         self._server: TcpLineServer | PtyLineServer = server(self._handle, requests_end, "simulated-chamber", faults,
-                                                             replies_end, protocol.encoding)
+                                                             replies_end, protocol.encoding,
+                                                             overlong=self.overlong_answer)
 
     @property
     def endpoint(self) -> str:
         """`host:port` on TCP, the device path on a pty: what the driver's config names."""
         return self._server.endpoint if isinstance(self._server, TcpLineServer) else self._server.path
+
+    @property
+    def buffered_bytes(self) -> int:
+        """Bytes held of requests not yet ended (bounded: sim/line_answers.py), for tests."""
+        return self._server.buffered_bytes
+
+    @property
+    def peak_buffered_bytes(self) -> int:
+        """The most bytes ever held of an unended request between two reads, for tests."""
+        return self._server.peak_buffered_bytes
 
     def start(self) -> SimulatedLineChamberServer:
         self._server.start()
@@ -63,19 +75,26 @@ class SimulatedLineChamberServer:
             if operation in _WRITES and self.local_mode and self._protocol.local_mode_answer is not None:
                 return self._protocol.local_mode_answer
             try:
-                values = self._serve(operation, match.groupdict())
-            except ValueError:
-                return self._protocol.unknown_command_answer  # a parameter it cannot read
+                value = finite_number(match["value"]) if "value" in match.groupdict() else None
+            except ValueError:  # `nan`, `inf`, `1e400`, `1_0`: refused as any request it cannot read, set point kept
+                return self._protocol.unknown_command_answer
+            values = self._serve(operation, value)
             return None if command.answer is None else command.answer.format(**values)
         return self._protocol.unknown_command_answer
 
-    def _serve(self, operation: Operation, fields: dict[str, str]) -> dict[str, object]:
+    def overlong_answer(self, head: str) -> str | None:
+        """A line too long to be a request (its first characters `head`): answered as an unknown request by a
+        controller it is addressed to, unanswered by the others on the bus."""
+        return self._protocol.unknown_command_answer if head.startswith(self._protocol.request_prefix) else None
+
+    def _serve(self, operation: Operation, value: float | None) -> dict[str, object]:
+        """Carry out a request (`value`: the set point it writes, already read) and give its answer's fields."""
         lab = self._lab
         with lab.lock:
             now = lab.clock.now()
             lab.moisture.dew_point_c(now)  # the air's moisture follows the air, request by request
-            if operation == "write_setpoint":
-                self._write_setpoint(now, float(fields["value"]))
+            if operation == "write_setpoint" and value is not None:
+                self._write_setpoint(now, value)
             elif operation in ("power_on", "power_off"):
                 lab.thermal.set_power(now, operation == "power_on")
             elif operation in ("purge_on", "purge_off"):
@@ -84,7 +103,7 @@ class SimulatedLineChamberServer:
             low, high = lab.controller_limits_c
             values: dict[str, object] = {"identity": self._identity, "sp": shown, "low": low, "high": high,
                                          "alarm": self._protocol.alarm_inactive[0], "units": self.units,
-                                         "value": float(fields.get("value", shown)), "pv": 0.0, "humidity": 0.0}
+                                         "value": shown if value is None else value, "pv": 0.0, "humidity": 0.0}
             if operation in ("read_temperature", "read_setpoint", "read_low_limit", "read_high_limit"):
                 values["pv"] = lab.chamber_reading_c()  # measured only when a reply may carry it (it draws noise)
             if operation == "humidity":

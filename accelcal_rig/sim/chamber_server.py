@@ -2,12 +2,14 @@
 
 Any Modbus master can talk to it. Each request is answered from the virtual lab at the shared clock's
 time; a set-point or power write goes into the lab. Registers outside the map do not exist (Modbus
-exception 2), as on a real controller.
+exception 2), as on a real controller; a value it cannot take (half a float, a NaN or infinite set point,
+an output value the map does not name) is exception 3, illegal data value, and changes nothing.
 """
 
 from __future__ import annotations
 
 import asyncio
+import math
 import struct
 import threading
 
@@ -128,6 +130,8 @@ class SimulatedChamberServer:
                 return ExcCodes.ILLEGAL_VALUE  # half a float: real controllers refuse it too
             offset = m.setpoint - address
             setpoint = self._decode(values[offset:offset + width])
+            if not math.isfinite(setpoint):
+                return ExcCodes.ILLEGAL_VALUE  # a NaN or infinite float: refused, the set point kept
             if m.setpoint_low_register is not None:  # a controller with limits clamps to them, silently
                 low, high = self._lab.controller_limits_c
                 setpoint = min(max(setpoint, low), high)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from accelcal_rig.config.rig import SensorConfig
 from accelcal_rig.instruments.adxl355_transport import BRIDGE_GREETING
-from accelcal_rig.sim.bridge_requests import register_request
+from accelcal_rig.sim.bridge_requests import overlong_request, register_request
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.icm42688_registers import SimulatedIcm42688
 from accelcal_rig.sim.lab import VirtualLab
@@ -24,7 +24,8 @@ class SimulatedIcm42688Bridge:
         self._lab = lab
         self._part = lab.duts[index].part
         self.device = SimulatedIcm42688(lab, index, wrong_who_am_i)
-        self._server = PtyLineServer(self._handle, b"\n", f"simulated-bridge-{lab.duts[index].serial}", faults)
+        self._server = PtyLineServer(self._handle, b"\n", f"simulated-bridge-{lab.duts[index].serial}", faults,
+                                     overlong=overlong_request)
         self.path = self.endpoint = self._server.path
 
     def start(self) -> SimulatedIcm42688Bridge:

@@ -1,5 +1,12 @@
 """A simulated line device's side of the conversation, whatever carries it (a pty, a TCP connection):
-requests cut at their terminator, answered one by one, each answer spoiled by any transient fault drawn."""
+requests cut at their terminator, answered one by one, each answer spoiled by any transient fault drawn.
+
+A line is bounded: a client that sends bytes and never a terminator (a wrong terminator setting, a binary
+stream, a hostile peer) must not grow the simulator's memory without end. A line longer than
+MAX_LINE_BYTES is discarded as it arrives (only its first bytes, for the answer, and the last few, for a
+terminator split between reads, are kept) and answered, once its terminator comes, as the device answers a
+request it does not know (`overlong`; none: silence); the next line is served as usual.
+"""
 
 from __future__ import annotations
 
@@ -11,31 +18,89 @@ from accelcal_rig.sim.faults import ReplyFaults
 #: A device's handler: the request line (stripped) → the reply without its terminator, or None (no reply).
 Handler = Callable[[str], str | None]
 
+#: What a device answers to a line longer than MAX_LINE_BYTES, given its first characters; None: nothing.
+Overlong = Callable[[str], str | None]
 
 #: Writes a reply after a delay (s) without holding up other devices: a server that answers many devices
 #: from one thread; None: the answering thread sleeps (it answers this device alone).
 Deferral = Callable[[float, bytes, Callable[[bytes], object]], None]
 
+#: The longest request line a simulator reads, in bytes without its terminator. Far above any legal request
+#: (a built-in one is under 300 bytes: an ACUTROL3000 move of six axes in one line; a profile's template is at
+#: most 256 characters and its request prefix 16, so even six joined moves of the longest template stay under
+#: 1 700; a bridge request is under 20) and far below what could fill a simulator's memory.
+MAX_LINE_BYTES = 4096
+#: How much of a discarded line is kept for its answer (a controller on a bus reads the address first).
+OVERLONG_HEAD_BYTES = 64
+
 
 class LineAnswers:
+    """One conversation's reader: the bytes of one client, cut into requests and answered in order."""
+
     def __init__(self, handle: Handler, request_terminator: bytes = b"\n", reply_terminator: bytes | None = None,
-                 encoding: str = "utf-8", faults: ReplyFaults | None = None, defer: Deferral | None = None) -> None:
+                 encoding: str = "utf-8", faults: ReplyFaults | None = None, defer: Deferral | None = None,
+                 overlong: Overlong | None = None) -> None:
         self._handle = handle
+        self._overlong = overlong
         self._request_terminator = request_terminator
         self._reply_terminator = request_terminator if reply_terminator is None else reply_terminator
         self._encoding = encoding
         self._faults = faults
         self._defer = defer
         self._pending = b""
+        #: The first bytes of the line being discarded (too long), None while the line is within bounds.
+        self._discarding: bytes | None = None
+        #: The most bytes ever held between two reads (what the bound keeps small), for tests.
+        self.peak_buffered_bytes = 0
+
+    @property
+    def buffered_bytes(self) -> int:
+        """Bytes held of the line not yet ended: at most MAX_LINE_BYTES and a terminator's first bytes."""
+        return len(self._pending) + len(self._discarding or b"")
 
     def feed(self, data: bytes, write: Callable[[bytes], object]) -> None:
-        """Take received bytes; answer each complete request through `write`."""
-        self._pending += data
-        while self._request_terminator in self._pending:
-            line, self._pending = self._pending.split(self._request_terminator, 1)
-            reply = self._handle(line.decode(self._encoding, errors="replace").strip())
+        """Take received bytes; answer each complete request through `write`. Each byte is looked at a bounded
+        number of times, so a long stream without a terminator costs time in proportion to its length. The
+        rest is stored before the first answer goes out: whoever reads an answer finds the reader settled."""
+        terminator = self._request_terminator
+        buffer = self._pending + data
+        requests: list[tuple[str, bool]] = []
+        start = 0
+        while (end := buffer.find(terminator, start)) >= 0:
+            requests.append(self._cut(buffer[start:end]))
+            start = end + len(terminator)
+        self._keep(buffer[start:])
+        self.peak_buffered_bytes = max(self.peak_buffered_bytes, self.buffered_bytes)
+        for request, overlong in requests:
+            reply = self._reply_to(request, overlong)
             if reply is not None:
                 self._send(reply.encode(self._encoding, errors="replace") + self._reply_terminator, write)
+
+    def _reply_to(self, request: str, overlong: bool) -> str | None:
+        """The device's answer to a request, or to a line over the bound (`request`: its first characters)."""
+        if not overlong:
+            return self._handle(request)
+        return self._overlong(request) if self._overlong is not None else None
+
+    def _cut(self, line: bytes) -> tuple[str, bool]:
+        """A complete line as it is answered: (its text, False), or for a line over the bound (its first
+        characters, True)."""
+        head, self._discarding = self._discarding, None
+        if head is None and len(line) <= MAX_LINE_BYTES:
+            return line.decode(self._encoding, errors="replace").strip(), False
+        head = line[:OVERLONG_HEAD_BYTES] if head is None else head
+        return head.decode(self._encoding, errors="replace").strip(), True
+
+    def _keep(self, rest: bytes) -> None:
+        """Hold the unterminated rest (a line within the bound, and perhaps the first bytes of its terminator),
+        or once it passes the bound only its tail, where a terminator split between two reads begins."""
+        tail = len(self._request_terminator) - 1
+        if self._discarding is None and len(rest) <= MAX_LINE_BYTES + tail:
+            self._pending = rest
+            return
+        if self._discarding is None:
+            self._discarding = rest[:OVERLONG_HEAD_BYTES]
+        self._pending = rest[len(rest) - tail:] if tail else b""
 
     def _send(self, reply: bytes, write: Callable[[bytes], object]) -> None:
         fault = self._faults.draw(("drop", "delay", "corrupt", "disconnect")) if self._faults else None

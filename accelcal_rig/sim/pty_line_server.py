@@ -19,7 +19,7 @@ import tty
 from accelcal_rig.core.descriptors import write_within
 from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.sim.faults import ReplyFaults
-from accelcal_rig.sim.line_answers import Handler, LineAnswers
+from accelcal_rig.sim.line_answers import Handler, LineAnswers, Overlong
 
 #: Longest a reply waits for its client to read it.
 WRITE_DEADLINE_S = 2.0
@@ -27,11 +27,12 @@ WRITE_DEADLINE_S = 2.0
 
 class PtyLineServer:
     """Reads requests ending in `terminator` from the pty and writes back `handle(request)` and the reply
-    terminator (the same unless given)."""
+    terminator (the same unless given); a line too long to be a request is answered by `overlong` (none:
+    not at all), without ever being held whole (sim/line_answers.py)."""
 
     def __init__(self, handle: Handler, terminator: bytes = b"\n", name: str = "pty",
                  faults: ReplyFaults | None = None, reply_terminator: bytes | None = None,
-                 encoding: str = "utf-8") -> None:
+                 encoding: str = "utf-8", overlong: Overlong | None = None) -> None:
         self.name = name
         self._master, self._slave = os.openpty()
         tty.setraw(self._master)
@@ -39,7 +40,7 @@ class PtyLineServer:
         os.set_blocking(self._master, False)  # the hub serves every device: none of them may block it
         self.path = os.ttyname(self._slave)
         self._answers = LineAnswers(handle, terminator, reply_terminator, encoding, faults,
-                                    defer=lambda delay_s, reply, _: _HUB.send(self, delay_s, reply))
+                                    defer=lambda delay_s, reply, _: _HUB.send(self, delay_s, reply), overlong=overlong)
         #: When this device's latest reply is due: a later one is never written before it.
         self.due_s = 0.0
         #: Held by the hub while it reads, answers or writes, and by `stop` while it closes: a descriptor is
@@ -61,6 +62,16 @@ class PtyLineServer:
     @property
     def fileno(self) -> int:
         return self._master
+
+    @property
+    def buffered_bytes(self) -> int:
+        """Bytes held of the line not yet ended (bounded)."""
+        return self._answers.buffered_bytes
+
+    @property
+    def peak_buffered_bytes(self) -> int:
+        """The most bytes ever held of an unended line, for tests."""
+        return self._answers.peak_buffered_bytes
 
     def received(self) -> bool:
         """Answer what has arrived; False once the pty is gone. A simulator that fails on a request is

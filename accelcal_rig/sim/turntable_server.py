@@ -4,13 +4,19 @@ motion at the shared clock's time."""
 
 from __future__ import annotations
 
+import re
+
 from accelcal_rig.config.rig import TurntableConfig
+from accelcal_rig.protocols.line_templates import finite_number
 from accelcal_rig.protocols.turntable_line import TurntableProtocol
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
+from accelcal_rig.sim.line_answers import MAX_LINE_BYTES
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 
 _OPERATIONS = ("identify", "move", "position", "busy", "rate", "rotate", "hold", "stop", "home", "fault")
+#: The fields of a request that carry a number (degrees, °/s, °/s²).
+_NUMBER_FIELDS = ("angle", "rate", "acceleration", "rate_limit")
 
 
 class SimulatedTurntableServer:
@@ -27,7 +33,8 @@ class SimulatedTurntableServer:
         self._patterns = [(name, command, command.request_pattern()) for name, command in commands]
         if protocol.write_terminator != protocol.read_terminator:
             raise ValueError("the simulated turntable needs one terminator for both directions")
-        self._server = PtyLineServer(self._handle, protocol.write_terminator.encode(), "simulated-turntable", faults)
+        self._server = PtyLineServer(self._handle, protocol.write_terminator.encode(), "simulated-turntable", faults,
+                                     overlong=_overlong_answer)
         self.path = self.endpoint = self._server.path
         n_axes = len(lab.motion.speeds_deg_s)
         #: Fault reply of each axis (fault injection sets them); a profile without per-axis faults reads axis 1's.
@@ -47,6 +54,16 @@ class SimulatedTurntableServer:
     def fault(self, value: str) -> None:
         self.faults = [value] * len(self.faults)
 
+    @property
+    def buffered_bytes(self) -> int:
+        """Bytes held of requests not yet ended (bounded: sim/line_answers.py), for tests."""
+        return self._server.buffered_bytes
+
+    @property
+    def peak_buffered_bytes(self) -> int:
+        """The most bytes ever held of an unended request between two reads, for tests."""
+        return self._server.peak_buffered_bytes
+
     def start(self) -> SimulatedTurntableServer:
         self._server.start()
         return self
@@ -64,9 +81,9 @@ class SimulatedTurntableServer:
                 try:  # every part read before any moves: a bad one moves nothing
                     n_axes = len(self._lab.motion.speeds_deg_s)
                     for fields in moves:
-                        if not 1 <= int(fields["axis"]) <= n_axes:
+                        if not 1 <= _axis_number(fields["axis"]) <= n_axes:
                             raise ValueError(f"no axis {fields['axis']}")
-                        float(fields["angle"])
+                        _numbers(fields)
                 except (ValueError, KeyError) as exc:
                     return f"ERR {exc}"
                 for fields in moves:
@@ -81,21 +98,22 @@ class SimulatedTurntableServer:
         for name, command, pattern in self._patterns:
             match = pattern.fullmatch(request)
             if match is not None:
-                if name in ("move", "stop", "home", "rotate", "hold"):
-                    self.last_command = request
-                try:
+                try:  # a refused request (no such axis, a number it cannot read) moves nothing
                     answer = self._answer(name, command.answer or "", match.groupdict())
                 except (ValueError, IndexError) as exc:
                     return True, f"ERR {exc}"
+                if name in ("move", "stop", "home", "rotate", "hold"):
+                    self.last_command = request
                 return True, None if command.answer is None else answer
         return False, None
 
     def _answer(self, name: str, template: str, fields: dict[str, str]) -> str:
+        numbers = _numbers(fields)  # every number read before anything moves
         lab, motion = self._lab, self._lab.motion
         with lab.lock:
             now = lab.clock.now()
             n_axes = len(motion.speeds_deg_s)
-            axis = int(fields["axis"]) - 1 if "axis" in fields else None
+            axis = _axis_number(fields["axis"]) - 1 if "axis" in fields else None
             if axis is not None and not 0 <= axis < n_axes:
                 raise ValueError(f"no axis {axis + 1}")
             axes = range(n_axes) if axis is None else (axis,)
@@ -106,10 +124,10 @@ class SimulatedTurntableServer:
                     self._set_up[a] = len(self._setup_seen[a]) == len(self._protocol.setup)
                     self._rate_mode[a] = self._rate_mode[a] and not self._set_up[a]
             elif name == "move" and not stalled and axis is not None and self._set_up[axis]:
-                motion.command_axis(now, axis, float(fields["angle"]))  # a stalled or unarmed table stays put
+                motion.command_axis(now, axis, numbers["angle"])  # a stalled or unarmed table stays put
             elif name == "rotate" and not stalled and axis is not None and (self._set_up[axis] or self._rate_mode[axis]):
-                motion.rotate(now, axis, float(fields["rate"]), float(fields["acceleration"])
-                              if "acceleration" in fields else self._lab.rate_acceleration_deg_s2[axis])
+                motion.rotate(now, axis, numbers["rate"], numbers["acceleration"]
+                              if "acceleration" in numbers else self._lab.rate_acceleration_deg_s2[axis])
                 self._rate_mode[axis] = True
                 if self._protocol.setup:  # out of position mode: a move needs the setup again
                     self._set_up[axis], self._setup_seen[axis] = False, set()
@@ -132,6 +150,26 @@ class SimulatedTurntableServer:
                 "fault": self.faults[shown],
             }
         return template.format(**values)
+
+
+def _axis_number(text: str) -> int:
+    """An axis as a controller reads one: ASCII digits only (int() would also take `+1`, `1_0` or other
+    scripts' digits)."""
+    if not re.fullmatch(r"[0-9]{1,3}", text):
+        raise ValueError(f"no axis {text}")
+    return int(text)
+
+
+def _numbers(fields: dict[str, str]) -> dict[str, float]:
+    """The request's numbers, each finite and written as a controller writes one: ValueError (answered `ERR …`)
+    for `nan`, `inf`, `1e400` and the like, which would otherwise reach the simulated motion."""
+    return {name: finite_number(fields[name]) for name in _NUMBER_FIELDS if name in fields}
+
+
+def _overlong_answer(head: str) -> str:
+    """A line longer than any request is answered as an unknown command (every profile's simulator answers
+    those `ERR …`)."""
+    return f"ERR unknown command {ascii(head)}... (a line over {MAX_LINE_BYTES} bytes)"  # ASCII, as its replies
 
 
 def serve_line(lab: VirtualLab, config: TurntableConfig, faults: InstrumentFaults) -> SimulatedTurntableServer:

@@ -146,3 +146,14 @@ def test_limits_that_are_not_a_range_are_refused() -> None:
     with context as line:
         with pytest.raises(InstrumentError, match=r"set point limits read 180…-70 °C: not a range"):
             LineChamber(line, "memory", protocol).controller_limits_c()
+
+
+@pytest.mark.parametrize("profile", sorted(LINE_PROFILES))
+@pytest.mark.parametrize("setpoint_c", [float("nan"), float("inf"), float("-inf")])
+def test_a_set_point_that_is_no_number_is_refused_before_the_wire(profile: str, setpoint_c: float) -> None:
+    context, protocol = talk(profile, [])  # nothing may be written
+    with context as line:
+        chamber = LineChamber(line, "memory", protocol)
+        with pytest.raises(InstrumentError, match=rf"^chamber \(memory\): setpoint {setpoint_c:g} °C refused: not a "
+                                                  r"finite number \(nothing was sent\)$"):
+            chamber.write_setpoint_c(setpoint_c)

@@ -130,3 +130,12 @@ def test_limits_that_are_no_range_are_refused_and_a_map_without_them_says_none()
         driver.controller_limits_c()
     f4t = chamber([], profile="watlow-f4t")[0]  # F4T Data Map 1: not in our map
     assert not isinstance(f4t, ControllerLimits) and controller_limits(f4t) is None
+
+
+@pytest.mark.parametrize("profile", ["watlow-f4", "watlow-f4t"])
+def test_a_set_point_that_is_no_number_is_refused_before_the_wire(profile: str) -> None:
+    driver, port = chamber([], profile=profile)  # nothing may be written
+    with pytest.raises(InstrumentError, match=r"^chamber \(modbus-rtu memory\): setpoint nan °C refused: not a finite "
+                                              r"number \(nothing was sent\)$"):
+        driver.write_setpoint_c(float("nan"))
+    port.assert_finished()

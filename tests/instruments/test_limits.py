@@ -92,3 +92,17 @@ def test_a_set_point_is_rounded_to_what_the_controller_holds_before_the_limits_a
     with pytest.raises(InstrumentError, match=r"setpoint 85.1 °C refused, limits are -40…85"):
         chamber.write_setpoint_c(85.06)  # what would go on the wire is beyond the limit
     assert inner.writes == [20.7, 85.0]
+
+
+def test_a_setpoint_or_angle_that_is_no_number_is_refused_by_name_even_on_a_continuous_axis() -> None:
+    inner = RecordingChamber()
+    with pytest.raises(InstrumentError, match=r"^chamber \(test-chamber\): setpoint nan °C refused: not a finite "
+                                              r"number"):
+        LimitedChamber(inner, ChamberConfig()).write_setpoint_c(float("nan"))
+    assert inner.writes == []
+    table = RecordingTurntable()
+    axes = [TurntableAxis(name="spin", axis=(0, 0, 1), continuous=True, min_deg=-180, max_deg=180)]
+    limited = LimitedTurntable(table, TurntableConfig(axes=axes))
+    with pytest.raises(InstrumentError, match=r"^turntable \(test-table\): axis spin to nan° refused: not a finite"):
+        limited.move_to(np.array([np.nan]))  # a continuous axis goes anywhere, but not to NaN
+    assert table.moves == []

@@ -71,3 +71,16 @@ def test_a_profile_with_other_templates_and_terminators() -> None:
     with expected_protocol([(b"AX1:POS 12.500\r\n", b"ACK\r\n")], write_terminator="\r\n",
                             read_terminator="\r\n") as line:
         table(line, n_axes=1, protocol=crlf).move_to(np.array([12.5]))
+
+
+@pytest.mark.parametrize("protocol", ["accelcal-line", "acutrol3000"])
+def test_a_move_or_rate_that_is_no_number_is_refused_before_anything_is_sent(protocol: str) -> None:
+    with expected_protocol([]) as line:  # nothing may be written, not even the profile's setup
+        driver = table(line, protocol=turntable_protocol(protocol))
+        with pytest.raises(InstrumentError, match=r"^turntable \(memory\): axis 2 to nan° refused: not a finite "
+                                                  r"number \(nothing was sent\)$"):
+            driver.move_to(np.array([0.0, np.nan, 0.0]))
+        with pytest.raises(InstrumentError, match=r"^turntable \(memory\): axis 1 at inf °/s refused"):
+            driver.rotate_at(0, float("inf"), 10.0)  # type: ignore[attr-defined]
+        with pytest.raises(InstrumentError, match=r"^turntable \(memory\): axis 1 acceleration nan °/s² refused"):
+            driver.rotate_at(0, 10.0, float("nan"))  # type: ignore[attr-defined]

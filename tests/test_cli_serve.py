@@ -1,0 +1,57 @@
+"""`rig serve` ends on SIGTERM or Ctrl-C by saying what it stopped, exit code 0: a dashboard's normal end, not
+an interrupted campaign. Run as a lab runs it (the console script, or `python -m accelcal_rig`), stopped once
+it has said where it listens."""
+
+from __future__ import annotations
+
+import os
+import re
+import selectors
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+RIG = str(Path(sys.executable).parent / "rig")
+#: Longest the dashboard may take to listen, or to stop once told (a loaded machine; a hang fails, never waits on).
+DEADLINE_S = 60.0
+
+
+def first_line(process: subprocess.Popen, deadline_s: float) -> str:
+    """The process's first stdout line, waited for at most `deadline_s` (it has died or hung otherwise)."""
+    assert process.stdout is not None
+    received = b""
+    end = time.monotonic() + deadline_s
+    with selectors.DefaultSelector() as selector:
+        selector.register(process.stdout, selectors.EVENT_READ)
+        while b"\n" not in received:
+            left = end - time.monotonic()
+            assert left > 0 and selector.select(left), f"nothing said within {deadline_s} s: {received!r}"
+            chunk = os.read(process.stdout.fileno(), 4096)
+            assert chunk, f"stdout closed first (exit {process.wait(DEADLINE_S)}): {received!r}"
+            received += chunk
+    return received.split(b"\n", 1)[0].decode()
+
+
+@pytest.mark.parametrize(("how", "stop", "token"), [
+    ([RIG], signal.SIGTERM, None),
+    ([RIG], signal.SIGINT, "s3cret-token"),
+    ([sys.executable, "-m", "accelcal_rig"], signal.SIGTERM, None),  # no `rig` script to map SIGTERM first
+], ids=["rig-sigterm", "rig-ctrl-c-with-token", "python-m-sigterm"])
+def test_rig_serve_says_what_it_stopped_and_exits_0(tmp_path: Path, how: list[str], stop: signal.Signals,
+                                                   token: str | None) -> None:
+    argv = [*how, "serve", "--campaigns", str(tmp_path), "--port", "0", *(["--token", token] if token else [])]
+    process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        announced = re.fullmatch(r"dashboard on (http://127\.0\.0\.1:\d+)/(\?token=.*)?", first_line(process, DEADLINE_S))
+        assert announced, "the first line names where it listens"
+        process.send_signal(stop)
+        _, err = process.communicate(timeout=DEADLINE_S)
+    finally:
+        process.kill()
+    assert process.returncode == 0, err.decode()
+    assert err.decode().strip().splitlines()[-1] == f"rig serve: stopped (dashboard on {announced[1]} closed)"
+    assert b"interrupted" not in err and (token is None or token.encode() not in err)
