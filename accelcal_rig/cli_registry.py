@@ -27,11 +27,13 @@ def registry_command(args: argparse.Namespace) -> int:
 
 def open_registry(args: argparse.Namespace, upgrade: bool = False):  # noqa: ANN201 - imported late (SQLAlchemy)
     """The registry the command names: --registry, else the rig config's (--config), else the environment's,
-    else the default file. Only a recording command (`upgrade`) migrates an older schema."""
+    else the default file. Only a recording command (`upgrade`) creates one or migrates an older schema; the
+    others read it read-only (a registry on a read-only mount included)."""
     from accelcal_rig.registry.database import Registry
     from accelcal_rig.registry.location import registry_url
 
-    return Registry.open(registry_url(args.registry, _from_config(args)), upgrade=upgrade)
+    return Registry.open(registry_url(args.registry, _from_config(args)), upgrade=upgrade, create=upgrade,
+                         read_only=not upgrade)
 
 
 def _from_config(args: argparse.Namespace) -> str | None:
@@ -111,19 +113,27 @@ def _add(args: argparse.Namespace) -> int:
 
 
 def _list(args: argparse.Namespace) -> int:
-    from accelcal_rig.registry.location import described, recording_url
+    """The calibrations recorded; none (not an error) in a registry not made yet, which listing leaves unmade."""
+    from accelcal_rig.registry.location import described, recording_url, registry_url
 
     since = _since(args.since) if args.since else None
-    registry = open_registry(args)
-    rows = registry.calibrations(serial=args.serial, part=args.part, since=since, verdict=args.verdict,
-                                 limit=args.limit, channel=args.channel, simulated=args.made)
+    url = registry_url(args.registry, _from_config(args))
+    registry = None if _not_made(url) else open_registry(args)
+    rows = [] if registry is None else registry.calibrations(
+        serial=args.serial, part=args.part, since=since, verdict=args.verdict, limit=args.limit,
+        channel=args.channel, simulated=args.made)
     if args.json:
         print(json.dumps([public(r) for r in rows], indent=2))
         return 0
     dry_runs = recording_url(None, None, simulated=True)
-    elsewhere = None if rows or args.made is False or registry.url == dry_runs else described(dry_runs)
+    elsewhere = None if rows or args.made is False or url == dry_runs else described(dry_runs)
     print("\n".join(calibration_table(rows, elsewhere)))
     return 0
+
+
+def _not_made(url: str) -> bool:
+    """An SQLite registry whose file does not exist yet (a recording command makes it)."""
+    return url.startswith("sqlite:///") and not Path(url.removeprefix("sqlite:///")).exists()
 
 
 def _show(args: argparse.Namespace) -> int:

@@ -150,7 +150,7 @@ def _registry(campaign_path: Path, follow_up: FollowUp, simulated: bool) -> Part
     try:
         url = registry_of(campaign_path, follow_up, simulated)
         entries = campaign_entries(campaign_path, follow_up.calibration)
-        registry = Registry.open(url, upgrade=False, create=False)
+        registry = Registry.open(url, upgrade=False, create=False, read_only=True)
         recorded = registry.ids_of(entries)
     except (RigError, OSError, SQLAlchemyError) as exc:
         return PartState("registry", UNKNOWN, str(exc).splitlines()[0])

@@ -19,7 +19,7 @@ from argon2 import PasswordHasher
 from argon2.exceptions import InvalidHashError, VerificationError
 
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.registry.database import Registry
+from accelcal_rig.registry.database import Registry, reads
 from accelcal_rig.registry.location import described
 from accelcal_rig.registry.schema import approvals, calibrations, certificate_revisions, users
 
@@ -90,16 +90,19 @@ class Approvals:
             if connection.execute(sa.update(users).where(users.c.name == name).values(**values)).rowcount == 0:
                 raise ConfigError(f"registry {described(self.registry.url)}: no user {name}")
 
+    @reads
     def users(self) -> list[User]:
         with self.registry.engine.connect() as connection:
             rows = connection.execute(sa.select(users).order_by(users.c.name)).all()
         return [User(r.name, r.full_name, r.role, r.disabled) for r in rows]
 
+    @reads
     def user(self, name: str) -> User | None:
         with self.registry.engine.connect() as connection:
             row = connection.execute(sa.select(users).where(users.c.name == name)).first()
         return None if row is None else User(row.name, row.full_name, row.role, row.disabled)
 
+    @reads
     def authenticate(self, name: str, password: str) -> User | None:
         """The user whose password this is, not disabled; None otherwise (the same time either way)."""
         with self.registry.engine.connect() as connection:
@@ -116,6 +119,7 @@ class Approvals:
         return User(row.name, row.full_name, row.role, row.disabled)
 
     # ------------------------------------------------------------------ decisions
+    @reads
     def rows_of(self, calibration_id: int) -> list[dict[str, Any]]:
         """The rows decided together with a calibration: its DUT's channels from the same fit of the same source
         (a refit is another calibration), lead first."""
@@ -130,9 +134,11 @@ class Approvals:
         with self.registry.engine.connect() as connection:
             return [dict(r._mapping) for r in connection.execute(query)]
 
+    @reads
     def lead_id(self, calibration_id: int) -> int:
         return int(self.rows_of(calibration_id)[0]["id"])
 
+    @reads
     def decision(self, calibration_id: int) -> Decision:
         """The latest decision on a DUT's calibration (its lead's record, in the order the database recorded
         them: each writer's clock may differ)."""
@@ -146,6 +152,7 @@ class Approvals:
         state: Literal["approved", "rejected"] = "rejected" if last.action == "reject" else "approved"
         return Decision(state, revision if state == "approved" else None, last.full_name, last.at, last.reason)
 
+    @reads
     def decisions(self, calibration_ids: list[int]) -> dict[int, Decision]:
         return {i: self.decision(i) for i in calibration_ids}
 
@@ -199,6 +206,7 @@ class Approvals:
              "revision": revision, "at": now} for r in rows])
         return revision
 
+    @reads
     def next_revision(self, calibration_id: int) -> int:
         lead = self.lead_id(calibration_id)
         with self.registry.engine.connect() as connection:
@@ -206,6 +214,7 @@ class Approvals:
                                         .where(certificate_revisions.c.calibration_id == lead)).scalar()
         return int(issued or 0) + 1
 
+    @reads
     def trail(self, serial: str | None = None, calibration_id: int | None = None) -> list[dict[str, Any]]:
         """The record, oldest first: every decision (one per DUT, not per channel row) with who, how and when."""
         query = (sa.select(approvals, calibrations.c.serial, calibrations.c.channel)
@@ -226,6 +235,7 @@ class Approvals:
                 out.append(row)
         return out
 
+    @reads
     def certificates(self, calibration_id: int) -> list[dict[str, Any]]:
         """Every revision issued for a DUT's calibration, without the documents."""
         lead = self.lead_id(calibration_id)
@@ -235,6 +245,7 @@ class Approvals:
                 sa.select(*listed).where(certificate_revisions.c.calibration_id == lead)
                 .order_by(certificate_revisions.c.revision))]
 
+    @reads
     def certificate(self, calibration_id: int, revision: int) -> dict[str, Any]:
         """One revision with its documents."""
         lead = self.lead_id(calibration_id)
@@ -246,6 +257,7 @@ class Approvals:
                               f"certificate revision {revision}")
         return dict(row._mapping)
 
+    @reads
     def approved_ids(self, calibration_ids: list[int]) -> set[int]:
         """Of these rows, those whose DUT's calibration is approved now."""
         return {i for i in calibration_ids if self.decision(i).state == "approved"}

@@ -5,12 +5,16 @@ a registered fit skipped by its unique key, a transaction that lost a deadlock t
 
 from __future__ import annotations
 
+import functools
+import os
+import sqlite3
 import time
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from datetime import datetime
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
+from urllib.parse import quote
 
 import sqlalchemy as sa
 from alembic import command
@@ -23,8 +27,9 @@ from sqlalchemy.engine import Connection, Engine
 
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.registry.location import described
-from accelcal_rig.registry.schema import approvals, calibrations
+from accelcal_rig.registry.schema import approvals, calibrations, registry_tables
 
+T = TypeVar("T")
 _MIGRATIONS = Path(__file__).parent / "migrations"
 #: A PostgreSQL advisory lock key for schema migrations (any constant the lab's other users do not take).
 _MIGRATION_LOCK = 0x0ACCE1CA1
@@ -34,6 +39,9 @@ _OPEN_ATTEMPTS = 20
 _BATCH = 500
 #: SQLite waits this long for another writer's lock before giving up.
 _SQLITE_BUSY_S = 60.0
+#: Seconds a PostgreSQL registry is given to answer a connection (the URL's own `connect_timeout` instead, if
+#: it has one).
+CONNECT_TIMEOUT_S = 10
 #: The verdict of a calibration no acceptance limits judged: stored as none (NULL), counted in no yield.
 NOT_JUDGED = "NOT JUDGED"
 
@@ -54,20 +62,36 @@ def head_revision() -> str:
     return head
 
 
+def reads(method: Callable[..., T]) -> Callable[..., T]:
+    """A reading method of the registry (or of what reads through it): what its database holds is input like
+    any file's, so a row that cannot be read (a table or column gone, a date that is not a date, a value of
+    the wrong type written by hand) is one line naming the registry, not a failure of the program."""
+    @functools.wraps(method)
+    def read(self: Any, *args: Any, **kwargs: Any) -> T:
+        try:
+            return method(self, *args, **kwargs)
+        except (sa.exc.SQLAlchemyError, ValueError, TypeError, KeyError) as exc:
+            url = self.url if isinstance(self, Registry) else self.registry.url
+            raise ConfigError(f"registry {described(url)}: cannot be read ({_first_line(exc)}): the database "
+                              "was damaged or changed by hand") from None
+    return read
+
+
 class Registry:
     def __init__(self, engine: Engine, url: str) -> None:
         self.engine = engine
         self.url = url
 
     @classmethod
-    def open(cls, url: str, upgrade: bool = True, create: bool = True) -> Registry:
-        """Connect. A new, empty database is created at the current schema when `create` (the commands that
-        record; a reader is refused in one line instead); an older one is migrated when `upgrade`, else
-        refused in one line (readers do not change a schema); one newer than this software is refused
-        either way."""
+    def open(cls, url: str, upgrade: bool = True, create: bool = True, read_only: bool = False) -> Registry:
+        """Connect, in one line when it cannot be. A new, empty database is created at the current schema when
+        `create` (the commands that record; a reader is refused instead: it never creates a registry); an
+        older one is migrated when `upgrade`, else refused (readers do not change a schema); one newer than
+        this software, a foreign database and one that lost a table are refused either way. `read_only`:
+        a reader's connection, which can read a registry on a read-only mount and writes nothing."""
         if not create and url.startswith("sqlite:///") and not Path(url.removeprefix("sqlite:///")).is_file():
             raise ConfigError(f"registry {described(url)}: does not exist (nothing recorded in it yet)")
-        engine = _engine(url)
+        engine = _engine(url, create=create, read_only=read_only)
         registry = cls(engine, url)
         for attempt in range(_OPEN_ATTEMPTS):
             try:
@@ -75,25 +99,51 @@ class Registry:
                 if found is not None and found not in known_revisions():
                     raise ConfigError(f"registry {described(url)}: schema {found} is newer than this software's "
                                       f"{head_revision()}: upgrade accelcal-rig")
+                if found is None and not create:
+                    registry._refuse_unmade()
                 if found is None or (upgrade and found != head_revision()):
                     registry.upgrade()
                 elif found != head_revision():
                     raise ConfigError(f"registry {described(url)}: schema {found} is older than this software's "
                                       f"{head_revision()}: a recording command (rig registry add, rig fit) upgrades it")
+                registry._check_tables()
                 return registry
             except sa.exc.OperationalError as exc:
                 # SQLite answers "locked" at once, busy timeout or not, to a connection switching a new file
                 # to WAL while another does: the other is done in a moment.
                 if "locked" not in str(exc.orig) or attempt == _OPEN_ATTEMPTS - 1:
-                    raise ConfigError(f"registry {described(url)}: cannot open: {exc.orig}") from None
+                    raise ConfigError(f"registry {described(url)}: cannot open: {_first_line(exc.orig)}") from None
                 time.sleep(0.05 * (attempt + 1))
             except (sa.exc.SQLAlchemyError, CommandError) as exc:
-                raise ConfigError(f"registry {described(url)}: {str(exc).splitlines()[0]}") from None
+                raise ConfigError(f"registry {described(url)}: {_first_line(exc)}") from None
         raise AssertionError("unreachable")
 
+    def _refuse_unmade(self) -> None:
+        """A reader's database with no schema revision: empty (nothing recorded), or someone else's."""
+        with self.engine.connect() as connection:
+            _refuse_foreign(connection, self.url)
+            if MigrationContext.configure(connection).get_current_revision() is None:
+                raise ConfigError(f"registry {described(self.url)}: empty (nothing recorded in it yet)")
+
+    def _check_tables(self) -> None:
+        """Every table and column of the current schema is there (a table dropped or altered by hand is
+        refused here in one line, not met as a failed query on some page)."""
+        inspector = sa.inspect(self.engine)
+        present = set(inspector.get_table_names())
+        for table in registry_tables():
+            if table.name not in present:
+                raise ConfigError(f"registry {described(self.url)}: table {table.name} is missing: the database "
+                                  "was damaged or changed by hand")
+            columns = {c["name"] for c in inspector.get_columns(table.name)}
+            lost = [c.name for c in table.columns if c.name not in columns]
+            if lost:
+                raise ConfigError(f"registry {described(self.url)}: table {table.name} lacks column "
+                                  f"{', '.join(lost)}: the database was damaged or changed by hand")
+
     def upgrade(self, revision: str = "head") -> None:
-        """Apply every migration not applied yet, one process at a time."""
+        """Apply every migration not applied yet, one process at a time; never into someone else's database."""
         with self._migration_lock() as connection:
+            _refuse_foreign(connection, self.url)
             config = migration_config()
             config.attributes["connection"] = connection
             command.upgrade(config, revision)
@@ -132,6 +182,7 @@ class Registry:
         raise AssertionError("unreachable")
 
     # ------------------------------------------------------------------ reading
+    @reads
     def calibrations(self, serial: str | None = None, part: str | None = None, since: datetime | None = None,
                      verdict: str | None = None, limit: int | None = None,
                      channel: str | None = None, simulated: bool | None = None) -> list[dict[str, Any]]:
@@ -160,6 +211,7 @@ class Registry:
         with self.engine.connect() as connection:
             return [dict(row._mapping) for row in connection.execute(query)]
 
+    @reads
     def calibration(self, row_id: int) -> dict[str, Any]:
         """One calibration's row with its stored fit."""
         with self.engine.connect() as connection:
@@ -168,6 +220,7 @@ class Registry:
             raise ConfigError(f"registry {described(self.url)}: no calibration {row_id}")
         return dict(row._mapping)
 
+    @reads
     def current(self, serial: str, simulated: bool = False, channel: str = "accel") -> dict[str, Any] | None:
         """The valid calibration of a serial's channel: its newest approved real calibration, unless a newer
         one failed its acceptance limits and was not rejected (the sensor is out of tolerance now: none is
@@ -186,6 +239,7 @@ class Registry:
                 return row
         return None
 
+    @reads
     def why_not_valid(self, serial: str, channel: str = "accel") -> str:
         """Why a serial's channel has no valid calibration (current() is None), in a few words."""
         rows = [r for r in self.calibrations(serial=serial, channel=channel) if not r["simulated"]]
@@ -199,6 +253,7 @@ class Registry:
                     "sensor is out of tolerance")
         return "none approved: a calibration awaiting approval or rejected is not valid (rig approve)"
 
+    @reads
     def ids_of(self, entries: list[dict[str, Any]]) -> dict[str, int]:
         """Of recorded entries (registry/entries.py), each serial's first row: its DUT's calibration's lead.
         A serial whose entries are not all recorded is left out."""
@@ -211,6 +266,7 @@ class Registry:
                 found.setdefault(entry["serial"], []).append(row_id)
         return {serial: min(i for i in ids if i is not None) for serial, ids in found.items() if None not in ids}
 
+    @reads
     def last_actions(self, ids: list[int]) -> dict[int, str]:
         """The latest approval action (approve, reject, reissue) recorded on each of these rows that has one."""
         if not ids:
@@ -220,6 +276,7 @@ class Registry:
         with self.engine.connect() as connection:
             return {int(i): str(action) for i, action in connection.execute(query)}
 
+    @reads
     def channels(self, serial: str | None = None) -> list[str]:
         """Every channel with a calibration recorded (of one serial, if given): `accel` first."""
         query = sa.select(calibrations.c.channel).distinct()
@@ -228,20 +285,22 @@ class Registry:
         with self.engine.connect() as connection:
             return sorted(connection.execute(query).scalars(), key=lambda c: (c != "accel", c))
 
+    @reads
     def parts(self) -> list[str]:
         """Every part with a calibration recorded."""
         with self.engine.connect() as connection:
             return sorted(connection.execute(sa.select(calibrations.c.part).distinct()).scalars())
 
+    @reads
     def count(self) -> int:
         with self.engine.connect() as connection:
             return int(connection.execute(sa.select(sa.func.count()).select_from(calibrations)).scalar_one())
 
     @contextmanager
     def _migration_lock(self) -> Iterator[Connection]:
-        """A connection whose transaction holds the schema for this process alone: PostgreSQL's
-        transaction-level advisory lock (released with the transaction, whatever happens in it), SQLite's
-        write lock (BEGIN IMMEDIATE)."""
+        """A connection whose one transaction holds the schema for this process alone from reading its
+        revision to the last migration: PostgreSQL's transaction-level advisory lock (released with the
+        transaction, whatever happens in it), SQLite's write lock (BEGIN IMMEDIATE)."""
         with self.engine.connect() as connection:
             if self.engine.dialect.name == "postgresql":
                 with connection.begin():
@@ -249,38 +308,84 @@ class Registry:
                     connection.execute(sa.text("SELECT pg_advisory_xact_lock(:key)"), {"key": _MIGRATION_LOCK})
                     yield connection
             else:
+                # One transaction around every migration, begun here: Alembic then takes it as the caller's
+                # and commits nothing of its own. Left to itself on SQLite it commits after each migration,
+                # and another process waiting for the lock reads the schema between two of them while this
+                # one goes on with the migrations it planned before: both apply the next one.
                 connection.info["begin"] = "BEGIN IMMEDIATE"  # see _engine's begin hook
                 try:
-                    yield connection
-                    connection.commit()
+                    with connection.begin():
+                        yield connection
                 finally:
                     connection.info.pop("begin", None)
 
 
-def _engine(url: str) -> Engine:
+def _engine(url: str, create: bool = True, read_only: bool = False) -> Engine:
     if url.startswith("sqlite:///"):
-        path = Path(url.removeprefix("sqlite:///"))
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise ConfigError(f"registry {url}: cannot create its folder: {exc}") from None
-        engine = sa.create_engine(url, connect_args={"timeout": _SQLITE_BUSY_S}, poolclass=sa.pool.NullPool)
-
-        @sa.event.listens_for(engine, "connect")
-        def _pragmas(dbapi_connection: Any, _: Any) -> None:
-            dbapi_connection.isolation_level = None  # SQLAlchemy's BEGIN, not pysqlite's own
-            cursor = dbapi_connection.cursor()
-            cursor.execute("PRAGMA journal_mode=WAL")  # readers never block the writer, nor it them
-            cursor.execute(f"PRAGMA busy_timeout={int(_SQLITE_BUSY_S * 1000)}")
-            cursor.execute("PRAGMA foreign_keys=ON")  # a decision names a calibration that exists
-            cursor.close()
-
-        @sa.event.listens_for(engine, "begin")
-        def _begin(connection: Connection) -> None:
-            connection.exec_driver_sql(connection.info.get("begin", "BEGIN"))
-        return engine
+        return _sqlite_engine(Path(url.removeprefix("sqlite:///")), create, read_only)
+    query = url.partition("?")[2]
+    # libpq's own connect_timeout, when the URL gives one; else ours: a server that accepts and never
+    # answers is one line within seconds, not a wait of minutes.
+    connect_args = {} if "connect_timeout=" in query else {"connect_timeout": CONNECT_TIMEOUT_S}
     try:
-        return sa.create_engine(url, pool_pre_ping=True)
+        return sa.create_engine(url, pool_pre_ping=True, connect_args=connect_args)
     except (sa.exc.ArgumentError, ModuleNotFoundError) as exc:
         raise ConfigError(f"registry {described(url)}: {exc} (PostgreSQL needs: pip install "
                           "'accelcal-rig[postgresql]')") from None
+
+
+def _sqlite_engine(path: Path, create: bool, read_only: bool) -> Engine:
+    """An SQLite registry: in WAL mode for the commands that write (readers never block the writer, nor it
+    them); a reader's connection read-only, and on a mount where not even SQLite's side files can be made,
+    opened as immutable (nothing can write there either)."""
+    if create:
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ConfigError(f"registry sqlite:///{path}: cannot create its folder: {exc}") from None
+    if read_only:
+        immutable = not os.access(path.parent, os.W_OK)
+        address = f"file:{quote(str(path))}?mode=ro" + ("&immutable=1" if immutable else "")
+        engine = sa.create_engine("sqlite://", poolclass=sa.pool.NullPool, creator=lambda: sqlite3.connect(
+            address, uri=True, timeout=_SQLITE_BUSY_S, check_same_thread=False))
+    else:
+        engine = sa.create_engine(f"sqlite:///{path}", connect_args={"timeout": _SQLITE_BUSY_S},
+                                  poolclass=sa.pool.NullPool)
+
+    @sa.event.listens_for(engine, "connect")
+    def _pragmas(dbapi_connection: Any, _: Any) -> None:
+        dbapi_connection.isolation_level = None  # SQLAlchemy's BEGIN, not pysqlite's own
+        cursor = dbapi_connection.cursor()
+        if not read_only and _ours_or_empty(cursor):
+            cursor.execute("PRAGMA journal_mode=WAL")  # readers never block the writer, nor it them
+        cursor.execute(f"PRAGMA busy_timeout={int(_SQLITE_BUSY_S * 1000)}")
+        cursor.execute("PRAGMA foreign_keys=ON")  # a decision names a calibration that exists
+        cursor.close()
+
+    @sa.event.listens_for(engine, "begin")
+    def _begin(connection: Connection) -> None:
+        connection.exec_driver_sql(connection.info.get("begin", "BEGIN"))
+    return engine
+
+
+def _refuse_foreign(connection: Connection, url: str) -> None:
+    """Refuse a database with tables and no schema revision: it is someone else's (read under the migration
+    lock, so that a registry another process is creating now is not taken for one)."""
+    if MigrationContext.configure(connection).get_current_revision() is not None:
+        return
+    tables = sa.inspect(connection).get_table_names()
+    if tables:
+        shown = ", ".join(sorted(tables)[:4]) + (", …" if len(tables) > 4 else "")
+        raise ConfigError(f"registry {described(url)}: not an accelcal-rig registry (it holds tables {shown} and no "
+                          "schema revision); name another with --registry")
+
+
+def _ours_or_empty(cursor: sqlite3.Cursor) -> bool:
+    """Whether an SQLite file is a registry or nothing yet: someone else's database is not switched to WAL
+    (opening it is refused; it must be left as it was)."""
+    tables = {row[0] for row in cursor.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+    return not tables or "alembic_version" in tables
+
+
+def _first_line(error: object) -> str:
+    return (str(error).strip().splitlines() or [type(error).__name__])[0]

@@ -98,3 +98,8 @@ certificate_revisions = sa.Table(
     sa.Column("sha256", sa.String(64), nullable=False),
     sa.UniqueConstraint("calibration_id", "revision", name="one_certificate_per_revision"),
 )
+
+
+def registry_tables() -> list[sa.Table]:
+    """Every table of the current schema (what opening a registry checks is there)."""
+    return list(metadata.sorted_tables)

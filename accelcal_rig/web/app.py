@@ -1,18 +1,21 @@
 """The dashboard's web application (Starlette, pages rendered on the server with Jinja2): campaigns running
 and recent, each campaign's progress, temperatures, warnings, report and certificates, and the registry
 (search by serial, a sensor's history and trend, a part's lot). Pages refresh themselves by polling the
-JSON endpoints with the bundled script. With a token, every request must carry it."""
+JSON endpoints with the bundled script. With a token, every request must carry it. Whatever cannot be
+served is one styled page with its status (web/errors.py), never a traceback."""
 
 from __future__ import annotations
 
 import hmac
 import secrets
+import threading
 from pathlib import Path
 from typing import Any
 from urllib.parse import quote
 
 from jinja2 import Environment, PackageLoader, select_autoescape
 from starlette.applications import Starlette
+from starlette.exceptions import HTTPException
 from starlette.middleware import Middleware
 from starlette.middleware.base import BaseHTTPMiddleware, RequestResponseEndpoint
 from starlette.middleware.sessions import SessionMiddleware
@@ -22,17 +25,24 @@ from starlette.responses import FileResponse, HTMLResponse, JSONResponse, PlainT
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
+from accelcal_rig.errors import ConfigError
 from accelcal_rig.registry.analysis import lot_statistics, trend
 from accelcal_rig.registry.database import Registry
 from accelcal_rig.registry.location import described
 from accelcal_rig.web.approval import BEARER_SCOPE_KEY, ApprovalSettings, approval_routes
 from accelcal_rig.web.campaigns import CampaignFolders
+from accelcal_rig.web.errors import CheckedInput, ErrorPages, Unforeseen, exception_handlers
 from accelcal_rig.web.svg import line_plot
 
 _STATIC = Path(__file__).parent / "static"
 #: The registry page's filter (`?made=`): every calibration, only real ones, only dry runs.
 _MADE: dict[str, bool | None] = {"": None, "real": False, "dry-run": True}
 _TOKEN_COOKIE = "accelcal_token"
+#: A page the dashboard serves but did not make (a certificate, a report: files anyone who can write the
+#: campaign's folder or the registry could have changed) runs in a sandbox of its own origin: no script of
+#: it can read the dashboard's pages, its session or its form token.
+SANDBOXED = {"Content-Security-Policy": "sandbox"}
+SANDBOXED_SUFFIXES = (".html", ".htm", ".svg", ".xhtml", ".xml")
 
 
 class _TokenRequired(BaseHTTPMiddleware):
@@ -89,7 +99,7 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
         try:
             summary, series = campaigns.summary(name), campaigns.series(name)
         except KeyError:
-            return PlainTextResponse(f"no campaign {name} in the watched folders", status_code=404)
+            raise HTTPException(404, f"no campaign {name} in the watched folders") from None
         path = campaigns.path(name)
         plot = line_plot(series.get("t_h", []), {"chamber air": series.get("chamber_c", []),
                                                   "DUTs (mean)": series.get("dut_c", [])},
@@ -101,40 +111,38 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
         try:
             return JSONResponse(campaigns.summary(request.path_params["name"]))
         except KeyError:
-            return JSONResponse({"error": "no such campaign"}, status_code=404)
+            raise HTTPException(404, "no such campaign") from None
 
     def campaign_file(request: Request) -> Response:
         """A certificate or a report file beside a watched campaign; nothing outside its folders."""
         try:
             path = campaigns.path(request.path_params["name"])
         except KeyError:
-            return PlainTextResponse("no such campaign", status_code=404)
+            raise HTTPException(404, "no such campaign") from None
         kind, relative = request.path_params["kind"], request.path_params["file"]
         base = {"certificates": path.with_suffix(".certificates"), "report": _report(path)}.get(kind)
-        if base is None:
-            return PlainTextResponse("no such file", status_code=404)
-        wanted = (base / relative).resolve()
-        if not wanted.is_relative_to(base.resolve()) or not wanted.is_file():
-            return PlainTextResponse("no such file", status_code=404)
-        return FileResponse(wanted)
+        wanted = _inside(base, relative) if base is not None else None
+        if wanted is None:
+            raise HTTPException(404, "no such file")
+        return FileResponse(wanted, headers=SANDBOXED if wanted.suffix.lower() in SANDBOXED_SUFFIXES else None)
 
     def registry_search(request: Request) -> Response:
         serial = request.query_params.get("serial", "").strip()
         if serial:
             return RedirectResponse(f"/registry/serials/{quote(serial, safe='')}", status_code=303)
-        reg = registry.get()
         made = request.query_params.get("made", "")
-        if made not in _MADE:
-            return PlainTextResponse(f"made={made}: not one of real, dry-run", status_code=400)
+        if made not in _MADE:  # the address checked before the registry is read
+            raise HTTPException(400, "made: not one of real, dry-run")
+        reg = registry.get()
         rows = reg.calibrations(limit=50, simulated=_MADE[made])
         return page("registry.html", rows=rows, parts=reg.parts(), made_filter=made)
 
     def serial_page(request: Request) -> Response:
         serial = request.path_params["serial"]
         reg = registry.get()
-        every = reg.calibrations(serial=serial)
+        every = reg.calibrations(serial=serial) if serial else []
         if not every:
-            return page("registry.html", rows=[], parts=[], missing=serial, made_filter="")
+            raise HTTPException(404, f"no calibration of {serial} in the registry" if serial else "no serial given")
         real = [r for r in every if not r["simulated"]]
         rows = real or every  # a serial only dry runs know is shown as such, marked simulated
         result = trend(rows)
@@ -155,18 +163,25 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
     def part_page(request: Request) -> Response:
         part = request.path_params["part"]
         every = registry.get().calibrations(part=part)
+        if not every:
+            raise HTTPException(404, f"no calibration of part {part} in the registry")
         real = [r for r in every if not r["simulated"]]
         rows = real or every
         gyro = [r for r in rows if r["channel"] == "gyro"]
-        return page("part.html", part=part, stats=lot_statistics(rows) if rows else None, only_simulated=not real,
+        return page("part.html", part=part, stats=lot_statistics(rows), only_simulated=not real,
                     gyro_stats=lot_statistics(gyro, "gyro") if gyro else None)
 
     def serial_json(request: Request) -> Response:
         rows = registry.get().calibrations(serial=request.path_params["serial"])
         return JSONResponse(_jsonable(trend(rows)) if rows else {"calibrations": []})
 
-    middleware = ([Middleware(_TokenRequired, token=token, secure=tls)] if token
-                  else [Middleware(TrustedHostMiddleware, allowed_hosts=hosts or LOOPBACK_HOSTS)])
+    pages = ErrorPages(templates, registry.label)
+    # Outermost the unforeseen error's page; then who may ask (their refusals say nothing of the dashboard,
+    # not even which registry: plain text); then the address checked before any route reads it.
+    middleware = [Middleware(Unforeseen, pages=pages, on_failure=registry.forget)]
+    middleware += ([Middleware(_TokenRequired, token=token, secure=tls)] if token
+                   else [Middleware(TrustedHostMiddleware, allowed_hosts=hosts or LOOPBACK_HOSTS)])
+    middleware.append(Middleware(CheckedInput, pages=pages))
     # The approver's session: signed with a key made now (a restart logs everyone out), never sent to
     # another site (SameSite=Strict), unreadable by scripts (HttpOnly), HTTPS-only when served over TLS.
     middleware.append(Middleware(SessionMiddleware, secret_key=secrets.token_urlsafe(32), session_cookie="accelcal_session",
@@ -179,28 +194,50 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
         Route("/registry", registry_search), Route("/registry/serials/{serial:path}", serial_page),
         Route("/registry/parts/{part}", part_page), Route("/api/registry/serials/{serial:path}", serial_json),
         Mount("/static", StaticFiles(directory=_STATIC), name="static"),
-    ], middleware=middleware)
+    ], middleware=middleware, exception_handlers=exception_handlers(pages, registry.forget))
 
 
 class _LazyRegistry:
-    """The registry, opened at its first use (a dashboard of campaigns works without one)."""
+    """The registry, opened at its first use (a dashboard of campaigns works without one), never created
+    (a GET, even a page elsewhere's, must not make a file) and never kept after a failure: a registry that
+    could not be read is opened again at the next request, so one repaired (or created) is seen at once."""
 
     def __init__(self, url: str | None) -> None:
         self.url = url
         self._registry: Registry | None = None
+        self._lock = threading.Lock()  # requests are answered on several threads
         self.label = described(url) if url else "none"
 
     def get(self) -> Registry:
-        if self._registry is None:
-            if self.url is None:
-                raise RuntimeError("no registry")
-            self._registry = Registry.open(self.url, upgrade=False)  # a view changes no schema
-        return self._registry
+        with self._lock:
+            if self._registry is None:
+                if self.url is None:
+                    raise ConfigError("no registry: serve one with rig serve --registry URL")
+                # A view changes no schema and creates nothing: a missing or older registry is one line.
+                self._registry = Registry.open(self.url, upgrade=False, create=False)
+            return self._registry
+
+    def forget(self) -> None:
+        """After a failure: the next request opens the registry again (its schema checked again). Without the
+        lock: called on the event loop, it must not wait for an open under way (a race at worst disposes a
+        registry just opened, which reconnects at its next use)."""
+        opened, self._registry = self._registry, None
+        if opened is not None:
+            opened.engine.dispose()
 
 
 def _certificates(campaign: Path) -> list[str]:
     folder = campaign.with_suffix(".certificates")
     return sorted(p.name for p in folder.glob("*") if p.suffix in (".html", ".pdf")) if folder.is_dir() else []
+
+
+def _inside(base: Path, relative: str) -> Path | None:
+    """The file `relative` names under `base`, if it is one there (never one outside, by `..` or a link)."""
+    try:
+        wanted = (base / relative).resolve()
+        return wanted if wanted.is_relative_to(base.resolve()) and wanted.is_file() else None
+    except OSError:  # a name the filesystem refuses (too long, not allowed): no such file
+        return None
 
 
 def _report(campaign: Path) -> Path | None:

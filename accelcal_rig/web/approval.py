@@ -12,14 +12,16 @@ the approver's name. Everything else on the dashboard is read-only as before.
 from __future__ import annotations
 
 import hmac
+import re
 import secrets
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
 
+from starlette.exceptions import HTTPException
 from starlette.requests import Request
-from starlette.responses import HTMLResponse, PlainTextResponse, RedirectResponse, Response
+from starlette.responses import HTMLResponse, RedirectResponse, Response
 from starlette.routing import Route
 
 from accelcal_rig.errors import RigError
@@ -33,6 +35,9 @@ BEARER_SCOPE_KEY = "accelcal.bearer"
 #: The largest row id a database holds (a longer number in a path is no calibration).
 MAX_ID = 2**63 - 1
 SESSION_TOKEN = "csrf"
+#: How the registry says a calibration or a certificate revision is not there; anything else it says of one
+#: (a row it cannot read) is a registry that cannot be read: the 503 page, not a 404.
+_NOT_THERE = re.compile(r": (?:no calibration \d+|calibration \d+ has no certificate revision \d+)$")
 
 
 class ApprovalSettings:
@@ -65,24 +70,25 @@ def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: 
             request.session[SESSION_TOKEN] = secrets.token_urlsafe(32)
         return str(request.session[SESSION_TOKEN])
 
-    async def form(request: Request) -> dict[str, str] | Response:
-        """The posted form, once its origin and token are checked; else the refusal."""
+    async def form(request: Request) -> dict[str, str]:
+        """The posted form, once its origin and token are checked; else the refusal (HTTPException: the
+        dashboard's error page)."""
         if not same_origin(request):
-            return PlainTextResponse("refused: a request from another site (Origin)", status_code=403)
+            raise HTTPException(403, "refused: a request from another site (Origin)")
         body = b""
         async for chunk in request.stream():
             body += chunk
             if len(body) > MAX_FORM_BYTES:
-                return PlainTextResponse("refused: form too large", status_code=413)
+                raise HTTPException(413, "refused: form too large")
         try:
             fields = {k: v[0] for k, v in parse_qs(body.decode("utf-8"), strict_parsing=False).items()}
         except UnicodeDecodeError:
-            return PlainTextResponse("refused: a form that is not UTF-8", status_code=400)
+            raise HTTPException(400, "refused: a form that is not UTF-8") from None
         if any("\x00" in k or "\x00" in v for k, v in fields.items()):
-            return PlainTextResponse("refused: a form with a NUL character", status_code=400)
+            raise HTTPException(400, "refused: a form with a NUL character")
         expected = request.session.get(SESSION_TOKEN)
         if not isinstance(expected, str) or not hmac.compare_digest(fields.get("csrf", "").encode(), expected.encode()):
-            return PlainTextResponse("refused: the form's token is missing or stale: reload the page", status_code=403)
+            raise HTTPException(403, "refused: the form's token is missing or stale: reload the page")
         return fields
 
     def login_page(request: Request) -> Response:
@@ -92,10 +98,8 @@ def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: 
 
     async def login(request: Request) -> Response:
         if settings.user_header:
-            return PlainTextResponse("the reverse proxy authenticates users here", status_code=404)
+            raise HTTPException(404, "the reverse proxy authenticates users here")
         fields = await form(request)
-        if isinstance(fields, Response):
-            return fields
         user = approvals().authenticate(fields.get("name", ""), fields.get("password", ""))
         if user is None:
             return page("login.html", csrf=token(request), error="unknown user or wrong password", proxy=None,
@@ -107,21 +111,19 @@ def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: 
         return RedirectResponse(target if _local(target) else "/registry", status_code=303)
 
     async def logout(request: Request) -> Response:
-        fields = await form(request)
-        if isinstance(fields, Response):
-            return fields
+        await form(request)
         request.session.clear()
         return RedirectResponse("/registry", status_code=303)
 
     def calibration_page(request: Request) -> Response:
         row_id = int(request.path_params["id"])
         if row_id > MAX_ID:
-            return PlainTextResponse(f"no calibration {row_id} in the registry", status_code=404)
+            raise HTTPException(404, "no such calibration in the registry")
         reg = registry.get()
         try:
             row = reg.calibration(row_id)
-        except RigError:
-            return PlainTextResponse(f"no calibration {row_id} in the registry", status_code=404)
+        except RigError as exc:
+            raise _not_there(exc, f"no calibration {row_id} in the registry") from None
         book = approvals()
         user, via_header = current_user(request)
         return page("calibration.html", row=row, decision=book.decision(row_id), trail=book.trail(calibration_id=row_id),
@@ -132,43 +134,41 @@ def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: 
     async def decide(request: Request) -> Response:
         row_id = int(request.path_params["id"])
         if row_id > MAX_ID:
-            return PlainTextResponse(f"no calibration {row_id} in the registry", status_code=404)
+            raise HTTPException(404, "no such calibration in the registry")
         fields = await form(request)
-        if isinstance(fields, Response):
-            return fields
         user, via_header = current_user(request)
         if user is None or not user.may_approve:
-            return PlainTextResponse("refused: log in as an approver", status_code=403)
+            raise HTTPException(403, "refused: log in as an approver")
         action = fields.get("action", "")
         if action not in ("approve", "reject", "reissue"):
-            return PlainTextResponse(f"action {action!r}: not one of approve, reject, reissue", status_code=400)
+            raise HTTPException(400, f"action {action[:40]!r}: not one of approve, reject, reissue")
         from starlette.concurrency import run_in_threadpool
 
         try:
             message = await run_in_threadpool(_decide, registry.get(), row_id, action, user,
                                               settings.authority(user, via_header), fields.get("reason", ""))
         except RigError as exc:
-            return PlainTextResponse(f"refused: {exc}", status_code=409)
+            raise HTTPException(409, f"refused: {exc}") from None
         except OSError as exc:  # the campaign or its calibration unreadable here: one line, nothing recorded
-            return PlainTextResponse(f"refused: {exc.filename or 'a file'}: {exc.strerror or exc}", status_code=409)
+            raise HTTPException(409, f"refused: {exc.filename or 'a file'}: {exc.strerror or exc}") from None
         return RedirectResponse(f"/registry/calibrations/{row_id}?message={_quote(message)}", status_code=303)
 
     def certificate_file(request: Request) -> Response:
         row_id, revision, kind = (int(request.path_params["id"]), int(request.path_params["revision"]),
                                   request.path_params["kind"])
         if row_id > MAX_ID or revision > MAX_ID:
-            return PlainTextResponse("no such certificate revision", status_code=404)
+            raise HTTPException(404, "no such certificate revision")
+        if kind not in ("pdf", "html"):  # the address checked before the registry is read
+            raise HTTPException(404, "no such certificate file")
         try:
             row = approvals().certificate(row_id, revision)
-        except RigError:
-            return PlainTextResponse("no such certificate revision", status_code=404)
-        if kind == "pdf":
-            if row["pdf"] is None:
-                return PlainTextResponse("issued as HTML only", status_code=404)
-            return Response(bytes(row["pdf"]), media_type="application/pdf")
+        except RigError as exc:
+            raise _not_there(exc, "no such certificate revision") from None
         if kind == "html":
-            return HTMLResponse(row["html"])
-        return PlainTextResponse("no such certificate file", status_code=404)
+            return HTMLResponse(row["html"], headers={"Content-Security-Policy": "sandbox"})  # see app.SANDBOXED
+        if row["pdf"] is None:
+            raise HTTPException(404, "issued as HTML only")
+        return Response(bytes(row["pdf"]), media_type="application/pdf")
 
     return [Route("/login", login_page, methods=["GET"]), Route("/login", login, methods=["POST"]),
             Route("/logout", logout, methods=["POST"]),
@@ -183,9 +183,18 @@ def same_origin(request: Request) -> bool:
     claimed = request.headers.get("origin") or request.headers.get("referer")
     if not claimed or claimed == "null":
         return False
-    parts = urlsplit(claimed)
+    try:
+        parts = urlsplit(claimed)
+    except ValueError:  # not an address at all ("http://[")
+        return False
     own = urlsplit(str(request.base_url))
     return (parts.scheme, parts.netloc) == (own.scheme, own.netloc)
+
+
+def _not_there(exc: RigError, message: str) -> Exception:
+    """What to raise for the registry's refusal: a 404 if it said the row is not there, else the refusal
+    itself (a registry that cannot be read, answered 503)."""
+    return HTTPException(404, message) if _NOT_THERE.search(str(exc)) else exc
 
 
 def _local(target: str) -> bool:

@@ -90,7 +90,7 @@ def test_which_registry_flag_rig_config_environment_and_dry_runs_apart(tmp_path:
     assert capsys.readouterr().out.strip() == f"{tmp_path / 'a.h5'}: 4 added"
     monkeypatch.setenv("ACCELCAL_REGISTRY", str(tmp_path / "environment.sqlite"))
     assert rig("registry", "list", "--json") == 0  # no flag, no config: the environment's
-    assert json.loads(capsys.readouterr().out) == [] and (tmp_path / "environment.sqlite").is_file()
+    assert json.loads(capsys.readouterr().out) == [] and not (tmp_path / "environment.sqlite").exists()  # read only
     assert rig("registry", "list") == 0  # an empty lab registry says where dry runs went
     assert f"dry runs are recorded apart, in sqlite:///{tmp_path / 'dry-runs.sqlite'}" in capsys.readouterr().out
     assert rig("registry", "list", "--config", procedure_dir / "sim.yaml", "--json") == 0
@@ -137,10 +137,20 @@ def test_hand_held_fits_are_recorded_with_their_part(tmp_path: Path, capsys) -> 
 ])
 def test_bad_requests_are_one_line(argv: list[str], message: str, tmp_path: Path, capsys) -> None:
     if "--registry" not in argv:
+        Registry.open(normalised(str(tmp_path / "empty.sqlite")))  # made, with nothing in it
         argv = [*argv, "--registry", str(tmp_path / "empty.sqlite")]
     assert rig(*argv) == 2
     err = capsys.readouterr().err.strip()
     assert err.endswith(message) and len(err.splitlines()) == 1
+
+
+def test_a_reader_of_a_registry_not_made_yet_says_so_and_makes_none(tmp_path: Path, capsys) -> None:
+    missing = tmp_path / "lab" / "registry.sqlite"
+    assert rig("registry", "show", "ANY", "--registry", missing) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"rig: error: registry sqlite:///{missing}: does not exist (nothing recorded in it yet)"
+    assert rig("registry", "list", "--registry", missing, "--json") == 0
+    assert json.loads(capsys.readouterr().out) == [] and not missing.parent.exists()
 
 
 def test_a_registry_that_cannot_take_the_record_loses_nothing(tmp_path: Path, capsys) -> None:

@@ -4,7 +4,12 @@ verdict."""
 
 from __future__ import annotations
 
+import socket
+import sqlite3
+import subprocess
+import threading
 from datetime import datetime, timedelta
+from pathlib import Path
 
 import pytest
 
@@ -128,8 +133,15 @@ def test_a_schema_newer_than_this_software_is_one_line(registry_url: str) -> Non
         Registry.open(registry_url)
 
 
-def test_readers_do_not_migrate_but_create_a_new_registry(registry_url: str) -> None:
-    assert Registry.open(registry_url, upgrade=False).revision() == head_revision()  # new: created
+def test_readers_do_not_migrate_and_create_nothing(registry_url: str) -> None:
+    if registry_url.startswith("sqlite:///"):
+        with pytest.raises(ConfigError, match="does not exist"):
+            Registry.open(registry_url, upgrade=False, create=False, read_only=True)
+        assert not Path(registry_url.removeprefix("sqlite:///")).exists()
+    else:  # a database with nothing in it: empty, and left so
+        with pytest.raises(ConfigError, match=r"empty \(nothing recorded in it yet\)"):
+            Registry.open(registry_url, upgrade=False, create=False, read_only=True)
+    assert Registry.open(registry_url, upgrade=False).revision() == head_revision()  # a recorder creates it
     older = Registry.open(registry_url)
     older.engine.dispose()
     import sqlalchemy as sa
@@ -152,3 +164,92 @@ def test_times_are_stored_as_utc(registry_url: str, quick_campaign) -> None:
 
     assert _utc("2026-06-01T14:00:00+02:00") == datetime(2026, 6, 1, 12, 0, 0)  # another zone, as UTC
     assert abs(stored["registered_at"] - datetime.utcnow()) < timedelta(minutes=5)
+
+
+def damaged(registry_url: str, quick_campaign, damage: str) -> None:
+    """A registry with a calibration in it, then changed by hand as `damage` says."""
+    import sqlalchemy as sa
+
+    campaign, calibration = quick_campaign
+    registry = Registry.open(registry_url)
+    registry.add(campaign_entries(campaign, calibration))
+    statement = {"a table dropped": "DROP TABLE certificate_revisions",
+                 "a column dropped": "ALTER TABLE users DROP COLUMN full_name",
+                 "a date that is not a date": "UPDATE calibrations SET calibrated_at = 'last tuesday'"}[damage]
+    with registry.engine.begin() as connection:
+        connection.execute(sa.text(statement))
+    registry.engine.dispose()
+
+
+@pytest.mark.parametrize(("damage", "message"), [
+    ("a table dropped", "table certificate_revisions is missing: the database was damaged or changed by hand"),
+    ("a column dropped", "table users lacks column full_name: the database was damaged or changed by hand"),
+])
+def test_a_registry_changed_by_hand_is_refused_when_opened(damage: str, message: str, registry_url: str,
+                                                          quick_campaign) -> None:
+    damaged(registry_url, quick_campaign, damage)
+    for reader in (True, False):
+        with pytest.raises(ConfigError, match=message):
+            Registry.open(registry_url, upgrade=not reader, create=not reader, read_only=reader)
+
+
+def test_a_row_that_cannot_be_read_is_one_line_naming_the_registry(tmp_path: Path, quick_campaign) -> None:
+    url = f"sqlite:///{tmp_path / 'registry.sqlite'}"  # SQLite keeps any text in a date column; PostgreSQL would not
+    damaged(url, quick_campaign, "a date that is not a date")
+    registry = Registry.open(url, upgrade=False, create=False, read_only=True)
+    with pytest.raises(ConfigError, match=r"cannot be read \(.*\): the database was damaged or changed by hand"):
+        registry.calibrations()
+
+
+def test_someone_elses_database_is_never_migrated_into(tmp_path: Path) -> None:
+    foreign = tmp_path / "inventory.sqlite"
+    with sqlite3.connect(foreign) as connection:
+        connection.execute("CREATE TABLE parts (id INTEGER PRIMARY KEY, name TEXT)")
+    before = foreign.read_bytes()
+    for reader in (True, False):
+        with pytest.raises(ConfigError, match=r"not an accelcal-rig registry \(it holds tables parts and no schema "
+                                              r"revision\)"):
+            Registry.open(f"sqlite:///{foreign}", upgrade=not reader, create=not reader, read_only=reader)
+    assert foreign.read_bytes() == before
+    not_a_database = tmp_path / "notes.sqlite"
+    not_a_database.write_text("minutes of the lab meeting\n" * 100)
+    with pytest.raises(ConfigError, match=r"registry sqlite:///.*notes.sqlite: .*file is not a database"):
+        Registry.open(f"sqlite:///{not_a_database}", upgrade=False, create=False, read_only=True)
+
+
+def test_a_registry_on_a_read_only_mount_is_read(tmp_path: Path, quick_campaign) -> None:
+    """Mounted read-only (root: a tmpfs remounted ro), where SQLite cannot make its WAL side files."""
+    mount = tmp_path / "mnt"
+    mount.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=8m", "tmpfs", str(mount)], capture_output=True).returncode:
+        pytest.skip("needs to mount a tmpfs (root)")
+    try:
+        url = f"sqlite:///{mount / 'registry.sqlite'}"
+        campaign, calibration = quick_campaign
+        Registry.open(url).add(campaign_entries(campaign, calibration))
+        subprocess.run(["mount", "-o", "remount,ro", str(mount)], check=True)
+        registry = Registry.open(url, upgrade=False, create=False, read_only=True)
+        assert registry.count() == 4 and len(registry.calibrations()) == 4
+        with pytest.raises(ConfigError):  # a recorder cannot: one line, not a crash
+            Registry.open(url).add(campaign_entries(campaign, calibration))
+    finally:
+        subprocess.run(["umount", str(mount)], capture_output=True)
+
+
+def test_a_server_that_accepts_and_never_answers_is_one_line_within_the_connect_timeout() -> None:
+    """The URL's own connect_timeout (1 s here; 10 s when it gives none): a deadline, not a wait of minutes."""
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(4)
+    held: list[socket.socket] = []
+    threading.Thread(target=lambda: held.append(listener.accept()[0]), daemon=True).start()
+    port = listener.getsockname()[1]
+    try:
+        with pytest.raises(ConfigError, match=rf"registry postgresql\+psycopg://lab@127.0.0.1:{port}/r\?connect_timeout=1: "
+                                              "cannot open: .*timeout"):
+            Registry.open(f"postgresql://lab@127.0.0.1:{port}/r?connect_timeout=1".replace(
+                "postgresql://", "postgresql+psycopg://"), upgrade=False, create=False, read_only=True)
+    finally:
+        listener.close()
+        for connection in held:
+            connection.close()

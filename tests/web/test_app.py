@@ -48,6 +48,7 @@ def test_a_campaign_page_has_its_plot_warnings_and_certificates(lab) -> None:
     assert "ADX355-A001.html" in page.text
     certificate = client.get("/campaigns/quick.h5/certificates/ADX355-A001.html")
     assert certificate.status_code == 200 and "ADX355-A001" in certificate.text
+    assert certificate.headers["content-security-policy"] == "sandbox"  # its scripts cannot reach the dashboard
     assert client.get("/campaigns/quick.h5/certificates/..%2Fquick.h5.journal").status_code == 404  # exists, outside
     assert client.get("/campaigns/nothing.h5").status_code == 404
 

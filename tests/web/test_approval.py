@@ -81,8 +81,9 @@ def test_an_approver_logs_in_and_approves_and_nothing_else_can(lab) -> None:
     assert "certificate revision 1" in approved.text
     pdf = client.get(f"/registry/calibrations/{row_id}/certificates/1.pdf")
     assert pdf.status_code == 200 and pdf.content.startswith(b"%PDF")
-    html = client.get(f"/registry/calibrations/{row_id}/certificates/1.html").text
-    assert "Jane Doe" in html and "DRAFT" not in html
+    issued = client.get(f"/registry/calibrations/{row_id}/certificates/1.html")
+    html = issued.text
+    assert "Jane Doe" in html and "DRAFT" not in html and issued.headers["content-security-policy"] == "sandbox"
     assert client.get(f"/registry/calibrations/{row_id}/certificates/2.pdf").status_code == 404
     (decision,) = Approvals(Registry.open(registry)).trail(calibration_id=row_id)
     assert decision["authority"] == "dashboard, password of registry user jdoe" and decision["revision"] == 1
