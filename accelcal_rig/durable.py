@@ -55,6 +55,30 @@ def clear_stale_temporaries(*paths: Path) -> None:
                 stale.unlink(missing_ok=True)
 
 
+def clear_dead_temporaries(*paths: Path) -> None:
+    """Remove what processes that are gone left half-built beside `paths` — a file no lock guards (a
+    calibration, a certificate, a progress view), whose writer may still be at work: only a `.tmp-PID` whose
+    process has ended on this machine goes (a live or unknown one's stays)."""
+    for path in paths:
+        for stale in stale_temporaries(path):
+            pid = stale.name.rpartition(".tmp-")[2]
+            if pid.isdigit() and not _alive(int(pid)):
+                with disk_errors(stale, "a file left half-built"):
+                    stale.unlink(missing_ok=True)
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
 def remove(path: Path, what: str) -> None:
     """Remove `path` if it is there; an error is one line naming it."""
     with disk_errors(path, what):

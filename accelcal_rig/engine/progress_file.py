@@ -14,6 +14,7 @@ import time
 from datetime import UTC, datetime
 from pathlib import Path
 
+from accelcal_rig.durable import temporary_beside
 from accelcal_rig.engine.progress import Progress, ProgressListener
 
 #: Shortest wall-clock interval between two writes within one phase.
@@ -37,7 +38,7 @@ class ProgressFile:
         self._phase, self._written_at = phase, now
         snapshot = {**dataclasses.asdict(progress), "line": progress.line(), "pid": os.getpid(),
                     "updated": datetime.now(UTC).isoformat(timespec="seconds")}
-        temporary = self._path.with_name(self._path.name + f".{os.getpid()}.tmp")
+        temporary = temporary_beside(self._path)
         try:
             temporary.write_text(json.dumps(snapshot))
             os.replace(temporary, self._path)

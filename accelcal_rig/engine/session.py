@@ -12,6 +12,7 @@ import numpy as np
 
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.core.logger import LOGGER
+from accelcal_rig.durable import clear_stale_temporaries
 from accelcal_rig.engine.audience import Audience
 from accelcal_rig.engine.campaign import CampaignRunner, CampaignSummary, FitOutcome, FitStage
 from accelcal_rig.engine.campaign_header import create_campaign_file, fit_attrs, instrument_info
@@ -111,6 +112,7 @@ def _finish_complete(prepared: PreparedCampaign, output: Path, stored: Campaign,
     done, if one was)."""
     done, fit = [], None
     with campaign_lock(output, "rig resume"):
+        clear_progress(output)
         if file_currency(output, stored, writing=False) != "current":
             repair_campaign(output)
             done.append(f"{output.name} brought up to date from its journal")
@@ -121,6 +123,13 @@ def _finish_complete(prepared: PreparedCampaign, output: Path, stored: Campaign,
                 raise RigError(f"{output}: the campaign is complete, but its fit failed: {exc}") from None
             done.append(fit.summary)
     return done, fit
+
+
+def clear_progress(output: Path) -> None:
+    """The campaign's progress view and its half-written versions, left by a run that was killed: removed
+    by the next command that holds the campaign (never shown as a live run's)."""
+    clear_stale_temporaries(progress_path(output))
+    progress_path(output).unlink(missing_ok=True)
 
 
 def _fitted_to(calibration: Path, output: Path) -> bool:
@@ -158,6 +167,7 @@ def _run(prepared: PreparedCampaign, output: Path, open_writer: Callable[[], Cam
     if fit_stage is not None:
         warm_up_workers(len(rig.fixture.sensors))  # a large fixture's fit workers load while it measures
     notifier = Notifier(notify) if notify.webhook_url or notify.command else None
+    clear_progress(output)
     audience = Audience(ProgressFile(progress_path(output), progress), estimate, notifier, str(output))
     runner = CampaignRunner(procedure, rig, prepared.plan, rig_connected, open_writer, fit_stage=fit_stage,
                             resume=resume, audience=audience)

@@ -19,7 +19,7 @@ from pydantic import Discriminator, Field, Tag, field_validator, model_validator
 from accelcal_rig.config.bounds import StrictModel, TemperatureC
 from accelcal_rig.config.load import load_validated
 from accelcal_rig.config.yaml_lines import CALIBRATION_LIMITS
-from accelcal_rig.durable import write_text_atomically
+from accelcal_rig.durable import clear_dead_temporaries, write_text_atomically
 from accelcal_rig.fit import gyro_model
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
 
@@ -285,7 +285,9 @@ def apply_gyro(calibration: GyroCalibration, rate_dps: np.ndarray, force_g: np.n
 
 
 def save_calibration(calibration: CalibrationFile, path: Path) -> None:
-    """Write the calibration file, replacing any file at `path` whole (never a half-written one)."""
+    """Write the calibration file, replacing any file at `path` whole (never a half-written one), and what
+    writers of it that were killed left half-built beside it."""
+    clear_dead_temporaries(path)
     dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml: a 64-DUT calibration is 2 MB of YAML
     data = calibration.model_dump(mode="json")
     text = yaml.dump(data, Dumper=dumper, sort_keys=False, width=120, allow_unicode=True)

@@ -21,7 +21,7 @@ import numpy as np
 
 from accelcal_rig import __version__
 from accelcal_rig.core.units import gravity_statement
-from accelcal_rig.durable import write_atomically, write_text_atomically
+from accelcal_rig.durable import clear_dead_temporaries, write_atomically, write_text_atomically
 from accelcal_rig.errors import ConfigError, RigError
 from accelcal_rig.fit.calibration import CalibrationFile, GyroCalibration, SensorCalibration, load_calibration
 from accelcal_rig.fit.sfem import PARAMETER_NAMES
@@ -78,6 +78,7 @@ def write_certificates(campaign_path: Path, calibration_path: Path, folder: Path
         sensor = calibration.sensors[serial]
         page = certificate_html(campaign, campaign_path, calibration, calibration_path, serial, sensor, operator)
         pdf_path = None
+        clear_dead_temporaries(folder / f"{name}.pdf", folder / f"{name}.html")  # what a killed writer left
         if render is not None:
             pdf_path = folder / f"{name}.pdf"
             write_atomically(pdf_path, _rendered_pdf(render, page, pdf_path), "the certificate")

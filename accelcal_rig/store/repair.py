@@ -29,7 +29,7 @@ from accelcal_rig.store.codec import (
 from accelcal_rig.store.content import Campaign, take_what_the_file_kept
 from accelcal_rig.store.hdf5_file import DamagedFile, campaign_image
 from accelcal_rig.store.journal import JournalWriter, read_journal
-from accelcal_rig.store.paths import journal_path
+from accelcal_rig.store.paths import journal_path, progress_path
 from accelcal_rig.store.read import file_identity, file_kept_more, read_hdf5_campaign
 from accelcal_rig.store.records import StateChange
 
@@ -111,7 +111,8 @@ def mend_journal(path: Path) -> list[str]:
 def repair_campaign(path: Path) -> list[str]:
     """Repair the campaign at `path`: what was done, one line each. Refused while a run holds it."""
     with lock.campaign_lock(path, "rig repair"):
-        clear_stale_temporaries(path, journal_path(path))  # what a killed run left half-built
+        clear_stale_temporaries(path, journal_path(path), progress_path(path))  # what a killed run left half-built
+        progress_path(path).unlink(missing_ok=True)  # a killed run's view of itself: no run is live now
         done = mend_journal(path)
         journal, found = JournalWriter.reopen(journal_path(path), 0)
         journal.close()

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from accelcal_rig.core.formatting import format_duration
+from accelcal_rig.store.lock import holder
 from accelcal_rig.store.paths import journal_path, progress_path
 from accelcal_rig.store.read import campaign_status, load_campaign
 
@@ -61,7 +62,7 @@ class CampaignFolders:
         stamp = tuple(_stamp(p) for p in (path, journal_path(path), progress_path(path)))
         with self._lock:
             cached = self._cache.get(path)
-        if cached is not None and cached.stamp == stamp:
+        if cached is not None and cached.stamp == stamp and not _writer_gone(path, cached.summary):
             return cached
         try:
             campaign = load_campaign(path)
@@ -78,6 +79,12 @@ class CampaignFolders:
         with self._lock:
             self._cache[path] = cached
         return cached
+
+
+def _writer_gone(path: Path, summary: dict[str, Any]) -> bool:
+    """A campaign shown as run by a live process whose process has ended since (a kill changes no file): what
+    was shown of it is stale. Asked only of a campaign shown as running (asking takes the lock a moment)."""
+    return str(summary.get("writer") or "").startswith("alive") and holder(path) is None
 
 
 def _stamp(path: Path) -> tuple[int, int]:

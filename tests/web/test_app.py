@@ -109,3 +109,27 @@ def test_rig_serve_refuses_an_open_address_without_a_token(capsys) -> None:
 
     assert main(["serve", "--host", "0.0.0.0"]) == 2
     assert "off 127.0.0.1 the dashboard needs --token" in capsys.readouterr().err
+
+
+def test_a_campaign_whose_writer_has_ended_is_not_shown_as_live_from_the_cache(lab, monkeypatch) -> None:
+    """A run killed changes no file: the campaign shown as run by a live process is read again once no process
+    holds it, and no longer shown live."""
+    from accelcal_rig.web import campaigns as module
+
+    folder, _ = lab
+    real = module.campaign_status
+    holding = {"now": True}
+
+    def status(path: Path, campaign) -> dict:  # noqa: ANN001 - as the module calls it
+        found = real(path, campaign)
+        alive = holding["now"]
+        return {**found, "state": "running", "writer": "alive (pid 4242)" if alive else "gone (pid 4242 ended)",
+                "progress": {"line": "T30 soak"} if alive else None}
+
+    monkeypatch.setattr(module, "campaign_status", status)
+    monkeypatch.setattr(module, "holder", lambda path: "pid 4242" if holding["now"] else None)
+    folders = module.CampaignFolders([folder])
+    assert folders.summary("quick.h5")["progress"] == {"line": "T30 soak", "left": None}
+    holding["now"] = False  # killed: no file changed
+    summary = folders.summary("quick.h5")
+    assert summary["progress"] is None and summary["writer"].startswith("gone")
