@@ -104,3 +104,12 @@ def stored_poses(campaign: Path) -> dict[str, bytes]:
                                  + [d.raw_codes.tobytes() + d.mean_g.tobytes() + d.stderr_g.tobytes()
                                     + repr(d.temperature_c).encode() + d.gravity_reference_g.tobytes() for d in p.duts])
             for p in loaded.poses}
+
+
+@pytest.fixture(scope="session")
+def imu_dry_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """The small IMU campaign (tests/fit/test_gyro_fit.py's PROCEDURE, seed 3), run once and fitted as `rig run`
+    fits it: (campaign, calibration). Modules take a copy of it (tests/report/imu_campaign.py's `copied`)."""
+    from tests.report.imu_campaign import imu_campaign
+
+    return imu_campaign(tmp_path_factory.mktemp("imu-session"))

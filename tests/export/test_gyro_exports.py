@@ -11,17 +11,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 
-from accelcal_rig.assembly import run_campaign
-from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.export.c_header import c_identifier, to_c_header
 from accelcal_rig.export.flight_stack import StackOptions
 from accelcal_rig.export.formats import export as export_format
 from accelcal_rig.fit import gyro_model
 from accelcal_rig.fit.calibration import CalibrationRangeWarning, GyroCalibration, apply_gyro, load_calibration
-from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save
-from accelcal_rig.store.read import load_campaign
 from tests.conftest import REPO
 from tests.export.stack_support import export, stated, written_comments
 from tests.export.test_ardupilot import read_ardupilot_params
@@ -44,17 +39,12 @@ SERIAL = "IMU-A001"
 
 
 @pytest.fixture(scope="module")
-def imu_calibration(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def imu_calibration(imu_dry_run: tuple[Path, Path], tmp_path_factory: pytest.TempPathFactory) -> Path:
     """tests/fit/test_gyro_fit.py's small IMU campaign (0 and 40 °C, seed 3), fitted: a calibration whose four
-    DUTs have an accel and a gyro channel."""
-    folder = tmp_path_factory.mktemp("imu-export")
-    procedure = folder / "imu.yaml"
-    procedure.write_text(yaml.safe_dump(PROCEDURE, sort_keys=False))
-    campaign = folder / "imu.h5"
-    run_campaign(prepare(procedure), campaign, dry_run=True, seed=3, overwrite=False)
-    output = folder / "imu.calibration.yaml"
-    fit_and_save(load_campaign(campaign), campaign, output, FitOptions(degree=1))
-    return output
+    DUTs have an accel and a gyro channel (this module's copy of tests/conftest.py's imu_dry_run)."""
+    from tests.report.imu_campaign import copied
+
+    return copied(imu_dry_run, tmp_path_factory.mktemp("imu-export"))[1]
 
 
 def bias_rad_s(gyro: GyroCalibration, temperature_c: np.ndarray) -> np.ndarray:

@@ -51,11 +51,11 @@ def _procedure(folder: Path, **changes: object) -> Path:
 
 
 @pytest.fixture(scope="module")
-def campaign_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    folder = tmp_path_factory.mktemp("imu")
-    path = folder / "imu.h5"
-    run_campaign(prepare(_procedure(folder)), path, dry_run=True, seed=3, overwrite=False)
-    return path
+def campaign_path(imu_dry_run: tuple[Path, Path], tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """This module's copy of the session's run of PROCEDURE (seed 3: tests/conftest.py's imu_dry_run)."""
+    from tests.report.imu_campaign import copied
+
+    return copied(imu_dry_run, tmp_path_factory.mktemp("imu"))[0]
 
 
 @pytest.fixture(scope="module")

@@ -16,15 +16,15 @@ from accelcal_rig.fit.calibration import load_calibration
 from accelcal_rig.registry.database import Registry, head_revision
 from accelcal_rig.registry.entries import campaign_entries
 from accelcal_rig.registry.figures import noise_figures
-from tests.report.imu_campaign import imu_campaign
+from tests.report.imu_campaign import copied
 
 _ADDED_BY_0004 = ("bias_dps", "bias_uncertainty_dps", "expanded_uncertainty_dps", "verification_rmse_dps",
                   "arw_deg_per_rthr", "bias_instability_dph", "vrw_m_s_per_rthr", "bias_instability_ug")
 
 
 @pytest.fixture(scope="module")
-def imu(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
-    return imu_campaign(tmp_path_factory.mktemp("imu"))
+def imu(imu_dry_run: tuple[Path, Path], tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    return copied(imu_dry_run, tmp_path_factory.mktemp("imu"))
 
 
 def test_an_imu_is_recorded_as_a_row_per_channel_once(registry_url: str, imu: tuple[Path, Path]) -> None:

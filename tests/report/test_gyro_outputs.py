@@ -13,13 +13,13 @@ import yaml
 from accelcal_rig.fit.calibration import load_calibration
 from accelcal_rig.report.certificate import write_certificates
 from accelcal_rig.report.html_report import FIGURES, GYRO_FIGURES, write_report
-from tests.report.imu_campaign import imu_campaign
+from tests.report.imu_campaign import copied
 from tests.report.test_html_report import png_size, referenced_files
 
 
 @pytest.fixture(scope="module")
-def imu(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
-    return imu_campaign(tmp_path_factory.mktemp("imu"))
+def imu(imu_dry_run: tuple[Path, Path], tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    return copied(imu_dry_run, tmp_path_factory.mktemp("imu"))
 
 
 def _edited(calibration: Path, folder: Path, change) -> Path:  # noqa: ANN001 - a function of the YAML data
