@@ -6,6 +6,7 @@
     python bench/reliability.py concurrent --trials 8   # --overwrite, resume, fit, repair against a running campaign
     python bench/reliability.py signals --trials 20     # SIGINT / SIGTERM at a random moment
     python bench/reliability.py faults --trials 2       # injected instrument faults, transient and persistent
+    python bench/reliability.py faults-sweep --json     # every transient fault kind alone at 1 %, 2 %, 5 %
 
 Every trial runs `rig run procedures/paper-24pos-thermal.yaml --dry-run` (11 setpoints × 24 poses × 4 DUTs)
 and judges what is left the way a careful lab would:
@@ -23,12 +24,18 @@ and judges what is left the way a careful lab would:
   readable; once the filler is removed `rig resume` must complete as above.
 - Concurrent commands against a running campaign must be refused with one line naming its process, and
   change nothing: the running campaign's journal records, log and final result are as if alone.
+- A fault sweep (`faults-sweep`) runs the paper campaign on configs/sim-lossy.yaml once per transient fault
+  kind, rate and fault seed (`--fault-seeds`, default 0: what `rig run --faults rate=…` draws), that kind
+  alone; a run that aborts is resumed with the same faults (`--resumes` times at most). It passes when the
+  campaign ends `done` with every planned pose stored exactly once, counted in the journal's pose records
+  and in the campaign file's rows, not as a reader deduplicates them.
 """
 
 from __future__ import annotations
 
 import argparse
 import hashlib
+import itertools
 import json
 import os
 import random
@@ -39,19 +46,25 @@ import subprocess
 import sys
 import tempfile
 import time
+import typing
+from collections import Counter
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
+import h5py
 from quiet import throwaway_registry  # bench/quiet.py, beside this script
 
+from accelcal_rig.config.rig import FaultInjection
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import load_calibration
 from accelcal_rig.store.content import Campaign
-from accelcal_rig.store.journal import read_journal
+from accelcal_rig.store.journal import Record, read_journal
 from accelcal_rig.store.paths import journal_path, log_path
 from accelcal_rig.store.read import file_currency, load_campaign
 
 REPO = Path(__file__).resolve().parent.parent
 PAPER = REPO / "procedures" / "paper-24pos-thermal.yaml"
+LOSSY_RIG = REPO / "configs" / "sim-lossy.yaml"
 RIG = str(Path(sys.executable).parent / "rig")
 WRITE_CALLS = ("pwrite64", "fdatasync", "fsync", "rename")
 
@@ -507,16 +520,136 @@ def fault_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, in
     return passed, total
 
 
+# ---------------------------------------------------------------------- a sweep of transient fault kinds
+#: Every transient fault kind the simulators inject, as the rig config's `simulation.faults.kinds` lists them.
+FAULT_KINDS: tuple[str, ...] = typing.get_args(typing.get_args(FaultInjection.model_fields["kinds"].annotation)[0])
+SWEEP_RATES = (0.01, 0.02, 0.05)
+
+
+def pose_copies(campaign: Path) -> tuple[int, int, int]:
+    """(distinct poses, journal pose records beyond one per step, campaign file rows beyond one per step): a
+    reader keeps the first copy of a pose stored twice, so duplicates are counted where they were written."""
+    journal_keys = Counter(r.meta.get("step_key") for r in _journal_records(campaign) if r.kind == "pose")
+    try:
+        with h5py.File(campaign, "r") as f:
+            file_keys = Counter(k.decode() if isinstance(k, bytes) else str(k) for k in f["poses/step_key"][()])
+    except (OSError, KeyError):
+        file_keys = Counter()
+    distinct = len(set(journal_keys) | set(file_keys))
+    return distinct, sum(journal_keys.values()) - len(journal_keys), sum(file_keys.values()) - len(file_keys)
+
+
+def _journal_records(campaign: Path) -> list[Record]:
+    try:
+        return read_journal(journal_path(campaign)).records
+    except OSError:
+        return []
+
+
+@dataclass
+class SweepRow:
+    """One run of the sweep: its faults, how it ended, what it stored and what it cost."""
+
+    kind: str
+    rate: float
+    seed: int
+    faults: str
+    exits: list[int]
+    abort_reasons: list[str]
+    state: str
+    poses_stored: int
+    poses_planned: int
+    duplicates: int
+    retries: int
+    wall_s: float
+    problems: list[str]
+
+    @property
+    def completed(self) -> bool:
+        return self.exits[-1] == 0 and self.state == "done"
+
+    @property
+    def ok(self) -> bool:
+        """Done with every planned pose stored exactly once."""
+        return self.completed and self.poses_stored == self.poses_planned and not self.duplicates and not self.problems
+
+    def as_json(self) -> dict[str, object]:
+        return {**asdict(self), "ok": self.ok, "completed": self.completed, "completed_first_run": self.exits[0] == 0,
+                "resumes": len(self.exits) - 1}
+
+
+def sweep_one(campaign: Path, kind: str, rate: float, seed: int, resumes: int) -> SweepRow:
+    """The paper campaign on the lossy rig with `kind` alone at `rate`; resumed with the same faults while it
+    aborts, `resumes` times at most. Wall seconds are the run's and its resumes' together."""
+    clean(campaign)
+    faults = f"rate={rate},kinds={kind},seed={seed}"
+    start = time.perf_counter()
+    run = rig("run", str(PAPER), "--config", str(LOSSY_RIG), "--dry-run", "-o", str(campaign), "-q",
+              "--no-pdf", "--faults", faults, timeout=3600)
+    exits, reasons = [run.returncode], []
+    while exits[-1] != 0 and len(exits) <= resumes and campaign.exists():
+        reasons.append(_last_line(run))
+        run = rig("resume", str(campaign), "--config", str(LOSSY_RIG), "-q", "--no-pdf", "--faults", faults,
+                  timeout=3600)
+        exits.append(run.returncode)
+    wall_s = time.perf_counter() - start
+    if exits[-1] != 0:
+        reasons.append(_last_line(run))
+    try:
+        loaded = load_campaign(campaign)
+        state, planned, problems = loaded.state, loaded.poses_planned, loaded.integrity_problems()
+        retries = sum(e.kind == "retry" for e in loaded.events)
+    except ConfigError as exc:
+        state, planned, problems, retries = "unreadable", 0, [str(exc)], 0
+    stored, journal_duplicates, file_duplicates = pose_copies(campaign)
+    return SweepRow(kind, rate, seed, faults, exits, reasons, state, stored, planned,
+                    journal_duplicates + file_duplicates, retries, round(wall_s, 1), problems[:3])
+
+
+def _last_line(run: subprocess.CompletedProcess) -> str:
+    lines = run.stderr.strip().splitlines()
+    return lines[-1][-200:] if lines else ""
+
+
+def fault_sweep(folder: Path, kinds: list[str], rates: list[float], seeds: list[int], resumes: int,
+                rows: list[SweepRow]) -> tuple[int, int]:
+    """Every kind alone at every rate with every fault seed; each row is printed as it ends and kept in `rows`."""
+    campaign = folder / "sweep.h5"
+    print(f"{'kind':10s} {'rate':>5s} {'seed':>4s}  {'ok':4s} {'first run':9s} {'resumes':>7s} {'poses':>9s} "
+          f"{'dupl.':>5s} {'retries':>7s} {'wall s':>7s}", flush=True)
+    for kind, rate, seed in itertools.product(kinds, rates, seeds):
+        row = sweep_one(campaign, kind, rate, seed, resumes)
+        rows.append(row)
+        print(f"{kind:10s} {rate:5.0%} {seed:4d}  {'pass' if row.ok else 'FAIL':4s} "
+              f"{'done' if row.exits[0] == 0 else 'aborted':9s} {len(row.exits) - 1:7d} "
+              f"{row.poses_stored:>4}/{row.poses_planned:<4} {row.duplicates:5d} {row.retries:7d} "
+              f"{row.wall_s:7.1f}" + "".join(f"\n    {r}" for r in row.abort_reasons), flush=True)
+    return sum(row.ok for row in rows), len(rows)
+
+
 def main() -> None:
     throwaway_registry()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("kind", choices=["syscalls", "crash", "diskfull", "concurrent", "signals", "faults"])
+    parser.add_argument("kind", choices=["syscalls", "crash", "diskfull", "concurrent", "signals", "faults",
+                                         "faults-sweep"])
     parser.add_argument("--trials", type=int, default=20)
     parser.add_argument("--points", type=int, default=220, help="syscalls: kill points over rig run")
     parser.add_argument("--resume-points", type=int, default=40, help="syscalls: kill points over rig resume")
     parser.add_argument("--seed", type=int, default=1)
-    parser.add_argument("--json", action="store_true", help="end with one JSON line of the totals")
+    parser.add_argument("--json", action="store_true", help="end with one JSON line of the totals (faults-sweep: "
+                        "and every row)")
+    parser.add_argument("--kinds", default=",".join(FAULT_KINDS), help="faults-sweep: the transient kinds, "
+                        "comma-separated (default: every one)")
+    parser.add_argument("--rates", default=",".join(f"{r:g}" for r in SWEEP_RATES),
+                        help="faults-sweep: the rates, comma-separated")
+    parser.add_argument("--fault-seeds", default="0", help="faults-sweep: the fault injection's seeds, "
+                        "comma-separated (default 0, as rig run draws them unless told)")
+    parser.add_argument("--resumes", type=int, default=2, help="faults-sweep: resumes of a run that aborted")
     args = parser.parse_args()
+    kinds = [k for k in args.kinds.split(",") if k]
+    if unknown := sorted(set(kinds) - set(FAULT_KINDS)):
+        parser.error(f"--kinds: {', '.join(unknown)} not among {', '.join(FAULT_KINDS)}")
+    rows: list[SweepRow] = []
     rng = random.Random(args.seed)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
@@ -527,10 +660,13 @@ def main() -> None:
             "concurrent": lambda: concurrent_trials(folder, args.trials, rng),
             "signals": lambda: signal_trials(folder, args.trials, rng),
             "faults": lambda: fault_trials(folder, args.trials, rng),
+            "faults-sweep": lambda: fault_sweep(folder, kinds, [float(r) for r in args.rates.split(",") if r],
+                                                [int(n) for n in args.fault_seeds.split(",") if n], args.resumes,
+                                                rows),
         }[args.kind]()
     print(f"{args.kind}: {passed}/{total} trials passed")
     if args.json:
-        print(json.dumps({"trials": args.kind, "passed": passed, "total": total}))
+        print(json.dumps({"trials": args.kind, "passed": passed, "total": total, **({"rows": [r.as_json() for r in rows]} if rows else {})}))
     sys.exit(0 if passed == total else 1)
 
 

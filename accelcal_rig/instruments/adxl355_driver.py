@@ -61,6 +61,9 @@ class Adxl355:
         self._clock = clock
         self._odr_hz = 125.0
         self._capture: _Capture | None = None
+        #: Clock time the last capture request was posted: when the bridge started it, however much later
+        #: its reply is read (after another DUT's retries, say).
+        self._capture_posted_s: float | None = None
         #: (clock time, raw code) of the last temperature that two reads agreed on.
         self._agreed: tuple[float, int] | None = None
 
@@ -183,15 +186,22 @@ class Adxl355:
     # ------------------------------------------------------------------ bridge-side capture
     def post_capture(self, n_samples: int) -> bool:
         """Send the capture request without waiting for its reply (False: not sent; `begin_capture` asks)."""
+        self._capture_posted_s = self._clock.now()
         return self._posted(lambda bridge: bridge.post_capture(n_samples))
 
     def begin_capture(self, n_samples: int, posted: bool = False) -> None:
         """The bridge starts capturing the next `n_samples` (and says the temperature then). `posted`: the
-        request went out with `post_capture`; its reply is read here, or the request retried if it failed."""
+        request went out with `post_capture`; its reply is read here, or the request retried if it failed.
+        The block starts when the bridge heard the request that started it, not when its reply was read:
+        the replies of posted requests are read one DUT after another, after any retries of those before."""
         raw = self._received(posted, lambda bridge: bridge.receive_capture(n_samples))
-        if raw is None:
+        if raw is not None and self._capture_posted_s is not None:
+            started_s = self._capture_posted_s
+        else:  # not posted, or its reply lost: a capture started again now, by the retried request
             raw = self._capturing_bus().start_capture(n_samples)
-        self._capture = _Capture(n_samples, self._clock.now(), float(self.part.temperature.celsius(raw)))
+            started_s = self._clock.now()
+        self._capture_posted_s = None
+        self._capture = _Capture(n_samples, started_s, float(self.part.temperature.celsius(raw)))
 
     def capture_wait_s(self) -> float:
         """Clock time until the rest of the block has been captured."""

@@ -17,7 +17,8 @@ OVERFLOW_ATTEMPTS = 3
 
 def capture_together(sensors: Sequence[BlockCapturing], n_samples: int, clock: Clock) -> list[SampleBlock]:
     """Start every capture, then fetch in rounds until all are complete. A capture that lost samples is
-    started again (that sensor only), OVERFLOW_ATTEMPTS times at most."""
+    started again (that sensor only), OVERFLOW_ATTEMPTS times at most. A capture whose start had to be
+    retried begins later than the others: each block is timed from its own start."""
     blocks: dict[int, SampleBlock] = {}
     pending = list(range(len(sensors)))
     for _ in range(OVERFLOW_ATTEMPTS):

@@ -105,12 +105,18 @@ class SimulatedChamberServer:
     async def _action(self, function_code: int, start_address: int, address: int, count: int,
                       current_registers: list[int], set_values: list[int] | list[bool] | None) -> ExcCodes | None:
         fault = self._faults.draw(("drop", "delay", "busy", "disconnect")) if self._faults else None
-        if fault == "drop":
-            await asyncio.sleep(_DROPPED_REPLY_LATE_S)
-        elif fault == "delay":
+        if fault == "delay":
             await asyncio.sleep(self._faults.faults.delay_s)  # type: ignore[union-attr]
         elif fault == "busy":
             return ExcCodes.DEVICE_BUSY
+        answer = self._answer(address, count, start_address, current_registers, set_values)
+        if fault == "drop":  # carried out at once, as a controller does; only its reply is lost (sent to nobody)
+            await asyncio.sleep(_DROPPED_REPLY_LATE_S)
+        return answer
+
+    def _answer(self, address: int, count: int, start_address: int, current_registers: list[int],
+                set_values: list[int] | list[bool] | None) -> ExcCodes | None:
+        """Carry out a request on the lab now: a write, or the registers read filled in."""
         requested = range(address, address + count)
         with self._lab.lock:
             if set_values is not None:

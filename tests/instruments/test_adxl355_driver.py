@@ -9,10 +9,11 @@ import pytest
 
 from accelcal_rig.config.load import load_rig
 from accelcal_rig.core.clock import VirtualClock
-from accelcal_rig.errors import InstrumentError
+from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.instruments.adxl355_driver import Adxl355
 from accelcal_rig.instruments.adxl355_transport import SerialBridge, SpidevBus
+from accelcal_rig.instruments.capture import capture_together
 from accelcal_rig.parts.adxl35x import ADXL355
 from accelcal_rig.sim.adxl355_bridge_server import SimulatedBridgeServer
 from accelcal_rig.sim.lab import VirtualLab
@@ -280,3 +281,52 @@ def test_torn_reads_in_the_status_burst_of_a_drained_block_are_outvoted_too() ->
     finally:
         driver.close()
         server.stop()
+
+
+def test_a_capture_started_together_is_timed_from_its_request_not_from_when_its_reply_was_read() -> None:
+    """Two bridges asked to capture at once; the first's reply is lost and its retried request lost again,
+    so the retry waits out a backoff on the campaign clock before the second's reply (there since the
+    request) is read. Each block must be timed from when its own capture began on the bridge: the second's
+    at the request, the first's at its retry. Timed from the reply, the second block claimed samples the
+    bridge took 0.5 s earlier (a dry run then found no truth behind it and aborted the campaign)."""
+    clock, backoff_s, n_samples = VirtualClock(), 0.5, 50  # a block of 0.4 s, shorter than the backoff
+    lab = VirtualLab(load_rig(SIM_RIG).model, clock, 3)
+    servers = [SimulatedBridgeServer(lab, index, 2).start() for index in (0, 1)]
+    bridges = [SerialBridge.open(server.path) for server in servers]
+    drivers = [Adxl355(bridge, f"ADX355-A00{index + 1}", clock) for index, bridge in enumerate(bridges)]
+
+    def retried(operation, reconnect=None):
+        """The engine's retry in small: a transient failure waits a backoff on the clock, then tries again."""
+        for _ in range(3):
+            try:
+                return operation()
+            except TransientInstrumentError:
+                clock.sleep(backoff_s)
+        return operation()
+
+    real_receive, lost = bridges[0].receive_capture, []
+
+    def lossy_receive(n: int) -> int:
+        reply = real_receive(n)  # the bridge started the capture and answered; the host never heard it
+        if len(lost) < 2:
+            lost.append(n)
+            raise TransientInstrumentError("reply lost on the line")
+        return reply
+
+    bridges[0].receive_capture = lossy_receive
+    try:
+        for driver in drivers:
+            driver.retry_exchanges(retried)
+            bring_up(driver)
+        asked_s = clock.now()
+        blocks = capture_together(drivers, n_samples, clock)
+        assert lost == [n_samples, n_samples]
+        assert blocks[0].t_start_s == pytest.approx(asked_s + backoff_s, abs=1 / 125)  # started again by the retry
+        assert blocks[1].t_start_s == pytest.approx(asked_s, abs=1 / 125)  # started by the request posted first
+        for index, block in enumerate(blocks):
+            truth = lab.truth_between(index, block.t_start_s, block.t_end_s)  # raised for the second before
+            assert truth["gravity_g"].shape == (3,)
+    finally:
+        for driver, server in zip(drivers, servers):
+            driver.close()
+            server.stop()
