@@ -150,6 +150,8 @@ def _registry(campaign_path: Path, follow_up: FollowUp, simulated: bool) -> Part
     try:
         url = registry_of(campaign_path, follow_up, simulated)
         entries = campaign_entries(campaign_path, follow_up.calibration)
+        if url.startswith("sqlite:///") and not Path(url.removeprefix("sqlite:///")).exists():
+            return PartState("registry", MISSING, f"none recorded: {described(url)} is not made yet")
         registry = Registry.open(url, upgrade=False, create=False, read_only=True)
         recorded = registry.ids_of(entries)
     except (RigError, OSError, SQLAlchemyError) as exc:

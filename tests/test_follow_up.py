@@ -101,7 +101,7 @@ def test_a_reader_of_the_status_creates_no_registry(finished, capsys) -> None:
     for side in registry.parent.glob(registry.name + "-*"):
         side.unlink()
     parts = {p["part"]: p for p in status_of(output, capsys)["follow_up"]}
-    assert parts["registry"]["state"] == "unknown" and "does not exist" in parts["registry"]["detail"]
+    assert parts["registry"]["state"] == "missing" and "is not made yet" in parts["registry"]["detail"]
     assert not registry.exists()
 
 
