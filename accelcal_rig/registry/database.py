@@ -72,7 +72,7 @@ def reads(method: Callable[..., T]) -> Callable[..., T]:
             return method(self, *args, **kwargs)
         except (sa.exc.SQLAlchemyError, ValueError, TypeError, KeyError) as exc:
             url = self.url if isinstance(self, Registry) else self.registry.url
-            raise ConfigError(f"registry {described(url)}: cannot be read ({_first_line(exc)}): the database "
+            raise ConfigError(f"registry {described(url)}: cannot be read ({_first_line(getattr(exc, 'orig', None) or exc)}): the database "
                               "was damaged or changed by hand") from None
     return read
 
@@ -115,7 +115,7 @@ class Registry:
                     raise ConfigError(f"registry {described(url)}: cannot open: {_first_line(exc.orig)}") from None
                 time.sleep(0.05 * (attempt + 1))
             except (sa.exc.SQLAlchemyError, CommandError) as exc:
-                raise ConfigError(f"registry {described(url)}: {_first_line(exc)}") from None
+                raise ConfigError(f"registry {described(url)}: {_first_line(getattr(exc, 'orig', None) or exc)}") from None
         raise AssertionError("unreachable")
 
     def _refuse_unmade(self) -> None:

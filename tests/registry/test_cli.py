@@ -144,6 +144,31 @@ def test_bad_requests_are_one_line(argv: list[str], message: str, tmp_path: Path
     assert err.endswith(message) and len(err.splitlines()) == 1
 
 
+@pytest.mark.parametrize(("damage", "message"), [
+    ("UPDATE calibrations SET calibrated_at = 'last tuesday'", "cannot be read (Invalid isoformat string: 'last "
+                                                               "tuesday'): the database was damaged or changed by hand"),
+    ("DROP TABLE users", "table users is missing: the database was damaged or changed by hand"),
+    (None, "file is not a database"),
+])
+def test_a_damaged_registry_is_one_line_and_exit_2(damage: str | None, message: str, tmp_path: Path, capsys) -> None:
+    import sqlite3
+
+    path = tmp_path / "registry.sqlite"
+    if damage is None:
+        path.write_bytes(b"x" * 4096)
+    else:
+        campaign = tmp_path / "quick.h5"
+        assert rig("run", REPO / "procedures" / "quick-6pos.yaml", "--dry-run", "-o", campaign, "-q", "--no-pdf",
+                   "--registry", path) == 0
+        with sqlite3.connect(path) as connection:
+            connection.execute(damage)
+    capsys.readouterr()
+    for argv in (["list"], ["show", "ADX355-A001"], ["stats", "--part", "adxl355", "--simulated"]):
+        assert rig("registry", *argv, "--registry", path) == 2, argv
+        err = capsys.readouterr().err.strip()
+        assert err == f"rig: error: registry sqlite:///{path}: {message}", argv
+
+
 def test_a_reader_of_a_registry_not_made_yet_says_so_and_makes_none(tmp_path: Path, capsys) -> None:
     missing = tmp_path / "lab" / "registry.sqlite"
     assert rig("registry", "show", "ANY", "--registry", missing) == 2
