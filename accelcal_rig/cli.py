@@ -156,6 +156,13 @@ def _finish_follow_up(output: Path, follow_up: FollowUp) -> int:
     from accelcal_rig.registry.location import campaign_rig_registry
 
     parts = {p.part: p for p in follow.state(output, follow_up)}
+    calibration = parts.get("calibration")
+    if calibration is None or calibration.state != follow.DONE:  # nothing to certify or record from
+        if calibration is not None and calibration.state != follow.NOT_DUE:
+            print(f"rig: error: no certificates or registry rows: calibration {calibration.state}: "
+                  f"{calibration.detail}", file=sys.stderr)
+            return 1
+        return 0
     code = 0
     if parts["certificates"].state != follow.DONE:
         code = _certify_after_run(output, follow_up)

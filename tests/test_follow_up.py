@@ -133,3 +133,19 @@ def test_kill_after_the_last_pose_then_one_resume_finishes_everything_once(targe
     assert parts == {"calibration": "done", "certificates": "done", "registry": "done"}
     assert set(rows_per_serial(registry).values()) == {1} and len(rows_per_serial(registry)) == len(stored.serials)
     assert len(list(folders["certificates"].glob("*.html"))) == len(stored.serials)
+
+
+def test_a_calibration_of_other_measurements_beside_a_campaign_without_a_fit_is_one_line(finished, write,
+                                                                                         capsys) -> None:
+    """A procedure that asks for no fit, a calibration of another campaign put beside it: the resume neither
+    fits nor certifies, and says why in one line (no traceback)."""
+    other_calibration = finished[0].with_suffix(".calibration.yaml")
+    procedure = write("nofit.yaml", TINY_PROCEDURE + "fit: {mode: none}\n")
+    output = procedure.with_suffix(".h5")
+    assert main(["run", str(procedure), "--dry-run", "-o", str(output), "-q", "--no-pdf"]) == 0
+    output.with_suffix(".calibration.yaml").write_text(  # the same seed measures the same: another digest
+        other_calibration.read_text().replace("measurements_sha256: ", "measurements_sha256: 00", 1))
+    capsys.readouterr()
+    assert main(["resume", str(output), "-q"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "Traceback" not in err and "calibration stale" in err, err
