@@ -18,6 +18,7 @@ from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.clock import Clock, RealClock, VirtualClock
 from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.engine import session
+from accelcal_rig.engine.check import InstrumentCheck, check_instruments
 from accelcal_rig.engine.connection import GuardedRig, RigConnector
 from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.preparation import PreparedCampaign
@@ -26,10 +27,10 @@ from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.engine.session import RunResult
 from accelcal_rig.instruments.connect import (
     EVERY_INSTRUMENT,
-    SomeInstruments,
     configured_endpoints,
     connect_rig,
-    connect_some,
+    missing_endpoints,
+    named_endpoints,
 )
 from accelcal_rig.instruments.interfaces import RigInstruments
 from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable
@@ -114,21 +115,16 @@ def served_rig(rig: RigConfig, clock: Clock, seed: int,
         simulated.stop()
 
 
-@contextmanager
-def connected(rig: LoadedConfig[RigConfig], *, dry_run: bool,
-              only: frozenset[str] = EVERY_INSTRUMENT) -> Iterator[SomeInstruments]:
-    """The rig's instruments in `only`, in real time, each checked by hand (`rig check`): a dry run's are
-    simulated."""
-    clock = RealClock()
+def checked(rig: LoadedConfig[RigConfig], *, dry_run: bool,
+            only: frozenset[str] = EVERY_INSTRUMENT) -> Iterator[InstrumentCheck]:
+    """`rig check`: each instrument in `only`, in real time, opened, described and closed on its own (a dry
+    run's simulated, its simulators serving until the last is checked)."""
     with ExitStack() as stack:
-        endpoints = (configured_endpoints(rig, only) if not dry_run
-                     else stack.enter_context(served_rig(rig.model, clock, 0)).endpoints)
-        instruments = connect_some(rig.model, endpoints, clock, only)
-        try:
-            yield instruments
-        finally:
-            for failure in instruments.close():
-                LOGGER.error(failure)
+        if dry_run:
+            endpoints, missing = stack.enter_context(served_rig(rig.model, RealClock(), 0)).endpoints, {}
+        else:
+            endpoints, missing = named_endpoints(rig.model, only), missing_endpoints(rig, only)
+        yield from check_instruments(rig.model, endpoints, RealClock(), only, dict(missing))
 
 
 def connector(prepared: PreparedCampaign, *, dry_run: bool,

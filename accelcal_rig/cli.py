@@ -32,6 +32,8 @@ EXIT_INTERRUPTED = 130
 EXIT_INTERNAL = 70
 #: `--fail-on-reject`: the campaign and the fit went through, and at least one DUT failed its limits.
 EXIT_REJECTED = 3
+#: `rig check`: an instrument failed its check (as an instrument's error is).
+EXIT_CHECK_FAILED = 2
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
@@ -237,16 +239,21 @@ def _cmd_repair(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from accelcal_rig.assembly import connected
-    from accelcal_rig.cli_format_campaign import check_closing_line
+    from accelcal_rig.assembly import checked
+    from accelcal_rig.cli_format_campaign import check_closing_line, check_failed_line, check_line, check_names
     from accelcal_rig.config.load import load_rig, load_rig_for_check, with_faults
-    from accelcal_rig.engine.check import check_lines
 
     only = frozenset(args.only or ("chamber", "turntable", "sensors"))
     rig = with_faults(load_rig_for_check(args.rig, only) if args.only else load_rig(args.rig), args.faults)
-    with connected(rig, dry_run=args.dry_run, only=only) as instruments:
-        for line in check_lines(instruments, rig.model):
-            print(line, flush=True)
+    names = check_names(rig.model, only)
+    failed = []
+    for instrument in checked(rig, dry_run=args.dry_run, only=only):
+        print(check_line(instrument, max(map(len, names))), flush=True)
+        if not instrument.ok:
+            failed.append(instrument.name)
+    if failed:
+        print(check_failed_line(rig.model.name, failed, len(names)), file=sys.stderr)
+        return EXIT_CHECK_FAILED
     print(check_closing_line(rig.model.name, only if args.only else None))
     return 0
 

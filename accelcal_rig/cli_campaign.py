@@ -9,7 +9,7 @@ import logging
 import signal
 import sys
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
@@ -22,7 +22,7 @@ from accelcal_rig.errors import ConfigError
 if TYPE_CHECKING:
     from accelcal_rig.config.lab import Receipt
     from accelcal_rig.engine.preparation import PreparedCampaign
-    from accelcal_rig.engine.progress import ProgressListener
+    from accelcal_rig.engine.progress import Progress, ProgressListener
     from accelcal_rig.follow_up import FollowUp
 
 
@@ -143,14 +143,46 @@ def until_signalled() -> Iterator[threading.Event]:
 def campaign_session(prepared: PreparedCampaign, output: Path, *, verbose: bool, quiet: bool, dry_run: bool,
                      overwrite: bool, resume: bool) -> Iterator[ProgressListener]:
     """Around a run: the campaign locked before anything of it changes (the log included), a new campaign's
-    disk space checked, the console and the log file attached; yields the progress listener."""
+    disk space checked, the console and the log file attached; yields the progress listener. A run that
+    fails before its campaign starts (a dead port, a refused instrument) leaves no file it made: its log is
+    not written and a lock file it created is removed."""
     from accelcal_rig.store.lock import campaign_lock
+    from accelcal_rig.store.paths import lock_path
 
+    made_lock = not lock_path(output).exists()
+    before = _footprint(output)
     with campaign_lock(output, "rig resume" if resume else "rig run"):
-        if not resume:
-            check_free_space(prepared, output, dry_run, overwrite)
-        with campaign_logging(output, verbose, quiet, append=resume, real_clock=not dry_run) as progress:
-            yield progress
+        try:
+            if not resume:
+                check_free_space(prepared, output, dry_run, overwrite)
+            with campaign_logging(output, verbose, quiet, append=resume, real_clock=not dry_run,
+                                  started=lambda: _footprint(output) != before) as progress:
+                yield progress
+        finally:
+            if made_lock and _footprint(output) == before:
+                _remove_lock(output)
+
+
+def _footprint(output: Path) -> tuple[tuple[int, int, int] | None, ...]:
+    """What a run changes once its campaign starts: the campaign file and its journal (inode, size, time)."""
+    from accelcal_rig.store.paths import journal_path
+
+    def identity(path: Path) -> tuple[int, int, int] | None:
+        try:
+            info = path.stat()
+        except OSError:
+            return None
+        return info.st_ino, info.st_size, info.st_mtime_ns
+
+    return identity(output), identity(journal_path(output))
+
+
+def _remove_lock(output: Path) -> None:
+    """Remove the lock file this run made, while still holding it (store.lock: a writer that then locks the
+    removed file sees it is gone and locks the new one)."""
+    from accelcal_rig.store.lock import remove_lock_file
+
+    remove_lock_file(output)
 
 
 def check_free_space(prepared: PreparedCampaign, output: Path, dry_run: bool, overwrite: bool) -> None:
@@ -170,14 +202,18 @@ def check_free_space(prepared: PreparedCampaign, output: Path, dry_run: bool, ov
 
 
 @contextmanager
-def campaign_logging(output: Path, verbose: bool, quiet: bool, append: bool,
-                     real_clock: bool) -> Iterator[ProgressListener]:
+def campaign_logging(output: Path, verbose: bool, quiet: bool, append: bool, real_clock: bool,
+                     started: Callable[[], bool] = lambda: True) -> Iterator[ProgressListener]:
     """Console on stderr at the chosen level (a live status line on a terminal, timestamped lines
     otherwise), the full debug log with progress lines in a file beside the campaign file (appended to by
-    a resumed run); yields the progress listener. Everything is detached and closed when the run ends."""
-    from accelcal_rig.report.live import LogFileHandler, ProgressLines, StatusLine, TerminalHandler, listeners
+    a resumed run); yields the progress listener. The file is written from the first progress of the
+    campaign on, with what was logged before it; a run whose campaign never started (`started()` false at
+    the end) writes none unless it appends to a log already there. Everything is detached and closed when
+    the run ends."""
+    from accelcal_rig.report.live import CampaignLog, ProgressLines, StatusLine, TerminalHandler, listeners
     from accelcal_rig.store.paths import log_path
 
+    _check_log_writable(log_path(output))
     status = StatusLine(sys.stderr, real_clock) if sys.stderr.isatty() and not quiet else None
     console: logging.Handler
     if status is not None:
@@ -187,25 +223,42 @@ def campaign_logging(output: Path, verbose: bool, quiet: bool, append: bool,
         console = logging.StreamHandler(sys.stderr)
         console.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s", "%Y-%m-%d %H:%M:%S"))
     console.setLevel(logging.DEBUG if verbose else logging.WARNING if quiet else logging.INFO)
-    try:
-        log_file = LogFileHandler(str(log_path(output)), mode="a" if append else "w")
-    except OSError as exc:
-        raise ConfigError(f"{log_path(output)}: cannot write the campaign's log: {exc.strerror}") from None
+    log_file = CampaignLog(str(log_path(output)), mode="a" if append else "w")
     log_file.setFormatter(logging.Formatter("%(asctime)s %(levelname)-7s %(message)s"))
     LOGGER.setLevel(logging.DEBUG)
     propagate, LOGGER.propagate = LOGGER.propagate, False
     for handler in (console, log_file):
         LOGGER.addHandler(handler)
     lines = ProgressLines(real_clock)
+
+    def first_progress_starts_the_log(progress: Progress) -> None:
+        log_file.start()
+        lines(progress)
+
     try:
-        yield listeners(lines, status) if status is not None else lines
+        yield (listeners(first_progress_starts_the_log, status) if status is not None
+               else first_progress_starts_the_log)
     finally:
         if status is not None:
             status.close()
+        if append or started():
+            log_file.start()
+        else:
+            log_file.discard()
         for handler in (console, log_file):
             LOGGER.removeHandler(handler)
             handler.close()
         LOGGER.propagate = propagate
+
+
+def _check_log_writable(log: Path) -> None:
+    """Refuse before the run a log that could not be written (its folder or the file read-only), without
+    making it: the file itself is made once the campaign starts."""
+    import os
+
+    target = log if log.exists() else log.parent
+    if not os.access(target, os.W_OK):
+        raise ConfigError(f"{log}: cannot write the campaign's log: permission denied")
 
 
 def campaign_status(campaign: Path, calibration: Path | None) -> dict[str, Any]:

@@ -12,6 +12,8 @@ from accelcal_rig.core.units import gravity_statement
 if TYPE_CHECKING:
     from pathlib import Path
 
+    from accelcal_rig.config.rig import RigConfig
+    from accelcal_rig.engine.check import InstrumentCheck
     from accelcal_rig.engine.preparation import PreparedCampaign
     from accelcal_rig.engine.session import RunResult
     from accelcal_rig.report.certificate import Written
@@ -53,6 +55,24 @@ def verdict_lines(verdicts: dict[str, tuple[str, tuple[str, ...]]]) -> list[str]
 
 def certificate_line(written: Written) -> str:
     return f"certificate {written.serial} → {written.html}" + (f", {written.pdf.name}" if written.pdf else "")
+
+
+def check_names(rig: RigConfig, only: frozenset[str]) -> list[str]:
+    """The instruments `rig check` will answer for, in its order: `chamber`, `turntable`, `sensor <serial>`."""
+    return [*(name for name in ("chamber", "turntable") if name in only),
+            *(f"sensor {sensor.serial}" for sensor in (rig.fixture.sensors if "sensors" in only else []))]
+
+
+def check_line(instrument: InstrumentCheck, width: int) -> str:
+    """`chamber    OK      tcp 10.0.0.7:10001: …` or `turntable  FAILED  turntable (serial …): cannot open …`."""
+    return f"{instrument.name:<{width}}  {'OK' if instrument.ok else 'FAILED':<6}  {instrument.text}"
+
+
+def check_failed_line(rig_name: str, failed: list[str], checked: int) -> str:
+    """`rig check`'s summary when an instrument failed: how many, and which."""
+    others = "; the others answered as configured" if len(failed) < checked else ""
+    return (f"rig: error: rig {rig_name}: {len(failed)} of {checked} instrument{'s' if checked != 1 else ''} failed "
+            f"the check ({', '.join(failed)}){others}")
 
 
 def check_closing_line(rig_name: str, only: frozenset[str] | None) -> str:

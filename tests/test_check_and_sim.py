@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import signal
 import subprocess
 import sys
@@ -17,6 +18,19 @@ from tests.conftest import REPO, SIM_RIG
 from tests.test_cli_serve import DEADLINE_S, first_line
 
 RIG = str(Path(sys.executable).parent / "rig")
+#: A line of `rig check`: the instrument, OK or FAILED, then what it answered or why it failed.
+CHECK_LINE = re.compile(r"(?P<name>chamber|turntable|sensor \S+) +(?P<status>OK|FAILED) +(?P<text>\S.*)")
+
+
+def check_lines(stdout: str) -> dict[str, tuple[str, str]]:
+    """`rig check`'s instrument lines: name → (status, text); every line but the closing one must be one."""
+    lines = stdout.splitlines()
+    found = {}
+    for line in lines[:-1] if lines and lines[-1].startswith("rig ") else lines:
+        match = CHECK_LINE.fullmatch(line)
+        assert match, f"not a rig check line: {line!r}"
+        found[match["name"]] = (match["status"], match["text"])
+    return found
 
 
 @pytest.fixture(scope="module")
@@ -50,13 +64,18 @@ def test_rig_check_describes_every_instrument(running_sim: dict, tmp_path: Path)
     result = subprocess.run([RIG, "check", str(rig_config_for(running_sim, tmp_path))], capture_output=True,
                             text=True, timeout=60)
     assert result.returncode == 0, result.stderr
-    lines = result.stdout.splitlines()
-    assert lines[0].startswith(f"chamber    modbus-tcp 127.0.0.1:{running_sim['chamber']['port']}: float32 controller")
-    assert lines[1].startswith("turntable  serial /dev/pts/") and "angles 0.000 0.000 0.000°" in lines[1]
-    assert sum(line.startswith("sensor ADX355-A") and "ADXL355 rev 1" in line for line in lines) == 4
+    lines = check_lines(result.stdout)
+    assert list(lines) == ["chamber", "turntable", "sensor ADX355-A001", "sensor ADX355-A002", "sensor ADX355-A003",
+                           "sensor ADX355-A004"]
+    assert all(status == "OK" for status, _ in lines.values())
+    assert lines["chamber"][1].startswith(f"modbus-tcp 127.0.0.1:{running_sim['chamber']['port']}: float32 controller")
+    assert lines["turntable"][1].startswith("serial /dev/pts/") and "angles 0.000 0.000 0.000°" in lines["turntable"][1]
+    assert sum("ADXL355 rev 1" in text for name, (_, text) in lines.items() if name.startswith("sensor ")) == 4
+    assert result.stdout.splitlines()[-1] == "rig simulated-rig: every instrument answered as configured"
 
 
-def test_rig_check_names_a_sensor_with_the_wrong_identity(running_sim: dict, tmp_path: Path) -> None:
+def test_rig_check_names_a_sensor_with_the_wrong_identity_and_checks_the_rest(running_sim: dict,
+                                                                              tmp_path: Path) -> None:
     impostor = PtyLineServer(lambda r: "ADXL355-BRIDGE 1 x" if r == "?" else "=AD1DE901").start()  # an ADXL359
     try:
         config = rig_config_for(running_sim, tmp_path, {"ADX355-A003": impostor.path})
@@ -64,16 +83,45 @@ def test_rig_check_names_a_sensor_with_the_wrong_identity(running_sim: dict, tmp
     finally:
         impostor.stop()
     assert result.returncode == 2
-    assert result.stderr.strip() == (f"rig: error: sensor ADX355-A003 (serial {impostor.path}): identity AD/1D/E9 "
-                                     "is not an ADXL355 (AD/1D/ED)")
+    lines = check_lines(result.stdout)
+    assert lines["sensor ADX355-A003"] == ("FAILED", f"sensor ADX355-A003 (serial {impostor.path}): identity "
+                                                     "AD/1D/E9 is not an ADXL355 (AD/1D/ED)")
+    assert [name for name, (status, _) in lines.items() if status == "OK"] == [
+        "chamber", "turntable", "sensor ADX355-A001", "sensor ADX355-A002", "sensor ADX355-A004"]
+    assert result.stderr.strip() == ("rig: error: rig simulated-rig: 1 of 6 instruments failed the check (sensor "
+                                     "ADX355-A003); the others answered as configured")
 
 
-def test_rig_check_names_a_dead_port(running_sim: dict, tmp_path: Path) -> None:
+def test_rig_check_with_dead_ports_says_each_and_every_other_instrument(running_sim: dict, tmp_path: Path) -> None:
+    """Bringing up a rig with a dead turntable port and a dead bridge: the chamber and the other sensors are
+    checked all the same, each dead port is its own line."""
     config = rig_config_for(running_sim, tmp_path, {"ADX355-A002": "/dev/nonexistent-bridge"})
+    rig = yaml.safe_load(config.read_text())
+    rig["turntable"]["endpoint"] = "/dev/nonexistent-turntable"
+    config.write_text(yaml.safe_dump(rig))
     result = subprocess.run([RIG, "check", str(config)], capture_output=True, text=True, timeout=60)
     assert result.returncode == 2
-    assert result.stderr.startswith("rig: error: sensor bridge (serial /dev/nonexistent-bridge): cannot open")
-    assert len(result.stderr.strip().splitlines()) == 1
+    lines = check_lines(result.stdout)
+    assert len(lines) == 6 and lines["chamber"][0] == "OK"
+    assert lines["turntable"][0] == "FAILED" and lines["turntable"][1].startswith(
+        "turntable (serial /dev/nonexistent-turntable): cannot open")
+    assert lines["sensor ADX355-A002"][0] == "FAILED" and lines["sensor ADX355-A002"][1].startswith(
+        "sensor bridge (serial /dev/nonexistent-bridge): cannot open")
+    assert [lines[f"sensor ADX355-A00{n}"][0] for n in (1, 3, 4)] == ["OK"] * 3
+    assert result.stderr.strip() == ("rig: error: rig simulated-rig: 2 of 6 instruments failed the check (turntable, "
+                                     "sensor ADX355-A002); the others answered as configured")
+
+
+def test_rig_check_names_each_instrument_without_an_endpoint(tmp_path: Path) -> None:
+    """A rig config written before its ports are known: every instrument is a line pointing at its key."""
+    config = yaml.safe_load(SIM_RIG.read_text())
+    path = tmp_path / "unwired.yaml"
+    path.write_text(yaml.safe_dump(config))
+    result = subprocess.run([RIG, "check", str(path)], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2
+    lines = check_lines(result.stdout)
+    assert all(status == "FAILED" and "endpoint: no endpoint given" in text for status, text in lines.values())
+    assert len(lines) == 6 and "6 of 6 instruments failed" in result.stderr
 
 
 def test_the_example_lab_config_is_valid() -> None:
@@ -99,7 +147,7 @@ def test_rig_check_of_the_chamber_alone(running_sim: dict, tmp_path: Path) -> No
                             capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
     lines = result.stdout.splitlines()
-    assert len(lines) == 2 and lines[0].startswith(f"chamber    modbus-tcp {endpoint}: float32 controller")
+    assert len(lines) == 2 and lines[0].startswith(f"chamber  OK      modbus-tcp {endpoint}: float32 controller")
     assert lines[1] == "rig simulated-rig: the chamber answered as configured (only those checked)"
 
 
@@ -121,8 +169,8 @@ def test_a_dry_run_check_of_the_sensors_alone(tmp_path: Path) -> None:
     result = subprocess.run([RIG, "check", str(tmp_path / "sensors.yaml"), "--dry-run", "--only", "sensors"],
                             capture_output=True, text=True, timeout=60)
     assert result.returncode == 0, result.stderr
-    lines = result.stdout.splitlines()
-    assert sum(line.startswith("sensor ADX355-A") for line in lines) == 4 and not any("chamber" in line for line in lines)
+    lines = check_lines(result.stdout)
+    assert list(lines) == [f"sensor ADX355-A00{n}" for n in range(1, 5)]
 
 
 def test_rig_check_of_a_line_chamber_says_what_frost_settings_can_count_on(tmp_path: Path) -> None:
@@ -141,7 +189,7 @@ def test_rig_check_of_a_line_chamber_says_what_frost_settings_can_count_on(tmp_p
         process.wait(timeout=20)
     assert result.returncode == 0, result.stderr
     line = result.stdout.splitlines()[0]
-    assert line.startswith(f"chamber    tcp {chamber['host']}:{chamber['port']}: accelcal-rig simulated simserv")
+    assert line.startswith(f"chamber  OK      tcp {chamber['host']}:{chamber['port']}: accelcal-rig simulated simserv")
     assert "the rig's -55…100 °C, the controller's -70…180 °C" in line
     assert "% RH (dew point 12.0 °C); dry-air purge output" in line
 

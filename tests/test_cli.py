@@ -219,9 +219,40 @@ def test_a_signal_before_the_campaign_starts_is_one_line_and_leaves_no_file(writ
 
     monkeypatch.setattr(assembly, "connect_rig", terminated)  # SIGTERM while connecting to the instruments
     path = write("tiny.yaml", TINY_PROCEDURE)
+    before = sorted(path.parent.iterdir())
     err = one_line_error(capsys, ["run", str(path), "--dry-run", "-o", str(path.with_suffix(".h5"))], 130)
     assert "interrupted before the campaign started" in err
-    assert not path.with_suffix(".h5").exists()
+    assert sorted(path.parent.iterdir()) == before  # no campaign, no lock, no log
+
+
+def dead_rig(workdir: Path) -> Path:
+    """The simulated rig's config wired to ports nothing answers on: a closed TCP port, serial devices that
+    do not exist."""
+    import yaml
+
+    config = yaml.safe_load((workdir / "sim.yaml").read_text())
+    config["chamber"]["endpoint"] = "127.0.0.1:1"
+    config["turntable"]["endpoint"] = str(workdir / "no-turntable")
+    for sensor in config["fixture"]["sensors"]:
+        sensor["endpoint"] = str(workdir / f"no-{sensor['serial']}")
+    (workdir / "dead.yaml").write_text(yaml.safe_dump(config))
+    return workdir / "dead.yaml"
+
+
+def test_a_run_that_cannot_reach_its_rig_leaves_no_file_and_an_old_campaigns_log_intact(write, workdir: Path,
+                                                                                       capsys) -> None:
+    procedure, config = write("tiny.yaml", TINY_PROCEDURE), dead_rig(workdir)
+    before = sorted(workdir.iterdir())
+    err = one_line_error(capsys, ["run", str(procedure), "--config", str(config), "-o", str(workdir / "c.h5")], 2)
+    assert err.startswith("rig: error: chamber (modbus-tcp 127.0.0.1:1): cannot connect")
+    assert sorted(workdir.iterdir()) == before  # no lock, no log
+    assert main(["run", str(procedure), "--dry-run", "-o", str(workdir / "c.h5"), "-q"]) == 0
+    capsys.readouterr()
+    kept = {path.name: path.read_bytes() for path in workdir.glob("c.h5*") if path.is_file()}
+    assert "c.h5.log" in kept and "c.h5.lock" in kept
+    one_line_error(capsys, ["run", str(procedure), "--config", str(config), "-o", str(workdir / "c.h5"),
+                            "--overwrite"], 2)
+    assert {path.name: path.read_bytes() for path in workdir.glob("c.h5*") if path.is_file()} == kept
 
 
 @pytest.mark.parametrize("kill_after_s", [0.0, 0.15])
@@ -409,7 +440,8 @@ def test_commands_against_a_running_campaign_are_refused_and_change_nothing(tmp_
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         deadline = time.monotonic() + 60
-        while not journal_path(campaign).exists() and time.monotonic() < deadline:
+        # the log is written from the campaign's first progress on, just after its journal appears
+        while not (journal_path(campaign).exists() and log_path(campaign).exists()) and time.monotonic() < deadline:
             time.sleep(0.005)
         for argv in (["run", str(procedure), "--dry-run", "-o", str(campaign), "--overwrite"],
                      ["run", str(procedure), "--dry-run", "-o", str(campaign), "--resume"],

@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import REPO, SIM_RIG
+from tests.test_check_and_sim import check_lines
 
 RIG = str(Path(sys.executable).parent / "rig")
 PACKAGE = REPO / "tests" / "plugins_acme"
@@ -40,8 +41,8 @@ def test_rig_check_finds_an_installed_chamber_driver_and_its_simulator(installed
     result = subprocess.run([RIG, "check", str(acme_rig(tmp_path)), "--dry-run"], capture_output=True, text=True,
                             env=env, timeout=120)
     assert result.returncode == 0, result.stderr
-    chamber = result.stdout.splitlines()[0]
-    assert chamber.startswith("chamber    acme 127.0.0.1:")
+    status, chamber = check_lines(result.stdout)["chamber"]
+    assert status == "OK" and chamber.startswith("acme 127.0.0.1:")
     assert (": ACME TC-1 (PV 23.0 °C), alarm clear; set point limits: the rig's -55…100 °C, the controller exposes "
             "none") in chamber
     assert "every instrument answered as configured" in result.stdout

@@ -1,12 +1,18 @@
-"""`rig check`: contact every instrument of a rig and describe it in one line, before a campaign."""
+"""`rig check`: contact every instrument of a rig and describe it in one line, before a campaign. Each is
+opened, asked and closed on its own, so a dead turntable port says nothing against the chamber or the
+sensors: every instrument gets its line, OK or its failure."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import TypeVar
 
 from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.humidity import dew_point_c
-from accelcal_rig.errors import InstrumentError
+from accelcal_rig.core.logger import LOGGER
+from accelcal_rig.errors import InstrumentError, RigError
 from accelcal_rig.instruments.capabilities import (
     AlarmReporting,
     ConstantRateRotation,
@@ -14,32 +20,86 @@ from accelcal_rig.instruments.capabilities import (
     has_purge,
     humidity_pct,
 )
-from accelcal_rig.instruments.connect import SomeInstruments
-from accelcal_rig.instruments.interfaces import Chamber, Turntable
+from accelcal_rig.instruments.connect import Endpoints, open_chamber, open_sensor, open_turntable
+from accelcal_rig.instruments.interfaces import Chamber, Sensor, Turntable
+
+Device = TypeVar("Device", Chamber, Turntable, Sensor)
 
 
-def check_lines(instruments: SomeInstruments, rig: RigConfig) -> Iterator[str]:
-    """One line per instrument connected; the first wrong answer raises InstrumentError naming it."""
-    chamber, turntable = instruments.chamber, instruments.turntable
-    if chamber is not None:
-        controller = controller_limits(chamber)
-        limits = (f"; set point limits: the rig's {rig.chamber.min_setpoint_c:g}…{rig.chamber.max_setpoint_c:g} °C, "
-                  "the " + (f"controller's {controller[0]:g}…{controller[1]:g} °C" if controller
-                            else "controller exposes none"))
-        yield f"chamber    {chamber.endpoint}: {chamber.identify()}{_alarm(chamber)}{limits}{_moisture(chamber, rig)}"
-    if turntable is not None:
-        angles = " ".join(f"{a:.3f}" for a in turntable.read_angles_deg())
-        yield (f"turntable  {turntable.endpoint}: {turntable.identify()}, angles {angles}°, "
-               f"{'in position' if _at_rest(turntable) else 'moving'}{_rates(turntable, rig)}")
-    for sensor in instruments.sensors:
-        identity = sensor.identify()
-        wrong = sensor.part.wrong_identity(identity.registers)
-        if wrong:
-            raise InstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): {wrong}")
-        ranges, odr_hz = sensor.read_settings()
-        yield (f"sensor {sensor.serial}  {sensor.endpoint}: {identity.describe(sensor.part.label)}, "
-               f"{sensor.part.describe_ranges(ranges)}, "
-               f"{odr_hz:g} Hz, {sensor.read_temperature_c():.1f} °C")
+@dataclass(frozen=True)
+class InstrumentCheck:
+    """One instrument's answer to `rig check`: what it said, or why it could not be checked."""
+
+    name: str  # `chamber`, `turntable`, `sensor <serial>`
+    ok: bool
+    text: str
+
+
+def check_instruments(rig: RigConfig, endpoints: Endpoints, clock: Clock, only: frozenset[str],
+                      missing: dict[str, RigError]) -> Iterator[InstrumentCheck]:
+    """Each instrument in `only`, in the rig's order, opened, described and closed on its own; one whose
+    endpoint is `missing` (chamber, turntable or a serial → the error) or that fails is a failed check, and
+    the next is checked all the same."""
+    if "chamber" in only:
+        yield _checked("chamber", missing.get("chamber"), lambda: open_chamber(rig, endpoints),
+                       lambda chamber: describe_chamber(chamber, rig))
+    if "turntable" in only:
+        yield _checked("turntable", missing.get("turntable"), lambda: open_turntable(rig, endpoints),
+                       lambda turntable: describe_turntable(turntable, rig))
+    for sensor in rig.fixture.sensors if "sensors" in only else []:
+        yield _checked(f"sensor {sensor.serial}", missing.get(sensor.serial),
+                       lambda sensor=sensor: open_sensor(rig, sensor, endpoints, clock), describe_sensor)  # type: ignore[misc]
+
+
+def _checked(name: str, missing: RigError | None, open_device: Callable[[], Device],
+             describe: Callable[[Device], str]) -> InstrumentCheck:
+    if missing is not None:
+        return InstrumentCheck(name, False, str(missing))
+    try:
+        device = open_device()
+    except RigError as exc:
+        return InstrumentCheck(name, False, _one_line(exc))
+    try:
+        return InstrumentCheck(name, True, describe(device))
+    except RigError as exc:
+        return InstrumentCheck(name, False, _one_line(exc))
+    finally:
+        try:
+            device.close()
+        except Exception as exc:  # noqa: BLE001 - a port that will not close is logged; the answer stands
+            LOGGER.error(f"{name} ({device.endpoint}): close failed: {exc}")
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())
+
+
+def describe_chamber(chamber: Chamber, rig: RigConfig) -> str:
+    """Its endpoint, identity, alarm (where its profile can ask), set point limits and what frost settings
+    can count on."""
+    controller = controller_limits(chamber)
+    limits = (f"; set point limits: the rig's {rig.chamber.min_setpoint_c:g}…{rig.chamber.max_setpoint_c:g} °C, "
+              "the " + (f"controller's {controller[0]:g}…{controller[1]:g} °C" if controller
+                        else "controller exposes none"))
+    return f"{chamber.endpoint}: {chamber.identify()}{_alarm(chamber)}{limits}{_moisture(chamber, rig)}"
+
+
+def describe_turntable(turntable: Turntable, rig: RigConfig) -> str:
+    """Its endpoint, identity, angles, whether in position, and the rates of the axes given a rate mode."""
+    angles = " ".join(f"{a:.3f}" for a in turntable.read_angles_deg())
+    return (f"{turntable.endpoint}: {turntable.identify()}, angles {angles}°, "
+            f"{'in position' if _at_rest(turntable) else 'moving'}{_rates(turntable, rig)}")
+
+
+def describe_sensor(sensor: Sensor) -> str:
+    """Its endpoint, identity (refused if not its part's), ranges, data rate and temperature."""
+    identity = sensor.identify()
+    wrong = sensor.part.wrong_identity(identity.registers)
+    if wrong:
+        raise InstrumentError(f"sensor {sensor.serial} ({sensor.endpoint}): {wrong}")
+    ranges, odr_hz = sensor.read_settings()
+    return (f"{sensor.endpoint}: {identity.describe(sensor.part.label)}, {sensor.part.describe_ranges(ranges)}, "
+            f"{odr_hz:g} Hz, {sensor.read_temperature_c():.1f} °C")
 
 
 def _rates(turntable: Turntable, rig: RigConfig) -> str:

@@ -7,8 +7,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from accelcal_rig.config.load import LoadedConfig
-from accelcal_rig.config.rig import RigConfig
+from accelcal_rig.config.rig import RigConfig, SensorConfig
 from accelcal_rig.core.clock import Clock
+from accelcal_rig.errors import ConfigError
 from accelcal_rig.instruments.interfaces import Chamber, RigInstruments, Sensor, Turntable, close_each
 from accelcal_rig.parts.part import Part
 from accelcal_rig.parts.registry import part
@@ -47,40 +48,69 @@ class SomeInstruments:
 def configured_endpoints(rig: LoadedConfig[RigConfig], only: frozenset[str] = EVERY_INSTRUMENT) -> Endpoints:
     """The endpoints the rig config names for the instruments in `only`; a missing one is an error pointing
     at its key."""
+    for problem in missing_endpoints(rig, only).values():
+        raise problem
+    return named_endpoints(rig.model, only)
+
+
+def missing_endpoints(rig: LoadedConfig[RigConfig], only: frozenset[str] = EVERY_INSTRUMENT) -> dict[str, ConfigError]:
+    """Each instrument in `only` whose endpoint the rig config leaves out (`chamber`, `turntable`, a sensor's
+    serial) → the error pointing at its key, in the rig's order."""
     model = rig.model
     missing = "no endpoint given: set it, or run with --dry-run to simulate this rig"
+    problems = {}
     if "chamber" in only and not model.chamber.endpoint:
-        raise rig.error(("chamber", "endpoint"), missing)
+        problems["chamber"] = rig.error(("chamber", "endpoint"), missing)
     if "turntable" in only and not model.turntable.endpoint:
-        raise rig.error(("turntable", "endpoint"), missing)
-    sensors = {}
+        problems["turntable"] = rig.error(("turntable", "endpoint"), missing)
     for index, sensor in enumerate(model.fixture.sensors if "sensors" in only else []):
         if not sensor.endpoint:
-            raise rig.error(("fixture", "sensors", index, "endpoint"), missing)
-        sensors[sensor.serial] = sensor.endpoint
+            problems[sensor.serial] = rig.error(("fixture", "sensors", index, "endpoint"), missing)
+    return problems
+
+
+def named_endpoints(model: RigConfig, only: frozenset[str] = EVERY_INSTRUMENT) -> Endpoints:
+    """The endpoints the rig config names (an empty one where it names none: see missing_endpoints)."""
+    sensors = {sensor.serial: sensor.endpoint or "" for sensor in (model.fixture.sensors if "sensors" in only else [])}
     return Endpoints(model.chamber.endpoint or "", model.turntable.endpoint or "", sensors)
+
+
+def open_chamber(rig: RigConfig, endpoints: Endpoints) -> Chamber:
+    """The chamber, through the driver its config (or the dry run) names."""
+    chamber: Chamber = load_driver("chamber", endpoints.drivers.get("chamber", rig.chamber.driver)).open(
+        rig.chamber, endpoints.chamber)
+    return chamber
+
+
+def open_turntable(rig: RigConfig, endpoints: Endpoints) -> Turntable:
+    """The turntable, through the driver its config (or the dry run) names."""
+    turntable: Turntable = load_driver("turntable", endpoints.drivers.get("turntable", rig.turntable.driver)).open(
+        rig.turntable, endpoints.turntable)
+    return turntable
+
+
+def open_sensor(rig: RigConfig, sensor: SensorConfig, endpoints: Endpoints, clock: Clock) -> Sensor:
+    """One DUT: its transport through the driver its config names, spoken as its part says."""
+    transport = load_driver("sensor", endpoints.drivers.get(sensor.serial, sensor.driver)).open(
+        sensor, endpoints.sensors[sensor.serial], rig.retry.attempts, clock)
+    return sensor_device(transport, sensor.serial, clock, part(sensor.part))
 
 
 def connect_some(rig: RigConfig, endpoints: Endpoints, clock: Clock,
                  only: frozenset[str] = EVERY_INSTRUMENT) -> SomeInstruments:
     """Open the instruments in `only`; if one fails, close those already open and raise."""
-    drivers = endpoints.drivers
     opened: list[Any] = []
     chamber = turntable = None
     try:
         if "chamber" in only:
-            chamber = load_driver("chamber", drivers.get("chamber", rig.chamber.driver)).open(
-                rig.chamber, endpoints.chamber)
+            chamber = open_chamber(rig, endpoints)
             opened.append(chamber)
         if "turntable" in only:
-            turntable = load_driver("turntable", drivers.get("turntable", rig.turntable.driver)).open(
-                rig.turntable, endpoints.turntable)
+            turntable = open_turntable(rig, endpoints)
             opened.append(turntable)
         sensors: list[Sensor] = []
         for sensor in rig.fixture.sensors if "sensors" in only else []:
-            transport = load_driver("sensor", drivers.get(sensor.serial, sensor.driver)).open(
-                sensor, endpoints.sensors[sensor.serial], rig.retry.attempts, clock)
-            sensors.append(sensor_device(transport, sensor.serial, clock, part(sensor.part)))
+            sensors.append(open_sensor(rig, sensor, endpoints, clock))
             opened.append(sensors[-1])
     except BaseException:
         for device in opened:

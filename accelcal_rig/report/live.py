@@ -125,6 +125,55 @@ class LogFileHandler(logging.FileHandler):
             pass  # already reported by flush
 
 
+class CampaignLog(logging.Handler):
+    """The log file beside a campaign, opened only once the campaign has started: until `start`, records are
+    kept in memory, so a run that fails before its campaign starts (a dead port) leaves no log behind and a
+    refused `--overwrite` does not empty the old campaign's log. `start` writes what was kept, then each
+    record as it comes; `discard` drops what was kept."""
+
+    def __init__(self, filename: str, mode: str) -> None:
+        super().__init__(logging.DEBUG)
+        self.filename, self.mode = filename, mode
+        self._kept: list[logging.LogRecord] | None = []
+        self._file: LogFileHandler | None = None
+
+    @property
+    def started(self) -> bool:
+        return self._kept is None
+
+    def start(self) -> None:
+        """Open the file and write what was kept. A file that cannot be opened now (its folder was checked
+        writable before the run) is one warning, as a failing write is: the campaign's event log goes on."""
+        if self._file is not None or self._kept is None:
+            return
+        try:
+            self._file = LogFileHandler(self.filename, self.mode)
+        except OSError as exc:
+            print(f"rig: warning: log file {self.filename}: {exc.strerror}; no lines go to it (the campaign's own "
+                  "event log is unaffected)", file=sys.stderr)
+            self._kept = None
+            return
+        self._file.setFormatter(self.formatter)
+        for record in self._kept or ():
+            self._file.handle(record)
+        self._kept = None
+
+    def discard(self) -> None:
+        """Forget what was kept: the campaign never started, and its log is not made."""
+        self._kept = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        if self._file is not None:
+            self._file.handle(record)
+        elif self._kept is not None:
+            self._kept.append(record)
+
+    def close(self) -> None:
+        if self._file is not None:
+            self._file.close()
+        super().close()
+
+
 class ProgressLines:
     """Logs a progress line (marked `progress`) at each new phase and every `every_s` of campaign time."""
 

@@ -2,8 +2,10 @@
 
 The lock is an advisory `flock` on a small file beside the campaign, which also says who holds it
 (process, host, command, since when). The kernel drops it when its process ends, however it ends, so a
-`kill -9` never leaves a campaign locked; the file itself stays (removing it would let two writers lock
-two different files). Readers never take it, they only ask whether it is held.
+`kill -9` never leaves a campaign locked. The file stays while a campaign is there; only a run that made it
+and failed before its campaign started removes it again, while holding it — and a writer that gets the lock
+checks that the file it locked is still the one at the path (else it locks the new one), so two writers
+never hold two different files. Readers never take it, they only ask whether it is held.
 """
 
 from __future__ import annotations
@@ -57,24 +59,22 @@ def acquire(campaign: Path, command: str) -> None:
     if key in _held:
         _held[key][1] += 1
         return
-    try:
-        fd = os.open(key, os.O_RDWR | os.O_CREAT | os.O_NONBLOCK, 0o666)
-    except OSError as exc:
-        raise ConfigError(f"{campaign}: cannot take its lock {key.name}: {exc.strerror}") from None
-    if not stat.S_ISREG(os.fstat(fd).st_mode):
-        os.close(fd)
-        raise ConfigError(f"{campaign}: its lock {key.name} is not a regular file")
+    fd = _open_lock(campaign, key)
     deadline = time.monotonic() + ACQUIRE_PATIENCE_S
     while True:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            break
         except OSError as exc:
             if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN) or time.monotonic() > deadline:
                 holder = _describe(fd)
                 os.close(fd)
                 raise CampaignBusy(f"{campaign}: in use by {holder}; nothing was changed") from None
             time.sleep(_RETRY_S)
+            continue
+        if _still_at(fd, key):
+            break
+        os.close(fd)  # its holder removed it while we waited: lock the file now at the path
+        fd = _open_lock(campaign, key)
     info = {"pid": os.getpid(), "host": socket.gethostname(), "command": command,
             "since": dt.datetime.now(dt.UTC).isoformat(timespec="seconds")}
     try:
@@ -85,6 +85,39 @@ def acquire(campaign: Path, command: str) -> None:
             os.close(fd)
             raise ConfigError(f"{campaign}: cannot write its lock {key.name}: {exc.strerror}") from None
     _held[key] = [fd, 1]
+
+
+def _open_lock(campaign: Path, key: Path) -> int:
+    try:
+        fd = os.open(key, os.O_RDWR | os.O_CREAT | os.O_NONBLOCK, 0o666)
+    except OSError as exc:
+        raise ConfigError(f"{campaign}: cannot take its lock {key.name}: {exc.strerror}") from None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise ConfigError(f"{campaign}: its lock {key.name} is not a regular file")
+    return fd
+
+
+def _still_at(fd: int, key: Path) -> bool:
+    """Whether the locked file is the one at `key` (not one its last holder removed)."""
+    try:
+        at_path = os.stat(key)
+    except FileNotFoundError:
+        return False
+    held = os.fstat(fd)
+    return (held.st_dev, held.st_ino) == (at_path.st_dev, at_path.st_ino)
+
+
+def remove_lock_file(campaign: Path) -> None:
+    """Remove the lock file while holding it (only the outermost holder in this process may): for a run that
+    made it and whose campaign never started. A writer waiting on it finds it gone and locks a new one."""
+    entry = _held.get(_key(campaign))
+    if entry is None or entry[1] != 1:
+        return
+    try:
+        os.unlink(_key(campaign))
+    except OSError:
+        pass  # a lock file left behind is harmless: the next writer takes it
 
 
 def release(campaign: Path) -> None:

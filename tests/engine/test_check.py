@@ -8,9 +8,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from accelcal_rig.assembly import connected
+from accelcal_rig.assembly import checked
 from accelcal_rig.config.load import load_rig
-from accelcal_rig.engine.check import check_lines
 from tests.conftest import SIM_RIG
 
 
@@ -21,9 +20,9 @@ def chamber_line(tmp_path: Path, driver: str, profile: str, **settings: object) 
     path = tmp_path / "rig.yaml"
     path.write_text(yaml.safe_dump(config))
     rig = load_rig(path)
-    with connected(rig, dry_run=True, only=frozenset({"chamber"})) as instruments:
-        (line,) = check_lines(instruments, rig.model)
-    return line
+    (chamber,) = checked(rig, dry_run=True, only=frozenset({"chamber"}))
+    assert chamber.ok and chamber.name == "chamber", chamber.text
+    return chamber.text
 
 
 @pytest.mark.parametrize(("driver", "profile", "settings"), [
@@ -33,7 +32,8 @@ def chamber_line(tmp_path: Path, driver: str, profile: str, **settings: object) 
 def test_a_chamber_without_an_alarm_query_says_nothing_about_an_alarm(tmp_path: Path, driver: str, profile: str,
                                                                       settings: dict) -> None:
     line = chamber_line(tmp_path, driver, profile, **settings)
-    assert line.startswith("chamber    ") and "°C); set point limits: the rig's" in line
+    assert line.startswith("tcp 127.0.0.1:") or line.startswith("modbus-tcp 127.0.0.1:")
+    assert "°C); set point limits: the rig's" in line
     assert "alarm" not in line
 
 
@@ -49,9 +49,9 @@ def turntable_line(tmp_path: Path, **axis_settings: object) -> str:
     path = tmp_path / "rig.yaml"
     path.write_text(yaml.safe_dump(config))
     rig = load_rig(path)
-    with connected(rig, dry_run=True, only=frozenset({"turntable"})) as instruments:
-        (line,) = check_lines(instruments, rig.model)
-    return line
+    (turntable,) = checked(rig, dry_run=True, only=frozenset({"turntable"}))
+    assert turntable.ok and turntable.name == "turntable", turntable.text
+    return turntable.text
 
 
 def test_a_table_reads_the_rate_of_the_axes_its_rig_gives_a_rate_mode_and_no_others(tmp_path: Path) -> None:

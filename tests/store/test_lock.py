@@ -54,3 +54,41 @@ def test_the_lock_is_reentrant_and_readers_never_create_it(tmp_path: Path) -> No
             pass
         assert lock.holds(campaign)
     assert not lock.holds(campaign) and holder(campaign) is None
+
+
+WAIT = ("import sys; from pathlib import Path; from accelcal_rig.store import lock; lock.ACQUIRE_PATIENCE_S = 60; "
+        "lock.acquire(Path(sys.argv[1]), 'rig resume'); print('held', flush=True); sys.stdin.read()")
+
+
+def test_a_lock_file_removed_by_its_holder_is_never_held_twice(tmp_path: Path) -> None:
+    """A run whose campaign never started removes the lock file it made, while holding it; a writer that was
+    waiting on that file then locks the file at the path, so two writers never hold two files."""
+    campaign = tmp_path / "c.h5"
+    lock.acquire(campaign, "rig run")
+    waiter = subprocess.Popen([sys.executable, "-c", WAIT, str(campaign)], stdin=subprocess.PIPE,
+                              stdout=subprocess.PIPE, text=True)
+    try:
+        while holder(campaign) is None or not _waiting_on(waiter.pid, tmp_path / "c.h5.lock"):
+            assert waiter.poll() is None
+        lock.remove_lock_file(campaign)
+        lock.release(campaign)
+        assert waiter.stdout.readline().strip() == "held"
+        assert (tmp_path / "c.h5.lock").exists() and holder(campaign).startswith(f"pid {waiter.pid} ")
+        with pytest.raises(CampaignBusy):
+            lock.ACQUIRE_PATIENCE_S, patience = 0.05, lock.ACQUIRE_PATIENCE_S
+            try:
+                lock.acquire(campaign, "rig run")
+            finally:
+                lock.ACQUIRE_PATIENCE_S = patience
+    finally:
+        waiter.kill()
+        waiter.wait()
+
+
+def _waiting_on(pid: int, lock_file: Path) -> bool:
+    """Whether process `pid` has `lock_file` open (it is then waiting for the lock, or about to)."""
+    try:
+        return any(os.path.realpath(f"/proc/{pid}/fd/{fd}") == str(lock_file.resolve())
+                   for fd in os.listdir(f"/proc/{pid}/fd"))
+    except OSError:
+        return False
