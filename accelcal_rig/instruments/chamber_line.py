@@ -2,7 +2,7 @@
 over TCP (`host:port`) or a serial line (a device path or any pyserial URL).
 
 Every failure is one line naming the chamber and its endpoint: a refusal (the profile's error replies,
-with their meaning: a controller in local mode says so), a garbled or unexpected reply (transient: asked
+with their meaning: a controller whose panel locks remote writes says so), a garbled or unexpected reply (transient: asked
 again), silence, a controller not in °C, or values no chamber reads.
 """
 
@@ -32,7 +32,6 @@ class LineChamber:
         self._line = line
         self.endpoint = endpoint
         self.protocol = protocol
-        self._error = re.compile(protocol.error_pattern)
         self._retry: RetryCall = lambda operation, reconnect: operation()
 
     @classmethod
@@ -104,21 +103,37 @@ class LineChamber:
         if command is None or command.reply is None:
             self._line.send(request)
             return {}
-        reply = self._line.ask(request)
-        refusal = self._error.search(reply)
-        if refusal is not None:
-            code = refusal.groupdict().get("code")
-            meaning = self.protocol.errors.get(code.strip()) if code else None
-            raise self._failure(f"{request!r} refused: {reply!r}" + (f" ({meaning})" if meaning else ""))
-        match = re.fullmatch(command.reply, reply)
-        if match is None:
-            raise TransientInstrumentError(f"chamber ({self.endpoint}): {request!r}: unexpected reply {reply!r}")
-        return {k: v for k, v in match.groupdict().items() if v is not None}
+        return read_reply(self.protocol, operation, request, self._line.ask(request), self.endpoint)
+
+
+def read_reply(protocol: ChamberLineProtocol, operation: Operation, request: str, reply: str,
+               endpoint: str) -> dict[str, str]:
+    """A reply to an operation's request, as the driver reads it: a refusal (the profile's error pattern, with
+    what its code means) is an InstrumentError; a reply that does not match the command's pattern in full
+    is transient (garbled: asked again); else the values its named groups carry."""
+    command = protocol.command(operation)
+    assert command is not None and command.reply is not None  # only an answered command has a reply to read
+    refusal = re.search(protocol.error_pattern, reply)
+    if refusal is not None:
+        code = refusal.groupdict().get("code")
+        meaning = protocol.errors.get(code.strip()) if code else None
+        raise InstrumentError(f"chamber ({endpoint}): {request!r} refused: {reply!r}"
+                              + (f" ({meaning})" if meaning else ""))
+    match = re.fullmatch(command.reply, reply)
+    if match is None:
+        raise TransientInstrumentError(f"chamber ({endpoint}): {request!r}: unexpected reply {reply!r}")
+    return {k: v for k, v in match.groupdict().items() if v is not None}
 
 
 class _Alarm(LineChamber):
     def alarm_active(self) -> bool:
-        return self._ask("alarm")["alarm"] not in self.protocol.alarm_inactive
+        """The profile's list of quiet replies, or its alarm bits of a status integer (SIMSERV's 8)."""
+        alarm = self._ask("alarm")["alarm"]
+        try:
+            return self.protocol.alarm_means_active(alarm)
+        except ValueError:
+            raise self._failure(f"alarm status {alarm!r} is not an integer (the profile reads alarm_bits of it)") \
+                from None
 
 
 class _Limits(LineChamber):

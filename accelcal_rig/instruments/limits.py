@@ -46,9 +46,11 @@ def refuse_non_finite(instrument: str, what: str, value: float, unit: str) -> No
 class LimitedChamber(ChamberDelegate):
     """Refuses setpoints outside the rig's chamber limits, and outside the controller's own where it exposes
     them (read once, at connect: a controller clamps silently what it will not take); verifies each write by
-    reading back. A set point is first rounded to what the controller holds (a 0.1 °C register or template),
-    so the value checked against the limits and read back is the one on the wire. Everything else is passed
-    on, with the capabilities of the chamber it guards and no others."""
+    reading back, whether the controller clamps (the Modbus and SIMSERV simulators acknowledge and clamp) or
+    ignores (an SCPI setting is unanswered) what it will not take. A set point is first rounded to what the
+    controller holds (a 0.1 °C register or template), so the value checked against the limits and read back
+    is the one on the wire. Everything else is passed on, with the capabilities of the chamber it guards and
+    no others."""
 
     def __init__(self, chamber: Chamber, limits: ChamberConfig) -> None:
         super().__init__(chamber)
@@ -73,9 +75,8 @@ class LimitedChamber(ChamberDelegate):
         self._chamber.write_setpoint_c(setpoint_c)
         readback = self._chamber.read_setpoint_c()
         if abs(readback - setpoint_c) > SETPOINT_READBACK_TOLERANCE_C:
-            raise InstrumentError(
-                f"chamber ({self.endpoint}): setpoint {setpoint_c:g} °C written but {readback:g} °C read back"
-            )
+            raise InstrumentError(f"chamber ({self.endpoint}): set point {setpoint_c:g} °C written, the controller "
+                                  f"holds {readback:g} °C (it clamped or refused it)")
 
 
 class _LimitsReadAtConnect(LimitedChamber):

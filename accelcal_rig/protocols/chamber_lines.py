@@ -15,21 +15,15 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from accelcal_rig.protocols.line_templates import (
-    NUMBER,
-    TemplateCommand,
-    decimals_of,
-    fields_of,
-    regular_expression,
-    request_pattern,
-    round_trips,
-)
+from accelcal_rig.protocols.line_dialects import Dialect, check, request_pattern, spelled
+from accelcal_rig.protocols.line_templates import NUMBER, TemplateCommand, decimals_of, fields_of, regular_expression
 
 #: What a request may name (the set point it writes), with a sample value.
 _SEND_SAMPLE: dict[str, object] = {"value": -12.5}
-#: What an answer may name: the request's set point, and the values replies carry.
+#: What an answer may name: the request's set point, the values replies carry, the request as the controller
+#: received it (an echo: ESPEC's `OK:<command>`), and the chamber's sensor types (ESPEC's `TYPE?`).
 _ANSWER_SAMPLE: dict[str, object] = {**_SEND_SAMPLE, "pv": 0.0, "sp": 0.0, "low": 0.0, "high": 0.0, "identity": "x",
-                                     "alarm": "0", "units": "C", "humidity": 0.0}
+                                     "alarm": "0", "units": "C", "humidity": 0.0, "request": "x", "sensors": "T"}
 
 Operation = Literal["identify", "read_temperature", "read_setpoint", "write_setpoint", "read_low_limit",
                     "read_high_limit", "power_on", "power_off", "alarm", "units", "humidity", "purge_on",
@@ -48,6 +42,8 @@ class ChamberLineProtocol(BaseModel):
 
     write_terminator: str = Field("\n", min_length=1, max_length=4)
     read_terminator: str = Field("\n", min_length=1, max_length=4)
+    dialect: Dialect = Field("plain", description="how the controller reads a request: plain text, ESPEC (a "
+                             "blank after a comma optional), SIMSERV (numbered commands), SCPI (headers)")
     encoding: Literal["ascii", "latin-1"] = Field("ascii", description="latin-1 where fields are separated by a "
                                                   "byte above 0x7F (SIMSERV's 0xB6)")
     request_prefix: str = Field("", max_length=16, description="sent before every request: an RS-485 address")
@@ -57,9 +53,12 @@ class ChamberLineProtocol(BaseModel):
     unknown_command_answer: str | None = Field(None, max_length=256, description="what the simulator answers to "
                                                "a request it does not know (none: silence)")
     local_mode_answer: str | None = Field(None, max_length=256, description="what the controller answers to a "
-                                          "remote write while it is in local/manual mode, for the simulator")
+                                          "remote write while its panel locks them (ESPEC: PROTECT ON), for the simulator")
     units_celsius: str = Field("C", max_length=16, description="the `units` reply that means °C")
-    alarm_inactive: list[str] = Field(["0"], max_length=64, description="`alarm` replies that mean no alarm")
+    alarm_inactive: list[str] = Field(["0"], max_length=64, description="`alarm` replies that mean no alarm "
+                                      "(where alarm_bits is not set)")
+    alarm_bits: int | None = Field(None, ge=1, le=2**31 - 1, description="where set, the `alarm` reply is a status "
+                                   "integer and an alarm is any of these bits set (SIMSERV: 8)")
     identify: LineCommand
     read_temperature: LineCommand
     read_setpoint: LineCommand
@@ -102,13 +101,17 @@ class ChamberLineProtocol(BaseModel):
             if operation != "write_setpoint" and fields_of(command.send):
                 raise ValueError(f"{operation}: only write_setpoint's request carries a value")
             try:
+                check(command.send, self.dialect)
+            except ValueError as exc:
+                raise ValueError(f"{operation}: {exc}") from None
+            try:
                 (self.request_prefix + command.send + (command.answer or "")).encode(self.encoding)
             except UnicodeEncodeError:
                 raise ValueError(f"{operation}: not {self.encoding} text") from None
             if command.send != command.send.strip():
                 raise ValueError(f"{operation}: the request {command.send!r} has blanks at either end (lost on "
                                  "the line)")
-            if not round_trips(command.send, _SEND_SAMPLE):
+            if not request_pattern(command.send, self.dialect).fullmatch(self._spelled(command, _SEND_SAMPLE)):
                 raise ValueError(f"{operation}: the request {command.send!r} does not read back as itself "
                                  "(no padding or blanks inside a field)")
         self._no_request_taken_for_another()
@@ -122,9 +125,9 @@ class ChamberLineProtocol(BaseModel):
             command = self.command(operation)
             if command is None:
                 continue
-            request = command.send.format(**_SEND_SAMPLE)
+            request = self._spelled(command, _SEND_SAMPLE)
             for earlier, other in seen:
-                if other.send != command.send and request_pattern(other.send).fullmatch(request):
+                if other.send != command.send and request_pattern(other.send, self.dialect).fullmatch(request):
                     raise ValueError(f"{operation}: its request {request!r} reads as {earlier}'s")
             seen.append((operation, command))
 
@@ -132,6 +135,15 @@ class ChamberLineProtocol(BaseModel):
     def setpoint_decimals(self) -> int | None:
         """The decimals the set point is written with (`{value:.1f}`: 1, a 0.1 °C step); None: in full."""
         return decimals_of(self.write_setpoint.send, "value")
+
+    def alarm_means_active(self, alarm: str) -> bool:
+        """Whether an `alarm` reply means an active alarm (ValueError: not the status integer expected)."""
+        if self.alarm_bits is not None:
+            return int(alarm) & self.alarm_bits != 0
+        return alarm not in self.alarm_inactive
+
+    def _spelled(self, command: LineCommand, fields: dict[str, object]) -> str:
+        return spelled(command.send, self.dialect).format(**fields)
 
     def command(self, operation: Operation) -> LineCommand | None:
         command: LineCommand | None = getattr(self, operation)
@@ -141,11 +153,12 @@ class ChamberLineProtocol(BaseModel):
         command = self.command(operation)
         if command is None:
             raise ValueError(f"the profile has no {operation} command")
-        return self.request_prefix + command.send.format(**fields)
+        return self.request_prefix + self._spelled(command, fields)
 
     def request_patterns(self) -> list[tuple[Operation, LineCommand, object]]:
-        """Every command's request as a pattern (after the prefix), for a simulator; in operation order."""
-        return [(operation, command, request_pattern(command.send))
+        """Every command's request as a pattern of every spelling the controller takes (after the prefix), for a
+        simulator; in operation order."""
+        return [(operation, command, request_pattern(command.send, self.dialect))
                 for operation in OPERATIONS if (command := self.command(operation)) is not None]
 
 
@@ -161,22 +174,32 @@ _CARRIES: dict[Operation, str] = {"identify": "identity", "read_temperature": "p
                                   "units": "units", "humidity": "humidity"}
 
 _N = NUMBER
-#: ESPEC P300 / SCP-220 class (ChamberConnectLibrary): `TEMP?` answers measured, set point, upper, lower.
-_ESPEC_TEMP = LineCommand(send="TEMP?", reply=rf"(?P<pv>{_N}),(?P<sp>{_N}),(?P<high>{_N}),(?P<low>{_N})",
+#: ESPEC P300 / SCP-220 class (ChamberConnectLibrary `p300.py`): `TEMP?` answers measured, set point, upper,
+#: lower; fields are read with float(), so a blank after a comma is taken (py-lab-hal splits on ", ").
+_ESPEC_TEMP = LineCommand(send="TEMP?", reply=rf"(?P<pv>{_N}),\s*(?P<sp>{_N}),\s*(?P<high>{_N}),\s*(?P<low>{_N})",
                           answer="{pv:.1f},{sp:.1f},{high:.1f},{low:.1f}")
+#: A setting is answered `OK:` and the command as received (EHS manual §1.3; ATWG checks the echo).
+_ESPEC_OK = r"OK:.*"
 ESPEC_P300 = ChamberLineProtocol(
-    write_terminator="\r\n", read_terminator="\r\n", default_port=10001,
+    dialect="espec", write_terminator="\r\n", read_terminator="\r\n", default_port=10001,
     error_pattern=r"^NA:(?P<code>.*)",
-    errors={"CMD ERR": "command not known to this controller", "PARA ERR": "parameter not accepted",
+    errors={"CMD ERR": "command not known to this controller", "ADDR ERR": "bad address",
+            "CONT NOT READY-1": "the chamber does not support PTCON or humidity",
+            "CONT NOT READY-2": "the chamber is not running a program",
+            "CONT NOT READY-3": "command not supported by this controller",
+            "CONT NOT READY-4": "keys may not be locked while the controller is off",
+            "CONT NOT READY-5": "the time signal named is not enabled",
+            "DATA NOT READY": "the program named does not exist",
+            "PARA ERR": "parameter missing or not recognised",
             "DATA OUT OF RANGE": "value beyond the controller's range",
-            "PROTECT ON": "the controller's key protection is on: remote writes are locked",
-            "CONT NOT READY-1": "the controller is in local mode (not ready for remote control)"},
-    unknown_command_answer="NA:CMD ERR", local_mode_answer="NA:CONT NOT READY-1",
-    identify=LineCommand(send="TYPE?", reply=r"(?P<identity>.+)", answer="{identity}"),
+            "PROTECT ON": "the controller's data protection is on (set on its panel): remote writes are locked",
+            "INVALID REQ": "function not supported", "CHB NOT READY": "the controller could not act on the command"},
+    unknown_command_answer="NA:CMD ERR", local_mode_answer="NA:PROTECT ON",
+    identify=LineCommand(send="TYPE?", reply=r"(?P<identity>.+)", answer="{sensors},{identity},{high:.1f}"),
     read_temperature=_ESPEC_TEMP, read_setpoint=_ESPEC_TEMP, read_low_limit=_ESPEC_TEMP, read_high_limit=_ESPEC_TEMP,
-    write_setpoint=LineCommand(send="TEMP, S{value:.1f}", reply=r"OK:.*", answer="OK:TEMP, S{value:.1f}"),
-    power_on=LineCommand(send="MODE, CONSTANT", reply=r"OK:.*", answer="OK:MODE, CONSTANT"),
-    power_off=LineCommand(send="MODE, STANDBY", reply=r"OK:.*", answer="OK:MODE, STANDBY"),
+    write_setpoint=LineCommand(send="TEMP, S{value:.1f}", reply=_ESPEC_OK, answer="OK:{request}"),
+    power_on=LineCommand(send="MODE,CONSTANT", reply=_ESPEC_OK, answer="OK:{request}"),
+    power_off=LineCommand(send="MODE,STANDBY", reply=_ESPEC_OK, answer="OK:{request}"),
     alarm=LineCommand(send="ALARM?", reply=r"(?P<alarm>\d+)(,.*)?", answer="{alarm}"),
     humidity=LineCommand(send="HUMI?", reply=rf"(?P<humidity>{_N}),.*", answer="{humidity:.0f},0,100,0"),
 )
@@ -197,40 +220,46 @@ THERMOTRON_8800 = ChamberLineProtocol(
 )
 
 #: Vötsch/Weiss SIMSERV: numbered commands, fields separated by ¶ (0xB6), chamber index 1; replies begin
-#: with a status, 1 = accepted.
+#: with a status, 1 = accepted, and any fields after the value are taken (the clients ignore them).
 _S = "\u00b6"
+_MORE = f"(?:{_S}.*)?"
 SIMSERV = ChamberLineProtocol(
-    write_terminator="\r", read_terminator="\r\n", encoding="latin-1", default_port=2049,
+    dialect="simserv", write_terminator="\r", read_terminator="\r\n", encoding="latin-1", default_port=2049,
     error_pattern=r"^(?P<code>-\d+)",
     errors={"-5": "command number not known", "-6": "too few or incorrect parameters",
             "-8": "data could not be read"},
     unknown_command_answer="-5",
-    identify=LineCommand(send=f"99997{_S}1", reply=rf"1{_S}(?P<identity>.*)", answer=f"1{_S}{{identity}}"),
-    read_temperature=LineCommand(send=f"11004{_S}1{_S}1", reply=rf"1{_S}(?P<pv>{_N})", answer=f"1{_S}{{pv:.1f}}"),
-    read_setpoint=LineCommand(send=f"11002{_S}1{_S}1", reply=rf"1{_S}(?P<sp>{_N})", answer=f"1{_S}{{sp:.1f}}"),
+    identify=LineCommand(send=f"99997{_S}1{_S}1", reply=rf"1{_S}(?P<identity>[^{_S}]*){_MORE}",
+                         answer=f"1{_S}{{identity}}"),
+    read_temperature=LineCommand(send=f"11004{_S}1{_S}1", reply=rf"1{_S}(?P<pv>{_N}){_MORE}", answer=f"1{_S}{{pv:.1f}}"),
+    read_setpoint=LineCommand(send=f"11002{_S}1{_S}1", reply=rf"1{_S}(?P<sp>{_N}){_MORE}", answer=f"1{_S}{{sp:.1f}}"),
     write_setpoint=LineCommand(send=f"11001{_S}1{_S}1{_S}{{value:.1f}}", reply="1", answer="1"),
-    read_low_limit=LineCommand(send=f"11007{_S}1{_S}1", reply=rf"1{_S}(?P<low>{_N})", answer=f"1{_S}{{low:.1f}}"),
-    read_high_limit=LineCommand(send=f"11009{_S}1{_S}1", reply=rf"1{_S}(?P<high>{_N})", answer=f"1{_S}{{high:.1f}}"),
-    power_on=LineCommand(send=f"14001{_S}1{_S}1{_S}1", reply="1", answer="1"),
+    read_low_limit=LineCommand(send=f"11007{_S}1{_S}1", reply=rf"1{_S}(?P<low>{_N}){_MORE}", answer=f"1{_S}{{low:.1f}}"),
+    read_high_limit=LineCommand(send=f"11009{_S}1{_S}1", reply=rf"1{_S}(?P<high>{_N}){_MORE}",
+                                answer=f"1{_S}{{high:.1f}}"),
+    power_on=LineCommand(send=f"14001{_S}1{_S}1{_S}1", reply="1", answer="1"),  # digital output 1: the manual run
     power_off=LineCommand(send=f"14001{_S}1{_S}1{_S}0", reply="1", answer="1"),
-    alarm=LineCommand(send=f"10012{_S}1", reply=rf"1{_S}(?P<alarm>\d+)", answer=f"1{_S}{{alarm}}"),
-    alarm_inactive=["1", "3", "5", "7"],  # status 1 idle, 3 running, +4 warnings; +8 means alarms
-    units=LineCommand(send=f"11023{_S}1{_S}1", reply=rf"1{_S}(?P<units>[A-Za-z°]+)", answer=f"1{_S}{{units}}"),
+    alarm=LineCommand(send=f"10012{_S}1", reply=rf"1{_S}(?P<alarm>\d+){_MORE}", answer=f"1{_S}{{alarm}}"),
+    alarm_bits=8,  # status 1 idle, +2 running, +4 warnings, +8 alarms
+    units=LineCommand(send=f"11023{_S}1{_S}1", reply=rf"1{_S}(?P<units>[A-Za-z°]+){_MORE}", answer=f"1{_S}{{units}}"),
     units_celsius="\u00b0C",
-    humidity=LineCommand(send=f"11004{_S}1{_S}2", reply=rf"1{_S}(?P<humidity>{_N})", answer=f"1{_S}{{humidity:.1f}}"),
-    purge_on=LineCommand(send=f"14001{_S}1{_S}8{_S}1", reply="1", answer="1"),
+    humidity=LineCommand(send=f"11004{_S}1{_S}2", reply=rf"1{_S}(?P<humidity>{_N}){_MORE}",
+                         answer=f"1{_S}{{humidity:.1f}}"),
+    purge_on=LineCommand(send=f"14001{_S}1{_S}8{_S}1", reply="1", answer="1"),  # output 8: chamber wiring
     purge_off=LineCommand(send=f"14001{_S}1{_S}8{_S}0", reply="1", answer="1"),
 )
 
-#: Watlow F4T over SCPI (TCP port 5025 only): loop 1 is temperature, loop 2 humidity; settings are not answered.
+#: Watlow F4T over SCPI (TCP port 5025 only): loop 1 is temperature, loop 2 humidity. Headers in the
+#: manual's notation (sent as upper-case long forms). Settings are not answered and the F4T has no error
+#: queue: a set point is confirmed by reading it back.
 WATLOW_F4T_SCPI = ChamberLineProtocol(
-    write_terminator="\n", read_terminator="\n", default_port=5025,
+    dialect="scpi", write_terminator="\n", read_terminator="\n", default_port=5025,
     identify=LineCommand(send="*IDN?", reply=r"(?P<identity>.+)", answer="{identity}"),
-    read_temperature=LineCommand(send=":SOURCE:CLOOP1:PVALUE?", reply=rf"(?P<pv>{_N})", answer="{pv:.2f}"),
-    read_setpoint=LineCommand(send=":SOURCE:CLOOP1:SPOINT?", reply=rf"(?P<sp>{_N})", answer="{sp:.2f}"),
-    write_setpoint=LineCommand(send=":SOURCE:CLOOP1:SPOINT {value:.2f}"),
-    units=LineCommand(send=":UNIT:TEMPERATURE?", reply=r"(?P<units>[A-Z]+)", answer="{units}"),
-    humidity=LineCommand(send=":SOURCE:CLOOP2:PVALUE?", reply=rf"(?P<humidity>{_N})", answer="{humidity:.2f}"),
+    read_temperature=LineCommand(send=":SOURce:CLOop1:PVALue?", reply=rf"(?P<pv>{_N})", answer="{pv:.2f}"),
+    read_setpoint=LineCommand(send=":SOURce:CLOop1:SPOint?", reply=rf"(?P<sp>{_N})", answer="{sp:.2f}"),
+    write_setpoint=LineCommand(send=":SOURce:CLOop1:SPOint {value:.2f}"),
+    units=LineCommand(send=":UNIT:TEMPerature?", reply=r"(?P<units>[A-Z]+)", answer="{units}"),
+    humidity=LineCommand(send=":SOURce:CLOop2:PVALue?", reply=rf"(?P<humidity>{_N})", answer="{humidity:.2f}"),
 )
 
 LINE_PROFILES: dict[str, ChamberLineProtocol] = {"espec-p300": ESPEC_P300, "thermotron-8800": THERMOTRON_8800,

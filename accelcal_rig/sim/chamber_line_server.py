@@ -1,7 +1,8 @@
 """A simulated chamber controller speaking a line-protocol profile, generated from the profile itself: each
-request is recognised by its command's template and answered with the command's answer template, from
-the virtual lab at the shared clock's time. On loopback TCP (a controller's Ethernet port) or a pty (its
-serial port)."""
+request is recognised by its command's template in every spelling the profile's dialect takes, and answered
+with the command's answer template, from the virtual lab at the shared clock's time; what the makers'
+clients send beyond the profile is answered by the dialect's extras (sim/line_extras.py). On loopback TCP
+(a controller's Ethernet port) or a pty (its serial port)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from accelcal_rig.protocols.chamber_lines import ChamberLineProtocol, Operation
 from accelcal_rig.protocols.line_templates import finite_number
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
+from accelcal_rig.sim.line_extras import Unknown, extras_for
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 from accelcal_rig.sim.tcp_line_server import TcpLineServer
 
@@ -25,11 +27,16 @@ class SimulatedLineChamberServer:
         self._lab = lab
         self._protocol = protocol
         self._patterns = protocol.request_patterns()
-        self._identity = identity
+        #: What the controller names itself (SIMSERV's type text, the controller field of ESPEC's TYPE?).
+        self.identity = identity
         #: What the controller says its units are (a test sets °F to see the driver refuse it).
         self.units = protocol.units_celsius if units is None else units
-        #: A controller switched to local/manual mode refuses remote writes (tests set it).
+        #: A controller whose panel locks remote writes (local mode; ESPEC: data protection) refuses them (tests set it).
         self.local_mode = False
+        #: Active alarms and warnings (tests set them): SIMSERV's status, ESPEC's alarm count.
+        self.alarms = 0
+        self.warnings = 0
+        self._extras = extras_for(protocol, lab, self)
         self._stall_after_s = stall_after_s
         #: The last set point written over the wire, for tests that check the safe state.
         self.last_setpoint_c: float | None = None
@@ -79,8 +86,11 @@ class SimulatedLineChamberServer:
             except ValueError:  # `nan`, `inf`, `1e400`, `1_0`: refused as any request it cannot read, set point kept
                 return self._protocol.unknown_command_answer
             values = self._serve(operation, value)
-            return None if command.answer is None else command.answer.format(**values)
-        return self._protocol.unknown_command_answer
+            return None if command.answer is None else command.answer.format(request=request, **values)
+        with self._lab.lock:
+            self._lab.moisture.dew_point_c(self._lab.clock.now())
+            extra = self._extras.answer(request)
+        return self._protocol.unknown_command_answer if isinstance(extra, Unknown) else extra
 
     def overlong_answer(self, head: str) -> str | None:
         """A line too long to be a request (its first characters `head`): answered as an unknown request by a
@@ -99,11 +109,15 @@ class SimulatedLineChamberServer:
                 lab.thermal.set_power(now, operation == "power_on")
             elif operation in ("purge_on", "purge_off"):
                 lab.moisture.set_purge(now, operation == "purge_on")
+            if operation in _WRITES:
+                self._extras.carried_out(operation)
             shown = self.last_setpoint_c if self.last_setpoint_c is not None else lab.thermal.setpoint_c
             low, high = lab.controller_limits_c
-            values: dict[str, object] = {"identity": self._identity, "sp": shown, "low": low, "high": high,
-                                         "alarm": self._protocol.alarm_inactive[0], "units": self.units,
-                                         "value": shown if value is None else value, "pv": 0.0, "humidity": 0.0}
+            quiet = "0" if self._protocol.alarm_bits is not None else self._protocol.alarm_inactive[0]
+            values: dict[str, object] = {"identity": self.identity, "sp": shown, "low": low, "high": high,
+                                         "alarm": quiet, "units": self.units, "sensors": "T",
+                                         "value": shown if value is None else value, "pv": 0.0, "humidity": 0.0,
+                                         **self._extras.values()}
             if operation in ("read_temperature", "read_setpoint", "read_low_limit", "read_high_limit"):
                 values["pv"] = lab.chamber_reading_c()  # measured only when a reply may carry it (it draws noise)
             if operation == "humidity":

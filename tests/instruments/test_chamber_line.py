@@ -68,11 +68,12 @@ def test_the_controllers_own_limits_refuse_before_the_wire(served) -> None:
     assert server.last_setpoint_c is None
 
 
-def test_a_controller_in_local_mode_refuses_remote_writes_in_one_line(served) -> None:
+def test_a_controller_whose_panel_locks_remote_writes_refuses_them_in_one_line(served) -> None:
+    """ESPEC's documented refusal for it is `PROTECT ON` (data protection set on the panel)."""
     chamber, server, _, _ = served("espec-p300")
     server.local_mode = True
     with pytest.raises(InstrumentError, match=r"^chamber \(tcp 127\.0\.0\.1:\d+\): 'TEMP, S25.0' refused: "
-                                              r"'NA:CONT NOT READY-1' \(the controller is in local mode"):
+                                              r"'NA:PROTECT ON' \(the controller's data protection is on"):
         chamber.write_setpoint_c(25.0)
     assert server.last_setpoint_c is None
 

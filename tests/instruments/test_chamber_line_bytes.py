@@ -24,12 +24,14 @@ def talk(profile: str | ChamberLineProtocol, conversation: Conversation):
 
 
 def test_espec_p300_reads_one_temp_reply_for_value_set_point_and_limits() -> None:
+    """It sends ESPEC's library's spelling (`MODE,CONSTANT`, `TEMP, S<v>`) and reads `TEMP?` with or without
+    a blank after each comma (py-lab-hal's PU-3J class splits on ", ")."""
     context, protocol = talk("espec-p300", [
         (b"TYPE?\r\n", b"DRY,P300,180\r\n"),
         (b"TEMP?\r\n", b"23.4,25.0,180.0,-70.0\r\n"), (b"TEMP?\r\n", b"23.4,25.0,180.0,-70.0\r\n"),
         (b"TEMP, S-40.0\r\n", b"OK:TEMP, S-40.0\r\n"),
-        (b"TEMP?\r\n", b"23.1,-40.0,180.0,-70.0\r\n"), (b"TEMP?\r\n", b"23.1,-40.0,180.0,-70.0\r\n"),
-        (b"MODE, CONSTANT\r\n", b"OK:MODE, CONSTANT\r\n"), (b"MODE, STANDBY\r\n", b"OK:MODE, STANDBY\r\n"),
+        (b"TEMP?\r\n", b"23.1,-40.0,180.0,-70.0\r\n"), (b"TEMP?\r\n", b"23.1, -40.0, 180.0, -70.0\r\n"),
+        (b"MODE,CONSTANT\r\n", b"OK:MODE,CONSTANT\r\n"), (b"MODE,STANDBY\r\n", b"OK:MODE,STANDBY\r\n"),
         (b"ALARM?\r\n", b"0\r\n"), (b"ALARM?\r\n", b"2,11,14\r\n"),
     ])
     with context as line:
@@ -61,12 +63,15 @@ def test_thermotron_8800_checks_its_units_and_answers_operations_with_zero() -> 
 
 
 def test_simserv_numbered_commands_with_its_separator_byte() -> None:
+    """`99997¶1¶1` asks for the test system type (basil, SengerM); fields after a value are taken; the alarm
+    is bit 8 of the status (1 idle, +2 running, +4 warnings, +8 alarms)."""
     context, protocol = talk("simserv", [
-        (b"99997\xb61\r", b"1\xb6LabEvent T/210/70/5\r\n"), (b"11023\xb61\xb61\r", b"1\xb6\xb0C\r\n"),
-        (b"11004\xb61\xb61\r", b"1\xb622.9\r\n"), (b"11002\xb61\xb61\r", b"1\xb623.0\r\n"),
+        (b"99997\xb61\xb61\r", b"1\xb6LabEvent T/210/70/5\r\n"), (b"11023\xb61\xb61\r", b"1\xb6\xb0C\r\n"),
+        (b"11004\xb61\xb61\r", b"1\xb622.9\xb6extra\r\n"), (b"11002\xb61\xb61\r", b"1\xb623.0\r\n"),
         (b"11001\xb61\xb61\xb6-40.0\r", b"1\r\n"),
         (b"11007\xb61\xb61\r", b"1\xb6-75.0\r\n"), (b"11009\xb61\xb61\r", b"1\xb6180.0\r\n"),
         (b"14001\xb61\xb61\xb61\r", b"1\r\n"), (b"10012\xb61\r", b"1\xb63\r\n"), (b"10012\xb61\r", b"1\xb611\r\n"),
+        (b"10012\xb61\r", b"1\xb67\r\n"), (b"10012\xb61\r", b"1\xb68\r\n"),
         (b"14001\xb61\xb68\xb61\r", b"1\r\n"),
     ])
     with context as line:
@@ -77,6 +82,8 @@ def test_simserv_numbered_commands_with_its_separator_byte() -> None:
         chamber.set_power(True)
         assert not chamber.alarm_active()  # 3: running
         assert chamber.alarm_active()  # 11 = 3 + 8: running with alarms
+        assert not chamber.alarm_active()  # 7 = 3 + 4: running with warnings only
+        assert chamber.alarm_active()  # 8: bit 8 alone (a status no client lists) is still an alarm
         chamber.set_purge(True)
 
 
@@ -103,8 +110,10 @@ def test_an_rs485_address_prefixes_every_request() -> None:
 
 
 @pytest.mark.parametrize(("profile", "sent", "reply", "message"), [
+    ("espec-p300", b"TEMP, S25.0\r\n", b"NA:PROTECT ON\r\n",
+     r"chamber \(memory\): 'TEMP, S25.0' refused: 'NA:PROTECT ON' \(the controller's data protection is on"),
     ("espec-p300", b"TEMP, S25.0\r\n", b"NA:CONT NOT READY-1\r\n",
-     r"chamber \(memory\): 'TEMP, S25.0' refused: 'NA:CONT NOT READY-1' \(the controller is in local mode"),
+     r"refused: 'NA:CONT NOT READY-1' \(the chamber does not support PTCON or humidity\)"),
     ("espec-p300", b"TEMP, S25.0\r\n", b"NA:DATA OUT OF RANGE\r\n", r"refused: 'NA:DATA OUT OF RANGE' \(value beyond"),
     ("simserv", b"11001\xb61\xb61\xb625.0\r", b"-6\r\n",
      r"chamber \(memory\): '11001¶1¶1¶25.0' refused: '-6' \(too few or incorrect parameters\)"),

@@ -1,9 +1,21 @@
+import re
+
 import numpy as np
 import pytest
 
+from accelcal_rig.config.load import load_rig
 from accelcal_rig.config.rig import ChamberConfig, TurntableAxis, TurntableConfig
+from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.errors import InstrumentError
+from accelcal_rig.instruments.chamber_line import LineChamber
+from accelcal_rig.instruments.chamber_modbus import ModbusChamber
 from accelcal_rig.instruments.limits import LimitedChamber, LimitedTurntable
+from accelcal_rig.protocols.chamber_lines import line_protocol
+from accelcal_rig.protocols.chamber_registers import register_map
+from accelcal_rig.sim.chamber_line_server import SimulatedLineChamberServer
+from accelcal_rig.sim.chamber_server import SimulatedChamberServer
+from accelcal_rig.sim.lab import VirtualLab
+from tests.conftest import SIM_RIG
 
 
 class RecordingChamber:
@@ -46,7 +58,8 @@ def test_out_of_limit_setpoint_is_refused_before_anything_is_written() -> None:
 
 def test_setpoint_that_does_not_read_back_is_an_error() -> None:
     chamber = LimitedChamber(RecordingChamber(readback_offset_c=0.5), ChamberConfig())
-    with pytest.raises(InstrumentError, match="written but .* read back"):
+    with pytest.raises(InstrumentError, match=r"^chamber \(test-chamber\): set point 10 °C written, the controller "
+                                              r"holds 10.5 °C \(it clamped or refused it\)$"):
         chamber.write_setpoint_c(10)
 
 
@@ -106,3 +119,40 @@ def test_a_setpoint_or_angle_that_is_no_number_is_refused_by_name_even_on_a_cont
     with pytest.raises(InstrumentError, match=r"^turntable \(test-table\): axis spin to nan° refused: not a finite"):
         limited.move_to(np.array([np.nan]))  # a continuous axis goes anywhere, but not to NaN
     assert table.moves == []
+
+
+def _clamping_simulators():
+    """Each simulator that acknowledges a set point beyond its controller's limits and clamps it, with a driver
+    of it: (driver, simulated lab, stop)."""
+    def modbus():
+        lab = VirtualLab(load_rig(SIM_RIG).model, VirtualClock(), 0)
+        server = SimulatedChamberServer(lab, register_map("watlow-f4")).start()
+        return ModbusChamber.tcp(server.host, server.port, register_map("watlow-f4")), lab, server.stop
+
+    def simserv():
+        lab = VirtualLab(load_rig(SIM_RIG).model, VirtualClock(), 0)
+        server = SimulatedLineChamberServer(lab, line_protocol("simserv")).start()
+        return LineChamber.open(server.endpoint, line_protocol("simserv"), timeout_s=2.0), lab, server.stop
+
+    return {"modbus watlow-f4": modbus, "line simserv": simserv}
+
+
+@pytest.mark.parametrize("simulator", ["modbus watlow-f4", "line simserv"])
+def test_a_set_point_the_controller_clamps_is_read_back_and_said_in_one_line(simulator: str) -> None:
+    """The rig's limits are wider than the controller's, and the controller's own are not checked first (as
+    with a profile or map that exposes none): the simulator acknowledges the write and clamps it, and the
+    read-back says so, naming the chamber, what was written and what the controller holds."""
+    chamber, lab, stop = _clamping_simulators()[simulator]()
+    try:
+        low, high = lab.controller_limits_c
+        beyond = high + 20.0
+        guarded = LimitedChamber(chamber, ChamberConfig(min_setpoint_c=low, max_setpoint_c=beyond))
+        guarded.controller_limits = None  # what a profile without limit commands leaves the gate
+        with pytest.raises(InstrumentError, match=rf"^chamber \({re.escape(chamber.endpoint)}\): set point "
+                                                  rf"{beyond:g} °C written, the controller holds {high:g} °C "
+                                                  r"\(it clamped or refused it\)$"):
+            guarded.write_setpoint_c(beyond)
+        assert lab.thermal.setpoint_c == pytest.approx(high)
+    finally:
+        chamber.close()
+        stop()

@@ -72,3 +72,40 @@ def test_a_rig_config_pairs_line_profiles_with_the_line_driver() -> None:
         ChamberConfig(driver="line", profile="watlow-f4")
     with pytest.raises(ValidationError, match=r"protocol_overrides\.units_celsius"):
         ChamberConfig(driver="line", profile="thermotron-8800", protocol_overrides={"units_celsius": "x" * 40})
+
+
+@pytest.mark.parametrize(("profile", "overrides", "message"), [
+    ("watlow-f4t-scpi", {"write_setpoint": {"send": ":source:cloop1:spoint {value}"}},
+     r"write_setpoint: ':source:cloop1:spoint' is not a SCPI header in the manuals' notation"),
+    ("watlow-f4t-scpi", {"units": {"send": ":UNIT:TEMP_C?", "reply": "(?P<units>C)", "answer": "C"}},
+     r"units: ':UNIT:TEMP_C\?' is not a SCPI header"),
+    ("simserv", {"identify": {"send": "99997\u00b61", "reply": "1\u00b6(?P<identity>.*)", "answer": "1\u00b6x"}},
+     r"identify: '99997¶1': SIMSERV command 99997 takes 2 fields after its number .* not 1 \(the controller "
+     r"answers -6\)"),
+    ("simserv", {"alarm": {"send": "10013\u00b61", "reply": "1\u00b6(?P<alarm>\\d+)", "answer": "1\u00b61"}},
+     r"alarm: '10013¶1': SIMSERV has no command '10013'"),
+])
+def test_a_request_the_controller_family_cannot_read_is_refused_naming_the_operation(
+        profile: str, overrides: dict, message: str) -> None:
+    with pytest.raises(ValidationError, match=message):
+        line_protocol(profile, overrides)
+
+
+def test_scpi_templates_are_sent_as_upper_case_long_forms_and_read_in_any_spelling() -> None:
+    protocol = line_protocol("watlow-f4t-scpi")
+    assert protocol.request("write_setpoint", value=30.0) == ":SOURCE:CLOOP1:SPOINT 30.00"
+    patterns = {operation: pattern for operation, _, pattern in protocol.request_patterns()}
+    for spelling in (":SOURCE:CLOOP1:SPOINT 30", "SOURCE:CLOOP1:SPOINT 30", ":sour:clo1:spo 30", "sour:clo:spo 30",
+                     ":SOURce:CLOop1:SPOint   3.0E+01"):
+        assert patterns["write_setpoint"].fullmatch(spelling), spelling  # type: ignore[attr-defined]
+    for other in (":SOURCE:CLOOP2:SPOINT 30", ":SOURC:CLOOP1:SPOINT 30", ":SOURCE:CLOOP1:SPOINT"):
+        assert not patterns["write_setpoint"].fullmatch(other), other  # type: ignore[attr-defined]
+
+
+def test_espec_requests_are_read_with_or_without_a_blank_after_each_comma() -> None:
+    patterns = {operation: pattern for operation, _, pattern in LINE_PROFILES["espec-p300"].request_patterns()}
+    for spelling in ("MODE,CONSTANT", "MODE, CONSTANT"):
+        assert patterns["power_on"].fullmatch(spelling)  # type: ignore[attr-defined]
+    for spelling in ("TEMP,S31.0", "TEMP, S31.0"):
+        assert patterns["write_setpoint"].fullmatch(spelling)["value"] == "31.0"  # type: ignore[attr-defined]
+    assert not patterns["power_on"].fullmatch("MODE,  CONSTANT")  # type: ignore[attr-defined]
