@@ -18,6 +18,12 @@ REG_FIFO_SAMPLES = 0x29
 REG_RANGE = 0x2C
 REG_POWER_CTL = 0x2D
 REG_RESET = 0x2F
+#: The last register of the map (RESET).
+REG_LAST = REG_RESET
+#: Identity, STATUS, FIFO_ENTRIES, TEMP2/TEMP1, the data registers, FIFO_DATA and the reserved 0x12…0x1D: read-only.
+READ_ONLY_REGISTERS = frozenset(range(0x00, 0x1E))
+#: Written only in standby (the data sheet: change FILTER and RANGE only in standby).
+STANDBY_ONLY_REGISTERS = frozenset({REG_FILTER, REG_RANGE})
 
 RESET_CODE = 0x52
 STATUS_NVM_BUSY = 0x10

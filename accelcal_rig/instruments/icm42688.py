@@ -19,6 +19,10 @@ REG_GYRO_CONFIG0 = 0x4F
 REG_ACCEL_CONFIG0 = 0x50
 REG_WHO_AM_I = 0x75
 REG_BANK_SEL = 0x76          # in every bank
+#: The last address as the project models bank 0 (the whole 7-bit space: the data sheet's map pages were not read).
+REG_LAST = 0x7F
+#: Bank 0's read-only registers the project knows: the data registers, INT_STATUS (and TMST_FSYNC between), WHO_AM_I.
+READ_ONLY_REGISTERS = frozenset({*range(REG_TEMP_DATA1, REG_INT_STATUS + 1), REG_WHO_AM_I})
 
 DEVICE_CONFIG_SOFT_RESET = 0x01
 INT_STATUS_RESET_DONE = 0x10

@@ -1,6 +1,9 @@
 """A simulated ADXL355 behind a serial bridge, on a pseudo-terminal: the register map, including the
 96-entry FIFO that fills at the output data rate on the shared clock, fed by the lab's sensor model,
-and the bridge's own block capture (protocol version 2), which drains the FIFO as firmware would."""
+and the bridge's own block capture (protocol version 2 on), which drains the FIFO as firmware would. The
+bridge answers as the reference firmware does (sim/bridge_requests.py); the part does with a write what the
+reference firmware's C model of it does (firmware/host/adxl355_model.h): a read-only register, or RANGE and
+FILTER while measuring, ignore it (the bridge refuses those before they reach the part)."""
 
 from __future__ import annotations
 
@@ -11,16 +14,23 @@ import numpy as np
 from accelcal_rig.config.rig import SensorConfig
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import BRIDGE_GREETING
-from accelcal_rig.sim.bridge_requests import overlong_request, register_request
+from accelcal_rig.sim.bridge_capture import CaptureRequests
+from accelcal_rig.sim.bridge_lines import LINE_ENCODING, STALE_LINE_S, overlong_line
+from accelcal_rig.sim.bridge_registers import RegisterMap, RegisterRequests
+from accelcal_rig.sim.bridge_requests import BridgeRequests
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 
-_READ_ONLY_BELOW = 0x1E
 _FIFO_REGISTERS = frozenset({adxl355.REG_STATUS, adxl355.REG_FIFO_ENTRIES, adxl355.REG_FIFO_DATA})  # ID, status, data and FIFO registers
 _SAMPLES_IN_FIFO = adxl355.FIFO_CAPACITY_ENTRIES // 3
+#: FILTER's ODR_LPF codes 11…15 are reserved: the part is taken to run at the slowest rate (code 10), as the C model.
+_SLOWEST_ODR_CODE = 10
 #: Samples the simulated bridge's capture buffer holds (9 bytes each: 36 kB, a small microcontroller's RAM).
 CAPTURE_CAPACITY_SAMPLES = 4096
+#: The register map as the bridge enforces it (ADXL355, ADXL357, ADXL359 alike).
+REGISTER_MAP = RegisterMap(last=adxl355.REG_LAST, read_only=adxl355.READ_ONLY_REGISTERS,
+                           burst_stays=adxl355.REG_FIFO_DATA, standby_only=adxl355.STANDBY_ONLY_REGISTERS)
 
 
 class SimulatedAdxl355:
@@ -66,12 +76,26 @@ class SimulatedAdxl355:
         return self._lab
 
     @property
+    def capturing(self) -> bool:
+        """Whether the bridge's capture still wants samples (as of now on the clock)."""
+        self._fill_fifo()
+        return self._capture_left > 0
+
+    @property
+    def captured_samples(self) -> int:
+        """Samples in the bridge's capture buffer now."""
+        self._fill_fifo()
+        return len(self._captured) // 9
+
+    @property
     def _odr_hz(self) -> float:
-        return self._part.output_data_rates_hz[self._regs[adxl355.REG_FILTER] & 0x0F]
+        return self._part.output_data_rates_hz[min(self._regs[adxl355.REG_FILTER] & 0x0F, _SLOWEST_ODR_CODE)]
 
     @property
     def _range_g(self) -> int:
-        return {code: g for g, code in self._part.channel("accel").range_codes.items()}[self._regs[adxl355.REG_RANGE] & 0x03]
+        """RANGE's range; its reserved code 0 as the lowest range (code 1), as the C model takes it."""
+        ranges = {code: g for g, code in self._part.channel("accel").range_codes.items()}
+        return ranges[self._regs[adxl355.REG_RANGE] & 0x03 or 1]
 
     def read(self, address: int, count: int) -> bytes:
         if not _FIFO_REGISTERS.isdisjoint(range(address, address + count)):
@@ -98,14 +122,16 @@ class SimulatedAdxl355:
         return bytes(self._regs[address:address + count])
 
     def write(self, address: int, value: int) -> None:
+        """What the part does with a write: RESET takes only its code; a read-only register, a register past the
+        map, and RANGE or FILTER while measuring ignore it (as the reference firmware's C model of the part)."""
         if address == adxl355.REG_RESET:
             if value == adxl355.RESET_CODE:
                 self.reset()
             return
-        if address < _READ_ONLY_BELOW or address >= len(self._regs):
-            raise ValueError(f"register 0x{address:02X} is read-only or does not exist")
-        if address in (adxl355.REG_RANGE, adxl355.REG_FILTER) and self.measuring:
-            raise ValueError("RANGE and FILTER change only in standby")
+        if address in adxl355.READ_ONLY_REGISTERS or address >= len(self._regs):
+            return
+        if address in adxl355.STANDBY_ONLY_REGISTERS and self.measuring:
+            return
         self._fill_fifo()
         was_measuring = self.measuring
         self._regs[address] = value
@@ -118,11 +144,9 @@ class SimulatedAdxl355:
 
     def start_capture(self, n_samples: int) -> int:
         """The bridge empties the FIFO and captures the next `n_samples` itself; returns the raw
-        temperature as it starts."""
-        if not self.measuring:
-            raise ValueError("capture needs the part measuring")
-        if not 0 < n_samples <= CAPTURE_CAPACITY_SAMPLES:
-            raise ValueError(f"capture count {n_samples} must be 1…{CAPTURE_CAPACITY_SAMPLES}")
+        temperature as it starts. The bridge has checked the part measures and the count fits its buffer
+        (sim/bridge_capture.py)."""
+        assert self.measuring and 0 < n_samples <= CAPTURE_CAPACITY_SAMPLES
         self._fill_fifo()
         self._fifo.clear()
         self._fifo_pending = 0
@@ -130,6 +154,11 @@ class SimulatedAdxl355:
         self._capture_left, self._captured = n_samples, bytearray()
         self._capture_end_temperature_raw = None
         return self._temperature_raw()
+
+    def stop_capture(self) -> None:
+        """The bridge ends its capture early (a write changed the stream): samples go to the FIFO again."""
+        self._fill_fifo()
+        self._capture_left = 0
 
     def fetch_capture(self, first: int) -> tuple[bytes, int | None]:
         """(the capture's samples from index `first` on, raw temperature at its end once it is complete).
@@ -190,16 +219,24 @@ class SimulatedAdxl355:
 
 
 class SimulatedBridgeServer:
-    """The bridge line protocol on a pseudo-terminal, in front of one simulated ADXL355."""
+    """The bridge line protocol on a pseudo-terminal, in front of one simulated ADXL355: version 3 as the
+    reference firmware speaks it (`part=adxl355`, as it names any part whose DEVID_AD is 0xAD), or version 2
+    (its greeting without `part=`) or 1 (no capture)."""
 
-    def __init__(self, lab: VirtualLab, index: int, protocol_version: int = 2, faults: ReplyFaults | None = None,
+    def __init__(self, lab: VirtualLab, index: int, protocol_version: int = 3, faults: ReplyFaults | None = None,
                  wrong_part_id: bool = False, stuck_after_s: float | None = None,
                  temperature_tear_rate: float = 0.0) -> None:
         self._lab = lab
         self._version = protocol_version
         self.device = SimulatedAdxl355(lab, index, wrong_part_id, stuck_after_s, temperature_tear_rate)
+        device = self.device
+        capture = CaptureRequests(device, CAPTURE_CAPACITY_SAMPLES) if protocol_version >= 2 else None
+        registers = RegisterRequests(device, REGISTER_MAP, lambda: not device.measuring, capture)
+        self._requests = BridgeRequests(self._greeting, registers, "adxl355", capture,
+                                        verbs="?RWCG" if capture is not None else "?RW")
         self._server = PtyLineServer(self._handle, b"\n", f"simulated-bridge-{lab.duts[index].serial}", faults,
-                                     overlong=overlong_request)
+                                     encoding=LINE_ENCODING, overlong=overlong_line, strip=False,
+                                     stale_after_s=STALE_LINE_S)
         self.path = self.endpoint = self._server.path
 
     @property
@@ -214,29 +251,18 @@ class SimulatedBridgeServer:
     def stop(self) -> None:
         self._server.stop()
 
-    def _handle(self, request: str) -> str:
-        parts = request.split()
-        try:
-            with self._lab.lock:
-                if parts == ["?"]:
-                    capture = f" capture={CAPTURE_CAPACITY_SAMPLES}" if self._version >= 2 else ""
-                    return f"{BRIDGE_GREETING} {self._version}{capture} accelcal-rig simulated bridge"
-                reply = register_request(self.device, parts)
-                if reply is not None:
-                    return reply
-                if self._version >= 2 and len(parts) == 2 and parts[0] == "C":
-                    return f"={self.device.start_capture(int(parts[1])):04X}"
-                if self._version >= 2 and len(parts) == 2 and parts[0] == "G":
-                    samples, end_temperature = self.device.fetch_capture(int(parts[1]))
-                    end = "" if end_temperature is None else f"T{end_temperature:04X}"
-                    return "=" + samples.hex().upper() + end
-        except ValueError as exc:
-            return f"!{exc}"
-        return f"!unknown request {request!r}"
+    def _handle(self, line: str) -> str | None:
+        with self._lab.lock:
+            return self._requests.answer(line)
+
+    def _greeting(self) -> str:
+        part = " part=adxl355" if self._version >= 3 else ""
+        capture = f" capture={CAPTURE_CAPACITY_SAMPLES}" if self._version >= 2 else ""
+        return f"{BRIDGE_GREETING} {self._version}{part}{capture} accelcal-rig simulated bridge"
 
 
 def serve_bridge(lab: VirtualLab, config: SensorConfig, faults: InstrumentFaults) -> SimulatedBridgeServer:
-    """The sensor drivers' simulator: a version 2 bridge in front of the DUT's simulated part."""
+    """The sensor drivers' simulator: a version 3 bridge in front of the DUT's simulated part."""
     settings = faults.settings
     index = [d.serial for d in lab.duts].index(config.serial)
     return SimulatedBridgeServer(lab, index, faults=faults.replies, wrong_part_id=config.serial == settings.sensor_wrong_id,

@@ -3,9 +3,13 @@ CONFIG0 registers, PWR_MGMT0, and data registers that hold the newest sample of 
 data rate on the shared clock, made from the lab's hidden truth of each (DATA_RDY set by a new sample, cleared
 by reading INT_STATUS). Register facts: `instruments/icm42688.py`, shared with the driver.
 
-Simplifications (not claims about the chip): only bank 0 exists; TEMP_DATA reads the DUT's temperature
-whatever the power mode; a sensor off reads DATA_INVALID (-32768) in its data registers; the first sample
-comes one period after PWR_MGMT0 turns the sensors on; both sensors sample at ACCEL_CONFIG0's rate.
+Simplifications (not claims about the chip), the same as the reference firmware's C model of the part
+(firmware/host/icm42688_model.h): only bank 0 is modelled (in another bank every register but REG_BANK_SEL reads 0
+and ignores writes); a read-only register ignores a write; TEMP_DATA reads the DUT's temperature whatever the power
+mode; a sensor off reads DATA_INVALID (-32768) in its data registers; the first sample comes one period after
+PWR_MGMT0 turns the sensors on; both sensors sample at ACCEL_CONFIG0's rate, whose code may be one the part's
+table does not offer (a low-power rate, or the reserved 0: taken as 1 kHz); a reserved accelerometer FS_SEL (4…7)
+is ±16 g.
 """
 
 from __future__ import annotations
@@ -17,10 +21,14 @@ import numpy as np
 from accelcal_rig.instruments import icm42688 as regs
 from accelcal_rig.sim.lab import VirtualLab
 
-_READ_ONLY = frozenset({*range(regs.REG_TEMP_DATA1, regs.REG_INT_STATUS + 1), regs.REG_WHO_AM_I})
 _DATA = range(regs.REG_TEMP_DATA1, regs.REG_GYRO_DATA_Z0 + 1)
 #: Reset values (data sheet register map): both CONFIG0 registers FS_SEL 0, ODR code 6 (1 kHz).
 _CONFIG0_RESET = 0x06
+#: ODR codes beyond the low-noise rates the part offers: the accelerometer's low-power rates (codes 12…14), and
+#: the reserved code 0 taken as 1 kHz (the C model's choice).
+_OTHER_ODR_HZ = {0: 1000.0, 12: 6.25, 13: 3.125, 14: 1.5625}
+#: The accelerometer's reserved FS_SEL codes (4…7) taken as ±16 g (FS_SEL 0).
+_ACCEL_FS_SEL_RESERVED = 4
 #: A read exactly at a sample instant sees that sample (in samples: far above the clock's rounding).
 _TICK_EPS = 1e-6
 
@@ -45,10 +53,10 @@ class SimulatedIcm42688:
         self._sample = self._invalid()
 
     def read(self, address: int, count: int) -> bytes:
-        self._check_bank(address)
-        if address + count > len(self._regs):
-            raise ValueError(f"read of {count} from 0x{address:02X} runs past the register map")
+        """`count` registers from `address` on, within the map (the bridge refuses a burst past it)."""
         span = range(address, address + count)
+        if self._bank:
+            return bytes(self._regs[regs.REG_BANK_SEL] if reg == regs.REG_BANK_SEL else 0 for reg in span)
         if not set(span).isdisjoint(_DATA) or regs.REG_INT_STATUS in span:
             self._update_data()
         self._regs[regs.REG_TEMP_DATA1:regs.REG_TEMP_DATA1 + 2] = self._temperature()
@@ -59,16 +67,13 @@ class SimulatedIcm42688:
         return value
 
     def write(self, address: int, value: int) -> None:
-        self._check_bank(address)
+        """What the part does with a write: a read-only register, or any but REG_BANK_SEL in another bank, ignores
+        it; DEVICE_CONFIG's SOFT_RESET resets every register."""
+        if (self._bank and address != regs.REG_BANK_SEL) or address in regs.READ_ONLY_REGISTERS:
+            return
         if address == regs.REG_DEVICE_CONFIG and value & regs.DEVICE_CONFIG_SOFT_RESET:
             self.reset()
             return
-        if address in _READ_ONLY or not 0 <= address < len(self._regs):
-            raise ValueError(f"register 0x{address:02X} is read-only or does not exist")
-        if address in (regs.REG_GYRO_CONFIG0, regs.REG_ACCEL_CONFIG0):
-            fs_sel, odr_code = regs.split_config0(value)
-            if self._part.odr_for_code(odr_code) is None:
-                raise ValueError(f"ODR code {odr_code} is no low-noise rate")
         self._update_data()
         was_on = self._measuring
         self._regs[address] = value
@@ -86,17 +91,19 @@ class SimulatedIcm42688:
 
     @property
     def _odr_hz(self) -> float:
-        rate = self._part.odr_for_code(regs.split_config0(self._regs[regs.REG_ACCEL_CONFIG0])[1])
-        assert rate is not None
-        return rate
+        code = regs.split_config0(self._regs[regs.REG_ACCEL_CONFIG0])[1]
+        rate = self._part.odr_for_code(code)
+        return rate if rate is not None else _OTHER_ODR_HZ[code]
+
+    @property
+    def _bank(self) -> int:
+        return self._regs[regs.REG_BANK_SEL] & 0x07
 
     def _range(self, channel: str, register: int) -> float:
         fs_sel = regs.split_config0(self._regs[register])[0]
+        if channel == "accel" and fs_sel >= _ACCEL_FS_SEL_RESERVED:
+            fs_sel = 0
         return {code: r for r, code in self._part.channel(channel).range_codes.items()}[fs_sel]
-
-    def _check_bank(self, address: int) -> None:
-        if address != regs.REG_BANK_SEL and self._regs[regs.REG_BANK_SEL] & 0x07:
-            raise ValueError(f"bank {self._regs[regs.REG_BANK_SEL] & 0x07} is not simulated (only bank 0)")
 
     def _update_data(self) -> None:
         """The newest sample due by the clock, made when first looked at (a sample nobody reads costs nothing);

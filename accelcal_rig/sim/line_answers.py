@@ -6,6 +6,10 @@ stream, a hostile peer) must not grow the simulator's memory without end. A line
 MAX_LINE_BYTES is discarded as it arrives (only its first bytes, for the answer, and the last few, for a
 terminator split between reads, are kept) and answered, once its terminator comes, as the device answers a
 request it does not know (`overlong`; none: silence); the next line is served as usual.
+
+A device may also drop the start of a line left without its terminator for a while (`stale_after_s`: a client
+that went away mid-request, noise from plugging in), and may take its lines as they came (`strip=False`: a
+device whose protocol says what a space or a control byte at either end means).
 """
 
 from __future__ import annotations
@@ -39,9 +43,12 @@ class LineAnswers:
 
     def __init__(self, handle: Handler, request_terminator: bytes = b"\n", reply_terminator: bytes | None = None,
                  encoding: str = "utf-8", faults: ReplyFaults | None = None, defer: Deferral | None = None,
-                 overlong: Overlong | None = None) -> None:
+                 overlong: Overlong | None = None, strip: bool = True, stale_after_s: float | None = None) -> None:
         self._handle = handle
         self._overlong = overlong
+        self._strip = strip
+        self._stale_after_s = stale_after_s
+        self._last_data_s = 0.0
         self._request_terminator = request_terminator
         self._reply_terminator = request_terminator if reply_terminator is None else reply_terminator
         self._encoding = encoding
@@ -58,11 +65,19 @@ class LineAnswers:
         """Bytes held of the line not yet ended: at most MAX_LINE_BYTES and a terminator's first bytes."""
         return len(self._pending) + len(self._discarding or b"")
 
+    def forget_line(self) -> None:
+        """Drop the line begun (its client went away)."""
+        self._pending, self._discarding = b"", None
+
     def feed(self, data: bytes, write: Callable[[bytes], object]) -> None:
         """Take received bytes; answer each complete request through `write`. Each byte is looked at a bounded
         number of times, so a long stream without a terminator costs time in proportion to its length. The
         rest is stored before the first answer goes out: whoever reads an answer finds the reader settled."""
         terminator = self._request_terminator
+        now_s = time.monotonic()
+        if self._stale_after_s is not None and now_s - self._last_data_s > self._stale_after_s:
+            self.forget_line()  # the start of a line its client left: dropped
+        self._last_data_s = now_s
         buffer = self._pending + data
         requests: list[tuple[str, bool]] = []
         start = 0
@@ -87,9 +102,12 @@ class LineAnswers:
         characters, True)."""
         head, self._discarding = self._discarding, None
         if head is None and len(line) <= MAX_LINE_BYTES:
-            return line.decode(self._encoding, errors="replace").strip(), False
-        head = line[:OVERLONG_HEAD_BYTES] if head is None else head
-        return head.decode(self._encoding, errors="replace").strip(), True
+            return self._text(line), False
+        return self._text(line[:OVERLONG_HEAD_BYTES] if head is None else head), True
+
+    def _text(self, line: bytes) -> str:
+        text = line.decode(self._encoding, errors="replace")
+        return text.strip() if self._strip else text
 
     def _keep(self, rest: bytes) -> None:
         """Hold the unterminated rest (a line within the bound, and perhaps the first bytes of its terminator),

@@ -96,14 +96,14 @@ static bool parse_options(int argc, char **argv, options *parsed)
     return parsed->part == PTY_HAL_PART_ADXL355 || parsed->model.tear_rate == 0.0; /* tears: the ADXL355's */
 }
 
-/* Until the next thing to do: bytes from the client, stdin's end, or (while capturing) the next
- * drain. Returns false once stdin has ended and that is to end the program. */
+/* Until the next thing to do: bytes from the client, a client opening or closing the port, stdin's end, or
+ * (while capturing) the next drain. Returns false once stdin has ended and that is to end the program. */
 static bool wait_for_work(bool watch_stdin)
 {
-    struct pollfd watched[2] = {{pty_hal_fd(), POLLIN, 0}, {STDIN_FILENO, POLLIN, 0}};
+    struct pollfd watched[3] = {{pty_hal_fd(), POLLIN, 0}, {pty_hal_clients_fd(), POLLIN, 0}, {STDIN_FILENO, POLLIN, 0}};
     const int timeout_ms = pty_hal_pending() ? 0 : bridge_capturing() ? 1 : 50;
 
-    if (pty_hal_poll(watched, watch_stdin ? 2u : 1u, timeout_ms) > 0 && watch_stdin && watched[1].revents != 0) {
+    if (pty_hal_poll(watched, watch_stdin ? 3u : 2u, timeout_ms) > 0 && watch_stdin && watched[2].revents != 0) {
         char discarded[64];
         if (read(STDIN_FILENO, discarded, sizeof discarded) <= 0) {
             return false;

@@ -14,6 +14,9 @@
 #include <termios.h>
 #include <time.h>
 #include <unistd.h>
+#if defined(__linux__)
+#include <sys/inotify.h>
+#endif
 
 #include "adxl355_model.h"
 #include "icm42688_model.h"
@@ -27,6 +30,10 @@ static int slave = -1;
 static uint8_t inbox[512];
 static size_t inbox_next;
 static size_t inbox_used;
+/* The client end's opens and closes by other processes (Linux's inotify on its path; -1: not watched), and
+ * how many were seen: the session (bridge_hal_uart_session). */
+static int clients = -1;
+static uint32_t session;
 
 /* The board clock (pty_hal_use_board_clock): its value at the last mark, and at that mark the monotonic
  * clock, the thread's CPU time and its run_delay (all in microseconds). */
@@ -74,12 +81,56 @@ bool pty_hal_open(char *path, size_t path_size)
         return false;
     }
     const int flags = fcntl(master, F_GETFL);
-    return flags >= 0 && fcntl(master, F_SETFL, flags | O_NONBLOCK) == 0;
+    if (flags < 0 || fcntl(master, F_SETFL, flags | O_NONBLOCK) != 0) {
+        return false;
+    }
+#if defined(__linux__)
+    /* Watched from here on: this process's own open of the client end above is no client's. */
+    clients = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+    if (clients >= 0 && inotify_add_watch(clients, path, IN_OPEN | IN_CLOSE) < 0) {
+        close(clients);
+        clients = -1;
+    }
+#endif
+    return true;
 }
 
 int pty_hal_fd(void)
 {
     return master;
+}
+
+int pty_hal_clients_fd(void)
+{
+    return clients;
+}
+
+/* Takes the opens and closes of the client end seen since the last look. On any, a new session begins, and
+ * what the client end still holds unread from us is dropped: it was for the client that went. (What a client
+ * sent and we have not read yet is kept: it may be the next client's first request.) */
+static void notice_clients(void)
+{
+#if defined(__linux__)
+    union { /* room for many events, aligned for them */
+        struct inotify_event event;
+        char bytes[16 * sizeof(struct inotify_event)];
+    } events;
+    bool changed = false;
+
+    while (clients >= 0 && read(clients, events.bytes, sizeof events.bytes) > 0) {
+        changed = true;
+    }
+    if (changed) {
+        ++session;
+        (void)tcflush(slave, TCIFLUSH);
+    }
+#endif
+}
+
+uint32_t bridge_hal_uart_session(void)
+{
+    notice_clients();
+    return session;
 }
 
 bool pty_hal_pending(void)
@@ -89,6 +140,7 @@ bool pty_hal_pending(void)
 
 int bridge_hal_uart_read(void)
 {
+    notice_clients(); /* a client's coming or going is taken before any byte it sent after */
     if (inbox_next == inbox_used) {
         const ssize_t got = read(master, inbox, sizeof inbox);
         if (got <= 0) {
@@ -196,16 +248,22 @@ int pty_hal_poll(struct pollfd *fds, nfds_t count, int timeout_ms)
 
 void bridge_hal_uart_write(const uint8_t *bytes, size_t len)
 {
+    const uint32_t client = bridge_hal_uart_session();
+
     while (len > 0) {
         const ssize_t sent = write(master, bytes, len);
         if (sent > 0) {
             bytes += sent;
             len -= (size_t)sent;
         } else if (sent < 0 && (errno == EAGAIN || errno == EINTR)) {
-            /* The client is not reading fast enough: wait for room, keeping the capture drained. */
-            struct pollfd room = {master, POLLOUT, 0};
-            (void)pty_hal_poll(&room, 1, 1);
+            /* The client is not reading fast enough: wait for room, keeping the capture drained, unless the
+             * client goes meanwhile (it closed the port, with the rest of the reply unread). */
+            struct pollfd room[2] = {{master, POLLOUT, 0}, {clients, POLLIN, 0}};
+            (void)pty_hal_poll(room, 2, 1);
             bridge_idle();
+            if (bridge_hal_uart_session() != client) {
+                return;
+            }
         } else {
             return; /* the terminal is gone: nobody to tell */
         }

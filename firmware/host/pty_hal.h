@@ -1,6 +1,7 @@
 /* The bridge HAL on POSIX: the host's end of a pseudo-terminal as the UART, a simulated part as the SPI
  * bus (the ADXL355 of adxl355_model.h, the ICM-42688-P of icm42688_model.h, or nothing), CLOCK_MONOTONIC
- * as the microsecond clock (or the board clock: see pty_hal_use_board_clock). */
+ * as the microsecond clock (or the board clock: see pty_hal_use_board_clock), and on Linux the opens and
+ * closes of the pseudo-terminal's client end as the session (a client coming or going, as DTR on a board). */
 #ifndef PTY_HAL_H
 #define PTY_HAL_H
 
@@ -29,6 +30,11 @@ bool pty_hal_open(char *path, size_t path_size);
 
 /* The descriptor to wait on for bytes from the client. */
 int pty_hal_fd(void);
+
+/* The descriptor to wait on for the client end being opened or closed by another process (Linux's inotify;
+ * -1 where it is not watched, which poll() ignores). bridge_hal_uart_session() counts those, and on each drops
+ * what the client end still holds unread from the bridge. */
+int pty_hal_clients_fd(void);
 
 /* From now on, bridge_hal_micros() (the core's clock, and so the model's) is the board clock: the time
  * a board running only this firmware would have seen. It moves on by the CPU time the process uses, by

@@ -9,7 +9,8 @@
  *   C <n>          -> =<TEMP2><TEMP1>      empty the FIFO, capture the next n samples (adxl355 only)
  *   G <first>      -> =<hex>[T<TEMP2><TEMP1>]  captured samples from index first on (adxl355 only)
  *   anything that fails -> !<message>
- * addr and v are hexadecimal, n and first decimal.
+ * addr and v are hexadecimal, n and first decimal. What each request that fails is answered, and the line
+ * rules: docs/instruments.md, "The serial bridge protocol".
  */
 #ifndef BRIDGE_H
 #define BRIDGE_H
@@ -17,7 +18,7 @@
 #include <stdbool.h>
 
 #define BRIDGE_PROTOCOL_VERSION 3
-#define BRIDGE_FIRMWARE_VERSION "1.1"
+#define BRIDGE_FIRMWARE_VERSION "1.2"
 
 /* The capture buffer: 4096 samples of 9 bytes (X, Y, Z FIFO entries of 3 bytes) = 36 kB. */
 #define BRIDGE_CAPTURE_SAMPLES 4096u
@@ -25,6 +26,10 @@
 
 /* The longest register burst `R` takes: the whole FIFO, 96 entries of 3 bytes. */
 #define BRIDGE_MAX_READ 288u
+
+/* The longest request line, in bytes before its LF (CRs aside): the longest request ("R 7F 288") is 8, so
+ * this leaves room for stray spaces and leading zeros; a longer line is refused. */
+#define BRIDGE_LINE_MAX 64u
 
 /* Replies go to the HAL in pieces this long, with the capture serviced between them (64: one USB
  * full-speed packet). */

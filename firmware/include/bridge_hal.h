@@ -1,7 +1,7 @@
 /*
  * The hardware abstraction the bridge core runs on: everything the core needs from a board.
  *
- * A board (boards/<board>/) or the host build (host/) provides these five functions; the core
+ * A board (boards/<board>/) or the host build (host/) provides these six functions; the core
  * (src/) provides bridge.h. Nothing else crosses the line, so the core builds freestanding.
  *
  * Threading: the core calls these from one context only (the main loop, through bridge_poll(), and
@@ -33,6 +33,15 @@ int bridge_hal_uart_read(void);
  * the host reads. The core never hands it more than BRIDGE_REPLY_CHUNK bytes at a time.
  */
 void bridge_hal_uart_write(const uint8_t *bytes, size_t len);
+
+/*
+ * Which client holds the line: a number that changes whenever a client closes the port or another opens it
+ * (USB CDC: DTR falling or rising; the host build: its pseudo-terminal's client end closed or opened). By the
+ * time the number has changed, the HAL has dropped what it still held for the client that went, as far as
+ * it can. The core then sends nothing more of that client's reply, and drops the start of its request, so
+ * the next client never reads the rest of a reply it did not ask for. A board that cannot tell returns 0.
+ */
+uint32_t bridge_hal_uart_session(void);
 
 /* A monotonic microsecond clock (its zero is arbitrary). 64 bits: it never wraps in practice. */
 uint64_t bridge_hal_micros(void);

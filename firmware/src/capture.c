@@ -63,11 +63,8 @@ static void empty_fifo(void)
 
 const char *capture_start(uint32_t count, uint8_t temperature[2])
 {
-    uint8_t power_ctl;
-
     capture_reset();
-    sensor_read(SENSOR_REG_POWER_CTL, &power_ctl, 1);
-    if (power_ctl & SENSOR_POWER_CTL_STANDBY) {
+    if (sensor_in_standby()) {
         return "capture needs the part measuring";
     }
     empty_fifo();

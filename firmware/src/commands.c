@@ -1,5 +1,9 @@
 /* The requests ?, R, W, C and G: parsed strictly, answered with exactly one line. R and W are framed for
- * the part found on SPI (sensor.h); C and G exist for a part the bridge captures (the ADXL355). */
+ * the part found on SPI (sensor.h); C and G exist for a part the bridge captures (the ADXL355).
+ *
+ * Each request is checked in the order docs/instruments.md gives ("The serial bridge protocol", its table of
+ * refusals): the verb and its number of words; a part that has the request; the arguments; the part's
+ * register map; the state (a capture, standby). The first check that fails is the answer. */
 #include "commands.h"
 
 #include <stdbool.h>
@@ -17,8 +21,9 @@
 
 /* ADXL355-BRIDGE 3 part=<name>[ capture=4096] <free text>: capture= only where C and G work. The part is
  * looked for again on every greeting (a sensor powered after the board, or another one plugged in). */
-static void greet(void)
+static void greet(char *const *arguments)
 {
+    (void)arguments;
     if (sensor_detect()) {
         capture_reset(); /* a capture of another part (or of none) means nothing now */
     }
@@ -64,31 +69,55 @@ static bool part_captures(void)
     return true;
 }
 
+/* "!<before> 0x<address><after>" */
+static void refuse_register(const char *before, uint8_t address, const char *after)
+{
+    reply_char('!');
+    reply_text(before);
+    reply_text(" 0x");
+    reply_hex(&address, 1);
+    reply_text(after);
+    reply_end();
+}
+
+/* The address word: 1 or 2 hex digits, 00..7F; false (and the refusal sent) otherwise. */
+static bool address_of(const char *text, uint8_t *address)
+{
+    if (!parse_hex_byte(text, address) || *address > SENSOR_REG_LAST) {
+        reply_error("bad address (hex 00..7F)");
+        return false;
+    }
+    return true;
+}
+
 static bool covers(uint8_t address, uint32_t count, uint8_t reg)
 {
     return address <= reg && reg < address + count;
 }
 
-static void read_registers(const char *address_text, const char *count_text)
+static void read_registers(char *const *arguments)
 {
     static uint8_t data[BRIDGE_MAX_READ];
     uint8_t address;
     uint32_t count;
 
-    if (!parse_hex_byte(address_text, &address) || address > SENSOR_REG_LAST) {
-        reply_error("R: address must be hex 00..7F");
+    if (!part_found() || !address_of(arguments[0], &address)) {
         return;
     }
-    if (!parse_decimal(count_text, BRIDGE_MAX_READ, &count) || count == 0) {
-        reply_error("R: count must be decimal 1..288");
+    if (!parse_decimal(arguments[1], BRIDGE_MAX_READ, &count) || count == 0) {
+        reply_error("bad count (decimal 1..288)");
         return;
     }
-    if (!part_found()) {
+    /* The registers a burst reads run from its address on, except from one the part does not move on from. */
+    const uint32_t last = sensor_burst_stays(address) ? address : address + count - 1u;
+    if (last > sensor_last_register()) {
+        const uint32_t missing = address > sensor_last_register() ? address : sensor_last_register() + 1u;
+        refuse_register("no register", (uint8_t)missing, "");
         return;
     }
     /* A burst from FIFO_DATA takes samples out of the FIFO: during a capture they belong to it. */
     if (capture_running() && covers(address, count, SENSOR_REG_FIFO_DATA)) {
-        reply_error("R: FIFO_DATA is being captured (fetch with G)");
+        reply_error("FIFO_DATA is being captured (fetch with G)");
         return;
     }
     sensor_read(address, data, count);
@@ -100,38 +129,46 @@ static void read_registers(const char *address_text, const char *count_text)
     reply_end();
 }
 
-/* Registers whose write changes or ends the stream a running capture is taking. */
+/* Registers whose write ends the stream a running capture is taking (RANGE and FILTER too, but those are
+ * written only in standby, and a capture runs only while the part measures). */
 static bool changes_the_stream(uint8_t address)
 {
-    return address == SENSOR_REG_FILTER || address == SENSOR_REG_FIFO_SAMPLES || address == SENSOR_REG_RANGE
-        || address == SENSOR_REG_POWER_CTL || address == SENSOR_REG_RESET;
+    return address == SENSOR_REG_FIFO_SAMPLES || address == SENSOR_REG_POWER_CTL || address == SENSOR_REG_RESET;
 }
 
-static void write_register(const char *address_text, const char *value_text)
+static void write_register(char *const *arguments)
 {
     uint8_t address;
     uint8_t value;
 
-    if (!parse_hex_byte(address_text, &address) || address > SENSOR_REG_LAST) {
-        reply_error("W: address must be hex 00..7F");
+    if (!part_found() || !address_of(arguments[0], &address)) {
         return;
     }
-    if (!parse_hex_byte(value_text, &value)) {
-        reply_error("W: value must be hex 00..FF");
+    if (!parse_hex_byte(arguments[1], &value)) {
+        reply_error("bad value (hex 00..FF)");
         return;
     }
-    if (!part_found()) {
+    if (address > sensor_last_register()) {
+        refuse_register("no register", address, "");
         return;
     }
-    if (changes_the_stream(address)) {
-        capture_stop("capture stopped: FILTER, FIFO_SAMPLES, RANGE, POWER_CTL or RESET written during it");
+    if (sensor_read_only(address)) {
+        refuse_register("read-only register", address, "");
+        return;
+    }
+    if (sensor_standby_only(address) && !sensor_in_standby()) {
+        refuse_register("register", address, " changes only in standby");
+        return;
+    }
+    if (capture_running() && changes_the_stream(address)) {
+        capture_stop("capture stopped: FIFO_SAMPLES, POWER_CTL or RESET written");
     }
     sensor_write(address, value);
     reply_char('=');
     reply_end();
 }
 
-static void start_capture(const char *count_text)
+static void start_capture(char *const *arguments)
 {
     uint32_t count;
     uint8_t temperature[2];
@@ -139,9 +176,9 @@ static void start_capture(const char *count_text)
     if (!part_captures()) {
         return;
     }
-    if (!parse_decimal(count_text, BRIDGE_CAPTURE_SAMPLES, &count) || count == 0) {
-        capture_reset();
-        reply_error("capture count must be decimal 1..4096 (capture=4096)");
+    capture_reset(); /* a C forgets the capture before it, even when it is refused */
+    if (!parse_decimal(arguments[0], BRIDGE_CAPTURE_SAMPLES, &count) || count == 0) {
+        reply_error("bad count (decimal 1..4096)");
         return;
     }
     const char *refusal = capture_start(count, temperature);
@@ -168,7 +205,7 @@ static void reply_progress(const capture_view *view)
  * reply goes out wait for the next fetch, and the end temperature is sent only if the capture was
  * already complete, so `T` always means every sample up to the count was in this reply or before.
  */
-static void fetch_capture(const char *first_text)
+static void fetch_capture(char *const *arguments)
 {
     uint32_t first;
     capture_view view;
@@ -176,13 +213,13 @@ static void fetch_capture(const char *first_text)
     if (!part_captures()) {
         return;
     }
-    if (!parse_decimal(first_text, BRIDGE_CAPTURE_SAMPLES, &first)) {
-        reply_error("G: first must be decimal 0..4096");
+    if (!parse_decimal(arguments[0], BRIDGE_CAPTURE_SAMPLES, &first)) {
+        reply_error("bad first (decimal 0..4096)");
         return;
     }
     capture_get(&view);
     if (view.state == CAPTURE_NONE) {
-        reply_error("G: no capture (start one with C)");
+        reply_error("no capture (start one with C)");
         return;
     }
     if (view.state == CAPTURE_LOST || view.state == CAPTURE_FAILED) {
@@ -204,6 +241,21 @@ static void fetch_capture(const char *first_text)
     reply_end();
 }
 
+/* Each request: its verb, its number of words with the verb, what a wrong number is answered, and its reader
+ * (given the words after the verb). */
+static const struct {
+    char verb;
+    size_t words;
+    const char *usage;
+    void (*answer)(char *const *arguments);
+} requests[] = {
+    {'?', 1u, "usage: ?", greet},
+    {'R', 3u, "usage: R <addr> <count>", read_registers},
+    {'W', 3u, "usage: W <addr> <value>", write_register},
+    {'C', 2u, "usage: C <count>", start_capture},
+    {'G', 2u, "usage: G <first>", fetch_capture},
+};
+
 void command_execute(char *line)
 {
     char *words[MAX_WORDS];
@@ -213,18 +265,15 @@ void command_execute(char *line)
         return; /* a blank line is no request: nothing to answer */
     }
     const char *verb = words[0];
-    const bool one_letter = verb[0] != '\0' && verb[1] == '\0';
-    if (one_letter && verb[0] == '?' && count == 1) {
-        greet();
-    } else if (one_letter && verb[0] == 'R' && count == 3) {
-        read_registers(words[1], words[2]);
-    } else if (one_letter && verb[0] == 'W' && count == 3) {
-        write_register(words[1], words[2]);
-    } else if (one_letter && verb[0] == 'C' && count == 2) {
-        start_capture(words[1]);
-    } else if (one_letter && verb[0] == 'G' && count == 2) {
-        fetch_capture(words[1]);
-    } else {
-        reply_error("unknown request (? R W C G)");
+    for (size_t i = 0; i < sizeof requests / sizeof requests[0]; ++i) {
+        if (verb[0] == requests[i].verb && verb[1] == '\0') {
+            if (count == requests[i].words) {
+                requests[i].answer(&words[1]);
+            } else {
+                reply_error(requests[i].usage);
+            }
+            return;
+        }
     }
+    reply_error("unknown request (? R W C G)");
 }

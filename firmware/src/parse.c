@@ -3,7 +3,7 @@
 
 static bool is_space(char c)
 {
-    return c == ' ' || c == '\t';
+    return c == ' '; /* a tab never gets here: it is no printable ASCII (line.c) */
 }
 
 size_t parse_words(char *line, char *words[], size_t max_words)
@@ -63,17 +63,20 @@ bool parse_hex_byte(const char *text, uint8_t *value)
 
 bool parse_decimal(const char *text, uint32_t max, uint32_t *value)
 {
-    /* Nine digits cannot overflow 32 bits, so no division is needed to guard the multiply (a
-     * Cortex-M0+ has no divide instruction); no request needs a longer number. */
+    /* Past `max` the value stops growing, so any number of digits (leading zeros, or a huge number) is read
+     * without overflow, and without a division to guard the multiply (a Cortex-M0+ has no divide
+     * instruction); `max` is far below 2^32 / 10. */
     uint32_t result = 0;
     size_t length = 0;
 
     for (; text[length] != '\0'; ++length) {
         const char c = text[length];
-        if (c < '0' || c > '9' || length == 9) {
+        if (c < '0' || c > '9') {
             return false;
         }
-        result = result * 10u + (uint32_t)(c - '0');
+        if (result <= max) {
+            result = result * 10u + (uint32_t)(c - '0');
+        }
     }
     if (length == 0 || result > max) {
         return false;

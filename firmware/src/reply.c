@@ -6,13 +6,21 @@
 
 static uint8_t pending[BRIDGE_REPLY_CHUNK];
 static size_t pending_used;
+static uint32_t client; /* the HAL's session of the client the reply is for */
+
+void reply_to(uint32_t session)
+{
+    client = session;
+}
 
 static void flush(void)
 {
-    if (pending_used > 0) {
+    /* Once the client has gone, the rest of its reply goes nowhere: not to whoever holds the line next (the HAL
+     * has dropped what it still held of it). */
+    if (pending_used > 0 && bridge_hal_uart_session() == client) {
         bridge_hal_uart_write(pending, pending_used);
-        pending_used = 0;
     }
+    pending_used = 0;
     bridge_idle(); /* a drain is due every millisecond; a chunk may have taken that long */
 }
 

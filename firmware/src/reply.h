@@ -9,6 +9,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* The replies from now on are for the client of the HAL's `session` (bridge_hal_uart_session): once the session
+ * differs (that client went away), nothing more of them is sent. */
+void reply_to(uint32_t session);
 void reply_char(char c);
 void reply_text(const char *text);
 /* Each byte as two upper-case hex digits. */

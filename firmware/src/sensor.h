@@ -57,11 +57,29 @@ bool sensor_detect(void);
 /* The part found by the last sensor_detect() ("none" before the first). */
 sensor_identity sensor_part(void);
 
+/*
+ * The register map of the part found, as the bridge enforces it (docs/instruments.md, "The serial bridge
+ * protocol": what each request that breaks it is answered). Only with a part found.
+ */
+/* The highest register address the part has (the ADXL355: RESET 0x2F; the ICM-42688-P: all of 0x00..0x7F). */
+uint8_t sensor_last_register(void);
+/* True if a burst from `address` reads that register again and again (the ADXL355's FIFO_DATA), so a burst of
+ * any length from it stays inside the map. */
+bool sensor_burst_stays(uint8_t address);
+/* True if `address` is read-only in the bank selected now: bank 0's facts (the part's table); in another bank
+ * (the ICM-42688-P's 1..4, selected by a W to REG_BANK_SEL) nothing is known, so nothing is refused. */
+bool sensor_read_only(uint8_t address);
+/* True if `address` may be written only while the part is in standby (the ADXL355's RANGE and FILTER). */
+bool sensor_standby_only(uint8_t address);
+/* True if the part is in standby (the ADXL355: POWER_CTL's STANDBY bit, read now). */
+bool sensor_in_standby(void);
+
 /* `count` registers from `address` in one burst, framed for the part found (from the ADXL355's
  * FIFO_DATA the part does not auto-increment: the burst drains the FIFO). Only with a part found. */
 void sensor_read(uint8_t address, uint8_t *dst, size_t count);
 
-/* One register, framed for the part found. Only with a part found. */
+/* One register, framed for the part found (a write to the part's bank select also notes the bank). Only with a
+ * part found. */
 void sensor_write(uint8_t address, uint8_t value);
 
 /* ADXL355: TEMP2, TEMP1 read until two reads in a row agree within SENSOR_TEMPERATURE_AGREE_LSB; the

@@ -10,6 +10,8 @@ from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.parts.adxl35x import ADXL355
 from accelcal_rig.sim.adxl355_bridge_server import CAPTURE_CAPACITY_SAMPLES, SimulatedAdxl355
+from accelcal_rig.sim.bridge_capture import CaptureRequests
+from accelcal_rig.sim.bridge_refusals import Refusal
 from accelcal_rig.sim.lab import VirtualLab
 from tests.conftest import SIM_RIG
 
@@ -75,10 +77,12 @@ def test_a_capture_delivers_consecutive_samples_in_pieces(part) -> None:
     assert log[1][0] == pytest.approx(log[0][1])  # the second piece starts where the first ended
 
 
-def test_a_capture_larger_than_the_buffer_is_refused(part) -> None:
+def test_a_capture_larger_than_the_buffer_is_refused_by_the_bridge(part) -> None:
     device, _ = part
-    with pytest.raises(ValueError, match=f"capture count {CAPTURE_CAPACITY_SAMPLES + 1} must be 1"):
-        device.start_capture(CAPTURE_CAPACITY_SAMPLES + 1)
+    capture = CaptureRequests(device, CAPTURE_CAPACITY_SAMPLES)
+    with pytest.raises(Refusal, match=rf"^bad count \(decimal 1\.\.{CAPTURE_CAPACITY_SAMPLES}\)$"):
+        capture.start(str(CAPTURE_CAPACITY_SAMPLES + 1))
+    assert capture.start(str(CAPTURE_CAPACITY_SAMPLES)).startswith("=")
 
 
 def test_standby_refuses_a_capture_and_clears_the_fifo(part) -> None:
@@ -86,5 +90,31 @@ def test_standby_refuses_a_capture_and_clears_the_fifo(part) -> None:
     clock.sleep(10 / ODR_HZ)
     device.write(adxl355.REG_POWER_CTL, adxl355.POWER_CTL_STANDBY)
     assert status_and_entries(device)[1] == 0
-    with pytest.raises(ValueError, match="capture needs the part measuring"):
-        device.start_capture(10)
+    with pytest.raises(Refusal, match="^capture needs the part measuring$"):
+        CaptureRequests(device, CAPTURE_CAPACITY_SAMPLES).start("10")
+
+
+def test_writes_the_part_ignores_change_nothing(part) -> None:
+    """As the part (and the reference firmware's C model of it): a read-only register, and RANGE or FILTER while
+    measuring, keep what they hold (the bridge refuses such writes before they reach the part)."""
+    device, _ = part
+    before = device.read(0x00, 4), device.read(adxl355.REG_FILTER, 1), device.read(adxl355.REG_RANGE, 1)
+    device.write(0x00, 0x12)
+    device.write(adxl355.REG_FILTER, 0x00)
+    device.write(adxl355.REG_RANGE, 0x83)
+    assert (device.read(0x00, 4), device.read(adxl355.REG_FILTER, 1), device.read(adxl355.REG_RANGE, 1)) == before
+
+
+def test_reserved_codes_run_as_the_c_model_runs_them() -> None:
+    """FILTER's reserved ODR_LPF codes (11…15) run at the slowest rate, 3.906 Hz, and RANGE's reserved code 0 at
+    ±2 g, as the reference firmware's C model takes them: a part so configured makes samples, where a lookup of
+    the part's tables used to fail in the middle of a request."""
+    clock = VirtualClock()
+    device = SimulatedAdxl355(VirtualLab(load_rig(SIM_RIG).model, clock, 5), 0)
+    device.write(adxl355.REG_FILTER, 0x0F)
+    device.write(adxl355.REG_RANGE, 0x80)
+    device.write(adxl355.REG_POWER_CTL, 0x00)
+    clock.sleep(10 / 3.906)
+    codes, _ = adxl355.decode_fifo(device.read(adxl355.REG_FIFO_DATA, 288))
+    assert codes.shape == (10, 3)
+    assert np.linalg.norm(codes.mean(axis=0)) == pytest.approx(ADXL355.channel("accel").lsb_per_unit[2], rel=0.05)

@@ -1,6 +1,6 @@
-"""What every simulated sensor bridge answers beyond its part's registers: a line longer than any request is
-refused as the reference firmware refuses it (`!request too long`, firmware/src/bridge.c), and the next
-request is answered."""
+"""What every simulated sensor bridge answers beyond its part's registers: a line far longer than the simulator's
+line reader holds is refused as the reference firmware refuses any line too long (`!line too long`,
+firmware/src/bridge.c), and the next request is answered. (Every other line: tests/firmware/test_bridge_conformance.py.)"""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ def test_a_multi_megabyte_line_is_refused_as_the_firmware_refuses_it(bridge: typ
             for _ in range(32):  # 2 MiB, no terminator
                 client.send(b"R 00 4" + b" " * 65530)
             client.send(b"\n?\n")
-            assert client.reply(b"\n") == b"!request too long\n"
+            assert client.reply(b"\n") == b"!line too long\n"
             assert client.reply(b"\n").startswith(b"ADXL355-BRIDGE ")
     finally:
         server.stop()

@@ -9,8 +9,11 @@
  */
 #include <stdint.h>
 
+#include <stdbool.h>
+
 #include "hardware/gpio.h"
 #include "hardware/spi.h"
+#include "pico/stdio_usb.h"
 #include "pico/stdlib.h"
 
 #include "bridge.h"
@@ -52,6 +55,22 @@ int bridge_hal_uart_read(void)
 void bridge_hal_uart_write(const uint8_t *bytes, size_t len)
 {
     stdio_put_string((const char *)bytes, (int)len, false, false);
+}
+
+/* A client opening the port raises DTR, closing it drops DTR: stdio_usb_connected() follows it. While it is
+ * down the SDK's USB stdio sends nothing; what tinyusb still held for the host when it fell is not cleared
+ * here (not verified on a board). */
+uint32_t bridge_hal_uart_session(void)
+{
+    static bool connected;
+    static uint32_t session;
+    const bool now = stdio_usb_connected();
+
+    if (now != connected) {
+        connected = now;
+        ++session;
+    }
+    return session;
 }
 
 uint64_t bridge_hal_micros(void)

@@ -1,0 +1,72 @@
+"""The serial bridge's own capture, C and G (docs/instruments.md, "The serial bridge protocol"), of a simulated
+ADXL355, with the reference firmware's refusals and rules (firmware/src/commands.c): a C forgets the capture
+before it, even one it refuses; G before any capture is refused; while a capture runs the FIFO is its own, and a
+write to FIFO_SAMPLES, POWER_CTL or RESET ends it, which G then reports with how far it got."""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+from accelcal_rig.instruments import adxl355
+from accelcal_rig.sim.bridge_numbers import decimal
+from accelcal_rig.sim.bridge_refusals import NEEDS_MEASURING, NO_CAPTURE, Refusal, bad_count, bad_first, capture_stopped
+
+#: Writes that end a running capture (RANGE and FILTER would too, but they are written only in standby).
+_STREAM_REGISTERS = frozenset({adxl355.REG_FIFO_SAMPLES, adxl355.REG_POWER_CTL, adxl355.REG_RESET})
+
+
+class CapturingPart(Protocol):
+    """A simulated part whose FIFO the bridge drains into its own buffer (SimulatedAdxl355)."""
+
+    @property
+    def measuring(self) -> bool: ...
+    @property
+    def capturing(self) -> bool: ...
+    @property
+    def captured_samples(self) -> int: ...
+    def start_capture(self, n_samples: int) -> int: ...
+    def fetch_capture(self, first: int) -> tuple[bytes, int | None]: ...
+    def stop_capture(self) -> None: ...
+
+
+class CaptureRequests:
+    """C and G for one simulated part, with a buffer of `capacity` samples."""
+
+    def __init__(self, device: CapturingPart, capacity: int) -> None:
+        self._device = device
+        self._capacity = capacity
+        self._wanted = 0  # the count of the capture there is (0: none)
+        self._stopped_after: int | None = None  # samples in when a write ended it
+
+    def start(self, count_text: str) -> str:
+        self._wanted, self._stopped_after = 0, None
+        count = decimal(count_text, self._capacity)
+        if not count:
+            raise Refusal(bad_count(self._capacity))
+        if not self._device.measuring:
+            raise Refusal(NEEDS_MEASURING)
+        temperature = self._device.start_capture(count)
+        self._wanted = count
+        return f"={temperature:04X}"
+
+    def fetch(self, first_text: str) -> str:
+        first = decimal(first_text, self._capacity)
+        if first is None:
+            raise Refusal(bad_first(self._capacity))
+        if not self._wanted:
+            raise Refusal(NO_CAPTURE)
+        if self._stopped_after is not None:
+            raise Refusal(capture_stopped(self._stopped_after, self._wanted))
+        samples, end_temperature = self._device.fetch_capture(first)
+        return "=" + samples.hex().upper() + ("" if end_temperature is None else f"T{end_temperature:04X}")
+
+    def holds(self, address: int, count: int) -> bool:
+        return self._running() and address <= adxl355.REG_FIFO_DATA < address + count
+
+    def before_write(self, address: int) -> None:
+        if address in _STREAM_REGISTERS and self._running():
+            self._stopped_after = self._device.captured_samples
+            self._device.stop_capture()
+
+    def _running(self) -> bool:
+        return bool(self._wanted) and self._stopped_after is None and self._device.capturing
