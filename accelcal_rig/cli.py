@@ -258,6 +258,22 @@ def _cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_characterise(args: argparse.Namespace) -> int:
+    from accelcal_rig.cli_characterise import characterise, characterise_json, characterise_lines
+    from accelcal_rig.config.write_thermal import write_thermal
+
+    result = characterise(args.campaign)
+    if args.write is not None:
+        write_thermal(args.write, result.thermal(), result.measured())
+    if args.json:
+        print(json.dumps({**characterise_json(result), "written": str(args.write) if args.write else None}))
+    else:
+        print("\n".join(characterise_lines(result)))
+        print(f"written    thermal: in {args.write} (its other lines as they were)" if args.write is not None
+              else f"write them into the rig config with: rig characterise {args.campaign} --write RIG")
+    return 0
+
+
 def _cmd_sim(args: argparse.Namespace) -> int:
     from accelcal_rig.assembly import served_rig
     from accelcal_rig.cli_campaign import until_signalled
@@ -451,7 +467,7 @@ def main(argv: list[str] | None = None, today: Callable[[], dt.date] = dt.date.t
     logging.getLogger("pymodbus").addHandler(logging.NullHandler())
     logging.getLogger("pymodbus").propagate = False
     handler = {"run": _cmd_run, "plan": _cmd_plan, "resume": _cmd_resume, "status": _cmd_status, "repair": _cmd_repair,
-               "fit": _cmd_fit, "check": _cmd_check,
+               "fit": _cmd_fit, "check": _cmd_check, "characterise": _cmd_characterise,
                "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export, "certificate": _cmd_certificate,
                "fit-recording": _cmd_fit_recording, "analyze": _cmd_analyze, "registry": _cmd_registry,
                "serve": _cmd_serve, "completion": _cmd_completion, "approve": _cmd_approve}[args.command]

@@ -18,7 +18,7 @@ from accelcal_rig.cli_grammar.common import (
 
 def add_campaign_commands(commands: Commands) -> None:
     """`rig run | plan | resume | status | repair | check | sim`, in this order."""
-    for add in (_add_run, _add_plan, _add_resume, _add_status, _add_repair, _add_check, _add_sim):
+    for add in (_add_run, _add_plan, _add_resume, _add_status, _add_repair, _add_check, _add_characterise, _add_sim):
         add(commands)
 
 
@@ -112,6 +112,21 @@ def _add_check(commands: Commands) -> None:
                        help="check only this instrument (repeat for more); the rig config may then leave out the "
                             "others' sections")
     check.add_argument("--faults", metavar="KEY=VALUE,...", help=FAULTS_HELP)
+
+
+def _add_characterise(commands: Commands) -> None:
+    """Fit a rig's thermal constants to a finished campaign."""
+    characterise = command(
+        commands, "characterise", "fit the rig's thermal constants to a finished campaign's ramps and soaks",
+        "Fit the chamber's heating and cooling rates (and the floor cooling slows towards), its air's lag and "
+        "overshoot, and each DUT's lag, to the air and DUT temperatures a campaign polled during its ramps and "
+        "soaks; compare the campaign's duration with its estimate, with the constants it ran with and with the "
+        "fitted ones; on a dry run, print the simulator's constants beside them. --write puts them into a rig "
+        "config's thermal: section (its comments kept), so rig plan's next estimate is the rig's own.",
+        "rig characterise campaign.h5 --write configs/lab-2.yaml")
+    characterise.add_argument("campaign", type=Path, help="campaign file (HDF5)")
+    characterise.add_argument("--write", type=Path, metavar="RIG", help="write the constants into this rig config")
+    characterise.add_argument("--json", action="store_true", help="print one JSON object")
 
 
 def _add_sim(commands: Commands) -> None:

@@ -14,7 +14,15 @@ from accelcal_rig.config.procedure import MAX_POLLS, Procedure
 from accelcal_rig.config.rig import FaultInjection, RigConfig
 from accelcal_rig.config.schedule import Schedule
 from accelcal_rig.config.suggestions import explained
-from accelcal_rig.config.yaml_lines import CONFIG_LIMITS, KeyPath, YamlLimits, format_key, load_yaml_with_lines, locate
+from accelcal_rig.config.yaml_lines import (
+    CONFIG_LIMITS,
+    KeyPath,
+    YamlLimits,
+    format_key,
+    load_yaml_with_lines,
+    locate,
+    yaml_text_with_lines,
+)
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.registry import part
 from accelcal_rig.protocols.chamber_lines import LINE_PROFILES
@@ -92,6 +100,12 @@ def load_procedure(path: Path) -> LoadedConfig[Procedure]:
 
 def load_rig(path: Path) -> LoadedConfig[RigConfig]:
     return load_validated(path, RigConfig)
+
+
+def validate_rig_text(text: str, path: Path) -> LoadedConfig[RigConfig]:
+    """The rig config `text` would be at `path` (a rewrite checked before it replaces the file)."""
+    data, lines, text = yaml_text_with_lines(text, path)
+    return _validated(path, RigConfig, data, lines, text)
 
 
 def resolve_rig_path(procedure: LoadedConfig[Procedure], override: Path | None) -> Path:

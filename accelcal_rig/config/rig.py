@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
 import numpy as np
@@ -353,6 +354,49 @@ class NotifyConfig(StrictModel):
     timeout_s: Real = Field(10.0, gt=0, le=120, description="longest one delivery may take")
 
 
+class RigThermal(StrictModel):
+    """The rig's own thermal behaviour as measured on it (`rig characterise CAMPAIGN --write RIG` fits and
+    writes it): what `rig plan`'s duration estimate plays a plan against. A constant left out falls back to
+    its default (THERMAL_DEFAULTS), and `rig plan` says which. Not the simulated lab's physics (`simulation:`)."""
+
+    heating_rate_c_per_min: Real | None = Field(None, ge=0.01, le=50, description="how fast the chamber moves its "
+                                                "air up (at most chamber.ramp_rate_c_per_min, the commanded rate)")
+    cooling_rate_c_per_min: Real | None = Field(None, ge=0.01, le=50, description="how fast it moves it down at "
+                                                "room temperature")
+    cooling_floor_c: TemperatureC | None = Field(None, description="cooling slows towards this temperature: at T, "
+                                                 "the cooling rate × (T − floor)/(room − floor); unset: it does not")
+    room_c: TemperatureC | None = Field(None, description="the room the chamber stands in (the floor is reckoned "
+                                        "from it)")
+    chamber_time_constant_min: Real | None = Field(None, ge=0.01, le=1440, description="the air's lag behind the "
+                                                   "controller's ramp")
+    chamber_overshoot_pct: Real | None = Field(None, ge=0, le=50, description="the controller drives past a set "
+                                               "point by this share of the step, peaking three air time constants "
+                                               "after its ramp arrives")
+    fixture_time_constant_min: Real | None = Field(None, ge=0.01, le=1440, description="the slowest DUT's lag "
+                                                   "behind the air (a soak waits for the slowest)")
+    measured: str | None = Field(None, max_length=500, description="where and when these were measured")
+
+
+#: What the estimate uses for a thermal constant the rig config leaves out (the heating and cooling rates:
+#: the chamber's commanded ramp rate; no floor; no overshoot).
+THERMAL_DEFAULTS: dict[str, float | None] = {"cooling_floor_c": None, "room_c": 23.0, "chamber_time_constant_min": 3.0,
+                                             "chamber_overshoot_pct": 0.0, "fixture_time_constant_min": 10.0}
+
+
+@dataclass(frozen=True)
+class EstimateThermal:
+    """The thermal constants an estimate plays a plan with, and the names of those that are defaults."""
+
+    heating_rate_c_per_min: float
+    cooling_rate_c_per_min: float
+    cooling_floor_c: float | None
+    room_c: float
+    chamber_time_constant_min: float
+    chamber_overshoot_pct: float
+    fixture_time_constant_min: float
+    defaults: tuple[str, ...]
+
+
 class RigConfig(StrictModel):
     name: str = Field(min_length=1, max_length=128)
     description: str = Field("", max_length=10_000)
@@ -362,6 +406,8 @@ class RigConfig(StrictModel):
     retry: RetryPolicy = RetryPolicy()
     notify: NotifyConfig = NotifyConfig()
     simulation: SimulationConfig = SimulationConfig()
+    thermal: RigThermal = Field(RigThermal(), description="the rig's own thermal constants, measured (rig "
+                                "characterise): what duration estimates use")
     gravity_m_s2: Real = Field(STANDARD_GRAVITY_M_S2, ge=9.7, le=9.9,
                                description="the site's gravity (a survey or a gravity model); the standard value "
                                            "by default, said so in reports")
@@ -388,6 +434,35 @@ class RigConfig(StrictModel):
             raise ValueError(f"simulation.cooling_floor_c: {floor:g} °C is not below the chamber's lowest set point "
                              f"({self.chamber.min_setpoint_c:g} °C) and the ambient: a compressor cools towards it")
         return self
+
+    @model_validator(mode="after")
+    def _thermal_floor_below_the_chamber(self) -> RigConfig:
+        floor = self.thermal.cooling_floor_c
+        if floor is not None and floor >= self.chamber.min_setpoint_c:
+            raise ValueError(f"thermal.cooling_floor_c: {floor:g} °C is not below the chamber's lowest set point "
+                             f"({self.chamber.min_setpoint_c:g} °C): cooling slows towards it")
+        return self
+
+    def estimate_thermal(self) -> EstimateThermal:
+        """The constants the duration estimate uses: the measured ones (`thermal:`), a default for any left out;
+        a rate above the commanded ramp rate is the commanded rate (the controller ramps no faster)."""
+        measured = self.thermal
+        commanded = self.chamber.ramp_rate_c_per_min
+        values: dict[str, float | None] = {}
+        defaults = []
+        for name in ("heating_rate_c_per_min", "cooling_rate_c_per_min", *THERMAL_DEFAULTS):
+            value = getattr(measured, name)
+            if value is None and not (name == "cooling_floor_c" and measured.cooling_rate_c_per_min is not None):
+                defaults.append(name)
+                value = THERMAL_DEFAULTS.get(name, commanded)
+            values[name] = value
+        heating, cooling = values["heating_rate_c_per_min"], values["cooling_rate_c_per_min"]
+        assert heating is not None and cooling is not None
+        room, chamber_tau, overshoot, fixture_tau = (values["room_c"], values["chamber_time_constant_min"],
+                                                     values["chamber_overshoot_pct"], values["fixture_time_constant_min"])
+        assert room is not None and chamber_tau is not None and overshoot is not None and fixture_tau is not None
+        return EstimateThermal(min(heating, commanded), min(cooling, commanded), values["cooling_floor_c"], room,
+                               chamber_tau, overshoot, fixture_tau, tuple(defaults))
 
     @property
     def gravity_g(self) -> float:

@@ -193,6 +193,11 @@ def load_yaml_with_lines(path: Path, limits: YamlLimits = CONFIG_LIMITS) -> tupl
     except UnicodeDecodeError as exc:
         line = raw[:exc.start].count(b"\n") + 1
         raise ConfigError(f"{path}:{line}: not UTF-8 text (byte 0x{raw[exc.start]:02x})") from None
+    return yaml_text_with_lines(text, path, limits)
+
+
+def yaml_text_with_lines(text: str, path: Path, limits: YamlLimits = CONFIG_LIMITS) -> tuple[Any, dict[KeyPath, int], str]:
+    """As load_yaml_with_lines, for the text of `path` (a file about to be written: checked first)."""
     data, root = _parse(text, str(path), limits)
     if root is None:
         raise ConfigError(f"{path}:1: file is empty")

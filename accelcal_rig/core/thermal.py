@@ -57,8 +57,10 @@ class ThermalModel:
                  dut_tau_s: list[float], self_heating_c: float, free_cooling_tau_s: float = 2700.0, *,
                  overshoot_fraction: float = 0.0, cooling_floor_c: float | None = None,
                  slot_offset_per_c: list[float] | None = None, hysteresis_span_c: float = 0.0,
-                 hysteresis_time_constant_s: float | None = None) -> None:
+                 hysteresis_time_constant_s: float | None = None, cooling_rate_c_per_s: float | None = None) -> None:
         self.ramp_rate_c_per_s = ramp_rate_c_per_s
+        #: How fast it cools at the ambient temperature (None: as fast as it heats, `ramp_rate_c_per_s`).
+        self.cooling_rate_c_per_s = ramp_rate_c_per_s if cooling_rate_c_per_s is None else cooling_rate_c_per_s
         self.overshoot_fraction = overshoot_fraction
         self.cooling_floor_c = cooling_floor_c
         #: Each slot's air: air + offset × (air − ambient) (0 for all: a uniform chamber).
@@ -121,12 +123,14 @@ class ThermalModel:
         return self._dut_c.copy()
 
     def ramp_rate_at_c_per_s(self, reference_c: float, cooling: bool) -> float:
-        """How fast the chamber can move its air from `reference_c`: the rig's ramp rate, and cooling slower
+        """How fast the chamber can move its air from `reference_c`: its heating rate, or its cooling rate, slower
         towards `cooling_floor_c` (a compressor's capacity falls with its evaporator temperature)."""
-        if not cooling or self.cooling_floor_c is None or self.ambient_c <= self.cooling_floor_c:
+        if not cooling:
             return self.ramp_rate_c_per_s
+        if self.cooling_floor_c is None or self.ambient_c <= self.cooling_floor_c:
+            return self.cooling_rate_c_per_s
         share = (reference_c - self.cooling_floor_c) / (self.ambient_c - self.cooling_floor_c)
-        return self.ramp_rate_c_per_s * float(np.clip(share, 0.05, 1.0))
+        return self.cooling_rate_c_per_s * float(np.clip(share, 0.05, 1.0))
 
     def advance_to(self, t_s: float) -> None:
         while self._t < t_s:
@@ -134,8 +138,8 @@ class ThermalModel:
             gap = self._target_c - self._reference_c
             rate = self.ramp_rate_at_c_per_s(self._reference_c, gap < 0)
             arrives_s = abs(gap) / rate
-            if self.powered and 0.0 < arrives_s < step:  # end this sub-step where the ramp arrives
-                step = arrives_s
+            if self.powered and 0.0 < arrives_s <= step * (1.0 + 1e-9):  # end this sub-step where the ramp arrives
+                step = arrives_s  # (also when it arrives just at the sub-step's end: its overshoot starts there)
             self._step(step, rate, arrives=self.powered and 0.0 < arrives_s <= step)
             self._t = t_s if step >= t_s - self._t else self._t + step
 

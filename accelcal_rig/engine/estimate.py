@@ -1,9 +1,10 @@
 """How long a campaign will take, before it starts: the plan's steps played against the rig's model, each
 by its own handler (engine/step_table.py), the one that runs it.
 
-The chamber ramps at the rig's ramp rate and its air lags with `simulation.chamber_time_constant_min`;
-each DUT lags the air with `simulation.fixture_time_constant_min` (the same thermal model a dry run uses,
-so set those two to a real rig's measured values). The ramp and soak are polled exactly as the engine
+The chamber ramps up and down at the rig's own measured rates (cooling slower towards a floor), its air lags
+and overshoots, and the DUTs lag the air as the slowest measured DUT does: the rig config's `thermal:`
+section, which `rig characterise` fits to a finished campaign, defaults where it has none (config/rig.py,
+`RigConfig.estimate_thermal`; the same thermal model a dry run's lab uses). The ramp and soak are polled exactly as the engine
 polls them, through the same soak detector, fed with what each DUT's part reads (engine/soak_estimate.py).
 Each pose costs its turntable travel at the axes' speeds, the table's settling
 (`simulation.turntable_settle_s`) and half a position poll, the procedure's settle time and the samples at

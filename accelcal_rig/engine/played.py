@@ -121,12 +121,13 @@ class PlayedRig:
     @classmethod
     def of(cls, procedure: Procedure, rig: RigConfig, readers: list[TemperatureFormat]) -> PlayedRig:
         sim = rig.simulation
-        serials = [s.serial for s in rig.fixture.sensors]
+        constants = rig.estimate_thermal()  # the rig's own (thermal:), defaults where it has none
         thermal = ThermalModel(
-            ambient_c=sim.ambient_c, ramp_rate_c_per_s=rig.chamber.ramp_rate_c_per_min / 60.0,
-            chamber_tau_s=sim.chamber_time_constant_min * 60.0, dut_tau_s=sim.fixture_time_constants_s(serials),
-            self_heating_c=sim.self_heating_c, overshoot_fraction=sim.chamber_overshoot_pct / 100.0,
-            cooling_floor_c=sim.cooling_floor_c, slot_offset_per_c=sim.slot_offsets_per_c(len(serials)),
+            ambient_c=constants.room_c, ramp_rate_c_per_s=constants.heating_rate_c_per_min / 60.0,
+            cooling_rate_c_per_s=constants.cooling_rate_c_per_min / 60.0,
+            chamber_tau_s=constants.chamber_time_constant_min * 60.0,
+            dut_tau_s=[constants.fixture_time_constant_min * 60.0] * len(rig.fixture.sensors), self_heating_c=0.0,
+            overshoot_fraction=constants.chamber_overshoot_pct / 100.0, cooling_floor_c=constants.cooling_floor_c,
         )
         speeds = np.array([a.speed_deg_s for a in rig.turntable.axes])
         acquisition = procedure.acquisition

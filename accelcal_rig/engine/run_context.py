@@ -55,6 +55,9 @@ class DutThermalState:
     moving: bool = False
     #: When the chamber air (or the software ramp) last reached its setpoint: where a soak's deadline starts.
     reached_s: float = 0.0
+    #: The last ramp's air polls (clock s, °C), from the set point's write: the soak after it keeps them.
+    ramp_t_s: list[float] = field(default_factory=list)
+    ramp_chamber_c: list[float] = field(default_factory=list)
     #: The ramp method's software ramp once running.
     software_ramp: SoftwareRamp | None = None
 

@@ -35,12 +35,17 @@ class RampStep:
             chamber.set_power(True)  # a cool-down switches it off; a resumed one needs it on again
         start_c = run.read_chamber_c()
         chamber.write_setpoint_c(setpoint_c)
+        trace_t, trace_c = run.dut.ramp_t_s, run.dut.ramp_chamber_c
+        trace_t[:], trace_c[:] = [run.clock.now()], [start_c]
         ramp_s = abs(setpoint_c - start_c) / (run.rig.chamber.ramp_rate_c_per_min / 60.0)
         timeout_s = soak.ramp_timeout_factor * ramp_s + soak.ramp_timeout_margin_min * 60.0
         run.events.info("ramp", f"ramp {format_fixed(start_c)} → {setpoint_c:g} °C (deadline {format_duration(timeout_s)})")
 
         def reached() -> bool:
-            within = abs(run.read_chamber_c() - setpoint_c) <= soak.chamber_tolerance_c
+            air_c = run.read_chamber_c()
+            trace_t.append(run.clock.now())
+            trace_c.append(air_c)
+            within = abs(air_c - setpoint_c) <= soak.chamber_tolerance_c
             run.report.publish(run.machine.state)
             return within
 
@@ -96,7 +101,10 @@ class SoakStep:
             t, chamber, dut = detector.trace()
             run.dut.settled_c = detector.settled_dut_c() if len(t) else np.full(len(run.sensors), np.nan)
             run.writer.write_soak(SoakTrace(label, setpoint_c, outcome, t, chamber, dut, t_reached, t_stable,
-                                            run.dut.settled_c, tuple(s.serial for s in run.sensors)))
+                                            run.dut.settled_c, tuple(s.serial for s in run.sensors),
+                                            np.array(run.dut.ramp_t_s), np.array(run.dut.ramp_chamber_c)))
+            run.dut.ramp_t_s.clear()  # each ramp's polls go with its own soak
+            run.dut.ramp_chamber_c.clear()
         if outcome == "timeout":
             if criterion.on_timeout == "skip":
                 n_poses = run.report.skip_setpoint()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.engine.estimate import DurationEstimate
 from accelcal_rig.engine.preparation import PreparedCampaign
@@ -58,8 +59,23 @@ def plan_lines(prepared: PreparedCampaign, estimate: DurationEstimate) -> list[s
                      f"{format_duration(row.soak_s):>8s} {format_duration(row.poses_s):>8s} "
                      f"{format_duration(t):>9s}  {settled}{outcome}")
     lines += ["", f"estimated duration {format_duration(estimate.total_s)} (h:mm:ss; from the rig's ramp rate, "
-                  "thermal time constants and axis speeds; instrument communication not included)"]
+                  "thermal time constants and axis speeds; instrument communication not included)",
+              thermal_line(rig)]
     return lines
+
+
+def thermal_line(rig: RigConfig) -> str:
+    """Which thermal constants the estimate used: the rig's measured ones (`thermal:`), or defaults, named."""
+    constants = rig.estimate_thermal()
+    used = (f"heating {constants.heating_rate_c_per_min:.3g} °C/min, cooling {constants.cooling_rate_c_per_min:.3g} "
+            "°C/min" + (f" (floor {constants.cooling_floor_c:.1f} °C)" if constants.cooling_floor_c is not None else "")
+            + f", air lag {constants.chamber_time_constant_min:.3g} min, overshoot "
+              f"{constants.chamber_overshoot_pct:.2g} %, fixture lag {constants.fixture_time_constant_min:.3g} min")
+    if not constants.defaults:
+        measured = f" ({rig.thermal.measured})" if rig.thermal.measured else ""
+        return f"thermal    the rig's own{measured}: {used}"
+    return (f"thermal    {used}; defaults for {', '.join(constants.defaults)} (the rig config's thermal: has none): "
+            "measure them with rig characterise CAMPAIGN --write RIG")
 
 
 def plan_warnings(prepared: PreparedCampaign) -> list[str]:
@@ -243,6 +259,8 @@ def plan_json(prepared: PreparedCampaign, estimate: DurationEstimate) -> dict[st
                     "need_bytes": storage.need_bytes, "start_free_bytes": int(START_MARGIN * storage.need_bytes)},
         "estimate": {
             "total_s": estimate.total_s,
+            "thermal": {**{k: v for k, v in vars(prepared.rig.model.estimate_thermal()).items() if k != "defaults"},
+                        "defaults": list(prepared.rig.model.estimate_thermal().defaults)},
             "setpoints": [{"setpoint_c": r.setpoint_c, "ramp_s": r.ramp_s, "soak_s": r.soak_s, "poses_s": r.poses_s,
                            "soak_outcome": r.soak_outcome, "settled_dut_c": list(r.settled_dut_c)}
                           for r in estimate.setpoints],

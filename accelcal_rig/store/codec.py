@@ -111,7 +111,8 @@ def encode_soak(soak: SoakTrace, serials: list[str]) -> bytes:
     """`serials`: whose temperatures the columns of `soak.dut_c` are, in order."""
     arrays = {"t_s": np.asarray(soak.t_s, dtype="f8"), "chamber_c": np.asarray(soak.chamber_c, dtype="f8"),
               "dut_c": np.asarray(soak.dut_c, dtype="f8"), "settled_dut_c": np.asarray(soak.settled_dut_c, dtype="f8"),
-              "times_s": np.array([soak.setpoint_c, soak.t_reached_s, soak.t_stable_s], dtype="f8")}
+              "times_s": np.array([soak.setpoint_c, soak.t_reached_s, soak.t_stable_s], dtype="f8"),
+              "ramp_t_s": np.asarray(soak.ramp_t_s, dtype="f8"), "ramp_chamber_c": np.asarray(soak.ramp_chamber_c, dtype="f8")}
     return encode_record("soak", {"label": soak.label, "outcome": soak.outcome, "serials": serials}, arrays)
 
 
@@ -236,9 +237,12 @@ def _soak(record: Record, header: CampaignHeader) -> SoakTrace:
     if sorted(columns) != sorted(header.serials) or arrays["settled_dut_c"].shape != (d,):
         raise ValueError(f"its sensors {columns} are not the campaign's {header.serials}")
     order = [columns.index(serial) for serial in header.serials]  # the campaign's order
+    ramp_t_s, ramp_c = arrays.get("ramp_t_s", np.zeros(0)), arrays.get("ramp_chamber_c", np.zeros(0))
+    if ramp_t_s.ndim != 1 or ramp_c.shape != ramp_t_s.shape:
+        raise ValueError("ramp columns of different lengths")
     return SoakTrace(str(record.meta["label"]), setpoint, str(record.meta["outcome"]), arrays["t_s"],
                      arrays["chamber_c"], arrays["dut_c"].reshape(m, d)[:, order], reached, stable,
-                     arrays["settled_dut_c"][order])
+                     arrays["settled_dut_c"][order], ramp_t_s=ramp_t_s, ramp_chamber_c=ramp_c)
 
 
 def replay(found: Scan, source: str) -> Campaign:

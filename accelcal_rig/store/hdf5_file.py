@@ -135,7 +135,7 @@ def _image(campaign: Campaign, journal_bytes: int) -> bytes:
             group = soaks.create_group(name)
             group.attrs.update({"setpoint_c": soak.setpoint_c, "outcome": soak.outcome, "t_reached_s": soak.t_reached_s,
                                 "t_stable_s": soak.t_stable_s})
-            for field in ("t_s", "chamber_c", "dut_c", "settled_dut_c"):
+            for field in ("t_s", "chamber_c", "dut_c", "settled_dut_c", "ramp_t_s", "ramp_chamber_c"):
                 _dataset(group, field, getattr(soak, field))
         events = file.create_group("events")
         _dataset(events, "t_s", np.array([e.t_s for e in campaign.events], dtype="f8"))
@@ -415,10 +415,15 @@ def _read_soaks(reader: _Reader, n_duts: int, notes: list[str]) -> list[SoakTrac
             t_s = reader.array(f"soaks/{name}/t_s", (), "f")
             m = len(t_s)
             dut_c = reader.array(f"soaks/{name}/dut_c", (n_duts,), "f", m) if m else np.zeros((0, n_duts))
+            ramp_t_s, ramp_c = np.zeros(0), np.zeros(0)
+            if "ramp_t_s" in group:  # files from before ramps were kept have none
+                ramp_t_s = reader.array(f"soaks/{name}/ramp_t_s", (), "f")
+                ramp_c = reader.array(f"soaks/{name}/ramp_chamber_c", (), "f", len(ramp_t_s))
             soaks.append(SoakTrace(
                 name.split("#")[0], reader.attr(group, "setpoint_c", float), reader.attr(group, "outcome", _text), t_s,
                 reader.array(f"soaks/{name}/chamber_c", (), "f", m), dut_c, reader.attr(group, "t_reached_s", float),
-                reader.attr(group, "t_stable_s", float), reader.array(f"soaks/{name}/settled_dut_c", (), "f")))
+                reader.attr(group, "t_stable_s", float), reader.array(f"soaks/{name}/settled_dut_c", (), "f"),
+                ramp_t_s=ramp_t_s, ramp_chamber_c=ramp_c))
         except (DamagedFile, OSError, ValueError, KeyError) as exc:
             notes.append(f"soaks/{name} unreadable ({exc}): left out")
     soaks.sort(key=lambda s: s.t_reached_s)

@@ -129,6 +129,11 @@ class SoakTrace:
     t_stable_s: float                 # NaN unless stable
     settled_dut_c: np.ndarray         # (n_dut,) mean over the final window
     serials: tuple[str, ...] = ()     # whose temperatures the columns of dut_c are (empty: the campaign's order)
+    #: The ramp before it: the chamber air polled from the set point's write (its first row) until it was
+    #: reached (empty: no ramp was run for it in this run, or a file from before ramps were kept). What
+    #: `rig characterise` fits the chamber's rates and lag to.
+    ramp_t_s: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    ramp_chamber_c: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass(frozen=True)

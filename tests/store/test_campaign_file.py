@@ -83,3 +83,22 @@ def test_the_file_records_each_instruments_driver_and_endpoint(campaign: Path) -
         assert turntable["driver"] == "SerialTurntable" and turntable["endpoint"].startswith("serial /dev/pts/")
         for dut in f["duts"].values():
             assert dut.attrs["driver"] == "Adxl355" and dut.attrs["endpoint"].startswith("serial /dev/pts/")
+
+
+def test_each_soak_keeps_the_ramp_before_it_in_the_journal_and_the_file(campaign: Path) -> None:
+    """The chamber air polled from the set point's write until it was reached: what `rig characterise`
+    fits the chamber's rates and lag to. The journal and the file hold the same polls."""
+    from accelcal_rig.store.hdf5_file import read_campaign_file
+    from accelcal_rig.store.read import load_campaign
+
+    from_journal = load_campaign(campaign)
+    with h5py.File(campaign, "r") as f:
+        from_file = read_campaign_file(f)
+        ramp_t_s, ramp_c = f["soaks/T30/ramp_t_s"][:], f["soaks/T30/ramp_chamber_c"][:]
+    (soak,) = from_journal.soaks
+    assert len(soak.ramp_t_s) > 2 and np.all(np.diff(soak.ramp_t_s) >= 0)
+    assert soak.ramp_t_s[-1] <= soak.t_reached_s + 1e-9
+    assert abs(soak.ramp_chamber_c[0] - 23.0) < 1.0 and abs(soak.ramp_chamber_c[-1] - 30.0) <= 1.0  # room → 30 °C, within tolerance
+    np.testing.assert_array_equal(from_file.soaks[0].ramp_t_s, soak.ramp_t_s)
+    np.testing.assert_array_equal(ramp_c, soak.ramp_chamber_c)
+    np.testing.assert_array_equal(ramp_t_s, soak.ramp_t_s)

@@ -1,0 +1,43 @@
+"""Measured thermal constants written into a rig config: the `thermal:` block replaced or appended, every
+other byte as the lab wrote it; a write that would break the config refused with the file unchanged."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from accelcal_rig.config.load import load_rig
+from accelcal_rig.config.write_thermal import write_thermal
+from accelcal_rig.errors import ConfigError
+from tests.conftest import SIM_RIG
+
+MEASURED = {"heating_rate_c_per_min": 2.75, "cooling_rate_c_per_min": 1.5, "cooling_floor_c": -80.0, "room_c": 22.5,
+            "chamber_time_constant_min": 3.25, "chamber_overshoot_pct": 1.5, "fixture_time_constant_min": 12.0}
+
+
+def test_the_section_is_appended_then_replaced_and_nothing_else_changes(tmp_path: Path) -> None:
+    config = tmp_path / "lab.yaml"
+    original = SIM_RIG.read_text() + "thermal:  # measured last spring\n  heating_rate_c_per_min: 9\n\n# the end\n"
+    config.write_text(original)
+    write_thermal(config, MEASURED, "rig characterise a.h5 on 2026-12-02")
+    text = config.read_text()
+    assert text.startswith(SIM_RIG.read_text()) and text.endswith("\n\n# the end\n")  # the comment after it kept
+    thermal = load_rig(config).model.thermal
+    assert (thermal.heating_rate_c_per_min, thermal.cooling_floor_c, thermal.measured) == (
+        2.75, -80.0, "rig characterise a.h5 on 2026-12-02")
+    write_thermal(config, {**MEASURED, "cooling_floor_c": None}, "again")  # a floor not seen: its key goes
+    assert load_rig(config).model.thermal.cooling_floor_c is None and config.read_text().count("thermal:") == 1
+
+
+def test_a_write_that_would_break_the_config_is_refused_and_the_file_left_as_it_was(tmp_path: Path) -> None:
+    config = tmp_path / "lab.yaml"
+    config.write_text(SIM_RIG.read_text())
+    with pytest.raises(ConfigError, match=r"thermal.cooling_floor_c: -50 °C is not below the chamber's lowest set "
+                                          r"point .* was left as it was"):
+        write_thermal(config, {**MEASURED, "cooling_floor_c": -50.0}, "x")  # the rig's chamber goes to -55 °C
+    assert config.read_text() == SIM_RIG.read_text()
+    config.write_text(SIM_RIG.read_text() + "thermal: {heating_rate_c_per_min: 2}\n")  # flow style: not ours to edit
+    with pytest.raises(ConfigError, match="its thermal: is not a block of its own lines"):
+        write_thermal(config, MEASURED, "x")
+    assert config.read_text().endswith("thermal: {heating_rate_c_per_min: 2}\n")
