@@ -311,8 +311,11 @@ def crash_trials(folder: Path, trials: int, rng: random.Random) -> tuple[int, in
 #: When the disk fills up (poses stored by then) and how much is left free then (bytes): from before the
 #: first pose to the fit, with nothing left (the next write fails) or a little (a later one does, or the
 #: check before a setpoint stops the campaign first).
+#: (poses stored, bytes left) when the disk fills, over the paper campaign's 432 poses (264 calibration, then 168
+#: verification): before the first, among the calibration poses, where verification begins, and at the very end
+#: (the fit, the certificates and the registry rows after the last pose).
 FULL_AT = [(0, 0), (0, 512 << 10), (1, 0), (30, 2 << 20), (75, 0), (100, 0), (100, 64 << 10), (150, 1 << 20),
-           (170, 0), (200, 0), (240, 256 << 10), (263, 0), (264, 0), (264, 3 << 20)]
+           (200, 0), (264, 0), (264, 3 << 20), (400, 256 << 10), (431, 0), (432, 0), (432, 3 << 20)]
 
 
 def diskfull_trials(folder: Path) -> tuple[int, int]:
@@ -388,9 +391,18 @@ def _diskfull_trial(mount: Path, after_poses: int, free: int) -> tuple[bool, str
     ballast.unlink()
     resumed = rig("resume", str(campaign), "-q")
     ok_after, note = judge_complete(campaign, before)
-    ok = said and not noise and status.returncode == 0 and resumed.returncode == 0 and ok_after
+    parts = follow_up_parts(campaign)
+    ok = (said and not noise and status.returncode == 0 and resumed.returncode == 0 and ok_after
+          and set(parts.values()) == {"done"})
     return ok, (f"exit {process.returncode}, {where}; said {last[-100:]!r}; safe state recorded {recorded}; "
-                f"resumed: {note}")
+                f"resumed: {note}; follow-up {parts}")
+
+
+def follow_up_parts(campaign: Path) -> dict[str, str]:
+    """Each part of the campaign's follow-up (calibration, certificates, registry) → its state, as `rig status`
+    reads it from the parts themselves."""
+    status = rig("status", str(campaign), "--json")
+    return {p["part"]: p["state"] for p in json.loads(status.stdout).get("follow_up", [])} if status.returncode == 0 else {}
 
 
 def _poses_stored(campaign: Path) -> int:
@@ -467,8 +479,7 @@ def _after_the_last_pose(campaign: Path, code: int, err: str) -> tuple[bool, str
     if code != 130 or not lines or "interrupted after the campaign ended" not in lines[-1]:
         return False, f"after the campaign was complete: exit {code} {lines[-1][-80:] if lines else ''}"
     resumed = rig("resume", str(campaign), "-q")
-    status = rig("status", str(campaign), "--json")
-    parts = {p["part"]: p["state"] for p in json.loads(status.stdout).get("follow_up", [])} if status.returncode == 0 else {}
+    parts = follow_up_parts(campaign)
     ok = resumed.returncode == 0 and set(parts.values()) == {"done"}
     return ok, f"in the follow-up: exit 130, then rig resume exit {resumed.returncode}, follow-up {parts}"
 

@@ -31,7 +31,6 @@ class SerialTurntable:
         self.endpoint = endpoint
         self.protocol = protocol
         self.n_axes = n_axes
-        self._error = re.compile(protocol.error_pattern)
         self._retry: RetryCall = lambda operation, reconnect: operation()
         self._set_up = False  # the profile's setup (interlock, mode) goes out before the first move
         self._polls_at_rest = 0
@@ -59,7 +58,7 @@ class SerialTurntable:
         p = self.protocol
         self._polls_at_rest = 0
         if p.multi_axis_move:
-            line = p.move_separator.join(p.move.send.format(axis=axis, angle=angle) for axis, angle in moves)
+            line = p.move_separator.join(p.request(p.move, axis=axis, angle=angle) for axis, angle in moves)
             self._ask(p.move, request=line)
         else:
             for axis, angle in moves:
@@ -123,17 +122,11 @@ class SerialTurntable:
         return self._retry(lambda: self._ask_once(command, request, **fields), self.reconnect)
 
     def _ask_once(self, command: Command, request: str | None, **fields: object) -> dict[str, str]:
-        request = command.send.format(**fields) if request is None else request
+        request = self.protocol.request(command, **fields) if request is None else request
         if command.reply is None:
             self._line.send(request)
             return {}
-        reply = self._line.ask(request)
-        if self._error.search(reply):
-            raise InstrumentError(f"turntable ({self.endpoint}): {request!r} refused: {reply!r}")
-        match = re.fullmatch(command.reply, reply)
-        if match is None:
-            raise TransientInstrumentError(f"turntable ({self.endpoint}): {request!r}: unexpected reply {reply!r}")
-        return {k: v for k, v in match.groupdict().items() if v is not None}
+        return read_reply(self.protocol, command, request, self._line.ask(request), self.endpoint)
 
 
 class _RateTable(SerialTurntable):
@@ -168,6 +161,19 @@ class _RateTable(SerialTurntable):
         if not 0 <= axis < self.n_axes:
             raise InstrumentError(f"turntable ({self.endpoint}): no axis {axis} (it has {self.n_axes})")
         return axis + 1
+
+
+def read_reply(protocol: TurntableProtocol, command: Command, request: str, reply: str,
+               endpoint: str) -> dict[str, str]:
+    """The values a reply carries (its pattern's named groups); a reply matching the profile's error pattern
+    is a refusal, one matching no pattern a garbled line (retried)."""
+    if re.search(protocol.error_pattern, reply):
+        raise InstrumentError(f"turntable ({endpoint}): {request!r} refused: {reply!r}")
+    assert command.reply is not None
+    match = re.fullmatch(command.reply, reply)
+    if match is None:
+        raise TransientInstrumentError(f"turntable ({endpoint}): {request!r}: unexpected reply {reply!r}")
+    return {k: v for k, v in match.groupdict().items() if v is not None}
 
 
 def _is_fault(protocol: TurntableProtocol, reply: str) -> bool:

@@ -8,6 +8,9 @@ must understand), and what a template must be to be sent at all.
 - `simserv`: numbered commands; a template must be a known command number with a field count it takes.
 - `scpi`: SCPI program headers (scpi_headers.py): templates in the manuals' notation, sent as upper-case
   long forms, read in any documented spelling.
+- `acl` (turntables): Acutronic's ACL (acl_messages.py): the same notation, sent as lower-case long forms,
+  each mnemonic read cut anywhere from its short form on; a request pattern is of the message's commands
+  from the root, joined by `;` (acl_messages.commands).
 """
 
 from __future__ import annotations
@@ -17,13 +20,18 @@ import string
 from collections.abc import Callable
 from typing import Literal
 
-from accelcal_rig.protocols import scpi_headers, simserv_commands
+from accelcal_rig.protocols import acl_messages, scpi_headers, simserv_commands
 
+#: A chamber profile's dialects.
 Dialect = Literal["plain", "espec", "simserv", "scpi"]
+#: Every dialect (a turntable profile's are `plain` and `acl`).
+LineDialect = Literal["plain", "espec", "simserv", "scpi", "acl"]
 
 
-def spelled(send: str, dialect: Dialect) -> str:
-    """The template as the driver sends it (SCPI: the header's upper-case long form)."""
+def spelled(send: str, dialect: LineDialect) -> str:
+    """The template as the driver sends it (SCPI: the header's upper-case long form; ACL: lower-case)."""
+    if dialect == "acl":
+        return acl_messages.spelled(send)
     if dialect != "scpi":
         return send
     header, parameters = scpi_headers.split_request(send)
@@ -31,17 +39,21 @@ def spelled(send: str, dialect: Dialect) -> str:
     return f"{long_form} {parameters}" if parameters else long_form
 
 
-def check(send: str, dialect: Dialect) -> None:
+def check(send: str, dialect: LineDialect) -> None:
     """ValueError where a template cannot be sent as the family's controllers read requests."""
-    if dialect == "simserv":
+    if dialect == "acl":
+        acl_messages.check(send)
+    elif dialect == "simserv":
         simserv_commands.check_request(send)
     elif dialect == "scpi":
         scpi_headers.read_notation(scpi_headers.split_request(send)[0])
 
 
-def request_pattern(send: str, dialect: Dialect) -> re.Pattern[str]:
+def request_pattern(send: str, dialect: LineDialect) -> re.Pattern[str]:
     """Every request the controller reads as this template's: literal text as the dialect reads it, each
     field a run of non-blank characters (a field named twice must read the same both times)."""
+    if dialect == "acl":
+        return re.compile(acl_messages.request_pattern(send))
     if dialect == "scpi":
         header, parameters = scpi_headers.split_request(send)
         head = scpi_headers.read_notation(header).pattern()

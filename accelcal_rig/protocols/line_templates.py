@@ -64,12 +64,6 @@ def decimals_of(value: str, field: str) -> int | None:
     return int(match.group(1)) if match else None
 
 
-def round_trips(send: str, sample: Mapping[str, object]) -> bool:
-    """The request a template makes of `sample` is recognised by the template's own pattern (no padding or
-    blanks inside a field that a simulator, or a controller's parser, would not read back)."""
-    return request_pattern(send).fullmatch(send.format(**sample)) is not None
-
-
 def request_pattern(send: str) -> re.Pattern[str]:
     """The `send` template as a pattern: literal text as it is, each field a run of non-blank characters
     (a field named twice must read the same both times)."""

@@ -5,7 +5,8 @@ case (`:SOURce:CLOop1:SPOint`): an instrument takes either form, in any case, wi
 colon, and a numeric suffix of 1 may be left out (`CLOop` is `CLOop1`). A mnemonic written all in upper
 case (`UNIT`) has one form. A profile's SCPI templates are written in that notation; the driver sends the
 long form in upper case (the makers' libraries' spelling), and the simulator reads any spelling the
-notation allows.
+notation allows. Acutronic's ACL (acl_messages.py) reads the same notation more loosely: a mnemonic may be
+cut anywhere from its short form to its long form.
 """
 
 from __future__ import annotations
@@ -31,6 +32,14 @@ class Mnemonic:
         suffix = "1?" if self.suffix in ("", "1") else re.escape(self.suffix)
         return f"(?i:{forms}){suffix}"
 
+    def abbreviation_pattern(self) -> str:
+        """Any leading part of the long form from the short form on, in any case (ACL: `:D:P`, `:Dem:Pos`,
+        `:Demand:Position` are one command, `:Demand:Posn` is an error); a suffix only as written."""
+        tail = ""
+        for character in reversed(self.long[len(self.short):]):
+            tail = f"(?:{re.escape(character)}{tail})?"
+        return f"(?i:{re.escape(self.short)}{tail}){re.escape(self.suffix)}"
+
 
 @dataclass(frozen=True)
 class Header:
@@ -39,11 +48,12 @@ class Header:
     query: bool
     common: str | None = None
 
-    def long_form(self) -> str:
-        """The header as the makers' libraries send it: long forms, upper case, suffixes written."""
+    def long_form(self, lower: bool = False) -> str:
+        """The header as the makers' libraries send it: long forms, upper case (`lower`: lower case, as
+        Acutronic's clients write ACL; a common command then as written), suffixes written."""
         if self.common is not None:
-            return self.common.upper()
-        text = ":".join(m.long + m.suffix for m in self.mnemonics)
+            return self.common if lower else self.common.upper()
+        text = ":".join((m.long.lower() if lower else m.long) + m.suffix for m in self.mnemonics)
         return (":" if self.colon else "") + text + ("?" if self.query else "")
 
     def pattern(self) -> str:

@@ -14,13 +14,21 @@ A rate table's profile also says how one axis turns at a constant rate (`rotate`
 `{acceleration}` in °/s², `{rate_limit}`, the rate's magnitude), how it is read back (`rate`) and how it is
 brought to rest and held (`hold`); a profile without them (None) has no rate mode, and its driver no
 constant-rate capability.
+
+A profile's `dialect` says how its controller reads a request (line_dialects.py): `plain`, the text as
+written; `acl`, Acutronic's command language (acl_messages.py): templates in the manual's notation, sent
+as lower-case long forms, read in any documented spelling and joined into lines by `;`.
 """
 
 from __future__ import annotations
 
+import re
+from typing import Literal
+
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from accelcal_rig.protocols.line_templates import NUMBER, TemplateCommand, regular_expression, round_trips
+from accelcal_rig.protocols.line_dialects import check, request_pattern, spelled
+from accelcal_rig.protocols.line_templates import NUMBER, TemplateCommand, regular_expression
 
 #: What a request may name, with sample values: its axis (1-based) and angle; a rate command its rate,
 #: acceleration limit and rate limit.
@@ -45,6 +53,8 @@ class Command(TemplateCommand):
 class TurntableProtocol(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
+    dialect: Literal["plain", "acl"] = Field("plain", description="how the controller reads a request: the text "
+                                            "as written, or Acutronic's ACL (headers in any documented spelling)")
     write_terminator: str = Field("\n", min_length=1, max_length=4)
     read_terminator: str = Field("\n", min_length=1, max_length=4)
     error_pattern: str = Field("^ERR", max_length=256)
@@ -103,14 +113,34 @@ class TurntableProtocol(BaseModel):
         if self.multi_axis_move and self.move.reply is not None:
             raise ValueError("multi_axis_move: the move must be unanswered (a controller answering each of the "
                              "joined commands would leave replies on the line)")
-        for name in ("identify", "move", "position", "busy", "rate", "rotate", "hold", "stop", "home", "fault"):
-            command = getattr(self, name)
-            if command is not None and command.send != command.send.strip():
+        if self.dialect == "acl" and self.move_separator != ";":
+            raise ValueError("move_separator: ACL joins commands in one line with ';'")
+        for name, command in self.commands():
+            if command.send != command.send.strip():
                 raise ValueError(f"{name}: the request {command.send!r} has blanks at either end (lost on the line)")
-            if command is not None and not round_trips(command.send, _SEND_SAMPLE):
+            try:
+                check(command.send, self.dialect)
+            except ValueError as exc:
+                raise ValueError(f"{name}: {exc}") from None
+            if not request_pattern(command.send, self.dialect).fullmatch(self.request(command, **_SEND_SAMPLE)):
                 raise ValueError(f"{name}: the request {command.send!r} does not read back as itself "
                                  "(no padding or blanks inside a field)")
         return self
+
+    def commands(self) -> list[tuple[str, Command]]:
+        """(name, command) of every operation the profile has, then its setup commands (`setup0`, …)."""
+        names = ("identify", "move", "position", "busy", "rate", "rotate", "hold", "stop", "home", "fault")
+        present = [(name, command) for name in names if (command := getattr(self, name)) is not None]
+        return present + [(f"setup{i}", command) for i, command in enumerate(self.setup)]
+
+    def request_pattern(self, command: Command) -> re.Pattern[str]:
+        """Every request the controller reads as the command's (ACL: its commands from the root, joined by
+        `;`, as acl_messages.commands gives a line)."""
+        return request_pattern(command.send, self.dialect)
+
+    def request(self, command: Command, **fields: object) -> str:
+        """The request as the driver sends it: the template in the dialect's spelling, filled in."""
+        return spelled(command.send, self.dialect).format(**fields)
 
 
 #: The built-in profile: a plain SCPI-like line protocol, one command per line, one reply per command.
@@ -133,22 +163,25 @@ _N = NUMBER
 #: has read zero for three polls; a tripped interlock reads "Fault". Rate mode (TM-8004-C §4.3.6, 4.6.2,
 #: 4.6.8, 4.7.5, 4.10.5): the rate mode's rate and acceleration limits, the rate demand, then rate mode; a
 #: hold demands zero rate, to which the axis decelerates at that acceleration limit and stays (in rate mode:
-#: the next move sets position mode up again).
+#: the next move sets position mode up again). Headers in the manual's notation, each short form the
+#: shortest its examples show (`:D:P`, `:R:P?`, `:R:A 2;R 2`, `:I:C 1`, `:M:P 2`, `:L:R`, `:LIM:ACC`, where
+#: `:L:A` would also be Limit:Absolute); sent as lower-case long forms, as both public clients spell them.
 ACUTROL3000 = TurntableProtocol(
+    dialect="acl",
     identify=Command(send="*IDN?", reply=r"(?P<identity>.+)", answer="{identity}"),
-    move=Command(send=":demand:position {axis},{angle:.5f}"),
+    move=Command(send=":Demand:Position {axis},{angle:.5f}"),
     multi_axis_move=True, move_separator=";",
-    position=Command(send=":read:position? {axis}", reply=rf"(?P<angle>{_N})", answer="{angle:.5f}"),
-    rate=Command(send=":read:rate? {axis}", reply=rf"(?P<rate>{_N})", answer="{rate:.5f}"),
+    position=Command(send=":Read:Position? {axis}", reply=rf"(?P<angle>{_N})", answer="{angle:.5f}"),
+    rate=Command(send=":Read:Rate? {axis}", reply=rf"(?P<rate>{_N})", answer="{rate:.5f}"),
     at_rest_deg_s=0.01, at_rest_polls=3,
-    rotate=Command(send=":limit:rate R,{axis},{rate_limit:.5f};:limit:acceleration R,{axis},{acceleration:.5f};"
-                   ":demand:rate {axis},{rate:.5f};:mode:rate {axis}"),
-    hold=Command(send=":demand:rate {axis},0"),
-    stop=Command(send=":demand:rate {axis},0;:mode:rate {axis};:demand:rate {axis},0"),
-    home=Command(send=":demand:position {axis},0"),
-    fault=Command(send=":interlock? {axis}", reply=r"(?P<fault>\w+)", answer="{fault}"),
+    rotate=Command(send=":Limit:Rate R,{axis},{rate_limit:.5f};:Limit:ACCeleration R,{axis},{acceleration:.5f};"
+                   ":Demand:Rate {axis},{rate:.5f};:Mode:Rate {axis}"),
+    hold=Command(send=":Demand:Rate {axis},0"),
+    stop=Command(send=":Demand:Rate {axis},0;:Mode:Rate {axis};:Demand:Rate {axis},0"),
+    home=Command(send=":Demand:Position {axis},0"),
+    fault=Command(send=":INTerlock? {axis}", reply=r"(?P<fault>\w+)", answer="{fault}"),
     fault_values=["Fault", "Open"],  # tripped, or opened since the setup closed it
-    setup=[Command(send=":interlock:close {axis}"), Command(send=":mode:position {axis}")],
+    setup=[Command(send=":Interlock:Close {axis}"), Command(send=":Mode:Position {axis}")],
     setup_pause_s=0.3,
 )
 

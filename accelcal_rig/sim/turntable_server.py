@@ -1,20 +1,28 @@
 """A simulated turntable controller on a pseudo-terminal, speaking a line-protocol profile: each request is
-recognised by its command's template and answered with the command's answer, from the lab's turntable
-motion at the shared clock's time."""
+recognised by its command's template in every spelling the profile's dialect takes and answered with the
+command's answer, from the lab's turntable motion at the shared clock's time. An ACL controller reads a line
+as commands joined by `;` (acl_messages.py): each run of them that is one of the profile's operations is
+carried out, as are the ACL queries and Off mode beyond the profile (sim/turntable_acl.py), and the
+queries' answers come back joined by `;`; a line with any command it does not know, or any it cannot carry
+out, is refused whole and nothing moves."""
 
 from __future__ import annotations
 
 import re
 
 from accelcal_rig.config.rig import TurntableConfig
+from accelcal_rig.protocols import acl_messages
+from accelcal_rig.protocols.line_dialects import request_pattern
 from accelcal_rig.protocols.line_templates import finite_number
-from accelcal_rig.protocols.turntable_line import TurntableProtocol
+from accelcal_rig.protocols.turntable_line import Command, TurntableProtocol
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.line_answers import MAX_LINE_BYTES
 from accelcal_rig.sim.pty_line_server import PtyLineServer
+from accelcal_rig.sim.turntable_acl import AclExtras
 
-_OPERATIONS = ("identify", "move", "position", "busy", "rate", "rotate", "hold", "stop", "home", "fault")
+#: Operations that move the table (the last of them is kept for tests).
+_MOTION = ("move", "stop", "home", "rotate", "hold")
 #: The fields of a request that carry a number (degrees, °/s, °/s²).
 _NUMBER_FIELDS = ("angle", "rate", "acceleration", "rate_limit")
 
@@ -28,9 +36,11 @@ class SimulatedTurntableServer:
         self.last_command: str | None = None
         self._protocol = protocol
         self._identity = identity
-        commands = [(name, getattr(protocol, name)) for name in _OPERATIONS if getattr(protocol, name) is not None]
-        commands += [(f"setup{i}", command) for i, command in enumerate(protocol.setup)]
-        self._patterns = [(name, command, command.request_pattern()) for name, command in commands]
+        self._patterns = [(name, command, request_pattern(command.send, protocol.dialect))
+                          for name, command in protocol.commands()]
+        #: An ACL message's operations, most commands first (a stop's first command is also a hold).
+        self._by_length = sorted(((command.send.count(acl_messages.SEPARATOR) + 1, name, command, pattern)
+                                  for name, command, pattern in self._patterns), key=lambda step: -step[0])
         if protocol.write_terminator != protocol.read_terminator:
             raise ValueError("the simulated turntable needs one terminator for both directions")
         self._server = PtyLineServer(self._handle, protocol.write_terminator.encode(), "simulated-turntable", faults,
@@ -45,6 +55,8 @@ class SimulatedTurntableServer:
         self._setup_seen: list[set[str]] = [set() for _ in range(n_axes)]
         #: Axes a rate command has put in rate mode (a profile with setup then ignores moves until it again).
         self._rate_mode = [False] * n_axes
+        self.acl = AclExtras(lab, n_axes, lambda: any(f in protocol.fault_values for f in self.faults),
+                             self._leave_position_mode)
 
     @property
     def fault(self) -> str:
@@ -73,6 +85,8 @@ class SimulatedTurntableServer:
 
     def _handle(self, request: str) -> str | None:
         protocol = self._protocol
+        if protocol.dialect == "acl":
+            return self._handle_message(request)
         if protocol.multi_axis_move and protocol.move_separator in request:  # every axis's move in one line
             pattern = protocol.move.request_pattern()
             matches = [pattern.fullmatch(part) for part in request.split(protocol.move_separator)]
@@ -93,6 +107,58 @@ class SimulatedTurntableServer:
         matched, answer = self._match(request)
         return answer if matched else f"ERR unknown command {request!r}"
 
+    def _handle_message(self, request: str) -> str | None:
+        """An ACL line: every command recognised and every value read before any is carried out."""
+        commands = acl_messages.commands(request)
+        steps: list[tuple[str, Command | None, dict[str, str], str]] = []
+        taken = 0
+        while taken < len(commands):
+            step = self._recognise(commands[taken:])
+            if step is None:
+                return f"ERR unknown command {request!r}"
+            steps.append(step)
+            taken += step[3].count(acl_messages.SEPARATOR) + 1
+        n_axes = len(self._lab.motion.speeds_deg_s)
+        try:
+            for _, _, fields, _ in steps:
+                _numbers(fields)
+                if "axis" in fields and not 1 <= _axis_number(fields["axis"]) <= n_axes:
+                    raise ValueError(f"no axis {fields['axis']}")
+        except ValueError as exc:
+            return f"ERR {exc}"
+        answers = []
+        for name, command, fields, text in steps:
+            axis = _axis_number(fields["axis"]) - 1 if "axis" in fields else None
+            if command is None:
+                with self._lab.lock:
+                    answer = self.acl.answer(text, axis)
+            else:
+                answer = self._answer(name, command.answer or "", fields)
+                answer = None if command.answer is None else answer
+            for part in text.split(acl_messages.SEPARATOR):
+                self.acl.observe(part, axis)
+            if answer is not None:
+                answers.append(answer)
+        if any(name in _MOTION for name, *_ in steps):
+            self.last_command = request
+        return acl_messages.SEPARATOR.join(answers) if answers else None
+
+    def _recognise(self, commands: list[str]) -> tuple[str, Command | None, dict[str, str], str] | None:
+        """The operation (or ACL extra: no command) the first of `commands` begin: (name, command, fields,
+        its commands joined)."""
+        for count, name, command, pattern in self._by_length:
+            text = acl_messages.SEPARATOR.join(commands[:count])
+            match = pattern.fullmatch(text) if count <= len(commands) else None
+            if match is not None:
+                return name, command, match.groupdict(), text
+        fields = self.acl.recognise(commands[0])
+        return None if fields is None else ("acl", None, fields, commands[0])
+
+    def _leave_position_mode(self, axis: int) -> None:
+        """Off mode (an ACL extra): a move needs the profile's setup again."""
+        if self._protocol.setup:
+            self._set_up[axis], self._setup_seen[axis] = False, set()
+
     def _match(self, request: str) -> tuple[bool, str | None]:
         """(whether one command's template matches the request, its answer: None if it is unanswered)."""
         for name, command, pattern in self._patterns:
@@ -102,7 +168,7 @@ class SimulatedTurntableServer:
                     answer = self._answer(name, command.answer or "", match.groupdict())
                 except (ValueError, IndexError) as exc:
                     return True, f"ERR {exc}"
-                if name in ("move", "stop", "home", "rotate", "hold"):
+                if name in _MOTION:
                     self.last_command = request
                 return True, None if command.answer is None else answer
         return False, None
