@@ -133,4 +133,6 @@ def _open_port(name: str, endpoint: str, baudrate: int, timeout_s: float) -> ser
     try:
         return serial.serial_for_url(endpoint, baudrate=baudrate, timeout=timeout_s, write_timeout=timeout_s)
     except (serial.SerialException, ValueError) as exc:
-        raise InstrumentError(f"{name}: cannot open: {exc}") from None
+        cause = exc.__context__  # pyserial wraps the system's error in its own words around it: say it once
+        detail = cause.strerror if isinstance(cause, OSError) and cause.strerror else str(exc)
+        raise InstrumentError(f"{name}: cannot open: {detail}") from None
