@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from accelcal_rig.core.formatting import format_duration
+from accelcal_rig.report.warning_groups import warning_groups
 from accelcal_rig.store.lock import holder
 from accelcal_rig.store.paths import journal_path, progress_path
 from accelcal_rig.store.read import campaign_status, load_campaign
@@ -68,7 +69,9 @@ class CampaignFolders:
             campaign = load_campaign(path)
             status = campaign_status(path, campaign)
             warnings = [e.message for e in campaign.events if e.level in ("warning", "error")]
-            summary = {**status, "name": name, "warnings": warnings[-20:], "error": None}
+            groups = [{**g.as_dict(), "first": format_duration(g.first_s), "last": format_duration(g.last_s)}
+                      for g in warning_groups(campaign.events)]
+            summary = {**status, "name": name, "warnings": warnings[-20:], "warning_groups": groups, "error": None}
             if summary.get("progress"):
                 remaining = summary["progress"].get("remaining_s")
                 summary["progress"]["left"] = format_duration(remaining) if remaining is not None else None

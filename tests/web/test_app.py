@@ -133,3 +133,25 @@ def test_a_campaign_whose_writer_has_ended_is_not_shown_as_live_from_the_cache(l
     holding["now"] = False  # killed: no file changed
     summary = folders.summary("quick.h5")
     assert summary["progress"] is None and summary["writer"].startswith("gone")
+
+
+def test_a_campaigns_retries_are_grouped_by_instrument_with_count_times_and_outcome(tmp_path: Path) -> None:
+    """Faults in 3 % of replies: the page has one row per instrument and kind of trouble, not a line per
+    attempt, each saying it recovered (the campaign went on to the end)."""
+    from accelcal_rig.cli import main
+    from accelcal_rig.store.read import load_campaign
+    from tests.conftest import REPO
+
+    campaign = tmp_path / "lossy.h5"
+    assert main(["run", str(REPO / "procedures" / "quick-6pos.yaml"), "--config",
+                 str(REPO / "configs" / "sim-lossy.yaml"), "--faults", "rate=0.03", "--dry-run", "-o", str(campaign), "-q", "--no-pdf",
+                 "--registry", normalised(str(tmp_path / "registry.sqlite"))]) == 0
+    retries = [e for e in load_campaign(campaign).events if e.kind == "retry"]
+    assert retries, "the faults made no retry: nothing to group"
+    client = TestClient(base_url="http://127.0.0.1", app=create_app([tmp_path], None))
+    groups = [g for g in client.get("/api/campaigns/lossy.h5").json()["warning_groups"] if g["kind"] == "retry"]
+    assert sum(g["count"] for g in groups) == len(retries) and len(groups) < len(retries)
+    assert all(g["recovered"] is True and g["source"] for g in groups)
+    assert len({(g["source"], g["what"]) for g in groups}) == len(groups)
+    page = client.get("/campaigns/lossy.h5").text
+    assert page.count(">recovered</td>") == len(groups)
