@@ -100,9 +100,12 @@ def _stamp(path: Path) -> tuple[int, int]:
 
 
 def _temperatures(campaign: Any) -> dict[str, list[float]]:
-    """Chamber air and the DUTs' mean temperature at every stored pose and soak poll, on the campaign clock."""
+    """Chamber air and the DUTs' mean temperature at every stored pose, ramp and soak poll, on the campaign
+    clock (a ramp polls the air only: its DUT value is missing, NaN)."""
     points: list[tuple[float, float, float]] = []
     for soak in campaign.soaks:
+        for t, chamber in zip(soak.ramp_t_s, soak.ramp_chamber_c):
+            points.append((float(t), float(chamber), float("nan")))
         for t, chamber, duts in zip(soak.t_s, soak.chamber_c, soak.dut_c):
             points.append((float(t), float(chamber), float(np.mean(duts))))
     for pose in campaign.poses:

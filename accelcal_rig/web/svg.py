@@ -11,13 +11,14 @@ COLOURS = ("#1f6feb", "#d1242f", "#1a7f37", "#8250df", "#bf8700")
 
 
 def line_plot(x: list[float], series: dict[str, list[float]], x_label: str, y_label: str) -> str:
-    """One SVG element: each series a polyline against `x`, with ticks and a legend; empty data says so."""
+    """One SVG element: each series a line against `x` (broken where a value is missing: NaN), with round ticks
+    and a legend keyed by each series' colour; empty data says so."""
     if not x:
         return f'<p class="empty">no {escape(y_label)} yet</p>'
     xs = np.asarray(x, dtype=float)
     ys = np.concatenate([np.asarray(v, dtype=float) for v in series.values()])
-    x0, x1 = _span(xs.min(), xs.max())
-    y0, y1 = _span(np.nanmin(ys), np.nanmax(ys))
+    x_ticks, y_ticks = nice_ticks(*_finite_span(xs)), nice_ticks(*_finite_span(ys))
+    x0, x1, y0, y1 = x_ticks[0], x_ticks[-1], y_ticks[0], y_ticks[-1]
     plot_w, plot_h = _WIDTH - _LEFT - _RIGHT, _HEIGHT - _TOP - _BOTTOM
 
     def px(v: np.ndarray) -> np.ndarray:
@@ -28,30 +29,62 @@ def line_plot(x: list[float], series: dict[str, list[float]], x_label: str, y_la
 
     parts = [f'<svg class="plot" viewBox="0 0 {_WIDTH} {_HEIGHT}" role="img" aria-label="{escape(y_label)}">',
              f'<rect x="{_LEFT}" y="{_TOP}" width="{plot_w}" height="{plot_h}" class="frame"/>']
-    for tick in np.linspace(x0, x1, 6):
+    for tick in x_ticks:
         parts.append(f'<text x="{px(np.array(tick)):.1f}" y="{_HEIGHT - 16}" class="tick" text-anchor="middle">'
-                     f'{tick:.3g}</text>')
-    for tick in np.linspace(y0, y1, 5):
+                     f'{_tick_text(tick, x_ticks)}</text>')
+    for tick in y_ticks:
         parts.append(f'<text x="{_LEFT - 6}" y="{py(np.array(tick)) + 4:.1f}" class="tick" text-anchor="end">'
-                     f'{tick:.3g}</text>')
+                     f'{_tick_text(tick, y_ticks)}</text>')
     parts.append(f'<text x="{_LEFT + plot_w / 2}" y="{_HEIGHT - 2}" class="label" text-anchor="middle">'
                  f'{escape(x_label)}</text>')
     parts.append(f'<text x="12" y="{_TOP + plot_h / 2}" class="label" text-anchor="middle" '
                  f'transform="rotate(-90 12 {_TOP + plot_h / 2})">{escape(y_label)}</text>')
     for k, (name, values) in enumerate(series.items()):
         colour = COLOURS[k % len(COLOURS)]
-        points = " ".join(f"{a:.1f},{b:.1f}" for a, b in zip(px(xs), py(np.asarray(values, dtype=float))))
-        parts.append(f'<polyline points="{points}" fill="none" stroke="{colour}" stroke-width="1.5"/>')
-        parts.append(f'<text x="{_LEFT + 8 + 130 * k}" y="{_TOP + 14}" class="legend" fill="{colour}">'
-                     f'{escape(name)}</text>')
+        for run in _runs(px(xs), py(np.asarray(values, dtype=float))):
+            points = " ".join(f"{a:.1f},{b:.1f}" for a, b in run)
+            parts.append(f'<polyline points="{points}" fill="none" stroke="{colour}" stroke-width="1.5"/>')
+        key_x = _LEFT + 8 + 150 * k
+        parts.append(f'<line x1="{key_x}" y1="{_TOP + 10}" x2="{key_x + 18}" y2="{_TOP + 10}" stroke="{colour}" '
+                     f'stroke-width="3" class="key"/>')
+        parts.append(f'<text x="{key_x + 24}" y="{_TOP + 14}" class="legend">{escape(name)}</text>')
     parts.append("</svg>")
     return "".join(parts)
 
 
-def _span(low: float, high: float) -> tuple[float, float]:
-    if not np.isfinite(low) or not np.isfinite(high):
-        return 0.0, 1.0
+def nice_ticks(low: float, high: float, most: int = 7) -> list[float]:
+    """Round ticks covering low…high: a step of 1, 2, 2.5 or 5 × 10^k, at most `most` ticks, the first at or
+    below `low` and the last at or above `high` (the axis runs between them)."""
     if high - low < 1e-9:
-        return low - 0.5, high + 0.5
-    margin = 0.05 * (high - low)
-    return low - margin, high + margin
+        low, high = low - 0.5, high + 0.5
+    for power in range(int(np.floor(np.log10(high - low))) - 1, 12):
+        for mantissa in (1.0, 2.0, 2.5, 5.0):
+            step = mantissa * 10.0 ** power
+            first, last = np.floor(low / step + 1e-9) * step, np.ceil(high / step - 1e-9) * step
+            if round((last - first) / step) + 1 <= most:
+                return [round(float(first + i * step), 10) for i in range(int(round((last - first) / step)) + 1)]
+    return [low, high]
+
+
+def _tick_text(tick: float, ticks: list[float]) -> str:
+    """A tick as few digits as its step needs (`-40`, `2.5`, `0`)."""
+    step = abs(ticks[1] - ticks[0]) if len(ticks) > 1 else 1.0
+    decimals = max(0, -int(np.floor(np.log10(step) + 1e-9))) if step < 1 else 0
+    text = f"{tick:.{decimals + (1 if round(step * 10 ** decimals, 6) % 1 else 0)}f}"
+    return "0" if float(text) == 0 else text
+
+
+def _runs(xs: np.ndarray, ys: np.ndarray) -> list[list[tuple[float, float]]]:
+    """The points in runs without a missing value: a line is broken where one is (NaN)."""
+    runs: list[list[tuple[float, float]]] = [[]]
+    for a, b in zip(xs, ys):
+        if np.isfinite(a) and np.isfinite(b):
+            runs[-1].append((float(a), float(b)))
+        elif runs[-1]:
+            runs.append([])
+    return [run for run in runs if run]
+
+
+def _finite_span(values: np.ndarray) -> tuple[float, float]:
+    finite = values[np.isfinite(values)]
+    return (float(finite.min()), float(finite.max())) if len(finite) else (0.0, 1.0)

@@ -155,3 +155,19 @@ def test_a_campaigns_retries_are_grouped_by_instrument_with_count_times_and_outc
     assert len({(g["source"], g["what"]) for g in groups}) == len(groups)
     page = client.get("/campaigns/lossy.h5").text
     assert page.count(">recovered</td>") == len(groups)
+
+
+def test_the_temperature_plot_draws_the_ramps(lab) -> None:
+    """Every ramp's air polls are in the plot's series (the DUTs' value missing there: not polled)."""
+    import numpy as np
+
+    from accelcal_rig.store.read import load_campaign
+    from accelcal_rig.web.campaigns import CampaignFolders
+
+    folder, _ = lab
+    campaign = load_campaign(folder / "quick.h5")
+    series = CampaignFolders([folder]).series("quick.h5")
+    ramp_polls = sum(len(s.ramp_t_s) for s in campaign.soaks)
+    assert ramp_polls > 0 and int(np.isnan(series["dut_c"]).sum()) == ramp_polls
+    assert len(series["chamber_c"]) == ramp_polls + sum(len(s.t_s) for s in campaign.soaks) + len(campaign.poses)
+    assert series["t_h"] == sorted(series["t_h"])
