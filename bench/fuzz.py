@@ -103,9 +103,9 @@ def report(kind: str, results: list[tuple[str, Outcome, str]]) -> int:
     return len(failed)
 
 
-def configs(folder: Path, cases: int) -> int:
+def configs(folder: Path, numbers: list[int]) -> int:
     results = []
-    for number in range(cases):
+    for number in numbers:
         case = config_case(number)
         outcome = run(["plan", str(case.write(folder / f"case{number}"))])
         named = "procedure.yaml" in outcome.stderr or "rig.yaml" in outcome.stderr
@@ -121,7 +121,7 @@ def _digests(folder: Path) -> list[str]:
             for n in (CAMPAIGN, JOURNAL)]
 
 
-def campaigns(folder: Path, cases: int) -> int:
+def campaigns(folder: Path, numbers: list[int]) -> int:
     from accelcal_rig.errors import ConfigError
     from accelcal_rig.store.read import campaign_status
 
@@ -137,7 +137,7 @@ def campaigns(folder: Path, cases: int) -> int:
     }
     writers = {"resume": lambda f: ["resume", str(f / CAMPAIGN), "-q"], "repair": lambda f: ["repair", str(f / CAMPAIGN)]}
     results = []
-    for number in range(cases):
+    for number in numbers:
         case = folder / f"case{number}"
         what = damaged_case(number, source, case)
         before = _digests(case)
@@ -165,10 +165,10 @@ def campaigns(folder: Path, cases: int) -> int:
     return report("campaigns", results)
 
 
-def recordings(folder: Path, cases: int) -> int:
+def recordings(folder: Path, numbers: list[int]) -> int:
     clean = clean_recording()
     results = []
-    for number in range(cases):
+    for number in numbers:
         case = recording_case(number, clean)
         outcome = run(case.argv(folder / f"case{number}"))
         written = (folder / f"case{number}" / "out.yaml").is_file()
@@ -177,11 +177,11 @@ def recordings(folder: Path, cases: int) -> int:
     return report("recordings", results)
 
 
-def exports(folder: Path, cases: int) -> int:
+def exports(folder: Path, numbers: list[int]) -> int:
     source = make_source(folder / "source", REPO / "configs" / "sim.yaml")
     text = (source / CALIBRATION).read_text()
     results = []
-    for number in range(cases):
+    for number in numbers:
         data, description = mutate(text, random.Random(number))
         path = folder / f"cal{number}.yaml"
         path.write_bytes(data)
@@ -195,13 +195,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("inputs", choices=["configs", "campaigns", "recordings", "exports"])
     parser.add_argument("--cases", type=int)
+    parser.add_argument("--only", metavar="N,M,…", help="these case numbers only (each case is made from its number: "
+                        "a failure is re-run on its own)")
     args = parser.parse_args()
     cases = args.cases or {"configs": 600, "campaigns": 132, "recordings": 300, "exports": 150}[args.inputs]
+    numbers = [int(n) for n in args.only.split(",")] if args.only else list(range(cases))
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
     silence_campaign_log()  # the source campaigns' soak warnings are not what is judged
     with tempfile.TemporaryDirectory() as tmp:
         failures = {"configs": configs, "campaigns": campaigns, "recordings": recordings,
-                    "exports": exports}[args.inputs](Path(tmp), cases)
+                    "exports": exports}[args.inputs](Path(tmp), numbers)
     sys.exit(1 if failures else 0)
 
 

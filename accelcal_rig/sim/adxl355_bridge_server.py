@@ -244,6 +244,11 @@ class SimulatedBridgeServer:
         """The bridge protocol version it speaks."""
         return self._version
 
+    @property
+    def session(self) -> int:
+        """How many times a client has come or gone, as the bridge saw it (tests wait on it, not on time)."""
+        return self._server.session
+
     def start(self) -> SimulatedBridgeServer:
         self._server.start()
         return self

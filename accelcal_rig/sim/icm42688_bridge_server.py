@@ -36,6 +36,11 @@ class SimulatedIcm42688Bridge:
                                      stale_after_s=STALE_LINE_S)
         self.path = self.endpoint = self._server.path
 
+    @property
+    def session(self) -> int:
+        """How many times a client has come or gone, as the bridge saw it (tests wait on it, not on time)."""
+        return self._server.session
+
     def start(self) -> SimulatedIcm42688Bridge:
         self._server.start()
         return self

@@ -123,6 +123,8 @@ static void notice_clients(void)
     if (changed) {
         ++session;
         (void)tcflush(slave, TCIFLUSH);
+        printf("session %lu\n", (unsigned long)session); /* for tests that wait until the bridge saw a client go */
+        (void)fflush(stdout);
     }
 #endif
 }

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import re
+import select
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -25,7 +26,7 @@ from accelcal_rig.sim.adxl355_bridge_server import SimulatedBridgeServer
 from accelcal_rig.sim.icm42688_bridge_server import SimulatedIcm42688Bridge
 from accelcal_rig.sim.lab import VirtualLab
 from tests.conftest import REPO, SIM_RIG
-from tests.firmware.host_firmware import running
+from tests.firmware.host_firmware import running, wait_until
 from tests.protocols.bridge_conformance import GREETING, NO_REPLY, Exchange, exchanges
 
 PARTS = ("adxl355", "icm42688p")
@@ -42,6 +43,8 @@ class Served:
     path: str
     #: Lets time pass for the part behind it (the simulator's virtual clock; the firmware's own clock runs by itself).
     let_time_pass: Callable[[float], None]
+    #: How many times a client has come or gone, as the bridge saw it: what a test waits on (never on time).
+    session: Callable[[], int]
 
 
 @contextmanager
@@ -52,7 +55,7 @@ def simulator(part: str) -> Iterator[Served]:
     lab = VirtualLab(load_rig(rig).model, clock, 0)
     server = (SimulatedBridgeServer(lab, 0) if part == "adxl355" else SimulatedIcm42688Bridge(lab, 0)).start()
     try:
-        yield Served(server.path, clock.sleep)
+        yield Served(server.path, clock.sleep, lambda: server.session)
     finally:
         server.stop()
 
@@ -61,7 +64,22 @@ def simulator(part: str) -> Iterator[Served]:
 def firmware(binary: Path, part: str, clock: str = "board") -> Iterator[Served]:
     """The reference firmware's host build in front of its C model of `part`."""
     with running(binary, "--part", part, clock=clock) as served:
-        yield Served(served.path, lambda seconds: None)
+        printed = [b""]
+
+        def session() -> int:
+            """The latest `session N` line the host build printed (it prints one as it sees a client come or go);
+            read with os.read, past the line of its path the harness read."""
+            assert served.process.stdout is not None
+            fd = served.process.stdout.fileno()
+            while select.select([fd], [], [], 0)[0]:
+                chunk = os.read(fd, 4096)
+                if not chunk:
+                    break
+                printed[0] += chunk
+            numbers = re.findall(rb"^session (\d+)$", printed[0], re.MULTILINE)
+            return int(numbers[-1]) if numbers else 0
+
+        yield Served(served.path, lambda seconds: None, session)
 
 
 class RawClient:
@@ -213,8 +231,7 @@ def test_a_reply_whose_client_went_away_is_not_read_by_the_next_client(bridge_ho
                                                                       implementation: str) -> None:
     """A client asks for a whole capture, reads the start of its reply and closes the port: the bridge sends
     nothing more of that reply, and what the port still held of it is dropped, so the next client to open the
-    port reads only the replies to its own requests. (Half a second for the bridge to see the client go: the
-    time under test.)"""
+    port reads only the replies to its own requests (opened once the bridge has seen the first one go)."""
     bridge = simulator("adxl355") if implementation == "simulator" else firmware(bridge_host, "adxl355")
     with bridge as served:
         with raw_client(served.path) as first:
@@ -222,7 +239,8 @@ def test_a_reply_whose_client_went_away_is_not_read_by_the_next_client(bridge_ho
             first.send(b"G 0\n")
             taken = first.some()
             assert taken.startswith(b"=") and b"\n" not in taken  # the reply is under way, far from whole
-        time.sleep(0.5)  # the time the bridge has to see the client go
+            during = served.session()
+        wait_until(lambda: served.session() > during, "the bridge seeing its client go")
         with raw_client(served.path) as second:
             assert second.pending(0.3) == b"", "the next client reads the rest of a reply it never asked for"
             assert ask(second, b"R 00 4") == b"=AD1DED01"
