@@ -199,7 +199,10 @@ def syscall_trials(folder: Path, points: int, resume_points: int) -> tuple[int, 
         clean(campaign)
         killed = killed_at(run, call, when)
         ok, note, figures = finish_after_kill(campaign)
-        ok = ok and killed.returncode != 0
+        if killed.returncode == 0:  # this run made fewer such calls than the counted one (they vary by a few)
+            print(f"run    {call:9s} #{when:4d}: not reached (the run ended first, exit 0; not counted); {note}",
+                  flush=True)
+            continue
         passed, total = passed + ok, total + 1
         print(f"run    {call:9s} #{when:4d}: {'pass' if ok else 'FAIL'}  {int(figures.get('stored_at_kill', 0)):3d} "
               f"stored at the kill; {note}", flush=True)
