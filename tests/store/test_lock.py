@@ -7,6 +7,7 @@ import signal
 import socket
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -68,8 +69,10 @@ def test_a_lock_file_removed_by_its_holder_is_never_held_twice(tmp_path: Path) -
     waiter = subprocess.Popen([sys.executable, "-c", WAIT, str(campaign)], stdin=subprocess.PIPE,
                               stdout=subprocess.PIPE, text=True)
     try:
+        give_up = time.monotonic() + 30.0
         while holder(campaign) is None or not _waiting_on(waiter.pid, tmp_path / "c.h5.lock"):
-            assert waiter.poll() is None
+            assert waiter.poll() is None and time.monotonic() < give_up, "the waiter never opened the lock file"
+            time.sleep(0.005)
         lock.remove_lock_file(campaign)
         lock.release(campaign)
         assert waiter.stdout.readline().strip() == "held"
