@@ -10,6 +10,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from pydantic import ValidationError
+
 from accelcal_rig.analysis.thermal_constants import ThermalConstants, fit_thermal_constants
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig, RigThermal
@@ -48,8 +50,14 @@ def characterise(campaign: Path) -> Characterised:
         constants = fit_thermal_constants(stored.soaks, stored.serials)
     except ValueError as exc:
         raise ConfigError(f"{campaign}: {exc}") from None
-    rig = RigConfig.model_validate(parse_yaml_text(stored.header.rig_yaml, f"{campaign}: its rig config"))
-    procedure = Procedure.model_validate(parse_yaml_text(stored.header.procedure_yaml, f"{campaign}: its procedure"))
+    try:
+        rig = RigConfig.model_validate(parse_yaml_text(stored.header.rig_yaml, f"{campaign}: its rig config"))
+        procedure = Procedure.model_validate(parse_yaml_text(stored.header.procedure_yaml,
+                                                             f"{campaign}: its procedure"))
+    except ValidationError as exc:  # a file from another version whose configs this one reads otherwise
+        first = exc.errors(include_url=False)[0]
+        raise ConfigError(f"{campaign}: its stored configs no longer validate ({'.'.join(map(str, first['loc']))}: "
+                          f"{first['msg']})") from None
     took = then = now = None
     if stored.state == "done" and len(stored.poses) == stored.poses_planned and stored.run_count == 1:
         plan = compile_plan(procedure, rig)
