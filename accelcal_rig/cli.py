@@ -82,21 +82,25 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
     """Run or resume under the CLI's signal handling and logging, the campaign locked before anything of it
     changes (the log included); print the summary, then finish the campaign's follow-up."""
     from accelcal_rig.assembly import run_campaign
-    from accelcal_rig.cli_campaign import campaign_session, follow_up_of, stop_on_first_signal
+    from accelcal_rig.cli_campaign import campaign_session, follow_up_of, live_publishing, stop_on_first_signal
     from accelcal_rig.engine.session import NothingToResume
+    from accelcal_rig.report.live import listeners
 
     follow_up = follow_up_of(args, output, resume and not overwrite)
     prepared = replace(prepared, follow_up=follow_up.to_json())
-    with stop_on_first_signal():
-        try:
-            with campaign_session(prepared, output, verbose=args.verbose, quiet=args.quiet, dry_run=dry_run,
-                                  overwrite=overwrite, resume=resume) as progress:
-                result = run_campaign(prepared, output, dry_run=dry_run, seed=seed, overwrite=overwrite,
-                                      calibration=follow_up.calibration, resume=resume, progress=progress)
-        except NothingToResume as done:
-            print(done)
-            return _complete_campaign_verdicts(done, output, follow_up, args)
-    return _after_campaign(prepared, result, output, follow_up, args, dry_run)
+    with live_publishing(prepared, output, follow_up, dry_run=dry_run, fresh=not resume,
+                         enabled=not args.no_publish) as publisher:
+        with stop_on_first_signal():
+            try:
+                with campaign_session(prepared, output, verbose=args.verbose, quiet=args.quiet, dry_run=dry_run,
+                                      overwrite=overwrite, resume=resume) as progress:
+                    watched = listeners(progress, publisher) if publisher is not None else progress
+                    result = run_campaign(prepared, output, dry_run=dry_run, seed=seed, overwrite=overwrite,
+                                          calibration=follow_up.calibration, resume=resume, progress=watched)
+            except NothingToResume as done:
+                print(done)
+                return _complete_campaign_verdicts(done, output, follow_up, args)
+        return _after_campaign(prepared, result, output, follow_up, args, dry_run)
 
 
 def _after_campaign(prepared: PreparedCampaign, result: RunResult, output: Path, follow_up: FollowUp,
@@ -334,7 +338,7 @@ def _cmd_completion(args: argparse.Namespace) -> int:
 
 
 def _cmd_serve(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_serve import open_dashboard, stopped_line
+    from accelcal_rig.cli_serve import open_dashboard, stopped_line, stops_ignored
 
     dashboard = None
     try:
@@ -343,7 +347,8 @@ def _cmd_serve(args: argparse.Namespace) -> int:
         dashboard.serve()
     except (KeyboardInterrupt, TerminationRequested):
         pass  # SIGINT or SIGTERM: how a dashboard is meant to end
-    print(stopped_line(dashboard), file=sys.stderr)
+    with stops_ignored():  # a second Ctrl-C as it says so is the same request
+        print(stopped_line(dashboard), file=sys.stderr)
     return 0
 
 
@@ -434,6 +439,19 @@ def _one_line(error: BaseException) -> str:
     return " ".join(str(error).splitlines())
 
 
+#: Commands a signal is the way to end (what they serve stops: exit 0), not a campaign interrupted.
+_ENDED_BY_SIGNAL = ("serve", "sim")
+
+
+def _interrupted(command: str | None) -> int:
+    """Say what a signal outside a command's own handling stopped; its exit code."""
+    if command in _ENDED_BY_SIGNAL:
+        print(f"rig {command}: stopped", file=sys.stderr)
+        return 0
+    print("rig: interrupted before the campaign started; nothing was moved", file=sys.stderr)
+    return EXIT_INTERRUPTED
+
+
 def run_program() -> None:
     """The `rig` executable: run the command, then exit without letting a late signal crash the exit.
 
@@ -449,8 +467,7 @@ def run_program() -> None:
     try:
         code = main()
     except KeyboardInterrupt:  # a signal between start and the command's own handling
-        print("rig: interrupted before the campaign started; nothing was moved", file=sys.stderr)
-        code = EXIT_INTERRUPTED
+        code = _interrupted(next((word for word in sys.argv[1:] if not word.startswith("-")), None))
     except BrokenPipeError:  # `rig status … | head`: the reader has gone; so has the need to print
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         code = 0
@@ -483,8 +500,7 @@ def main(argv: list[str] | None = None, today: Callable[[], dt.date] = dt.date.t
         print(f"rig: error: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
     except (KeyboardInterrupt, TerminationRequested):
-        print("rig: interrupted before the campaign started; nothing was moved", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return _interrupted(args.command)
     except Exception as exc:  # noqa: BLE001 - a bug still reaches the operator as one line, not a traceback
         if os.environ.get("RIG_TRACEBACK") or isinstance(exc, BrokenPipeError):
             raise

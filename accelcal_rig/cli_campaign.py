@@ -24,6 +24,7 @@ if TYPE_CHECKING:
     from accelcal_rig.engine.preparation import PreparedCampaign
     from accelcal_rig.engine.progress import Progress, ProgressListener
     from accelcal_rig.follow_up import FollowUp
+    from accelcal_rig.registry.publisher import LivePublisher
 
 
 def prepare_run(args: argparse.Namespace) -> tuple[PreparedCampaign, bool]:
@@ -262,10 +263,12 @@ def _check_log_writable(log: Path) -> None:
 
 
 def campaign_status(campaign: Path, calibration: Path | None) -> dict[str, Any]:
-    """`rig status --json`: the campaign's state and progress, its DUTs' verdicts from its calibration, and
-    each part of its follow-up (calibration, certificates, registry) with what is missing."""
+    """`rig status --json`: the campaign's state and progress, its DUTs' verdicts from its calibration, each
+    part of its follow-up (calibration, certificates, registry) with what is missing, and every DUT the early
+    check flagged (`early_check`: serial, setpoint_c, finding, value, limit, action, and a dead axis's axis)."""
     from accelcal_rig import follow_up
     from accelcal_rig.fit.campaign_file import calibration_verdicts
+    from accelcal_rig.fit.early_check import logged_findings
     from accelcal_rig.fit.recorded_options import NO_FIT, requested_mode
     from accelcal_rig.store.read import campaign_status as stored_status
     from accelcal_rig.store.read import load_campaign
@@ -275,4 +278,48 @@ def campaign_status(campaign: Path, calibration: Path | None) -> dict[str, Any]:
     fit_due = requested_mode(stored.attrs) != NO_FIT
     parts = follow_up.state(campaign, found, fit_due)
     return {**stored_status(campaign, stored), **calibration_verdicts(campaign, found.calibration),
-            "follow_up": [p.as_dict() for p in parts]}
+            "follow_up": [p.as_dict() for p in parts],
+            "early_check": [f.as_dict() for f in logged_findings(stored.events)]}
+
+
+@contextmanager
+def live_publishing(prepared: PreparedCampaign, output: Path, follow_up: FollowUp, *, dry_run: bool, fresh: bool,
+                    enabled: bool) -> Iterator[LivePublisher | None]:
+    """The campaign's live status published to the registry its calibrations go to (a dry run's to the dry
+    runs' own), from its first progress to its last word: how it ended, each DUT's verdict once judged. Yields
+    the publisher (None with `rig run --no-publish`), whose events come from the log."""
+    from accelcal_rig.registry.location import configured, recording_url
+    from accelcal_rig.registry.publisher import Identity, LivePublisher
+
+    if not enabled:
+        yield None
+        return
+    url = recording_url(follow_up.registry, configured(prepared.rig.model.registry, prepared.rig.path), dry_run)
+    identity = Identity(prepared.rig.model.name, output.resolve(), prepared.procedure.model.name, dry_run)
+    publisher = LivePublisher(url, identity, fresh)
+    handler = publisher.handler()
+    LOGGER.addHandler(handler)
+    try:
+        yield publisher
+    finally:
+        LOGGER.removeHandler(handler)
+        if publisher.started:
+            publisher.finish(**_last_word(output, follow_up))
+        problem = publisher.close()
+        if problem is not None:
+            print(f"rig: warning: {problem}", file=sys.stderr)
+
+
+def _last_word(output: Path, follow_up: FollowUp) -> dict[str, Any]:
+    """How the campaign in `output` stands now, for its live status: its state, its poses, its verdicts."""
+    from accelcal_rig.fit.campaign_file import calibration_verdicts
+    from accelcal_rig.store.read import load_campaign
+
+    try:
+        campaign = load_campaign(output)
+        verdicts = calibration_verdicts(output, follow_up.calibration)["verdicts"] if campaign.state == "done" else None
+    except Exception as exc:  # noqa: BLE001 - a view: a file that cannot be read now is said so, not raised
+        return {"state": "stopped", "abort_reason": f"campaign file unreadable: {str(exc).splitlines()[0]}"}
+    state = campaign.state if campaign.state in ("done", "aborted") else "stopped"
+    return {"state": state, "poses_done": len(campaign.poses), "verdicts": verdicts,
+            "abort_reason": campaign.abort_reason or ""}

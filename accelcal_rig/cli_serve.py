@@ -5,12 +5,19 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import socket
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from accelcal_rig.errors import ConfigError
+
+#: Longest wait, as the dashboard stops, for its open connections (a page's event stream) to close.
+SHUTDOWN_S = 2
 
 
 @dataclass
@@ -46,8 +53,39 @@ class Dashboard:
         the handler it found (the `rig` program's: KeyboardInterrupt), for the caller to end on."""
         import uvicorn
 
-        config = uvicorn.Config(self.app, log_level="warning", ssl_certfile=self.tls_cert, ssl_keyfile=self.tls_key)
-        uvicorn.Server(config).run(sockets=[self.listening])
+        # No lifespan: the app has no start-up or shutdown of its own, and a second Ctrl-C while it stops would
+        # cancel uvicorn's wait for one, which it logs as a traceback.
+        # An open page holds an event stream (web/lab.py) that never ends by itself: a stop waits for the
+        # connections at most SHUTDOWN_S, then closes them.
+        config = uvicorn.Config(self.app, log_level="warning", ssl_certfile=self.tls_cert, ssl_keyfile=self.tls_key,
+                                lifespan="off", timeout_graceful_shutdown=SHUTDOWN_S)
+        server = uvicorn.Server(config)
+        stop_streams = getattr(self.app.state, "stop_streams", None)
+        handle_exit = server.handle_exit
+
+        def stopping(signum: int, frame: Any) -> None:
+            if stop_streams is not None:
+                stop_streams()  # the event streams end themselves: no connection is cut
+            handle_exit(signum, frame)
+
+        server.handle_exit = stopping  # type: ignore[method-assign,assignment]
+        server.run(sockets=[self.listening])
+
+
+@contextmanager
+def stops_ignored() -> Iterator[None]:
+    """While `rig serve` says it stopped: another Ctrl-C or SIGTERM asks for what is under way already, and
+    must not turn the stop into an interrupted command. The handlers are put back after (for a caller that
+    goes on, as a test calling `main` does)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {stop: signal.signal(stop, signal.SIG_IGN) for stop in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for stop, handler in previous.items():
+            signal.signal(stop, handler)
 
 
 def stopped_line(dashboard: Dashboard | None) -> str:

@@ -57,11 +57,9 @@ def of_run(args: argparse.Namespace, output: Path, calibration: Path) -> FollowU
 def of_campaign(attrs: dict[str, Any], output: Path, args: argparse.Namespace | None = None) -> FollowUp:
     """A stored campaign's follow-up: what its `rig run` recorded, each part overridden by a flag given now
     (`rig resume --certificates …`), else beside the campaign (a campaign from before it was recorded)."""
-    try:
-        stored = json.loads(str(attrs.get("follow_up") or "{}"))
-    except ValueError:
-        stored = {}
-    stored = stored if isinstance(stored, dict) else {}
+    from accelcal_rig.store.follow_up_record import recorded_follow_up
+
+    stored = recorded_follow_up(attrs)
 
     def given(name: str) -> Any:
         return getattr(args, name, None) if args is not None else None

@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from accelcal_rig.core.formatting import format_duration
+from accelcal_rig.fit.early_check import Finding
 
 
 def status_lines(status: dict[str, Any]) -> list[str]:
@@ -39,6 +40,8 @@ def status_lines(status: dict[str, Any]) -> list[str]:
     for part in status.get("follow_up") or []:
         if part["state"] != "not due" and not (part["part"] == "calibration" and part["state"] == "done"):
             lines.append(f"{part['part']:<10} {part['state']}: {part['detail']}")
+    for flagged in status.get("early_check") or []:
+        lines.append(f"flagged    {early_finding(flagged)}")
     for serial, judged in (status.get("verdicts") or {}).items():
         reasons = f": {'; '.join(judged['reasons'])}" if judged["verdict"] in ("FAIL", "CONDITIONAL") else ""
         lines.append(f"verdict    {serial} {judged['verdict'] or 'not judged'}{reasons}")
@@ -46,6 +49,11 @@ def status_lines(status: dict[str, Any]) -> list[str]:
     if hint:
         lines.append(f"next       {hint}")
     return lines
+
+
+def early_finding(flagged: dict[str, Any]) -> str:
+    """One finding of the early check as its event says it, without the `DUT ` it begins with."""
+    return Finding(**flagged).message().removeprefix("DUT ")
 
 
 def _state(status: dict[str, Any]) -> str:

@@ -55,3 +55,43 @@ def test_rig_serve_says_what_it_stopped_and_exits_0(tmp_path: Path, how: list[st
     assert process.returncode == 0, err.decode()
     assert err.decode().strip().splitlines()[-1] == f"rig serve: stopped (dashboard on {announced[1]} closed)"
     assert b"interrupted" not in err and (token is None or token.encode() not in err)
+
+
+def test_ctrl_c_once_it_answers_says_the_server_stopped_and_a_second_changes_nothing(tmp_path: Path) -> None:
+    """Ctrl-C pressed twice, the second as it stops (an impatient operator): still the one line saying the
+    dashboard stopped, exit 0, no traceback (uvicorn's wait for a lifespan cancelled) and no campaign named."""
+    import http.client
+
+    process = subprocess.Popen([RIG, "serve", "--campaigns", str(tmp_path), "--port", "0"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE)
+    try:
+        address = re.fullmatch(r"dashboard on http://(127\.0\.0\.1):(\d+)/", first_line(process, DEADLINE_S))
+        assert address, "the first line names where it listens"
+        browser = http.client.HTTPConnection(address[1], int(address[2]), timeout=DEADLINE_S)
+        browser.request("GET", "/api/campaigns")  # serving now; the connection kept open, as a browser's is
+        assert browser.getresponse().read() == b"[]"
+        process.send_signal(signal.SIGINT)
+        assert browser.sock is not None
+        with selectors.DefaultSelector() as selector:  # stopping: it closes the idle connection
+            selector.register(browser.sock, selectors.EVENT_READ)
+            assert selector.select(DEADLINE_S) and browser.sock.recv(1) == b"", "the first Ctrl-C did not stop it"
+        process.send_signal(signal.SIGINT)  # as it stops
+        _, err = process.communicate(timeout=DEADLINE_S)
+    finally:
+        process.kill()
+    text = err.decode()
+    assert process.returncode == 0, text
+    assert text.strip().splitlines() == [f"rig serve: stopped (dashboard on http://{address[1]}:{address[2]} closed)"]
+
+
+def test_a_signal_before_rig_serve_handles_it_says_the_server_stopped(monkeypatch, capsys) -> None:
+    """A Ctrl-C the command's own handling did not catch (arriving as it starts or ends) ends a dashboard too:
+    it stopped, exit 0, not "interrupted before the campaign started"."""
+    from accelcal_rig import cli
+
+    def interrupted(args: object) -> int:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "_cmd_serve", interrupted)
+    assert cli.main(["serve", "--campaigns", "."]) == 0
+    assert capsys.readouterr().err == "rig serve: stopped\n"

@@ -70,6 +70,9 @@ def campaign_output_options(command: argparse.ArgumentParser) -> None:
                                                             "(default: beside the campaign, .certificates)")
     certificate_options(command)
     registry_option(command)
+    command.add_argument("--no-publish", action="store_true",
+                         help="do not publish the campaign's live status to the registry (what rig serve --registry "
+                              "shows of every rig)")
 
 
 def certificate_options(command: argparse.ArgumentParser) -> None:

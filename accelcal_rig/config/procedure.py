@@ -16,6 +16,10 @@ from accelcal_rig.config.schedule import MAX_SCHEDULE_POSES, Schedule
 MAX_POLLS = 200_000
 #: Most poses a plan may hold (setpoints × schedule, or a cool-down's records).
 MAX_PLAN_POSES = 20_000
+#: The early check's default limits (docs/procedures.md, "The early check": healthy and faulty DUTs measured).
+EARLY_RESIDUAL_RATIO_LIMIT = 20.0
+EARLY_DIRECTION_LIMIT_DEG = 10.0
+EARLY_AXIS_GAIN_LIMIT = 0.5
 
 
 
@@ -160,6 +164,23 @@ class Frost(StrictModel):
     dew_point_timeout_min: Real = Field(60.0, gt=0, le=1440, description="longest wait for that margin")
 
 
+class EarlyCheck(StrictModel):
+    """After each soaked setpoint's calibration poses, every DUT against its own fit of them: a loose mount, a
+    DUT mounted in another orientation or a dead axis is an event at the first setpoint, not a failed fit after
+    the last (docs/procedures.md, "The early check"; the defaults are measured there)."""
+
+    action: Literal["warn", "drop", "none"] = Field("warn", description="warn: an event (log, rig status, "
+                                                   "notification); drop: that, and the DUT is left out of the fit "
+                                                   "(measured on); none: no check")
+    residual_ratio_limit: Real = Field(EARLY_RESIDUAL_RATIO_LIMIT, gt=1, le=1e6, description="a DUT whose own fit's "
+                                       "residuals exceed this many times its noise (√χ²_red) moved between poses")
+    direction_limit_deg: Real = Field(EARLY_DIRECTION_LIMIT_DEG, gt=0, le=180, description="a DUT whose measured "
+                                      "gravity directions are turned more than this from its mount's is mounted "
+                                      "otherwise than configured")
+    axis_gain_limit: Real = Field(EARLY_AXIS_GAIN_LIMIT, gt=0, lt=1, description="an axis responding less than "
+                                  "this (g per g of specific force across the poses) is dead")
+
+
 class Procedure(StrictModel):
     """A whole campaign. Setpoints run in the order given."""
 
@@ -185,6 +206,7 @@ class Procedure(StrictModel):
     frost: Frost = Field(Frost(), description="dry-air purge and the dew point requirement")
     rates: RateSteps | None = Field(None, description="a gyroscope's rate steps at every setpoint (a rate table)")
     noise: NoiseRecord | None = Field(None, description="a still record at every setpoint (Allan deviation)")
+    early_check: EarlyCheck = Field(EarlyCheck(), description="every DUT checked after each setpoint's poses")
 
     @model_validator(mode="after")
     def _gyroscope_steps_fit(self) -> Procedure:

@@ -269,6 +269,16 @@ class FaultInjection(StrictModel):
     sensor_wrong_id: str | None = Field(None, max_length=64, description="serial of a DUT whose part ID reads wrong")
     sensor_stuck: str | None = Field(None, max_length=64, description="serial of a DUT whose samples freeze")
     sensor_stuck_after_min: Real = Field(0.0, ge=0, le=_YEAR_MIN, description="when that DUT's samples freeze")
+    sensor_loose: str | None = Field(None, max_length=64, description="serial of a DUT loose on its mount: turned "
+                                     "a little, at random, at every pose")
+    sensor_loose_deg: Real = Field(3.0, ge=0, le=90, description="the RMS angle of that DUT's turn at each pose")
+    sensor_misoriented: str | None = Field(None, max_length=64, description="serial of a DUT mounted otherwise than "
+                                           "its mount_euler_deg says")
+    sensor_misoriented_about: Literal["x", "y", "z"] = Field("z", description="the DUT's axis it is turned about")
+    sensor_misoriented_deg: Real = Field(180.0, ge=-360, le=360, description="how far it is turned")
+    sensor_dead_axis: str | None = Field(None, max_length=64, description="serial of a DUT with a dead axis (it "
+                                         "reads its bias whatever the pose)")
+    sensor_dead_axis_name: Literal["x", "y", "z"] = Field("x", description="which of its axes is dead")
     sensor_temperature_tear_rate: Real = Field(
         0.0, ge=0, le=1, description="share of every DUT's TEMP2/TEMP1 reads that straddle an update of the high "
                                      "nibble (not double-buffered on a real ADXL355): off by 256 LSB, about 28 °C")
@@ -339,7 +349,7 @@ class RetryPolicy(StrictModel):
     max_backoff_s: Real = Field(8.0, ge=0, le=3600, description="longest wait between tries")
 
 
-NotifyEvent = Literal["start", "soak", "fault", "safe", "finish"]
+NotifyEvent = Literal["start", "soak", "fault", "safe", "finish", "early_check"]
 
 
 class NotifyConfig(StrictModel):
@@ -349,7 +359,7 @@ class NotifyConfig(StrictModel):
                                     description="http(s) URL to POST each event to")
     command: list[Annotated[str, Field(max_length=4096)]] = Field([], max_length=64,
                                                                   description="program and arguments to run for each event")
-    events: list[NotifyEvent] = Field(["start", "soak", "fault", "safe", "finish"],
+    events: list[NotifyEvent] = Field(["start", "soak", "fault", "safe", "finish", "early_check"],
                                       description="which events to send")
     timeout_s: Real = Field(10.0, gt=0, le=120, description="longest one delivery may take")
 

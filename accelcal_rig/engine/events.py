@@ -27,7 +27,9 @@ class EventLog:
                 self._writer.log_event(Event(t_s, level, kind, message))
             except Exception as exc:  # noqa: BLE001 - logging must never stop a campaign or its safe state
                 LOGGER.error("event not written to the campaign file (%s): %s", exc, message)
-        LOGGER.log(_LEVELS[level], "[%s] %s", format_duration(t_s), message)
+        # Marked as the campaign's event, for whoever follows the log for them (registry/publisher.py).
+        LOGGER.log(_LEVELS[level], "[%s] %s", format_duration(t_s), message,
+                   extra={"event_kind": kind, "clock_s": t_s, "event_message": message})
 
     def info(self, kind: str, message: str) -> None:
         self.emit("info", kind, message)

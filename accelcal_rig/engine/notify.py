@@ -1,4 +1,5 @@
-"""Notifications for unattended runs: a webhook and/or a local command on start, soak, fault, safe, finish.
+"""Notifications for unattended runs: a webhook and/or a local command on start, soak, fault, safe, finish and
+each finding of the early check (`early_check`: a DUT flagged after a setpoint's poses).
 
 Deliveries run on one background thread, each bounded by `timeout_s`, so a dead webhook or a hanging
 command never holds up the campaign; a failure is logged and the campaign goes on. When the run ends
@@ -32,7 +33,7 @@ class DeliveryFailed(Exception):
 
 @dataclass(frozen=True)
 class Notification:
-    event: str                     # start | soak | fault | safe | finish
+    event: str                     # start | soak | fault | safe | finish | early_check
     message: str
     campaign: str                  # the campaign file
     procedure: str

@@ -17,6 +17,7 @@ from accelcal_rig.engine.events import EventLog
 from accelcal_rig.engine.retry import Retrier
 from accelcal_rig.engine.states import StateMachine
 from accelcal_rig.errors import InstrumentError
+from accelcal_rig.fit.early_check import dropped
 from accelcal_rig.instruments.capabilities import alarm_active
 from accelcal_rig.instruments.interfaces import Chamber, RigInstruments, Sensor, TruthSource, Turntable
 from accelcal_rig.plan.compile import Plan
@@ -101,12 +102,16 @@ class RunContext:
     cooldown: CooldownState = field(default_factory=CooldownState)
     #: Whether this run last switched the dry-air purge on (None: it has not switched it).
     purge_on: bool | None = None
+    #: The DUTs the early check dropped (`early_check.action: drop`), by serial: measured on, not checked again,
+    #: left out of the fit. A resumed run reads them from the campaign's events.
+    dropped: set[str] = field(init=False)
     #: Fixture frame → each DUT's frame, by serial.
     fixture_to_dut: dict[str, np.ndarray] = field(init=False)
     kinematics: TurntableKinematics = field(init=False)
 
     def __post_init__(self) -> None:
         self.dut = DutThermalState(np.zeros(len(self.sensors)))
+        self.dropped = set(dropped(self.writer.campaign.events))
         self.fixture_to_dut = {s.serial: fixture_to_dut(s.mount_euler_deg) for s in self.rig.fixture.sensors}
         self.kinematics = TurntableKinematics(self.rig.turntable.axes)
 

@@ -190,9 +190,11 @@ def _fit_stage(procedure: Procedure, output: Path, calibration: Path) -> FitStag
     assert options is not None, "a procedure without a fit has no fit stage"
 
     def stage(campaign: Campaign) -> FitOutcome:
-        _, report = fit_and_save(campaign, output, calibration, options, run_end=True)
+        fitted, report = fit_and_save(campaign, output, calibration, options, run_end=True)
         return FitOutcome(summary_line(report, calibration),
                           {serial: (r["verdict"], tuple(r["verdict_reasons"])) for serial, r in report.items()},
-                          tuple(f"sensor {serial}: {w}" for serial, r in report.items() for w in r["warnings"]))
+                          tuple(f"sensor {serial}: {w}" for serial, r in report.items() for w in r["warnings"])
+                          + tuple(f"sensor {serial}: not fitted, no calibration or certificate: {why}"
+                                  for serial, why in fitted.dropped.items()))
 
     return stage

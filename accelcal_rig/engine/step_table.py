@@ -15,11 +15,13 @@ from accelcal_rig.engine.cooldown_steps import COOLDOWN_RECORD
 from accelcal_rig.engine.frost_steps import AWAIT_DEW_POINT_MARGIN, SET_PURGE
 from accelcal_rig.engine.pose_steps import MEASURE
 from accelcal_rig.engine.rate_steps import NOISE_BLOCK, RATE_STEP, STOP_ROTATION
+from accelcal_rig.engine.setpoint_check_steps import CHECK_SETPOINT
 from accelcal_rig.engine.step_handler import StepHandler
 from accelcal_rig.engine.thermal_steps import ADVANCE_RAMP, RAMP, RAMP_SEGMENT, SOAK, START_SOFTWARE_RAMP
 from accelcal_rig.plan.steps import (
     AdvanceRamp,
     AwaitDewPointMargin,
+    CheckSetpoint,
     CooldownRecord,
     MeasurePose,
     NoiseBlock,
@@ -63,5 +65,7 @@ def handler_for(step: Step) -> StepHandler[Any]:
             return SET_PURGE
         case AwaitDewPointMargin():
             return AWAIT_DEW_POINT_MARGIN
+        case CheckSetpoint():
+            return CHECK_SETPOINT
         case _:
             assert_never(step)

@@ -190,6 +190,9 @@ class CalibrationFile(StrictModel):
     software_version: str
     source: dict[str, str]
     duts: dict[str, DutCalibration] = Field(min_length=1, max_length=1024)
+    dropped: dict[str, Annotated[str, Field(max_length=1000)]] = Field(
+        {}, max_length=1024, description="the campaign's DUTs left out of the fit, each with why (the early check "
+                                         "dropped it: procedure early_check.action drop); written only when any")
 
     @model_validator(mode="before")
     @classmethod
@@ -290,6 +293,8 @@ def save_calibration(calibration: CalibrationFile, path: Path) -> None:
     clear_dead_temporaries(path)
     dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # libyaml: a 64-DUT calibration is 2 MB of YAML
     data = calibration.model_dump(mode="json")
+    if not data["dropped"]:
+        del data["dropped"]  # a file with every DUT fitted reads as it did before DUTs could be dropped
     text = yaml.dump(data, Dumper=dumper, sort_keys=False, width=120, allow_unicode=True)
     write_text_atomically(path, "# accelcal-rig calibration: Eq. 1 parameters as polynomials of the sensor "
                                 "temperature\n" + text, "the calibration")

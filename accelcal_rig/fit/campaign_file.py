@@ -16,7 +16,7 @@ from accelcal_rig.errors import ConfigError, RigError
 from accelcal_rig.fit.calibration import load_calibration
 from accelcal_rig.fit.campaign_fit import fit_and_save
 from accelcal_rig.fit.recorded_options import recorded_options
-from accelcal_rig.store.content import measurements_sha256
+from accelcal_rig.store.content import Campaign, measurements_sha256
 from accelcal_rig.store.lock import holder
 from accelcal_rig.store.read import load_campaign, usable_campaign
 
@@ -43,17 +43,20 @@ def fit_campaign_file(path: Path, output: Path, **overrides: Any) -> FitOutcome:
     if output.is_dir():
         raise ConfigError(f"{output}: is a folder; name the calibration file to write")
     try:
-        _, report = fit_and_save(campaign, path, output, options)
+        fitted, report = fit_and_save(campaign, path, output, options)
     except (ValueError, np.linalg.LinAlgError) as exc:
         raise RigError(f"{path}: fit failed: {str(exc).splitlines()[0]}") from None
+    warnings += [f"sensor {serial}: not fitted: {why}" for serial, why in fitted.dropped.items()]
     if campaign.state != "done":
         warnings.append(f"campaign state is {campaign.state}: fitted the poses stored so far")
     return FitOutcome(report, warnings)
 
 
-def calibration_verdicts(campaign_path: Path, calibration_path: Path | None = None) -> dict[str, Any]:
+def calibration_verdicts(campaign_path: Path, calibration_path: Path | None = None,
+                         campaign: Campaign | None = None) -> dict[str, Any]:
     """What `rig status` says of a campaign's calibration: the file (default beside the campaign), whether it
-    was fitted to the measurements the campaign holds now, and each DUT's verdict with its reasons."""
+    was fitted to the measurements the campaign holds now, and each DUT's verdict with its reasons.
+    `campaign`: the campaign read already (a reader that has it need not read it twice)."""
     path = calibration_path or campaign_path.with_suffix(".calibration.yaml")
     if not path.is_file():
         return {"calibration": None, "verdicts": None}
@@ -62,7 +65,7 @@ def calibration_verdicts(campaign_path: Path, calibration_path: Path | None = No
     except ConfigError as exc:
         return {"calibration": f"{path}: unreadable: {str(exc).splitlines()[0]}", "verdicts": None}
     fitted = calibration.source.get("measurements_sha256")
-    current = fitted == measurements_sha256(load_campaign(campaign_path))
+    current = fitted == measurements_sha256(campaign if campaign is not None else load_campaign(campaign_path))
     partial = calibration.source.get("partial")
     return {
         "calibration": f"{path}" + ("" if current else " (fitted to other measurements than the campaign's now: "

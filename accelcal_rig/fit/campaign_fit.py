@@ -36,6 +36,7 @@ from accelcal_rig.fit.calibration import (
 )
 from accelcal_rig.fit.calibration import FORMAT_NAME as CALIBRATION_FORMAT
 from accelcal_rig.fit.calibration import FORMAT_VERSION as CALIBRATION_VERSION
+from accelcal_rig.fit.early_check import dropped
 from accelcal_rig.fit.expected import expected_norm_rmse_mg, expected_reference_rmse_mg, thermal_jacobian
 from accelcal_rig.fit.fixture_pool import map_over_duts
 from accelcal_rig.fit.gyro_acceptance import judge_gyro
@@ -276,7 +277,11 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     """Fit every DUT of a stored campaign; the calibration file and the report `rig fit --json` prints
     (per serial). Nothing is written: the campaign's measurements are only read. `run_end`: the fit stage of
     the run itself, whose campaign is done but for the fit."""
-    stored = [read_dut_poses(campaign, s) for s in campaign.serials]  # each DUT's acceleration channel
+    left_out = dropped(campaign.events)
+    serials = [s for s in campaign.serials if s not in left_out]
+    if not serials:
+        raise ValueError(f"every DUT was dropped by the early check ({'; '.join(left_out.values())}): nothing to fit")
+    stored = [read_dut_poses(campaign, s) for s in serials]  # each DUT's acceleration channel
     if options.hysteresis == "on":
         stored = [with_approach(campaign, poses) for poses in stored]
     results = map_over_duts(bind(fit_dut, options=options), stored)
@@ -285,12 +290,12 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     judged = {r.serial: judge(r.metrics, r.thermal, options.mode, limits, partial, r.parameter_u) for r in results}
     noise = {serial: {channel: figures for channel in (ACCELERATION, ANGULAR_RATE)
                       if (figures := _noise_figures(campaign, serial, channel)) is not None}
-             for serial in campaign.serials}
+             for serial in serials}
     gyroscopes = {serial: fit_gyroscope(campaign, serial, options, noise[serial].get(ANGULAR_RATE))
-                  for serial in campaign.serials}
+                  for serial in serials}
     gyro_verdicts = {serial: judge_gyro(gyro.metrics, gyro.thermal, limits, partial, gyro.parameter_u)
                      for serial, gyro in gyroscopes.items() if isinstance(gyro, GyroFitResult)}
-    uncalibrated = {serial: not_calibrated(campaign, serial, gyroscopes[serial]) for serial in campaign.serials}
+    uncalibrated = {serial: not_calibrated(campaign, serial, gyroscopes[serial]) for serial in serials}
     duts = {}
     for r in results:
         accel = r.calibration.model_copy(update={
@@ -308,6 +313,7 @@ def fit_campaign(campaign: Campaign, options: FitOptions,
     calibration = CalibrationFile(
         format=CALIBRATION_FORMAT, format_version=CALIBRATION_VERSION, created=utc_now(),
         software_version=__version__, source={**source, **({"partial": partial} if partial else {})}, duts=duts,
+        dropped=left_out,
     )
     overall = {serial: dut_verdict(judged[serial], gyro_verdicts.get(serial)) for serial in judged}
     report = {r.serial: {**plain(r.metrics), "warnings": r.thermal.warnings, "verdict": overall[r.serial].verdict,

@@ -22,6 +22,7 @@ from accelcal_rig.plan.gyro_steps import noise_blocks, rate_poses, rate_steps
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.plan.steps import (
     AdvanceRamp,
+    CheckSetpoint,
     CooldownRecord,
     Measurement,
     MeasurePose,
@@ -186,6 +187,8 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
             body: tuple[Step, ...] = tuple(step for m in measure for step in (AdvanceRamp(setpoint), m))
         else:
             body = (*measure, *_gyroscope(procedure, rig, setpoint, spun, poses, calibrate=True, verify=verified))
+        if at_rest and procedure.early_check.action != "none":
+            body = _checked_after_poses(body, setpoint)
         stages.append(Stage(setpoint, entry, body, restart))
         if verify is not None and index + 1 < len(setpoints):
             passed = _passed_between(setpoint, setpoints[index + 1], verify.setpoints_c, stages)
@@ -195,6 +198,14 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
                           for v in passed)
     stages = with_frost_steps(stages, procedure.frost)
     return Plan(tuple(s.setpoint_c for s in stages), poses, tuple(stages), names, checks)
+
+
+def _checked_after_poses(body: tuple[Step, ...], setpoint_c: float) -> tuple[Step, ...]:
+    """The body with the early check right after its last calibration pose (before the verification poses and
+    a gyroscope's steps: a DUT it drops is known before them). Only where the DUTs were soaked: poses taken
+    on a ramp drift with their temperature, which no fit of one setpoint follows."""
+    last = max(i for i, step in enumerate(body) if isinstance(step, MeasurePose))
+    return (*body[:last + 1], CheckSetpoint(setpoint_c), *body[last + 1:])
 
 
 def _gyroscope(procedure: Procedure, rig: RigConfig, setpoint_c: float, spun: dict[str, Pose],

@@ -76,6 +76,15 @@ class AdvanceRamp:
 
 
 @dataclass(frozen=True)
+class CheckSetpoint:
+    """After a setpoint's calibration poses: every DUT against its own fit of them (the early check), while
+    the campaign can still act on what it finds. Stores no record: a plan's fingerprint is the same with it
+    or without it."""
+
+    setpoint_c: float
+
+
+@dataclass(frozen=True)
 class Measurement:
     """A block of samples from every DUT at `pose`, stored under `key`."""
 
@@ -158,7 +167,7 @@ class NoiseBlock(Measurement):
 
 
 Step = (Ramp | Soak | SetPurge | AwaitDewPointMargin | StartSoftwareRamp | RampSegment | AdvanceRamp | MeasurePose
-        | VerifyPose | CooldownRecord | RateStep | VerifyRate | StopRotation | NoiseBlock)
+        | VerifyPose | CooldownRecord | RateStep | VerifyRate | StopRotation | NoiseBlock | CheckSetpoint)
 #: The steps that store a record in the campaign (what its stored plan lists).
 Record = Soak | Measurement
 

@@ -52,6 +52,8 @@ calibrations = sa.Table(
     sa.Column("bias_instability_dph", sa.JSON, nullable=True),              # [x, y, z]
     sa.Column("vrw_m_s_per_rthr", sa.JSON, nullable=True),                  # [x, y, z]
     sa.Column("bias_instability_ug", sa.JSON, nullable=True),               # [x, y, z]
+    # Added by migration 0007: the lab's lot of the DUT (its own word for it, not the part number).
+    sa.Column("lot", sa.String(64), nullable=True),
     sa.Index("calibrations_serial_channel", "serial", "channel"),
     sa.UniqueConstraint("source_sha256", "serial", "fit_sha256", name="one_calibration_per_fit"),
 )
@@ -97,6 +99,58 @@ certificate_revisions = sa.Table(
     sa.Column("pdf", sa.LargeBinary, nullable=True),
     sa.Column("sha256", sa.String(64), nullable=False),
     sa.UniqueConstraint("calibration_id", "revision", name="one_certificate_per_revision"),
+)
+
+# Added by migration 0007: what running campaigns publish while they run (registry/live.py): one row per
+# campaign file on its host with its latest snapshot, its events, and its temperatures thinned in time.
+live_campaigns = sa.Table(
+    "live_campaigns", metadata,
+    sa.Column("key", sa.String(64), primary_key=True),             # the campaign file on its host (live.campaign_key)
+    sa.Column("rig", sa.String(128), nullable=False),
+    sa.Column("host", sa.String(255), nullable=False),
+    sa.Column("campaign", sa.String(4096), nullable=False),        # the file's path on its host
+    sa.Column("procedure", sa.String(128), nullable=False),
+    sa.Column("dry_run", sa.Boolean, nullable=False),
+    sa.Column("pid", sa.Integer, nullable=False),
+    sa.Column("state", sa.String(16), nullable=False),             # running | done | aborted | stopped
+    sa.Column("phase", sa.String(32), nullable=False),
+    sa.Column("setpoint_c", sa.Float, nullable=True),
+    sa.Column("setpoint_number", sa.Integer, nullable=False),
+    sa.Column("setpoints_total", sa.Integer, nullable=False),
+    sa.Column("poses_done", sa.Integer, nullable=False),
+    sa.Column("poses_total", sa.Integer, nullable=False),
+    sa.Column("chamber_c", sa.Float, nullable=True),
+    sa.Column("dut_c", sa.JSON, nullable=False),                   # [each DUT's last reading]
+    sa.Column("remaining_s", sa.Float, nullable=True),
+    sa.Column("clock_s", sa.Float, nullable=False),
+    sa.Column("line", sa.Text, nullable=False),                    # the progress line rig status prints
+    sa.Column("warnings", sa.Integer, nullable=False),
+    sa.Column("errors", sa.Integer, nullable=False),
+    sa.Column("verdicts", sa.JSON, nullable=False),                # {serial: {verdict, reasons}} once judged
+    sa.Column("findings", sa.JSON, nullable=False),                # [early findings on DUTs]
+    sa.Column("abort_reason", sa.Text, nullable=False),
+    sa.Column("started_at", sa.DateTime, nullable=False),          # UTC, the campaign's
+    sa.Column("updated_at", sa.DateTime, nullable=False, index=True),  # UTC, the database's clock
+)
+
+live_events = sa.Table(
+    "live_events", metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("key", sa.String(64), nullable=False, index=True),
+    sa.Column("clock_s", sa.Float, nullable=False),                # campaign clock
+    sa.Column("at", sa.DateTime, nullable=False),                  # UTC, the publisher's
+    sa.Column("level", sa.String(16), nullable=False),
+    sa.Column("kind", sa.String(32), nullable=False),
+    sa.Column("message", sa.Text, nullable=False),
+)
+
+live_temperatures = sa.Table(
+    "live_temperatures", metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("key", sa.String(64), nullable=False, index=True),
+    sa.Column("clock_s", sa.Float, nullable=False),
+    sa.Column("chamber_c", sa.Float, nullable=True),
+    sa.Column("dut_c", sa.Float, nullable=True),                   # the DUTs' mean
 )
 
 

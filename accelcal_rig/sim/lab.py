@@ -24,6 +24,7 @@ from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.sim.bias_wander import BiasWander
 from accelcal_rig.sim.moisture import ChamberMoisture
+from accelcal_rig.sim.mount_faults import MountFaults
 from accelcal_rig.sim.truth import DutTruth, fixture_parameters_at, gyro_truth_for_serial, truth_for_serial
 from accelcal_rig.sim.turntable_motion import TurntableMotion
 
@@ -128,6 +129,8 @@ class VirtualLab:
             else np.zeros((0, 12, 4))
         self._fixture_to_duts = np.stack([d.fixture_to_dut for d in self.duts]) if self.duts else np.zeros((0, 3, 3))
         self._instant_cache: _Instant | None = None
+        #: A DUT mounted otherwise than configured, a loose one, a dead axis (`simulation.faults`).
+        self.mount_faults = MountFaults(sim.faults, serials, seed)
         #: The simulated site's true gravity in standard g: the rig config's value, off by a draw of its stated
         #: uncertainty (its own stream, so a stated uncertainty of zero changes no other draw).
         draw = np.random.default_rng([seed, 1_000_003]).normal() if rig.gravity_uncertainty_m_s2 > 0 else 0.0
@@ -183,7 +186,8 @@ class VirtualLab:
         temperature, params, gravity = float(instant.temperature_c[index]), instant.parameters[index].copy(), \
             instant.gravity_g[index].copy()
         noise = self.dut_rngs[index].normal(0.0, self.noise_g(index, odr_hz), (n_samples, 3))
-        raw_g = instant.reading_g[index] + self.unmodelled_g(index, gravity) + noise
+        reading_g = self.mount_faults.reading_g(index, instant.reading_g[index], params[0:3])
+        raw_g = reading_g + self.unmodelled_g(index, gravity) + noise
         dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, params, gravity, temperature))
         return dut.part.channel("accel").quantise(raw_g, range_g)
 
@@ -224,6 +228,8 @@ class VirtualLab:
             temperature_c = self.thermal.duts_c(now)
             parameters = fixture_parameters_at(self._truth_coefficients, temperature_c)
             gravity_g = self.site_gravity_g * (self._fixture_to_duts @ self._gravity_in_fixture(now))
+            if self.mount_faults.any_turned:
+                gravity_g = np.einsum("nij,nj->ni", self.mount_faults.turns(self.motion.position_deg(now)), gravity_g)
             self._instant_cache = _Instant(now, temperature_c, parameters, gravity_g, distort(gravity_g, parameters))
         return self._instant_cache
 

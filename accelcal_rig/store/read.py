@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import socket
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -204,7 +205,7 @@ def campaign_status(path: Path, campaign: Campaign | None = None) -> dict[str, A
         "last_event": campaign.events[-1].message if campaign.events else "",
         "integrity": "; ".join(campaign.integrity_problems()) or "ok",
         "campaign_file": file_currency(path, campaign, alive),
-        "progress": read_progress(path) if alive else None,
+        "progress": with_stored_count(read_progress(path), len(campaign.poses)) if alive else None,
     }
 
 
@@ -215,6 +216,26 @@ def read_progress(path: Path) -> dict[str, Any] | None:
     except (OSError, ValueError):
         return None
     return snapshot if isinstance(snapshot, dict) else None
+
+
+#: The pose count among a progress line's parts (engine/progress.py Progress.line joins them with " · ").
+_POSE_COUNT = re.compile(r"pose \d+/\d+")
+_PARTS = " · "
+
+
+def with_stored_count(snapshot: dict[str, Any] | None, poses_stored: int) -> dict[str, Any] | None:
+    """The snapshot counting the poses the campaign stores: it is written at most every half second (a dry
+    run stores many poses between two) and may be older than the journal, whose poses are the truth."""
+    if snapshot is None:
+        return None
+    parts = [f"pose {poses_stored}/{snapshot.get('poses_total', '?')}" if _POSE_COUNT.fullmatch(part) else part
+             for part in str(snapshot.get("line", "")).split(_PARTS)]
+    return {**snapshot, "poses_done": poses_stored, "line": _PARTS.join(parts)}
+
+
+def without_pose_count(line: str) -> str:
+    """A progress line without its pose count, for a view that shows the stored count beside it."""
+    return _PARTS.join(part for part in line.split(_PARTS) if not _POSE_COUNT.fullmatch(part))
 
 
 def usable_campaign(path: Path) -> Campaign:

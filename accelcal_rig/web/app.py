@@ -32,6 +32,8 @@ from accelcal_rig.registry.location import described
 from accelcal_rig.web.approval import BEARER_SCOPE_KEY, ApprovalSettings, approval_routes
 from accelcal_rig.web.campaigns import CampaignFolders
 from accelcal_rig.web.errors import CheckedInput, ErrorPages, Unforeseen, exception_handlers
+from accelcal_rig.web.interruptions import resume_markers
+from accelcal_rig.web.lab import LabRigs
 from accelcal_rig.web.svg import line_plot
 
 _STATIC = Path(__file__).parent / "static"
@@ -89,7 +91,25 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
         return HTMLResponse(templates.get_template(name).render(registry=registry.label, **values), status_code=status)
 
     def front(request: Request) -> Response:
-        return page("front.html", campaigns=campaigns.summaries(), folders=campaigns.folders)
+        return page("front.html", campaigns=campaigns.summaries(), folders=campaigns.folders,
+                    show_rigs=registry.url is not None, **lab.overview())
+
+    def rigs_fragment(request: Request) -> Response:
+        return HTMLResponse(templates.get_template("_rigs.html").render(registry=registry.label, **lab.overview()))
+
+    def rigs_json(request: Request) -> Response:
+        found = lab.overview()
+        if found["rigs_error"]:
+            raise HTTPException(503, found["rigs_error"])
+        return JSONResponse(_jsonable(found["lab"]))
+
+    def live_page(request: Request) -> Response:
+        found = lab.campaign(request.path_params["key"])
+        return page("live.html", **found)
+
+    def live_json(request: Request) -> Response:
+        found = lab.campaign(request.path_params["key"])
+        return JSONResponse(_jsonable({**found["c"], "events": found["events"], "warning_groups": found["groups"]}))
 
     def campaigns_json(request: Request) -> Response:
         return JSONResponse(campaigns.summaries())
@@ -103,22 +123,25 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
         path = campaigns.path(name)
         plot = line_plot(series.get("t_h", []), {"chamber air": series.get("chamber_c", []),
                                                   "DUTs (mean)": series.get("dut_c", [])},
-                         "campaign time (h)", "temperature (°C)")
+                         "campaign time (h)", "temperature (°C)", markers=resume_markers(campaigns.interruptions(name)),
+                         marker_key="resumed (run N)", gap_key="rig down")
         return page("campaign.html", c=summary, plot=plot, certificates=_certificates(path),
                     report=_report(path))
 
     def campaign_json(request: Request) -> Response:
+        name = request.path_params["name"]
         try:
-            return JSONResponse(campaigns.summary(request.path_params["name"]))
+            return JSONResponse(campaigns.summary(name))
         except KeyError:
-            raise HTTPException(404, "no such campaign") from None
+            raise HTTPException(404, f"no campaign {name} in the watched folders") from None
 
     def campaign_file(request: Request) -> Response:
         """A certificate or a report file beside a watched campaign; nothing outside its folders."""
+        name = request.path_params["name"]
         try:
-            path = campaigns.path(request.path_params["name"])
+            path = campaigns.path(name)
         except KeyError:
-            raise HTTPException(404, "no such campaign") from None
+            raise HTTPException(404, f"no campaign {name} in the watched folders") from None
         kind, relative = request.path_params["kind"], request.path_params["file"]
         base = {"certificates": path.with_suffix(".certificates"), "report": _report(path)}.get(kind)
         wanted = _inside(base, relative) if base is not None else None
@@ -175,6 +198,7 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
         rows = registry.get().calibrations(serial=request.path_params["serial"])
         return JSONResponse(_jsonable(trend(rows)) if rows else {"calibrations": []})
 
+    lab = LabRigs(registry.get)
     pages = ErrorPages(templates, registry.label)
     # Outermost the unforeseen error's page; then who may ask (their refusals say nothing of the dashboard,
     # not even which registry: plain text); then the address checked before any route reads it.
@@ -186,15 +210,19 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
     # another site (SameSite=Strict), unreadable by scripts (HttpOnly), HTTPS-only when served over TLS.
     middleware.append(Middleware(SessionMiddleware, secret_key=secrets.token_urlsafe(32), session_cookie="accelcal_session",
                                  same_site="strict", https_only=tls, max_age=8 * 3600))
-    return Starlette(routes=[
+    app = Starlette(routes=[
         *approval_routes(registry, page, ApprovalSettings(user_header)),
         Route("/", front), Route("/api/campaigns", campaigns_json),
+        Route("/fragments/rigs", rigs_fragment), Route("/api/rigs", rigs_json), Route("/api/live/stream", lab.stream),
+        Route("/live/{key}", live_page), Route("/api/live/{key}", live_json),
         Route("/campaigns/{name}", campaign), Route("/api/campaigns/{name}", campaign_json),
         Route("/campaigns/{name}/{kind}/{file:path}", campaign_file),
         Route("/registry", registry_search), Route("/registry/serials/{serial:path}", serial_page),
         Route("/registry/parts/{part}", part_page), Route("/api/registry/serials/{serial:path}", serial_json),
         Mount("/static", StaticFiles(directory=_STATIC), name="static"),
     ], middleware=middleware, exception_handlers=exception_handlers(pages, registry.forget))
+    app.state.stop_streams = lab.stop_streams  # rig serve ends the event streams as it stops
+    return app
 
 
 class _LazyRegistry:

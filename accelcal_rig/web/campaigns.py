@@ -1,5 +1,5 @@
 """The campaigns in the watched folders, read as `rig status` reads them (the journal, never the writer's
-lock), each read again only when its files change."""
+lock), each read again only when its files change: the campaign's, its progress snapshot, its calibration."""
 
 from __future__ import annotations
 
@@ -11,12 +11,20 @@ from typing import Any
 import numpy as np
 
 from accelcal_rig.core.formatting import format_duration
+from accelcal_rig.errors import RigError
+from accelcal_rig.fit.campaign_file import calibration_verdicts
 from accelcal_rig.report.warning_groups import warning_groups
+from accelcal_rig.store.follow_up_record import recorded_calibration
 from accelcal_rig.store.lock import holder
 from accelcal_rig.store.paths import journal_path, progress_path
-from accelcal_rig.store.read import campaign_status, load_campaign
+from accelcal_rig.store.read import campaign_status, load_campaign, without_pose_count
+from accelcal_rig.web.interruptions import Interruption, interruptions
 
 _JOURNAL_SUFFIX = ".journal"
+
+
+#: A DUT without a verdict stored (its procedure states no acceptance limits), as every page names it.
+NOT_JUDGED = "NOT JUDGED"
 
 
 @dataclass
@@ -24,6 +32,9 @@ class _Cached:
     stamp: tuple[tuple[int, int], ...]
     summary: dict[str, Any]
     series: dict[str, list[float]]
+    #: Where the campaign's calibration is (its follow-up says; beside it until read): its changes are watched.
+    calibration: Path
+    stops: list[Interruption]
 
 
 class CampaignFolders:
@@ -53,6 +64,9 @@ class CampaignFolders:
     def series(self, name: str) -> dict[str, list[float]]:
         return self._read(self.path(name), name).series
 
+    def interruptions(self, name: str) -> list[Interruption]:
+        return self._read(self.path(name), name).stops
+
     def path(self, name: str) -> Path:
         paths = self.paths()
         if name not in paths:
@@ -60,28 +74,53 @@ class CampaignFolders:
         return paths[name]
 
     def _read(self, path: Path, name: str) -> _Cached:
-        stamp = tuple(_stamp(p) for p in (path, journal_path(path), progress_path(path)))
         with self._lock:
             cached = self._cache.get(path)
-        if cached is not None and cached.stamp == stamp and not _writer_gone(path, cached.summary):
+        calibration = cached.calibration if cached is not None else path.with_suffix(".calibration.yaml")
+        files = tuple(_stamp(p) for p in (path, journal_path(path), progress_path(path)))
+        if cached is not None and cached.stamp == (*files, _stamp(calibration)) \
+                and not _writer_gone(path, cached.summary):
             return cached
+        stops: list[Interruption] = []
+        calibration_stamp = _stamp(calibration)
         try:
             campaign = load_campaign(path)
             status = campaign_status(path, campaign)
             warnings = [e.message for e in campaign.events if e.level in ("warning", "error")]
             groups = [{**g.as_dict(), "first": format_duration(g.first_s), "last": format_duration(g.last_s)}
                       for g in warning_groups(campaign.events)]
-            summary = {**status, "name": name, "warnings": warnings[-20:], "warning_groups": groups, "error": None}
+            stops = interruptions(campaign)
+            summary = {**status, "name": name, "warnings": warnings[-20:], "warning_groups": groups, "error": None,
+                       "interruptions": [stop.as_dict() for stop in stops]}
             if summary.get("progress"):
                 remaining = summary["progress"].get("remaining_s")
                 summary["progress"]["left"] = format_duration(remaining) if remaining is not None else None
+                summary["progress"]["now"] = without_pose_count(str(summary["progress"].get("line", "")))
             series = _temperatures(campaign)
+            calibration = recorded_calibration(campaign.attrs, path)
+            calibration_stamp = _stamp(calibration)  # before it is read: one written meanwhile is read next time
+            summary.update(_verdicts(path, calibration, campaign))
         except Exception as exc:  # noqa: BLE001 - a damaged file is shown as such, the others still are
-            summary, series = {"name": name, "file": str(path), "state": "unreadable", "error": str(exc)}, {}
-        cached = _Cached(stamp, summary, series)
+            summary = {"name": name, "file": str(path), "state": "unreadable", "error": str(exc), "verdicts": {},
+                       "interruptions": []}
+            series, stops = {}, []
+        cached = _Cached((*files, calibration_stamp), summary, series, calibration, stops)
         with self._lock:
             self._cache[path] = cached
         return cached
+
+
+def _verdicts(path: Path, calibration: Path, campaign: Any) -> dict[str, Any]:
+    """Each DUT's verdict and reasons from the campaign's calibration (`verdicts` empty until there is one, or
+    when it cannot be read: `calibration` says why), and whether it was fitted to the measurements stored now."""
+    try:
+        found = calibration_verdicts(path, calibration, campaign)
+    except (RigError, OSError, ValueError, KeyError, TypeError) as exc:  # the campaign is still shown
+        return {"calibration": f"{calibration}: cannot be judged: {(str(exc).splitlines() or [type(exc).__name__])[0]}",
+                "verdicts": {}}
+    return {"calibration": found["calibration"],
+            "verdicts": {serial: {"verdict": judged["verdict"] or NOT_JUDGED, "reasons": list(judged["reasons"])}
+                         for serial, judged in (found["verdicts"] or {}).items()}}
 
 
 def _writer_gone(path: Path, summary: dict[str, Any]) -> bool:

@@ -6,6 +6,7 @@ from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.plan.steps import (
     AdvanceRamp,
+    CheckSetpoint,
     CooldownRecord,
     MeasurePose,
     Ramp,
@@ -24,7 +25,7 @@ def test_paper_plan_ramps_soaks_measures_and_verifies_at_each_setpoint_and_betwe
     for stage in plan.stages:
         assert stage.entry == stage.restart_entry == (Ramp(stage.setpoint_c), Soak(f"T{stage.setpoint_c:g}/soak",
                                                                                     stage.setpoint_c))
-        poses = [MeasurePose] * 24 if stage.setpoint_c in calibration else []
+        poses = [MeasurePose] * 24 + [CheckSetpoint] if stage.setpoint_c in calibration else []
         assert [type(s) for s in stage.body] == poses + [VerifyPose] * 12
     assert len(plan.pose_steps) == 11 * 36 + 3 * 12
     keys = [s.key for s in plan.records]

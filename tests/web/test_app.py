@@ -129,7 +129,7 @@ def test_a_campaign_whose_writer_has_ended_is_not_shown_as_live_from_the_cache(l
     monkeypatch.setattr(module, "campaign_status", status)
     monkeypatch.setattr(module, "holder", lambda path: "pid 4242" if holding["now"] else None)
     folders = module.CampaignFolders([folder])
-    assert folders.summary("quick.h5")["progress"] == {"line": "T30 soak", "left": None}
+    assert folders.summary("quick.h5")["progress"] == {"line": "T30 soak", "left": None, "now": "T30 soak"}
     holding["now"] = False  # killed: no file changed
     summary = folders.summary("quick.h5")
     assert summary["progress"] is None and summary["writer"].startswith("gone")

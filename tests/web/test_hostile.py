@@ -11,6 +11,7 @@ import hashlib
 import logging
 import re
 import shutil
+import socket
 import sqlite3
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,6 +24,7 @@ from starlette.testclient import TestClient
 
 from accelcal_rig.registry.approvals import Approvals, IssuedCertificate
 from accelcal_rig.registry.database import Registry
+from accelcal_rig.registry.live import campaign_key
 from accelcal_rig.registry.location import normalised
 from accelcal_rig.web.app import create_app
 
@@ -86,7 +88,8 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Lab:
     book.record(row_id, "approve", approver, "test", certificate=IssuedCertificate(1, "N-1", "<p>1</p>", None))
     book.registry.engine.dispose()
     values = {"name": "quick.h5", "kind": "certificates", "file": "ADX355-A001.html", "serial": "ADX355-A001",
-              "part": "adxl355", "id": str(row_id), "revision": "1", "path": "dashboard.css"}
+              "part": "adxl355", "id": str(row_id), "revision": "1", "path": "dashboard.css",
+              "key": campaign_key(socket.gethostname(), str((folder / "quick.h5").resolve()))}  # the run published it
     return Lab(folder, good, row_id, values)
 
 
