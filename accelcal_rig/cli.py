@@ -100,7 +100,12 @@ def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace,
             except NothingToResume as done:
                 print(done)
                 return _complete_campaign_verdicts(done, output, follow_up, args)
-        return _after_campaign(prepared, result, output, follow_up, args, dry_run)
+        code = _after_campaign(prepared, result, output, follow_up, args, dry_run)
+        if publisher is not None:  # the run's own account: its file need not be read again
+            summary = result.summary
+            publisher.finish(summary.state, summary.poses_done, {
+                serial: {"verdict": verdict, "reasons": list(reasons)} for serial, (verdict, reasons) in summary.verdicts.items()})
+        return code
 
 
 def _after_campaign(prepared: PreparedCampaign, result: RunResult, output: Path, follow_up: FollowUp,

@@ -303,7 +303,7 @@ def live_publishing(prepared: PreparedCampaign, output: Path, follow_up: FollowU
         yield publisher
     finally:
         LOGGER.removeHandler(handler)
-        if publisher.started:
+        if publisher.started and not publisher.finished:  # a run that ended without its summary: read the file
             publisher.finish(**_last_word(output, follow_up))
         problem = publisher.close()
         if problem is not None:

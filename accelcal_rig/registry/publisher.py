@@ -68,6 +68,7 @@ class LivePublisher:
         self._row: dict[str, Any] = _first_row(identity)
         self._changed = False
         self._started = False      # nothing is published before the campaign's first progress
+        self.finished = False      # the campaign's last word was given
         self._events: deque[LiveEvent] = deque(maxlen=EVENTS_WAITING)
         self._temperatures: list[tuple[float, float | None, float | None]] = []
         self._last_point_s = float("-inf")
@@ -118,6 +119,7 @@ class LivePublisher:
         with self._lock:
             if not self._started:
                 return
+            self.finished = True
             self._row.update(state=state[:16], remaining_s=None, abort_reason=abort_reason,
                              phase="done" if state == "done" else state[:32])
             if poses_done is not None:
