@@ -59,10 +59,11 @@ def _receipt(args: argparse.Namespace) -> Receipt:
         received = iso_date(args.received) if args.received else None
     except ValueError as exc:
         raise ConfigError(f"--received: {exc}") from None
-    for option, text, longest in (("--customer", args.customer, 200), ("--condition", args.condition, 500)):
+    for option, text, longest in (("--customer", args.customer, 200), ("--condition", args.condition, 500),
+                                  ("--lot", args.lot, 64)):
         if len(text) > longest or any(ord(c) < 32 or ord(c) == 127 for c in text):
             raise ConfigError(f"{option}: not one line of at most {longest} characters")
-    return Receipt(args.customer, received, args.condition)
+    return Receipt(args.customer, received, args.condition, args.lot)
 
 
 def prepare_resume(args: argparse.Namespace) -> tuple[PreparedCampaign, bool, int]:

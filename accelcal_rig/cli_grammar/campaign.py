@@ -46,6 +46,9 @@ def _add_run(commands: Commands) -> None:
                      help="when the DUTs were received, for every DUT whose fixture entry has no received_date")
     run.add_argument("--condition", metavar="TEXT", default="",
                      help="the DUTs' condition on receipt, for every DUT whose fixture entry states none")
+    run.add_argument("--lot", metavar="LOT", default="",
+                     help="the lab's lot of the DUTs (its own word: a production or incoming lot, not the part "
+                          "number), for every DUT whose fixture entry names none (recorded in the registry)")
     campaign_output_options(run)
 
 

@@ -101,3 +101,4 @@ class Receipt:
     customer: str = ""
     received_date: dt.date | None = None
     condition: str = ""
+    lot: str = ""                     # the lab's lot (`rig run --lot`), not the part number

@@ -211,6 +211,8 @@ class SensorConfig(StrictModel):
                           "it); empty: rig run --customer's, else not stated")
     received_date: IsoDate | None = Field(None, description="when the laboratory received the item (YYYY-MM-DD); "
                                           "unset: rig run --received's, else not stated")
+    lot: str = Field("", max_length=64, pattern=ONE_LINE, description="the lab's lot this DUT belongs to (its own word "
+                     "for it: a production or incoming lot, not the part number); empty: rig run --lot's, else none")
     condition: str = Field("", max_length=500, pattern=ONE_LINE, description="the item's condition on receipt (e.g. "
                            "'no visible damage'); empty: rig run --condition's, else not stated")
 

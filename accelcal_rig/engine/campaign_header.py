@@ -52,7 +52,7 @@ def receipt_info(sensor: SensorConfig, default: Receipt) -> dict[str, str]:
     (`rig run --customer` …); "" for what neither states."""
     received = sensor.received_date or default.received_date
     return {"customer": sensor.customer or default.customer, "received_date": received.isoformat() if received else "",
-            "condition": sensor.condition or default.condition}
+            "condition": sensor.condition or default.condition, "lot": sensor.lot or default.lot}
 
 
 def create_campaign_file(prepared: PreparedCampaign, output: Path, connected: ConnectedRig, *,

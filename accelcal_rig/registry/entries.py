@@ -54,11 +54,12 @@ def campaign_entries(campaign_path: Path, calibration_path: Path | None = None) 
         raise ConfigError(f"{calibration_path}: fitted to other measurements than {campaign_path} holds (its "
                           f"measurements_sha256 differs): fit this campaign (rig fit {campaign_path} -o CAL)")
     parts = {str(d["serial"]): str(d.get("part", "unknown")) for d in campaign.header.duts}
+    lots = {str(d["serial"]): str(d.get("lot") or "") or None for d in campaign.header.duts}  # absent before 0007
     source = {"kind": "campaign", "path": str(campaign_path.resolve()), "sha256": file_sha256(campaign_path),
               "procedure": str(campaign.attrs.get("procedure_name", "")), "rig": str(campaign.attrs.get("rig_name", "")),
               "simulated": bool(campaign.attrs.get("dry_run", False)),
               "measured": campaign.finished or campaign.header.created}
-    return [_entry(calibration, channel, sensor, parts.get(serial, "unknown"), source)
+    return [{**_entry(calibration, channel, sensor, parts.get(serial, "unknown"), source), "lot": lots.get(serial)}
             for serial, dut in calibration.duts.items() for channel, sensor in dut.channels.items()]
 
 
@@ -68,7 +69,8 @@ def recording_entries(recording_path: Path, calibration: CalibrationFile, part: 
     measured = datetime.fromtimestamp(recording_path.stat().st_mtime, UTC).isoformat()  # when it was recorded
     source = {"kind": "recording", "path": str(recording_path.resolve()), "sha256": file_sha256(recording_path),
               "procedure": "hand-held", "rig": "hand-held", "simulated": simulated, "measured": measured}
-    return [_entry(calibration, ACCELERATION, sensor, part, source) for sensor in calibration.sensors.values()]
+    return [{**_entry(calibration, ACCELERATION, sensor, part, source), "lot": None}
+            for sensor in calibration.sensors.values()]
 
 
 def _entry(calibration: CalibrationFile, channel: str, sensor: SensorCalibration | GyroCalibration, part: str,
