@@ -304,9 +304,12 @@ def live_publishing(prepared: PreparedCampaign, output: Path, follow_up: FollowU
         yield publisher
     finally:
         LOGGER.removeHandler(handler)
-        if publisher.started and not publisher.finished:  # a run that ended without its summary: read the file
-            publisher.finish(**_last_word(output, follow_up))
-        problem = publisher.close()
+        try:
+            if publisher.started and not publisher.finished:  # a run that ended without its summary: read the file
+                publisher.finish(**_last_word(output, follow_up))
+            problem = publisher.close()
+        except (KeyboardInterrupt, TerminationRequested):  # the campaign has ended: only its view is cut short
+            problem = "live status: interrupted before the campaign's last state was published (its campaign file has it)"
         if problem is not None:
             print(f"rig: warning: {problem}", file=sys.stderr)
 

@@ -46,3 +46,34 @@ def test_a_registry_that_cannot_be_reached_is_a_warning_not_a_failure(tmp_path: 
     assert len(lines) == 2, run.stderr  # the first failure, and the last word that did not get there
     assert "the campaign goes on, retrying" in lines[0] and "127.0.0.1" in lines[0]
     assert lines[1].startswith("rig: warning: live status: the campaign's last state did not reach")
+
+
+def test_an_interrupt_while_the_last_word_is_published_is_one_line(tmp_path: Path, monkeypatch, capsys) -> None:
+    """Ctrl-C after the campaign ended, while its live status is closing (a slow database): one warning line,
+    and the command's own outcome stands (nothing raised out of it)."""
+    from types import SimpleNamespace
+
+    from accelcal_rig import cli_campaign
+    from accelcal_rig.registry import publisher
+
+    class Interrupted:
+        def __init__(self, *args: object) -> None:
+            self.started, self.finished = True, True
+
+        def handler(self):
+            import logging
+
+            return logging.NullHandler()
+
+        def close(self) -> str | None:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(publisher, "LivePublisher", Interrupted)
+    prepared = SimpleNamespace(rig=SimpleNamespace(model=SimpleNamespace(registry=None, name="rig-a"), path=tmp_path / "r.yaml"),
+                               procedure=SimpleNamespace(model=SimpleNamespace(name="p")))
+    follow_up = SimpleNamespace(registry=str(tmp_path / "lab.sqlite"))
+    with cli_campaign.live_publishing(prepared, tmp_path / "c.h5", follow_up, dry_run=True, fresh=True,  # type: ignore[arg-type]
+                                      enabled=True) as live:
+        assert isinstance(live, Interrupted)
+    assert capsys.readouterr().err.strip() == ("rig: warning: live status: interrupted before the campaign's last state "
+                                               "was published (its campaign file has it)")
