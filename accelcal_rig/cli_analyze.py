@@ -14,7 +14,7 @@ if TYPE_CHECKING:
     from accelcal_rig.analysis.cooldown import CooldownResult
     from accelcal_rig.analysis.positions import SizeSummary
     from accelcal_rig.analysis.tilt import TiltRow
-    from accelcal_rig.fit.calibration import CalibrationFile
+    from accelcal_rig.fit.calibration import ChannelCalibration
     from accelcal_rig.fit.lm import FreeParameters
 
 
@@ -60,8 +60,8 @@ def cooldown_results(campaign: Path, calibration_path: Path, setpoint: float | N
     if figure is not None:
         _check_figure_path(figure)
     _, duts, _ = poses_at_setpoint(campaign, setpoint)
-    calibration = _calibrations_for(calibration_path, campaign, list(duts))
-    results = [analyse_cooldown(poses, calibration.sensors[serial]) for serial, poses in duts.items()]
+    accelerometers = _accelerometers_of(calibration_path, campaign, list(duts))
+    results = [analyse_cooldown(poses, accelerometers[serial]) for serial, poses in duts.items()]
     if figure is not None:
         from accelcal_rig.report.analysis_figures import cooldown_figure
 
@@ -77,12 +77,12 @@ def tilt_results(campaign: Path, calibration_path: Path,
     from accelcal_rig.analysis.tilt import tilt_rows
 
     setpoint, duts, numbers = poses_at_setpoint(campaign, setpoint_c)
-    calibration = _calibrations_for(calibration_path, campaign, list(duts))
-    rows = {serial: tilt_rows(poses, numbers, calibration.sensors[serial]) for serial, poses in duts.items()}
+    accelerometers = _accelerometers_of(calibration_path, campaign, list(duts))
+    rows = {serial: tilt_rows(poses, numbers, accelerometers[serial]) for serial, poses in duts.items()}
     outside = [f"{s} ({duts[s].temperature_c.min():.1f}…{duts[s].temperature_c.max():.1f} °C outside "
-               f"{calibration.sensors[s].validity_c[0]:.1f}…{calibration.sensors[s].validity_c[1]:.1f} °C)"
-               for s in duts if not (calibration.sensors[s].validity_c[0] <= duts[s].temperature_c.min()
-                                     and duts[s].temperature_c.max() <= calibration.sensors[s].validity_c[1])]
+               f"{accelerometers[s].validity_c[0]:.1f}…{accelerometers[s].validity_c[1]:.1f} °C)"
+               for s in duts if not (accelerometers[s].validity_c[0] <= duts[s].temperature_c.min()
+                                     and duts[s].temperature_c.max() <= accelerometers[s].validity_c[1])]
     return setpoint, rows, outside
 
 
@@ -137,15 +137,17 @@ def _positions_fit(campaign: Path, requested: str | None) -> tuple[str, FreePara
     return mode, options.free
 
 
-def _calibrations_for(calibration_path: Path, campaign: Path, serials: list[str]) -> CalibrationFile:
+def _accelerometers_of(calibration_path: Path, campaign: Path, serials: list[str]) -> dict[str, ChannelCalibration]:
+    """Each DUT's accelerometer calibration (the analyses of a tilt check and a cool-down are of acceleration)."""
+    from accelcal_rig.analysis.campaign_poses import ACCELERATION
     from accelcal_rig.fit.calibration import load_calibration
 
-    calibration = load_calibration(calibration_path)
-    missing = [serial for serial in serials if serial not in calibration.sensors]
+    accelerometers = load_calibration(calibration_path).of_quantity(ACCELERATION)
+    missing = [serial for serial in serials if serial not in accelerometers]
     if missing:
-        raise ConfigError(f"{calibration_path}: no calibration for {', '.join(missing)} of {campaign} "
-                          f"(it has {', '.join(calibration.sensors)})")
-    return calibration
+        raise ConfigError(f"{calibration_path}: no accelerometer calibration for {', '.join(missing)} of {campaign} "
+                          f"(it has {', '.join(accelerometers) or 'none'})")
+    return accelerometers
 
 
 def _check_figure_path(path: Path) -> None:

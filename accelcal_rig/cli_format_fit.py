@@ -1,56 +1,44 @@
 """What `rig fit` and `rig fit-recording` print, as lines: a campaign fit's report (`FitOutcome.report`,
-as `rig fit --json` prints it) as a table, and a hand-held recording's fit (`RecordingFit.report`, with its
-gyro's when it has one)."""
+as `rig fit --json` prints it) as a table per quantity of the figures its channel model names, and a hand-held
+recording's fit (`RecordingFit.report`, with its gyro's when it has one)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Any
 
-from accelcal_rig.core.units import gravity_statement
 from accelcal_rig.fit.campaign_fit import summary_line
+from accelcal_rig.fit.channel_models import model_for_quantity
 
 
 def fit_lines(report: dict[str, Any], output: Path) -> list[str]:
-    """The table of every DUT's figures, the one-line summary naming the calibration file, the gravity."""
-    return [*fit_table(report), *gyro_table(report), summary_line(report, output),
-            f"gravity: {gravity_statement(next(iter(report.values()))['gravity_m_s2'])}"]
+    """A table per calibrated quantity of every DUT's figures, the one-line summary naming the calibration file."""
+    return [*fit_tables(report), summary_line(report, output)]
 
 
-def gyro_table(report: dict[str, Any]) -> list[str]:
-    """Each calibrated gyroscope's figures: its rate steps before and after, the rates and poses it never saw."""
-    gyros = {serial: r["gyro"] for serial, r in report.items() if "gyro" in r}
-    if not gyros:
-        return []
-    lines = [f"{'gyroscope':14s} {'raw':>8s} {'in-sample':>9s} {'verification (never fitted)':^37s}  "
-             f"{'U k=2':>7s}  verdict",
-             f"{'':14s} {'rms °/s':>8s} {'rms °/s':>9s} {'rms °/s':>8s} {'axis °/s':>9s} {'scale ppm':>9s} "
-             f"{'rest °/s':>8s}  {'°/s':>7s}"]
-    for serial, g in gyros.items():
-        v = g.get("verification") or {}
-        cells = [v.get("rmse_dps"), v.get("max_axis_error_dps"), v.get("scale_error_ppm"), v.get("rest_error_dps")]
-        shown = [f"{c:{w}.{d}f}" if c is not None else f"{'none':>{w}s}" for c, w, d in
-                 zip(cells, (8, 9, 9, 8), (4, 4, 0, 4))]
-        lines.append(f"{serial:14s} {g['rmse_before_dps']:8.3f} {g['rmse_after_dps']:9.4f} {' '.join(shown)}  "
-                     f"{max(g['expanded_uncertainty_dps']):7.4f}  {g['verdict']}")
-        lines += _reasons(g)
-    return lines
-
-
-def fit_table(report: dict[str, Any]) -> list[str]:
-    """In-sample figures (the poses fitted) beside verification figures (poses the fit never saw)."""
-    lines = [f"{'':14s} {'raw':>8s} {'in-sample (the fitted poses)':^36s}  {'verification (never fitted)':^33s}".rstrip(),
-             f"{'sensor':14s} {'|g| mg':>8s} {'floor':>7s} {'expected':>8s} {'|g| mg':>7s} {'drift mg':>10s}  "
-             f"{'|g| mg':>7s} {'axis mg':>7s} {'tilt °':>7s} {'drift mg':>9s}  {'U k=2 mg':>8s}  verdict"]
-    for serial, r in report.items():
-        v = r.get("verification")
-        verification = (f"{v['rmse_mg']:7.4f} {v['max_axis_error_mg']:7.4f} {v['max_tilt_error_deg']:7.4f} "
-                        f"{max(v['drift_mg']):9.4f}" if v else f"{'none':>7s} {'':7s} {'':7s} {'':9s}")
-        lines.append(f"{serial:14s} {r['rmse_before_mg']:8.3f} {r['noise_floor_mg']:7.4f} {r['expected_fit_rmse_mg']:8.4f} "
-                     f"{r['rmse_after_mg']:7.4f} {max(r['drift_after_mg']):10.4f}  {verification}  "
-                     f"{max(r['expanded_uncertainty_mg']):8.4f}  {r['verdict']}")
-        lines += _reasons(r)
-        lines += [f"  warning: {warning}" for warning in r["warnings"]]
+def fit_tables(report: dict[str, Any]) -> list[str]:
+    """Per quantity, each DUT's channel of it: its model's figures (in-sample first, then on the records the fit
+    never saw; a per-axis figure's largest axis), its verdict, why it failed or is conditional, and its fit's
+    warnings. The reasons and warnings are the DUT's channel's own."""
+    by_quantity: dict[str, list[tuple[str, str, dict[str, Any]]]] = {}
+    for serial, dut in report.items():
+        for channel, figures in dut["channels"].items():
+            by_quantity.setdefault(figures["quantity"], []).append((serial, channel, figures))
+    lines: list[str] = []
+    for quantity, rows in by_quantity.items():
+        model = model_for_quantity(quantity)
+        if model is None:
+            continue
+        widths = [max(len(f.short or f.label), len(f.unit) + 2, 7) for f in model.figures]
+        lines.append(f"{model.sensor:14s} {'channel':8s} " + " ".join(f"{f.short or f.label:>{w}s}" for f, w in
+                                                                   zip(model.figures, widths)) + "  verdict")
+        lines.append(f"{'':14s} {'':8s} " + " ".join(f"{'(' + f.unit + ')':>{w}s}" for f, w in zip(model.figures, widths)))
+        for serial, channel, figures in rows:
+            lines.append(f"{serial:14s} {channel:8s} " + " ".join(f"{f.text(figures):>{w}s}" for f, w in
+                                                               zip(model.figures, widths)) + f"  {figures['verdict']}")
+            lines += _reasons(figures)
+            lines += [f"  warning: {warning}" for warning in figures.get("warnings", [])]
+        lines += [f"{what}: {statement}" for what, statement in model.reference_statements(rows[0][2])]
     return lines
 
 

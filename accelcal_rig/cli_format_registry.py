@@ -25,108 +25,98 @@ def calibration_table(rows: list[dict[str, Any]], dry_runs: str | None = None) -
 
 
 def _channel(row: dict[str, Any]) -> str:
-    return str(row.get("channel") or "accel")
+    return str(row["channel"])
+
+
+#: Decimals a figure is shown with, by its unit (others: 3).
+_DIGITS = {"ppm": 0, "°/s": 4}
+
+
+def _digits(unit: str) -> int:
+    return _DIGITS.get(unit, 3)
 
 
 def sensor_lines(serial: str, current: dict[str, dict[str, Any] | None], rows: list[dict[str, Any]],
                  simulated: bool, why: dict[str, str] | None = None) -> list[str]:
     """`rig registry show`: the sensor's valid calibration of each channel (or why it has none), then its
-    history; each channel named where the sensor has more than its accelerometer."""
-    labelled = set(current) != {"accel"}
+    history; each channel named where the sensor has more than one."""
+    labelled = len(current) > 1
     lines = []
     for channel, valid in current.items():
-        lines += _current_lines(serial, valid, [r for r in rows if _channel(r) == channel], simulated,
-                                f" {channel}" if labelled else "", (why or {}).get(channel, ""))
+        lines += _current_lines(serial, valid, simulated, f" {channel}" if labelled else "",
+                                (why or {}).get(channel, ""))
     lines.append(f"history ({len(rows)}):")
     for r in rows:
-        bias = triple(r["bias_dps"], "°/s", digits=4) if _channel(r) == "gyro" else triple(r["bias_mg"], "mg")
+        bias = r["figures"].get("bias")
+        shown = triple(bias["value"], bias["unit"], digits=_digits(bias["unit"])) if bias else "—"
         lines.append(f"  {r['id']:>6}  {r['calibrated_at']:%Y-%m-%d %H:%M}  {r['verdict'] or 'NOT JUDGED':<10}  "
                      + (f"{_channel(r):<5}  " if labelled else "")
-                     + f"bias {bias}  {Path(r['source_path']).name}" + (" (simulated)" if r["simulated"] else ""))
+                     + f"bias {shown}  {Path(r['source_path']).name}" + (" (simulated)" if r["simulated"] else ""))
     return lines
 
 
-def _current_lines(serial: str, current: dict[str, Any] | None, rows: list[dict[str, Any]],
-                   simulated: bool, label: str = "", why: str = "") -> list[str]:
+def _current_lines(serial: str, current: dict[str, Any] | None, simulated: bool, label: str = "",
+                   why: str = "") -> list[str]:
     if current is None:
         return [f"{serial}{label}: no valid calibration ({why or 'its newest calibration failed its acceptance limits'})"]
     dry = " (SIMULATED: a dry run)" if current["simulated"] else ""
-    figures = _gyro_figures(current) if _channel(current) == "gyro" else [
-        f"  at {current['reference_c']:g} °C: bias {triple(current['bias_mg'], 'mg', current['bias_uncertainty_mg'])}; "
-        f"scale error {triple(current['scale_error_ppm'], 'ppm', current['scale_uncertainty_ppm'], 0)}; "
-        f"non-orthogonality ≤ {current['nonorthogonality_mrad']:.3f} mrad"
-        + _noise(current, "vrw_m_s_per_rthr", "VRW", "m/s/√h", "bias_instability_ug", "µg")]
     return [f"{serial}{label} ({current['part']}): valid calibration {current['id']}{dry}, "
             f"measured {current['calibrated_at']:%Y-%m-%d} "
             f"by {current['procedure']} on {current['rig']}, {current['valid_from_c']:.1f}…{current['valid_to_c']:.1f} °C, "
             f"verdict {current['verdict'] or 'NOT JUDGED (no acceptance limits stated)'}",
-            *figures,
+            f"  at {current['reference_c']:g} °C: " + "; ".join(figure_text(f) for f in current["figures"].values()),
             f"  source {current['source_path']} (SHA-256 {current['source_sha256'][:16]}…), software "
             f"{current['software_version']}"]
 
 
-def _gyro_figures(row: dict[str, Any]) -> list[str]:
-    """A gyroscope's figures: bias and scale error at the reference temperature, the expanded uncertainty at the
-    largest calibrated rate, the verification RMS error, its noise."""
-    expanded = row["expanded_uncertainty_dps"]
-    rmse = row["verification_rmse_dps"]
-    return [f"  at {row['reference_c']:g} °C: bias {triple(row['bias_dps'], '°/s', row['bias_uncertainty_dps'], 4)}; "
-            f"scale error {triple(row['scale_error_ppm'], 'ppm', row['scale_uncertainty_ppm'], 0)}",
-            f"  expanded uncertainty (k = 2) at the largest calibrated rate {triple(expanded, '°/s', digits=4)}; "
-            f"verification RMS error {f'{rmse:.4f} °/s' if rmse is not None else '— (no verification rate steps)'}"
-            + _noise(row, "arw_deg_per_rthr", "ARW", "°/√h", "bias_instability_dph", "°/h")]
+def figure_text(figure: dict[str, Any]) -> str:
+    """`bias +1.234±0.010/… mg`: a registry figure with its values (each ± its expanded uncertainty, where stated)."""
+    if figure["axes"]:
+        return f"{figure['label']} {triple(figure['value'], figure['unit'], figure['expanded_u'], _digits(figure['unit']))}"
+    value = figure["value"][0]
+    return f"{figure['label']} {value:.{_digits(figure['unit']) + 1}f} {figure['unit']}"
 
 
-def _noise(row: dict[str, Any], walk: str, walk_name: str, walk_unit: str, instability: str, unit: str) -> str:
-    """`; ARW 0.127/0.162/0.180 °/√h, bias instability 3.4/0.0/6.7 °/h` where the row has them, else ""."""
-    if row.get(walk) is None:
-        return ""
-    text = f"; {walk_name} " + "/".join(f"{v:.4g}" for v in row[walk]) + f" {walk_unit}"
-    if row.get(instability) is not None:
-        text += ", bias instability " + "/".join(f"{v:.3g}" for v in row[instability]) + f" {unit}"
-    return text
-
-
-def trend_lines(serial: str, calibrations: int, result: dict[str, Any], channel: str = "accel") -> list[str]:
-    """`rig registry trend`: each calibration's figures at the reference temperature, then the drift per year
-    (one channel's: an accelerometer's bias in mg, a gyroscope's in °/s)."""
-    unit, shown, digits = ("dps", "°/s", 4) if channel == "gyro" else ("mg", "mg", 3)
-    label = f" {channel}" if channel != "accel" else ""
+def trend_lines(serial: str, calibrations: int, result: dict[str, Any], channel: str, labelled: bool = False) -> list[str]:
+    """`rig registry trend`: each calibration's figures at the reference temperature, then each one's drift per
+    year, in its unit (one channel's; named where the sensor has more than one)."""
+    label = f" {channel}" if labelled else ""
     lines = [f"{serial}{label}: {calibrations} calibrations, figures at the reference temperature (± expanded, k = 2)"]
     for point in result["calibrations"]:
-        lines.append(f"  {point['calibrated_at'][:10]}  bias "
-                     f"{triple(point[f'bias_{unit}'], shown, point[f'bias_uncertainty_{unit}'], digits)}"
-                     f"  scale {triple(point['scale_error_ppm'], 'ppm', point['scale_uncertainty_ppm'], 0)}")
+        lines.append(f"  {point['calibrated_at'][:10]}  " + "  ".join(
+            f"{f['label']} {triple(f['value'], f['unit'], f['expanded_u'], _digits(f['unit']))}"
+            for f in point["figures"].values()))
     withheld = result.get("drift_not_stated")
     if withheld:
         option = " (--min-span-days sets it)" if 0 < result["span_days"] < result["min_span_days"] else ""
         return [*lines, f"  drift per year: not stated: {withheld}{option}"]
-    for key, drift_unit in ((f"bias_drift_{unit}_per_year", shown), ("scale_drift_ppm_per_year", "ppm")):
-        drift = result[key]
-        what = key.split("_drift")[0]
+    for name, drift in result["drift_per_year"].items():
         if drift is None:
-            lines.append(f"  {what} drift: needs two calibrations at different times with its figures")
+            lines.append(f"  {name.replace('_', ' ')} drift: needs two calibrations at different times with its figures")
         else:
-            lines.append(f"  {what} drift per year: "
-                         + ", ".join(f"{axis} {_drift_text(d, drift_unit)}" for axis, d in zip("xyz", drift)))
+            lines.append(f"  {drift['label']} drift per year: "
+                         + ", ".join(f"{axis} {_drift_text(d, drift['unit'])}" for axis, d in zip("xyz", drift["axes"])))
     return lines
 
 
-def lot_lines(part: str, result: dict[str, Any], channel: str = "accel") -> list[str]:
-    """`rig registry stats`: the lot's yield, each figure's distribution per axis, the outliers (one channel's)."""
+def lot_lines(part: str, result: dict[str, Any], channel: str, labelled: bool = False) -> list[str]:
+    """`rig registry stats`: the lot's yield, each figure's distribution per axis, the outliers (one channel's;
+    named where the lot has more than one)."""
     judged = "none judged against acceptance limits"
     if result["judged"]:
         conditional = result.get("conditional", 0)
         judged = (f"{result['passed']} of {result['judged']} judged passed ({result['yield']:.1%})"
                   + (f", {conditional} conditional (inside a guard band: neither passed nor failed)" if conditional
                      else ""))
-    label = f" {channel}" if channel != "accel" else ""
+    label = f" {channel}" if labelled else ""
     lines = [f"{part}{label}: {result['sensors']} sensors ({result['calibrations']} calibrations), newest of each: "
              f"{judged}"]
-    for name, columns in result["distributions"].items():
+    for distribution in result["distributions"].values():
+        columns = distribution["axes"]
+        name = f"{distribution['label']} ({distribution['unit']})"
         for axis, summary in zip("xyz" if len(columns) == 3 else " ", columns):
             if summary is not None:
-                lines.append(f"  {name:<22} {axis}  median {summary['median']:+10.4g}  p5…p95 {summary['p5']:+.4g}…"
+                lines.append(f"  {name:<28} {axis}  median {summary['median']:+10.4g}  p5…p95 {summary['p5']:+.4g}…"
                              f"{summary['p95']:+.4g}  std {summary['std']:.3g}  (n {summary['n']})")
     for outlier in result["outliers"]:
         lines.append(f"  outlier: {outlier['serial']} (calibration {outlier['id']}) {outlier['figure']} "

@@ -169,7 +169,7 @@ def _trend(args: argparse.Namespace) -> int:
         print(json.dumps({"serial": args.serial, "channels": {c: r for c, (_, r) in results.items()}}, indent=2))
     else:
         print("\n".join(line for channel, (n, result) in results.items()
-                        for line in trend_lines(args.serial, n, result, channel)))
+                        for line in trend_lines(args.serial, n, result, channel, len(results) > 1)))
     return 0
 
 
@@ -182,7 +182,8 @@ def _stats(args: argparse.Namespace) -> int:
                           + _simulated_hint(args))
     results = {channel: lot_statistics(of, channel) for channel, of in by_channel(rows).items()}
     print(json.dumps({"part": args.part, "channels": results}, indent=2) if args.json else
-          "\n".join(line for channel, result in results.items() for line in lot_lines(args.part, result, channel)))
+          "\n".join(line for channel, result in results.items()
+                    for line in lot_lines(args.part, result, channel, len(results) > 1)))
     return 0
 
 
@@ -193,20 +194,23 @@ def _export(args: argparse.Namespace) -> int:
 
     registry = open_registry(args)
     if args.id is not None:
-        row = registry.calibration(args.id)
-        if row["serial"] != args.serial:
-            raise ConfigError(f"calibration {args.id} is of {row['serial']}, not {args.serial}")
-    else:
-        found = registry.current(args.serial, simulated=args.simulated)
-        if found is None:
+        rows = [registry.calibration(args.id)]
+        if rows[0]["serial"] != args.serial:
+            raise ConfigError(f"calibration {args.id} is of {rows[0]['serial']}, not {args.serial}")
+    else:  # the sensor's valid calibration of each channel it has one of
+        valid = [found for channel in registry.channels(args.serial)
+                 if (found := registry.current(args.serial, simulated=args.simulated, channel=channel)) is not None]
+        if not valid:
             raise ConfigError(f"serial {args.serial}: no valid calibration in the registry" + (
-                f" ({registry.why_not_valid(args.serial)})" if not args.simulated and registry.calibrations(
-                    serial=args.serial, simulated=False) else _simulated_hint(args)))
-        row = registry.calibration(found["id"])
+                f" ({'; '.join(registry.why_not_valid(args.serial, c) for c in registry.channels(args.serial))})"
+                if not args.simulated and registry.calibrations(serial=args.serial, simulated=False)
+                else _simulated_hint(args)))
+        rows = [registry.calibration(found["id"]) for found in valid]
     if args.output is not None and not args.output.parent.is_dir():
         raise ConfigError(f"{args.output}: folder {args.output.parent} does not exist")
-    exported = export(calibration_file_of(row), args.format,
-                      StackOptions(Path(f"registry calibration {row['id']}"), None, args.instance, args.device_id))
+    ids = ", ".join(str(row["id"]) for row in rows)
+    exported = export(calibration_file_of(rows), args.format,
+                      StackOptions(Path(f"registry calibration {ids}"), None, args.instance, args.device_id))
     return write_export(exported, args.format, args.output)
 
 

@@ -118,7 +118,7 @@ def _certificates(follow_up: FollowUp, calibration: Any) -> PartState:
     from accelcal_rig.report.certificate import certificate_current, certificate_names
 
     folder = follow_up.certificates
-    names = certificate_names(list(calibration.sensors))
+    names = certificate_names(list(calibration.duts))
     pdf = follow_up.pdf and _pdf_available()
     missing = [serial for serial, name in names.items()
                if not certificate_current(folder / f"{name}.html", folder / f"{name}.pdf" if pdf else None,

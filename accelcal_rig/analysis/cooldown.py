@@ -13,9 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from accelcal_rig.fit.calibration import CalibrationRangeWarning, SensorCalibration, apply
+from accelcal_rig.fit.calibration import CalibrationRangeWarning, ChannelCalibration, apply
 from accelcal_rig.fit.metrics import temperature_coefficient_ug_per_k
-from accelcal_rig.store.read import DutPoses
+from accelcal_rig.store.read import VectorPoses
 
 
 @dataclass(frozen=True)
@@ -32,13 +32,13 @@ class CooldownResult:
     outside_range: int              # records outside the calibrated range (clamped or extrapolated)
 
 
-def analyse_cooldown(poses: DutPoses, calibration: SensorCalibration) -> CooldownResult:
+def analyse_cooldown(poses: VectorPoses, calibration: ChannelCalibration) -> CooldownResult:
     low, high = calibration.validity_c
     outside = int(np.sum((poses.temperature_c < low) | (poses.temperature_c > high)))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CalibrationRangeWarning)  # counted in `outside_range`
-        after = apply(calibration, poses.mean_g, poses.temperature_c)
-    before = poses.mean_g
+        after = apply(calibration, poses.mean, poses.temperature_c)
+    before = poses.mean
     return CooldownResult(
         poses.serial, poses.t_s, poses.temperature_c, before, after,
         temperature_coefficient_ug_per_k(before, poses.temperature_c),

@@ -17,7 +17,7 @@ from accelcal_rig.fit.lm import DegenerateDesign, FitMode, FreeParameters, fit_s
 from accelcal_rig.fit.metrics import noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.sfem import correct
 from accelcal_rig.plan.schedules import sphere
-from accelcal_rig.store.read import DutPoses
+from accelcal_rig.store.read import VectorPoses
 
 #: The numbers of positions of the paper's Table 4.
 PAPER_SIZES = (1296, 648, 324, 162, 81, 64, 48, 36, 24, 21, 18, 16, 12)
@@ -56,10 +56,10 @@ def structured_subset(directions: np.ndarray, size: int) -> np.ndarray:
     return np.array(sorted(chosen))
 
 
-def score_subsets(poses: DutPoses, sizes: tuple[int, ...], mode: FitMode, free: FreeParameters, subsets: int,
+def score_subsets(poses: VectorPoses, sizes: tuple[int, ...], mode: FitMode, free: FreeParameters, subsets: int,
                   rng: np.random.Generator) -> list[SubsetScore]:
-    n = len(poses.mean_g)
-    directions = poses.mean_g / np.linalg.norm(poses.mean_g, axis=1, keepdims=True)
+    n = len(poses.mean)
+    directions = poses.mean / np.linalg.norm(poses.mean, axis=1, keepdims=True)
     accuracy_rad = np.radians(poses.reference_accuracy_arcsec / 3600.0)
     scores = []
     for size in (s for s in sizes if s <= n):
@@ -68,13 +68,13 @@ def score_subsets(poses: DutPoses, sizes: tuple[int, ...], mode: FitMode, free: 
         for kind, chosen in choices:
             held = np.setdiff1d(np.arange(n), chosen) if size < n else np.arange(n)
             try:
-                fit = fit_sfem(poses.mean_g[chosen], poses.stderr_g[chosen],
-                               poses.reference_g[chosen] if mode == "reference" else None, mode, free, accuracy_rad)
+                fit = fit_sfem(poses.mean[chosen], poses.stderr[chosen],
+                               poses.reference[chosen] if mode == "reference" else None, mode, free, accuracy_rad)
             except DegenerateDesign:
-                scores.append(SubsetScore(size, kind, float("nan"), norm_rmse_mg(poses.mean_g[held]), len(held)))
+                scores.append(SubsetScore(size, kind, float("nan"), norm_rmse_mg(poses.mean[held]), len(held)))
                 continue
-            compensated = correct(poses.mean_g[held], fit.parameters)
-            scores.append(SubsetScore(size, kind, norm_rmse_mg(compensated), norm_rmse_mg(poses.mean_g[held]),
+            compensated = correct(poses.mean[held], fit.parameters)
+            scores.append(SubsetScore(size, kind, norm_rmse_mg(compensated), norm_rmse_mg(poses.mean[held]),
                                       len(held) if size < n else 0))
     return scores
 
@@ -92,6 +92,6 @@ def summarise(serial: str, scores: list[SubsetScore]) -> list[SizeSummary]:
     return rows
 
 
-def floor_mg(poses: DutPoses) -> float:
+def floor_mg(poses: VectorPoses) -> float:
     """The RMSE the per-pose standard errors alone leave: what a perfect calibration would score."""
-    return noise_floor_mg(poses.mean_g, poses.stderr_g)
+    return noise_floor_mg(poses.mean, poses.stderr)

@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from accelcal_rig.fit.calibration import CalibrationRangeWarning, SensorCalibration, apply
+from accelcal_rig.fit.calibration import CalibrationRangeWarning, ChannelCalibration, apply
 from accelcal_rig.fit.metrics import tilt_angles_deg
-from accelcal_rig.store.read import DutPoses
+from accelcal_rig.store.read import VectorPoses
 
 SEOQ_FULL_SCALE_DEG = 30.0
 
@@ -37,12 +37,12 @@ def pitch_roll_deg(readings_g: np.ndarray) -> np.ndarray:
     return np.column_stack([pitch, roll])
 
 
-def tilt_rows(poses: DutPoses, pose_numbers: np.ndarray, calibration: SensorCalibration) -> list[TiltRow]:
-    reference = pitch_roll_deg(poses.reference_g)
-    before = pitch_roll_deg(poses.mean_g)
+def tilt_rows(poses: VectorPoses, pose_numbers: np.ndarray, calibration: ChannelCalibration) -> list[TiltRow]:
+    reference = pitch_roll_deg(poses.reference)
+    before = pitch_roll_deg(poses.mean)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CalibrationRangeWarning)  # reported by the caller, once
-        after = pitch_roll_deg(apply(calibration, poses.mean_g, poses.temperature_c))
+        after = pitch_roll_deg(apply(calibration, poses.mean, poses.temperature_c))
     seoq = np.abs(before - after) / SEOQ_FULL_SCALE_DEG * 100.0
     return [TiltRow(poses.serial, int(n), tuple(r), tuple(b), tuple(a), tuple(q))  # type: ignore[arg-type]
             for n, r, b, a, q in zip(pose_numbers, reference, before, after, seoq)]

@@ -99,8 +99,9 @@ def _add_stats(actions: Commands) -> None:
 
 
 def _channel_option(action: argparse.ArgumentParser) -> None:
-    action.add_argument("--channel", choices=["accel", "gyro"],
-                        help="only this channel of the DUTs (default: every channel, each named)")
+    action.add_argument("--channel", metavar="CHANNEL",
+                        help="only this channel of the DUTs, as their parts name it: accel, gyro, … (default: every "
+                             "channel the registry holds, each named)")
 
 
 def _simulated_option(action: argparse.ArgumentParser) -> None:

@@ -3,9 +3,9 @@ pass."""
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import ConfigDict, Field, field_validator, model_validator
 
 from accelcal_rig.config.bounds import Real, StrictModel, TemperatureC
 from accelcal_rig.config.schedule import Schedule
@@ -40,62 +40,59 @@ class Verification(StrictModel):
 
 
 
+#: A limit on a figure or a parameter: positive, at most what any channel model states as its largest.
+Limit = Annotated[Real, Field(gt=0, le=1e6)]
+#: The keys of `acceptance` that are not a channel's limits.
+SHARED_KEYS = ("allow_partial", "decision_rule", "guard_band_factor")
+#: The keys of an accelerometer's limits written before limits were keyed by channel (at the top of
+#: `acceptance`), read as the limits of the channel that had them: `accel`.
+_BEFORE_CHANNELS = ("max_verification_rmse_mg", "max_axis_error_mg", "max_drift_mg", "max_tilt_error_deg", "parameters")
+_BEFORE_CHANNELS_CHANNEL = "accel"
+#: Extra keys allowed, each checked as its annotation says (pydantic's `__pydantic_extra__`).
+_OPEN = ConfigDict(extra="allow", frozen=True, allow_inf_nan=False)
+
+
 class ParameterLimits(StrictModel):
-    """Limits on the calibration's parameters at `at_c`, e.g. the datasheet's zero-g offset; a limit left
-    out is not judged."""
+    """Limits on a channel's calibration parameters at `at_c`, each keyed as its channel model names the kind of
+    parameter it judges (an accelerometer's `bias_mg`, `scale_error_ppm`, `nonorthogonality_mrad`,
+    `misalignment_mrad`; a gyroscope's `bias_dps`, `cross_axis_mrad`, …: docs/procedures.md); a limit left out is
+    not judged."""
+
+    model_config = _OPEN
+    __pydantic_extra__: dict[str, Limit] = Field(init=False)  # type: ignore[assignment]
 
     at_c: TemperatureC = Field(25.0, description="temperature the parameters are judged at (inside the "
                                                  "calibrated range)")
-    bias_mg: Real | None = Field(None, gt=0, le=1000, description="|bias| of each axis")
-    scale_error_ppm: Real | None = Field(None, gt=0, le=1e6, description="|scale − 1| of each axis")
-    nonorthogonality_mrad: Real | None = Field(None, gt=0, le=1000, description="|each non-orthogonality|")
-    misalignment_mrad: Real | None = Field(None, gt=0, le=1000, description="|each misalignment| (reference "
-                                                                             "mode only)")
+
+    def limits(self) -> dict[str, float]:
+        return dict(self.__pydantic_extra__ or {})
 
 
-class GyroParameterLimits(StrictModel):
-    """Limits on a gyroscope's calibration at `at_c` (a data sheet's figures); a limit left out is not judged."""
+class ChannelLimits(StrictModel):
+    """What one channel of every DUT must meet to PASS, keyed as its channel model names its figures (an
+    accelerometer's `max_verification_rmse_mg`, a gyroscope's `max_verification_rmse_dps`, …: docs/procedures.md):
+    figure limits judged on the verification records, parameter limits on the calibration at `parameters.at_c`."""
 
-    at_c: TemperatureC = Field(25.0, description="temperature the parameters are judged at (inside the "
-                                                 "calibrated range)")
-    bias_dps: Real | None = Field(None, gt=0, le=1000, description="|bias| of each axis, the Earth's rate taken "
-                                                                  "out as the calibration states")
-    scale_error_ppm: Real | None = Field(None, gt=0, le=1e6, description="|scale − 1| of each axis")
-    cross_axis_mrad: Real | None = Field(None, gt=0, le=1000, description="|each cross-axis term| of K")
-    gsens_dps_per_g: Real | None = Field(None, gt=0, le=1000, description="|each g-sensitivity term|")
+    model_config = _OPEN
+    __pydantic_extra__: dict[str, Limit] = Field(init=False)  # type: ignore[assignment]
 
+    parameters: ParameterLimits | None = None
 
-class GyroAcceptance(StrictModel):
-    """What a DUT's gyroscope must meet to PASS; the verification limits are judged on the rate steps and
-    poses the fit never saw (`rates.verify_rates_dps`, `verify:`)."""
-
-    max_verification_rmse_dps: Real | None = Field(None, gt=0, le=10_000, description="RMS axis error of the "
-                                                   "compensated verification rate steps against their references")
-    max_axis_error_dps: Real | None = Field(None, gt=0, le=10_000, description="largest axis error of a "
-                                            "compensated verification rate step")
-    max_scale_error_ppm: Real | None = Field(None, gt=0, le=1e6, description="largest relative error along the "
-                                             "turning axis at the verification rates")
-    max_rest_error_dps: Real | None = Field(None, gt=0, le=10_000, description="RMS axis error of the compensated "
-                                            "verification poses (at rest: the bias left)")
-    parameters: GyroParameterLimits | None = None
-
-    def verification_limits(self) -> list[str]:
-        names = ["max_verification_rmse_dps", "max_axis_error_dps", "max_scale_error_ppm", "max_rest_error_dps"]
-        return [n for n in names if getattr(self, n) is not None]
+    def figure_limits(self) -> dict[str, float]:
+        return dict(self.__pydantic_extra__ or {})
 
 
 class Acceptance(StrictModel):
-    """What a DUT's calibration must meet to PASS; each limit left out is not judged. The verification
-    limits are judged on the verification poses (a `verify:` section is needed for them)."""
+    """What a DUT's calibration must meet to PASS: each channel's limits under its channel's name
+    (`acceptance: {accel: {…}, gyro: {…}}`), and how every figure is decided. A limit left out is not judged;
+    the verification limits are judged on the verification records (a `verify:` section is needed for them).
+    Limits written before they were keyed by channel (an accelerometer's at the top of `acceptance`) are the
+    `accel` channel's."""
 
-    max_verification_rmse_mg: Real | None = Field(None, gt=0, le=1000, description="Eq. 9 |g| RMSE")
-    max_axis_error_mg: Real | None = Field(None, gt=0, le=1000, description="largest per-axis error of the "
-                                           "compensated vector against the reference gravity")
-    max_drift_mg: Real | None = Field(None, gt=0, le=1000, description="residual zero-g drift per axis over "
-                                      "the verification temperatures (max − min)")
-    max_tilt_error_deg: Real | None = Field(None, gt=0, le=90, description="largest Eq. 10 pitch or roll error")
-    parameters: ParameterLimits | None = None
-    gyro: GyroAcceptance | None = Field(None, description="a gyroscope's limits (a procedure with rates:)")
+    model_config = _OPEN
+    __pydantic_extra__: dict[Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]{0,31}$")], ChannelLimits] = Field(
+        init=False)  # type: ignore[assignment]
+
     allow_partial: bool = Field(False, description="a campaign that stopped before its last pose may pass")
     decision_rule: Literal["simple", "guarded"] | None = Field(
         None, description="how each figure's expanded uncertainty is taken into its verdict (ILAC-G8:09/2019): "
@@ -104,17 +101,34 @@ class Acceptance(StrictModel):
     guard_band_factor: Real = Field(1.0, gt=0, le=3, description="guarded acceptance: the guard band in "
                                                                  "expanded uncertainties (k = 2)")
 
+    @model_validator(mode="before")
+    @classmethod
+    def _before_channels(cls, data: Any) -> Any:
+        """An accelerometer's limits at the top of `acceptance` (before limits were keyed by channel) are the
+        `accel` channel's."""
+        if not isinstance(data, dict) or not any(key in data for key in _BEFORE_CHANNELS):
+            return data
+        if _BEFORE_CHANNELS_CHANNEL in data:
+            raise ValueError(f"{', '.join(k for k in _BEFORE_CHANNELS if k in data)}: the {_BEFORE_CHANNELS_CHANNEL} "
+                             f"channel's limits go under {_BEFORE_CHANNELS_CHANNEL}:, beside the others there")
+        moved = {key: data[key] for key in _BEFORE_CHANNELS if key in data}
+        return {**{k: v for k, v in data.items() if k not in moved}, _BEFORE_CHANNELS_CHANNEL: moved}
+
     @model_validator(mode="after")
     def _guard_band_guards(self) -> Acceptance:
         if self.guard_band_factor != 1.0 and self.decision_rule != "guarded":
             raise ValueError("acceptance.guard_band_factor is the guard band of decision_rule: guarded")
         return self
 
+    @property
+    def channels(self) -> dict[str, ChannelLimits]:
+        """Each channel's limits by the channel's name."""
+        return dict(self.__pydantic_extra__ or {})
+
     def states_limits(self) -> bool:
         """Whether any limit is stated (a rule without one judges nothing)."""
-        return bool(self.verification_limits()) or self.parameters is not None or self.gyro is not None
+        return any(limits.figure_limits() or limits.parameters is not None for limits in self.channels.values())
 
     def verification_limits(self) -> list[str]:
-        """The keys of the limits that need verification poses."""
-        names = ["max_verification_rmse_mg", "max_axis_error_mg", "max_drift_mg", "max_tilt_error_deg"]
-        return [n for n in names if getattr(self, n) is not None]
+        """Every figure limit (judged on verification records) as `<channel>.<key>`."""
+        return [f"{channel}.{key}" for channel, limits in self.channels.items() for key in limits.figure_limits()]

@@ -10,7 +10,7 @@ from typing import Any, Generic, TypeVar
 from pydantic import BaseModel, ValidationError
 
 from accelcal_rig.config.bounds import NUMBERS_FROM_TEXT
-from accelcal_rig.config.procedure import MAX_POLLS, Procedure
+from accelcal_rig.config.procedure import BEFORE_RANGES, MAX_POLLS, Procedure
 from accelcal_rig.config.rig import FaultInjection, RigConfig
 from accelcal_rig.config.schedule import Schedule
 from accelcal_rig.config.suggestions import explained
@@ -118,23 +118,32 @@ def resolve_rig_path(procedure: LoadedConfig[Procedure], override: Path | None) 
     return path
 
 
+def _range_key(procedure: LoadedConfig[Procedure], channel: str) -> KeyPath:
+    """Where a channel's range is in the procedure: `acquisition.ranges.<channel>`, or the key that gave it before
+    ranges were keyed by channel (`range_g`, `range_dps`)."""
+    for key, named in BEFORE_RANGES.items():
+        if named == channel and ("acquisition", key) in procedure.lines:
+            return ("acquisition", key)
+    return ("acquisition", "ranges", channel)
+
+
 def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedConfig[RigConfig]) -> None:
     """Cross-file checks that neither file can make alone: setpoints and angles inside the rig's limits, the
     range and data rate among those of every DUT's part."""
     chamber = rig.model.chamber
     acquisition = procedure.model.acquisition
-    ranges = acquisition.ranges()
+    ranges = acquisition.ranges
     for sensor in rig.model.fixture.sensors:
         dut_part = part(sensor.part)
         for channel in dut_part.channels:  # every channel of every DUT's part needs its range, and one it has
-            key = acquisition.RANGE_KEYS.get(channel.name, f"range of {channel.name}")
+            key = _range_key(procedure, channel.name)
             if channel.name not in ranges:
-                raise procedure.error(("acquisition", key), f"not set: sensor {sensor.serial} of {rig.path} is an "
+                raise procedure.error(key, f"not set: sensor {sensor.serial} of {rig.path} is an "
                                                              f"{dut_part.label}, whose {channel.name} channel needs "
                                                              f"its ± full scale in {channel.unit}")
             problem = channel.range_problem(ranges[channel.name], dut_part.label)
             if problem:
-                raise procedure.error(("acquisition", key), f"{problem}: sensor {sensor.serial} of {rig.path}")
+                raise procedure.error(key, f"{problem}: sensor {sensor.serial} of {rig.path}")
         problem = dut_part.rate_problem(acquisition.odr_hz)
         if problem:
             raise procedure.error(("acquisition", "odr_hz"), f"{problem}: sensor {sensor.serial} of {rig.path}")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import ClassVar, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
@@ -68,25 +68,41 @@ class SoakCriterion(StrictModel):
         return self
 
 
+#: The channel whose range acquisition took as `range_g` before ranges were keyed by channel, and its default.
+_RANGE_G_CHANNEL, _RANGE_G_DEFAULT = "accel", 2
+#: Each channel's key before ranges were keyed by channel (read as `ranges.<channel>`).
+BEFORE_RANGES = {"range_g": "accel", "range_dps": "gyro"}
+
+
 class Acquisition(StrictModel):
     """How each pose is measured."""
 
     samples_per_pose: Whole = Field(200, ge=2, le=100_000)
-    range_g: Whole = Field(2, ge=1, le=1000, description="± full scale in g, one of every DUT part's ranges")
+    ranges: dict[Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]{0,31}$")], Annotated[Real, Field(gt=0, le=1e6)]] = Field(
+        {_RANGE_G_CHANNEL: _RANGE_G_DEFAULT}, max_length=16,
+        description="± full scale of each channel by the channel's name, in its unit (accel: 2 g, gyro: 2000 °/s), one "
+                    "of every DUT part's ranges for it; accel 2 g unless given")
     odr_hz: Real = Field(125.0, gt=0, le=100_000, description="output data rate, one of every DUT part's")
     settle_s: Real = Field(5.0, ge=0, le=3600, description="wait after the turntable is in position")
-    range_dps: Real | None = Field(None, gt=0, le=100_000, description="± full scale in °/s of every DUT part's "
-                                   "gyroscope, one of its ranges; needed where a part has one")
 
-    def ranges(self) -> dict[str, float]:
-        """The ± full scale asked of each channel, by the channel's name (a gyroscope's only when given)."""
-        ranges: dict[str, float] = {"accel": self.range_g}
-        if self.range_dps is not None:
-            ranges["gyro"] = self.range_dps
-        return ranges
-
-    #: Each channel's key in `acquisition`, as a configuration error names it.
-    RANGE_KEYS: ClassVar[dict[str, str]] = {"accel": "range_g", "gyro": "range_dps"}
+    @model_validator(mode="before")
+    @classmethod
+    def _before_ranges(cls, data: Any) -> Any:
+        """`range_g` and `range_dps` (before ranges were keyed by channel) are `ranges.accel` and `ranges.gyro`;
+        the accelerometer's range is 2 g unless given."""
+        if not isinstance(data, dict):
+            return data
+        ranges = data.get("ranges", {})
+        if not isinstance(ranges, dict):
+            return data
+        ranges = dict(ranges)
+        for key, channel in BEFORE_RANGES.items():
+            if key in data:
+                if channel in ranges:
+                    raise ValueError(f"{key} and ranges.{channel} both give the {channel} channel's range: keep one")
+                ranges[channel] = data[key]
+        ranges.setdefault(_RANGE_G_CHANNEL, _RANGE_G_DEFAULT)
+        return {**{k: v for k, v in data.items() if k not in BEFORE_RANGES}, "ranges": ranges}
 
 
 class FitOptions(StrictModel):
@@ -210,34 +226,13 @@ class Procedure(StrictModel):
 
     @model_validator(mode="after")
     def _gyroscope_steps_fit(self) -> Procedure:
-        if self.rates is None and self.noise is None and self.acceptance.gyro is None:
+        if self.rates is None and self.noise is None:
             return self
         if self.method != "soak" or self.cooldown is not None:
             raise ValueError("rates and noise are measured at rest at each setpoint: method: soak, no cool-down")
-        if self.acquisition.range_dps is None:
-            raise ValueError("rates and noise measure a gyroscope: set acquisition.range_dps")
-        if self.rates is not None:
-            beyond = [r for r in (*self.rates.rates_dps, *self.rates.verify_rates_dps) if r >= self.acquisition.range_dps]
-            if beyond:
-                raise ValueError(f"rates.rates_dps: {max(beyond):g} °/s is not inside the gyroscope's range "
-                                 f"(acquisition.range_dps ±{self.acquisition.range_dps:g} °/s)")
-            if self.rates.verify_rates_dps and self.verify is None:
-                raise ValueError("rates.verify_rates_dps are measured where the verification poses are: add a "
-                                 "verify: section")
-        gyro = self.acceptance.gyro
-        if gyro is not None:
-            if self.rates is None:
-                raise ValueError("acceptance.gyro judges a gyroscope's calibration: add rates:")
-            on_rates = [n for n in gyro.verification_limits() if n != "max_rest_error_dps"]
-            if on_rates and not self.rates.verify_rates_dps:
-                raise ValueError(f"acceptance.gyro.{on_rates[0]} is judged on verification rate steps: add "
-                                 "rates.verify_rates_dps")
-            if gyro.max_rest_error_dps is not None and self.verify is None:
-                raise ValueError("acceptance.gyro.max_rest_error_dps is judged on verification poses: add a verify: "
-                                 "section")
-            if gyro.parameters is not None and not min(self.setpoints_c) <= gyro.parameters.at_c <= max(self.setpoints_c):
-                raise ValueError(f"acceptance.gyro.parameters.at_c: {gyro.parameters.at_c:g} °C is outside the "
-                                 "calibrated range")
+        if self.rates is not None and self.rates.verify_rates_dps and self.verify is None:
+            raise ValueError("rates.verify_rates_dps are measured where the verification poses are: add a verify: "
+                             "section")
         if self.noise is not None and self.noise.pose > self.schedule.size:
             raise ValueError(f"noise.pose: pose {self.noise.pose} asked for, the schedule has {self.schedule.size}")
         return self
@@ -291,16 +286,12 @@ class Procedure(StrictModel):
         if verify is None:
             needed = self.acceptance.verification_limits()
             if needed:
-                raise ValueError(f"acceptance.{needed[0]} is judged on verification poses: add a verify: section")
+                raise ValueError(f"acceptance.{needed[0]} is judged on verification records: add a verify: section")
             return self
         if self.cooldown is not None:
             raise ValueError("a cool-down procedure has no verification poses (verify)")
         if verify.setpoints_c and self.method == "ramp":
             raise ValueError("verify.setpoints_c: the ramp passes every temperature; verify at_setpoints instead")
-        temperatures = len(verify.setpoints_c) + (self.verified_bands() if verify.at_setpoints else 0)
-        if self.acceptance.max_drift_mg is not None and temperatures < 2:
-            raise ValueError("acceptance.max_drift_mg is judged across verification temperatures: verify at two or "
-                             "more")
         low, high = min(self.setpoints_c), max(self.setpoints_c)
         for setpoint in verify.setpoints_c:
             if setpoint in self.setpoints_c:
@@ -313,12 +304,18 @@ class Procedure(StrictModel):
 
     @model_validator(mode="after")
     def _parameters_judged_inside(self) -> Procedure:
-        limits = self.acceptance.parameters
         low, high = min(self.setpoints_c), max(self.setpoints_c)
-        if limits is not None and not low <= limits.at_c <= high:
-            raise ValueError(f"acceptance.parameters.at_c: {limits.at_c:g} °C is outside the calibrated range "
-                             f"{low:g} … {high:g} °C")
+        for channel, limits in self.acceptance.channels.items():
+            if limits.parameters is not None and not low <= limits.parameters.at_c <= high:
+                raise ValueError(f"acceptance.{channel}.parameters.at_c: {limits.parameters.at_c:g} °C is outside the "
+                                 f"calibrated range {low:g} … {high:g} °C")
         return self
+
+    def verification_temperatures(self) -> int:
+        """How many temperatures the verification records are taken at (0 without a verify: section)."""
+        if self.verify is None:
+            return 0
+        return len(self.verify.setpoints_c) + (self.verified_bands() if self.verify.at_setpoints else 0)
 
     @model_validator(mode="after")
     def _plan_size(self) -> Procedure:

@@ -267,11 +267,11 @@ class CampaignRunner:
             identity = run.retrier.call(partial(_checked_identity, sensor))
             sensor.reset()
             sensor.standby()
-            sensor.configure(acquisition.ranges(), acquisition.odr_hz)
+            sensor.configure(acquisition.ranges, acquisition.odr_hz)
             sensor.start_measurement()
             events.info("preflight", f"sensor {sensor.serial}: {identity.describe(sensor.part.label)} "
                                      f"({sensor.part.describe_identity(identity.registers)}), "
-                                     f"{sensor.part.describe_ranges(acquisition.ranges())}, {acquisition.odr_hz:g} Hz")
+                                     f"{sensor.part.describe_ranges(acquisition.ranges)}, {acquisition.odr_hz:g} Hz")
 
     def _check_controller_limits(self, run: RunContext) -> None:
         """Every setpoint the campaign will write within what the controller itself accepts, or a fault now

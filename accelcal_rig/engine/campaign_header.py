@@ -63,12 +63,11 @@ def create_campaign_file(prepared: PreparedCampaign, output: Path, connected: Co
     mounts = {s.serial: s for s in rig.model.fixture.sensors}
     duts = [
         {"serial": s.serial, "name": mounts[s.serial].name, "mount_euler_deg": list(mounts[s.serial].mount_euler_deg),
-         "part": s.part.name, "range_g": acquisition.range_g, "odr_hz": acquisition.odr_hz,
-         "lsb_g": s.part.channel("accel").lsb(acquisition.range_g),
-         "driver": type(s).__name__, "endpoint": s.endpoint, **receipt_info(mounts[s.serial], prepared.receipt)}
+         "part": s.part.name, "odr_hz": acquisition.odr_hz, "driver": type(s).__name__, "endpoint": s.endpoint,
+         **receipt_info(mounts[s.serial], prepared.receipt)}
         for s in instruments.sensors
     ]
-    ranges = acquisition.ranges()
+    ranges = acquisition.ranges
     channels = {s.serial: tuple(ChannelInfo(c.name, c.quantity, c.unit, c.axes, ranges[c.name], c.lsb(ranges[c.name]))
                                 for c in s.part.channels) for s in instruments.sensors}
     truth = ({s.serial: instruments.truth.describe(s.serial, acquisition.odr_hz) for s in instruments.sensors}

@@ -63,7 +63,7 @@ def acquire_and_store(step: Measurement, run: RunContext, commanded: np.ndarray)
     may_saturate = frozenset(c.name for s in run.sensors for c in s.part.channels
                              if turning and c.quantity == "acceleration")
     blocks = run.retrier.call(partial(acquire_together, run.sensors, acquisition.samples_per_pose, run.clock,
-                                      acquisition.ranges(), may_saturate))
+                                      acquisition.ranges, may_saturate))
     chamber_after = run.read_chamber_c()
     run.machine.go(State.STORE, step.key)
     gravity_fixture = np.array(step.pose.gravity_fixture)
@@ -114,7 +114,7 @@ def move_to(run: RunContext, commanded: np.ndarray) -> None:
 def _dut_record(run: RunContext, index: int, block: SampleBlock, at: PoseInstant) -> DutPoseRecord:
     """Each of the DUT's channels at the pose (its part's, in order), and its temperatures against the band."""
     sensor, settled_c = run.sensors[index], run.dut.settled_c[index]
-    ranges = run.procedure.acquisition.ranges()
+    ranges = run.procedure.acquisition.ranges
     channels = {}
     for channel in sensor.part.channels:
         codes = block.codes[channel.name]

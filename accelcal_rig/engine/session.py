@@ -193,7 +193,9 @@ def _fit_stage(procedure: Procedure, output: Path, calibration: Path) -> FitStag
         fitted, report = fit_and_save(campaign, output, calibration, options, run_end=True)
         return FitOutcome(summary_line(report, calibration),
                           {serial: (r["verdict"], tuple(r["verdict_reasons"])) for serial, r in report.items()},
-                          tuple(f"sensor {serial}: {w}" for serial, r in report.items() for w in r["warnings"])
+                          tuple(f"sensor {serial}{'' if len(r['channels']) == 1 else ' ' + channel}: {w}"
+                                for serial, r in report.items() for channel, figures in r["channels"].items()
+                                for w in figures["warnings"])
                           + tuple(f"sensor {serial}: not fitted, no calibration or certificate: {why}"
                                   for serial, why in fitted.dropped.items()))
 

@@ -27,7 +27,6 @@ from accelcal_rig.export.flight_stack import (
     dps,
     gyro_not_exported,
     gyro_of,
-    gyro_offset_cubic,
     header,
     instance_index,
     mg,
@@ -39,7 +38,7 @@ from accelcal_rig.export.flight_stack import (
     refit_note,
     select_sensor,
 )
-from accelcal_rig.fit.calibration import CalibrationFile, GyroCalibration, SensorCalibration
+from accelcal_rig.fit.calibration import CalibrationFile, ChannelCalibration
 
 #: INS_TCAL1_ to INS_TCAL3_, one per IMU.
 INSTANCES = (1, 3)
@@ -57,7 +56,7 @@ def to_ardupilot_params(calibration: CalibrationFile, options: StackOptions) -> 
     n = instance_index(options, *INSTANCES, default=INSTANCES[0], parameters="ArduPilot (INS_TCAL1_ to INS_TCAL3_)")
     cubic = offset_cubic(sensor, REFERENCE_C)
     gyro = gyro_of(calibration, sensor.serial)
-    gyro_cubic = None if gyro is None else gyro_offset_cubic(gyro, REFERENCE_C)
+    gyro_cubic = None if gyro is None else offset_cubic(gyro, REFERENCE_C)
     notes = _notes(sensor, cubic, n)
     if gyro is not None and gyro_cubic is not None:
         notes += _gyro_notes(gyro, gyro_cubic, cubic, n)
@@ -96,7 +95,7 @@ def _offsets_name(n: int) -> str:
     return f"INS_ACC{'' if n == 1 else n}OFFS_X/Y/Z"
 
 
-def _notes(sensor: SensorCalibration, cubic: OffsetCubic, n: int) -> list[str]:
+def _notes(sensor: ChannelCalibration, cubic: OffsetCubic, n: int) -> list[str]:
     """What the file cannot carry or needs from the user, stated in its header and on stderr."""
     at_c = min(max(REFERENCE_C, cubic.t_min_c), cubic.t_max_c)
     return [not_exported(sensor, "ArduPilot"), range_note(sensor, cubic, "ArduPilot", f"INS_TCAL{n}_TMIN/TMAX"),
@@ -112,7 +111,7 @@ def _gyro_offsets_name(n: int) -> str:
     return f"INS_GYR{'' if n == 1 else n}OFFS_X/Y/Z"
 
 
-def _gyro_notes(gyro: GyroCalibration, cubic: OffsetCubic, accel: OffsetCubic, n: int) -> list[str]:
+def _gyro_notes(gyro: ChannelCalibration, cubic: OffsetCubic, accel: OffsetCubic, n: int) -> list[str]:
     """The gyroscope's statements: what GYR1…GYR3 cannot hold, the range it shares with the accelerometer, and
     the offset left to ArduPilot's boot-time gyro calibration."""
     at_c = min(max(REFERENCE_C, accel.t_min_c), accel.t_max_c)

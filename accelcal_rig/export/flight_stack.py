@@ -20,7 +20,8 @@ from numpy.polynomial import Polynomial
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit import gyro_model
-from accelcal_rig.fit.calibration import CalibrationFile, GyroCalibration, SensorCalibration
+from accelcal_rig.fit.calibration import CalibrationFile, ChannelCalibration
+from accelcal_rig.fit.channel_models import model_of
 from accelcal_rig.fit.sfem import error_matrix
 
 #: Both stacks hold the offset as a cubic in the temperature difference.
@@ -75,17 +76,38 @@ class ParamsExport:
     notes: tuple[str, ...]
 
 
-def select_sensor(calibration: CalibrationFile, options: StackOptions) -> SensorCalibration:
-    """The sensor `--serial` names, or the file's only one: a flight stack's parameters are one sensor's."""
-    serials = list(calibration.sensors)
+#: The roles a flight stack's thermal compensation has a place for: its accelerometers' and its gyroscopes'.
+ACCELEROMETER, GYROSCOPE = "accelerometer", "gyroscope"
+
+
+def select_sensor(calibration: CalibrationFile, options: StackOptions) -> ChannelCalibration:
+    """The accelerometer calibration of the sensor `--serial` names, or of the file's only one: a flight stack's
+    parameters are one sensor's, its accelerometer's at least (the channel whose model a stack holds as one)."""
+    serials = list(calibration.duts)
     if options.serial is None:
-        if len(serials) == 1:
-            return calibration.sensors[serials[0]]
-        raise ConfigError(f"{options.source}: sensors: {len(serials)} sensors ({_listed(serials)}): "
-                          "choose one with --serial")
-    if options.serial not in calibration.sensors:
+        if len(serials) != 1:
+            raise ConfigError(f"{options.source}: sensors: {len(serials)} sensors ({_listed(serials)}): "
+                              "choose one with --serial")
+        serial = serials[0]
+    elif options.serial not in calibration.duts:
         raise ConfigError(f"{options.source}: sensors: no sensor {options.serial!r} (the file has {_listed(serials)})")
-    return calibration.sensors[options.serial]
+    else:
+        serial = options.serial
+    found = in_role(calibration, serial, ACCELEROMETER)
+    if found is None:
+        raise ConfigError(f"{options.source}: sensor {serial}: no accelerometer calibration (its channels: "
+                          f"{', '.join(calibration.duts[serial].channels)}): a flight stack's thermal compensation "
+                          "holds an accelerometer's, and a gyroscope's beside it")
+    return found
+
+
+def in_role(calibration: CalibrationFile, serial: str, role: str) -> ChannelCalibration | None:
+    """The DUT's calibration of the channel whose model a flight stack holds in `role`, where it has one."""
+    for channel in calibration.duts[serial].channels.values():
+        stack = model_of(channel).flight_stack
+        if stack is not None and stack.role == role:
+            return channel
+    return None
 
 
 def _listed(serials: Sequence[str], most: int = 8) -> str:
@@ -101,19 +123,16 @@ def instance_index(options: StackOptions, low: int, high: int, default: int, par
     return index
 
 
-def offset_cubic(sensor: SensorCalibration, t_ref_c: float) -> OffsetCubic:
-    """The accelerometer's bias (Eq. 1's b, in g over x = (T - mid) / half-width) as a cubic in (T - t_ref_c)
-    in m/s². Up to degree 3 this is the same polynomial written about another point (exact but for rounding);
-    above, the least-squares cubic over the calibrated range, and how far it strays is part of the result."""
-    return _bias_cubic(sensor.polynomial.matrix()[:3] * STANDARD_GRAVITY_M_S2, sensor.polynomial.domain_c,
-                       sensor.validity_c, t_ref_c)
-
-
-def gyro_offset_cubic(gyro: GyroCalibration, t_ref_c: float) -> OffsetCubic:
-    """The gyroscope's bias (`bias_*_dps`, in °/s over x) as a cubic in (T - t_ref_c) in rad/s, as
-    `offset_cubic` makes the accelerometer's."""
-    return _bias_cubic(gyro.polynomial.matrix()[:3] * RAD_PER_DEG, gyro.polynomial.domain_c, gyro.validity_c,
-                       t_ref_c)
+def offset_cubic(calibration: ChannelCalibration, t_ref_c: float) -> OffsetCubic:
+    """The channel's bias (the parameters its model's `flight_stack` names, over x = (T - mid) / half-width) as a
+    cubic in (T - t_ref_c) in SI units (an accelerometer's m/s², a gyroscope's rad/s). Up to degree 3 this is the
+    same polynomial written about another point (exact but for rounding); above, the least-squares cubic over
+    the calibrated range, and how far it strays is part of the result."""
+    stack = model_of(calibration).flight_stack
+    assert stack is not None
+    rows = [list(calibration.polynomial.names).index(name) for name in stack.bias]
+    return _bias_cubic(calibration.polynomial.matrix()[rows] * stack.si_factor, calibration.polynomial.domain_c,
+                       calibration.validity_c, t_ref_c)
 
 
 def _bias_cubic(bias: np.ndarray, domain_c: tuple[float, float], validity_c: tuple[float, float],
@@ -158,7 +177,7 @@ def steepest_slope_mg_per_c(cubic: OffsetCubic) -> float:
     return steepest_slope(cubic) / STANDARD_GRAVITY_M_S2 * 1e3
 
 
-def not_exported(sensor: SensorCalibration, stack: str) -> str:
+def not_exported(sensor: ChannelCalibration, stack: str) -> str:
     """Eq. 1's S, C and M over the calibrated range, and what leaving them out costs at 1 g.
 
     With the bias alone the stack outputs U - b = A⁻¹·f for the true specific force f (A = M·C·S), so the
@@ -178,7 +197,7 @@ def not_exported(sensor: SensorCalibration, stack: str) -> str:
             f"{_spread(cross_mrad):.3f} mrad; together up to {left_mg:.3f} mg at 1 g left uncorrected")
 
 
-def gyro_not_exported(gyro: GyroCalibration, stack: str) -> str:
+def gyro_not_exported(gyro: ChannelCalibration, stack: str) -> str:
     """The gyroscope model's terms an offset-only thermal model cannot hold, over the calibrated range, and what
     leaving them out costs at full scale.
 
@@ -193,7 +212,7 @@ def gyro_not_exported(gyro: GyroCalibration, stack: str) -> str:
     nonlinearity_ppm = parameters[:, gyro_model.NONLINEARITY] * 1e6
     gsens = gyro_model.gsensitivity_matrix(parameters)
     gsens_norm = np.linalg.norm(gsens, ord=2, axis=(1, 2))
-    rate_dps = gyro.range_dps * _sphere(_DIRECTIONS)
+    rate_dps = gyro.range * _sphere(_DIRECTIONS)
     left = [np.linalg.norm(_rate_terms_left(p, rate_dps), axis=1).max() for p in parameters[:: _GRID_POINTS // 40]]
     together = float(max(left)) + float(gsens_norm.max())
     return (f"not exported ({stack} holds gyro offsets only): scale error up to {np.max(np.abs(scale_ppm)):.0f} ppm, "
@@ -202,7 +221,7 @@ def gyro_not_exported(gyro: GyroCalibration, stack: str) -> str:
             f"by up to {_spread(cross_mrad):.3f} mrad; +/- asymmetry up to {np.max(np.abs(asymmetry_ppm)):.0f} ppm; "
             f"cubic nonlinearity up to {np.max(np.abs(nonlinearity_ppm)):.0f} ppm at 1000 deg/s; g-sensitivity up "
             f"to {gsens_norm.max():.4f} deg/s per g, changing by up to {_spread(gsens.reshape(len(gsens), 9)):.4f} "
-            f"deg/s per g; together up to {together:.3f} deg/s at full scale ({gyro.range_dps:g} deg/s) and 1 g "
+            f"deg/s per g; together up to {together:.3f} deg/s at full scale ({gyro.range:g} deg/s) and 1 g "
             "left uncorrected")
 
 
@@ -228,11 +247,10 @@ def _spread(values: np.ndarray) -> float:
     return float(np.max(values.max(axis=0) - values.min(axis=0)))
 
 
-def range_note(sensor: SensorCalibration | GyroCalibration, cubic: OffsetCubic, stack: str, names: str) -> str:
+def range_note(sensor: ChannelCalibration, cubic: OffsetCubic, stack: str, names: str, label: str = "temperature") -> str:
     """The calibrated range against the clipping range written (the same), and what each does beyond it."""
     low, high = sensor.validity_c
     beyond = "clamps" if sensor.out_of_range == "clamp" else "extrapolates"
-    label = "gyro temperature" if isinstance(sensor, GyroCalibration) else "temperature"
     return (f"{label}: calibrated {low:.2f} to {high:.2f} degC (beyond it the calibration {beyond}); {names} "
             f"written {cubic.t_min_c:.2f} to {cubic.t_max_c:.2f} degC: {stack} clips the temperature to them, so "
             "beyond them it holds the offset of the nearer end")
@@ -261,9 +279,9 @@ def dps(values_rad_s: np.ndarray) -> str:
     return ", ".join(f"{v:.5f}" for v in np.asarray(values_rad_s) / RAD_PER_DEG)
 
 
-def gyro_of(calibration: CalibrationFile, serial: str) -> GyroCalibration | None:
+def gyro_of(calibration: CalibrationFile, serial: str) -> ChannelCalibration | None:
     """The DUT's gyroscope calibration, where it has one: a flight stack's file then carries it too."""
-    return calibration.gyroscopes.get(serial)
+    return in_role(calibration, serial, GYROSCOPE)
 
 
 GYRO_AXES_NOTE = ("the gyro coefficients are in the gyroscope's own x, y, z as calibrated (its sensitivity matrix "

@@ -11,12 +11,17 @@ from accelcal_rig.durable import write_text_atomically
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.export.ardupilot import to_ardupilot_params
 from accelcal_rig.export.c_header import to_c_header
-from accelcal_rig.export.flight_stack import StackOptions
+from accelcal_rig.export.flight_stack import ACCELEROMETER, GYROSCOPE, StackOptions
 from accelcal_rig.export.px4 import to_px4_params
 from accelcal_rig.export.tables import to_csv, to_json
 from accelcal_rig.fit.calibration import CalibrationFile
+from accelcal_rig.fit.channel_model import ChannelModel
+from accelcal_rig.fit.channel_models import model_of
 
 FORMATS = ("json", "csv", "c-header", "px4-params", "ardupilot-params")
+STACK_FORMATS = ("px4-params", "ardupilot-params")
+#: The sensors a flight stack's thermal compensation holds.
+STACK_ROLES = (ACCELEROMETER, GYROSCOPE)
 
 
 @dataclass(frozen=True)
@@ -36,28 +41,36 @@ def export(calibration: CalibrationFile, format_name: str, options: StackOptions
     if (options.serial, options.instance, options.device_id) != (None, None, None):
         raise ConfigError(f"--serial, --instance and --device-id are for px4-params and ardupilot-params, not {format_name}")
     text = {"json": to_json, "csv": to_csv, "c-header": to_c_header}[format_name](calibration)
-    return Exported(text, f"{len(calibration.sensors)} sensors",
-                    tuple(not_exported(calibration, calibration.sensors, format_name)))
-
-
-#: The formats that leave a calibrated gyroscope out (every other one carries it beside the accelerometer).
-WITHOUT_GYRO = {"csv": "the json export and the c-header carry it"}
+    return Exported(text, f"{len(calibration.duts)} sensors",
+                    tuple(not_exported(calibration, calibration.duts, format_name)))
 
 
 def not_exported(calibration: CalibrationFile, serials: Iterable[str], format_name: str = "") -> list[str]:
-    """The channels of these DUTs an export leaves out, each with why: every export holds the accel channel, and
-    every one but csv a calibrated gyro channel; a channel no model calibrated is in none."""
+    """The channels of these DUTs an export leaves out, each with why: json, csv and the c-header hold every
+    calibrated channel (the c-header every one whose model has C code); a flight stack's file the channels its
+    thermal compensation has a place for; a channel no model calibrated is in none."""
     uncalibrated = calibration.not_calibrated()
-    gyroscopes = calibration.gyroscopes
     notes = []
     for serial in serials:
         notes += [f"sensor {serial}: its {channel} channel is not in this export: not calibrated ({why})"
                   for channel, why in uncalibrated.get(serial, {}).items()
                   if channel not in calibration.duts[serial].channels]
-        if serial in gyroscopes and format_name in WITHOUT_GYRO:
-            notes.append(f"sensor {serial}: its gyro channel (calibrated, model gyro-rate-table) is not in this "
-                         f"{format_name} export: {WITHOUT_GYRO[format_name]}")
+        for channel, calibrated in calibration.duts[serial].channels.items():
+            model = model_of(calibrated)
+            why = _left_out(model, format_name)
+            if why:
+                notes.append(f"sensor {serial}: its {channel} channel (calibrated, model {calibrated.model}) is not in "
+                             f"this {format_name} export: {why}")
     return notes
+
+
+def _left_out(model: ChannelModel, format_name: str) -> str:
+    """Why an export cannot hold a calibrated channel of this model ("": it holds it)."""
+    if format_name == "c-header" and model.c_export is None:
+        return f"the {model.sensor} model has no C code (the json export carries it)"
+    if format_name in STACK_FORMATS and (model.flight_stack is None or model.flight_stack.role not in STACK_ROLES):
+        return f"the flight stack's thermal compensation has no place for a {model.sensor} (the json export carries it)"
+    return ""
 
 
 def write_export(exported: Exported, format_name: str, output: Path | None) -> int:

@@ -22,7 +22,6 @@ from accelcal_rig.export.flight_stack import (
     dps,
     gyro_not_exported,
     gyro_of,
-    gyro_offset_cubic,
     header,
     instance_index,
     mg,
@@ -35,7 +34,7 @@ from accelcal_rig.export.flight_stack import (
     steepest_slope,
     steepest_slope_mg_per_c,
 )
-from accelcal_rig.fit.calibration import CalibrationFile, GyroCalibration, SensorCalibration
+from accelcal_rig.fit.calibration import CalibrationFile, ChannelCalibration
 
 #: TC_A0_… to TC_A3_… and TC_G0_… to TC_G3_… (the module's ACCEL_COUNT_MAX and GYRO_COUNT_MAX are 4); which one
 #: holds a sensor does not matter, its ID does.
@@ -58,7 +57,7 @@ def to_px4_params(calibration: CalibrationFile, options: StackOptions) -> Params
     low, high = sensor.validity_c
     cubic = offset_cubic(sensor, round(0.5 * (low + high), 2))  # a TREF the file holds exactly
     gyro = gyro_of(calibration, sensor.serial)
-    gyro_cubic = None if gyro is None else gyro_offset_cubic(gyro, round(0.5 * sum(gyro.validity_c), 2))
+    gyro_cubic = None if gyro is None else offset_cubic(gyro, round(0.5 * sum(gyro.validity_c), 2))
     device_id = 0 if options.device_id is None else options.device_id
     notes = _notes(sensor, cubic, n, device_id)
     if gyro is not None and gyro_cubic is not None:
@@ -96,7 +95,7 @@ def _parameters(kind: str, n: int, device_id: int, cubic: OffsetCubic) -> list[t
     return sorted(params)
 
 
-def _notes(sensor: SensorCalibration, cubic: OffsetCubic, n: int, device_id: int) -> list[str]:
+def _notes(sensor: ChannelCalibration, cubic: OffsetCubic, n: int, device_id: int) -> list[str]:
     """What the file cannot carry or needs from the user, stated in its header and on stderr."""
     notes = [not_exported(sensor, "PX4"), range_note(sensor, cubic, "PX4", f"TC_A{n}_TMIN/TMAX"),
              *refit_note(cubic, "PX4"),
@@ -111,9 +110,9 @@ def _notes(sensor: SensorCalibration, cubic: OffsetCubic, n: int, device_id: int
     return notes
 
 
-def _gyro_notes(gyro: GyroCalibration, cubic: OffsetCubic, n: int, device_id: int) -> list[str]:
+def _gyro_notes(gyro: ChannelCalibration, cubic: OffsetCubic, n: int, device_id: int) -> list[str]:
     """The gyroscope's statements: what TC_G cannot hold, its range, X0, the republish step and its ID."""
-    notes = [gyro_not_exported(gyro, "PX4"), range_note(gyro, cubic, "PX4", f"TC_G{n}_TMIN/TMAX"),
+    notes = [gyro_not_exported(gyro, "PX4"), range_note(gyro, cubic, "PX4", f"TC_G{n}_TMIN/TMAX", "gyro temperature"),
              *refit_note(cubic, "PX4", what="gyro bias"),
              f"TC_G{n}_X0_ holds the gyro offset at TREF = {cubic.t_ref_c:.2f} degC ({dps(cubic.coefficients[:, 0])} "
              "deg/s): the CAL_GYRO offsets PX4 subtracts after it must not hold it again (zero them, and do not "

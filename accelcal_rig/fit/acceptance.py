@@ -4,8 +4,10 @@ passes, CONDITIONAL when one lies inside its guard band (guarded acceptance) and
 reasons otherwise; NOT JUDGED when the procedure states no limit (no specification, no statement of
 conformity: the results and their uncertainties are all there is to say).
 
-Verification limits are judged on the verification poses only; parameter limits on the calibration at the
-limits' temperature; a campaign that stopped before its last pose fails unless the procedure allows it.
+Every quantity is judged alike: the channel's model (fit/channel_model.py) names the verification figures a
+limit may judge and its kinds of parameter. Verification limits are judged on the verification records only;
+parameter limits on the calibration at the limits' temperature; a campaign that stopped before its last pose
+fails unless the procedure allows it.
 """
 
 from __future__ import annotations
@@ -21,14 +23,16 @@ from accelcal_rig.config.acceptance import Acceptance
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.yaml_lines import parse_yaml_text
 from accelcal_rig.errors import ConfigError
+from accelcal_rig.fit.channel_model import ChannelFit, ChannelModel, ParameterGroup
 from accelcal_rig.fit.decision import DecisionRule, LimitCheck, check, is_conditional, worst
 from accelcal_rig.fit.parameter_uncertainty import ParameterUncertainty
 from accelcal_rig.fit.thermal import ThermalModel
 from accelcal_rig.fit.uncertainty import COVERAGE_FACTOR
 
 Verdict = Literal["PASS", "FAIL", "CONDITIONAL", "NOT JUDGED"]
-#: The reason of a calibration that no limits judged.
+#: The reason of a calibration that no limits judged (and a gyroscope's, before limits were keyed by channel).
 NO_LIMITS = "no acceptance limits stated"
+UNJUDGED_REASONS = (NO_LIMITS, "no gyroscope acceptance limits stated")
 NOT_JUDGED: Verdict = "NOT JUDGED"
 
 
@@ -81,40 +85,28 @@ def verdict_of(checks: list[LimitCheck], rule: DecisionRule, partial: tuple[bool
     return Judgement(verdict, reasons + notes, checks, rule.statement())
 
 
-def judge(metrics: dict[str, Any], thermal: ThermalModel, mode: str, limits: Acceptance, partial: str = "",
-          parameter_u: ParameterUncertainty | None = None) -> Judgement:
-    """Every stated limit against the fit's figures, each with its own expanded uncertainty under the
-    procedure's decision rule; `partial` says how the campaign fell short, if it did."""
-    rule = rule_of(limits)
+def judge(model: ChannelModel, channel: str, fitted: ChannelFit, acceptance: Acceptance,
+          partial: str = "") -> Judgement:
+    """Every limit the procedure states on this channel (`acceptance.<channel>`) against its fit's figures, each
+    with its own expanded uncertainty under the procedure's decision rule; `partial` says how the campaign fell
+    short, if it did. The figures and parameters a limit names are the channel model's."""
+    rule = rule_of(acceptance)
+    limits = acceptance.channels.get(channel)
     checks: list[LimitCheck] = []
     missing: list[str] = []
-    verification = metrics.get("verification")
-    expanded = (verification or {}).get("expanded_u", {})
-    figures = [("max_verification_rmse_mg", "verification |g| RMSE", "rmse_mg", "mg"),
-               ("max_axis_error_mg", "largest verification axis error", "max_axis_error_mg", "mg"),
-               ("max_tilt_error_deg", "largest verification tilt error", "max_tilt_error_deg", "°")]
-    for key, label, figure, unit in figures:
-        limit = getattr(limits, key)
-        if limit is None:
-            continue
-        if verification is None:
-            missing.append(f"{label}: no verification poses stored (limit {limit:g} {unit})")
-            continue
-        checks.append(check(key, label, float(verification[figure]), expanded.get(figure), limit, unit, rule))
-    if limits.max_drift_mg is not None:
-        if verification is None or len(verification["by_setpoint"]) < 2:
-            missing.append(f"verification drift: fewer than two verification temperatures (limit "
-                           f"{limits.max_drift_mg:g} mg)")
-        else:
-            drift_u = expanded.get("drift_mg", [None] * 3)
-            checks += [check("max_drift_mg", f"verification drift of {axis}", float(d), drift_u[a],
-                             limits.max_drift_mg, "mg", rule) for a, (axis, d) in enumerate(zip("xyz", verification["drift_mg"]))]
-    notes = []
-    if limits.parameters is not None:
-        checks.extend(_parameter_checks(thermal, mode, limits, rule, parameter_u))
-        if mode != "reference" and limits.parameters.misalignment_mrad is not None:
-            notes.append("misalignment not judged: a norm-only fit determines none")
-    judgement = verdict_of(checks, rule, _partial(partial, limits.allow_partial), NO_LIMITS)
+    notes: list[str] = []
+    if limits is not None:
+        verification = fitted.figures.get("verification")
+        checks, missing = _figure_checks(model, channel, limits.figure_limits(), verification, rule)
+        if limits.parameters is not None:
+            stated = limits.parameters.limits()
+            _known_keys(model, channel, stated)
+            groups, unjudged = model.judged_groups(fitted.calibration)
+            checks += parameter_checks(fitted.thermal, limits.parameters.at_c, fitted.parameter_u, model,
+                                       [g for g in groups if g.key in stated], stated, rule, channel)
+            left_out = [g for g in model.parameter_groups if g not in groups]
+            notes = [note for note, group in zip(unjudged, left_out) if group.key in stated]
+    judgement = verdict_of(checks, rule, _partial(partial, acceptance.allow_partial), NO_LIMITS)
     if notes and not missing:
         reasons = notes if judgement.verdict == NOT_JUDGED and not partial else judgement.reasons + notes
         return Judgement(judgement.verdict, reasons, judgement.checks, judgement.rule)
@@ -124,19 +116,59 @@ def judge(metrics: dict[str, Any], thermal: ThermalModel, mode: str, limits: Acc
     return judgement
 
 
+def _figure_checks(model: ChannelModel, channel: str, stated: dict[str, float], verification: dict[str, Any] | None,
+                   rule: DecisionRule) -> tuple[list[LimitCheck], list[str]]:
+    """Each stated figure limit against the verification figure it names (each axis of a per-axis one); the
+    limits with nothing to judge them on, each with why."""
+    _known_keys(model, channel, stated)
+    checks: list[LimitCheck] = []
+    missing: list[str] = []
+    expanded = (verification or {}).get("expanded_u", {})
+    for spec in model.limits:
+        limit = stated.get(spec.key)
+        if limit is None:
+            continue
+        value = None if verification is None else verification.get(spec.figure)
+        if value is None:
+            missing.append(f"{spec.label}: {spec.missing} (limit {limit:g} {spec.unit})")
+            continue
+        if spec.needs_temperatures and len((verification or {}).get("by_setpoint", [])) < spec.needs_temperatures:
+            missing.append(f"{spec.label}: fewer than {_COUNTS.get(spec.needs_temperatures, spec.needs_temperatures)} "
+                           f"verification temperatures (limit {limit:g} {spec.unit})")
+            continue
+        key = f"{channel}.{spec.key}"
+        if isinstance(value, list):
+            uncertainty = expanded.get(spec.figure) or [None] * len(value)
+            checks += [check(key, f"{spec.label} of {axis}", float(v), u, limit, spec.unit, rule)
+                       for axis, v, u in zip("xyz", value, uncertainty)]
+        else:
+            checks.append(check(key, spec.label, float(value), expanded.get(spec.figure), limit, spec.unit, rule))
+    return checks, missing
+
+
+_COUNTS = {2: "two", 3: "three"}
+
+
+def _known_keys(model: ChannelModel, channel: str, stated: dict[str, float]) -> None:
+    """A limit its channel's model does not know is the procedure's mistake (the run's preparation refuses it; a
+    campaign stored before a model changed may still hold one)."""
+    known = {spec.key for spec in model.limits} | {group.key for group in model.parameter_groups}
+    unknown = [key for key in stated if key not in known]
+    if unknown:
+        raise ConfigError(f"acceptance.{channel}: {unknown[0]} is not a limit of the {model.sensor} model (its limits: "
+                          f"{', '.join(sorted(known))})")
+
+
 def _partial(partial: str, allowed: bool) -> tuple[bool, str] | None:
     if not partial:
         return None
     return allowed, partial + (" (acceptance.allow_partial)" if allowed else ": a partial campaign fails")
 
 
-#: One parameter limit: (procedure key, label, limit, the parameters it judges, unit factor, offset, unit, names).
-ParameterLimit = tuple[str, str, "float | None", Any, float, float, str, Sequence[str]]
-
-
 def parameter_checks(thermal: ThermalModel, at_c: float, parameter_u: ParameterUncertainty | None,
-                     limits: list[ParameterLimit], rule: DecisionRule, prefix: str = "") -> list[LimitCheck]:
-    """Every stated parameter limit of any channel's model against its parameters at `at_c`, each with its own
+                     model: ChannelModel, groups: Sequence[ParameterGroup], stated: dict[str, float],
+                     rule: DecisionRule, channel: str) -> list[LimitCheck]:
+    """Every stated parameter limit of a channel's model against its parameters at `at_c`, each with its own
     expanded uncertainty there: (value + offset) × factor, signed. Outside the DUTs' own range the range's
     nearest edge is judged, and said so."""
     at = thermal.parameters_at(at_c, "clamp")
@@ -145,29 +177,13 @@ def parameter_checks(thermal: ThermalModel, at_c: float, parameter_u: ParameterU
     where = f"{at_c:g} °C" if used_c == at_c else f"{used_c:.2f} °C (the calibrated range's edge nearest {at_c:g} °C)"
     u = COVERAGE_FACTOR * parameter_u.standard(at_c)[0] if parameter_u is not None else np.full(len(at), np.nan)
     checks = []
-    for key, label, limit, index, factor, offset, unit, names in limits:
-        if limit is None:
-            continue
-        values, expanded = (np.atleast_1d(at[index]) + offset) * factor, np.atleast_1d(u[index]) * factor
-        checks += [check(f"{prefix}parameters.{key}", f"{prefix.rstrip('.') + ' ' if prefix else ''}{label} {name} at "
-                         f"{where}", float(v), None if np.isnan(e) else float(e), limit, unit, rule, signed=True)
-                   for name, v, e in zip(names, values, expanded)]
+    for group in groups:
+        index = [model.parameter_names.index(name) for name in group.names]
+        values, expanded = (at[index] + group.offset) * group.factor, u[index] * group.factor
+        checks += [check(f"{channel}.parameters.{group.key}", f"{group.label} {column} at {where}", float(v),
+                         None if np.isnan(e) else float(e), stated[group.key], group.unit, rule, signed=True)
+                   for column, v, e in zip(group.columns, values, expanded)]
     return checks
-
-
-def _parameter_checks(thermal: ThermalModel, mode: str, limits: Acceptance, rule: DecisionRule,
-                      parameter_u: ParameterUncertainty | None) -> list[LimitCheck]:
-    """Eq. 1's limits (misalignment only where a reference fit determines it)."""
-    assert limits.parameters is not None
-    p = limits.parameters
-    rows: list[ParameterLimit] = [
-        ("bias_mg", "bias", p.bias_mg, slice(0, 3), 1e3, 0.0, "mg", "xyz"),
-        ("scale_error_ppm", "scale error", p.scale_error_ppm, slice(3, 6), 1e6, -1.0, "ppm", "xyz"),
-        ("nonorthogonality_mrad", "non-orthogonality", p.nonorthogonality_mrad, slice(6, 9), 1e3, 0.0, "mrad",
-         ("yx", "zx", "zy"))]
-    if mode == "reference":
-        rows.append(("misalignment_mrad", "misalignment", p.misalignment_mrad, slice(9, 12), 1e3, 0.0, "mrad", "xyz"))
-    return parameter_checks(thermal, p.at_c, parameter_u, rows, rule)
 
 
 def recorded_acceptance(procedure_yaml: str, where: str) -> Acceptance:

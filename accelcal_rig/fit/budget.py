@@ -29,7 +29,7 @@ from accelcal_rig.fit.uncertainty import (
     output_uncertainty,
     two_stage_map,
 )
-from accelcal_rig.store.read import DutPoses
+from accelcal_rig.store.read import VectorPoses
 
 #: Orientations and temperatures the worst case is sought over.
 BUDGET_ORIENTATIONS = 48
@@ -58,7 +58,7 @@ class FittedTerms:
         return self.approach[:, None] * self.hysteresis_g + self.rate_c_per_min[:, None] * self.rate_g
 
 
-def calibration_covariance(poses: DutPoses, groups: list[np.ndarray], fits: list[SfemFit], thermal: ThermalModel,
+def calibration_covariance(poses: VectorPoses, groups: list[np.ndarray], fits: list[SfemFit], thermal: ThermalModel,
                            temperatures: np.ndarray, pose_temperatures: np.ndarray, mode: FitMode,
                            joint: bool, terms: FittedTerms | None = None) -> CoefficientCovariance:
     """The coefficients' covariance by source, for the estimator the fit used.
@@ -81,7 +81,7 @@ def calibration_covariance(poses: DutPoses, groups: list[np.ndarray], fits: list
     sigmas = np.array([f.sigma for f in fits])
     rows = np.concatenate(groups)
     per_pose_rows = 3 if mode == "reference" else 1
-    shift = terms.shift_g() if terms is not None else np.zeros((len(poses.mean_g), 3))
+    shift = terms.shift_g() if terms is not None else np.zeros((len(poses.mean), 3))
     n_coefficients = int(np.sum(free)) * n_powers
     if joint:
         powers = [np.vander(thermal.scaled(pose_temperatures[g]), n_powers, increasing=True) for g in groups]
@@ -96,16 +96,16 @@ def calibration_covariance(poses: DutPoses, groups: list[np.ndarray], fits: list
         mapping = two_stage_map([f.jacobian for f in fits], thermal.scaled(temperatures), sigmas, free, n_powers)
         residual_model = thermal.residuals if len(thermal.residuals) else np.zeros((0, 12))
     accuracy = np.radians(poses.reference_accuracy_arcsec / 3600)
-    compensated = correct(poses.mean_g[rows] - shift[rows], thermal.parameters_at(pose_temperatures[rows], "extrapolate"))
+    compensated = correct(poses.mean[rows] - shift[rows], thermal.parameters_at(pose_temperatures[rows], "extrapolate"))
     if mode == "reference":
-        reference = poses.reference_g[rows]
-        sigma = reference_sigma_g(np.maximum(poses.stderr_g[rows], 1e-9), reference, accuracy)
+        reference = poses.reference[rows]
+        sigma = reference_sigma_g(np.maximum(poses.stderr[rows], 1e-9), reference, accuracy)
         residuals = ((compensated - reference) / sigma).ravel()
     else:
         reference = None
-        residuals = (np.linalg.norm(compensated, axis=1) - poses.gravity_g) / norm_sigma(poses.mean_g[rows],
-                                                                                          poses.stderr_g[rows])
-    found = coefficient_covariance(mapping, reference, poses.stderr_g[rows], accuracy, free, n_powers, residuals,
+        residuals = (np.linalg.norm(compensated, axis=1) - poses.magnitude) / norm_sigma(poses.mean[rows],
+                                                                                          poses.stderr[rows])
+    found = coefficient_covariance(mapping, reference, poses.stderr[rows], accuracy, free, n_powers, residuals,
                                    residual_model, sigmas, temperatures)
     if joint:  # the bands' own biases about the model: the polynomial's and the terms' coefficients fitted per axis
         offsets, offset_sigma, left = band_misfit(residuals, jacobian, [f.jacobian[:, 0:3] for f in fits])
@@ -157,7 +157,7 @@ def hysteresis_u_g(h_g: np.ndarray, h_variance_g2: np.ndarray) -> np.ndarray:
     return np.sqrt(np.asarray(h_g, dtype=float) ** 2 + np.maximum(np.asarray(h_variance_g2, dtype=float), 0.0))
 
 
-def temperature_scatter_c(poses: DutPoses, pose_temperatures: np.ndarray, n_groups: int) -> float:
+def temperature_scatter_c(poses: VectorPoses, pose_temperatures: np.ndarray, n_groups: int) -> float:
     """The scatter of a pose's temperature reading about its setpoint's line in time: the uncertainty of a
     reading's temperature."""
     residual = poses.temperature_c - pose_temperatures
@@ -175,17 +175,18 @@ def smoothed_temperature_u_c(t_s: np.ndarray, groups: list[np.ndarray], scatter_
     return u
 
 
-def budget(poses: DutPoses, covariance: CoefficientCovariance, thermal: ThermalModel, temperatures: np.ndarray,
-           scatter_c: float) -> dict[str, Any]:
+def budget(poses: VectorPoses, covariance: CoefficientCovariance, thermal: ThermalModel, temperatures: np.ndarray,
+           scatter_c: float, milli: str = "mg") -> dict[str, Any]:
     """The budget of a reading like a calibration pose at each calibration temperature and the worst case
-    over the range, per axis, in mg: each source's largest value over every orientation, and the combined."""
+    over the range, per axis, in thousandths of the channel's unit (`milli`: mg for an accelerometer): each
+    source's largest value over every orientation, and the combined."""
     grid = np.unique(np.concatenate([temperatures, np.linspace(*thermal.domain_c, BUDGET_TEMPERATURES)]))
-    directions = fibonacci_sphere(BUDGET_ORIENTATIONS) * poses.gravity_g
+    directions = fibonacci_sphere(BUDGET_ORIENTATIONS) * poses.magnitude
     t = np.repeat(grid, len(directions))
     raw = distort(np.tile(directions, (len(grid), 1)), thermal.parameters_at(t, "extrapolate"))
-    reading = np.median(poses.stderr_g, axis=0)
+    reading = np.median(poses.stderr, axis=0)
     sources = output_uncertainty(raw, t, thermal, covariance, np.tile(reading, (len(t), 1)), np.full(len(t), scatter_c),
-                                 poses.gravity_uncertainty_g / poses.gravity_g)
+                                 poses.magnitude_u / poses.magnitude)
     standard = combined(sources)
 
     def worst(values: np.ndarray, at: np.ndarray) -> list[float]:
@@ -194,20 +195,20 @@ def budget(poses: DutPoses, covariance: CoefficientCovariance, thermal: ThermalM
     rows = []
     for temperature in temperatures:
         at = np.isclose(t, temperature)
-        rows.append({"temperature_c": float(temperature), "standard_mg": worst(standard, at),
-                     "expanded_mg": [COVERAGE_FACTOR * u for u in worst(standard, at)],
-                     "sources_mg": {name: worst(u, at) for name, u in sources.items()}})
+        rows.append({"temperature_c": float(temperature), f"standard_{milli}": worst(standard, at),
+                     f"expanded_{milli}": [COVERAGE_FACTOR * u for u in worst(standard, at)],
+                     f"sources_{milli}": {name: worst(u, at) for name, u in sources.items()}})
     everywhere = np.ones(len(t), dtype=bool)
     per_temperature = standard.reshape(len(grid), len(directions), 3).max(axis=1)
     return {
         "coverage_factor": COVERAGE_FACTOR,
         "reading": f"a reading averaged like a calibration pose (standard error {', '.join(f'{r * 1e3:.4f}' for r in reading)} "
-                   f"mg per axis), its temperature read like a pose's (±{scatter_c:.3f} °C)",
-        "reading_stderr_mg": (reading * 1e3).tolist(),
+                   f"{milli} per axis), its temperature read like a pose's (±{scatter_c:.3f} °C)",
+        f"reading_stderr_{milli}": (reading * 1e3).tolist(),
         "temperature_u_c": scatter_c,
-        "sources_mg": {name: worst(u, everywhere) for name, u in sources.items()},
-        "standard_mg": worst(standard, everywhere),
-        "expanded_mg": [COVERAGE_FACTOR * u for u in worst(standard, everywhere)],
+        f"sources_{milli}": {name: worst(u, everywhere) for name, u in sources.items()},
+        f"standard_{milli}": worst(standard, everywhere),
+        f"expanded_{milli}": [COVERAGE_FACTOR * u for u in worst(standard, everywhere)],
         "worst_at_c": grid[np.argmax(per_temperature, axis=0)].tolist(),
         "by_temperature": rows,
         "not_included": not_included(poses, covariance),
@@ -219,7 +220,7 @@ def budget(poses: DutPoses, covariance: CoefficientCovariance, thermal: ThermalM
 MOVING_C_PER_MIN = 0.1
 
 
-def not_included(poses: DutPoses, covariance: CoefficientCovariance) -> dict[str, str]:
+def not_included(poses: VectorPoses, covariance: CoefficientCovariance) -> dict[str, str]:
     """What the budget leaves out because this calibration cannot measure it, each with why: the
     hysteresis where no fit measured it; the bias by the rate of temperature change where the calibration
     poses were taken while it moved and no fit measured it."""
@@ -243,24 +244,30 @@ def not_included(poses: DutPoses, covariance: CoefficientCovariance) -> dict[str
     return missing
 
 
-def truth_errors(checks: DutPoses, covariance: CoefficientCovariance, thermal: ThermalModel,
+def truth_errors(checks: VectorPoses, covariance: CoefficientCovariance, thermal: ThermalModel,
                  compensated_g: np.ndarray, temperature_c: np.ndarray, temperature_u_c: np.ndarray,
                  mode: FitMode, out_of_range: OutOfRange) -> tuple[np.ndarray, dict[str, np.ndarray]] | None:
-    """Dry runs: each verification pose's axis errors (n, 3) in g against the simulation truth, and the
-    budget's sources of its standard uncertainty (output_uncertainty); None without a truth. The truth is
-    what the true parameters, in the fit's gauge, make of the noiseless reading: the true gravity itself in
-    reference mode."""
-    if checks.truth_parameters is None or checks.truth_gravity_g is None:
+    """Dry runs: each verification pose's axis errors (n, 3) in the channel's unit against the simulation truth,
+    and the budget's sources of its standard uncertainty (output_uncertainty); None without a truth. The truth
+    is what the true parameters, in the fit's gauge, make of the noiseless reading (the true reference itself
+    in reference mode) where the campaign stored the true reference; else what they make of the reading
+    itself (its noise then in neither)."""
+    if checks.truth_parameters is None:
         return None
     truth = checks.truth_parameters
     gauge = norm_only_gauge(truth) if mode == "norm-only" else truth
-    expected = correct(distort(checks.truth_gravity_g, truth), gauge)
-    sources = output_uncertainty(checks.mean_g, temperature_c, thermal, covariance, checks.stderr_g, temperature_u_c,
-                                 checks.gravity_uncertainty_g / checks.gravity_g, out_of_range)
+    if checks.truth_reference is None:
+        expected = correct(checks.mean, gauge)
+        sources = output_uncertainty(checks.mean, temperature_c, thermal, covariance, np.zeros_like(checks.stderr),
+                                     temperature_u_c, checks.magnitude_u / checks.magnitude, out_of_range)
+        return compensated_g - expected, sources
+    expected = correct(distort(checks.truth_reference, truth), gauge)
+    sources = output_uncertainty(checks.mean, temperature_c, thermal, covariance, checks.stderr, temperature_u_c,
+                                 checks.magnitude_u / checks.magnitude, out_of_range)
     return compensated_g - expected, sources
 
 
-def truth_coverage(checks: DutPoses, covariance: CoefficientCovariance, thermal: ThermalModel,
+def truth_coverage(checks: VectorPoses, covariance: CoefficientCovariance, thermal: ThermalModel,
                    compensated_g: np.ndarray, temperature_c: np.ndarray, temperature_u_c: np.ndarray,
                    mode: FitMode, out_of_range: OutOfRange) -> float | None:
     """Dry runs: the fraction of verification-pose axis errors against the simulation truth (truth_errors)

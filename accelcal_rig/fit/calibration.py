@@ -1,40 +1,40 @@
-"""The calibration file: per DUT, one calibration per channel (the thermal polynomials of Eq. 1's parameters
-and how they were made), and the channels it measured that no channel model calibrates yet, each with why.
+"""The calibration file: per DUT, one calibration per channel (its channel model's parameters as polynomials of
+the sensor's temperature, and how they were made), and the channels it measured that no channel model
+calibrates, each with why.
 
-A versioned YAML artefact, checked on load. Version 2 holds `duts: {serial: {channels: {accel: …},
-not_calibrated: {gyro: why}}}`; version 1 (`sensors: {serial: …}`, every DUT an accelerometer) is read as
-version 2 with each calibration its DUT's `accel` channel. `apply` compensates raw readings with it.
+A versioned YAML artefact, checked on load. Version 3 holds `duts: {serial: {channels: {accel: …, gyro: …},
+not_calibrated: {…: why}}}`, every channel's calibration the one shape `ChannelCalibration` (its `quantity`
+names its model). Version 2 (each quantity's entry its own shape: `range_g`, `range_dps`) and version 1
+(`sensors: {serial: …}`, every DUT an accelerometer, read as its `accel` channel) are read as version 3.
+`apply` compensates raw readings with it, as the channel's model does.
 """
 
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import yaml
-from pydantic import Discriminator, Field, Tag, field_validator, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from accelcal_rig.config.bounds import StrictModel, TemperatureC
 from accelcal_rig.config.load import load_validated
 from accelcal_rig.config.yaml_lines import CALIBRATION_LIMITS
 from accelcal_rig.durable import clear_dead_temporaries, write_text_atomically
-from accelcal_rig.fit import gyro_model
-from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
 
 FORMAT_NAME = "accelcal-rig calibration"
-FORMAT_VERSION = 2
-READABLE_VERSIONS = (1, 2)
-#: The channel every version-1 calibration is, and the one readers that handle a single channel take.
-ACCELERATION = "accel"
-#: A six-axis part's gyroscope channel.
-ANGULAR_RATE = "gyro"
+FORMAT_VERSION = 3
+READABLE_VERSIONS = (1, 2, 3)
+#: The quantity every version-1 calibration is (an accelerometer's), and its channel's name then.
+VERSION_1_QUANTITY = "acceleration"
+VERSION_1_CHANNEL = "accel"
 
 
 class CalibrationRangeWarning(UserWarning):
     """Samples outside the calibrated temperature range were clamped or extrapolated."""
-
 
 
 def _ordered(value: tuple[float, float]) -> tuple[float, float]:
@@ -44,27 +44,20 @@ def _ordered(value: tuple[float, float]) -> tuple[float, float]:
 
 
 class PolynomialModel(StrictModel):
-    """Each parameter's coefficients in x = (T − mid(domain)) / half-width(domain), increasing powers."""
-
-    #: The model's parameters, in its order: Eq. 1's.
-    NAMES: ClassVar[tuple[str, ...]] = PARAMETER_NAMES
+    """Each parameter's coefficients in x = (T − mid(domain)) / half-width(domain), increasing powers, in the
+    order of its channel model's parameters (checked by the calibration that holds it)."""
 
     domain_c: tuple[TemperatureC, TemperatureC]
     degree: int = Field(ge=0, le=6)
-    coefficients: dict[str, Annotated[list[Annotated[float, Field(ge=-1e6, le=1e6)]], Field(min_length=1, max_length=7)]]
-
-    @field_validator("coefficients")
-    @classmethod
-    def _all_parameters(cls, value: dict[str, list[float]]) -> dict[str, list[float]]:
-        if set(value) != set(cls.NAMES):
-            raise ValueError(f"coefficients needed for exactly {', '.join(cls.NAMES)}")
-        return value
+    coefficients: dict[Annotated[str, Field(max_length=64)],
+                       Annotated[list[Annotated[float, Field(ge=-1e6, le=1e6)]], Field(min_length=1, max_length=7)]] = \
+        Field(max_length=64)
 
     _domain = field_validator("domain_c")(_ordered)
 
     def matrix(self) -> np.ndarray:
         width = max(len(c) for c in self.coefficients.values())
-        return np.array([self.coefficients[n] + [0.0] * (width - len(self.coefficients[n])) for n in self.NAMES])
+        return np.array([c + [0.0] * (width - len(c)) for c in self.coefficients.values()])
 
     def at(self, temperature_c: np.ndarray | float) -> np.ndarray:
         """Every parameter (..., P) at each temperature, as the polynomials give it (no clamping here)."""
@@ -72,11 +65,9 @@ class PolynomialModel(StrictModel):
         x = (np.asarray(temperature_c, dtype=float) - 0.5 * (d_low + d_high)) / (0.5 * (d_high - d_low))
         return np.moveaxis(np.polynomial.polynomial.polyval(x, self.matrix().T), 0, -1)
 
-
-class GyroPolynomialModel(PolynomialModel):
-    """The rate-table gyroscope model's 27 parameters (fit/gyro_model.py), each a polynomial."""
-
-    NAMES: ClassVar[tuple[str, ...]] = gyro_model.PARAMETER_NAMES
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(self.coefficients)
 
 
 class SetpointFit(StrictModel):
@@ -88,37 +79,54 @@ class SetpointFit(StrictModel):
     sigma: dict[str, float | None]
 
 
-def _within_validity(polynomial: PolynomialModel, validity_c: tuple[float, float], out_of_range: str, who: str,
-                     temperature_c: np.ndarray | float) -> np.ndarray:
-    """Every channel model's parameters at each temperature, as its file's `out_of_range` says outside its
-    validity (clamped or extrapolated, warned either way)."""
-    temperature_c = np.asarray(temperature_c, dtype=float)
-    low, high = validity_c
-    outside = (temperature_c < low) | (temperature_c > high)
-    if np.any(outside):
-        action = "clamped to" if out_of_range == "clamp" else "extrapolated beyond"
-        warnings.warn(CalibrationRangeWarning(
-            f"{who}: {int(outside.sum())} of {outside.size} temperatures {action} the calibrated {low:g}…{high:g} °C"),
-            stacklevel=4)
-    if out_of_range == "clamp":
-        temperature_c = np.clip(temperature_c, low, high)
-    return polynomial.at(temperature_c)
-
-
 #: A sensor's verdict: CONDITIONAL where guarded acceptance leaves a figure inside its guard band.
 VerdictName = Literal["PASS", "FAIL", "CONDITIONAL", "NOT JUDGED"]
 
+#: How calibrations written before version 3 named a channel's range and code size, by the quantity they
+#: were of: an accelerometer's `range_g`/`lsb_g`, a gyroscope's `range_dps`/`lsb_dps` (its model's
+#: statements `earth_rate` and `gauge` at the top of its entry).
+_BEFORE_VERSION_3 = {"range_g": ("acceleration", "g", "lsb_g", "sfem-eq1"),
+                     "range_dps": ("angular rate", "dps", "lsb_dps", "gyro-rate-table")}
 
-class SensorCalibration(StrictModel):
+
+def _version_3_entry(data: dict[str, Any]) -> dict[str, Any]:
+    """A channel's entry as version 3 writes it, from one of any version."""
+    if "range" in data:
+        return data
+    for old, (quantity, unit, lsb, model) in _BEFORE_VERSION_3.items():
+        if old in data:
+            entry = {k: v for k, v in data.items() if k not in (old, lsb, "earth_rate", "gauge")}
+            statements = {k: data[k] for k in ("earth_rate", "gauge") if k in data}
+            return {**entry, "range": data[old], "lsb": data.get(lsb), "quantity": quantity, "unit": unit,
+                    "model": data.get("model", model), **({"statements": statements} if statements else {})}
+    return data
+
+
+class ChannelCalibration(StrictModel):
+    """One channel of one DUT calibrated: its model's parameters as polynomials of the sensor's own
+    temperature, the setpoint fits they came from, the figures, the verdict and the decision, and what its
+    model states of how it was made (`statements`). The same shape for every quantity: the channel model
+    (fit/channel_models.py, by `quantity`) knows what its parameters and figures mean."""
+
+    model: str = Field(min_length=1, max_length=64, description="the channel model's parameterisation, e.g. "
+                                                                 "sfem-eq1 (Eq. 1), gyro-rate-table")
+    quantity: str = Field(min_length=1, max_length=64, description="what the channel measures: acceleration, "
+                                                                    "angular rate, …")
+    unit: str = Field(min_length=1, max_length=16, description="the unit of its readings: g, dps, …")
     serial: str = Field(min_length=1, max_length=128)
-    mode: Literal["reference", "norm-only"]
-    free_parameters: list[str] = Field(max_length=12)
-    range_g: float = Field(gt=0, le=1000, description="measuring range, ± g (2, 4 or 8 for an ADXL355)")
-    lsb_g: float = Field(gt=0, le=1, description="g per code, for compensating raw codes")
+    mode: str = Field(min_length=1, max_length=32, description="how it was fitted: reference, norm-only, rate-table, "
+                                                                "hand-held")
+    free_parameters: list[Annotated[str, Field(max_length=64)]] = Field(max_length=64, description="the parameters "
+                                                                         "the data determined; the others hold "
+                                                                         "their nominal values")
+    range: float = Field(gt=0, le=1e6, description="measuring range, ± in `unit`")
+    lsb: float = Field(gt=0, le=100, description="`unit` per code, for compensating raw codes")
     validity_c: tuple[TemperatureC, TemperatureC]
     out_of_range: Literal["clamp", "extrapolate"] = "clamp"
     polynomial: PolynomialModel
     setpoints: list[SetpointFit]
+    statements: dict[Annotated[str, Field(max_length=64)], Annotated[str, Field(max_length=1000)]] = Field(
+        {}, max_length=16, description="what the model states of how it was made (a gyroscope's Earth rate and gauge)")
     metrics: dict[str, Any] = {}
     warnings: list[str] = []
     verdict: VerdictName | None = Field(None, description="against the procedure's acceptance limits under its "
@@ -127,52 +135,60 @@ class SensorCalibration(StrictModel):
     decision: dict[str, Any] = Field({}, description="the decision rule as stated and every figure judged: its "
                                                      "value, expanded uncertainty, limit and outcome")
 
+    @model_validator(mode="before")
+    @classmethod
+    def _of_its_model(cls, data: Any) -> Any:
+        """An entry written before version 3 read as one of version 3 (its range and code size named in its
+        quantity's unit, an accelerometer's without a `model`, a gyroscope's statements beside its figures);
+        then its quantity's model found, and its polynomials put in the model's order of parameters."""
+        if not isinstance(data, dict):
+            return data
+        data = _version_3_entry(data)
+        from accelcal_rig.fit.channel_models import model_for_quantity  # the models build calibrations
+
+        quantity = data.get("quantity")
+        model = model_for_quantity(quantity) if isinstance(quantity, str) else None
+        if model is None:
+            return data  # the field's own check says what is wrong
+        if data.get("model") != model.model_id:
+            raise ValueError(f"a {quantity} calibration of model {data.get('model')!r}: this accelcal-rig's "
+                             f"{model.sensor} model is {model.model_id!r}")
+        polynomial = data.get("polynomial")
+        coefficients = polynomial.get("coefficients") if isinstance(polynomial, dict) else None
+        if isinstance(coefficients, dict):
+            names = model.parameter_names
+            if set(coefficients) != set(names):
+                raise ValueError(f"polynomial coefficients needed for exactly {', '.join(names)}")
+            data = {**data, "polynomial": {**polynomial, "coefficients": {n: coefficients[n] for n in names}}}
+        return data
+
+    @field_validator("quantity")
+    @classmethod
+    def _a_model_calibrates_it(cls, value: str) -> str:
+        from accelcal_rig.fit.channel_models import known_quantities, model_for_quantity
+
+        if model_for_quantity(value) is None:
+            raise ValueError(f"no channel model calibrates {value!r} here (known: {', '.join(known_quantities())})")
+        return value
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        return self.polynomial.names
+
     def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:
-        """Eq. 1 parameters (..., 12) at each temperature, as the file's `out_of_range` says outside it."""
-        return _within_validity(self.polynomial, self.validity_c, self.out_of_range, f"sensor {self.serial}",
-                                temperature_c)
-
-
-class GyroCalibration(StrictModel):
-    """A gyroscope's calibration on a rate table (fit/gyro_model.py): its 27 parameters as polynomials of its
-    own temperature, how the Earth's rate was taken out, and the gauge its misalignment is in."""
-
-    model: Literal["gyro-rate-table"] = "gyro-rate-table"
-    serial: str = Field(min_length=1, max_length=128)
-    mode: Literal["rate-table", "hand-held"] = Field("rate-table", description="rate steps on a rate table, or "
-                                                     "the turns between a hand-held recording's still intervals")
-    free_parameters: list[str] = Field(list(gyro_model.PARAMETER_NAMES), max_length=27, description="the "
-                                       "parameters the data determined; the others hold their nominal values")
-    range_dps: float = Field(gt=0, le=100_000, description="measuring range, ± °/s")
-    lsb_dps: float = Field(gt=0, le=100, description="°/s per code, for compensating raw codes")
-    validity_c: tuple[TemperatureC, TemperatureC]
-    out_of_range: Literal["clamp", "extrapolate"] = "clamp"
-    polynomial: GyroPolynomialModel
-    setpoints: list[SetpointFit]
-    earth_rate: str = Field(max_length=500, description="how the Earth's rate entered the references")
-    gauge: str = Field(max_length=500, description="the frame the sensitivity matrix is relative to")
-    metrics: dict[str, Any] = {}
-    warnings: list[str] = []
-    verdict: VerdictName | None = None
-    verdict_reasons: list[str] = []
-    decision: dict[str, Any] = {}
-
-    def parameters_at(self, temperature_c: np.ndarray | float) -> np.ndarray:
-        """The model's 27 parameters (..., 27) at each temperature, as the file's `out_of_range` says outside it."""
-        return _within_validity(self.polynomial, self.validity_c, self.out_of_range, f"gyroscope {self.serial}",
-                                temperature_c)
-
-
-def _channel_model(value: Any) -> str:
-    """Which model a channel's calibration is: its `model`, Eq. 1 for one that names none (every file before
-    gyroscopes)."""
-    model = value.get("model", "sfem-eq1") if isinstance(value, dict) else getattr(value, "model", "sfem-eq1")
-    return str(model)
-
-
-ChannelCalibration = Annotated[
-    Annotated[SensorCalibration, Tag("sfem-eq1")] | Annotated[GyroCalibration, Tag("gyro-rate-table")],
-    Discriminator(_channel_model)]
+        """The model's parameters (..., P) at each temperature, as the file's `out_of_range` says outside its
+        validity (clamped or extrapolated, warned either way)."""
+        temperature_c = np.asarray(temperature_c, dtype=float)
+        low, high = self.validity_c
+        outside = (temperature_c < low) | (temperature_c > high)
+        if np.any(outside):
+            action = "clamped to" if self.out_of_range == "clamp" else "extrapolated beyond"
+            warnings.warn(CalibrationRangeWarning(
+                f"{self.quantity} of sensor {self.serial}: {int(outside.sum())} of {outside.size} temperatures "
+                f"{action} the calibrated {low:g}…{high:g} °C"), stacklevel=3)
+        if self.out_of_range == "clamp":
+            temperature_c = np.clip(temperature_c, low, high)
+        return self.polynomial.at(temperature_c)
 
 
 class DutCalibration(StrictModel):
@@ -185,7 +201,6 @@ class DutCalibration(StrictModel):
 class CalibrationFile(StrictModel):
     format: str
     format_version: int
-    model: Literal["sfem-eq1"] = "sfem-eq1"
     created: str
     software_version: str
     source: dict[str, str]
@@ -196,13 +211,18 @@ class CalibrationFile(StrictModel):
 
     @model_validator(mode="before")
     @classmethod
-    def _version_1(cls, data: Any) -> Any:
-        """A version-1 file's `sensors` are its DUTs' acceleration channels."""
-        if isinstance(data, dict) and data.get("format_version") == 1 and "sensors" in data and "duts" not in data:
+    def _earlier_versions(cls, data: Any) -> Any:
+        """A version-1 file's `sensors` are its DUTs' acceleration channels; the file-wide `model` of versions
+        1 and 2 (every channel's is its own now) is left."""
+        if not isinstance(data, dict):
+            return data
+        if data.get("format_version") == 1 and "sensors" in data and "duts" not in data:
             sensors = data["sensors"]
-            duts = ({serial: {"channels": {ACCELERATION: calibration}} for serial, calibration in sensors.items()}
+            duts = ({serial: {"channels": {VERSION_1_CHANNEL: calibration}} for serial, calibration in sensors.items()}
                     if isinstance(sensors, dict) else sensors)
-            data = {**{k: v for k, v in data.items() if k != "sensors"}, "duts": duts, "format_version": 2}
+            data = {**{k: v for k, v in data.items() if k != "sensors"}, "duts": duts}
+        if data.get("format_version") in (1, 2) and data.get("model", "sfem-eq1") == "sfem-eq1":
+            data = {k: v for k, v in data.items() if k != "model"}
         return data
 
     @field_validator("format")
@@ -220,71 +240,57 @@ class CalibrationFile(StrictModel):
                              f"{', '.join(map(str, READABLE_VERSIONS))})")
         return value
 
-    @property
-    def sensors(self) -> dict[str, SensorCalibration]:
-        """Each DUT's acceleration calibration by serial, for the readers that handle only that channel."""
-        return {serial: calibration for serial, dut in self.duts.items()
-                if isinstance(calibration := dut.channels.get(ACCELERATION), SensorCalibration)}
+    def calibrated(self) -> list[tuple[str, str, ChannelCalibration]]:
+        """Every calibrated channel: (serial, channel, calibration), DUT by DUT in the file's order."""
+        return [(serial, name, calibration) for serial, dut in self.duts.items()
+                for name, calibration in dut.channels.items()]
 
-    @property
-    def gyroscopes(self) -> dict[str, GyroCalibration]:
-        """Each DUT's gyroscope calibration by serial, where it has one."""
-        return {serial: calibration for serial, dut in self.duts.items()
-                if isinstance(calibration := dut.channels.get(ANGULAR_RATE), GyroCalibration)}
+    def of_quantity(self, quantity: str) -> dict[str, ChannelCalibration]:
+        """Each DUT's calibration of its channel that measures `quantity`, by serial, where it has one (the
+        readers that need one quantity: a tilt check's accelerometers)."""
+        found: dict[str, ChannelCalibration] = {}
+        for serial, _, calibration in self.calibrated():
+            if calibration.quantity == quantity and serial not in found:
+                found[serial] = calibration
+        return found
 
-    def sensor(self, serial: str) -> SensorCalibration:
-        """The accelerometer calibration of one DUT; KeyError saying what the file has."""
-        calibration = self._channel(serial, ACCELERATION)
-        assert isinstance(calibration, SensorCalibration)
-        return calibration
-
-    def gyroscope(self, serial: str) -> GyroCalibration:
-        """The gyroscope calibration of one DUT; KeyError saying what the file has."""
-        calibration = self._channel(serial, ANGULAR_RATE)
-        if not isinstance(calibration, GyroCalibration):
-            raise KeyError(f"sensor {serial}: its {ANGULAR_RATE} channel is not a rate-table calibration")
-        return calibration
-
-    def _channel(self, serial: str, channel: str) -> SensorCalibration | GyroCalibration:
+    def channel(self, serial: str, channel: str) -> ChannelCalibration:
+        """One DUT's calibration of one channel; KeyError saying what the file has."""
         if serial not in self.duts:
             raise KeyError(f"no calibration for sensor {serial} (file has {', '.join(self.duts)})")
         dut = self.duts[serial]
         if channel not in dut.channels:
-            why = dut.not_calibrated.get(channel, "the file has none")
+            why = dut.not_calibrated.get(channel, f"the file has {', '.join(dut.channels)}")
             raise KeyError(f"sensor {serial}: no calibration of its {channel} channel ({why})")
         return dut.channels[channel]
 
-    def with_sensors(self, sensors: dict[str, SensorCalibration]) -> CalibrationFile:
-        """A copy whose DUTs are `sensors`, each its DUT's acceleration calibration (what the others held
-        beside it kept)."""
-        duts = {serial: (self.duts[serial].model_copy(update={"channels": {**self.duts[serial].channels,
-                                                                           ACCELERATION: calibration}})
-                         if serial in self.duts else DutCalibration(channels={ACCELERATION: calibration}))
-                for serial, calibration in sensors.items()}
-        return self.model_copy(update={"duts": duts})
+    def with_channels(self, serial: str, channels: dict[str, ChannelCalibration]) -> CalibrationFile:
+        """A copy with these channels of `serial` (what it held beside them kept; a DUT it lacked added)."""
+        dut = self.duts.get(serial)
+        updated = (dut.model_copy(update={"channels": {**dut.channels, **channels}}) if dut is not None
+                   else DutCalibration(channels=channels))
+        return self.model_copy(update={"duts": {**self.duts, serial: updated}})
 
     def not_calibrated(self) -> dict[str, dict[str, str]]:
         """Each DUT's channels that no channel model calibrated yet, and why (empty: every channel is)."""
         return {serial: dict(dut.not_calibrated) for serial, dut in self.duts.items() if dut.not_calibrated}
 
 
-def apply(calibration: SensorCalibration, accel_g: np.ndarray, temperature_c: np.ndarray | float) -> np.ndarray:
-    """Compensate raw readings (..., 3) in g taken at the sensor's own temperatures (...) → specific force in g."""
-    return correct(np.asarray(accel_g, dtype=float), calibration.parameters_at(temperature_c))
+def apply(calibration: ChannelCalibration, reading: np.ndarray, temperature_c: np.ndarray | float,
+          companions: Mapping[str, np.ndarray] | None = None) -> np.ndarray:
+    """Compensate raw readings (..., axes) in the channel's unit taken at the sensor's own temperatures (...) →
+    the quantity in the DUT frame, as the channel's model does it. `companions`: the DUT's other channels'
+    compensated readings by quantity where the model needs them (a gyroscope's specific force)."""
+    from accelcal_rig.fit.channel_models import model_of
+
+    return model_of(calibration).compensate(calibration, np.asarray(reading, dtype=float), temperature_c,
+                                            companions or {})
 
 
-def apply_codes(calibration: SensorCalibration, codes: np.ndarray, temperature_c: np.ndarray | float) -> np.ndarray:
-    """As `apply`, from signed 20-bit ADXL355 codes at the calibration's range."""
-    return apply(calibration, np.asarray(codes, dtype=float) * calibration.lsb_g, temperature_c)
-
-
-def apply_gyro(calibration: GyroCalibration, rate_dps: np.ndarray, force_g: np.ndarray,
-               temperature_c: np.ndarray | float) -> np.ndarray:
-    """Compensate raw gyroscope readings (..., 3) in °/s, taken at the sensor's own temperatures (...) while
-    it felt the specific force `force_g` (..., 3, in g: the compensated accelerometer's reading) → the angular
-    rate in the DUT frame, °/s."""
-    return gyro_model.correct_rate(np.asarray(rate_dps, dtype=float), np.asarray(force_g, dtype=float),
-                                   calibration.parameters_at(temperature_c))
+def apply_codes(calibration: ChannelCalibration, codes: np.ndarray, temperature_c: np.ndarray | float,
+                companions: Mapping[str, np.ndarray] | None = None) -> np.ndarray:
+    """As `apply`, from the part's signed codes at the calibration's range."""
+    return apply(calibration, np.asarray(codes, dtype=float) * calibration.lsb, temperature_c, companions)
 
 
 def save_calibration(calibration: CalibrationFile, path: Path) -> None:
@@ -296,8 +302,8 @@ def save_calibration(calibration: CalibrationFile, path: Path) -> None:
     if not data["dropped"]:
         del data["dropped"]  # a file with every DUT fitted reads as it did before DUTs could be dropped
     text = yaml.dump(data, Dumper=dumper, sort_keys=False, width=120, allow_unicode=True)
-    write_text_atomically(path, "# accelcal-rig calibration: Eq. 1 parameters as polynomials of the sensor "
-                                "temperature\n" + text, "the calibration")
+    write_text_atomically(path, "# accelcal-rig calibration: each channel model's parameters as polynomials of the "
+                                "sensor's temperature\n" + text, "the calibration")
     _remember(path, CalibrationFile.model_validate(data))  # what reading it back gives, without the parse
 
 
@@ -313,9 +319,10 @@ def load_calibration(path: Path) -> CalibrationFile:
 
 
 def _in_version_1(key: tuple[str | int, ...], lines: dict[tuple[str | int, ...], int]) -> tuple[str | int, ...]:
-    """Where a key of a DUT's accel calibration stands in a version-1 file (`sensors.<serial>.…`), so that a
-    problem in one is reported at its own line."""
-    if len(key) >= 4 and key[0] == "duts" and key[2:4] == ("channels", ACCELERATION) and ("sensors", key[1]) in lines:
+    """Where a key of a DUT's calibration stands in a version-1 file (`sensors.<serial>.…`), so that a problem in
+    one is reported at its own line."""
+    if (len(key) >= 4 and key[0] == "duts" and key[2:4] == ("channels", VERSION_1_CHANNEL)
+            and ("sensors", key[1]) in lines):
         return ("sensors", key[1], *key[4:])
     return key
 

@@ -13,8 +13,9 @@ from typing import Any
 import numpy as np
 
 from accelcal_rig.errors import ConfigError, RigError
-from accelcal_rig.fit.calibration import load_calibration
-from accelcal_rig.fit.campaign_fit import fit_and_save
+from accelcal_rig.fit.acceptance import NOT_JUDGED, Judgement
+from accelcal_rig.fit.calibration import CalibrationFile, load_calibration
+from accelcal_rig.fit.campaign_fit import dut_verdict, fit_and_save
 from accelcal_rig.fit.recorded_options import recorded_options
 from accelcal_rig.store.content import Campaign, measurements_sha256
 from accelcal_rig.store.lock import holder
@@ -70,6 +71,13 @@ def calibration_verdicts(campaign_path: Path, calibration_path: Path | None = No
     return {
         "calibration": f"{path}" + ("" if current else " (fitted to other measurements than the campaign's now: "
                                                        "fit again)") + (f"; {partial}" if partial else ""),
-        "verdicts": {serial: {"verdict": s.verdict, "reasons": s.verdict_reasons}
-                     for serial, s in calibration.sensors.items()},
+        "verdicts": {serial: {"verdict": judged.verdict, "reasons": judged.reasons}
+                     for serial, judged in dut_verdicts(calibration).items()},
     }
+
+
+def dut_verdicts(calibration: CalibrationFile) -> dict[str, Judgement]:
+    """Each DUT's verdict and reasons from its channels' as the calibration file keeps them."""
+    return {serial: dut_verdict([(name, Judgement(channel.verdict or NOT_JUDGED, list(channel.verdict_reasons)))
+                                 for name, channel in dut.channels.items()])
+            for serial, dut in calibration.duts.items()}

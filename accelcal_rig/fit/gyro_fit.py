@@ -17,21 +17,24 @@ from typing import Any
 
 import numpy as np
 import yaml
-from numpy.polynomial import polynomial
 from scipy.optimize import least_squares
 from scipy.stats import chi2
 
 from accelcal_rig.core.earth import EARTH_RATE_DPS
 from accelcal_rig.fit import gyro_model
 from accelcal_rig.fit.allan import FLICKER_FLOOR
-from accelcal_rig.fit.calibration import GyroCalibration, GyroPolynomialModel, SetpointFit, plain
+from accelcal_rig.fit.calibration import ChannelCalibration, PolynomialModel, SetpointFit, plain
+from accelcal_rig.fit.channel_model import ChannelFit
 from accelcal_rig.fit.gyro_budget import gyro_budget, truth_coverage
-from accelcal_rig.fit.parameter_uncertainty import ParameterUncertainty, certificate_temperatures, of_gyro
+from accelcal_rig.fit.parameter_uncertainty import certificate_temperatures, of_gyro
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
 from accelcal_rig.fit.uncertainty import COVERAGE_FACTOR
 from accelcal_rig.store.content import Campaign
+from accelcal_rig.store.read import described_truth
 from accelcal_rig.store.records import ChannelInfo
 
+#: The calibration file's name of the model.
+MODEL_ID = "gyro-rate-table"
 #: The kinds of record the gyroscope fit uses: the static poses (bias, g-sensitivity) and the rate steps.
 CALIBRATION_KINDS = ("pose", "rate")
 VERIFICATION_KINDS = ("verify", "verify-rate")
@@ -65,18 +68,12 @@ class GyroRecords:
         return np.isin(self.kind, kinds)
 
 
-def read_gyro_records(campaign: Campaign, serial: str, channel: str = "gyro") -> GyroRecords:
-    """The DUT's gyroscope channel over every stored record, with the acceleration reference beside it."""
+def read_gyro_records(campaign: Campaign, serial: str, channel: str, force_g: np.ndarray) -> GyroRecords:
+    """The DUT's gyroscope channel over every stored record, with the specific force it felt at each (`force_g`,
+    in standard g) beside it."""
     keys = campaign.pose_column("step_key")
     plan = campaign.header.plan
     kinds = dict(zip(plan.step_key, plan.kind))
-    truth = None
-    described = campaign.header.truth.get(serial, {})
-    temperature = campaign.truth_column(serial, "temperature_c")
-    if "gyro_polynomial_coefficients" in described and temperature is not None:
-        coefficients = np.asarray(described["gyro_polynomial_coefficients"], dtype=float)
-        x = (temperature - float(described["t_ref_c"])) / float(described["half_range_c"])
-        truth = np.moveaxis(polynomial.polyval(x, coefficients.T), 0, -1)
     return GyroRecords(
         serial=serial, info=campaign.channel_info(serial, channel),
         kind=np.array([kinds.get(str(k), "") for k in keys]),
@@ -85,8 +82,8 @@ def read_gyro_records(campaign: Campaign, serial: str, channel: str = "gyro") ->
         mean_dps=campaign.channel_column(serial, channel, "mean"),
         stderr_dps=campaign.channel_column(serial, channel, "stderr"),
         reference_dps=campaign.channel_column(serial, channel, "reference"),
-        force_g=campaign.channel_column(serial, "accel", "reference"),
-        truth_parameters=truth,
+        force_g=force_g,
+        truth_parameters=described_truth(campaign, serial, channel),
     )
 
 
@@ -140,15 +137,6 @@ def _check_identified(jacobian: np.ndarray, n_records: int) -> None:
         raise GyroDesignError(f"the {n_records} records cannot separate {', '.join(involved)}")
 
 
-@dataclass(frozen=True)
-class GyroFitResult:
-    serial: str
-    calibration: GyroCalibration
-    metrics: dict[str, Any]           # what `rig fit --json` prints under `gyro`
-    thermal: ThermalModel
-    parameter_u: ParameterUncertainty  # each parameter's own uncertainty at a temperature (limits judge with it)
-
-
 def site_of(campaign: Campaign) -> dict[str, Any]:
     """The rig config's latitude, heading and table rate accuracy as the campaign recorded its rig."""
     try:
@@ -177,7 +165,7 @@ GAUGE = ("the fixture frame as the rate table realises it: turning about each fi
 
 
 def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: dict[str, Any],
-             allan: dict[str, Any] | None = None) -> GyroFitResult:
+             allan: dict[str, Any] | None = None) -> ChannelFit:
     """Fit each setpoint, the polynomials over temperature, and the figures of the calibration. `allan`: the
     noise record's figures (fit/noise_record.py), whose bias instability bounds how well a bias holds."""
     calibrating = records.rows(*CALIBRATION_KINDS)
@@ -236,21 +224,22 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
                 records.mean_dps[checks], records.force_g[checks], records.reference_dps[checks],
                 records.temperature_c[checks], records.truth_parameters[checks], thermal, temperatures, covariances,
                 sigmas, temperature_u_c, systematic, out_of_range)
-    calibration = GyroCalibration(
-        serial=records.serial, range_dps=records.info.range, lsb_dps=records.info.lsb,
-        validity_c=thermal.domain_c, out_of_range=out_of_range,
-        polynomial=GyroPolynomialModel(domain_c=thermal.domain_c, degree=degree,
-                                       coefficients={n: plain(c) for n, c in
-                                                     zip(gyro_model.PARAMETER_NAMES, thermal.coefficients)}),
+    calibration = ChannelCalibration(
+        model=MODEL_ID, quantity=records.info.quantity, unit=records.info.unit, serial=records.serial,
+        mode="rate-table", free_parameters=list(gyro_model.PARAMETER_NAMES), range=records.info.range,
+        lsb=records.info.lsb, validity_c=thermal.domain_c, out_of_range=out_of_range,
+        polynomial=PolynomialModel(domain_c=thermal.domain_c, degree=degree,
+                                   coefficients={n: plain(c) for n, c in
+                                                 zip(gyro_model.PARAMETER_NAMES, thermal.coefficients)}),
         setpoints=[SetpointFit(setpoint_c=float(s), temperature_c=float(t), n_poses=f.n_records,
                                chi2_reduced=plain(f.chi2_reduced),
                                parameters=dict(zip(gyro_model.PARAMETER_NAMES, plain(f.parameters))),
                                sigma=dict(zip(gyro_model.PARAMETER_NAMES, plain(f.sigma))))
                    for s, t, f in zip(setpoints, temperatures, fits)],
-        earth_rate=metrics["earth_rate"], gauge=GAUGE,
+        statements={"earth_rate": metrics["earth_rate"], "gauge": GAUGE},
         metrics={k: plain(v) for k, v in metrics.items() if k != "truth_error"}, warnings=thermal.warnings,
     )
-    return GyroFitResult(records.serial, calibration, plain(metrics), thermal, parameter_u)
+    return ChannelFit(records.serial, calibration, plain(metrics), thermal, parameter_u)
 
 
 def _figures(records: GyroRecords, thermal: ThermalModel, out_of_range: OutOfRange,

@@ -12,27 +12,21 @@ from typing import Any
 
 import numpy as np
 
-from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.fit.allan import Estimate, allan_deviation, bias_instability, random_walk
+from accelcal_rig.fit.channel_model import NoiseFigures
 from accelcal_rig.store.content import Campaign
 
 NOISE_KIND = "noise"
-#: Each channel's figures in the units their users quote: (random walk name, its factor from the data's
-#: unit per √Hz, bias instability name, its factor from the data's unit).
-_UNITS = {
-    "angular rate": ("arw_deg_per_rthr", 60.0, "bias_instability_dph", 3600.0),
-    "acceleration": ("vrw_m_s_per_rthr", STANDARD_GRAVITY_M_S2 * 60.0, "bias_instability_ug", 1e6),
-}
 #: The record's figures are quoted at the setpoint nearest this (the data sheets' room temperature).
 QUOTED_AT_C = 25.0
 
 
-def noise_allan(campaign: Campaign, serial: str, channel: str, odr_hz: float) -> dict[str, Any] | None:
-    """The Allan figures of one DUT's channel from the campaign's noise records (None: it has none): those of
-    the record nearest 25 °C, and each setpoint's in `by_setpoint`."""
+def noise_allan(campaign: Campaign, serial: str, channel: str, odr_hz: float,
+                quoted_as: NoiseFigures) -> dict[str, Any] | None:
+    """The Allan figures of one DUT's channel from the campaign's noise records (None: it has none), in the
+    units its channel model quotes them (`quoted_as`): those of the record nearest 25 °C, and each setpoint's in
+    `by_setpoint`."""
     info = campaign.channel_info(serial, channel)
-    if info.quantity not in _UNITS:
-        return None
     plan = campaign.header.plan
     keys = campaign.pose_column("step_key")
     noise = np.isin(keys, list(plan.keys_of(NOISE_KIND)))
@@ -49,7 +43,7 @@ def noise_allan(campaign: Campaign, serial: str, channel: str, odr_hz: float) ->
         span_s = float(ends[rows[-1]] - starts[rows[0]])
         gaps_s = float(np.sum(np.maximum(starts[rows[1:]] - ends[rows[:-1]], 0.0)))
         try:
-            figures = axis_figures(stream, odr_hz, info.quantity)
+            figures = axis_figures(stream, odr_hz, quoted_as)
         except ValueError as exc:
             figures = {"not_resolved": str(exc)}
         by_setpoint.append({"setpoint_c": float(setpoint), "samples": int(len(stream)), "duration_s": span_s,
@@ -58,12 +52,11 @@ def noise_allan(campaign: Campaign, serial: str, channel: str, odr_hz: float) ->
     return {**quoted, "by_setpoint": by_setpoint}
 
 
-def axis_figures(stream: np.ndarray, odr_hz: float, quantity: str) -> dict[str, Any]:
+def axis_figures(stream: np.ndarray, odr_hz: float, quoted_as: NoiseFigures) -> dict[str, Any]:
     """Per axis: the random walk and the bias instability with their 68 % intervals and averaging times."""
-    walk_name, walk_factor, instability_name, instability_factor = _UNITS[quantity]
     curves = allan_deviation(stream, odr_hz)
-    return {walk_name: [_scaled(random_walk(c), walk_factor) for c in curves],
-            instability_name: [_scaled(bias_instability(c), instability_factor) for c in curves]}
+    return {quoted_as.random_walk: [_scaled(random_walk(c), quoted_as.random_walk_factor) for c in curves],
+            quoted_as.instability: [_scaled(bias_instability(c), quoted_as.instability_factor) for c in curves]}
 
 
 def _scaled(estimate: Estimate, factor: float) -> dict[str, float]:

@@ -22,8 +22,32 @@ from accelcal_rig.fit.gyro_budget import between_setpoints_sigma, thermal_model_
 from accelcal_rig.fit.thermal import ThermalModel
 from accelcal_rig.fit.uncertainty import COVERAGE_FACTOR, CoefficientCovariance
 
-#: Where a certificate states a gyroscope's parameters (clamped to the calibrated range).
+#: Where a certificate states a calibration's parameters (clamped to the calibrated range).
 REFERENCE_C = 25.0
+
+
+def reference_c(validity_c: tuple[float, float]) -> float:
+    """Where a certificate states a calibration's parameters: 25 °C, or the calibrated range's nearest end."""
+    low, high = validity_c
+    return float(np.clip(REFERENCE_C, low, high))
+
+
+def expanded_at(metrics: dict[str, Any], name: str, temperature_c: float) -> float | None:
+    """A parameter's expanded uncertainty (k = 2) at a temperature, from the fit's table (exact where the table
+    has the temperature, between them interpolated); None for a file fitted before the table existed."""
+    table = metrics.get("parameter_uncertainty")
+    if not isinstance(table, dict) or name not in table.get("expanded", {}):
+        return None
+    return float(np.interp(temperature_c, table["temperatures_c"], table["expanded"][name]))
+
+
+def nearest_setpoint_sigma(setpoints: list[Any], temperature_c: float) -> dict[str, float | None]:
+    """The per-setpoint fit's 1σ nearest a temperature (a calibration fitted before each parameter's own
+    uncertainty was stated has only these)."""
+    if not setpoints:
+        return {}
+    nearest = min(setpoints, key=lambda s: abs(float(s.temperature_c) - temperature_c))
+    return dict(nearest.sigma)
 
 
 def certificate_temperatures(domain_c: tuple[float, float]) -> np.ndarray:

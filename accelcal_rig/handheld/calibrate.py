@@ -12,25 +12,21 @@ import numpy as np
 
 from accelcal_rig import __version__
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
-from accelcal_rig.fit import gyro_model
+from accelcal_rig.fit import acceleration, angular_rate, gyro_model
 from accelcal_rig.fit.calibration import (
-    ACCELERATION,
-    ANGULAR_RATE,
     FORMAT_NAME,
     FORMAT_VERSION,
     CalibrationFile,
+    ChannelCalibration,
     DutCalibration,
-    GyroCalibration,
-    GyroPolynomialModel,
     PolynomialModel,
-    SensorCalibration,
     SetpointFit,
     plain,
 )
 from accelcal_rig.fit.lm import DegenerateDesign, FreeParameters, SfemFit
 from accelcal_rig.fit.metrics import noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.robust import fit_norm_only_with_floor
-from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct
+from accelcal_rig.fit.sfem import correct
 from accelcal_rig.handheld.gyro import HandheldGyroFit, fit_handheld_gyro
 from accelcal_rig.handheld.recording import Recording, RecordingUnusable
 from accelcal_rig.handheld.static_intervals import Detection
@@ -66,12 +62,17 @@ def missing_orientations(mean_g: np.ndarray) -> list[str]:
     return missing
 
 
+#: A recording's channels, named as the built-in parts name an IMU's (a recording's columns are an accelerometer's
+#: and, where it has them, a gyroscope's).
+ACCEL_CHANNEL, GYRO_CHANNEL = "accel", "gyro"
+#: Eq. 1's parameters as the accelerometer's model names them.
+PARAMETER_NAMES = acceleration.MODEL.parameter_names
 #: A hand-held recording determines the gyroscope's bias and K; the rest of the model holds its nominal value.
 HANDHELD_GYRO_PARAMETERS = tuple(gyro_model.PARAMETER_NAMES[i] for i in range(gyro_model.CROSS.stop))
 
 
 def gyro_calibration(gyro: HandheldGyroFit, recording: Recording, serial: str, temperature_c: float,
-                     validity_c: tuple[float, float]) -> GyroCalibration:
+                     validity_c: tuple[float, float]) -> ChannelCalibration:
     """The hand-held gyroscope fit as the calibration file's `gyro` channel: bias and K constant over the
     recording's temperature, every other term of the rate-table model at its nominal value (not determined)."""
     parameters = gyro_model.IDENTITY_PARAMETERS.copy()
@@ -83,19 +84,22 @@ def gyro_calibration(gyro: HandheldGyroFit, recording: Recording, serial: str, t
         sigma[gyro_model.CROSS.start + column] = gyro.matrix_sigma[i, j]
     names = gyro_model.PARAMETER_NAMES
     assert recording.gyro_dps is not None
-    return GyroCalibration(
-        serial=serial, mode="hand-held", free_parameters=list(HANDHELD_GYRO_PARAMETERS),
-        range_dps=max(250.0, float(np.ceil(np.abs(recording.gyro_dps).max()))), lsb_dps=recording.gyro_lsb_dps or 1.0,
+    model = angular_rate.MODEL
+    return ChannelCalibration(
+        model=model.model_id, quantity=model.quantity, unit="dps", serial=serial, mode="hand-held",
+        free_parameters=list(HANDHELD_GYRO_PARAMETERS),
+        range=max(250.0, float(np.ceil(np.abs(recording.gyro_dps).max()))), lsb=recording.gyro_lsb_dps or 1.0,
         validity_c=validity_c, out_of_range="clamp",
-        polynomial=GyroPolynomialModel(domain_c=validity_c, degree=0,
-                                       coefficients={n: [float(p)] for n, p in zip(names, parameters)}),
+        polynomial=PolynomialModel(domain_c=validity_c, degree=0,
+                                   coefficients={n: [float(p)] for n, p in zip(names, parameters)}),
         setpoints=[SetpointFit(setpoint_c=temperature_c, temperature_c=temperature_c, n_poses=gyro.segments,
                                chi2_reduced=plain(gyro.chi2_reduced), parameters=dict(zip(names, plain(parameters))),
                                sigma=dict(zip(names, plain(sigma))))],
-        earth_rate="not taken out: a hand-held recording leaves the Earth's rate (up to 0.0042 °/s) in the bias",
-        gauge="the accelerometer's calibrated frame (its norm-only gauge): the turns between still intervals define "
-              "K relative to the gravity directions it measures; asymmetry, nonlinearity and g-sensitivity are not "
-              "determined (held at zero)",
+        statements={
+            "earth_rate": "not taken out: a hand-held recording leaves the Earth's rate (up to 0.0042 °/s) in the bias",
+            "gauge": "the accelerometer's calibrated frame (its norm-only gauge): the turns between still intervals "
+                     "define K relative to the gravity directions it measures; asymmetry, nonlinearity and "
+                     "g-sensitivity are not determined (held at zero)"},
         metrics=plain({"residual_rms_before_deg": float(np.sqrt(np.mean(gyro.residual_before_deg ** 2))),
                        "residual_rms_after_deg": float(np.sqrt(np.mean(gyro.residual_after_deg ** 2))),
                        "segments": gyro.segments, "rank": gyro.rank, "condition": gyro.condition}),
@@ -175,9 +179,10 @@ def fit_recording(recording: Recording, detection: Detection, free: FreeParamete
         "chi2_reduced_before": robust.chi2_reduced_before, "scatter_floor_mg": robust.scatter_floor_g * 1e3,
         "n_intervals": len(intervals), "temperature_c": temperature,
     }
-    calibration = SensorCalibration(
+    calibration = ChannelCalibration(
+        model=acceleration.MODEL.model_id, quantity=acceleration.MODEL.quantity, unit="g",
         serial=serial, mode="norm-only", free_parameters=[n for n, f in zip(PARAMETER_NAMES, fit.free) if f],
-        range_g=max(2.0, float(np.ceil(np.abs(recording.accel_g).max()))), lsb_g=recording.lsb_g,
+        range=max(2.0, float(np.ceil(np.abs(recording.accel_g).max()))), lsb=recording.lsb_g,
         validity_c=(low, high), out_of_range="clamp",
         polynomial=PolynomialModel(domain_c=(low, high), degree=0,
                                    coefficients={n: [float(p)] for n, p in zip(PARAMETER_NAMES, fit.parameters)}),
@@ -187,9 +192,9 @@ def fit_recording(recording: Recording, detection: Detection, free: FreeParamete
                                sigma=dict(zip(PARAMETER_NAMES, plain(fit.sigma))))],
         metrics=plain(metrics), warnings=warnings,
     )
-    channels: dict[str, SensorCalibration | GyroCalibration] = {ACCELERATION: calibration}
+    channels = {ACCEL_CHANNEL: calibration}
     if gyro is not None:
-        channels[ANGULAR_RATE] = gyro_calibration(gyro, recording, serial, temperature, (low, high))
+        channels[GYRO_CHANNEL] = gyro_calibration(gyro, recording, serial, temperature, (low, high))
     calibration_file = CalibrationFile(
         format=FORMAT_NAME, format_version=FORMAT_VERSION, created=utc_now(), software_version=__version__,
         source={"recording": recording.source, "measurements_sha256": recording.sha256,

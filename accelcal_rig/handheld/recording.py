@@ -256,8 +256,12 @@ def read_campaign_recording(path: Path, serial: str | None, setpoint_c: float | 
     rows = np.flatnonzero(mask & np.isin(campaign.pose_column("step_key"),
                                          list(campaign.header.plan.keys_of(*STATIC_KINDS))))
     dut = dut_description(campaign, serial)
-    lsb_g, odr_hz = float(dut["lsb_g"]), float(dut["odr_hz"])
-    codes = campaign.dut_column(serial, "raw_codes")[rows]
+    accelerometer = campaign.channel_of(serial, "acceleration")
+    if accelerometer is None:
+        raise ConfigError(f"{path}: sensor {serial} has no accelerometer (its channels: "
+                          f"{', '.join(c.name for c in campaign.header.dut_channels(serial))})")
+    lsb_g, odr_hz = accelerometer.lsb, float(dut["odr_hz"])
+    codes = campaign.channel_column(serial, accelerometer.name, "raw_codes")[rows]
     pose_temperature = campaign.dut_column(serial, "temperature_c")[rows].mean(axis=1)
     t_start = campaign.pose_column("t_start_s")[rows]
     n = codes.shape[1]

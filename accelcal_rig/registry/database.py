@@ -27,7 +27,7 @@ from sqlalchemy.engine import Connection, Engine
 
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.registry.location import described
-from accelcal_rig.registry.schema import approvals, calibrations, registry_tables
+from accelcal_rig.registry.schema import approvals, calibration_figures, calibrations, registry_tables
 
 T = TypeVar("T")
 _MIGRATIONS = Path(__file__).parent / "migrations"
@@ -164,15 +164,23 @@ class Registry:
         return added, len(pending) - len(added)
 
     def _insert(self, batch: list[dict[str, Any]]) -> list[int]:
-        """The ids of the entries of `batch` not registered before, inserted in one transaction."""
+        """The ids of the entries of `batch` not registered before, inserted in one transaction with their
+        figures."""
         dialect = self.engine.dialect.name
         insert = postgresql.insert(calibrations) if dialect == "postgresql" else sqlite.insert(calibrations)
         statement = insert.on_conflict_do_nothing(index_elements=["source_sha256", "serial", "fit_sha256"])
+        rows = [{k: v for k, v in entry.items() if k != "figures"} for entry in batch]
+        figures = {_identity(entry): entry.get("figures", []) for entry in batch}
+        returning = statement.returning(calibrations.c.id, calibrations.c.source_sha256, calibrations.c.serial,
+                                        calibrations.c.fit_sha256)
         for attempt in range(10):
             try:
                 with self.engine.begin() as connection:
-                    result = connection.execute(statement.returning(calibrations.c.id), batch)
-                    return [int(row_id) for row_id in result.scalars()]
+                    added = [(int(row.id), _identity(row._mapping)) for row in connection.execute(returning, rows)]
+                    kept = [{**figure, "calibration_id": row_id} for row_id, key in added for figure in figures[key]]
+                    if kept:
+                        connection.execute(sa.insert(calibration_figures), kept)
+                    return [row_id for row_id, _ in added]
             except sa.exc.OperationalError as exc:  # SQLite past its busy timeout; PostgreSQL a lost deadlock
                 again = ("locked" in str(exc.orig) if dialect == "sqlite"
                          else getattr(exc.orig, "sqlstate", None) in ("40P01", "40001"))
@@ -209,16 +217,16 @@ class Registry:
         if limit is not None:
             query = query.limit(limit)
         with self.engine.connect() as connection:
-            return [dict(row._mapping) for row in connection.execute(query)]
+            return _with_figures(connection, [dict(row._mapping) for row in connection.execute(query)])
 
     @reads
     def calibration(self, row_id: int) -> dict[str, Any]:
-        """One calibration's row with its stored fit."""
+        """One calibration's row with its stored fit and its figures."""
         with self.engine.connect() as connection:
             row = connection.execute(sa.select(calibrations).where(calibrations.c.id == row_id)).first()
-        if row is None:
-            raise ConfigError(f"registry {described(self.url)}: no calibration {row_id}")
-        return dict(row._mapping)
+            if row is None:
+                raise ConfigError(f"registry {described(self.url)}: no calibration {row_id}")
+            return _with_figures(connection, [dict(row._mapping)])[0]
 
     @reads
     def current(self, serial: str, simulated: bool = False, channel: str = "accel") -> dict[str, Any] | None:
@@ -278,12 +286,12 @@ class Registry:
 
     @reads
     def channels(self, serial: str | None = None) -> list[str]:
-        """Every channel with a calibration recorded (of one serial, if given): `accel` first."""
+        """Every channel with a calibration recorded (of one serial, if given), by name."""
         query = sa.select(calibrations.c.channel).distinct()
         if serial is not None:
             query = query.where(calibrations.c.serial == serial)
         with self.engine.connect() as connection:
-            return sorted(connection.execute(query).scalars(), key=lambda c: (c != "accel", c))
+            return sorted(connection.execute(query).scalars())
 
     @reads
     def parts(self) -> list[str]:
@@ -318,6 +326,26 @@ class Registry:
                         yield connection
                 finally:
                     connection.info.pop("begin", None)
+
+
+def _identity(entry: Any) -> tuple[str, str, str]:
+    """What identifies a calibration (its unique key)."""
+    return str(entry["source_sha256"]), str(entry["serial"]), str(entry["fit_sha256"])
+
+
+def _with_figures(connection: Connection, rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Each row with its figures (`figures`: name → {label, unit, axes, value, expanded_u, trend, lot}), read in
+    chunks of ids."""
+    found: dict[int, dict[str, dict[str, Any]]] = {int(row["id"]): {} for row in rows}
+    ids = list(found)
+    for start in range(0, len(ids), _BATCH):
+        query = (sa.select(calibration_figures).where(calibration_figures.c.calibration_id.in_(ids[start:start + _BATCH]))
+                 .order_by(calibration_figures.c.id))
+        for figure in connection.execute(query):
+            values = figure._mapping
+            found[int(values["calibration_id"])][str(values["name"])] = {
+                key: values[key] for key in ("label", "unit", "axes", "value", "expanded_u", "trend", "lot")}
+    return [{**row, "figures": found[int(row["id"])]} for row in rows]
 
 
 def _engine(url: str, create: bool = True, read_only: bool = False) -> Engine:

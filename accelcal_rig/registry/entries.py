@@ -13,14 +13,14 @@ from typing import Any
 
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import (
-    ACCELERATION,
     FORMAT_VERSION,
+    VERSION_1_CHANNEL,
     CalibrationFile,
-    GyroCalibration,
-    SensorCalibration,
+    ChannelCalibration,
     load_calibration,
 )
-from accelcal_rig.registry.figures import channel_figures
+from accelcal_rig.fit.channel_models import model_of
+from accelcal_rig.fit.parameter_uncertainty import reference_c
 from accelcal_rig.store.content import measurements_sha256
 from accelcal_rig.store.read import load_campaign
 
@@ -59,8 +59,8 @@ def campaign_entries(campaign_path: Path, calibration_path: Path | None = None) 
               "procedure": str(campaign.attrs.get("procedure_name", "")), "rig": str(campaign.attrs.get("rig_name", "")),
               "simulated": bool(campaign.attrs.get("dry_run", False)),
               "measured": campaign.finished or campaign.header.created}
-    return [{**_entry(calibration, channel, sensor, parts.get(serial, "unknown"), source), "lot": lots.get(serial)}
-            for serial, dut in calibration.duts.items() for channel, sensor in dut.channels.items()]
+    return [{**_entry(calibration, channel, calibrated, parts.get(serial, "unknown"), source), "lot": lots.get(serial)}
+            for serial, channel, calibrated in calibration.calibrated()]
 
 
 def recording_entries(recording_path: Path, calibration: CalibrationFile, part: str,
@@ -69,18 +69,16 @@ def recording_entries(recording_path: Path, calibration: CalibrationFile, part: 
     measured = datetime.fromtimestamp(recording_path.stat().st_mtime, UTC).isoformat()  # when it was recorded
     source = {"kind": "recording", "path": str(recording_path.resolve()), "sha256": file_sha256(recording_path),
               "procedure": "hand-held", "rig": "hand-held", "simulated": simulated, "measured": measured}
-    return [{**_entry(calibration, ACCELERATION, sensor, part, source), "lot": None}
-            for sensor in calibration.sensors.values()]
+    return [{**_entry(calibration, channel, calibrated, part, source), "lot": None}
+            for _, channel, calibrated in calibration.calibrated()]
 
 
-def _entry(calibration: CalibrationFile, channel: str, sensor: SensorCalibration | GyroCalibration, part: str,
+def _entry(calibration: CalibrationFile, channel: str, sensor: ChannelCalibration, part: str,
            source: dict[str, Any]) -> dict[str, Any]:
     stored = {"file": {"format": calibration.format, "format_version": calibration.format_version,
-                       "model": calibration.model, "created": calibration.created,
-                       "software_version": calibration.software_version, "source": calibration.source},
+                       "created": calibration.created, "software_version": calibration.software_version,
+                       "source": calibration.source},
               "sensor": json.loads(sensor.model_dump_json())}
-    verification = sensor.metrics.get("verification") if isinstance(sensor.metrics.get("verification"), dict) else {}
-    rmse = verification.get("rmse_mg") if verification and channel == ACCELERATION else None
     return {
         "serial": sensor.serial, "channel": channel, "part": part, "source_kind": source["kind"],
         "source_path": source["path"],
@@ -92,8 +90,10 @@ def _entry(calibration: CalibrationFile, channel: str, sensor: SensorCalibration
         "valid_from_c": float(sensor.validity_c[0]), "valid_to_c": float(sensor.validity_c[1]),
         "verdict": sensor.verdict if sensor.verdict in STORED_VERDICTS else None,
         "verdict_reasons": list(sensor.verdict_reasons),
-        "verification_rmse_mg": float(rmse) if rmse is not None else None,
-        "calibration": stored, **channel_figures(stored, channel),
+        "calibration": stored, "reference_c": reference_c(sensor.validity_c),
+        "figures": [{"name": f.name, "label": f.label, "unit": f.unit, "axes": "xyz" if len(f.values) == 3 else "",
+                     "value": list(f.values), "expanded_u": None if f.expanded is None else list(f.expanded),
+                     "trend": f.trend, "lot": f.lot} for f in model_of(sensor).stored_figures(sensor)],
     }
 
 
@@ -103,10 +103,11 @@ def _utc(timestamp: str) -> datetime:
     return (moment.astimezone(UTC) if moment.tzinfo else moment).replace(tzinfo=None)
 
 
-def calibration_file_of(row: dict[str, Any]) -> CalibrationFile:
-    """A registered calibration as a one-sensor calibration file again (for `rig registry export`): the
-    channel it is, in the current format whatever format it was fitted in."""
-    stored = row["calibration"]
-    channels = {row.get("channel") or ACCELERATION: stored["sensor"]}
-    return CalibrationFile.model_validate({**stored["file"], "format_version": FORMAT_VERSION,
-                                           "duts": {row["serial"]: {"channels": channels}}})
+def calibration_file_of(rows: list[dict[str, Any]]) -> CalibrationFile:
+    """Registered calibrations of one sensor (each of a channel) as a one-sensor calibration file again (for `rig
+    registry export`), in the current format whatever format each was fitted in (the first's file facts)."""
+    stored = rows[0]["calibration"]
+    channels = {row.get("channel") or VERSION_1_CHANNEL: row["calibration"]["sensor"] for row in rows}
+    file = {k: v for k, v in stored["file"].items() if k != "model"}  # a file-wide model: versions 1 and 2
+    return CalibrationFile.model_validate({**file, "format_version": FORMAT_VERSION,
+                                           "duts": {rows[0]["serial"]: {"channels": channels}}})

@@ -1,5 +1,6 @@
 """The registry's tables as the current migration leaves them (accelcal_rig/registry/migrations): one row
-per calibration of one channel of one DUT (an IMU's accelerometer and gyroscope are two rows). What
+per calibration of one channel of one DUT (an IMU's accelerometer and gyroscope are two rows), and its figures
+with their units, one row each. What
 identifies a calibration is its source file's SHA-256, the DUT's serial and the fit's own digest (each
 channel's fit its own): registering the same file again adds nothing; a refit of it with other options is
 another calibration."""
@@ -29,29 +30,12 @@ calibrations = sa.Table(
     sa.Column("valid_to_c", sa.Float, nullable=False),
     sa.Column("verdict", sa.String(16), nullable=True),                     # PASS | FAIL | CONDITIONAL | none (NOT JUDGED); 0005 widened it
     sa.Column("verdict_reasons", sa.JSON, nullable=False),
-    sa.Column("verification_rmse_mg", sa.Float, nullable=True),
     sa.Column("calibration", sa.JSON, nullable=False),                      # the whole fit, to export again
-    # Added by migration 0002: when the fit was made, and the figures queried across calibrations, at the
-    # reference temperature.
+    # Added by migration 0002: when the fit was made, and where its figures (calibration_figures) are stated.
     sa.Column("fitted_at", sa.DateTime, nullable=True),                     # UTC
     sa.Column("reference_c", sa.Float, nullable=True),
-    sa.Column("bias_mg", sa.JSON, nullable=True),                           # [x, y, z]
-    sa.Column("bias_uncertainty_mg", sa.JSON, nullable=True),               # [x, y, z], k = 2
-    sa.Column("scale_error_ppm", sa.JSON, nullable=True),                   # [x, y, z]
-    sa.Column("scale_uncertainty_ppm", sa.JSON, nullable=True),             # [x, y, z], k = 2
-    sa.Column("nonorthogonality_mrad", sa.Float, nullable=True),            # the largest of the three
     # Added by migration 0003: which channel of its DUT the calibration is.
     sa.Column("channel", sa.String(16), nullable=False, server_default="accel"),
-    # Added by migration 0004: a gyroscope's figures (°/s; its scale error is in scale_error_ppm) and each
-    # channel's noise from the campaign's still record (Allan deviation), per axis.
-    sa.Column("bias_dps", sa.JSON, nullable=True),                          # [x, y, z]
-    sa.Column("bias_uncertainty_dps", sa.JSON, nullable=True),              # [x, y, z], k = 2, at rest
-    sa.Column("expanded_uncertainty_dps", sa.JSON, nullable=True),          # [x, y, z], k = 2, at the largest rate
-    sa.Column("verification_rmse_dps", sa.Float, nullable=True),
-    sa.Column("arw_deg_per_rthr", sa.JSON, nullable=True),                  # [x, y, z]
-    sa.Column("bias_instability_dph", sa.JSON, nullable=True),              # [x, y, z]
-    sa.Column("vrw_m_s_per_rthr", sa.JSON, nullable=True),                  # [x, y, z]
-    sa.Column("bias_instability_ug", sa.JSON, nullable=True),               # [x, y, z]
     # Added by migration 0007: the lab's lot of the DUT (its own word for it, not the part number).
     sa.Column("lot", sa.String(64), nullable=True),
     sa.Index("calibrations_serial_channel", "serial", "channel"),
@@ -59,6 +43,23 @@ calibrations = sa.Table(
 )
 
 COLUMNS = tuple(column.name for column in calibrations.columns)
+
+# Added by migration 0008: each calibration's figures with their units (the columns 0002 and 0004 had, `bias_mg`,
+# `bias_dps`, …, moved here), as its channel's model states them (fit/channel_model.py StoredFigure).
+calibration_figures = sa.Table(
+    "calibration_figures", metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("calibration_id", sa.Integer, sa.ForeignKey("calibrations.id"), nullable=False, index=True),
+    sa.Column("name", sa.String(64), nullable=False),                   # bias, scale_error, …
+    sa.Column("label", sa.String(128), nullable=False),                 # as people say it
+    sa.Column("unit", sa.String(16), nullable=False),                   # mg, °/s, ppm, …
+    sa.Column("axes", sa.String(8), nullable=False),                    # "xyz": a value per axis; "": one value
+    sa.Column("value", sa.JSON, nullable=False),                        # [x, y, z] or [value]
+    sa.Column("expanded_u", sa.JSON, nullable=True),                    # as value, k = 2, where stated
+    sa.Column("trend", sa.Boolean, nullable=False),                     # a sensor's drift per year is stated of it
+    sa.Column("lot", sa.Boolean, nullable=False),                       # a lot's statistics show its spread
+    sa.UniqueConstraint("calibration_id", "name", name="one_figure_per_name"),
+)
 
 # Added by migration 0006: the lab's users, the append-only record of approvals, and every certificate
 # revision issued (the database refuses to change or delete the last two).

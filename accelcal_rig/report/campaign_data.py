@@ -17,26 +17,22 @@ from accelcal_rig.config.acceptance import Acceptance
 from accelcal_rig.config.procedure import SoakCriterion
 from accelcal_rig.config.yaml_lines import parse_yaml_text
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
-from accelcal_rig.errors import RigError
-from accelcal_rig.fit.acceptance import Judgement, judge, recorded_acceptance
+from accelcal_rig.fit.acceptance import Judgement, recorded_acceptance
 from accelcal_rig.fit.allan import AllanCurve, allan_deviation
-from accelcal_rig.fit.calibration import ACCELERATION, ANGULAR_RATE, GyroCalibration, load_calibration
-from accelcal_rig.fit.campaign_fit import (
-    DutFitResult,
-    FitOptions,
-    fit_dut,
-    fit_gyroscope,
-    not_calibrated,
-    partial_campaign,
-)
-from accelcal_rig.fit.gyro_acceptance import judge_gyro
-from accelcal_rig.fit.gyro_fit import GyroFitResult
-from accelcal_rig.fit.noise_record import NOISE_KIND, QUOTED_AT_C, noise_allan
+from accelcal_rig.fit.campaign_fit import FitOptions, FittedChannel, fit_channels
+from accelcal_rig.fit.channel_model import ChannelFit
+from accelcal_rig.fit.channel_models import model_for_quantity
+from accelcal_rig.fit.noise_record import NOISE_KIND, QUOTED_AT_C
 from accelcal_rig.fit.recorded_options import recorded_options
+from accelcal_rig.fit.vector_model import VectorFitDetail
 from accelcal_rig.parts.registry import DEFAULT_PART, known_parts
-from accelcal_rig.store.content import Campaign, measurements_sha256
-from accelcal_rig.store.read import DutPoses, campaign_status, dut_description, load_campaign, read_dut_poses
+from accelcal_rig.store.content import Campaign
+from accelcal_rig.store.read import VectorPoses, campaign_status, dut_description, load_campaign
 from accelcal_rig.store.records import STATIC_KINDS, StoredEvent
+
+#: The quantity whose poses the report's own figures draw (the paper's: |g| before and after, the pose clouds,
+#: Eq. 1's parameters over temperature, the residual drift); every channel's figures are in its table.
+DRAWN_QUANTITY = "acceleration"
 
 
 @dataclass(frozen=True)
@@ -53,12 +49,19 @@ class SoakRecord:
 
 @dataclass(frozen=True)
 class DutReport:
-    poses: DutPoses                   # the calibration poses (the verification poses' figures are in the fit's)
+    """A DUT's accelerometer as the report's figures draw it."""
+
+    poses: VectorPoses                # the calibration poses (the verification poses' figures are in the fit's)
     pose_numbers: np.ndarray          # (N,) 1-based pose of the schedule
-    fit: DutFitResult | None
+    fit: ChannelFit | None
     truth_by_setpoint: np.ndarray | None   # (K, 12) simulation truth averaged per setpoint, dry runs only
     judgement: Judgement | None = None     # against the procedure's acceptance limits
-    verification: DutPoses | None = None   # the verification poses (never fitted), at every setpoint they were taken
+    verification: VectorPoses | None = None  # the verification poses (never fitted), at every setpoint they were taken
+
+    @property
+    def detail(self) -> VectorFitDetail | None:
+        """The Eq. 1 fit's setpoints, fits and compensated poses (None: not fitted)."""
+        return None if self.fit is None else self.fit.detail
 
 
 @dataclass(frozen=True)
@@ -66,6 +69,7 @@ class NoiseCurves:
     """One channel's Allan deviation per axis from a DUT's still record (the one its figures are quoted at)."""
 
     channel: str
+    quantity: str
     setpoint_c: float
     curves: list[AllanCurve]          # per axis, in the channel's unit (g, °/s)
     figures: dict[str, Any]           # the calibration's `allan` entry: random walk and bias instability per axis
@@ -87,12 +91,10 @@ class CampaignData:
     gravity_m_s2: float               # the site's, as the rig config stated it
     acceptance: Acceptance            # the procedure's limits
     zero_g_offset_mg: dict[str, float | None]  # per DUT, its part's data sheet range of the 0 g offset
-    #: Per DUT, the channels it measured that no channel model calibrates yet, each with why.
+    #: Per DUT, the channels it measured that no channel model calibrates, each with why.
     not_calibrated: dict[str, dict[str, str]] = field(default_factory=dict)
-    #: Per DUT with a calibrated gyroscope, its calibration (verdict, figures, polynomials and setpoints).
-    gyros: dict[str, GyroCalibration] = field(default_factory=dict)
-    #: Where the gyroscopes came from: the calibration file beside the campaign, or a fit made here.
-    gyro_source: str = ""
+    #: Per DUT, every calibrated channel (fitted and judged here as `rig fit` would), by channel.
+    channels: dict[str, dict[str, FittedChannel]] = field(default_factory=dict)
     #: Per DUT, its channels' Allan curves from the campaign's still record.
     noise: dict[str, list[NoiseCurves]] = field(default_factory=dict)
 
@@ -107,79 +109,55 @@ def read_campaign_data(path: Path) -> CampaignData:
     options = recorded_options(attrs, str(path))
     pose_numbers = campaign.pose_column("pose_number")
     keys = campaign.pose_column("step_key")
-    if len(keys):  # the accelerometer's poses are those at rest (read_dut_poses): their numbers likewise
+    if len(keys):  # the accelerometer's poses are those at rest (read_vector_poses): their numbers likewise
         pose_numbers = pose_numbers[np.isin(keys, list(campaign.header.plan.keys_of(*STATIC_KINDS)))]
     damaged = campaign.unusable_reasons()
     limits = recorded_acceptance(campaign.header.procedure_yaml, str(path))
-    partial = partial_campaign(campaign)
-    duts, reasons = {}, []
+    fitted: dict[str, dict[str, FittedChannel]] = {}
+    not_calibrated: dict[str, dict[str, str]] = {}
+    reasons: list[str] = []
+    if options is None:
+        reasons.append("the procedure measures only (fit.mode: none)")
+    elif damaged:
+        reasons.append(f"damaged measurements: {damaged[0]}")
+    elif campaign.poses:
+        try:
+            found = fit_channels(campaign, options, str(path))
+            fitted, not_calibrated = found.fitted, {s: left for s, left in found.uncalibrated.items() if left}
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            reasons.append(str(exc))
+    else:
+        reasons.append("no poses stored")
+    duts = {}
     for serial in campaign.serials:
-        stored = read_dut_poses(campaign, serial)
+        info = campaign.channel_of(serial, DRAWN_QUANTITY)
+        if info is None:
+            continue
+        model = model_for_quantity(DRAWN_QUANTITY)
+        assert model is not None
+        stored = model.records(campaign, info, serial, options or FitOptions())
+        drawn = fitted.get(serial, {}).get(info.name)
+        if drawn is None and options is not None and not damaged and campaign.poses and not reasons:
+            reasons.append(f"sensor {serial}: {not_calibrated.get(serial, {}).get(info.name, 'not fitted')}")
         poses = stored.subset(~stored.verification)
-        fit, judgement = None, None
-        if options is None:
-            reasons.append("the procedure measures only (fit.mode: none)")
-        elif damaged:
-            reasons.append(f"damaged measurements: {damaged[0]}")
-        elif len(poses.setpoint_c):
-            try:
-                fit = fit_dut(stored, options)
-                judgement = judge(fit.metrics, fit.thermal, options.mode, limits, partial, fit.parameter_u)
-            except (ValueError, np.linalg.LinAlgError) as exc:
-                reasons.append(str(exc))
-        else:
-            reasons.append("no poses stored")
-        duts[serial] = DutReport(poses, pose_numbers[~stored.verification], fit, _truth_by_setpoint(poses), judgement,
+        duts[serial] = DutReport(poses, pose_numbers[~stored.verification], None if drawn is None else drawn.fit,
+                                 _truth_by_setpoint(poses), None if drawn is None else drawn.judgement,
                                  stored.subset(stored.verification))
     soaks = [SoakRecord(name, s.setpoint_c, s.outcome, s.t_s, s.chamber_c, s.dut_c, s.t_reached_s, s.t_stable_s)
              for name, s in zip(campaign.soak_names(), campaign.soaks)]
     events = list(campaign.events)
     soaks.sort(key=lambda s: s.t_reached_s)
     reason = "; ".join(dict.fromkeys(reasons))
-    gyros, source = ({}, "") if options is None or damaged else _gyroscopes(path, campaign, options, limits, partial)
     return CampaignData(path, status, str(attrs.get("procedure_path", "")), str(attrs.get("rig_name", "")), band_c,
                         options, duts, soaks, events, campaign.pose_column("t_start_s"), reason,
                         float(attrs.get("gravity_m_s2", STANDARD_GRAVITY_M_S2)), limits,
                         {s: _datasheet_offset_mg(campaign, s) for s in campaign.serials},
-                        {s: left for s in campaign.serials
-                         if (left := {c: why for c, why in not_calibrated(campaign, s).items()
-                                      if not (c == ANGULAR_RATE and s in gyros)})},
-                        gyros, source, {} if damaged else _noise_curves(campaign, gyros))
+                        not_calibrated, fitted, {} if damaged else _noise_curves(campaign, fitted))
 
 
-def _gyroscopes(path: Path, campaign: Campaign, options: FitOptions, limits: Acceptance,
-                partial: str) -> tuple[dict[str, GyroCalibration], str]:
-    """Each DUT's gyroscope calibration: from the calibration file beside the campaign (FILE.calibration.yaml)
-    when it was fitted to the measurements the campaign holds now, else fitted and judged here as `rig fit`
-    would (the file is only read)."""
-    beside = path.with_suffix(".calibration.yaml")
-    if beside.is_file():
-        try:
-            calibration = load_calibration(beside)
-        except (RigError, OSError):
-            calibration = None
-        if calibration is not None and calibration.source.get("measurements_sha256") == measurements_sha256(campaign):
-            return calibration.gyroscopes, f"the calibration file beside the campaign ({beside.name})"
-    gyros = {}
-    for serial in campaign.serials:
-        try:
-            fitted = fit_gyroscope(campaign, serial, options)
-        except (ValueError, np.linalg.LinAlgError):
-            continue
-        if not isinstance(fitted, GyroFitResult):
-            continue
-        verdict = judge_gyro(fitted.metrics, fitted.thermal, limits, partial, fitted.parameter_u)
-        odr_hz = float(campaign.header.duts[campaign.serials.index(serial)].get("odr_hz") or 0.0)
-        allan = noise_allan(campaign, serial, ANGULAR_RATE, odr_hz) if odr_hz > 0 else None
-        gyros[serial] = fitted.calibration.model_copy(update={
-            "verdict": verdict.verdict, "verdict_reasons": verdict.reasons,
-            "metrics": {**fitted.calibration.metrics, **({"allan": allan} if allan else {})}})
-    return gyros, "fitted from the campaign for this report (no calibration file beside it of these measurements)"
-
-
-def _noise_curves(campaign: Campaign, gyros: dict[str, GyroCalibration]) -> dict[str, list[NoiseCurves]]:
-    """Each DUT's accelerometer and gyroscope Allan curves from the still record nearest 25 °C, beside the
-    figures the fit read off them (where it has them)."""
+def _noise_curves(campaign: Campaign, fitted: dict[str, dict[str, FittedChannel]]) -> dict[str, list[NoiseCurves]]:
+    """Each DUT's Allan curves of every channel whose model quotes noise figures, from the still record nearest
+    25 °C, beside the figures the fit read off them (where it has them)."""
     keys = campaign.pose_column("step_key") if campaign.poses else np.zeros(0, dtype=str)
     noise = np.isin(keys, list(campaign.header.plan.keys_of(NOISE_KIND)))
     if not noise.any():
@@ -191,19 +169,18 @@ def _noise_curves(campaign: Campaign, gyros: dict[str, GyroCalibration]) -> dict
     out: dict[str, list[NoiseCurves]] = {}
     for serial in campaign.serials:
         odr_hz = float(campaign.header.duts[campaign.serials.index(serial)].get("odr_hz") or 0.0)
-        names = {c.name for c in campaign.header.dut_channels(serial)}
-        for channel in (ACCELERATION, ANGULAR_RATE):
-            if channel not in names or odr_hz <= 0:
+        for info in campaign.header.dut_channels(serial):
+            model = model_for_quantity(info.quantity)
+            if model is None or model.noise is None or odr_hz <= 0:
                 continue
-            info = campaign.channel_info(serial, channel)
-            codes = campaign.channel_column(serial, channel, "raw_codes")[rows]
+            codes = campaign.channel_column(serial, info.name, "raw_codes")[rows]
             try:
                 curves = allan_deviation(codes.reshape(-1, codes.shape[-1]) * info.lsb, odr_hz)
             except ValueError:
                 continue
-            figures = noise_allan(campaign, serial, channel, odr_hz) if channel == ACCELERATION else (
-                gyros[serial].metrics.get("allan") if serial in gyros else None)
-            out.setdefault(serial, []).append(NoiseCurves(channel, float(quoted), curves, figures or {}))
+            channel = fitted.get(serial, {}).get(info.name)
+            figures = channel.allan if channel is not None else None
+            out.setdefault(serial, []).append(NoiseCurves(info.name, info.quantity, float(quoted), curves, figures or {}))
     return out
 
 
@@ -212,11 +189,12 @@ def _datasheet_offset_mg(campaign: Campaign, serial: str) -> float | None:
     name = str(dut_description(campaign, serial).get("part", DEFAULT_PART))
     if name not in known_parts():
         return None
-    offset_g = known_parts()[name].channel("accel").zero_offset
+    channel = next((c for c in known_parts()[name].channels if c.quantity == DRAWN_QUANTITY), None)
+    offset_g = None if channel is None else channel.zero_offset
     return None if offset_g is None else offset_g * 1000.0
 
 
-def _truth_by_setpoint(poses: DutPoses) -> np.ndarray | None:
+def _truth_by_setpoint(poses: VectorPoses) -> np.ndarray | None:
     if poses.truth_parameters is None or not len(poses.setpoint_c):
         return None
     setpoints = list(dict.fromkeys(poses.setpoint_c.tolist()))

@@ -2,9 +2,9 @@
 `certificate` extra) its PDF, from a campaign file and the calibration fitted to it.
 
 A certificate states only what the two files hold: the item and its identity as read at preflight, the
-campaign and its instruments, the calibration, its verification, its uncertainty budget and its verdict (an
-IMU's both sensors: the gyroscope's, and the noise of each, in certificate_gyro.py); fields for the signatures
-of who performed and who approved it. A dry run's certificate says on every
+campaign and its instruments, and for each calibrated channel of the DUT what its channel model states (its
+results, verification and uncertainty budget, fit/channel_model.py `sections`) and its noise; the statement
+of conformity over every channel; fields for the signatures of who performed and who approved it. A dry run's certificate says on every
 page that no physical sensor was calibrated; a partial campaign's says it was partial.
 """
 
@@ -17,15 +17,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from accelcal_rig import __version__
-from accelcal_rig.core.units import gravity_statement
 from accelcal_rig.durable import clear_dead_temporaries, write_atomically, write_text_atomically
 from accelcal_rig.errors import ConfigError, RigError
-from accelcal_rig.fit.calibration import CalibrationFile, GyroCalibration, SensorCalibration, load_calibration
-from accelcal_rig.fit.sfem import PARAMETER_NAMES
-from accelcal_rig.report import certificate_decision, certificate_gyro, certificate_lab
+from accelcal_rig.fit.calibration import CalibrationFile, ChannelCalibration, load_calibration
+from accelcal_rig.fit.channel_model import Section
+from accelcal_rig.fit.channel_models import model_of
+from accelcal_rig.report import certificate_decision, certificate_lab
 from accelcal_rig.store.content import Campaign, measurements_sha256
 from accelcal_rig.store.read import dut_description, usable_campaign
 from accelcal_rig.store.records import utc_now
@@ -74,9 +72,8 @@ def write_certificates(campaign_path: Path, calibration_path: Path, folder: Path
     warnings = [] if render is not None or not pdf else [
         "PDFs need WeasyPrint: pip install 'accelcal-rig[certificate]' (HTML certificates written)"]
     written: list[Written] = []
-    for serial, name in certificate_names(list(calibration.sensors)).items():
-        sensor = calibration.sensors[serial]
-        page = certificate_html(campaign, campaign_path, calibration, calibration_path, serial, sensor, operator)
+    for serial, name in certificate_names(list(calibration.duts)).items():
+        page = certificate_html(campaign, campaign_path, calibration, calibration_path, serial, operator)
         pdf_path = None
         clear_dead_temporaries(folder / f"{name}.pdf", folder / f"{name}.html")  # what a killed writer left
         if render is not None:
@@ -136,14 +133,13 @@ def render_certificate(campaign_path: Path, calibration_path: Path, serial: str,
                        pdf: bool = True, reason: str = "", operator: str = "") -> Rendered:
     """One DUT's certificate issued as `revision`, approved by `approver` today: what an approval keeps."""
     campaign, calibration = _certifiable(campaign_path, calibration_path)
-    sensor = calibration.sensors.get(serial)
-    if sensor is None:
+    if serial not in calibration.duts:
         raise ConfigError(f"{calibration_path}: no sensor {serial}")
     approval = Approval(approver, utc_now()[:10], reason)
-    page = certificate_html(campaign, campaign_path, calibration, calibration_path, serial, sensor, operator, revision,
+    page = certificate_html(campaign, campaign_path, calibration, calibration_path, serial, operator, revision,
                             approval)
     render = _pdf_renderer() if pdf else None
-    number = certificate_number(campaign, sensor, calibration, revision).base
+    number = certificate_lab.certificate_number(serial, calibration, revision).base
     return Rendered(number, page, None if render is None else _rendered_pdf(render, page, calibration_path))
 
 
@@ -155,9 +151,7 @@ def _certifiable(campaign_path: Path, calibration_path: Path) -> tuple[Campaign,
     if calibration.source.get("measurements_sha256") != measurements_sha256(campaign):
         raise ConfigError(f"{calibration_path}: fitted to other measurements than {campaign_path} holds now: fit it "
                           "again (rig fit) before certifying")
-    judged: list[tuple[str, SensorCalibration | GyroCalibration]] = [*calibration.sensors.items(),
-                                                                     *calibration.gyroscopes.items()]
-    old = [s for s, c in judged if "uncertainty_budget" not in c.metrics or c.verdict is None]
+    old = [s for s, _, c in calibration.calibrated() if "uncertainty_budget" not in c.metrics or c.verdict is None]
     if old:
         raise ConfigError(f"{calibration_path}: sensor {old[0]} has no uncertainty budget or verdict (written by an "
                           "earlier accelcal-rig): fit it again (rig fit) before certifying")
@@ -202,68 +196,64 @@ def _grid(header: list[str], rows: Sequence[Sequence[object]], text_columns: int
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
-def certificate_number(campaign: Campaign, sensor: SensorCalibration, calibration: CalibrationFile,
-                       revision: int = 1) -> certificate_lab.CertificateNumber:
-    """Unique to the DUT, its measurements and their fit, with its revision (certificate_lab)."""
-    return certificate_lab.certificate_number(sensor.serial, calibration, revision)
-
-
 def certificate_html(campaign: Campaign, campaign_path: Path, calibration: CalibrationFile, calibration_path: Path,
-                     serial: str, sensor: SensorCalibration, operator: str = "", revision: int = 1,
-                     approval: Approval | None = None) -> str:
+                     serial: str, operator: str = "", revision: int = 1, approval: Approval | None = None) -> str:
     """The certificate's page; without `approval` a draft, every page saying it is not issued yet."""
     dut = dut_description(campaign, serial)
-    attrs, metrics = campaign.attrs, sensor.metrics
-    number = certificate_number(campaign, sensor, calibration, revision)
+    attrs = campaign.attrs
+    channels = dict(calibration.duts[serial].channels)
+    models = {name: model_of(channel) for name, channel in channels.items()}
+    number = certificate_lab.certificate_number(serial, calibration, revision)
     banners = [] if approval is not None else [
         "DRAFT: not issued until a person approves it (rig approve, or the dashboard)."]
     if attrs.get("dry_run"):
         banners.append("SIMULATED: a dry run against simulated instruments. No physical sensor was calibrated.")
     if calibration.source.get("partial"):
         banners.append(f"PARTIAL: {calibration.source['partial']}.")
-    uncalibrated = calibration.duts[serial].not_calibrated if serial in calibration.duts else {}
-    gyro = calibration.gyroscopes.get(serial)
-    covered = "accel and gyro channels" if gyro is not None else "accel channel"
+    uncalibrated = calibration.duts[serial].not_calibrated
+    covered = f"{' and '.join(channels)} channel{'s' if len(channels) > 1 else ''}"
     banners += [f"NOT CALIBRATED: its {channel} channel ({why}). This certificate covers its {covered} only."
                 for channel, why in uncalibrated.items()]
-    style = STYLE + certificate_decision.STYLE + (DRY_RUN_PAGES if attrs.get("dry_run") else "") + (GYRO_STYLE if gyro is not None else "")
-    item = ("MEMS IMU: accelerometer and gyroscope" if gyro is not None
-            else f"MEMS accelerometer{' channel' if uncalibrated else ''}")
+    several = len(channels) > 1
+    style = (STYLE + certificate_decision.STYLE + (DRY_RUN_PAGES if attrs.get("dry_run") else "")
+             + (SEVERAL_STYLE if several else ""))
+    sensors = [model.sensor for model in models.values()]
+    item = f"MEMS {' and '.join(sensors)}{' channel' if uncalibrated and not several else ''}"
     parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Calibration certificate {_e(number)}"
              f"</title><style>{style}</style><style>{certificate_lab.LAB_STYLE}</style></head><body>",
              certificate_lab.header_html(campaign),
-             f"<h1>Calibration certificate: {item}</h1>",
+             f"<h1>Calibration certificate: {_e(item)}</h1>",
              f"<p>Certificate <b class='number'>{_e(number)}</b> — "
              f"{'issued ' + _e(approval.date) if approval else 'draft of ' + _e(utc_now()[:10])} by accelcal-rig "
              f"{_e(__version__)}</p>",
              *(f"<div class='banner'>{_e(b)}</div>" for b in banners)]
+    configured = "; ".join(f"{name} ±{c.range:g} {c.unit}, {c.lsb:.4g} {c.unit} per code" for name, c in channels.items())
     parts += ["<div class='front'>", "<h2>Item calibrated</h2>", _rows([
         ("serial", serial),
         ("part", f"{dut.get('part', '?')}: {_identity(campaign, serial)}"),
-        ("configured", f"±{dut.get('range_g', '?')} g, {dut.get('odr_hz', '?')} Hz, {float(dut.get('lsb_g', 0)) * 1e6:.4g} µg "
-                       "per code"),
+        ("configured", f"{configured}; {dut.get('odr_hz', '?')} Hz"),
         ("mount on the fixture", f"{dut.get('name', '')} ({', '.join(f'{a:g}' for a in dut.get('mount_euler_deg', []))}° "
                                  "xyz Euler)"),
         *certificate_lab.item_rows(campaign, serial),
     ])]
     parts += ["<h2>Calibration</h2>", _rows([
-        *certificate_lab.calibration_rows(campaign, campaign_path.name, calibration, calibration_path.name, sensor,
-                                          gyro is not None),
-        ("gravity", gravity_statement(float(metrics.get("gravity_m_s2", 9.80665)))),
+        *certificate_lab.calibration_rows(campaign, campaign_path.name, calibration, calibration_path.name,
+                                          [models[n].method(c) for n, c in channels.items()]),
+        *(row for n, c in channels.items() for row in models[n].reference_statements(c.metrics)),
         *certificate_lab.environment_rows(campaign, serial),
         ("performed by", operator or "—"),
     ]), certificate_lab.traceability_html(campaign), "</div>"]
-    accel = " (accelerometer)" if gyro is not None else ""
-    parts += ["<section>", f"<h2>Results{accel}</h2>", _results(sensor), "</section>"]
-    parts += ["<section>", f"<h2>Verification{accel} (poses the calibration never saw)</h2>", _verification(metrics),
-              "</section>"]
-    parts += ["<section>", f"<h2>Uncertainty of a compensated reading{accel}</h2>", _uncertainty(metrics), "</section>"]
-    if gyro is not None:
-        parts += _gyro_sections(gyro)
-    noise = certificate_gyro.noise(sensor, gyro)
+    for name, channel in channels.items():
+        for section in models[name].sections(channel):
+            parts.append(section_html(section, models[name].sensor if several else ""))
+    noise = noise_html(channels)
     if noise:
         parts += ["<section>", "<h2>Noise (Allan deviation)</h2>", noise, "</section>"]
-    parts += certificate_decision.conformity_section(sensor, gyro)
+    parts += certificate_decision.conformity_section(
+        [(models[n].sensor.capitalize(), c) for n, c in channels.items()])
+    ranges = "; ".join(f"{name} {c.validity_c[0]:.2f} … {c.validity_c[1]:.2f} °C (outside it "
+                       f"{'clamped to its edge' if c.out_of_range == 'clamp' else 'extrapolated'})"
+                       for name, c in channels.items())
     parts += ["<section><h2>Signatures</h2>",
               "<table class='signatures'><tr><th class='text'></th><th class='text'>name</th><th class='text'>date"
               "</th><th class='text'>signature</th></tr>"
@@ -273,27 +263,58 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
               *([f"<p>Revision {revision} replaces revision {revision - 1}: {_e(approval.reason)}</p>"]
                 if approval is not None and revision > 1 and approval.reason else []),
               "<p class='note'>The results refer only to the item calibrated, under the conditions stated, within "
-              f"the calibrated temperature range {sensor.validity_c[0]:.2f} … {sensor.validity_c[1]:.2f} °C. Outside "
-              f"it the calibration {'is clamped to its edge' if sensor.out_of_range == 'clamp' else 'extrapolates'}."
-              "</p>", certificate_lab.end_html(number), "</section></body></html>"]
+              f"the calibrated temperature range: {_e(ranges)}.</p>", certificate_lab.end_html(number),
+              "</section></body></html>"]
     return "\n".join(parts)
 
 
-#: An IMU's certificate states two sensors on at most two pages: its tables a little tighter.
-GYRO_STYLE = """
+#: A certificate of several channels states them on at most two pages: its tables a little tighter.
+SEVERAL_STYLE = """
 body { font-size: 7.5pt; } h1 { font-size: 13pt; } h2 { font-size: 9.5pt; margin: 2.5mm 0 0.8mm 0; }
 th, td { padding: 0.3pt 3pt; } p { margin: 0.8mm 0; } ul { margin: 0.5mm 0; } .signatures td { height: 10mm; }
 """
 
 
-def _gyro_sections(gyro: GyroCalibration) -> list[str]:
-    """The gyroscope's results, verification, uncertainty and the statements of how it was referenced."""
-    return ["<section>", "<h2>Results (gyroscope)</h2>", certificate_gyro.gyro_results(gyro),
-            certificate_gyro.gyro_statements(gyro), "</section>",
-            "<section>", "<h2>Verification (gyroscope: rate steps the calibration never saw)</h2>",
-            certificate_gyro.gyro_verification(gyro), "</section>",
-            "<section>", "<h2>Uncertainty of a compensated rate (gyroscope)</h2>", certificate_gyro.gyro_uncertainty(gyro),
-            "</section>"]
+def section_html(section: Section, sensor: str = "") -> str:
+    """A model's section as HTML: its title (the sensor's where the certificate has several), paragraphs, facts,
+    table and notes, every text escaped."""
+    title = f"{sensor.capitalize()}: {section.title}" if sensor else section.title
+    parts = ["<section>", f"<h2>{_e(title)}</h2>", *(f"<p>{_e(p)}</p>" for p in section.paragraphs)]
+    if section.facts:
+        parts.append(_rows(list(section.facts)))
+    if section.table is not None:
+        parts.append(_grid(list(section.table.header), section.table.rows, section.table.text_columns))
+    parts += [f"<p class='note'>{_e(n)}</p>" for n in section.notes]
+    return "".join(parts) + "</section>"
+
+
+def _interval(entry: dict[str, Any], spec: str) -> str:
+    return f"{format(entry['value'], spec)} [{format(entry['low'], spec)}, {format(entry['high'], spec)}]"
+
+
+def noise_html(channels: dict[str, ChannelCalibration]) -> str:
+    """Each channel's Allan figures per axis with their 68 % intervals, and the record they come from; "" when
+    the campaign had no still record."""
+    rows, records = [], []
+    for channel in channels.values():
+        model = model_of(channel)
+        allan, quoted = channel.metrics.get("allan"), model.noise
+        if not isinstance(allan, dict) or quoted is None:
+            continue
+        for key, name, unit, spec in ((quoted.random_walk, quoted.random_walk_label, quoted.random_walk_unit,
+                                       quoted.random_walk_spec),
+                                      (quoted.instability, "bias instability", quoted.instability_unit,
+                                       quoted.instability_spec)):
+            if isinstance(allan.get(key), list):
+                rows.append([f"{model.sensor}: {name} ({unit})", *(_interval(e, spec) for e in allan[key])])
+        if "duration_s" in allan:
+            records.append(f"{model.sensor}: {allan['samples']} samples over {allan['duration_s']:.1f} s at "
+                           f"{allan['setpoint_c']:g} °C")
+    if not rows:
+        return ""
+    return ("<p>Overlapping Allan deviation of a still record per axis (IEEE Std 952 practice): the random walk and "
+            "the bias instability fitted to it, each [68 % interval]. Records: " + _e("; ".join(records)) + ".</p>"
+            + _grid(["figure", "x", "y", "z"], rows))
 
 
 def _identity(campaign: Campaign, serial: str) -> str:
@@ -301,67 +322,3 @@ def _identity(campaign: Campaign, serial: str) -> str:
     prefix = f"sensor {serial}: "
     found = [e.message[len(prefix):] for e in campaign.events if e.kind == "preflight" and e.message.startswith(prefix)]
     return found[-1] if found else "identity not recorded"
-
-
-#: (label, parameter index, factor to the unit shown, offset, format) of each row of the results table.
-_RESULT_ROWS = [
-    *((f"bias {axis} (mg)", k, 1e3, 0.0, "+.3f") for k, axis in enumerate("xyz")),
-    *((f"scale error {axis} (ppm)", 3 + k, 1e6, -1.0, "+.0f") for k, axis in enumerate("xyz")),
-    *((f"non-orthogonality {name} (mrad)", 6 + k, 1e3, 0.0, "+.4f") for k, name in enumerate(("yx", "zx", "zy"))),
-]
-_MISALIGNMENT_ROWS = [(f"misalignment {axis} (mrad)", 9 + k, 1e3, 0.0, "+.4f") for k, axis in enumerate("xyz")]
-
-
-def _results(sensor: SensorCalibration) -> str:
-    low, high = sensor.validity_c
-    temperatures = np.array([low, 0.5 * (low + high), high])
-    values = sensor.parameters_at(temperatures)              # (3, 12)
-
-    def cell(i: int, k: int, factor: float, offset: float, spec: str) -> str:
-        u = certificate_decision.expanded_at(sensor.metrics, PARAMETER_NAMES[k], float(temperatures[i]))
-        text = format((values[i, k] + offset) * factor, spec)
-        return text if u is None else f"{text} ± {format(u * factor, spec.lstrip('+'))}"
-
-    rows = [[label, *(cell(i, k, factor, offset, spec) for i in range(3))]
-            for label, k, factor, offset, spec in _RESULT_ROWS + (_MISALIGNMENT_ROWS if sensor.mode == "reference" else [])]
-    return (f"<p>Calibrated range {low:.2f} … {high:.2f} °C (the DUT's own temperature sensor). Parameters of Eq. 1, "
-            "U<sub>SF</sub> = M·C·S·(U − b), at the ends and the middle of the range, each ± its expanded uncertainty "
-            "(k = 2: the fit's, carried through its polynomial, the thermal model's scatter and, for the scale "
-            "factors, the site's gravity); the full polynomials are in the calibration file.</p>"
-            + _grid(["parameter", *(f"at {t:.2f} °C" for t in temperatures)], rows))
-
-
-def _verification(metrics: dict[str, Any]) -> str:
-    v = metrics.get("verification")
-    if v is None:
-        return "<p><b>No verification poses:</b> the calibration was not checked on poses it was not fitted to.</p>"
-    temperatures = ", ".join(f"{r['setpoint_c']:g}" for r in v["by_setpoint"])
-    expanded = v.get("expanded_u", {})
-
-    def u(key: str, spec: str = ".4f") -> str:
-        return f" ± {format(expanded[key], spec)}" if key in expanded else ""
-
-    drift_u = expanded.get("drift_mg")
-    drift = ", ".join(f"{d * 1e3:.1f}" + (f" ± {drift_u[a] * 1e3:.1f}" if drift_u else "") for a, d in enumerate(v["drift_mg"]))
-    return _rows([
-        ("poses", f"{v['n_poses']} at {temperatures} °C"),
-        ("|g| RMSE (Eq. 9)", f"{v['rmse_mg']:.4f}{u('rmse_mg')} mg (their noise floor {v['noise_floor_mg']:.4f} mg)"),
-        ("largest axis error", f"{v['max_axis_error_mg']:.4f}{u('max_axis_error_mg')} mg ({v['frame']})"),
-        ("largest tilt error (Eq. 10)", f"{v['max_tilt_error_deg']:.4f}{u('max_tilt_error_deg')}°"),
-        ("residual zero-g drift x, y, z", drift + " µg over the range"),
-    ]) + ("<p class='note'>± the figure's expanded uncertainty (k = 2) as a measurement of the calibrated DUT's "
-          "error: the table's pointing, the site's gravity and the reading's noise.</p>" if expanded else "")
-
-
-def _uncertainty(metrics: dict[str, Any]) -> str:
-    budget = metrics["uncertainty_budget"]
-    rows = [[name.replace("_", " "), *(f"{u * 1e3:.1f}" for u in values)] for name, values in budget["sources_mg"].items()]
-    rows.append(["combined standard uncertainty", *(f"{u * 1e3:.1f}" for u in budget["standard_mg"])])
-    rows.append([f"expanded uncertainty (k = {budget['coverage_factor']:g}, about 95 %)",
-                 *(f"{u * 1e3:.1f}" for u in budget["expanded_mg"])])
-    coverage = metrics.get("truth_coverage_k2")
-    check = (f"<p class='note'>Checked against the simulation truth: {coverage * 100:.1f} % of the verification "
-             "poses' axis errors lie inside their expanded uncertainty.</p>" if coverage is not None else "")
-    return ("<p>For " + _e(budget["reading"]) + ": each source's largest standard uncertainty over every orientation "
-            "and the calibrated range, per axis (GUM, sources uncorrelated).</p>"
-            + _grid(["source", "x (µg)", "y (µg)", "z (µg)"], rows) + check)

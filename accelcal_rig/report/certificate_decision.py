@@ -6,12 +6,9 @@ stated it, for the results tables."""
 from __future__ import annotations
 
 import html
-from typing import Any
-
-import numpy as np
 
 from accelcal_rig.fit.acceptance import combined_verdict
-from accelcal_rig.fit.calibration import GyroCalibration, SensorCalibration
+from accelcal_rig.fit.calibration import ChannelCalibration
 from accelcal_rig.fit.decision import LimitCheck, worst
 
 STYLE = """
@@ -24,16 +21,7 @@ def _e(value: object) -> str:
     return html.escape(str(value))
 
 
-def expanded_at(metrics: dict[str, Any], name: str, temperature_c: float) -> float | None:
-    """A parameter's expanded uncertainty (k = 2) at a temperature, from the fit's table (exact where the table
-    has the temperature, between them interpolated); None for a file fitted before the table existed."""
-    table = metrics.get("parameter_uncertainty")
-    if not isinstance(table, dict) or name not in table.get("expanded", {}):
-        return None
-    return float(np.interp(temperature_c, table["temperatures_c"], table["expanded"][name]))
-
-
-def _checks(calibration: SensorCalibration | GyroCalibration) -> list[LimitCheck]:
+def _checks(calibration: ChannelCalibration) -> list[LimitCheck]:
     """Of each limit, the figure that decided it (the worst outcome, then the least margin)."""
     checks = [LimitCheck(**c) for c in calibration.decision.get("limits", [])]
     keys = dict.fromkeys(c.limit_key for c in checks)
@@ -54,10 +42,10 @@ def _table(checks: list[LimitCheck]) -> str:
             f"{rows}</table>")
 
 
-def conformity_section(sensor: SensorCalibration, gyro: GyroCalibration | None) -> list[str]:
-    """The statement of conformity: none without limits; else the rule, the DUT's verdict and each sensor's
-    deciding figures."""
-    sensors: list[SensorCalibration | GyroCalibration] = [sensor] + ([gyro] if gyro is not None else [])
+def conformity_section(labelled: list[tuple[str, ChannelCalibration]]) -> list[str]:
+    """The statement of conformity: none without limits; else the rule, the DUT's verdict and each channel's
+    deciding figures (each under its sensor's name, where the DUT has several)."""
+    sensors = [calibration for _, calibration in labelled]
     if all(c.verdict in (None, "NOT JUDGED") for c in sensors):
         return ["<section><h2>Statement of conformity</h2><p>None: the procedure states no acceptance limits (no "
                 "specification to judge against). The results above are stated with their uncertainties.</p></section>"]
@@ -74,9 +62,7 @@ def conformity_section(sensor: SensorCalibration, gyro: GyroCalibration | None) 
                      + (f"<b>Conditional fail:</b> {_e('; '.join(c.label for c in beyond))} measured beyond the limit."
                         if beyond else "Each such figure was measured within its limit (conditional pass).")
                      + "</p>")
-    labelled: list[tuple[str, SensorCalibration | GyroCalibration]] = (
-        [("", sensor)] if gyro is None else [("Accelerometer", sensor), ("Gyroscope", gyro)])
-    for label, calibration in labelled:
+    for label, calibration in (labelled if len(labelled) > 1 else [("", c) for _, c in labelled]):
         head = (f"<p>{_e(label)}: <b class='{_e(calibration.verdict or '')}'>{_e(calibration.verdict or 'NOT JUDGED')}"
                 "</b></p>") if label else ""
         checks = _checks(calibration)

@@ -17,14 +17,9 @@ import numpy as np
 from accelcal_rig.config.lab import REFERENCE_LABELS, InstrumentIdentity
 from accelcal_rig.config.yaml_lines import parse_yaml_text
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.fit.calibration import CalibrationFile, SensorCalibration
+from accelcal_rig.fit.calibration import CalibrationFile
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.read import dut_description
-
-#: The paper whose method the accelerometer's calibration follows (the text in ../shared/reference/paper.txt
-#: has its abstract and body; its title and venue are those of the publication the abstract is from).
-PAPER = ("“Thermal Calibration of Triaxial Accelerometer for Tilt Measurement”, Sensors 23(4), 2105 (2023), "
-         "doi:10.3390/s23042105")
 
 NOT_STATED = "not stated in the rig config"
 
@@ -123,8 +118,9 @@ def procedure_text(campaign: Campaign) -> str:
             else f"{attrs.get('procedure_name', '')} (version not stated in the procedure)")
 
 
-def method_text(campaign: Campaign, sensor: SensorCalibration, gyro: bool) -> str:
-    """The fit, the paper it follows (cited), and where the campaign departs from it."""
+def method_text(campaign: Campaign, methods: list[str]) -> str:
+    """Each channel's fit as its model states it (and the source it follows), and how the campaign took its
+    temperatures (where it departs from the paper)."""
     try:
         stated = parse_yaml_text(campaign.header.procedure_yaml, "the stored procedure") or {}
     except ConfigError:
@@ -132,17 +128,11 @@ def method_text(campaign: Campaign, sensor: SensorCalibration, gyro: bool) -> st
     ramp = isinstance(stated, dict) and stated.get("method") == "ramp"
     how = ("measured while ramping the temperature (a departure from the paper's soak method)" if ramp
            else "soaked at each temperature, as in the paper")
-    setpoints = len(sensor.setpoints)
-    text = (f"Eq. 1 sensor frame error model, {sensor.mode} fit of {len(sensor.free_parameters)} parameters at each of "
-            f"{setpoints} setpoint{'s' if setpoints != 1 else ''}, polynomials of degree {sensor.polynomial.degree} in "
-            f"temperature, after {PAPER}; {how}")
-    if gyro:
-        text += "; the gyroscope's rate-table model is this laboratory's addition (not in the paper)"
-    return text
+    return "; ".join([*methods, how])
 
 
 def calibration_rows(campaign: Campaign, campaign_name: str, calibration: CalibrationFile, calibration_name: str,
-                     sensor: SensorCalibration, gyro: bool) -> Rows:
+                     methods: list[str]) -> Rows:
     """Where, when and how: the place and dates, the procedure and its version, the method cited, the rig's
     instruments, and the files by their base names."""
     first, last = calibration_dates(campaign)
@@ -150,7 +140,7 @@ def calibration_rows(campaign: Campaign, campaign_name: str, calibration: Calibr
         ("place of calibration", place_of_calibration(campaign)),
         ("date of calibration", first if first == last else f"{first} … {last}"),
         ("procedure", procedure_text(campaign)),
-        ("method", method_text(campaign, sensor, gyro)),
+        ("method", method_text(campaign, methods)),
         ("instruments", f"rig {campaign.attrs.get('rig_name', '')}: "
                         + "; ".join(f"{name} {text}" for name, text in instrument_identities(campaign))),
         ("measured data (SHA-256)", str(calibration.source.get("measurements_sha256", ""))),

@@ -15,6 +15,7 @@ import numpy as np
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.durable import write_atomically
 from accelcal_rig.errors import ConfigError
+from accelcal_rig.fit.channel_models import model_for_quantity
 from accelcal_rig.fit.sfem import PARAMETER_NAMES, correct, distort, norm_only_gauge
 from accelcal_rig.report.campaign_data import CampaignData
 
@@ -68,11 +69,11 @@ def norm_deviation(data: CampaignData, path: Path) -> Path:
                                 sharex=True, constrained_layout=True)
     for column, serial in enumerate(serials):
         dut = data.duts[serial]
-        gravity = dut.poses.gravity_g
-        raw = (np.linalg.norm(dut.poses.mean_g, axis=1) - gravity) * 1e3
-        after = (np.linalg.norm(dut.fit.compensated_g, axis=1) - gravity) * 1e3 if dut.fit else None
+        gravity = dut.poses.magnitude
+        raw = (np.linalg.norm(dut.poses.mean, axis=1) - gravity) * 1e3
+        after = (np.linalg.norm(dut.detail.compensated, axis=1) - gravity) * 1e3 if dut.detail else None
         if dut.fit:  # what noise alone spreads a perfectly calibrated pose over
-            band = 2 * dut.fit.metrics["noise_floor_mg"]
+            band = 2 * dut.fit.figures["noise_floor_mg"]
             axes[1, column].axhspan(-band, band, color="0.88", zorder=0, label="±2 × noise floor")
         for setpoint in dict.fromkeys(dut.poses.setpoint_c.tolist()):
             rows = np.flatnonzero(dut.poses.setpoint_c == setpoint)
@@ -83,7 +84,7 @@ def norm_deviation(data: CampaignData, path: Path) -> Path:
                 axes[1, column].plot(dut.pose_numbers[rows], after[rows], "o-", ms=3, lw=0.8, color=colour)
         title = serial
         if dut.fit:
-            title += f"\nRMSE {dut.fit.metrics['rmse_before_mg']:.2f} → {dut.fit.metrics['rmse_after_mg']:.4f} mg in-sample"
+            title += f"\nRMSE {dut.fit.figures['rmse_before_mg']:.2f} → {dut.fit.figures['rmse_after_mg']:.4f} mg in-sample"
             axes[1, column].legend(fontsize=7, loc="upper right")
         axes[0, column].set_title(title, fontsize=9)
         axes[1, column].set_xlabel("pose")
@@ -135,8 +136,8 @@ def ellipsoid(data: CampaignData, path: Path) -> Path:
 
     def error_of(serial: str) -> np.ndarray:
         poses = data.duts[serial].poses
-        return (poses.mean_g - poses.reference_g if with_reference
-                else np.linalg.norm(poses.mean_g, axis=1) - poses.gravity_g)
+        return (poses.mean - poses.reference if with_reference
+                else np.linalg.norm(poses.mean, axis=1) - poses.magnitude)
 
     # One magnification for every panel, so the DUTs compare at a glance.
     gain = 0.3 / max([float(np.max(np.abs(error_of(s)))) for s in fitted] + [1e-9])
@@ -144,18 +145,19 @@ def ellipsoid(data: CampaignData, path: Path) -> Path:
     for index, serial in enumerate(fitted):
         dut = data.duts[serial]
         assert dut.fit is not None
-        raw, compensated = dut.poses.mean_g, dut.fit.compensated_g
-        reference = dut.poses.reference_g if with_reference else None
-        middle = len(dut.fit.fits) // 2
-        surface = _exaggerated(distort(sphere, dut.fit.fits[middle].parameters), sphere if with_reference else None,
+        assert dut.detail is not None
+        raw, compensated = dut.poses.mean, dut.detail.compensated
+        reference = dut.poses.reference if with_reference else None
+        middle = len(dut.detail.fits) // 2
+        surface = _exaggerated(distort(sphere, dut.detail.fits[middle].parameters), sphere if with_reference else None,
                                gain)
         colours = cmap(norm(dut.poses.setpoint_c))
         for column, (points, mesh, title) in enumerate([
-                (raw, surface, f"{serial} raw; ellipsoid at {dut.fit.setpoints_c[middle]:g} °C"),
+                (raw, surface, f"{serial} raw; ellipsoid at {dut.detail.setpoints_c[middle]:g} °C"),
                 (compensated, sphere, f"{serial} calibrated; unit sphere")]):
             axis = figure.add_subplot(rows, 4, 2 * index + column + 1, projection="3d")
             axis.plot_wireframe(*np.moveaxis(mesh, -1, 0), color="0.75", lw=0.4)
-            axis.scatter(*_exaggerated(points, reference, gain, dut.poses.gravity_g).T, c=colours, s=12,
+            axis.scatter(*_exaggerated(points, reference, gain, dut.poses.magnitude).T, c=colours, s=12,
                          depthshade=False)
             axis.set_title(title, fontsize=9)
             axis.set_box_aspect((1, 1, 1))
@@ -182,11 +184,11 @@ def parameters(data: CampaignData, path: Path) -> Path:
     figure, axes = plt.subplots(4, 3, figsize=(12, 11), constrained_layout=True)
     colours = plt.get_cmap("tab10")
     for index, (serial, dut) in enumerate(data.duts.items()):
-        if dut.fit is None:
+        if dut.fit is None or dut.detail is None:
             continue
-        fit, colour = dut.fit, colours(index % 10)
-        estimates = np.array([f.parameters for f in fit.fits])
-        sigmas = np.array([f.sigma for f in fit.fits])
+        fit, detail, colour = dut.fit, dut.detail, colours(index % 10)
+        estimates = np.array([f.parameters for f in detail.fits])
+        sigmas = np.array([f.sigma for f in detail.fits])
         dense = np.linspace(*fit.thermal.domain_c, 200)
         curve = fit.thermal.parameters_at(dense, "extrapolate")
         middle = fit.thermal.parameters_at(0.5 * sum(fit.thermal.domain_c), "extrapolate")
@@ -197,11 +199,11 @@ def parameters(data: CampaignData, path: Path) -> Path:
             axis = axes[k // 3, k % 3]
             group, axis_name = name.split("_")[0], name.split("_")[1]
             label, scale = PARAMETER_DISPLAY[group]
-            axis.errorbar(fit.temperatures_c, (estimates[:, k] - middle[k]) * scale, yerr=sigmas[:, k] * scale,
+            axis.errorbar(detail.temperatures_c, (estimates[:, k] - middle[k]) * scale, yerr=sigmas[:, k] * scale,
                           fmt="o", ms=3, color=colour, label=serial if k == 0 else None)
             axis.plot(dense, (curve[:, k] - middle[k]) * scale, "-", lw=1, color=colour)
             if truth is not None:
-                axis.plot(fit.temperatures_c, (truth[:, k] - middle[k]) * scale, "x", ms=5, color="k",
+                axis.plot(detail.temperatures_c, (truth[:, k] - middle[k]) * scale, "x", ms=5, color="k",
                           label="simulated truth" if k == 0 and index == 0 else None)
             axis.set_title(label.format(axis=axis_name), fontsize=9)
             axis.tick_params(labelsize=8)
@@ -214,6 +216,15 @@ def parameters(data: CampaignData, path: Path) -> Path:
     return save(figure, path)
 
 
+def drift_limit_mg(data: CampaignData) -> float | None:
+    """The procedure's limit on the drawn channel's verification drift (max − min), in mg, where it states one."""
+    for dut in data.duts.values():
+        limits = data.acceptance.channels.get(dut.poses.channel)
+        if limits is not None and "max_drift_mg" in limits.figure_limits():
+            return limits.figure_limits()["max_drift_mg"]
+    return None
+
+
 def drift(data: CampaignData, path: Path) -> Path:
     """Fig. 11: zero-g offset per axis over temperature, before compensation (the fitted raw bias, mg) and
     after (what the polynomial model makes of that raw zero-g reading, µg), each relative to its mean; after
@@ -224,18 +235,18 @@ def drift(data: CampaignData, path: Path) -> Path:
     colours = plt.get_cmap("tab10")
     interpolated = []
     for index, (serial, dut) in enumerate(data.duts.items()):
-        if dut.fit is None:
+        if dut.fit is None or dut.detail is None:
             continue
-        fit, colour = dut.fit, colours(index % 10)
-        bias = np.array([f.parameters[0:3] for f in fit.fits])
-        after = correct(bias, fit.thermal.parameters_at(fit.temperatures_c, "extrapolate"))
-        powers = min(fit.thermal.degree, len(fit.fits) - 1) + 1
-        verification = fit.metrics.get("verification")
+        fit, detail, colour = dut.fit, dut.detail, colours(index % 10)
+        bias = np.array([f.parameters[0:3] for f in detail.fits])
+        after = correct(bias, fit.thermal.parameters_at(detail.temperatures_c, "extrapolate"))
+        powers = min(fit.thermal.degree, len(detail.fits) - 1) + 1
+        verification = fit.figures.get("verification")
         for axis_index in range(3):
-            axes[0, axis_index].plot(fit.temperatures_c, (bias[:, axis_index] - bias[:, axis_index].mean()) * 1e3,
+            axes[0, axis_index].plot(detail.temperatures_c, (bias[:, axis_index] - bias[:, axis_index].mean()) * 1e3,
                                      "o-", ms=3, color=colour, label=serial if axis_index == 0 else None)
-            if len(fit.fits) > powers:
-                axes[1, axis_index].plot(fit.temperatures_c,
+            if len(detail.fits) > powers:
+                axes[1, axis_index].plot(detail.temperatures_c,
                                          (after[:, axis_index] - after[:, axis_index].mean()) * 1e6, "o-", ms=3,
                                          color=colour)
             if verification is not None:
@@ -243,10 +254,10 @@ def drift(data: CampaignData, path: Path) -> Path:
                 offsets = np.array([r["offset_mg"][axis_index] for r in rows]) * 1e3
                 axes[1, axis_index].plot([r["temperature_c"] for r in rows], offsets - offsets.mean(), "o", ms=5,
                                          mfc="none", color=colour)
-        if len(fit.fits) <= powers:
-            interpolated.append(f"{serial}: degree {fit.thermal.degree} through {len(fit.fits)} temperatures "
+        if len(detail.fits) <= powers:
+            interpolated.append(f"{serial}: degree {fit.thermal.degree} through {len(detail.fits)} temperatures "
                                 "interpolates them: its drift after is 0 by construction, not measured")
-    limit = data.acceptance.max_drift_mg
+    limit = drift_limit_mg(data)
     for axis_index, name in enumerate("xyz"):
         axes[0, axis_index].set_title(f"{name} axis", fontsize=10)
         axes[1, axis_index].set_xlabel("sensor temperature (°C)")
@@ -311,68 +322,70 @@ def soak_traces(data: CampaignData, band_c: float, path: Path) -> Path:
     return save(figure, path)
 
 
-def gyro_parameters(data: CampaignData, path: Path) -> Path:
-    """Each calibrated gyroscope's scale error (ppm) and bias (°/s) per axis over temperature: each setpoint's
-    estimate ±1σ and the polynomial through them."""
+def channel_parameters(data: CampaignData, quantity: str, path: Path) -> Path:
+    """Each calibrated channel of `quantity`'s first two kinds of parameter (its model's: a bias and a scale error)
+    per axis over temperature: each setpoint's estimate ±1σ and the polynomial through them."""
     plt = pyplot()
-    figure, axes = plt.subplots(2, 3, figsize=(13, 7), sharex=True, squeeze=False)
+    model = model_for_quantity(quantity)
+    assert model is not None
+    groups = model.parameter_groups[:2]
+    figure, axes = plt.subplots(len(groups), 3, figsize=(13, 3.5 * len(groups)), sharex=True, squeeze=False)
     colours = plt.get_cmap("tab10")
-    for index, (serial, gyro) in enumerate(data.gyros.items()):
+    calibrated = [(serial, fitted.fit.calibration) for serial, channels in data.channels.items()
+                  for fitted in channels.values() if fitted.model.quantity == quantity]
+    for index, (serial, calibration) in enumerate(calibrated):
         colour = colours(index % 10)
-        low, high = gyro.validity_c
+        low, high = calibration.validity_c
         curve_t = np.linspace(low, high, 100)
-        curve = gyro.polynomial.at(curve_t)
-        names = list(gyro.polynomial.NAMES)
-        setpoints_t = np.array([s.temperature_c for s in gyro.setpoints])
-        for column, axis in enumerate("xyz"):
-            for row, (name, factor, offset) in enumerate(((f"scale_{axis}", 1e6, -1.0), (f"bias_{axis}_dps", 1.0, 0.0))):
+        curve = calibration.polynomial.at(curve_t)
+        names = list(calibration.parameter_names)
+        setpoints_t = np.array([s.temperature_c for s in calibration.setpoints])
+        for row, group in enumerate(groups):
+            for column, name in enumerate(group.names[:3]):
                 k = names.index(name)
                 ax = axes[row, column]
-                ax.plot(curve_t, (curve[:, k] + offset) * factor, color=colour, lw=1.2,
+                ax.plot(curve_t, (curve[:, k] + group.offset) * group.factor, color=colour, lw=1.2,
                         label=serial if (row, column) == (0, 0) else None)
-                values = np.array([(s.parameters[name] + offset) * factor for s in gyro.setpoints])
-                sigmas = np.array([(s.sigma.get(name) or 0.0) * factor for s in gyro.setpoints])
+                values = np.array([(s.parameters[name] + group.offset) * group.factor for s in calibration.setpoints])
+                sigmas = np.array([(s.sigma.get(name) or 0.0) * group.factor for s in calibration.setpoints])
                 ax.errorbar(setpoints_t, values, yerr=sigmas, fmt="o", ms=4, color=colour, capsize=3)
-    for column, axis in enumerate("xyz"):
-        axes[0, column].set_title(f"gyro {axis}")
-        axes[0, column].set_ylabel(f"scale error {axis} (ppm)")
-        axes[1, column].set_ylabel(f"bias {axis} (°/s)")
-        axes[1, column].set_xlabel("sensor temperature (°C)")
-        for row in range(2):
+    for row, group in enumerate(groups):
+        for column, axis in enumerate(group.columns[:3]):
+            axes[0, column].set_title(f"{model.sensor} {axis}")
+            axes[row, column].set_ylabel(f"{group.label} {axis} ({group.unit})")
             axes[row, column].grid(alpha=0.3)
-    if data.gyros:
+            axes[-1, column].set_xlabel("sensor temperature (°C)")
+    if calibrated:
         axes[0, 0].legend(fontsize=8)
-    figure.suptitle("Gyroscope scale error and bias over temperature: each setpoint's fit (±1σ) and the polynomial")
+    figure.suptitle(f"{model.sensor.capitalize()} {groups[0].label} and {groups[1].label} over temperature: each "
+                    "setpoint's fit (±1σ) and the polynomial")
     figure.tight_layout()
     return save(figure, path)
 
 
 #: σ(τ) of flicker noise of bias instability B on its flat part, as a factor of B (fit/allan.py).
 _FLICKER_FLOOR = float(np.sqrt(2.0 * np.log(2.0) / np.pi))
-#: Per channel: (panel title, unit shown, factor from the data's unit, random walk key and its factor to the
-#: data's unit per √Hz, bias instability key and its factor to the data's unit).
-_ALLAN_PANELS = {
-    "gyro": ("gyroscope", "°/h", 3600.0, "arw_deg_per_rthr", 1 / 60.0, "bias_instability_dph", 1 / 3600.0),
-    "accel": ("accelerometer", "µg", 1e6, "vrw_m_s_per_rthr", 1 / (60.0 * 9.80665), "bias_instability_ug", 1e-6),
-}
-
-
 def allan(data: CampaignData, path: Path) -> Path:
     """The overlapping Allan deviation of each DUT's still record per axis, log-log, both sensors; the fitted
     random walk marked where it is read off (σ(1 s) = N on the −½ slope, dashed) and the bias instability at its
     averaging time (0.664·B, a triangle)."""
     plt = pyplot()
-    channels = [c for c in ("gyro", "accel") if any(n.channel == c for curves in data.noise.values() for n in curves)]
+    channels = list(dict.fromkeys(n.quantity for curves in data.noise.values() for n in curves))
     figure, axes = plt.subplots(1, max(len(channels), 1), figsize=(7 * max(len(channels), 1), 5.5), squeeze=False)
     colours = plt.get_cmap("tab10")
     styles = ("-", "--", ":")
     for column, channel in enumerate(channels):
-        title, unit, factor, walk, walk_factor, instability, instability_factor = _ALLAN_PANELS[channel]
+        model = model_for_quantity(channel)
+        assert model is not None and model.noise is not None
+        quoted = model.noise
+        title, unit, factor = model.sensor, quoted.instability_unit, quoted.instability_factor
+        walk, walk_factor = quoted.random_walk, 1.0 / quoted.random_walk_factor
+        instability, instability_factor = quoted.instability, 1.0 / quoted.instability_factor
         ax = axes[0, column]
         for index, (serial, records) in enumerate(data.noise.items()):
             colour = colours(index % 10)
             for record in records:
-                if record.channel != channel:
+                if record.quantity != channel:
                     continue
                 for k, (axis, curve) in enumerate(zip("xyz", record.curves)):
                     ax.loglog(curve.tau_s, curve.deviation * factor, styles[k], color=colour, lw=1.0,

@@ -18,8 +18,9 @@ from accelcal_rig.core.units import gravity_statement
 from accelcal_rig.durable import write_text_atomically
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.campaign_fit import FitOptions
+from accelcal_rig.fit.channel_models import model_for_quantity
 from accelcal_rig.report import figures
-from accelcal_rig.report.campaign_data import CampaignData, read_campaign_data
+from accelcal_rig.report.campaign_data import DRAWN_QUANTITY, CampaignData, read_campaign_data
 from accelcal_rig.store.records import utc_now
 
 STYLE = """
@@ -87,8 +88,8 @@ def write_report(campaign: Path, output: Path) -> Path:
     figures.parameters(data, folder / FIGURES["parameters"])
     figures.drift(data, folder / FIGURES["drift"])
     figures.soak_traces(data, data.soak_band_c, folder / FIGURES["soaks"])
-    if data.gyros:
-        figures.gyro_parameters(data, folder / GYRO_FIGURES["gyro_parameters"])
+    for quantity in _other_quantities(data):
+        figures.channel_parameters(data, quantity, folder / _parameters_figure(quantity))
     if data.noise:
         figures.allan(data, folder / GYRO_FIGURES["allan"])
     page = output / "index.html"
@@ -125,8 +126,7 @@ def _page(data: CampaignData) -> str:
               _figure("drift", "Zero-g offset per axis over temperature: the raw bias (top), and what the "
                                "compensation makes of the raw zero-g reading (bottom). Paper Fig. 11."),
               _drift_table(data)]
-    if data.gyros:
-        parts += _gyro_section(data)
+    parts += _channels_section(data)
     if data.noise:
         parts += ["<h2>Noise: Allan deviation</h2>",
                   _figure("allan", "Overlapping Allan deviation of each DUT's still record per axis, log-log, both "
@@ -135,7 +135,7 @@ def _page(data: CampaignData) -> str:
                                    "at (none where B is zero)."),
                   _noise_table(data)]
     parts += ["<h2>Soaks</h2>", _figure("soaks", "Temperature traces of every soak."), _soak_table(data)]
-    if any(d.fit is not None and "truth_error" in d.fit.metrics for d in data.duts.values()):
+    if any(d.fit is not None and "truth_error" in d.fit.figures for d in data.duts.values()):
         parts += ["<h2>Against the simulated truth</h2>", _truth_table(data)]
     parts += ["<h2>Event log</h2>", _event_table(data), "</body></html>"]
     return "\n".join(parts)
@@ -163,7 +163,7 @@ def _summary(data: CampaignData) -> list[str]:
         if dut.fit is None:
             sensors.append([serial, "—", "—", "—", "—", "—", "no fit"])
             continue
-        m = dut.fit.metrics
+        m = dut.fit.figures
         sensors.append([serial, f"{m['rmse_before_mg']:.3f}", f"{m['noise_floor_mg']:.4f}",
                         f"{m['expected_fit_rmse_mg']:.4f}", f"{m['rmse_after_mg']:.4f}",
                         " / ".join(f"{v * 1e3:.1f}" for v in m["drift_after_mg"]),
@@ -198,49 +198,59 @@ def _summary(data: CampaignData) -> list[str]:
     return out
 
 
-def _gyro_section(data: CampaignData) -> list[str]:
-    """The gyroscopes: rmse before and after, verification figures, expanded uncertainty and verdict per DUT, and
-    their scale error and bias over temperature."""
-    rows, classes = [], []
-    for serial, gyro in data.gyros.items():
-        m = gyro.metrics
-        v: dict = m["verification"] if isinstance(m.get("verification"), dict) else {}
-        budget = m.get("uncertainty_budget") or {}
+def _other_quantities(data: CampaignData) -> list[str]:
+    """The calibrated quantities besides the one the report's own figures draw (each gets its parameters' figure)."""
+    return list(dict.fromkeys(c.model.quantity for channels in data.channels.values() for c in channels.values()
+                              if c.model.quantity != DRAWN_QUANTITY))
 
-        def dps(value: object, digits: int = 4) -> str:
-            return "—" if value is None else f"{float(value):.{digits}f}"  # type: ignore[arg-type]
 
-        expanded = m.get("expanded_uncertainty_dps")
-        rows.append([serial, gyro.verdict or "—", "; ".join(gyro.verdict_reasons), dps(m.get("rmse_before_dps"), 3),
-                     dps(m.get("rmse_after_dps")), v.get("rate_steps", "—"), dps(v.get("rmse_dps")),
-                     dps(v.get("max_axis_error_dps")), dps(v.get("scale_error_ppm"), 0), dps(v.get("rest_error_dps")),
-                     " / ".join(f"{u:.4f}" for u in expanded) if expanded else "—",
-                     f"{float(budget['largest_rate_dps']):g}" if "largest_rate_dps" in budget else "—"])
-        classes.append(_VERDICT_ROWS.get(gyro.verdict or "", ""))
-    earth = sorted({g.earth_rate for g in data.gyros.values()})
-    return ["<h2>Gyroscope calibration</h2>",
-            _table(["DUT", "verdict", "reasons", "rate RMS before (°/s)", "after, in-sample (°/s)",
-                    "verification rate steps", "verification RMS (°/s)", "largest axis error (°/s)",
-                    "scale error (ppm)", "error at rest (°/s)", "expanded uncertainty x/y/z (k = 2, °/s)",
-                    "at rate (°/s)"], rows, text_columns=3, row_classes=classes),
-            f"<p class='note'>From {_e(data.gyro_source)}. Rate RMS: every calibration rate step's axes against its "
-            "reference (the table's rate and the Earth's), raw and compensated; verification: the rate steps and poses "
-            "the fit never saw, compensated as the calibration file would; the expanded uncertainty is the "
-            "calibration's share at the largest calibrated rate about each axis, the worst over the range. Earth's "
-            f"rate: {_e('; '.join(earth))}.</p>",
-            "<h2>Gyroscope parameters over temperature</h2>",
-            _figure("gyro_parameters", "Each gyroscope's scale error and bias per axis fitted at each setpoint (±1σ) "
-                                       "and its polynomial over the sensor temperature.")]
+def _parameters_figure(quantity: str) -> str:
+    return f"{quantity.replace(' ', '_')}_parameters.png"
+
+
+def _channels_section(data: CampaignData) -> list[str]:
+    """Every calibrated channel, a table per quantity: each DUT's verdict and its model's figures (in-sample and on
+    the records the fit never saw); and, for a quantity the report's figures do not draw, its parameters over
+    temperature."""
+    parts = []
+    quantities = list(dict.fromkeys(c.model.quantity for channels in data.channels.values() for c in channels.values()))
+    for quantity in quantities:
+        fitted = [(serial, name, c) for serial, channels in data.channels.items() for name, c in channels.items()
+                  if c.model.quantity == quantity]
+        model = fitted[0][2].model
+        rows, classes = [], []
+        for serial, name, c in fitted:
+            rows.append([serial, name, c.judgement.verdict, "; ".join(c.judgement.reasons),
+                         *(f.text(c.fit.figures) for f in model.figures)])
+            classes.append(_VERDICT_ROWS.get(c.judgement.verdict, ""))
+        parts += [f"<h2>Calibration of every {_e(model.sensor)} ({_e(quantity)})</h2>",
+                  _table(["DUT", "channel", "verdict", "reasons", *(f"{f.label} ({f.unit})" for f in model.figures)],
+                         rows, text_columns=4, row_classes=classes),
+                  "<p class='note'>Fitted from the campaign for this report with the options it records, as rig fit "
+                  "does; a per-axis figure shows its largest axis; verification figures are on records the fit never "
+                  "saw.</p>"]
+        if quantity != DRAWN_QUANTITY:
+            parts += [f"<h2>{_e(model.sensor.capitalize())} parameters over temperature</h2>",
+                      _figure(_parameters_figure(quantity).removesuffix(".png"),
+                              f"Each {model.sensor}'s {model.parameter_groups[0].label} and "
+                              f"{model.parameter_groups[1].label} per axis fitted at each setpoint (±1σ) and its "
+                              "polynomial over the sensor temperature.")]
+    return parts
 
 
 def _noise_table(data: CampaignData) -> str:
     """Per DUT and channel: the random walk and bias instability per axis with their 68 % intervals."""
-    keys = {"gyro": (("arw_deg_per_rthr", "ARW (°/√h)", ".4f"), ("bias_instability_dph", "bias instability (°/h)", ".2f")),
-            "accel": (("vrw_m_s_per_rthr", "VRW (m/s/√h)", ".5f"), ("bias_instability_ug", "bias instability (µg)", ".1f"))}
     rows = []
     for serial, records in data.noise.items():
         for record in records:
-            for key, label, spec in keys[record.channel]:
+            model = model_for_quantity(record.quantity)
+            quoted = model.noise if model is not None else None
+            if quoted is None:
+                continue
+            keys = ((quoted.random_walk, f"{quoted.random_walk_label} ({quoted.random_walk_unit})",
+                     quoted.random_walk_spec),
+                    (quoted.instability, f"bias instability ({quoted.instability_unit})", quoted.instability_spec))
+            for key, label, spec in keys:
                 values = record.figures.get(key)
                 if isinstance(values, list):
                     rows.append([serial, record.channel, label, f"{record.setpoint_c + 0.0:g}",
@@ -262,13 +272,13 @@ def _rmse_table(data: CampaignData) -> str:
     fitted = {s: d.fit for s, d in data.duts.items() if d.fit is not None}
     if not fitted:
         return "<p>No fit.</p>"
-    setpoints = sorted({r["setpoint_c"] for f in fitted.values() for r in f.metrics["rmse_by_setpoint"]})
+    setpoints = sorted({r["setpoint_c"] for f in fitted.values() for r in f.figures["rmse_by_setpoint"]})
     header = ["setpoint (°C)"] + [f"{serial} {what}" for serial in fitted for what in ("before", "own fit", "polynomial")]
     rows = []
     for setpoint in setpoints:
         row: list[object] = [f"{setpoint:g}"]
         for fit in fitted.values():
-            record = next((r for r in fit.metrics["rmse_by_setpoint"] if r["setpoint_c"] == setpoint), None)
+            record = next((r for r in fit.figures["rmse_by_setpoint"] if r["setpoint_c"] == setpoint), None)
             row += [f"{record['before_mg']:.3f}", f"{record['measurement_mg']:.4f}", f"{record['polynomial_mg']:.4f}"] \
                 if record else ["—"] * 3
         rows.append(row)
@@ -283,14 +293,14 @@ def _uncertainty_table(data: CampaignData) -> str:
     for serial, dut in data.duts.items():
         if dut.fit is None:
             continue
-        budget = dut.fit.metrics["uncertainty_budget"]
+        budget = dut.fit.figures["uncertainty_budget"]
         for name, values in budget["sources_mg"].items():
             rows.append([serial, name.replace("_", " "), *(f"{v * 1e3:.1f}" for v in values)])
             classes.append("")
         rows.append([serial, "combined (k = 1)", *(f"{v * 1e3:.1f}" for v in budget["standard_mg"])])
         rows.append([serial, f"expanded (k = {budget['coverage_factor']:g})", *(f"{v * 1e3:.1f}" for v in budget["expanded_mg"])])
         classes += ["", "total"]
-        coverage = dut.fit.metrics.get("truth_coverage_k2")
+        coverage = dut.fit.figures.get("truth_coverage_k2")
         if coverage is not None:
             notes.append(f"{serial}: {coverage * 100:.1f} % of its verification axis errors against the simulation "
                          "truth lie inside their expanded uncertainty")
@@ -325,7 +335,9 @@ def _span(values: list[float], digits: int) -> str:
 def _parameter_table(data: CampaignData) -> str:
     """Absolute values at the acceptance limits' temperature (else 25 °C, clamped into the range), beside the
     data sheet's range and the procedure's limits."""
-    limits = data.acceptance.parameters
+    channel = next((dut.poses.channel for dut in data.duts.values()), "")
+    drawn = data.acceptance.channels.get(channel)
+    limits = drawn.parameters if drawn is not None else None
     at_c = limits.at_c if limits is not None else 25.0
     rows, classes = [], []
     for serial, dut in data.duts.items():
@@ -343,9 +355,7 @@ def _parameter_table(data: CampaignData) -> str:
     if not rows:
         return "<p>No fit.</p>"
     stated = ("; the procedure's limits: " + ", ".join(
-        f"{name.replace('_', ' ')} {getattr(limits, name):g}" for name in
-        ("bias_mg", "scale_error_ppm", "nonorthogonality_mrad", "misalignment_mrad") if getattr(limits, name) is not None)
-              if limits is not None else "")
+        f"{name.replace('_', ' ')} {value:g}" for name, value in limits.limits().items()) if limits is not None else "")
     return (_table(["DUT", "at (°C)", "bias x (mg)", "bias y (mg)", "bias z (mg)", "data sheet 0 g offset (mg)",
                     "scale error x (ppm)", "y (ppm)", "z (ppm)", "non-orth. yx (mrad)", "zx (mrad)", "zy (mrad)"],
                    rows, text_columns=1, row_classes=classes)
@@ -356,12 +366,12 @@ def _parameter_table(data: CampaignData) -> str:
 def _drift_table(data: CampaignData) -> str:
     rows = []
     for serial, dut in data.duts.items():
-        if dut.fit is None:
+        if dut.fit is None or dut.detail is None:
             continue
-        m = dut.fit.metrics
+        m = dut.fit.figures
         low, high = m["temperature_range_c"]
-        interpolates = len(dut.fit.fits) <= min(dut.fit.thermal.degree, len(dut.fit.fits) - 1) + 1
-        after = (["0 by construction (the polynomial interpolates)"] + ["—"] * 2 if interpolates and len(dut.fit.fits) > 1
+        interpolates = len(dut.detail.fits) <= min(dut.fit.thermal.degree, len(dut.detail.fits) - 1) + 1
+        after = (["0 by construction (the polynomial interpolates)"] + ["—"] * 2 if interpolates and len(dut.detail.fits) > 1
                  else [f"{v * 1e3:.1f}" for v in m["drift_after_mg"]])
         rows.append([serial, f"{format_fixed(low)} … {format_fixed(high)}", *(f"{v:.3f}" for v in m["drift_before_mg"]),
                      *after])
@@ -384,9 +394,9 @@ def _soak_table(data: CampaignData) -> str:
 def _truth_table(data: CampaignData) -> str:
     rows = []
     for serial, dut in data.duts.items():
-        if dut.fit is None or "truth_error" not in dut.fit.metrics:
+        if dut.fit is None or "truth_error" not in dut.fit.figures:
             continue
-        z = np.array([r["z"] for r in dut.fit.metrics["truth_error"]])
+        z = np.array([r["z"] for r in dut.fit.figures["truth_error"]])
         rows.append([serial, len(z), f"{np.mean(np.abs(z) <= 3) * 100:.1f} %", f"{np.max(np.abs(z)):.2f}",
                      f"{np.sqrt(np.mean(z ** 2)):.2f}"])
     return _table(["DUT", "estimates", "within 3σ of truth", "max |z|", "RMS z"], rows) + (

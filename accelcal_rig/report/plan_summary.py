@@ -102,7 +102,8 @@ def _storage_line(prepared: PreparedCampaign) -> str:
 def _poses_line(prepared: PreparedCampaign) -> str:
     procedure, plan = prepared.procedure.model, prepared.plan
     acquisition, cooldown = procedure.acquisition, procedure.cooldown
-    samples = (f"{acquisition.samples_per_pose} samples at {acquisition.odr_hz:g} Hz, ±{acquisition.range_g} g, "
+    ranges = ", ".join(f"{channel} ±{value:g}" for channel, value in acquisition.ranges.items())
+    samples = (f"{acquisition.samples_per_pose} samples at {acquisition.odr_hz:g} Hz, {ranges}, "
                f"settle {acquisition.settle_s:g} s")
     if cooldown is not None:
         return (f"records    {len(plan.pose_steps)} at pose {cooldown.pose} of the {procedure.schedule.kind} schedule, "
@@ -154,19 +155,12 @@ def _verification_lines(prepared: PreparedCampaign) -> list[str]:
     lines = [f"verify     {len(plan.verification_poses)} poses ({verify.schedule.kind}, listed as v1…) "
              f"{' and '.join(where)}: {total} in all, never fitted"]
     limits = procedure.acceptance
-    judged = [f"{name} {getattr(limits, name):g}" for name in limits.verification_limits()]
-    if limits.parameters is not None:
-        p = limits.parameters
-        judged += [f"{name} {getattr(p, name):g} at {p.at_c:g} °C" for name in
-                   ("bias_mg", "scale_error_ppm", "nonorthogonality_mrad", "misalignment_mrad")
-                   if getattr(p, name) is not None]
-    gyro = limits.gyro
-    if gyro is not None:
-        judged += [f"gyro {name} {getattr(gyro, name):g}" for name in gyro.verification_limits()]
-        if gyro.parameters is not None:
-            judged += [f"gyro {name} {getattr(gyro.parameters, name):g} at {gyro.parameters.at_c:g} °C" for name in
-                       ("bias_dps", "scale_error_ppm", "cross_axis_mrad", "gsens_dps_per_g")
-                       if getattr(gyro.parameters, name) is not None]
+    judged = []
+    for channel, stated in limits.channels.items():
+        judged += [f"{channel} {name} {value:g}" for name, value in stated.figure_limits().items()]
+        if stated.parameters is not None:
+            judged += [f"{channel} {name} {value:g} at {stated.parameters.at_c:g} °C"
+                       for name, value in stated.parameters.limits().items()]
     rule = ("" if not judged else f"; {limits.decision_rule} acceptance" + (
         f", guard band {limits.guard_band_factor:g} × U" if limits.decision_rule == "guarded" else "")
         if limits.decision_rule else "; simple acceptance (no decision_rule stated)")

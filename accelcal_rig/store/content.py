@@ -146,6 +146,11 @@ class Campaign:
                 return info
         raise KeyError(f"sensor {serial} has no {channel!r} channel")
 
+    def channel_of(self, serial: str, quantity: str) -> ChannelInfo | None:
+        """The DUT's first channel that measures `quantity` (a reader of one quantity: a tilt check's
+        accelerometer), None where it has none."""
+        return next((info for info in self.header.dut_channels(serial) if info.quantity == quantity), None)
+
     def truth_column(self, serial: str, name: str) -> np.ndarray | None:
         """Simulation truth of one field over the poses (dry runs), None when the campaign has none."""
         if serial not in self.header.truth:

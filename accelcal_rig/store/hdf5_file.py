@@ -352,10 +352,10 @@ def _read_header(reader: _Reader) -> CampaignHeader:
         if not isinstance(group, h5py.Group):
             raise DamagedFile(f"duts/{serial}: not a group")
         duts.append({"serial": serial, **{k: plain_value(v) for k, v in group.attrs.items() if k != "serial"}})
-        for name in ("range_g", "lsb_g", "odr_hz"):
-            reader.attr(group, name, float)
-        if int(file.attrs.get("format_version", 0)) >= 3:
+        if int(file.attrs.get("format_version", 0)) >= 3:  # each channel's range and code size with the channel
             channels[serial] = _read_channels(group)
+        for name in ("odr_hz",) if serial in channels else ("range_g", "lsb_g", "odr_hz"):
+            reader.attr(group, name, float)
     truth = {}
     if "simulation_truth" in file:
         for serial, group in reader.node("simulation_truth", h5py.Group).items():

@@ -249,67 +249,89 @@ def usable_campaign(path: Path) -> Campaign:
 
 
 @dataclass(frozen=True)
-class DutPoses:
-    """One DUT's stored poses as arrays (row i is pose i of `poses/`)."""
+class VectorPoses:
+    """One DUT's stored poses of one three-axis channel as arrays (row i is pose i of `poses/`), in the channel's
+    unit: its means, their standard errors and what it should have read (its reference), beside the pose's
+    setpoint, time and the DUT's own temperature. `magnitude` is the size of every reference (the site's
+    gravity in standard g for an accelerometer), stated by the channel's model."""
 
     serial: str
-    range_g: float
-    lsb_g: float
+    channel: str
+    unit: str
+    range: float
+    lsb: float
     setpoint_c: np.ndarray            # (N,)
     t_s: np.ndarray                   # (N,) clock time of each pose's first sample
     temperature_c: np.ndarray         # (N,) DUT's own sensor, mean of before and after the block
-    mean_g: np.ndarray                # (N, 3)
-    stderr_g: np.ndarray              # (N, 3)
-    reference_g: np.ndarray           # (N, 3) expected reading from the turntable
+    mean: np.ndarray                  # (N, 3)
+    stderr: np.ndarray                # (N, 3)
+    reference: np.ndarray             # (N, 3) what it should have read, from the turntable's pose
     reference_accuracy_arcsec: float  # ± per turntable axis, from the rig config
-    truth_parameters: np.ndarray | None  # (N, 12) simulation truth, dry runs only
+    truth_parameters: np.ndarray | None  # (N, P) simulation truth, dry runs only
     verification: np.ndarray          # (N,) bool: a verification pose (the fit never sees it)
-    gravity_g: float = 1.0            # the site's gravity in standard g (the magnitude of every reference)
-    truth_gravity_g: np.ndarray | None = None  # (N, 3) the simulation's true specific force, dry runs only
-    gravity_uncertainty_g: float = 0.0
+    rows: np.ndarray                  # (N,) each pose's row among the campaign's stored poses
+    magnitude: float = 1.0            # the size of every reference, in the channel's unit
+    truth_reference: np.ndarray | None = None  # (N, 3) the simulation's true reference, dry runs that store it
+    magnitude_u: float = 0.0          # the magnitude's standard uncertainty, in the channel's unit
     approach: np.ndarray | None = None  # (N,) +1 warming, −1 cooling towards each pose (fit.hysteresis)
     rate_c_per_min: np.ndarray | None = None  # (N,) each pose's rate of temperature change (fit.hysteresis)
 
-    def subset(self, rows: np.ndarray) -> DutPoses:
+    def subset(self, rows: np.ndarray) -> VectorPoses:
         """These poses only (a boolean mask or indices)."""
-        arrays = {name: getattr(self, name)[rows] for name in ("setpoint_c", "t_s", "temperature_c", "mean_g",
-                                                                "stderr_g", "reference_g", "verification")}
-        truth = self.truth_parameters[rows] if self.truth_parameters is not None else None
-        gravity = self.truth_gravity_g[rows] if self.truth_gravity_g is not None else None
-        approach = self.approach[rows] if self.approach is not None else None
-        rate = self.rate_c_per_min[rows] if self.rate_c_per_min is not None else None
-        return replace(self, **arrays, truth_parameters=truth, truth_gravity_g=gravity, approach=approach,
-                       rate_c_per_min=rate)
+        def taken(value: np.ndarray | None) -> np.ndarray | None:
+            return None if value is None else value[rows]
+
+        return replace(self, setpoint_c=self.setpoint_c[rows], t_s=self.t_s[rows], temperature_c=self.temperature_c[rows],
+                       mean=self.mean[rows], stderr=self.stderr[rows], reference=self.reference[rows],
+                       verification=self.verification[rows], rows=self.rows[rows],
+                       truth_parameters=taken(self.truth_parameters), truth_reference=taken(self.truth_reference),
+                       approach=taken(self.approach), rate_c_per_min=taken(self.rate_c_per_min))
 
 
 def dut_description(campaign: Campaign, serial: str) -> dict[str, Any]:
     return campaign.header.duts[campaign.serials.index(serial)]
 
 
-def read_dut_poses(campaign: Campaign, serial: str) -> DutPoses:
-    """The DUT's accelerometer poses: those taken at rest, the table standing (a rate step's turning table
-    and a noise record's blocks are a gyroscope's)."""
-    dut = dut_description(campaign, serial)
+def read_vector_poses(campaign: Campaign, serial: str, channel: str) -> VectorPoses:
+    """One three-axis channel of the DUT over its poses taken at rest, the table standing (a rate step's turning
+    table and a noise record's blocks are not a static pose); its magnitude 1 until its model states it."""
+    info = campaign.channel_info(serial, channel)
     keys = campaign.pose_column("step_key")
     static = np.isin(keys, list(campaign.header.plan.keys_of(*STATIC_KINDS))) if len(keys) else np.zeros(0, bool)
-    poses = DutPoses(
-        serial=serial,
-        range_g=float(dut["range_g"]),
-        lsb_g=float(dut["lsb_g"]),
+    poses = VectorPoses(
+        serial=serial, channel=channel, unit=info.unit, range=info.range, lsb=info.lsb,
         setpoint_c=campaign.pose_column("setpoint_c"),
         t_s=campaign.pose_column("t_start_s"),
         temperature_c=campaign.dut_column(serial, "temperature_c").mean(axis=1),
-        mean_g=campaign.dut_column(serial, "mean_g"),
-        stderr_g=campaign.dut_column(serial, "stderr_g"),
-        reference_g=campaign.dut_column(serial, "gravity_reference_g"),
+        mean=campaign.channel_column(serial, channel, "mean"),
+        stderr=campaign.channel_column(serial, channel, "stderr"),
+        reference=campaign.channel_column(serial, channel, "reference"),
         reference_accuracy_arcsec=float(campaign.header.turntable_accuracy_arcsec),
-        truth_parameters=campaign.truth_column(serial, "parameters"),
-        verification=np.isin(campaign.pose_column("step_key"), list(campaign.header.plan.verification_keys)),
-        gravity_g=site_gravity_g(float(campaign.attrs.get("gravity_m_s2", STANDARD_GRAVITY_M_S2))),
-        gravity_uncertainty_g=site_gravity_g(float(campaign.attrs.get("gravity_uncertainty_m_s2", 0.0))),
-        truth_gravity_g=campaign.truth_column(serial, "gravity_g"),
+        truth_parameters=None,
+        verification=np.isin(keys, list(campaign.header.plan.verification_keys)),
+        rows=np.arange(len(keys)),
     )
     return poses if static.all() else poses.subset(static)
+
+
+def described_truth(campaign: Campaign, serial: str, channel: str) -> np.ndarray | None:
+    """A dry run's true parameters (N, P) of one of a DUT's channels at each stored pose's true temperature, from
+    the simulation's description of it (`<channel>_polynomial_coefficients`: cubics in (T − t_ref_c) /
+    half_range_c); None where the campaign has none."""
+    described = campaign.header.truth.get(serial, {})
+    temperature = campaign.truth_column(serial, "temperature_c")
+    key = f"{channel}_polynomial_coefficients"
+    if key not in described or temperature is None:
+        return None
+    coefficients = np.asarray(described[key], dtype=float)
+    x = (temperature - float(described["t_ref_c"])) / float(described["half_range_c"])
+    return np.moveaxis(np.polynomial.polynomial.polyval(x, coefficients.T), 0, -1)
+
+
+def site_gravity(campaign: Campaign) -> tuple[float, float]:
+    """The site's gravity and its standard uncertainty, in standard g, as the campaign recorded them."""
+    return (site_gravity_g(float(campaign.attrs.get("gravity_m_s2", STANDARD_GRAVITY_M_S2))),
+            site_gravity_g(float(campaign.attrs.get("gravity_uncertainty_m_s2", 0.0))))
 
 
 def rows_at_setpoint(path: Path, campaign: Campaign, setpoint_c: float | None) -> tuple[float, np.ndarray]:

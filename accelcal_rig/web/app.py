@@ -26,7 +26,7 @@ from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.registry.analysis import lot_statistics, trend
+from accelcal_rig.registry.analysis import by_channel, lot_statistics, trend
 from accelcal_rig.registry.database import Registry
 from accelcal_rig.registry.location import described
 from accelcal_rig.web.approval import BEARER_SCOPE_KEY, ApprovalSettings, approval_routes
@@ -168,20 +168,11 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
             raise HTTPException(404, f"no calibration of {serial} in the registry" if serial else "no serial given")
         real = [r for r in every if not r["simulated"]]
         rows = real or every  # a serial only dry runs know is shown as such, marked simulated
-        result = trend(rows)
-        points = result["calibrations"]
-        accel = [r for r in rows if r["channel"] == "accel"]  # the plot and trend are the accelerometer's
-        times = [(r["calibrated_at"] - accel[-1]["calibrated_at"]).total_seconds() / 86400.0 for r in reversed(accel)]
-        plot = line_plot(times, {f"bias {axis}": [p["bias_mg"][k] for p in points] for k, axis in enumerate("xyz")},
-                         "days since the first calibration", "bias at the reference temperature (mg)")
-        gyro = trend(rows, "gyro") if any(r["channel"] == "gyro" for r in rows) else None
         decided = {i: {"approve": "approved", "reissue": "approved", "reject": "rejected"}[a]
                    for i, a in reg.last_actions([r["id"] for r in every]).items()}
-        return page("serial.html", serial=serial, rows=every, current=reg.current(serial, simulated=not real),
-                    why_not_valid=reg.why_not_valid(serial), decisions=decided,
-                    gyro_why_not_valid=reg.why_not_valid(serial, "gyro") if gyro else "",
-                    trend=result, plot=plot, only_simulated=not real, gyro_trend=gyro,
-                    gyro_current=reg.current(serial, simulated=not real, channel="gyro") if gyro else None)
+        channels = [_channel_view(reg, serial, channel, of, not real) for channel, of in by_channel(rows).items()]
+        return page("serial.html", serial=serial, rows=every, channels=channels, decisions=decided,
+                    only_simulated=not real)
 
     def part_page(request: Request) -> Response:
         part = request.path_params["part"]
@@ -190,13 +181,13 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
             raise HTTPException(404, f"no calibration of part {part} in the registry")
         real = [r for r in every if not r["simulated"]]
         rows = real or every
-        gyro = [r for r in rows if r["channel"] == "gyro"]
-        return page("part.html", part=part, stats=lot_statistics(rows), only_simulated=not real,
-                    gyro_stats=lot_statistics(gyro, "gyro") if gyro else None)
+        lots = {channel: lot_statistics(of, channel) for channel, of in by_channel(rows).items()}
+        return page("part.html", part=part, lots=lots, only_simulated=not real)
 
     def serial_json(request: Request) -> Response:
         rows = registry.get().calibrations(serial=request.path_params["serial"])
-        return JSONResponse(_jsonable(trend(rows)) if rows else {"calibrations": []})
+        return JSONResponse({"channels": {channel: _jsonable(trend(of, channel))
+                                          for channel, of in by_channel(rows).items()}} if rows else {"channels": {}})
 
     lab = LabRigs(registry.get)
     pages = ErrorPages(templates, registry.label)
@@ -272,6 +263,25 @@ def _report(campaign: Path) -> Path | None:
     """A report `rig report` wrote for it: FILE.report/ beside it."""
     folder = campaign.with_suffix(".report")
     return folder if (folder / "index.html").is_file() else None
+
+
+def _channel_view(reg: Registry, serial: str, channel: str, rows: list[dict[str, Any]],
+                  simulated: bool) -> dict[str, Any]:
+    """One channel of a serial as its page shows it: its valid calibration (or why none), its trend and the bias
+    plot over time (in the bias's own unit)."""
+    result = trend(rows, channel)
+    ordered = sorted(rows, key=lambda r: (r["calibrated_at"], r["id"]))
+    biased = [r for r in ordered if "bias" in r["figures"]]
+    plot = ""
+    if biased:
+        unit = biased[0]["figures"]["bias"]["unit"]
+        times = [(r["calibrated_at"] - biased[0]["calibrated_at"]).total_seconds() / 86400.0 for r in biased]
+        plot = line_plot(times, {f"bias {axis}": [r["figures"]["bias"]["value"][k] for r in biased]
+                                 for k, axis in enumerate("xyz")},
+                         "days since the first calibration", f"bias at the reference temperature ({unit})")
+    current = reg.current(serial, simulated=simulated, channel=channel)
+    return {"channel": channel, "current": current, "trend": result, "plot": plot,
+            "why_not_valid": "" if current is not None else reg.why_not_valid(serial, channel)}
 
 
 def _jsonable(value: Any) -> Any:

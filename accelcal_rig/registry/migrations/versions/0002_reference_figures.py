@@ -11,7 +11,7 @@ from datetime import UTC, datetime
 import sqlalchemy as sa
 from alembic import op
 
-from accelcal_rig.registry.figures import reference_figures
+from accelcal_rig.registry.migrations.frozen_figures import reference_figures
 
 revision = "0002"
 down_revision = "0001"

@@ -11,7 +11,7 @@ Revises: 0003
 import sqlalchemy as sa
 from alembic import op
 
-from accelcal_rig.registry.figures import noise_figures
+from accelcal_rig.registry.migrations.frozen_figures import noise_figures
 
 revision = "0004"
 down_revision = "0003"

@@ -1,9 +1,8 @@
-"""What a registry row says of a calibration beyond its identity: bias, scale error and non-orthogonality at
-the reference temperature, with their expanded uncertainties (k = 2), computed from the stored fit.
-
-Migration 0002 fills these for calibrations recorded before it, so this reads the fit as stored (a plain
-dict of the calibration file's sensor entry), not a model class that may change.
-"""
+"""The figures migrations 0002 and 0004 computed from each stored fit for the columns they added (bias, scale
+error and non-orthogonality at the reference temperature with their expanded uncertainties; the noise
+figures), as they computed them: frozen history, read from the fit as stored (a plain dict of the calibration
+file's entry of its channel, version 2), not from a model class that changes. Registry rows recorded since
+take their figures from their channel's model (registry/figures.py)."""
 
 from __future__ import annotations
 
@@ -70,13 +69,6 @@ def _nearest_setpoint_sigma(setpoints: list[dict[str, Any]], temperature_c: floa
     return dict(nearest.get("sigma", {}))
 
 
-#: The figures a gyroscope's row holds; an accelerometer's row leaves them empty, and the other way round.
-GYRO_COLUMNS = ("bias_dps", "bias_uncertainty_dps", "expanded_uncertainty_dps", "verification_rmse_dps", "arw_deg_per_rthr",
-                "bias_instability_dph")
-ACCEL_COLUMNS = ("bias_mg", "bias_uncertainty_mg", "nonorthogonality_mrad", "vrw_m_s_per_rthr", "bias_instability_ug")
-_GYRO_NAMES = ("bias_x_dps", "bias_y_dps", "bias_z_dps", "scale_x", "scale_y", "scale_z")
-
-
 def noise_figures(calibration: dict[str, Any]) -> dict[str, Any]:
     """The Allan figures of a stored calibration (the noise record nearest 25 °C), per axis, where it has them:
     an accelerometer's velocity random walk and bias instability, a gyroscope's angle random walk and bias
@@ -85,48 +77,3 @@ def noise_figures(calibration: dict[str, Any]) -> dict[str, Any]:
     names = ("vrw_m_s_per_rthr", "bias_instability_ug", "arw_deg_per_rthr", "bias_instability_dph")
     return {name: ([float(e["value"]) for e in allan[name]] if isinstance(allan.get(name), list) else None)
             for name in names}
-
-
-def gyro_figures(calibration: dict[str, Any]) -> dict[str, Any]:
-    """Figures of a stored gyroscope calibration at the reference temperature: bias and scale error, each with
-    its own expanded uncertainty (a fit from before they were stated: the bias's of a compensated rate at rest,
-    the scale's twice the 1σ of the setpoint fit nearest it), the expanded uncertainty of a compensated rate at the largest calibrated
-    rate, the verification rate steps' RMS error, and its noise."""
-    sensor = calibration["sensor"]
-    low, high = sensor["validity_c"]
-    reference = float(np.clip(REFERENCE_C, low, high))
-    polynomial = sensor["polynomial"]
-    d_low, d_high = polynomial["domain_c"]
-    x = (reference - 0.5 * (d_low + d_high)) / (0.5 * (d_high - d_low)) if d_high > d_low else 0.0
-    values = {name: float(np.polynomial.polynomial.polyval(x, polynomial["coefficients"][name])) for name in _GYRO_NAMES}
-    sigma = _nearest_setpoint_sigma(sensor.get("setpoints", []), reference)
-    scale_sigma = [float(s) for axis in "xyz" if (s := sigma.get(f"scale_{axis}")) is not None]
-    metrics = sensor.get("metrics", {})
-    expanded = metrics.get("expanded_uncertainty_dps")
-    verification = metrics.get("verification") if isinstance(metrics.get("verification"), dict) else {}
-    rmse = verification.get("rmse_dps")
-    at_rest = (metrics.get("uncertainty_budget") or {}).get("at_rest") or {}
-    noise = noise_figures(calibration)
-    own = _parameter_expanded(metrics, reference)  # each parameter's own, where the fit stated them
-    return {
-        "reference_c": reference,
-        "bias_dps": [values[f"bias_{axis}_dps"] for axis in "xyz"],
-        "scale_error_ppm": [1e6 * (values[f"scale_{axis}"] - 1.0) for axis in "xyz"],
-        "scale_uncertainty_ppm": ([1e6 * own[f"scale_{axis}"] for axis in "xyz"] if own is not None
-                                  else [2e6 * s for s in scale_sigma] if len(scale_sigma) == 3 else None),
-        "bias_uncertainty_dps": ([own[f"bias_{axis}_dps"] for axis in "xyz"] if own is not None
-                                 else [float(u) for u in at_rest["expanded_dps"]] if at_rest.get("expanded_dps") else None),
-        "expanded_uncertainty_dps": [float(u) for u in expanded] if expanded else None,
-        "verification_rmse_dps": float(rmse) if rmse is not None else None,
-        "arw_deg_per_rthr": noise["arw_deg_per_rthr"], "bias_instability_dph": noise["bias_instability_dph"],
-        **dict.fromkeys(ACCEL_COLUMNS),
-    }
-
-
-def channel_figures(calibration: dict[str, Any], channel: str) -> dict[str, Any]:
-    """Every figure column of a registry row of this channel (`accel` or `gyro`), from its stored fit."""
-    if channel == "gyro":
-        return gyro_figures(calibration)
-    noise = noise_figures(calibration)
-    return {**reference_figures(calibration), "vrw_m_s_per_rthr": noise["vrw_m_s_per_rthr"],
-            "bias_instability_ug": noise["bias_instability_ug"], **dict.fromkeys(GYRO_COLUMNS)}
