@@ -140,13 +140,13 @@ class Eq1Model:
             FigureLimit(f"max_axis_error_{m}", f"max_axis_error_{m}", "largest verification axis error", m, 1000,
                         f"largest per-axis error of the compensated vector against the reference "
                         f"{spec.reference_label}", missing=_NO_POSES),
-            FigureLimit(f"max_drift_{m}", f"drift_{m}", "verification drift", m, 1000,
-                        "residual zero offset drift per axis over the verification temperatures (max − min)",
-                        needs_temperatures=2, missing=_NO_POSES),
             FigureLimit(f"max_{spec.angle}_error_deg", f"max_{spec.angle}_error_deg",
                         f"largest verification {angle} error", "°", 90,
                         "largest Eq. 10 pitch or roll error" if spec.angle == "tilt"
                         else "largest angle between a compensated vector and its reference", missing=_NO_POSES),
+            FigureLimit(f"max_drift_{m}", f"drift_{m}", "verification drift", m, 1000,
+                        "residual zero offset drift per axis over the verification temperatures (max − min)",
+                        needs_temperatures=2, missing=_NO_POSES),
         )
         self.parameter_groups = (
             ParameterGroup(f"bias_{m}", "bias", self.parameter_names[BIAS], ("x", "y", "z"), 1e3, 0.0, m, "+.4f",
