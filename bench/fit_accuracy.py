@@ -22,8 +22,10 @@ from quiet import silence_campaign_log  # bench/quiet.py, beside this script
 
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.engine.preparation import prepare
-from accelcal_rig.fit.campaign_fit import FitOptions, fit_campaign, fit_dut
-from accelcal_rig.store.read import load_campaign, read_dut_poses
+from accelcal_rig.fit.acceleration import ACCELERATION, accelerometer_poses
+from accelcal_rig.fit.campaign_fit import FitOptions, fit_campaign
+from accelcal_rig.fit.vector_model import fit_vector
+from accelcal_rig.store.read import load_campaign
 
 REPO = Path(__file__).resolve().parent.parent
 PAPER = REPO / "procedures" / "paper-24pos-thermal.yaml"
@@ -95,10 +97,10 @@ def accuracy(seeds: int, folder: Path) -> None:
 def speed(folder: Path) -> None:
     path = dry_run(PAPER, folder, 0)
     for mode in MODES:
-        poses = read_dut_poses(load_campaign(path), "ADX355-A001")
+        poses = accelerometer_poses(load_campaign(path), "ADX355-A001")
         start = time.perf_counter()
         for _ in range(5):
-            fit_dut(poses, FitOptions(mode=mode))
+            fit_vector(poses, FitOptions(mode=mode), ACCELERATION)
         one = (time.perf_counter() - start) / 5
         start = time.perf_counter()
         fit_campaign(load_campaign(path), FitOptions(mode=mode), {"campaign": str(path)})

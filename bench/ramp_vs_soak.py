@@ -36,7 +36,7 @@ def quality(calibration_path: Path) -> dict[str, float]:
     calibration = load_calibration(calibration_path)
     directions = sphere(500)
     errors, bias, scale = [], [], []
-    for serial, sensor in calibration.sensors.items():
+    for serial, sensor in calibration.of_quantity("acceleration").items():
         temperatures = np.arange(np.ceil(sensor.validity_c[0]), np.floor(sensor.validity_c[1]) + 1)
         truth = truth_for_serial(serial).parameters_at(temperatures)          # (T, 12)
         fitted = sensor.parameters_at(temperatures)

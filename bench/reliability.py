@@ -97,7 +97,7 @@ def judge_complete(campaign: Path, before: dict[str, bytes], rmse_limit: float =
     currency = file_currency(campaign, loaded, writing=False)
     calibration = campaign.with_suffix(".calibration.yaml")
     try:
-        metrics = load_calibration(calibration).sensors
+        metrics = load_calibration(calibration).of_quantity("acceleration")
         worst = max(s.metrics["rmse_after_mg"] / s.metrics["noise_floor_mg"] for s in metrics.values())
     except (ConfigError, KeyError, ZeroDivisionError) as exc:
         return False, f"calibration: {exc}"

@@ -56,7 +56,7 @@ def run(criterion: str, poll_s: float, duts: int, seed: int) -> dict[str, Any]:
             record["soak_hours"] = sum(float(g["t_s"][-1] - g.attrs["t_reached_s"]) for g in soaks) / 3600
             record["soak_minutes"] = [round(float(g["t_s"][-1] - g.attrs["t_reached_s"]) / 60, 1) for g in soaks]
         if calibration.is_file() and record["state"] == "done":
-            checks = [s.metrics["verification"] for s in load_calibration(calibration).sensors.values()]
+            checks = [s.metrics["verification"] for s in load_calibration(calibration).of_quantity("acceleration").values()]
             record["verification_rmse_mg"] = max(v["rmse_mg"] for v in checks)
             record["residual_drift_mg"] = max(max(v["drift_mg"]) for v in checks)
         return record

@@ -108,7 +108,7 @@ def at_rest(calibration_path: Path) -> tuple[float, float]:
     what each sensor would read at rest by its hidden truth, over its calibrated range."""
     directions = sphere(100)
     rmse, drift = [], []
-    for serial, sensor in load_calibration(calibration_path).sensors.items():
+    for serial, sensor in load_calibration(calibration_path).of_quantity("acceleration").items():
         temperatures = np.linspace(*sensor.validity_c, 1 + int(2 * np.ptp(sensor.validity_c)))
         truth = truth_for_serial(serial).parameters_at(temperatures)                    # (T, 12)
         raw = distort(directions[None, :, :], truth[:, None, :])                        # (T, D, 3)
@@ -131,7 +131,7 @@ def figures(method: str, duts: int, seed: int) -> dict[str, Any]:
         started = time.perf_counter()
         run = run_campaign(prepared, output, dry_run=True, seed=seed, overwrite=False, calibration=calibration_path)
         wall_s = time.perf_counter() - started
-        sensors = load_calibration(calibration_path).sensors
+        sensors = load_calibration(calibration_path).of_quantity("acceleration")
         at_rest_rmse_mg, at_rest_drift_mg = at_rest(calibration_path)
     metrics = [s.metrics for s in sensors.values()]
     verification = [m["verification"] for m in metrics]

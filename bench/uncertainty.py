@@ -35,13 +35,15 @@ from throughput import METHODS, SENSOR_EFFECTS, variant  # bench/throughput.py: 
 
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.engine.preparation import prepare
-from accelcal_rig.fit import campaign_fit
+from accelcal_rig.fit import vector_model
+from accelcal_rig.fit.acceleration import ACCELERATION, accelerometer_poses
 from accelcal_rig.fit.budget import truth_errors
-from accelcal_rig.fit.campaign_fit import FitOptions, fit_campaign, fit_dut, with_approach
+from accelcal_rig.fit.campaign_fit import FitOptions, fit_campaign
 from accelcal_rig.fit.recorded_options import recorded_options
 from accelcal_rig.fit.uncertainty import COVERAGE_FACTOR, combined
+from accelcal_rig.fit.vector_model import fit_vector, with_approach
 from accelcal_rig.store.content import Campaign
-from accelcal_rig.store.read import load_campaign, read_dut_poses
+from accelcal_rig.store.read import load_campaign
 
 REPO = Path(__file__).resolve().parent.parent
 PAPER = REPO / "procedures" / "paper-24pos-thermal.yaml"
@@ -70,7 +72,7 @@ def approached_from(campaign: Campaign, serial: str, t_s: np.ndarray, temperatur
     times = [np.asarray(s.t_s, dtype=float) for s in campaign.soaks if len(s.t_s)]
     readings = [np.asarray(s.dut_c, dtype=float)[:, (list(s.serials) or campaign.serials).index(serial)]
                 for s in campaign.soaks if len(s.t_s)]
-    poses = read_dut_poses(campaign, serial)
+    poses = accelerometer_poses(campaign, serial)
     history_t = np.concatenate(times + [poses.t_s])
     history_c = np.concatenate(readings + [poses.temperature_c])
     order = np.argsort(history_t, kind="stable")
@@ -87,16 +89,16 @@ def verification_checks(campaign: Campaign) -> list[dict[str, Any]]:
     """Each DUT fitted as its procedure says, and of its verification poses, one record per pose: its
     temperature, the direction it was approached from and its rate of change, each axis's error against
     the truth, each source of the budget and the combined standard uncertainty (mg). The fit is the
-    campaign's own (fit_dut); only its truth check is recorded on its way (truth_errors, the same inputs).
+    campaign's own (fit_vector); only its truth check is recorded on its way (truth_errors, the same inputs).
     Directions: `approach` as the fit sees it (the last ten minutes), `side` the last move beyond MOVE_C."""
     options = recorded_options(campaign.attrs, "the campaign's procedure's fit")
     assert options is not None
     records: list[dict[str, Any]] = []
-    real = campaign_fit.truth_coverage
+    real = vector_model.truth_coverage
     seen: list[tuple[Any, ...]] = []
-    with mock.patch.object(campaign_fit, "truth_coverage", lambda *args: seen.append(args) or real(*args)):
+    with mock.patch.object(vector_model, "truth_coverage", lambda *args: seen.append(args) or real(*args)):
         for serial in campaign.serials:  # with_approach: each pose's direction, to sort by
-            fit_dut(with_approach(campaign, read_dut_poses(campaign, serial)), options)
+            fit_vector(with_approach(campaign, accelerometer_poses(campaign, serial, options)), options, ACCELERATION)
     for serial, arguments in zip(campaign.serials, seen):
         checks, _, _, _, temperature_c, _, _, _ = arguments
         errors, sources = truth_errors(*arguments)

@@ -10,10 +10,12 @@ from pathlib import Path
 import numpy as np
 
 from accelcal_rig.cli import main
+from accelcal_rig.fit.acceleration import accelerometer_poses
 from accelcal_rig.fit.calibration import load_calibration
-from accelcal_rig.fit.campaign_fit import FitOptions, fit_dut
-from accelcal_rig.store.read import load_campaign, read_dut_poses
+from accelcal_rig.fit.campaign_fit import FitOptions
+from accelcal_rig.store.read import load_campaign
 from tests.conftest import TINY_PROCEDURE
+from tests.fit.vector_poses import fit_accelerometer
 
 VERIFIED = TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c: [20, 40]") + """\
 verify: {schedule: {kind: sphere, count: 8}, setpoints_c: [30]}
@@ -38,15 +40,16 @@ def test_a_dut_beyond_its_limits_fails_and_fail_on_reject_exits_3(write, workdir
     calibration = workdir / "again.yaml"
     assert main(["fit", str(campaign), "-o", str(calibration), "--json"]) == 0  # without the flag: 0
     report = json.loads(capsys.readouterr().out)
-    for sensor in report.values():
-        assert sensor["verdict"] == "FAIL" and sensor["verdict_reasons"][0].startswith("verification |g| RMSE")
+    for dut in report.values():
+        sensor = dut["channels"]["accel"]
+        assert dut["verdict"] == "FAIL" and dut["verdict_reasons"][0].startswith("verification |g| RMSE")
         verification = sensor["verification"]
         assert verification["n_poses"] == 3 * 8 and {"rmse_mg", "max_axis_error_mg", "max_tilt_error_deg"} <= set(
             verification)
         assert verification["rmse_mg"] > 0.5 * sensor["noise_floor_mg"]  # held out: no fit can beat its noise here
         assert sensor["in_sample"]["n_poses"] == 2 * 6
         assert sensor["expected_fit_rmse_mg"] < sensor["noise_floor_mg"]
-    assert {s.verdict for s in load_calibration(calibration).sensors.values()} == {"FAIL"}
+    assert {s.verdict for s in load_calibration(calibration).of_quantity("acceleration").values()} == {"FAIL"}
     assert main(["fit", str(campaign), "-o", str(calibration), "--fail-on-reject"]) == 3
 
 
@@ -58,12 +61,12 @@ def test_verification_poses_are_stored_apart_and_never_fitted(write, workdir: Pa
     stored = load_campaign(campaign)
     kinds = dict(zip(stored.header.plan.step_key, stored.header.plan.kind))
     assert kinds["T30/verify01"] == "verify" and kinds["T20/pose01"] == "pose" and "T30/pose01" not in kinds
-    poses = read_dut_poses(stored, stored.serials[0])
+    poses = accelerometer_poses(stored, stored.serials[0])
     assert poses.verification.sum() == 3 * 8 and len(poses.verification) == 2 * 6 + 3 * 8
-    with_checks = fit_dut(poses, FitOptions(degree=1))
-    without = fit_dut(poses.subset(~poses.verification), FitOptions(degree=1))
+    with_checks = fit_accelerometer(poses, FitOptions(degree=1))
+    without = fit_accelerometer(poses.subset(~poses.verification), FitOptions(degree=1))
     np.testing.assert_array_equal(with_checks.thermal.coefficients, without.thermal.coefficients)
-    assert "verification" in with_checks.metrics and "verification" not in without.metrics
+    assert "verification" in with_checks.figures and "verification" not in without.figures
 
 
 def test_resuming_a_complete_campaign_whose_fit_is_missing_fits_judges_and_certifies(write, workdir: Path,
@@ -105,7 +108,7 @@ def test_without_limits_nothing_is_judged_and_nothing_is_stated_as_conformity(wr
     assert {v["verdict"] for v in verdicts.values()} == {"NOT JUDGED"}
     assert main(["fit", str(campaign), "-o", str(workdir / "cal.yaml"), "--json", "--registry", str(registry)]) == 0
     assert {r["verdict"] for r in json.loads(capsys.readouterr().out).values()} == {"NOT JUDGED"}
-    assert {s.verdict for s in load_calibration(workdir / "cal.yaml").sensors.values()} == {"NOT JUDGED"}
+    assert {s.verdict for s in load_calibration(workdir / "cal.yaml").of_quantity("acceleration").values()} == {"NOT JUDGED"}
     page = next((workdir / "c.certificates").glob("*.html")).read_text(encoding="utf-8")
     assert "Statement of conformity" in page and "class='verdict" not in page and "None: the procedure" in page
     assert main(["registry", "list", "--registry", str(registry)]) == 0
@@ -129,18 +132,18 @@ def test_a_limit_inside_the_guard_band_is_conditional_under_guarded_and_pass_und
         return json.loads(capsys.readouterr().out)
 
     learned = run("learn", "{decision_rule: guarded, parameters: {at_c: 30, bias_mg: 1000}}")
-    biases = [(serial, c) for serial, sensor in learned.items() for c in sensor["decision"]["limits"]]
-    assert {c["limit_key"] for _, c in biases} == {"parameters.bias_mg"} and len(biases) == 3 * len(learned)
+    biases = [(serial, c) for serial, dut in learned.items() for c in dut["channels"]["accel"]["decision"]["limits"]]
+    assert {c["limit_key"] for _, c in biases} == {"accel.parameters.bias_mg"} and len(biases) == 3 * len(learned)
     assert all(c["outcome"] == "pass" and c["expanded_u"] > 0 for _, c in biases)
     serial, largest = max(biases, key=lambda b: abs(b[1]["value"]))
     limit = abs(largest["value"]) + 0.5 * largest["expanded_u"]
 
     guarded = run("guarded", f"{{decision_rule: guarded, parameters: {{at_c: 30, bias_mg: {limit!r}}}}}")
     simple = run("simple", f"{{decision_rule: simple, parameters: {{at_c: 30, bias_mg: {limit!r}}}}}")
-    same = next(c for c in guarded[serial]["decision"]["limits"] if c["label"] == largest["label"])
+    same = next(c for c in guarded[serial]["channels"]["accel"]["decision"]["limits"] if c["label"] == largest["label"])
     assert same["value"] == largest["value"]                       # the same measurements, judged again
     assert guarded[serial]["verdict"] == "CONDITIONAL" and same["outcome"] == "conditional pass"
-    assert "guarded acceptance" in guarded[serial]["decision"]["decision_rule"]
-    assert simple[serial]["verdict"] == "PASS" and "simple acceptance" in simple[serial]["decision"]["decision_rule"]
+    assert "guarded acceptance" in guarded[serial]["channels"]["accel"]["decision"]["decision_rule"]
+    assert simple[serial]["verdict"] == "PASS" and "simple acceptance" in simple[serial]["channels"]["accel"]["decision"]["decision_rule"]
     assert any("conditional pass" in r for r in guarded[serial]["verdict_reasons"])
-    assert load_calibration(workdir / "guarded.yaml.cal").sensor(serial).verdict == "CONDITIONAL"
+    assert load_calibration(workdir / "guarded.yaml.cal").channel(serial, "accel").verdict == "CONDITIONAL"

@@ -118,6 +118,10 @@ def resolve_rig_path(procedure: LoadedConfig[Procedure], override: Path | None) 
     return path
 
 
+#: What a rate step turns: the quantity of the channels whose range its rates must be inside.
+RATE_QUANTITY = "angular rate"
+
+
 def _range_key(procedure: LoadedConfig[Procedure], channel: str) -> KeyPath:
     """Where a channel's range is in the procedure: `acquisition.ranges.<channel>`, or the key that gave it before
     ranges were keyed by channel (`range_g`, `range_dps`)."""
@@ -148,9 +152,17 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
         if problem:
             raise procedure.error(("acquisition", "odr_hz"), f"{problem}: sensor {sensor.serial} of {rig.path}")
         gyroscope_steps = [k for k in ("rates", "noise") if getattr(procedure.model, k) is not None]
-        if gyroscope_steps and not any(c.quantity == "angular rate" for c in dut_part.channels):
+        gyroscopes = [c for c in dut_part.channels if c.quantity == RATE_QUANTITY]
+        if gyroscope_steps and not gyroscopes:
             raise procedure.error((gyroscope_steps[0],), f"sensor {sensor.serial} of {rig.path} is an "
                                                          f"{dut_part.label}, which has no gyroscope")
+        rates = procedure.model.rates
+        for channel in gyroscopes if rates is not None else ():
+            assert rates is not None
+            beyond = [r for r in (*rates.rates_dps, *rates.verify_rates_dps) if r >= ranges[channel.name]]
+            if beyond:
+                raise procedure.error(("rates", "rates_dps"), f"{max(beyond):g} °/s is not inside the gyroscope's "
+                                      f"range (acquisition ranges.{channel.name} ±{ranges[channel.name]:g} °/s)")
     for index, setpoint in enumerate(procedure.model.setpoints_c):
         if not chamber.min_setpoint_c <= setpoint <= chamber.max_setpoint_c:
             raise procedure.error(

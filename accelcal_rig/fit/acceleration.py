@@ -14,6 +14,7 @@ import numpy as np
 
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, gravity_statement
 from accelcal_rig.fit.channel_model import FlightStackOffsets, NoiseFigures
+from accelcal_rig.fit.options import FitOptions
 from accelcal_rig.fit.vector_model import Eq1Model, VectorQuantity
 from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.read import VectorPoses, site_gravity
@@ -49,3 +50,12 @@ ACCELERATION = VectorQuantity(
 )
 
 MODEL = Eq1Model(ACCELERATION)
+
+
+def accelerometer_poses(campaign: Campaign, serial: str, options: FitOptions | None = None) -> VectorPoses:
+    """The DUT's accelerometer poses as its model reads them (the site's gravity, the truth of a dry run; each
+    pose's approach with `fit.hysteresis`); ValueError for a DUT without an accelerometer."""
+    info = campaign.channel_of(serial, ACCELERATION.quantity)
+    if info is None:
+        raise ValueError(f"sensor {serial} has no accelerometer")
+    return MODEL.records(campaign, info, serial, options or FitOptions())

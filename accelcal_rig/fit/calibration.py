@@ -97,8 +97,8 @@ def _version_3_entry(data: dict[str, Any]) -> dict[str, Any]:
         if old in data:
             entry = {k: v for k, v in data.items() if k not in (old, lsb, "earth_rate", "gauge")}
             statements = {k: data[k] for k in ("earth_rate", "gauge") if k in data}
-            return {**entry, "range": data[old], "lsb": data.get(lsb), "quantity": quantity, "unit": unit,
-                    "model": data.get("model", model), **({"statements": statements} if statements else {})}
+            return {**entry, "range": data[old], **({"lsb": data[lsb]} if lsb in data else {}), "quantity": quantity,
+                    "unit": unit, "model": data.get("model", model), **({"statements": statements} if statements else {})}
     return data
 
 
@@ -319,11 +319,16 @@ def load_calibration(path: Path) -> CalibrationFile:
 
 
 def _in_version_1(key: tuple[str | int, ...], lines: dict[tuple[str | int, ...], int]) -> tuple[str | int, ...]:
-    """Where a key of a DUT's calibration stands in a version-1 file (`sensors.<serial>.…`), so that a problem in
-    one is reported at its own line."""
+    """Where a key of a DUT's calibration stands in a file of an earlier version, so that a problem in one is
+    reported at its own key and line: a version-1 file's `sensors.<serial>.…`; a channel's range and code size by
+    the names of its quantity's unit (`range_g`, `lsb_dps`) before version 3."""
     if (len(key) >= 4 and key[0] == "duts" and key[2:4] == ("channels", VERSION_1_CHANNEL)
             and ("sensors", key[1]) in lines):
-        return ("sensors", key[1], *key[4:])
+        key = ("sensors", key[1], *key[4:])
+    if key and key[-1] in ("range", "lsb"):
+        for old, (_, unit, _, _) in _BEFORE_VERSION_3.items():
+            if (*key[:-1], old) in lines:
+                return (*key[:-1], f"{key[-1]}_{unit}")
     return key
 
 

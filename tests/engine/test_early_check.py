@@ -64,7 +64,7 @@ def test_a_loose_and_a_turned_dut_are_flagged_at_the_first_setpoint_and_the_soun
     status = campaign_status(output, None)
     assert {f["action"] for f in status["early_check"]} == {"warn"}
     assert sum(line.startswith("flagged    ") for line in status_lines(status)) == 4
-    assert set(load_calibration(output.with_suffix(".calibration.yaml")).sensors) == {LOOSE, TURNED, *SOUND}
+    assert set(load_calibration(output.with_suffix(".calibration.yaml")).of_quantity("acceleration")) == {LOOSE, TURNED, *SOUND}
 
 
 def test_no_dut_of_a_sound_fixture_is_flagged(write, workdir: Path) -> None:
@@ -83,7 +83,7 @@ def test_drop_leaves_the_dut_out_of_the_fit_with_its_reason_and_its_poses_in_the
     assert flagged(output) == [(LOOSE, 30.0, "loose_mount")]  # dropped: not judged again at 40 °C
     assert campaign_status(output, None)["early_check"][0]["action"] == "drop"
     calibration = load_calibration(output.with_suffix(".calibration.yaml"))
-    assert set(calibration.sensors) == set(SOUND) | {TURNED}
+    assert set(calibration.of_quantity("acceleration")) == set(SOUND) | {TURNED}
     assert calibration.dropped[LOOSE].startswith(f"dropped by the early check: DUT {LOOSE} at +30 °C: residuals")
     stored = load_campaign(output)
     assert len(stored.poses) == 12 and all(LOOSE in [d.serial for d in p.duts] for p in stored.poses)

@@ -39,7 +39,7 @@ def test_a_site_with_stronger_gravity_reads_more_than_1_g_and_is_fitted_to_it(wr
     _, report = fit_campaign(campaign, FitOptions(mode=mode, degree=0, free=free), {"campaign": str(output)})
     for r in report.values():  # 0.29 mg of |g| would remain if the fit aimed at 1 g
         assert r["rmse_after_mg"] < 2 * r["noise_floor_mg"] < 0.1 and r["gravity_m_s2"] == pytest.approx(9.8123)
-    sensor = load_calibration(workdir / f"site-{mode}.cal.yaml").sensor(campaign.serials[0])
+    sensor = load_calibration(workdir / f"site-{mode}.cal.yaml").channel(campaign.serials[0], "accel")
     raw = campaign.dut_column(campaign.serials[0], "mean_g")
     temperature = campaign.dut_column(campaign.serials[0], "temperature_c").mean(axis=1)
     compensated = np.linalg.norm(apply(sensor, raw, np.clip(temperature, *sensor.validity_c)), axis=1)

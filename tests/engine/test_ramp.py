@@ -55,7 +55,7 @@ def test_a_ramp_campaign_measures_while_the_temperature_moves(write, workdir: Pa
     # Within one setpoint's poses the temperature rose, by more than the reading's noise (σ ≈ 0.06 °C).
     assert temperature[later][-1] - temperature[later][0] > 0.15
     # The joint fit follows each pose's temperature: the calibration matches the truth over the range.
-    sensor = load_calibration(workdir / "cal.yaml").sensor("ADX355-A001")
+    sensor = load_calibration(workdir / "cal.yaml").channel("ADX355-A001", "accel")
     temperatures = np.linspace(*sensor.validity_c, 5)
     bias_error = sensor.parameters_at(temperatures)[:, :3] - truth_for_serial("ADX355-A001").parameters_at(temperatures)[:, :3]
     assert np.abs(bias_error).max() < 60e-6  # g
@@ -133,7 +133,7 @@ def test_a_bidirectional_ramp_measures_both_ways_and_its_fit_finds_the_hysteresi
     result = run_campaign(prepared, workdir / "both.h5", dry_run=True, seed=2, overwrite=False,
                           calibration=workdir / "both.yaml")
     assert result.summary.state == "done" and result.summary.poses_done == 7 * 6
-    sensor = load_calibration(workdir / "both.yaml").sensor("ADX355-A001")
+    sensor = load_calibration(workdir / "both.yaml").channel("ADX355-A001", "accel")
     found = np.array(sensor.metrics["hysteresis_mg"])
     from accelcal_rig.parts.adxl35x import ADXL355
     from accelcal_rig.sim.lab import SimulatedDut

@@ -8,13 +8,13 @@ from pathlib import Path
 import numpy as np
 
 from accelcal_rig.cli import main
-from accelcal_rig.fit.calibration import PolynomialModel, SensorCalibration, apply
+from accelcal_rig.fit.calibration import ChannelCalibration, PolynomialModel, apply
 from accelcal_rig.fit.sfem import PARAMETER_NAMES
 
 G0 = 9.80665  # m/s² per standard g: the unit both stacks work in
 
 
-def bias_only(sensor: SensorCalibration) -> SensorCalibration:
+def bias_only(sensor: ChannelCalibration) -> ChannelCalibration:
     """The sensor's Eq. 1 with its bias polynomials and nothing else: scale 1, no cross-axis terms."""
     neutral = {name: [1.0] if name.startswith("scale_") else [0.0] for name in PARAMETER_NAMES[3:]}
     bias = {name: sensor.polynomial.coefficients[name] for name in PARAMETER_NAMES[:3]}
@@ -23,7 +23,7 @@ def bias_only(sensor: SensorCalibration) -> SensorCalibration:
     return sensor.model_copy(update={"polynomial": polynomial})
 
 
-def bias_removed_m_s2(sensor: SensorCalibration, raw_m_s2: np.ndarray, temperature_c: np.ndarray) -> np.ndarray:
+def bias_removed_m_s2(sensor: ChannelCalibration, raw_m_s2: np.ndarray, temperature_c: np.ndarray) -> np.ndarray:
     """What `apply` makes of raw readings (m/s²) with the bias part of the calibration only."""
     return apply(bias_only(sensor), raw_m_s2 / G0, temperature_c) * G0
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from accelcal_rig.cli import main
-from accelcal_rig.fit.calibration import load_calibration, save_calibration
+from accelcal_rig.fit.calibration import DutCalibration, load_calibration, save_calibration
 from tests.export.stack_support import G0, bias_removed_m_s2, export, stated, written_comments
 
 REFERENCE_C = 35.0  # ArduPilot's TEMP_REFERENCE
@@ -70,7 +70,7 @@ def test_with_ardupilots_own_offsets_the_correction_is_the_bias_apply_removes(fi
     calibration_path = fitted_paper_campaign[1]
     calibration = load_calibration(calibration_path)
     rng = np.random.default_rng(11)
-    for serial, sensor in calibration.sensors.items():
+    for serial, sensor in calibration.of_quantity("acceleration").items():
         params = read_ardupilot_params(ardupilot_export(capsys, calibration_path, tmp_path, "--serial", serial)[0])
         assert params["INS_TCAL1_ENABLE"] == 1
         low, high = sensor.validity_c
@@ -88,7 +88,7 @@ def test_with_ardupilots_own_offsets_the_correction_is_the_bias_apply_removes(fi
 
 def test_beyond_tmin_and_tmax_the_correction_holds_at_the_nearer_end(fitted_paper_campaign, tmp_path, capsys) -> None:
     calibration_path = fitted_paper_campaign[1]
-    sensor = load_calibration(calibration_path).sensor("ADX355-A002")
+    sensor = load_calibration(calibration_path).channel("ADX355-A002", "accel")
     params = read_ardupilot_params(ardupilot_export(capsys, calibration_path, tmp_path, "--serial", "ADX355-A002")[0])
     low, high = sensor.validity_c
     assert (params["INS_TCAL1_TMIN"], params["INS_TCAL1_TMAX"]) == pytest.approx((low, high), abs=1e-6)
@@ -103,7 +103,7 @@ def test_beyond_tmin_and_tmax_the_correction_holds_at_the_nearer_end(fitted_pape
 def test_the_file_and_stderr_state_the_offset_left_to_ardupilot_and_what_is_not_exported(fitted_paper_campaign,
                                                                                           tmp_path, capsys) -> None:
     calibration_path = fitted_paper_campaign[1]
-    sensor = load_calibration(calibration_path).sensor("ADX355-A001")
+    sensor = load_calibration(calibration_path).channel("ADX355-A001", "accel")
     out, notes = ardupilot_export(capsys, calibration_path, tmp_path, "--serial", "ADX355-A001")
     assert set(notes) <= written_comments(out)
     at_35 = stated(r"at 35\.00 degC it is (-?[\d.]+), (-?[\d.]+), (-?[\d.]+) mg", notes)
@@ -118,14 +118,15 @@ def test_the_file_and_stderr_state_the_offset_left_to_ardupilot_and_what_is_not_
 def test_a_polynomial_above_degree_3_is_refitted_and_how_far_it_strays_is_stated(fitted_paper_campaign, tmp_path,
                                                                                  capsys) -> None:
     calibration = load_calibration(fitted_paper_campaign[1])
-    sensor = calibration.sensor("ADX355-A001")
+    sensor = calibration.channel("ADX355-A001", "accel")
     coefficients = dict(sensor.polynomial.coefficients)
     coefficients["bias_x_g"] = [*coefficients["bias_x_g"], 2e-4, -1e-4]  # x⁴ and x⁵: 0.1 … 0.3 mg at the ends
     quintic = sensor.model_copy(update={"polynomial": sensor.polynomial.model_copy(
         update={"degree": 5, "coefficients": coefficients})})
     path = tmp_path / "quintic.calibration.yaml"
-    save_calibration(calibration.with_sensors({sensor.serial: quintic}), path)
-    quintic = load_calibration(path).sensor(sensor.serial)
+    only = calibration.model_copy(update={"duts": {sensor.serial: DutCalibration(channels={"accel": quintic})}})
+    save_calibration(only, path)
+    quintic = load_calibration(path).channel(sensor.serial, "accel")
     out, notes = ardupilot_export(capsys, path, tmp_path)  # the file's only sensor: no --serial needed
     params = read_ardupilot_params(out)
     refit_mg, = stated(r"degree-5 bias polynomial refitted as ArduPilot's cubic: up to ([\d.]+) mg", notes)

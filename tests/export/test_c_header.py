@@ -61,13 +61,13 @@ def inputs(calibration: CalibrationFile, n: int = 400) -> tuple[list[str], np.nd
     """Random readings of each sensor from −60 to 80 °C (beyond the calibrated range on both sides), half
     as g and half as 20-bit codes."""
     rng = np.random.default_rng(7)
-    serials = list(calibration.sensors)
+    serials = list(calibration.of_quantity("acceleration"))
     sensor = rng.integers(0, len(serials), n)
     temperature = rng.uniform(-60.0, 80.0, n)
     direction = rng.normal(size=(n, 3))
     reading = direction / np.linalg.norm(direction, axis=1, keepdims=True) * rng.uniform(0.5, 1.5, (n, 1))
     codes = rng.random(n) < 0.5
-    lsb = np.array([calibration.sensors[serials[i]].lsb_g for i in sensor])
+    lsb = np.array([calibration.of_quantity("acceleration")[serials[i]].lsb for i in sensor])
     reading[codes] = np.rint(reading[codes] / lsb[codes, None])
     return serials, sensor, temperature, reading, codes
 
@@ -77,7 +77,7 @@ def python_apply(calibration: CalibrationFile, serials, sensor, temperature, rea
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CalibrationRangeWarning)
         for i in range(len(sensor)):
-            cal = calibration.sensors[serials[sensor[i]]]
+            cal = calibration.of_quantity("acceleration")[serials[sensor[i]]]
             f = apply_codes if codes[i] else apply
             expected[i] = f(cal, reading[i], temperature[i])
     return expected
@@ -90,8 +90,8 @@ def calibration(fitted_paper_campaign: tuple[Path, Path]) -> CalibrationFile:
 
 @pytest.mark.parametrize("out_of_range", ["clamp", "extrapolate"])
 def test_compiled_header_matches_python_apply(calibration: CalibrationFile, tmp_path: Path, out_of_range: str) -> None:
-    calibration = calibration.with_sensors({
-        k: s.model_copy(update={"out_of_range": out_of_range}) for k, s in calibration.sensors.items()})
+    for serial, sensor in calibration.of_quantity("acceleration").items():
+        calibration = calibration.with_channels(serial, {"accel": sensor.model_copy(update={"out_of_range": out_of_range})})
     serials, sensor, temperature, reading, codes = inputs(calibration)
     stdin = "".join(f"{s} {float(t)!r} {float(a)!r} {float(b)!r} {float(c)!r} {int(k)}\n"
                     for s, t, (a, b, c), k in zip(sensor, temperature, reading, codes))
@@ -106,7 +106,7 @@ def test_compiled_header_matches_python_apply(calibration: CalibrationFile, tmp_
 
 def test_header_names_each_sensor_by_serial(calibration: CalibrationFile) -> None:
     header = to_c_header(calibration)
-    for index, serial in enumerate(calibration.sensors):
+    for index, serial in enumerate(calibration.of_quantity("acceleration")):
         assert f"#define ACCELCAL_SENSOR_{c_identifier(serial)} {index}" in header
         assert f'"{serial}"' in header
     assert c_identifier("7-up.b") == "_7_UP_B"

@@ -2,7 +2,7 @@
 written again here (PX4's calc_thermal_offsets_3D and Gyroscope::Correct; ArduPilot's TCal::correct_sensor with
 the offsets its boot-time gyro calibration would hold) remove the calibration's `bias_*_dps` polynomial over the
 calibrated range; the sizes stated of what they cannot hold match the model's parameters; the C header,
-compiled, compensates as `apply_gyro` does; csv says it leaves the gyroscope out."""
+compiled, compensates as `apply` does; csv holds it beside the accelerometer."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from accelcal_rig.export.c_header import c_identifier, to_c_header
 from accelcal_rig.export.flight_stack import StackOptions
 from accelcal_rig.export.formats import export as export_format
 from accelcal_rig.fit import gyro_model
-from accelcal_rig.fit.calibration import CalibrationRangeWarning, GyroCalibration, apply_gyro, load_calibration
+from accelcal_rig.fit.calibration import CalibrationRangeWarning, ChannelCalibration, apply, load_calibration
 from tests.conftest import REPO
 from tests.export.stack_support import export, stated, written_comments
 from tests.export.test_ardupilot import read_ardupilot_params
@@ -47,7 +47,7 @@ def imu_calibration(imu_dry_run: tuple[Path, Path], tmp_path_factory: pytest.Tem
     return copied(imu_dry_run, tmp_path_factory.mktemp("imu-export"))[1]
 
 
-def bias_rad_s(gyro: GyroCalibration, temperature_c: np.ndarray) -> np.ndarray:
+def bias_rad_s(gyro: ChannelCalibration, temperature_c: np.ndarray) -> np.ndarray:
     """The calibration's own bias polynomials (bias_x_dps …) at each temperature, in rad/s."""
     return gyro.polynomial.at(temperature_c)[..., :3] * RAD
 
@@ -78,7 +78,7 @@ def px4_bound(params: dict[str, float], n: int, temperature_c: np.ndarray, relat
 def test_px4_removes_the_gyro_bias_polynomial(imu_calibration, tmp_path, capsys) -> None:
     calibration = load_calibration(imu_calibration)
     rng = np.random.default_rng(17)
-    for n, (serial, gyro) in enumerate(calibration.gyroscopes.items()):
+    for n, (serial, gyro) in enumerate(calibration.of_quantity("angular rate").items()):
         out, notes = stack_export(capsys, imu_calibration, tmp_path, "px4-params", "--serial", serial,
                                   "--instance", str(n), "--device-id", str(1000 + n))
         params = read_qgc_params(out)
@@ -103,7 +103,7 @@ def test_px4_removes_the_gyro_bias_polynomial(imu_calibration, tmp_path, capsys)
 
 
 def test_px4_clips_the_gyro_temperature_and_states_its_offset(imu_calibration, tmp_path, capsys) -> None:
-    gyro = load_calibration(imu_calibration).gyroscope(SERIAL)
+    gyro = load_calibration(imu_calibration).channel(SERIAL, "gyro")
     out, notes = stack_export(capsys, imu_calibration, tmp_path, "px4-params", "--serial", SERIAL)
     params = read_qgc_params(out)
     low, high = gyro.validity_c
@@ -134,7 +134,7 @@ def test_ardupilot_with_its_boot_gyro_offsets_removes_the_gyro_bias(imu_calibrat
                                                                     cal_temp_c: float) -> None:
     calibration = load_calibration(imu_calibration)
     rng = np.random.default_rng(23)
-    for serial, gyro in calibration.gyroscopes.items():
+    for serial, gyro in calibration.of_quantity("angular rate").items():
         out, notes = stack_export(capsys, imu_calibration, tmp_path, "ardupilot-params", "--serial", serial)
         params = read_ardupilot_params(out)
         assert all(f"INS_TCAL1_GYR{k}_{a}" in params for k in (1, 2, 3) for a in "XYZ") and len(params) == 3 + 18
@@ -158,7 +158,7 @@ def test_ardupilot_with_its_boot_gyro_offsets_removes_the_gyro_bias(imu_calibrat
 
 
 def test_what_the_offset_only_model_cannot_hold_is_stated_with_its_sizes(imu_calibration, tmp_path, capsys) -> None:
-    gyro = load_calibration(imu_calibration).gyroscope(SERIAL)
+    gyro = load_calibration(imu_calibration).channel(SERIAL, "gyro")
     for fmt in ("px4-params", "ardupilot-params"):
         out, notes = stack_export(capsys, imu_calibration, tmp_path, fmt, "--serial", SERIAL)
         assert set(notes) <= written_comments(out)
@@ -182,7 +182,7 @@ def test_what_the_offset_only_model_cannot_hold_is_stated_with_its_sizes(imu_cal
         worst = 0.0
         for p in parameters[::100]:
             omega = rng.normal(size=(3000, 3))
-            omega *= gyro.range_dps / np.linalg.norm(omega, axis=1, keepdims=True)
+            omega *= gyro.range / np.linalg.norm(omega, axis=1, keepdims=True)
             force = rng.normal(size=(3000, 3))
             force /= np.linalg.norm(force, axis=1, keepdims=True)
             left = gyro_model.distort_rate(omega, force, p) - p[:3] - omega
@@ -191,9 +191,9 @@ def test_what_the_offset_only_model_cannot_hold_is_stated_with_its_sizes(imu_cal
         assert scale > 100 and together > 1.0  # this gyroscope's are large: the statement matters
 
 
-def test_the_c_header_compensates_gyro_samples_as_apply_gyro(imu_calibration, tmp_path) -> None:
+def test_the_c_header_compensates_gyro_samples_as_apply_does(imu_calibration, tmp_path) -> None:
     calibration = load_calibration(imu_calibration)
-    gyros = list(calibration.gyroscopes.values())
+    gyros = list(calibration.of_quantity("angular rate").values())
     header = to_c_header(calibration)
     for index, gyro in enumerate(gyros):
         assert f"#define ACCELCAL_GYRO_{c_identifier(gyro.serial)} {index}" in header
@@ -205,20 +205,20 @@ def test_the_c_header_compensates_gyro_samples_as_apply_gyro(imu_calibration, tm
     force = rng.normal(size=(n, 3))
     force /= np.linalg.norm(force, axis=1, keepdims=True)
     codes = rng.random(n) < 0.3
-    rate[codes] = np.rint(rate[codes] / gyros[0].lsb_dps)
+    rate[codes] = np.rint(rate[codes] / gyros[0].lsb)
     expected = np.empty_like(rate)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", CalibrationRangeWarning)
         for i in range(n):
-            raw = rate[i] * (gyros[which[i]].lsb_dps if codes[i] else 1.0)
-            expected[i] = apply_gyro(gyros[which[i]], raw, force[i], temperature[i])
+            raw = rate[i] * (gyros[which[i]].lsb if codes[i] else 1.0)
+            expected[i] = apply(gyros[which[i]], raw, temperature[i], {"acceleration": force[i]})
     stdin = "".join(f"{w} {t!r} {a!r} {b!r} {c!r} {f0!r} {f1!r} {f2!r} {int(k)}\n" for w, t, (a, b, c), (f0, f1, f2), k
                     in zip(which, temperature.tolist(), rate.tolist(), force.tolist(), codes))
     in_double = run_gyro_c(header, tmp_path, stdin, "double")
     assert np.max(np.abs(in_double - expected)) < 1e-9  # deg/s at up to 2000 deg/s: the same arithmetic
     in_float = run_gyro_c(header, tmp_path, stdin, "float")
     assert np.max(np.abs(in_float - expected) / np.maximum(1.0, np.abs(expected))) < 2e-6
-    assert np.max(np.abs(expected - rate * np.where(codes, gyros[0].lsb_dps, 1.0)[:, None])) > 1.0  # it did correct
+    assert np.max(np.abs(expected - rate * np.where(codes, gyros[0].lsb, 1.0)[:, None])) > 1.0  # it did correct
 
 
 GYRO_PROGRAM = r"""
@@ -263,16 +263,13 @@ def run_gyro_c(header: str, folder: Path, stdin: str, real: str) -> np.ndarray:
     return result
 
 
-def test_json_carries_the_gyro_and_csv_says_it_leaves_it_out(imu_calibration) -> None:
+def test_json_csv_and_the_c_header_carry_the_gyro_beside_the_accelerometer(imu_calibration) -> None:
     calibration = load_calibration(imu_calibration)
     options = StackOptions(imu_calibration)
     for fmt in ("json", "c-header", "csv"):
         exported = export_format(calibration, fmt, options)
-        gyro_notes = [note for note in exported.notes if "gyro channel" in note]
-        assert not any("not calibrated" in note for note in gyro_notes)
-        if fmt == "csv":
-            assert len(gyro_notes) == 4 and all("is not in this csv export" in note for note in gyro_notes)
-            assert "bias_x_dps" not in exported.text
-        else:
-            assert gyro_notes == []
-    assert '"bias_x_dps"' in export_format(calibration, "json", options).text
+        assert exported.notes == (), fmt
+        assert "bias_x_dps" in exported.text and "bias_x_g" in exported.text, fmt
+    rows = [line.split(",") for line in export_format(calibration, "csv", options).text.splitlines()[1:]]
+    assert {(row[1], row[2], row[3]) for row in rows} == {("accel", "sfem-eq1", "g"), ("gyro", "gyro-rate-table", "dps")}
+    assert len(rows) == 4 * (12 + 27)

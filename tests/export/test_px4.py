@@ -60,7 +60,7 @@ def test_the_offsets_px4_subtracts_are_the_bias_apply_removes(fitted_paper_campa
     calibration_path = fitted_paper_campaign[1]
     calibration = load_calibration(calibration_path)
     rng = np.random.default_rng(3)
-    for serial, sensor in calibration.sensors.items():
+    for serial, sensor in calibration.of_quantity("acceleration").items():
         out, _ = px4_export(capsys, calibration_path, tmp_path, "--serial", serial)
         params = read_qgc_params(out)
         assert params["TC_A_ENABLE"] == 1 and params["TC_A0_ID"] == 0
@@ -75,7 +75,7 @@ def test_the_offsets_px4_subtracts_are_the_bias_apply_removes(fitted_paper_campa
 
 def test_beyond_tmin_and_tmax_px4_holds_the_offset_of_the_nearer_end(fitted_paper_campaign, tmp_path, capsys) -> None:
     calibration_path = fitted_paper_campaign[1]
-    sensor = load_calibration(calibration_path).sensor("ADX355-A003")
+    sensor = load_calibration(calibration_path).channel("ADX355-A003", "accel")
     params = read_qgc_params(px4_export(capsys, calibration_path, tmp_path, "--serial", "ADX355-A003")[0])
     low, high = sensor.validity_c
     assert (params["TC_A0_TMIN"], params["TC_A0_TMAX"]) == pytest.approx((low, high), abs=1e-6)
@@ -94,7 +94,7 @@ def test_beyond_tmin_and_tmax_px4_holds_the_offset_of_the_nearer_end(fitted_pape
 def test_what_px4_cannot_hold_is_stated_with_its_size_on_stderr_and_in_the_file(fitted_paper_campaign, tmp_path,
                                                                                 capsys) -> None:
     calibration_path = fitted_paper_campaign[1]
-    sensor = load_calibration(calibration_path).sensor("ADX355-A001")
+    sensor = load_calibration(calibration_path).channel("ADX355-A001", "accel")
     out, notes = px4_export(capsys, calibration_path, tmp_path, "--serial", "ADX355-A001")
     assert set(notes) <= written_comments(out)
     assert any("in the sensor chip's own x, y, z" in note for note in notes)  # the stack's axes may differ
@@ -135,10 +135,10 @@ def test_serial_picks_the_sensor_and_an_unknown_or_missing_one_is_one_line(fitte
     for serial in ("ADX355-A001", "ADX355-A002"):
         params = read_qgc_params(px4_export(capsys, calibration_path, tmp_path, "--serial", serial)[0])
         x0[serial] = params["TC_A0_X0_0"]
-        bias_x = -bias_removed_m_s2(calibration.sensor(serial), np.zeros((1, 3)), params["TC_A0_TREF"])[0, 0]
+        bias_x = -bias_removed_m_s2(calibration.channel(serial, "accel"), np.zeros((1, 3)), params["TC_A0_TREF"])[0, 0]
         assert x0[serial] == pytest.approx(bias_x, rel=1e-8)
     assert abs(x0["ADX355-A001"] - x0["ADX355-A002"]) > 1e-3
-    for options, expected in (([], ["choose one with --serial", *calibration.sensors]),
+    for options, expected in (([], ["choose one with --serial", *calibration.of_quantity("acceleration")]),
                               (["--serial", "NOPE"], ["no sensor 'NOPE'", "ADX355-A004"])):
         assert main(["export", str(calibration_path), "--format", "px4-params", *options]) == 2
         err = capsys.readouterr().err

@@ -22,9 +22,9 @@ def test_json_is_the_calibration_file_itself(fitted_paper_campaign: tuple[Path, 
 def test_csv_rows_evaluate_to_the_calibrations_parameters(fitted_paper_campaign: tuple[Path, Path]) -> None:
     calibration = load_calibration(fitted_paper_campaign[1])
     rows = list(csv.DictReader(io.StringIO(to_csv(calibration))))
-    assert len(rows) == 12 * len(calibration.sensors)
+    assert len(rows) == 12 * len(calibration.of_quantity("acceleration"))
     temperatures = np.array([-35.0, 0.0, 22.5, 55.0])  # inside the calibrated range
-    for serial, sensor in calibration.sensors.items():
+    for serial, sensor in calibration.of_quantity("acceleration").items():
         mine = [r for r in rows if r["serial"] == serial]
         assert [r["parameter"] for r in mine] == list(PARAMETER_NAMES)
         from_csv = np.empty((len(temperatures), 12))
@@ -32,5 +32,5 @@ def test_csv_rows_evaluate_to_the_calibrations_parameters(fitted_paper_campaign:
             x = (temperatures - float(row["t_mid_c"])) / float(row["t_half_range_c"])
             coefficients = [float(row[f"c{j}"]) for j in range(4)]
             from_csv[:, k] = np.polynomial.polynomial.polyval(x, coefficients)
-            assert row["out_of_range"] == sensor.out_of_range and float(row["lsb_g"]) == sensor.lsb_g
+            assert row["out_of_range"] == sensor.out_of_range and float(row["lsb"]) == sensor.lsb
         np.testing.assert_allclose(from_csv, sensor.parameters_at(temperatures), rtol=0, atol=1e-15)

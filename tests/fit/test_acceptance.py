@@ -6,11 +6,11 @@ import pytest
 from pydantic import ValidationError
 
 from accelcal_rig.config.acceptance import Acceptance, ParameterLimits
-from accelcal_rig.fit.acceptance import judge
 from accelcal_rig.fit.decision import DecisionRule, decide
 from accelcal_rig.fit.parameter_uncertainty import ParameterUncertainty
 from accelcal_rig.fit.sfem import IDENTITY_PARAMETERS
 from accelcal_rig.fit.thermal import ThermalModel
+from tests.fit.vector_poses import judge_accelerometer as judge
 
 VERIFIED = {"verification": {"rmse_mg": 0.014, "max_axis_error_mg": 0.05, "max_tilt_error_deg": 0.004,
                              "drift_mg": [0.02, 0.08, 0.01], "by_setpoint": [{}, {}],
@@ -39,7 +39,7 @@ def test_within_every_limit_passes_and_states_each_figure_with_its_uncertainty()
                               "verification drift of y 0.08 ± 0.015 mg, limit ≤ 0.1 mg: pass",
                               "bias y at 25 °C -30 ± 0.2 mg, limit ±31 mg: pass"]
     assert "simple acceptance" in judged.rule and "states no rule" in judged.rule
-    bias = [c for c in judged.checks if c.limit_key == "parameters.bias_mg"]
+    bias = [c for c in judged.checks if c.limit_key == "accel.parameters.bias_mg"]
     assert [round(c.value, 6) for c in bias] == [12, -30, 1] and all(c.signed for c in bias)
 
 

@@ -8,12 +8,14 @@ import numpy as np
 import pytest
 
 from accelcal_rig.fit.budget import FittedTerms, band_misfit, hysteresis_u_g, not_included
-from accelcal_rig.fit.campaign_fit import FitOptions, fit_dut
+from accelcal_rig.fit.options import FitOptions
 from accelcal_rig.fit.sfem import correct, distort
 from accelcal_rig.fit.uncertainty import COVERAGE_FACTOR, CoefficientCovariance, model_variance
 from accelcal_rig.plan.schedules import sphere
 from accelcal_rig.sim.truth import truth_for_serial
-from accelcal_rig.store.read import DutPoses
+from accelcal_rig.store.read import VectorPoses
+
+from .vector_poses import accel_poses, fit_accelerometer
 
 TRUTH = truth_for_serial("ADX355-A002")
 NOISE_G = 5e-6
@@ -23,7 +25,7 @@ POSE_S = 10.0
 
 
 def ramp_poses(centres_c: list[float], rates_c_per_min: list[float], approach: list[float], shift_g: np.ndarray,
-               seed: int) -> DutPoses:
+               seed: int) -> VectorPoses:
     """Bands of POSES_PER_BAND evenly spread poses, each band centred on its temperature and moving at its
     rate while measured, each pose's reading Eq. 1 of the truth plus `shift_g` (per band, (K, 3)) and noise."""
     rng = np.random.default_rng(seed)
@@ -44,12 +46,12 @@ def ramp_poses(centres_c: list[float], rates_c_per_min: list[float], approach: l
     readings = distort(reference, parameters) + np.repeat(shift_g, POSES_PER_BAND, axis=0)
     readings += rng.normal(0.0, NOISE_G, readings.shape)
     n = len(temperature_c)
-    return DutPoses("ADX355-A002", 2.0, 3.9e-6, np.concatenate(label), np.concatenate(t), temperature_c, readings,
+    return accel_poses("ADX355-A002", 2.0, 3.9e-6, np.concatenate(label), np.concatenate(t), temperature_c, readings,
                     np.full((n, 3), NOISE_G), reference, 0.0, parameters, np.zeros(n, dtype=bool),
                     truth_gravity_g=reference, approach=np.concatenate(side), rate_c_per_min=np.concatenate(rate))
 
 
-def bidirectional(h_g: np.ndarray, c_g: np.ndarray, seed: int) -> DutPoses:
+def bidirectional(h_g: np.ndarray, c_g: np.ndarray, seed: int) -> VectorPoses:
     """Down 55 → −35 at −2 °C/min, a band at rest at −40, up −30 → 50 at +2 °C/min: ±h by direction, c × rate."""
     down, up = [55.0 - 10 * k for k in range(10)], [-30.0 + 10 * k for k in range(9)]
     centres = down + [-40.0] + up
@@ -61,14 +63,14 @@ def bidirectional(h_g: np.ndarray, c_g: np.ndarray, seed: int) -> DutPoses:
 
 def test_a_joint_fits_hysteresis_and_rate_terms_are_no_scatter_and_its_hysteresis_is_a_source() -> None:
     h_g, c_g = np.array([0.05e-3, -0.08e-3, 0.03e-3]), np.array([0.1e-3, -0.05e-3, 0.08e-3])
-    result = fit_dut(bidirectional(h_g, c_g, seed=2), FitOptions(temperature_model="joint", hysteresis="on"))
-    budget = result.metrics["uncertainty_budget"]
+    result = fit_accelerometer(bidirectional(h_g, c_g, seed=2), FitOptions(temperature_model="joint", hysteresis="on"))
+    budget = result.figures["uncertainty_budget"]
     # What the fit took off the readings is not left in its residuals: they are the noise's alone.
     assert budget["sources_mg"]["scatter_beyond_noise"] == [0.0, 0.0, 0.0]
     assert max(budget["sources_mg"]["thermal_model"]) < 0.005
     # A reading at rest lies on one branch, ±h from the calibration: ĥ, and what is not known of it, u(ĥ),
     # which is what ĥ misses h by.
-    found = np.abs(result.metrics["hysteresis_mg"]) / 2
+    found = np.abs(result.figures["hysteresis_mg"]) / 2
     hysteresis = np.array(budget["sources_mg"]["hysteresis"])
     u_found = np.sqrt(hysteresis**2 - found**2)
     assert np.all(hysteresis > found) and np.all(u_found < 0.2 * np.abs(h_g) * 1e3)
@@ -79,8 +81,8 @@ def test_a_joint_fits_hysteresis_and_rate_terms_are_no_scatter_and_its_hysteresi
 
 def test_a_fit_that_cannot_measure_the_hysteresis_or_the_rate_says_so_and_states_no_zero() -> None:
     h_g, c_g = np.array([0.05e-3, -0.08e-3, 0.03e-3]), np.array([0.1e-3, -0.05e-3, 0.08e-3])
-    result = fit_dut(bidirectional(h_g, c_g, seed=3), FitOptions(temperature_model="joint", hysteresis="off"))
-    budget = result.metrics["uncertainty_budget"]
+    result = fit_accelerometer(bidirectional(h_g, c_g, seed=3), FitOptions(temperature_model="joint", hysteresis="off"))
+    budget = result.figures["uncertainty_budget"]
     assert "hysteresis" not in budget["sources_mg"]
     assert set(budget["not_included"]) == {"hysteresis", "rate_of_change"}
     assert "2.00 °C/min" in budget["not_included"]["rate_of_change"]
@@ -98,9 +100,9 @@ def test_a_one_way_ramps_misfit_at_its_soaked_ends_is_stated_there_and_covers_a_
     rates = [0.0] + [0.5] * 18 + [0.0]
     c_g = np.array([0.1e-3, -0.12e-3, 0.08e-3])
     poses = ramp_poses(centres, rates, [1.0] * len(centres), np.array(rates)[:, None] * c_g, seed=5)
-    result = fit_dut(poses, FitOptions(temperature_model="joint"))
+    result = fit_accelerometer(poses, FitOptions(temperature_model="joint"))
     rows = {round(r["temperature_c"]): r["sources_mg"]["thermal_model"]
-            for r in result.metrics["uncertainty_budget"]["by_temperature"]}
+            for r in result.figures["uncertainty_budget"]["by_temperature"]}
     assert max(rows[-40]) > 0.01 and max(rows[60]) > 0.01        # mg: where the model misses …
     assert max(rows[10]) < 0.5 * max(rows[-40])                     # … not spread over the range
     # A new reading at rest at each end, against the truth: inside the expanded uncertainty.
@@ -113,7 +115,7 @@ def test_a_one_way_ramps_misfit_at_its_soaked_ends_is_stated_there_and_covers_a_
         reading += rng.normal(0.0, NOISE_G, reading.shape)
         at = np.full(len(directions), end)
         groups = [np.flatnonzero(poses.setpoint_c == s) for s in dict.fromkeys(poses.setpoint_c.tolist())]
-        covariance = calibration_covariance(poses, groups, result.fits, result.thermal, result.temperatures_c,
+        covariance = calibration_covariance(poses, groups, result.detail.fits, result.thermal, result.detail.temperatures_c,
                                             poses.temperature_c, "reference", True)
         u = combined(output_uncertainty(reading, at, result.thermal, covariance, np.full(reading.shape, NOISE_G),
                                         np.zeros(len(at)), 0.0))

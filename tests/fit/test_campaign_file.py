@@ -25,8 +25,8 @@ def test_recorded_options_with_an_override(paper_campaign: Path, tmp_path: Path)
     before = campaign.read_bytes()
     outcome = fit_campaign_file(campaign, tmp_path / "cal.yaml", degree=2, mode=None)
     calibration = load_calibration(tmp_path / "cal.yaml")
-    assert all(s.polynomial.degree == 2 for s in calibration.sensors.values())  # the campaign records 3
-    assert set(outcome.report) == set(calibration.sensors) and outcome.warnings == []
+    assert all(s.polynomial.degree == 2 for s in calibration.of_quantity("acceleration").values())  # the campaign records 3
+    assert set(outcome.report) == set(calibration.of_quantity("acceleration")) and outcome.warnings == []
     assert campaign.read_bytes() == before  # only read
 
 

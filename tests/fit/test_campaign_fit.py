@@ -17,8 +17,9 @@ from accelcal_rig.store.read import load_campaign, read_hdf5_campaign
 @pytest.fixture(scope="module")
 def reports(paper_campaign: Path) -> dict[str, dict]:
     campaign = load_campaign(paper_campaign)
-    return {mode: fit_campaign(campaign, FitOptions(mode=mode), {"campaign": "x"})[1]
-            for mode in ("reference", "norm-only")}
+    """Per fit mode, each DUT's accelerometer figures (`rig fit --json`'s `channels.accel`)."""
+    fitted = {mode: fit_campaign(campaign, FitOptions(mode=mode), {"campaign": "x"})[1] for mode in ("reference", "norm-only")}
+    return {mode: {serial: dut["channels"]["accel"] for serial, dut in report.items()} for mode, report in fitted.items()}
 
 
 @pytest.mark.parametrize("mode", ["reference", "norm-only"])

@@ -78,7 +78,7 @@ def test_the_fit_calibrates_the_accelerometer_and_names_the_gyroscope_with_why(w
         assert report[serial]["not_calibrated"] == dut.not_calibrated
     assert summary_line(report, tmp_path / "cal.yaml").endswith("not calibrated (measured and stored): gyro")
     with pytest.raises(KeyError, match="no calibration of its gyro channel"):
-        calibration.gyroscope("ADX355-A001")
+        calibration.channel("ADX355-A001", "gyro")
 
 
 @pytest.mark.parametrize("format_name", ["json", "csv", "c-header", "px4-params"])

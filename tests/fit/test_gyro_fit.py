@@ -13,20 +13,29 @@ import yaml
 
 from accelcal_rig.analysis.campaign_poses import poses_at_setpoint
 from accelcal_rig.assembly import run_campaign
-from accelcal_rig.config.acceptance import Acceptance, GyroAcceptance
+from accelcal_rig.config.acceptance import Acceptance
 from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.fit.calibration import apply_gyro, load_calibration
+from accelcal_rig.fit.acceleration import accelerometer_poses
+from accelcal_rig.fit.acceptance import judge
+from accelcal_rig.fit.angular_rate import MODEL as GYRO_MODEL
+from accelcal_rig.fit.angular_rate import specific_force_g
+from accelcal_rig.fit.calibration import apply, load_calibration
 from accelcal_rig.fit.campaign_fit import FitOptions, fit_and_save
-from accelcal_rig.fit.gyro_acceptance import judge_gyro
-from accelcal_rig.fit.gyro_fit import fit_gyro, read_gyro_records, site_of
+from accelcal_rig.fit.gyro_fit import GyroRecords, fit_gyro, read_gyro_records, site_of
 from accelcal_rig.handheld.recording import read_campaign_recording
 from accelcal_rig.plan.steps import RateStep, StopRotation, VerifyRate
 from accelcal_rig.sim.devices import build_simulated_rig
-from accelcal_rig.store.read import load_campaign, read_dut_poses
+from accelcal_rig.store.content import Campaign
+from accelcal_rig.store.read import load_campaign
 from tests.conftest import REPO
 
 RIG = REPO / "configs" / "sim-imu.yaml"
+
+
+def gyro_records(campaign: Campaign, serial: str) -> GyroRecords:
+    """The DUT's gyroscope records, the specific force beside them, as its channel model reads them."""
+    return read_gyro_records(campaign, serial, "gyro", specific_force_g(campaign, serial))
 PROCEDURE = {
     "name": "imu-small", "rig": str(RIG), "setpoints_c": [0, 20, 40],
     "soak": {"criterion": "settling", "min_dwell_min": 10, "window_min": 10, "poll_s": 60},
@@ -85,7 +94,7 @@ def test_the_accelerometer_fit_sees_only_the_poses_taken_at_rest(campaign_path: 
     campaign = load_campaign(campaign_path)
     kinds = set(campaign.header.plan.kind)
     assert {"rate", "verify-rate", "noise"} <= kinds                            # stored as written, whole
-    poses = read_dut_poses(campaign, campaign.serials[0])
+    poses = accelerometer_poses(campaign, campaign.serials[0])
     assert len(poses.setpoint_c) == 3 * 24 + 2 * 6
 
 
@@ -100,7 +109,7 @@ def test_the_analyses_and_hand_held_readers_take_the_poses_at_rest_only(campaign
 
 def test_every_gyroscope_reference_holds_the_table_and_the_earth(campaign_path: Path) -> None:
     campaign = load_campaign(campaign_path)
-    records = read_gyro_records(campaign, campaign.serials[0])
+    records = gyro_records(campaign, campaign.serials[0])
     at_rest = records.rows("pose")
     earth = np.linalg.norm(records.reference_dps[at_rest], axis=1)
     assert earth == pytest.approx(np.degrees(7.292115e-5), rel=1e-6)   # latitude and heading given: all of it
@@ -110,12 +119,12 @@ def test_every_gyroscope_reference_holds_the_table_and_the_earth(campaign_path: 
 
 def test_the_fit_recovers_the_hidden_gyroscope_within_its_uncertainty(fitted: tuple[Path, dict]) -> None:
     _, report = fitted
-    z = np.array([t["z"] for r in report.values() for t in r["gyro"]["truth_error"]])
+    z = np.array([t["z"] for r in report.values() for t in r["channels"]["gyro"]["truth_error"]])
     assert len(z) == 4 * 3 * 27
     assert np.max(np.abs(z)) < 4.5                      # 324 values: 4.5σ is one in 3 × 10⁵ for each
     assert 0.6 < np.std(z) < 1.5                        # the quoted σ is the scatter, neither much more nor less
     for serial, dut in report.items():
-        gyro = dut["gyro"]
+        gyro = dut["channels"]["gyro"]
         assert gyro["rmse_after_dps"] < gyro["rmse_before_dps"] / 100, serial
         assert "latitude 48.14" in gyro["earth_rate"] and "heading 30" in gyro["earth_rate"]
 
@@ -125,14 +134,14 @@ def test_rates_the_fit_never_saw_are_compensated(fitted: tuple[Path, dict], camp
     calibration = load_calibration(path)
     campaign = load_campaign(campaign_path)
     for serial in campaign.serials:
-        verification = report[serial]["gyro"]["verification"]
+        verification = report[serial]["channels"]["gyro"]["verification"]
         assert verification["rate_steps"] == 24
         assert verification["rmse_dps"] < verification["rmse_before_dps"] / 50
         # Compensated with the calibration file, as firmware would: the same figure.
-        records = read_gyro_records(campaign, serial)
+        records = gyro_records(campaign, serial)
         rows = records.rows("verify-rate")
-        rate = apply_gyro(calibration.gyroscope(serial), records.mean_dps[rows], records.force_g[rows],
-                          records.temperature_c[rows])
+        rate = apply(calibration.channel(serial, "gyro"), records.mean_dps[rows], records.temperature_c[rows],
+                     {"acceleration": records.force_g[rows]})
         rms = float(np.sqrt(np.mean((rate - records.reference_dps[rows]) ** 2)))
         assert rms == pytest.approx(verification["rmse_dps"], rel=1e-6)
         assert calibration.duts[serial].not_calibrated == {}
@@ -146,7 +155,7 @@ def test_the_noise_record_gives_each_axis_its_random_walk(fitted: tuple[Path, di
     campaign = load_campaign(campaign_path)
     bounds: list[float] = []
     for serial, dut in report.items():
-        allan = dut["gyro"]["allan"]
+        allan = dut["channels"]["gyro"]["allan"]
         truth = campaign.header.truth[serial]
         sigma, lsb = float(truth["gyro_noise_dps_per_sample"]), campaign.channel_info(serial, "gyro").lsb
         low, high = sigma / 10.0 * 60.0, np.sqrt(sigma**2 + lsb**2 / 4) / 10.0 * 60.0
@@ -154,7 +163,7 @@ def test_the_noise_record_gives_each_axis_its_random_walk(fitted: tuple[Path, di
             assert axis["low"] < axis["value"] < axis["high"]
             assert 0.9 * low < axis["value"] < 1.1 * high
         assert allan["samples"] == 2000 and allan["gaps_share"] < 0.05 and allan["setpoint_c"] == 20
-        assert len(allan["by_setpoint"]) == 3 and "vrw_m_s_per_rthr" in dut["allan"]
+        assert len(allan["by_setpoint"]) == 3 and "vrw_m_s_per_rthr" in dut["channels"]["accel"]["allan"]
         for axis in allan["bias_instability_dph"]:   # a value with its interval, or 0 and an upper bound
             assert 0 <= axis["low"] <= axis["value"] <= axis["high"] and axis["high"] > 0
         bounds.extend(max(a["value"], a["high"]) for a in allan["bias_instability_dph"])
@@ -199,19 +208,19 @@ def test_each_gyroscope_is_judged_against_its_limits(fitted: tuple[Path, dict], 
     path, report = fitted
     calibration = load_calibration(path)
     for serial, dut in report.items():
-        assert dut["gyro"]["verdict"] == "PASS" == calibration.gyroscope(serial).verdict
+        assert dut["channels"]["gyro"]["verdict"] == "PASS" == calibration.channel(serial, "gyro").verdict
         assert any("verification rate RMS error" in r and "limit ≤ 0.5 °/s: pass" in r
-                   for r in dut["gyro"]["verdict_reasons"])
+                   for r in dut["channels"]["gyro"]["verdict_reasons"])
     # The same figures against limits they cannot meet: FAIL, each reason naming its figure.
     campaign = load_campaign(campaign_path)
     serial = campaign.serials[0]
-    fit = fit_gyro(read_gyro_records(campaign, serial), 1, "clamp", site_of(campaign))
-    assert fit.metrics["verification"]["rmse_dps"] == report[serial]["gyro"]["verification"]["rmse_dps"]
-    tight = GyroAcceptance.model_validate({"max_verification_rmse_dps": 1e-6, "max_scale_error_ppm": 1e-3,
-                                           "parameters": {"at_c": 20, "gsens_dps_per_g": 1e-6}})
-    judged = judge_gyro(fit.metrics, fit.thermal, Acceptance(gyro=tight), parameter_u=fit.parameter_u)
+    fit = fit_gyro(gyro_records(campaign, serial), 1, "clamp", site_of(campaign))
+    assert fit.figures["verification"]["rmse_dps"] == report[serial]["channels"]["gyro"]["verification"]["rmse_dps"]
+    tight = Acceptance.model_validate({"gyro": {"max_verification_rmse_dps": 1e-6, "max_scale_error_ppm": 1e-3,
+                                                "parameters": {"at_c": 20, "gsens_dps_per_g": 1e-6}}})
+    judged = judge(GYRO_MODEL, "gyro", fit, tight)
     assert judged.verdict == "FAIL" and len(judged.reasons) == 3
-    assert any(r.startswith("gyro g-sensitivity") and "limit ±1e-06 °/s/g: fail" in r for r in judged.reasons)
+    assert any(r.startswith("g-sensitivity") and "limit ±1e-06 °/s/g: fail" in r for r in judged.reasons)
     # Each figure judged carries its own expanded uncertainty: the verification's from the table's rate
     # accuracy and the noise, each parameter's from the fit through its polynomial.
     assert all(c.expanded_u is not None and c.expanded_u > 0 for c in judged.checks)
@@ -225,19 +234,19 @@ def test_the_budget_covers_the_truth_as_its_coverage_factor_says(fitted: tuple[P
     (144 per DUT here, so a DUT's share scatters: the bench measures it over many seeds); the budget names its
     sources and grows with the rate."""
     _, report = fitted
-    shares = [dut["gyro"]["truth_coverage_k2"] for dut in report.values()]
+    shares = [dut["channels"]["gyro"]["truth_coverage_k2"] for dut in report.values()]
     assert 0.85 <= float(np.mean(shares)) <= 1.0 and min(shares) >= 0.75
     for dut in report.values():
-        budget = dut["gyro"]["uncertainty_budget"]
+        budget = dut["channels"]["gyro"]["uncertainty_budget"]
         assert set(budget["at_largest_rate"]["sources_dps"]) == {"fit", "thermal model", "temperature", "table rate",
                                                                  "table pointing", "earth rate", "bias instability"}
         # The noise record's bias instability (or its upper bound) is how far a bias wanders: at rest, in the budget.
-        assert budget["at_rest"]["sources_dps"]["bias instability"] == pytest.approx(dut["gyro"]["bias_instability_1sigma_dps"])
-        assert min(dut["gyro"]["bias_instability_1sigma_dps"]) > 0
+        assert budget["at_rest"]["sources_dps"]["bias instability"] == pytest.approx(dut["channels"]["gyro"]["bias_instability_1sigma_dps"])
+        assert min(dut["channels"]["gyro"]["bias_instability_1sigma_dps"]) > 0
         assert budget["largest_rate_dps"] == 1000
         assert all(turning > resting for turning, resting in zip(budget["at_largest_rate"]["expanded_dps"],
                                                                  budget["at_rest"]["expanded_dps"]))
-        assert dut["gyro"]["expanded_uncertainty_dps"] == budget["at_largest_rate"]["expanded_dps"]
+        assert dut["channels"]["gyro"]["expanded_uncertainty_dps"] == budget["at_largest_rate"]["expanded_dps"]
         assert budget["at_largest_rate"]["sources_dps"]["earth rate"] == [0.0, 0.0, 0.0]   # placed: taken out
 
 

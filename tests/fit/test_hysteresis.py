@@ -68,11 +68,11 @@ def test_poses_approached_one_way_only_fit_no_hysteresis_term() -> None:
     to an arbitrary split (a campaign stopped before its way back)."""
     from dataclasses import replace
 
-    from accelcal_rig.fit.campaign_fit import _both_ways
-    from accelcal_rig.store.read import DutPoses
+    from accelcal_rig.fit.vector_model import _both_ways
+    from tests.fit.vector_poses import accel_poses
 
     n = 30
-    base = DutPoses("X", 2.0, 1e-6, np.zeros(n), np.arange(n, dtype=float), np.linspace(-40, 60, n),
+    base = accel_poses("X", 2.0, 1e-6, np.zeros(n), np.arange(n, dtype=float), np.linspace(-40, 60, n),
                     np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3)), 3.0, None, np.zeros(n, dtype=bool))
     assert _both_ways(replace(base, approach=-np.ones(n))) is None
     split = np.where(np.arange(n) < n // 2, -1.0, 1.0)  # cooling over −40…10, warming over 10…60: no overlap

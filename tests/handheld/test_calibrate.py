@@ -56,7 +56,7 @@ def test_the_calibration_file_applies_like_a_campaigns(tmp_path: Path) -> None:
     write_csv(simulated, tmp_path / "s.csv")
     _, result = calibrate_csv(tmp_path / "s.csv", CsvLayout.parse_columns("time_s,ax,ay,az,temp_c"))
     save_calibration(result.calibration, tmp_path / "cal.yaml")
-    sensor = load_calibration(tmp_path / "cal.yaml").sensor("HH-7")
+    sensor = load_calibration(tmp_path / "cal.yaml").channel("HH-7", "accel")
     still = simulated.raw_g[simulated.still]
     compensated = apply(sensor, still, 25.0)
     assert np.sqrt(np.mean((np.linalg.norm(compensated, axis=1) - 1.0) ** 2)) < 0.3e-3  # per-sample noise ~0.2 mg
@@ -147,8 +147,8 @@ def test_codes_without_counts_per_g_give_the_same_calibrated_output(tmp_path: Pa
     guessed, without = calibrate_csv(tmp_path / "codes.csv", CsvLayout.parse_columns(columns, units="counts"))
     assert guessed.lsb_g != known.lsb_g and any("--counts-per-g not given" in n for n in guessed.notes)
     codes = np.rint(simulated.raw_g[simulated.still][:50] * 256000.0)
-    a = apply(with_scale.calibration.sensor("HH-7"), codes * known.lsb_g, 25.0)
-    b = apply(without.calibration.sensor("HH-7"), codes * guessed.lsb_g, 25.0)
+    a = apply(with_scale.calibration.channel("HH-7", "accel"), codes * known.lsb_g, 25.0)
+    b = apply(without.calibration.channel("HH-7", "accel"), codes * guessed.lsb_g, 25.0)
     np.testing.assert_allclose(a, b, atol=2e-6)  # the fitted scale absorbs the provisional one
 
 

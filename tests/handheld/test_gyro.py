@@ -146,7 +146,7 @@ def test_the_command_reports_the_gyro_and_keeps_the_calibration_file(tmp_path: P
     # The calibration file holds the gyroscope as its DUT's gyro channel: bias and K as fitted, the rest of the
     # rate-table model nominal and said to be undetermined; compensating with it is what the fit does.
     assert "gyro" not in without
-    calibration = load_calibration(tmp_path / "cal.yaml").gyroscope("s")   # the recording names the sensor
+    calibration = load_calibration(tmp_path / "cal.yaml").channel("s", "gyro")   # the recording names the sensor
     assert calibration.mode == "hand-held" and len(calibration.free_parameters) == 12
     raw = TRUE_MATRIX @ np.array([[10.0, -20.0, 30.0], [-200.0, 5.0, 90.0]]).T + TRUE_BIAS_DPS[:, None]
     expected = (raw.T - np.array(gyro["bias_dps"])) @ np.linalg.inv(np.array(gyro["matrix"])).T

@@ -10,12 +10,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sqlalchemy as sa
+from accelcal_rig.registry.figures import noise_figures
 
 from accelcal_rig.cli import main
 from accelcal_rig.fit.calibration import load_calibration
 from accelcal_rig.registry.database import Registry, head_revision
 from accelcal_rig.registry.entries import campaign_entries
-from accelcal_rig.registry.figures import noise_figures
 from tests.report.imu_campaign import copied
 
 _ADDED_BY_0004 = ("bias_dps", "bias_uncertainty_dps", "expanded_uncertainty_dps", "verification_rmse_dps",
@@ -35,9 +35,9 @@ def test_an_imu_is_recorded_as_a_row_per_channel_once(registry_url: str, imu: tu
     assert registry.add(campaign_entries(campaign, calibration_path)) == ([], 8)   # idempotent
     calibration = load_calibration(calibration_path)
     gyros = registry.calibrations(channel="gyro")
-    assert sorted(r["serial"] for r in gyros) == sorted(calibration.gyroscopes) and len(registry.calibrations()) == 8
+    assert sorted(r["serial"] for r in gyros) == sorted(calibration.of_quantity("angular rate")) and len(registry.calibrations()) == 8
     for row in gyros:
-        gyro = calibration.gyroscope(row["serial"])
+        gyro = calibration.channel(row["serial"], "gyro")
         assert row["verdict"] == gyro.verdict and row["bias_mg"] is None and row["verification_rmse_mg"] is None
         assert row["verification_rmse_dps"] == pytest.approx(gyro.metrics["verification"]["rmse_dps"])
         assert row["expanded_uncertainty_dps"] == pytest.approx(gyro.metrics["expanded_uncertainty_dps"])
@@ -46,7 +46,7 @@ def test_an_imu_is_recorded_as_a_row_per_channel_once(registry_url: str, imu: tu
         assert row["arw_deg_per_rthr"] == pytest.approx([e["value"] for e in gyro.metrics["allan"]["arw_deg_per_rthr"]])
         assert row["bias_instability_dph"] is not None and row["vrw_m_s_per_rthr"] is None
     for row in registry.calibrations(channel="accel"):
-        sensor = calibration.sensor(row["serial"])
+        sensor = calibration.channel(row["serial"], "accel")
         assert row["bias_dps"] is None and row["verification_rmse_mg"] == pytest.approx(sensor.metrics["verification"]["rmse_mg"])
         assert row["vrw_m_s_per_rthr"] == pytest.approx([e["value"] for e in sensor.metrics["allan"]["vrw_m_s_per_rthr"]])
     valid = registry.current("IMU-A001", simulated=True, channel="gyro")
@@ -68,7 +68,7 @@ def test_list_show_trend_stats_by_channel(imu: tuple[Path, Path], tmp_path: Path
     assert "channel" in table[0] and sum(" gyro " in line for line in table) == 4 and sum(" accel " in line for line in table) == 4
     assert main(["registry", "show", "IMU-A001", "--simulated", "--registry", registry]) == 0
     shown = capsys.readouterr().out
-    gyro = load_calibration(calibration).gyroscope("IMU-A001")
+    gyro = load_calibration(calibration).channel("IMU-A001", "gyro")
     assert shown.startswith("IMU-A001 accel (") and "valid calibration" in shown.splitlines()[0]
     assert "IMU-A001 gyro (" in shown and f"verification RMS error {gyro.metrics['verification']['rmse_dps']:.4f} °/s" in shown
     assert "ARW " in shown and "history (2):" in shown

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import pytest
 import sqlalchemy as sa
+from accelcal_rig.registry.figures import reference_figures
 
 from accelcal_rig.registry.database import Registry, head_revision
 from accelcal_rig.registry.entries import campaign_entries
-from accelcal_rig.registry.figures import reference_figures
 from tests.registry.conftest import synthetic_entries
 
 _ADDED_BY_0004 = ("bias_dps", "bias_uncertainty_dps", "expanded_uncertainty_dps", "verification_rmse_dps",

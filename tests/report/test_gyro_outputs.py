@@ -36,10 +36,10 @@ def test_an_imu_certificate_states_its_gyroscope_as_its_calibration_holds_it(imu
     campaign, calibration_path = imu
     calibration = load_calibration(calibration_path)
     written, _ = write_certificates(campaign, calibration_path, tmp_path / "certs", pdf=False)
-    assert [w.serial for w in written] == list(calibration.gyroscopes) and len(written) == 4
+    assert [w.serial for w in written] == list(calibration.of_quantity("angular rate")) and len(written) == 4
     for w in written:
         page = w.html.read_text(encoding="utf-8")
-        gyro = calibration.gyroscope(w.serial)
+        gyro = calibration.channel(w.serial, "gyro")
         v, budget = gyro.metrics["verification"], gyro.metrics["uncertainty_budget"]
         assert "NOT CALIBRATED" not in page and "MEMS IMU: accelerometer and gyroscope" in page
         assert (f"<td class='text'>{v['rmse_dps']:.4f} ± {v['expanded_u']['rmse_dps']:.4f} °/s (before calibration "
@@ -55,7 +55,7 @@ def test_an_imu_certificate_states_its_gyroscope_as_its_calibration_holds_it(imu
         bias_x = gyro.parameters_at(25.0)[0]
         assert f"{bias_x:+.4f} ± " in page  # the bias at the reference temperature with its expanded uncertainty
         arw = gyro.metrics["allan"]["arw_deg_per_rthr"][0]["value"]
-        vrw = calibration.sensor(w.serial).metrics["allan"]["vrw_m_s_per_rthr"][0]["value"]
+        vrw = calibration.channel(w.serial, "accel").metrics["allan"]["vrw_m_s_per_rthr"][0]["value"]
         assert f"{arw:.4f} [" in page and f"{vrw:.5f} [" in page and "angle random walk" in page
         assert page.count("class='verdict PASS'") == 1 and "Gyroscope: <b class='PASS'>PASS</b>" in page
 
@@ -114,7 +114,7 @@ def test_the_report_has_the_gyroscope_section_and_figures(imu: tuple[Path, Path]
         assert f"<h2>{heading}</h2>" in text
     assert "Not calibrated:" not in text and "the calibration file beside the campaign (imu.calibration.yaml)" in text
     section = text.split("<h2>Gyroscope calibration</h2>")[1].split("<h2>")[0]
-    for serial, gyro in calibration.gyroscopes.items():
+    for serial, gyro in calibration.of_quantity("angular rate").items():
         row = re.search(rf"<tr[^>]*><td class=\"text\">{serial}</td><td class=\"text\">(PASS|FAIL)</td>.*?</tr>", section)
         assert row is not None and row.group(1) == gyro.verdict
         assert f"<td>{gyro.metrics['verification']['rmse_dps']:.4f}</td>" in row.group(0)
@@ -138,5 +138,5 @@ def test_without_a_calibration_beside_it_the_report_fits_the_gyroscope_itself(im
     shutil.copy(journal_path(campaign), journal_path(alone))
     text = write_report(alone, tmp_path / "report").read_text(encoding="utf-8")
     assert "fitted from the campaign for this report" in text and "<h2>Gyroscope calibration</h2>" in text
-    expected = load_calibration(calibration).gyroscope("IMU-A001").metrics["verification"]["rmse_dps"]
+    expected = load_calibration(calibration).channel("IMU-A001", "gyro").metrics["verification"]["rmse_dps"]
     assert f"<td>{expected:.4f}</td>" in text  # the same fit as rig fit's
