@@ -206,8 +206,8 @@ def test_a_trend_of_fits_without_stated_uncertainty_is_printed_not_a_crash(tmp_p
     later = recording_entries(recording, load_calibration(tmp_path / "hand.yaml"), "unknown")[0]
     from datetime import timedelta
 
-    Registry.open(registry).add([later | {"fit_sha256": "f" * 64, "calibrated_at": first["calibrated_at"]
-                                          + timedelta(days=100), "bias_mg": [b + 1.0 for b in first["bias_mg"]]}])
+    Registry.open(registry).add([shifted(later, 1.0) | {"fit_sha256": "f" * 64, "calibrated_at": first["calibrated_at"]
+                                                        + timedelta(days=100)}])
     capsys.readouterr()
     serial = first["serial"]
     assert rig("registry", "trend", serial, "--registry", registry) == 0
@@ -226,15 +226,14 @@ def test_a_trend_of_calibrations_minutes_apart_states_no_drift(tmp_path: Path, q
 
     registry = normalised(str(tmp_path / "lab.sqlite"))
     first = campaign_entries(*quick_campaign)[0] | {"simulated": False}
-    later = first | {"fit_sha256": "e" * 64, "calibrated_at": first["calibrated_at"] + timedelta(minutes=12),
-                     "bias_mg": [b + 0.5 for b in first["bias_mg"]]}
+    later = shifted(first, 0.5) | {"fit_sha256": "e" * 64, "calibrated_at": first["calibrated_at"] + timedelta(minutes=12)}
     Registry.open(registry).add([first, later])
     assert rig("registry", "trend", first["serial"], "--registry", registry) == 0
     out = capsys.readouterr().out.splitlines()
     assert len(out) == 4 and out[-1] == ("  drift per year: not stated: the calibrations span 12 minutes, under the "
                                          "30 days a drift per year needs (--min-span-days sets it)")
     assert rig("registry", "trend", first["serial"], "--min-span-days", "0.001", "--json", "--registry", registry) == 0
-    drift = json.loads(capsys.readouterr().out)["channels"]["accel"]["bias_drift_mg_per_year"]
+    drift = json.loads(capsys.readouterr().out)["channels"]["accel"]["drift_per_year"]["bias"]["axes"]
     minutes_per_year = 365.25 * 1440
     assert drift[0]["per_year"] == pytest.approx(0.5 * minutes_per_year / 12)
 
@@ -249,3 +248,9 @@ def test_a_hand_held_fit_of_a_dry_runs_campaign_is_a_dry_run_too(tmp_path: Path,
     rows = Registry.open(normalised(str(tmp_path / "dry-runs.sqlite"))).calibrations()
     assert [(r["source_kind"], r["simulated"]) for r in rows] == [("recording", True)]
     assert not (tmp_path / "lab.sqlite").exists()
+
+
+def shifted(entry: dict, by: float) -> dict:
+    """A registry entry whose bias figure is `by` more on every axis (a later calibration of the same sensor)."""
+    figures = [f | {"value": [v + by for v in f["value"]]} if f["name"] == "bias" else f for f in entry["figures"]]
+    return entry | {"figures": figures}

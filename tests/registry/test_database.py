@@ -12,12 +12,12 @@ from datetime import datetime, timedelta
 from pathlib import Path
 
 import pytest
-from accelcal_rig.registry.figures import reference_figures
 
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import load_calibration
 from accelcal_rig.registry.database import Registry, head_revision
 from accelcal_rig.registry.entries import calibration_file_of, campaign_entries
+from accelcal_rig.registry.migrations.frozen_figures import reference_figures
 
 
 def test_first_use_creates_the_schema_at_its_current_version(registry_url: str) -> None:
@@ -40,7 +40,7 @@ def test_a_campaign_is_recorded_once_per_dut_however_often_it_is_added(registry_
     row = registry.calibration(added[0])
     assert row["part"] == "adxl355" and row["simulated"] and row["procedure"] == "quick-6pos"
     assert row["source_path"] == str(campaign.resolve()) and len(row["source_sha256"]) == 64
-    assert row["bias_mg"] == pytest.approx(reference_figures(row["calibration"])["bias_mg"])
+    assert row["figures"]["bias"]["value"] == pytest.approx(reference_figures(row["calibration"])["bias_mg"])
     # What is stored is the whole fit: it makes the calibration file again, equal to the one fitted.
     again = calibration_file_of([row]).of_quantity("acceleration")[row["serial"]]
     assert again == load_calibration(calibration).of_quantity("acceleration")[row["serial"]]

@@ -1,21 +1,33 @@
 """A lab upgrades without losing records: a database made by the first schema version, with calibrations
-in it, is brought to the current one, and the figures the new version adds are filled from each stored fit."""
+in it, is brought to the current one, and the figures the later versions add are filled from each stored fit
+(migrations 0002 and 0004, as they computed them) and moved with their units (0008)."""
 
 from __future__ import annotations
 
 import pytest
 import sqlalchemy as sa
-from accelcal_rig.registry.figures import reference_figures
 
 from accelcal_rig.registry.database import Registry, head_revision
 from accelcal_rig.registry.entries import campaign_entries
+from accelcal_rig.registry.migrations.frozen_figures import reference_figures
 from tests.registry.conftest import synthetic_entries
 
-_ADDED_BY_0004 = ("bias_dps", "bias_uncertainty_dps", "expanded_uncertainty_dps", "verification_rmse_dps",
-                  "arw_deg_per_rthr", "bias_instability_dph", "vrw_m_s_per_rthr", "bias_instability_ug")
-_ADDED_BY_0003 = ("channel",)
-_ADDED_BY_0002 = ("fitted_at", "reference_c", "bias_mg", "bias_uncertainty_mg", "scale_error_ppm", "scale_uncertainty_ppm",
-                  "nonorthogonality_mrad")
+
+def of_schema(entries: list[dict], table: sa.Table) -> list[dict]:
+    """Today's entries as a registry of an earlier schema held them: its columns only, the figures it had
+    columns for in them (migration 0008 moved them out)."""
+    from tests.registry.test_figures_migration import COLUMNS
+
+    columns = {c.name for c in table.columns}
+    rows = []
+    for entry in entries:
+        row = {k: v for k, v in entry.items() if k in columns}
+        for figure in entry["figures"]:
+            column, uncertainty = COLUMNS[(figure["name"], figure["unit"])]
+            value = figure["value"] if figure["axes"] else figure["value"][0]
+            row.update({column: value, **({uncertainty: figure["expanded_u"]} if uncertainty else {})})
+        rows.append({k: v for k, v in row.items() if k in columns})
+    return rows
 
 
 def test_a_first_version_database_upgrades_with_its_records_and_their_figures(registry_url: str, quick_campaign) -> None:
@@ -23,11 +35,10 @@ def test_a_first_version_database_upgrades_with_its_records_and_their_figures(re
     registry = Registry(_engine_of(registry_url), registry_url)
     registry.upgrade("0001")
     assert registry.revision() == "0001"
-    version_1 = [{k: v for k, v in e.items() if k not in _ADDED_BY_0002 + _ADDED_BY_0003 + _ADDED_BY_0004}
-                 for e in [*campaign_entries(campaign, calibration),
-                           *synthetic_entries(campaign_entries(campaign, calibration)[0], 3)]]
     table = sa.Table("calibrations", sa.MetaData(), autoload_with=registry.engine)
-    assert not set(_ADDED_BY_0002) & {c.name for c in table.columns}  # the first schema has none of them
+    version_1 = of_schema([*campaign_entries(campaign, calibration),
+                           *synthetic_entries(campaign_entries(campaign, calibration)[0], 3)], table)
+    assert not {"fitted_at", "reference_c", "bias_mg"} & {c.name for c in table.columns}  # the first schema has none
     with registry.engine.begin() as connection:
         connection.execute(table.insert(), version_1)
     upgraded = Registry.open(registry_url)
@@ -37,10 +48,12 @@ def test_a_first_version_database_upgrades_with_its_records_and_their_figures(re
     for listed in rows:
         row = upgraded.calibration(listed["id"])
         expected = reference_figures(row["calibration"])
+        figures = row["figures"]
         assert row["reference_c"] == expected["reference_c"]
-        assert row["bias_mg"] == pytest.approx(expected["bias_mg"])
-        assert row["scale_error_ppm"] == pytest.approx(expected["scale_error_ppm"])
-        assert row["bias_uncertainty_mg"] == pytest.approx(expected["bias_uncertainty_mg"])
+        assert figures["bias"]["value"] == pytest.approx(expected["bias_mg"]) and figures["bias"]["unit"] == "mg"
+        assert figures["scale_error"]["value"] == pytest.approx(expected["scale_error_ppm"])
+        assert figures["bias"]["expanded_u"] == pytest.approx(expected["bias_uncertainty_mg"])
+        assert figures["nonorthogonality"]["value"] == pytest.approx([expected["nonorthogonality_mrad"]])
         assert row["fitted_at"] is not None and row["fitted_at"].tzinfo is None
         assert row["channel"] == "accel"  # every calibration before channels: its DUT's accelerometer
 
@@ -50,9 +63,8 @@ def test_a_second_version_database_upgrades_and_its_calibrations_are_acceleratio
     campaign, calibration = quick_campaign
     registry = Registry(_engine_of(registry_url), registry_url)
     registry.upgrade("0002")
-    version_2 = [{k: v for k, v in e.items() if k not in _ADDED_BY_0003 + _ADDED_BY_0004}
-                 for e in campaign_entries(campaign, calibration)]
     table = sa.Table("calibrations", sa.MetaData(), autoload_with=registry.engine)
+    version_2 = of_schema(campaign_entries(campaign, calibration), table)
     assert "channel" not in {c.name for c in table.columns}
     with registry.engine.begin() as connection:
         connection.execute(table.insert(), version_2)

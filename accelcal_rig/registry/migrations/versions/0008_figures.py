@@ -17,17 +17,17 @@ depends_on = None
 
 #: Each figure column of 0002 and 0004 (and 0001's verification RMSE), its uncertainty column and what it moves
 #: to: (name, label, unit, per axis, trend, lot).
-_MOVED = {
+_MOVED = {  # in the order each channel's model states its figures: bias, scale error, then the others
     "bias_mg": ("bias_uncertainty_mg", "bias", "bias", "mg", True, True, True),
+    "bias_dps": ("bias_uncertainty_dps", "bias", "bias", "°/s", True, True, True),
     "scale_error_ppm": ("scale_uncertainty_ppm", "scale_error", "scale error", "ppm", True, True, True),
     "nonorthogonality_mrad": (None, "nonorthogonality", "non-orthogonality", "mrad", False, False, True),
-    "verification_rmse_mg": (None, "verification_rmse", "verification |g| RMSE", "mg", False, False, False),
-    "vrw_m_s_per_rthr": (None, "velocity_random_walk", "velocity random walk", "m/s/√h", True, False, False),
-    "bias_instability_ug": (None, "bias_instability", "bias instability", "µg", True, False, False),
-    "bias_dps": ("bias_uncertainty_dps", "bias", "bias", "°/s", True, True, True),
     "expanded_uncertainty_dps": (None, "expanded_uncertainty", "expanded uncertainty at the largest rate", "°/s",
                                  True, False, False),
+    "verification_rmse_mg": (None, "verification_rmse", "verification |g| RMSE", "mg", False, False, False),
     "verification_rmse_dps": (None, "verification_rmse", "verification rate RMS error", "°/s", False, False, True),
+    "vrw_m_s_per_rthr": (None, "velocity_random_walk", "velocity random walk", "m/s/√h", True, False, False),
+    "bias_instability_ug": (None, "bias_instability", "bias instability", "µg", True, False, False),
     "arw_deg_per_rthr": (None, "angle_random_walk", "angle random walk", "°/√h", True, False, True),
     "bias_instability_dph": (None, "bias_instability", "bias instability", "°/h", True, False, True),
 }
@@ -79,16 +79,14 @@ def upgrade() -> None:
                               "trend": trend, "lot": lot})
         if moved:
             connection.execute(figures.insert(), moved)
-    with op.batch_alter_table("calibrations") as table:
-        for name in columns:
-            table.drop_column(name)
+    for name in columns:  # in place (SQLite ≥ 3.35 and PostgreSQL): rebuilding the table would break the keys
+        op.execute(f"ALTER TABLE calibrations DROP COLUMN {name}")  # of the approvals and figures that name its rows
 
 
 def downgrade() -> None:
     columns = [*_MOVED, *_UNCERTAINTIES]
-    with op.batch_alter_table("calibrations") as table:
-        for name in columns:
-            table.add_column(sa.Column(name, sa.Float if name in _SCALARS else sa.JSON, nullable=True))
+    for name in columns:
+        op.add_column("calibrations", sa.Column(name, sa.Float if name in _SCALARS else sa.JSON, nullable=True))
     rows = sa.table("calibrations", sa.column("id", sa.Integer), *(sa.column(name, sa.JSON) for name in columns))
     figures = _figures_table()
     by_figure = {(name, unit): (column, uncertainty) for column, (uncertainty, name, _, unit, *_) in _MOVED.items()}
