@@ -286,6 +286,30 @@ class FaultInjection(StrictModel):
                                      "nibble (not double-buffered on a real ADXL355): off by 256 LSB, about 28 °C")
 
 
+#: nT per gauss.
+NT_PER_GAUSS = 1e5
+
+
+class SiteField(StrictModel):
+    """The Earth's magnetic field at the rig: what a magnetometer's reference is at each pose (its size, and with
+    the table's heading_deg its direction). From a survey, or a geomagnetic model for the site and date (WMM,
+    IGRF: e.g. `pip install pygeomag`, docs/instruments.md "ST LIS3MDL"); the steel of a chamber and a table
+    changes it: measure it where the fixture is."""
+
+    total_intensity_nt: Real = Field(ge=1000, le=100_000, description="its total intensity F, nT")
+    inclination_deg: Real = Field(ge=-90, le=90, description="its inclination I, degrees below the horizontal")
+    declination_deg: Real = Field(0.0, ge=-180, le=180, description="its declination D, degrees east of true north")
+    total_intensity_uncertainty_nt: Real = Field(0.0, ge=0, le=10_000, description="F's standard uncertainty, nT")
+
+    def world_gauss(self, heading_deg: float) -> np.ndarray:
+        """The field in the lab's world frame (z up, x the table's x axis at zero angles, at azimuth
+        `heading_deg` east of true north), gauss."""
+        size = self.total_intensity_nt / NT_PER_GAUSS
+        inclination, azimuth = np.radians(self.inclination_deg), np.radians(self.declination_deg - heading_deg)
+        return size * np.array([np.cos(inclination) * np.cos(azimuth), -np.cos(inclination) * np.sin(azimuth),
+                                -np.sin(inclination)])
+
+
 class SimulationConfig(StrictModel):
     """Physics of the virtual lab used by `--dry-run` (docs/procedures.md, "The simulated rig")."""
 
@@ -303,6 +327,9 @@ class SimulationConfig(StrictModel):
                                "config states none (the Earth turns in every lab)")
     heading_deg: Real = Field(30.0, ge=-360, le=360, description="the simulated table's heading where the rig "
                               "config states none")
+    magnetic_field: SiteField = Field(SiteField(total_intensity_nt=48_800.0, inclination_deg=64.4, declination_deg=4.4),
+                                      description="the simulated site's magnetic field where the rig config states "
+                                                  "none (about Munich's in 2026, WMM2025)")
     gyro_bias_instability_dph: Real = Field(0.0, ge=0, le=10_000, description="every simulated gyroscope's bias "
                                             "instability (a flicker floor of its Allan deviation over 1…1000 s), °/h")
     controller_limits_c: tuple[TemperatureC, TemperatureC] = Field(
@@ -432,6 +459,8 @@ class RigConfig(StrictModel):
     heading_deg: Real | None = Field(None, ge=-360, le=360, description="the azimuth of the table's x axis (world "
                                      "x at zero angles), degrees east of true north: with latitude_deg, the Earth's "
                                      "horizontal rate (cos(latitude) × 15.04 °/h) is part of the reference too")
+    magnetic_field: SiteField | None = Field(None, description="the site's magnetic field where the fixture is: a "
+                                             "magnetometer's reference (its direction needs heading_deg too)")
     lab: LabConfig | None = Field(None, description="the laboratory and the place of calibration its certificates "
                                   "state; unset: they say it is not stated")
     references: References = Field(References(), description="each reference's certificate, issuer and due date "

@@ -262,7 +262,7 @@ class SpidevBus:
         return cls(device, f"spidev {bus}.{chip_select}", framing)
 
     def read(self, address: int, count: int) -> bytes:
-        return bytes(self._device.xfer2([self._framing.read_command(address)] + [0] * count)[1:])
+        return bytes(self._device.xfer2([self._framing.read_command(address, count)] + [0] * count)[1:])
 
     def write(self, address: int, value: int) -> None:
         self._device.xfer2([self._framing.write_command(address), value])

@@ -1,7 +1,7 @@
 """A TDK ICM-42688-P at register level over any RegisterTransport (a serial bridge, spidev): bring-up, both
 sensors' full scale and rate, temperature, and blocks of samples read from the data registers at the output
-data rate on the injected clock — one burst per sample, TEMP_DATA1 up to INT_STATUS, whose DATA_RDY says the
-sample is new. Register facts: `instruments/icm42688.py`; the part's: `parts/icm42688.py`."""
+data rate on the injected clock (instruments/polled_block.py) — one burst per sample, TEMP_DATA1 up to
+INT_STATUS, whose DATA_RDY says the sample is new. Register facts: `instruments/icm42688.py`; the part's: `parts/icm42688.py`."""
 
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ from accelcal_rig.instruments import icm42688 as regs
 from accelcal_rig.instruments.adxl355_transport import RegisterTransport
 from accelcal_rig.instruments.capabilities import Reconnecting
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
+from accelcal_rig.instruments.polled_block import poll_block
 from accelcal_rig.instruments.retrying import RetryCall, RetryingTransport
 from accelcal_rig.parts.icm42688 import ICM42688P
 from accelcal_rig.parts.part import Part
@@ -25,12 +26,6 @@ RESET_TIMEOUT_S = 0.1
 RESET_POLL_S = 0.001
 #: After PWR_MGMT0 turns the gyroscope on, its data are not valid for this long (the Linux driver waits 60 ms).
 GYRO_STARTUP_S = 0.06
-#: A sample read later than this many sample periods after the previous one may have missed one between.
-LATE_PERIODS = 1.5
-#: Reads of a sample that DATA_RDY says is not new yet, per sample, before giving up on the part.
-STALE_READS = 16
-#: Blocks started again after a late read before the link is declared too slow for the rate.
-LATE_ATTEMPTS = 3
 
 
 class Icm42688:
@@ -116,14 +111,14 @@ class Icm42688:
         return float(self.part.temperature.celsius(raw))
 
     def acquire(self, n_samples: int) -> SampleBlock:
-        """`n_samples` consecutive samples, each read once it is new; a block with a late read (a sample may
-        have gone by unread) is started again, LATE_ATTEMPTS times at most."""
-        for _ in range(LATE_ATTEMPTS):
-            block = self._try_block(n_samples)
-            if block is not None:
-                return block
-        raise self._fault(f"reads came later than {LATE_PERIODS:g} sample periods in {LATE_ATTEMPTS} attempts: the "
-                          f"link cannot poll {self._odr_hz:g} Hz")
+        """`n_samples` consecutive samples, each read once DATA_RDY says it is new (instruments/polled_block.py)."""
+        raw, t_start = poll_block(self._clock, self._odr_hz, n_samples, self._read_sample, self._fault)
+        temperature, accel, gyro = regs.decode_samples(raw)
+        if np.any(accel == regs.DATA_INVALID) or np.any(gyro == regs.DATA_INVALID):
+            raise self._fault("a data register holds no reading (is the part measuring?)")
+        celsius = self.part.temperature.celsius
+        return SampleBlock({"accel": accel, "gyro": gyro}, t_start, t_start + (n_samples - 1) / self._odr_hz,
+                           (float(celsius(int(temperature[0]))), float(celsius(int(temperature[-1])))))
 
     def close(self) -> None:
         self._bus.close()
@@ -138,41 +133,7 @@ class Icm42688:
             self._bare.reconnect()
 
     # ------------------------------------------------------------------ polling the data registers
-    def _try_block(self, n_samples: int) -> SampleBlock | None:
-        period = 1.0 / self._odr_hz
-        self._read_sample()  # clears DATA_RDY: the next sample counted is one that arrives from now on
-        raw = bytearray()
-        t_start = previous = self._clock.now()
-        for index in range(n_samples):
-            # Paced from the block's first read, not from the last one: each read's round trip would
-            # otherwise push the next a little later, until a sample went by unread.
-            due = t_start + index * period if index else previous + period
-            self._clock.sleep(max(0.0, due - self._clock.now()))
-            sample = self._fresh_sample(period)
-            now = self._clock.now()
-            if now - previous > LATE_PERIODS * period:
-                return None
-            if index == 0:
-                t_start = now
-            previous = now
-            raw += sample
-        temperature, accel, gyro = regs.decode_samples(bytes(raw))
-        if np.any(accel == regs.DATA_INVALID) or np.any(gyro == regs.DATA_INVALID):
-            raise self._fault("a data register holds no reading (is the part measuring?)")
-        celsius = self.part.temperature.celsius
-        return SampleBlock({"accel": accel, "gyro": gyro}, t_start, t_start + (n_samples - 1) * period,
-                           (float(celsius(int(temperature[0]))), float(celsius(int(temperature[-1])))))
-
-    def _fresh_sample(self, period: float) -> bytes:
-        """The next sample whose DATA_RDY is set, re-read an eighth of a period later while it is not."""
-        for _ in range(STALE_READS):
-            sample, status = self._read_sample()
-            if status & regs.INT_STATUS_DATA_RDY:
-                return sample
-            self._clock.sleep(period / 8)
-        raise self._fault(f"no new sample in {STALE_READS} reads (DATA_RDY never set): is it measuring?")
-
-    def _read_sample(self) -> tuple[bytes, int]:
-        """One burst TEMP_DATA1…INT_STATUS: (the sample's 14 bytes, INT_STATUS, which the read clears)."""
+    def _read_sample(self) -> tuple[bytes, bool]:
+        """One burst TEMP_DATA1…INT_STATUS: (the sample's 14 bytes, INT_STATUS's DATA_RDY, which the read clears)."""
         raw = self._bus.read(regs.REG_TEMP_DATA1, regs.SAMPLE_AND_STATUS_BYTES)
-        return raw[:regs.SAMPLE_BYTES], raw[-1]
+        return raw[:regs.SAMPLE_BYTES], bool(raw[-1] & regs.INT_STATUS_DATA_RDY)

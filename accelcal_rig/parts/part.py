@@ -86,13 +86,16 @@ class Channel:
 @dataclass(frozen=True)
 class SpiFraming:
     """How the part's SPI command byte carries a register address and the read bit (mode 0, the address
-    first, then the data): an ADXL355 reads with (address << 1) | 1; an ICM-42688-P with address | 0x80."""
+    first, then the data): an ADXL355 reads with (address << 1) | 1; an ICM-42688-P with address | 0x80; an
+    LIS3MDL with address | 0x80, and 0x40 more to read several registers in one burst."""
 
     address_shift: int
     read_bit: int
+    #: set in the command byte of a read of more than one register (0: every burst increments)
+    burst_bit: int = 0
 
-    def read_command(self, address: int) -> int:
-        return (address << self.address_shift) | self.read_bit
+    def read_command(self, address: int, count: int = 1) -> int:
+        return (address << self.address_shift) | self.read_bit | (self.burst_bit if count > 1 else 0)
 
     def write_command(self, address: int) -> int:
         return address << self.address_shift

@@ -9,11 +9,12 @@ from importlib.metadata import entry_points
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.adxl35x import ADXL355, ADXL357, ADXL359
 from accelcal_rig.parts.icm42688 import ICM42688P
+from accelcal_rig.parts.lis3mdl import LIS3MDL
 from accelcal_rig.parts.part import Part
 
 ENTRY_POINT_GROUP = "accelcal_rig.parts"
 DEFAULT_PART = "adxl355"
-_BUILT_IN = {part.name: part for part in (ADXL355, ADXL357, ADXL359, ICM42688P)}
+_BUILT_IN = {part.name: part for part in (ADXL355, ADXL357, ADXL359, ICM42688P, LIS3MDL)}
 
 
 @cache

@@ -181,7 +181,18 @@ class SimulationTruth:
             "fixture_time_constant_s": dut.tau_s,
             "noise_g_per_sample": self._lab.noise_g(self._index[serial], odr_hz),
             **self._gyro(serial, odr_hz),
+            **self._mag(serial, odr_hz),
         }
+
+    def _mag(self, serial: str, odr_hz: float) -> dict[str, np.ndarray | str | float]:
+        """A magnetometer's hidden model (Eq. 1's parameters, the bias in gauss) and the site's true field."""
+        index = self._index[serial]
+        dut = self._lab.duts[index]
+        if dut.mag_truth is None:
+            return {}
+        return {"mag_polynomial_coefficients": dut.mag_truth.coefficients,
+                "mag_noise_gauss_per_sample": self._lab.mag_noise_gauss(index, odr_hz),
+                "field_world_gauss": np.asarray(self._lab.field_world_gauss, dtype=float)}
 
     def _gyro(self, serial: str, odr_hz: float) -> dict[str, np.ndarray | str | float]:
         """A gyroscope's hidden model beside the accelerometer's (fit.gyro_model's parameters, the same cubics)."""

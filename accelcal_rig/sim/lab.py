@@ -25,8 +25,17 @@ from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.sim.bias_wander import BiasWander
 from accelcal_rig.sim.moisture import ChamberMoisture
 from accelcal_rig.sim.mount_faults import MountFaults
-from accelcal_rig.sim.truth import DutTruth, fixture_parameters_at, gyro_truth_for_serial, truth_for_serial
+from accelcal_rig.sim.truth import (
+    DutTruth,
+    fixture_parameters_at,
+    gyro_truth_for_serial,
+    mag_truth_for_serial,
+    truth_for_serial,
+)
 from accelcal_rig.sim.turntable_motion import TurntableMotion
+
+#: The quantity the lab's magnetometers measure (a part's channel of it is fed the site's field).
+MAGNETIC_FIELD = "magnetic field"
 
 
 class SimulatedDut:
@@ -39,6 +48,9 @@ class SimulatedDut:
         self.truth: DutTruth = truth_for_serial(serial)
         #: A gyroscope's hidden truth, where the part has one (its own seed: the acceleration truth is unchanged).
         self.gyro_truth: DutTruth | None = gyro_truth_for_serial(serial) if "gyro" in dut_part.channel_names else None
+        #: A magnetometer's hidden truth (Eq. 1: hard iron, soft iron), where the part has one.
+        self.mag_truth: DutTruth | None = (mag_truth_for_serial(serial) if any(
+            c.quantity == MAGNETIC_FIELD for c in dut_part.channels) else None)
         #: Fixture frame → DUT frame.
         self.fixture_to_dut = fixture_to_dut(mount_euler_deg)
         self.tau_s = tau_s
@@ -89,10 +101,11 @@ class VirtualLab:
         serials = [s.serial for s in rig.fixture.sensors]
         self.duts = [SimulatedDut(s.serial, s.mount_euler_deg, tau_s, part(s.part))
                      for s, tau_s in zip(rig.fixture.sensors, sim.fixture_time_constants_s(serials))]
-        #: Each DUT's noise density: the rig config's, or its part's.
-        self.noise_density_g_per_rthz = [1e-6 * (d.part.channel("accel").noise_density_micro_per_rthz
-                                                 if sim.noise_density_ug_per_rthz
+        #: Each DUT's accelerometer's noise density: the rig config's, or its part's (none without an accelerometer).
+        self.noise_density_g_per_rthz = [1e-6 * (_accelerometer_noise(d.part) if sim.noise_density_ug_per_rthz
                                                  is None else sim.noise_density_ug_per_rthz) for d in self.duts]
+        #: Each magnetometer's noise stream, its own (a rig without magnetometers draws nothing more).
+        self.mag_rngs = [np.random.default_rng([seed, index, 4]) for index in range(len(rig.fixture.sensors))]
         self.thermal = ThermalModel(
             ambient_c=sim.ambient_c,
             ramp_rate_c_per_s=rig.chamber.ramp_rate_c_per_min / 60.0,
@@ -137,9 +150,15 @@ class VirtualLab:
         self.site_gravity_g = site_gravity_g(rig.gravity_m_s2 + rig.gravity_uncertainty_m_s2 * draw)
         #: The Earth's rate in the lab's world frame: at the rig config's site, else the simulation's (the
         #: Earth turns in every lab, whether the rig config says where it is or not).
+        heading_deg = sim.heading_deg if rig.heading_deg is None else rig.heading_deg
         self.earth_rate_world_dps = earth_rate_world_dps(
-            sim.latitude_deg if rig.latitude_deg is None else rig.latitude_deg,
-            sim.heading_deg if rig.heading_deg is None else rig.heading_deg)
+            sim.latitude_deg if rig.latitude_deg is None else rig.latitude_deg, heading_deg)
+        #: The site's magnetic field in the lab's world frame, gauss: the rig config's, else the simulation's, off
+        #: by a draw of its stated uncertainty (its own stream).
+        field = rig.magnetic_field or sim.magnetic_field
+        draw = (np.random.default_rng([seed, 1_000_011]).normal() * field.total_intensity_uncertainty_nt
+                / field.total_intensity_nt)
+        self.field_world_gauss = field.world_gauss(heading_deg) * (1.0 + draw)
 
     def chamber_reading_c(self) -> float:
         """Chamber air as its controller reads it, with regulation noise."""
@@ -219,6 +238,30 @@ class VirtualLab:
         wander = self.bias_wander[index].at(t_start_s + np.arange(n_samples) / odr_hz)
         return dut.part.channel("gyro").quantise(reading + noise + wander, range_dps)
 
+    def mag_noise_gauss(self, index: int, odr_hz: float) -> float:
+        """DUT `index`'s magnetometer's per-sample white noise: its part's density × √(ENBW of an ODR/4 low-pass)."""
+        channel = next(c for c in self.duts[index].part.channels if c.quantity == MAGNETIC_FIELD)
+        return 1e-6 * channel.noise_density_micro_per_rthz * float(np.sqrt(np.pi / 2 * odr_hz / 4))
+
+    def dut_field_samples(self, index: int, t_start_s: float, n_samples: int, odr_hz: float,
+                          range_gauss: float) -> np.ndarray:
+        """`n_samples` magnetometer codes (n, 3) of DUT `index` from `t_start_s` on: the site's field in its frame
+        at the table's true angles, through its hidden Eq. 1 (hard and soft iron) at its temperature now, white
+        noise from a stream of its own, its part's codes; the fixture's truth behind them recorded as an
+        accelerometer's block records it."""
+        dut, instant = self.duts[index], self._instant()
+        if dut.mag_truth is None:
+            raise ValueError(f"{dut.serial}: the {dut.part.label} has no magnetometer")
+        temperature = float(instant.temperature_c[index])
+        field = dut.fixture_to_dut @ self.kinematics.world_in_fixture(self.motion.position_deg(self.clock.now()),
+                                                                      self.field_world_gauss)
+        reading = distort(field, dut.mag_truth.parameters_at(temperature))
+        noise = self.mag_rngs[index].normal(0.0, self.mag_noise_gauss(index, odr_hz), (n_samples, 3))
+        dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, instant.parameters[index].copy(),
+                              instant.gravity_g[index].copy(), temperature))
+        channel = next(c for c in dut.part.channels if c.quantity == MAGNETIC_FIELD)
+        return channel.quantise(reading + noise, range_gauss)
+
     def _instant(self) -> _Instant:
         """Every DUT's truth at the clock's time, evaluated for the whole fixture at once: all its sensors are
         sampled at the same instants (a capture fetched from each in turn), and 64 evaluations of Eq. 1 one
@@ -264,3 +307,8 @@ class VirtualLab:
         if key != self._gravity_angles_key:  # the table stands still between moves: one chain per pose
             self._gravity_angles_key, self._gravity_fixture = key, self.kinematics.gravity_in_fixture(angles)
         return self._gravity_fixture
+
+
+def _accelerometer_noise(dut_part: Part) -> float:
+    """A part's accelerometer's noise density, µg/√Hz (0 for a part without one)."""
+    return next((c.noise_density_micro_per_rthz for c in dut_part.channels if c.quantity == "acceleration"), 0.0)

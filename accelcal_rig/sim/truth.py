@@ -49,16 +49,23 @@ def fixture_parameters_at(coefficients: np.ndarray, temperature_c: np.ndarray) -
 
 def truth_for_serial(serial: str) -> DutTruth:
     """The deterministic hidden truth of the DUT with this serial number."""
-    seed = int.from_bytes(hashlib.sha256(serial.encode()).digest()[:8], "little")
+    return _cubic_truth(serial, serial, _NOMINAL_CENTRE, _NOMINAL_HALF_WIDTH, _DRIFT_LOW, _DRIFT_HIGH)
+
+
+def _cubic_truth(serial: str, seed_text: str, centre: np.ndarray, half_width: np.ndarray, drift_low: np.ndarray,
+                 drift_high: np.ndarray) -> DutTruth:
+    """Each parameter a cubic over temperature: its value at 25 °C within centre ± half_width, its drift over
+    DRIFT_RANGE_C between drift_low and drift_high (either sign), its shape drawn; seeded by `seed_text`."""
+    seed = int.from_bytes(hashlib.sha256(seed_text.encode()).digest()[:8], "little")
     rng = np.random.default_rng(seed)
-    nominal = _NOMINAL_CENTRE + rng.uniform(-1, 1, 12) * _NOMINAL_HALF_WIDTH
-    drift = rng.uniform(_DRIFT_LOW, _DRIFT_HIGH) * rng.choice([-1.0, 1.0], 12)
-    shape = np.column_stack([np.ones(12), rng.uniform(-0.4, 0.4, (12, 2))])  # x + a2 x² + a3 x³
+    count = len(centre)
+    nominal = centre + rng.uniform(-1, 1, count) * half_width
+    drift = rng.uniform(drift_low, drift_high) * rng.choice([-1.0, 1.0], count)
+    shape = np.column_stack([np.ones(count), rng.uniform(-0.4, 0.4, (count, 2))])  # x + a2 x² + a3 x³
     x = (np.linspace(*DRIFT_RANGE_C, 201) - T_REF_C) / HALF_RANGE_C
-    curves = polynomial.polyval(x, np.column_stack([np.zeros(12), shape]).T)
+    curves = polynomial.polyval(x, np.column_stack([np.zeros(count), shape]).T)
     span = curves.max(axis=1) - curves.min(axis=1)
-    coefficients = np.column_stack([nominal, shape * (drift / span)[:, None]])
-    return DutTruth(serial, coefficients)
+    return DutTruth(serial, np.column_stack([nominal, shape * (drift / span)[:, None]]))
 
 
 # A gyroscope's hidden truth: the rate-table model's 27 parameters (fit/gyro_model.py), the same smooth cubics
@@ -77,13 +84,20 @@ def gyro_truth_for_serial(serial: str) -> DutTruth:
     """The deterministic hidden truth of the gyroscope of the DUT with this serial number (fit.gyro_model's
     parameters): its own seed, so an accelerometer's truth (`truth_for_serial`) is the same with or without a
     gyroscope beside it."""
-    seed = int.from_bytes(hashlib.sha256(f"gyro:{serial}".encode()).digest()[:8], "little")
-    rng = np.random.default_rng(seed)
-    count = len(_GYRO_CENTRE)
-    nominal = _GYRO_CENTRE + rng.uniform(-1, 1, count) * _GYRO_HALF_WIDTH
-    drift = rng.uniform(_GYRO_DRIFT_LOW, _GYRO_DRIFT_HIGH) * rng.choice([-1.0, 1.0], count)
-    shape = np.column_stack([np.ones(count), rng.uniform(-0.4, 0.4, (count, 2))])
-    x = (np.linspace(*DRIFT_RANGE_C, 201) - T_REF_C) / HALF_RANGE_C
-    curves = polynomial.polyval(x, np.column_stack([np.zeros(count), shape]).T)
-    span = curves.max(axis=1) - curves.min(axis=1)
-    return DutTruth(serial, np.column_stack([nominal, shape * (drift / span)[:, None]]))
+    return _cubic_truth(serial, f"gyro:{serial}", _GYRO_CENTRE, _GYRO_HALF_WIDTH, _GYRO_DRIFT_LOW, _GYRO_DRIFT_HIGH)
+
+
+# A magnetometer's hidden truth: Eq. 1's 12 parameters (its hard-iron offset is the bias, its soft-iron matrix
+# M·C·S), the same smooth cubics. Magnitudes of an LIS3MDL on a fixture: zero-gauss level and hard iron within
+# ±0.3 gauss at 25 °C drifting 2–10 mgauss over −40…60 °C (the data sheet states no temperature coefficient: an
+# assumption), scale within ±3 % drifting 0.05–0.3 %, non-orthogonality and misalignment within ±1°.
+_MAG_NOMINAL_HALF_WIDTH = np.repeat([0.3, 0.03, 1.0 * _DEG, 1.0 * _DEG], 3)
+_MAG_DRIFT_LOW = np.repeat([2e-3, 500e-6, 0.005 * _DEG, 0.005 * _DEG], 3)
+_MAG_DRIFT_HIGH = np.repeat([10e-3, 3000e-6, 0.05 * _DEG, 0.05 * _DEG], 3)
+
+
+def mag_truth_for_serial(serial: str) -> DutTruth:
+    """The deterministic hidden truth of the magnetometer of the DUT with this serial number (Eq. 1's
+    parameters, the bias in gauss): its own seed, as a gyroscope's."""
+    return _cubic_truth(serial, f"mag:{serial}", _NOMINAL_CENTRE, _MAG_NOMINAL_HALF_WIDTH, _MAG_DRIFT_LOW,
+                        _MAG_DRIFT_HIGH)

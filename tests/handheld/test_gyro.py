@@ -14,7 +14,7 @@ from scipy.spatial.transform import Rotation
 
 from accelcal_rig.cli import main
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.fit.calibration import apply_gyro, load_calibration
+from accelcal_rig.fit.calibration import apply, load_calibration
 from accelcal_rig.fit.sfem import distort, norm_only_gauge
 from accelcal_rig.handheld.calibrate import fit_recording
 from accelcal_rig.handheld.gyro import EARTH_RATE_DPS, fit_handheld_gyro, still_gyro_bias
@@ -150,8 +150,8 @@ def test_the_command_reports_the_gyro_and_keeps_the_calibration_file(tmp_path: P
     assert calibration.mode == "hand-held" and len(calibration.free_parameters) == 12
     raw = TRUE_MATRIX @ np.array([[10.0, -20.0, 30.0], [-200.0, 5.0, 90.0]]).T + TRUE_BIAS_DPS[:, None]
     expected = (raw.T - np.array(gyro["bias_dps"])) @ np.linalg.inv(np.array(gyro["matrix"])).T
-    np.testing.assert_allclose(apply_gyro(calibration, raw.T, np.zeros((2, 3)), 25.0), expected, rtol=1e-9)
-    assert "not taken out" in calibration.earth_rate and "not determined" in calibration.gauge
+    np.testing.assert_allclose(apply(calibration, raw.T, 25.0, {"acceleration": np.zeros((2, 3))}), expected, rtol=1e-9)
+    assert "not taken out" in calibration.statements["earth_rate"] and "not determined" in calibration.statements["gauge"]
     assert main([*argv, "--gyro-columns", GYRO_COLUMNS]) == 0
     out = capsys.readouterr().out
     assert "gyro: 15 moves between static intervals" in out and "Earth's rate" in out
