@@ -168,9 +168,21 @@ def _earth_rate_fixture_dps(run: RunContext, at: PoseInstant) -> np.ndarray:
     return run.kinematics.world_in_fixture(angles, world).mean(axis=0)
 
 
+def _field_reference(run: RunContext, serial: str, channel: Channel, at: PoseInstant) -> np.ndarray:
+    """The site's magnetic field in the DUT's frame, gauss: the rig config's field at the commanded pose through
+    the table's heading and the nominal mount. Without the heading its direction about the vertical is not known
+    (taken as 0: only the field's size is then a reference, and the magnetometer's model fits against that)."""
+    field = run.rig.magnetic_field
+    assert field is not None, "preparation refuses a magnetometer on a rig that states no magnetic_field"
+    world = field.world_gauss(run.rig.heading_deg if run.rig.heading_deg is not None else 0.0)
+    return run.fixture_to_dut[serial] @ run.kinematics.world_in_fixture(np.array(at.step.pose.angles_deg), world)
+
+
 #: What a channel should read at a pose, by the quantity it measures.
 REFERENCES: dict[str, Callable[[RunContext, str, Channel, PoseInstant], np.ndarray]] = {
-    "acceleration": _gravity_reference, "angular rate": _rate_reference}
+    "acceleration": _gravity_reference, "angular rate": _rate_reference, "magnetic field": _field_reference}
+#: What of the rig config a quantity's reference needs (a key that must be stated), and what it is.
+REFERENCE_NEEDS: dict[str, tuple[str, str]] = {"magnetic field": ("magnetic_field", "the site's magnetic field")}
 
 
 def _angle_difference(a_deg: np.ndarray, b_deg: np.ndarray) -> np.ndarray:

@@ -21,7 +21,7 @@ from accelcal_rig.config.load import (
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.geometry import fixture_to_dut
-from accelcal_rig.engine.pose_steps import REFERENCES
+from accelcal_rig.engine.pose_steps import REFERENCE_NEEDS, REFERENCES
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
 from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, VerificationSeenByFit, compile_plan
@@ -86,6 +86,11 @@ def _check_every_channel_has_a_reference(rig: LoadedConfig[RigConfig]) -> None:
                 raise rig.error(("fixture", "sensors", index, "part"),
                                 f"the {part(sensor.part).label}'s {channel.name} channel measures {channel.quantity!r}, "
                                 f"which no pose has a reference for (known: {', '.join(sorted(REFERENCES))})")
+            key, what = REFERENCE_NEEDS.get(channel.quantity, ("", ""))
+            if key and getattr(rig.model, key) is None:
+                raise rig.error(("fixture", "sensors", index, "part"),
+                                f"the {part(sensor.part).label}'s {channel.name} channel measures {channel.quantity}, "
+                                f"whose reference at each pose is {what}: state {key} in {rig.path}")
 
 
 def _check_design_identifies_fit(procedure: LoadedConfig[Procedure], rig: RigConfig, plan: Plan) -> None:

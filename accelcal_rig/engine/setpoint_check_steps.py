@@ -10,13 +10,12 @@ import numpy as np
 from accelcal_rig.engine.played import PlayedRig
 from accelcal_rig.engine.run_context import RunContext
 from accelcal_rig.engine.step_handler import StepHandler
+from accelcal_rig.fit.channel_models import model_for_quantity
 from accelcal_rig.fit.early_check import EVENT_KIND, CheckLimits, findings, logged_findings
 from accelcal_rig.fit.setpoint_check import SetpointFigures, design_determined, setpoint_figures
 from accelcal_rig.plan.steps import CheckSetpoint
+from accelcal_rig.store.content import Campaign
 from accelcal_rig.store.records import PoseRecord
-
-#: The channel the check judges: the one whose poses have a gravity reference.
-CHECKED_CHANNEL = "accel"
 
 
 class CheckSetpointStep:
@@ -36,11 +35,13 @@ def check_setpoint(step: CheckSetpoint, run: RunContext) -> None:
     calibration_keys = campaign.header.plan.keys_of("pose")
     poses = [p for p in campaign.poses if p.setpoint_c == step.setpoint_c and p.step_key in calibration_keys]
     where = f"early check at {step.setpoint_c:+g} °C"
-    indices = [k for k, serial in enumerate(campaign.serials) if serial not in run.dropped
-               and CHECKED_CHANNEL in poses[0].duts[k].channels] if poses else []
+    checked = {serial: channel for serial in campaign.serials if (channel := checked_channel(campaign, serial))}
+    indices = [k for k, serial in enumerate(campaign.serials) if serial not in run.dropped and serial in checked
+               and checked[serial] in poses[0].duts[k].channels] if poses else []
     if not indices:
         return
-    mean_g, stderr_g, reference_g = (_stacked(poses, indices, name) for name in ("mean", "stderr", "reference"))
+    channels = [checked[campaign.serials[k]] for k in indices]
+    mean_g, stderr_g, reference_g = (_stacked(poses, indices, channels, name) for name in ("mean", "stderr", "reference"))
     if not design_determined(reference_g[0]):
         run.events.info(EVENT_KIND, f"{where}: not possible, the {len(poses)} poses do not determine each DUT's "
                                     "own fit (directions too few or all near one plane)")
@@ -62,9 +63,19 @@ def check_setpoint(step: CheckSetpoint, run: RunContext) -> None:
                                 f"{len(serials)} DUTs flagged")
 
 
-def _stacked(poses: list[PoseRecord], indices: list[int], name: str) -> np.ndarray:
-    """One field of the checked channel, (D, n, 3): the DUTs at `indices` over the poses."""
-    return np.array([[getattr(p.duts[k].channels[CHECKED_CHANNEL], name) for p in poses] for k in indices],
+def checked_channel(campaign: Campaign, serial: str) -> str | None:
+    """The DUT's channel the check judges: its first whose channel model has a check of each setpoint (an
+    accelerometer's, against gravity); None where it has none."""
+    for info in campaign.header.dut_channels(serial):
+        model = model_for_quantity(info.quantity)
+        if model is not None and model.setpoint_check:
+            return info.name
+    return None
+
+
+def _stacked(poses: list[PoseRecord], indices: list[int], channels: list[str], name: str) -> np.ndarray:
+    """One field of each DUT's checked channel, (D, n, 3): the DUTs at `indices` over the poses."""
+    return np.array([[getattr(p.duts[k].channels[channel], name) for p in poses] for k, channel in zip(indices, channels)],
                     dtype=float)
 
 

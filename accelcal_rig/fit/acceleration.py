@@ -44,7 +44,7 @@ ACCELERATION = VectorQuantity(
     result_digits={"bias": "+.3f", "non-orthogonality": "+.4f", "misalignment": "+.4f"},
     noise=NoiseFigures("vrw_m_s_per_rthr", "velocity random walk", "m/s/√h", STANDARD_GRAVITY_M_S2 * 60.0,
                        "bias_instability_ug", "µg", 1e6, ".5f", ".1f"),
-    statements=_gravity,
+    statements=_gravity, setpoint_check=True,
     flight_stack=FlightStackOffsets("accelerometer", ("bias_x_g", "bias_y_g", "bias_z_g"), STANDARD_GRAVITY_M_S2,
                                     "m/s²"),
 )
@@ -58,4 +58,4 @@ def accelerometer_poses(campaign: Campaign, serial: str, options: FitOptions | N
     info = campaign.channel_of(serial, ACCELERATION.quantity)
     if info is None:
         raise ValueError(f"sensor {serial} has no accelerometer")
-    return MODEL.records(campaign, info, serial, options or FitOptions())
+    return MODEL.records(campaign, info, serial, options or FitOptions()).poses

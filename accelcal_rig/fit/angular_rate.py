@@ -94,6 +94,7 @@ class AngularRateModel:
                          ".4f", ".2f")
     flight_stack = FlightStackOffsets("gyroscope", ("bias_x_dps", "bias_y_dps", "bias_z_dps"), np.pi / 180.0, "rad/s")
     c_export = gyro_c_export()
+    setpoint_check = False
 
     def records(self, campaign: Campaign, channel: ChannelInfo, serial: str,
                 options: FitOptions) -> tuple[GyroRecords, dict[str, Any]] | str:

@@ -255,6 +255,12 @@ class ChannelModel(Protocol):
         ...
 
     @property
+    def setpoint_check(self) -> bool:
+        """Whether its channel is checked after each setpoint's poses (the early check: a DUT loose, turned or with
+        a dead axis; fit/setpoint_check.py): a model whose every pose has a vector reference it knows well."""
+        ...
+
+    @property
     def c_export(self) -> CExport | None:
         """How the C header carries its calibrations (None: it has no C code)."""
         ...

@@ -1,4 +1,4 @@
-"""The channel models by quantity: the built-in ones (acceleration, angular rate) and any a package registers
+"""The channel models by quantity: the built-in ones (acceleration, angular rate, magnetic field) and any a package registers
 under the entry-point group `accelcal_rig.channel_models` (an entry point's object a `ChannelModel` whose
 `quantity` is the entry point's name). A built-in quantity cannot be taken over by a plug-in."""
 
@@ -8,12 +8,13 @@ from functools import cache
 from importlib.metadata import entry_points
 
 from accelcal_rig.errors import ConfigError
-from accelcal_rig.fit import acceleration, angular_rate
+from accelcal_rig.fit import acceleration, angular_rate, magnetic_field
 from accelcal_rig.fit.calibration import ChannelCalibration
 from accelcal_rig.fit.channel_model import ChannelModel
 
 ENTRY_POINT_GROUP = "accelcal_rig.channel_models"
-_BUILT_IN: dict[str, ChannelModel] = {model.quantity: model for model in (acceleration.MODEL, angular_rate.MODEL)}
+_BUILT_IN: dict[str, ChannelModel] = {model.quantity: model for model in (acceleration.MODEL, angular_rate.MODEL,
+                                                                           magnetic_field.MODEL)}
 
 
 @cache

@@ -100,8 +100,14 @@ class VectorQuantity:
     flight_stack: FlightStackOffsets | None = None
     #: the C header's names for it: "" the accelerometer's (the header's first), else a token ("mag")
     c_token: str = ""
+    #: whether the early check judges it after each setpoint (its reference's direction always known)
+    setpoint_check: bool = False
     #: what its references were, from a calibration's figures: (what, statement) rows of a certificate
     statements: Callable[[Mapping[str, Any]], list[tuple[str, str]]] = lambda figures: []
+    #: whether the campaign places the reference's direction (else only its size is known: fitted norm-only)
+    direction_known: Callable[[Campaign], bool] = lambda campaign: True
+    #: the site's reference as the campaign recorded it, kept with the figures (`site_<quantity>`; None: none)
+    site_description: Callable[[Campaign], dict[str, Any] | None] = lambda campaign: None
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
@@ -120,6 +126,7 @@ class Eq1Model:
         self.parameter_names = spec.parameter_names
         self.noise, self.flight_stack = spec.noise, spec.flight_stack
         self.c_export = eq1_c_export(spec.c_token, spec.unit, spec.sensor, self.parameter_names)
+        self.setpoint_check = spec.setpoint_check
         m, size = spec.milli, spec.magnitude_label
         self.figures = (
             Figure(f"rmse_before_{m}", f"raw {size} RMSE", m, ".3f", f"raw {size}"),
@@ -161,16 +168,19 @@ class Eq1Model:
 
     # --- records and the fit ---------------------------------------------------------------------------------
 
-    def records(self, campaign: Campaign, channel: ChannelInfo, serial: str, options: FitOptions) -> VectorPoses:
+    def records(self, campaign: Campaign, channel: ChannelInfo, serial: str, options: FitOptions) -> VectorRecords:
         poses = read_vector_poses(campaign, serial, channel.name)
         magnitude, magnitude_u = self.spec.site(campaign)
         truth, reference = self.spec.truth(campaign, serial, channel.name, poses)
         poses = replace(poses, magnitude=magnitude, magnitude_u=magnitude_u, truth_parameters=truth,
                         truth_reference=reference)
-        return with_approach(campaign, poses) if options.hysteresis == "on" else poses
+        poses = with_approach(campaign, poses) if options.hysteresis == "on" else poses
+        site = self.spec.site_description(campaign)
+        known = self.spec.direction_known(campaign)
+        return VectorRecords(poses, None if site is None else {**site, "direction_known": known}, known)
 
-    def fit(self, records: VectorPoses, options: FitOptions, allan: dict[str, Any] | None) -> ChannelFit:
-        return fit_vector(records, options, self.spec)
+    def fit(self, records: VectorRecords, options: FitOptions, allan: dict[str, Any] | None) -> ChannelFit:
+        return fit_vector(records.poses, options, self.spec, records.site, records.direction_known)
 
     def judged_groups(self, calibration: ChannelCalibration) -> tuple[tuple[ParameterGroup, ...], list[str]]:
         """Every group; misalignment only where a reference fit determines it."""
@@ -318,6 +328,16 @@ class Eq1Model:
 
 
 @dataclass(frozen=True)
+class VectorRecords:
+    """A channel's poses as its Eq. 1 model fits them, the site's reference as the campaign recorded it, and
+    whether the reference's direction is known (else only its size)."""
+
+    poses: VectorPoses
+    site: dict[str, Any] | None = None
+    direction_known: bool = True
+
+
+@dataclass(frozen=True)
 class VectorFitDetail:
     """What an Eq. 1 fit's report draws: each setpoint and its DUT temperature, its fit, the calibration poses
     compensated with the thermal model, and the figures (the simulation truth's errors among them)."""
@@ -344,8 +364,46 @@ def smoothed_temperatures(poses: VectorPoses, groups: list[np.ndarray]) -> np.nd
     return smoothed
 
 
-def fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity) -> ChannelFit:
-    """Fit the calibration poses; judge the result on them (in-sample) and on the verification poses."""
+#: The figures that need the reference's direction: not stated where only its size is known.
+_DIRECTED = ("max_axis_error", "rms_axis_error", "drift", "offset")
+
+
+def fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity, site: dict[str, Any] | None = None,
+               direction_known: bool = True) -> ChannelFit:
+    """Fit the calibration poses; judge the result on them (in-sample) and on the verification poses. Where the
+    reference's direction is not known (`direction_known` False), norm-only against its size, and the figures
+    that need its direction left out."""
+    if not direction_known and options.mode != "norm-only":
+        options = replace(options, mode="norm-only")
+    fitted = _fit_vector(stored, options, spec)
+    if site is not None:
+        fitted.figures[f"site_{spec.quantity.replace(' ', '_')}"] = site
+    if direction_known:
+        return fitted
+    note = (f"the {spec.reference_label}'s direction at each pose is not known (the rig config states no table "
+            f"heading): fitted norm-only against its size; the figures that need its direction are not stated")
+    fitted.thermal.warnings.append(note)
+    figures = _undirected(fitted.figures, spec)
+    calibration = fitted.calibration.model_copy(update={"metrics": _undirected(fitted.calibration.metrics, spec),
+                                                        "warnings": fitted.thermal.warnings})
+    return replace(fitted, figures=figures, calibration=calibration)
+
+
+def _undirected(metrics: dict[str, Any], spec: VectorQuantity) -> dict[str, Any]:
+    """The figures without those that need the reference's direction (each verification and in-sample set's, and
+    their expanded uncertainties)."""
+    directed = {f"{name}_{spec.milli}" for name in _DIRECTED} | {f"max_{spec.angle}_error_deg"}
+
+    def without(figures: Any) -> Any:
+        if not isinstance(figures, dict):
+            return figures
+        return {k: (without(v) if k in ("expanded_u",) else [without(r) for r in v] if k == "by_setpoint" else v)
+                for k, v in figures.items() if k not in directed}
+
+    return {k: without(v) if k in ("verification", "in_sample") else v for k, v in metrics.items()}
+
+
+def _fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity) -> ChannelFit:
     m = spec.milli
     poses = stored.subset(~stored.verification)
     if not len(poses.setpoint_c):

@@ -135,7 +135,7 @@ def read_campaign_data(path: Path) -> CampaignData:
             continue
         model = model_for_quantity(DRAWN_QUANTITY)
         assert model is not None
-        stored = model.records(campaign, info, serial, options or FitOptions())
+        stored = model.records(campaign, info, serial, options or FitOptions()).poses
         drawn = fitted.get(serial, {}).get(info.name)
         if drawn is None and options is not None and not damaged and campaign.poses and not reasons:
             reasons.append(f"sensor {serial}: {not_calibrated.get(serial, {}).get(info.name, 'not fitted')}")
