@@ -79,10 +79,15 @@ def stored_poses(campaign: Path) -> dict[str, bytes]:
     return {p.step_key: b"".join([p.commanded_angles_deg.tobytes(), p.measured_angles_deg.tobytes(),
                                   repr((p.setpoint_c, p.pose_number, p.t_start_s, p.t_end_s,
                                         p.chamber_temperature_c)).encode()]
-                                 + [d.raw_codes.tobytes() + d.mean_g.tobytes() + d.stderr_g.tobytes() +
-                                    d.gravity_reference_g.tobytes() + repr((d.temperature_c, d.temperature_in_band)).encode()
+                                 + [_channels_bytes(d) + repr((d.temperature_c, d.temperature_in_band)).encode()
                                     for d in p.duts])
             for p in loaded.poses}
+
+
+def _channels_bytes(dut) -> bytes:  # noqa: ANN001 (a DutPoseRecord)
+    """A DUT's pose record's channels (codes, means, standard errors, references) as bytes."""
+    return b"".join(c.raw_codes.tobytes() + c.mean.tobytes() + c.stderr.tobytes() + c.reference.tobytes()
+                    for c in dut.channels.values())
 
 
 def judge_complete(campaign: Path, before: dict[str, bytes], rmse_limit: float = 1.2) -> tuple[bool, str]:

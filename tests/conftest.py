@@ -94,6 +94,12 @@ def kill_mid_pose(campaign: Path, keep_poses: int) -> int:
     return len(torn)
 
 
+def _channels_bytes(dut) -> bytes:  # noqa: ANN001 (a DutPoseRecord)
+    """A DUT's pose record's channels (codes, means, standard errors, references) as bytes."""
+    return b"".join(c.raw_codes.tobytes() + c.mean.tobytes() + c.stderr.tobytes() + c.reference.tobytes()
+                    for c in dut.channels.values())
+
+
 def stored_poses(campaign: Path) -> dict[str, bytes]:
     """Every stored pose's data as bytes, by step key (to compare before and after)."""
     from accelcal_rig.store.read import load_campaign
@@ -101,8 +107,8 @@ def stored_poses(campaign: Path) -> dict[str, bytes]:
     loaded = load_campaign(campaign)
     return {p.step_key: b"".join([p.commanded_angles_deg.tobytes(), p.measured_angles_deg.tobytes(),
                                   repr((p.setpoint_c, p.t_start_s, p.t_end_s, p.chamber_temperature_c)).encode()]
-                                 + [d.raw_codes.tobytes() + d.mean_g.tobytes() + d.stderr_g.tobytes()
-                                    + repr(d.temperature_c).encode() + d.gravity_reference_g.tobytes() for d in p.duts])
+                                 + [_channels_bytes(d)
+                                    + repr(d.temperature_c).encode() for d in p.duts])
             for p in loaded.poses}
 
 

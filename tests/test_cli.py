@@ -157,7 +157,8 @@ def test_rig_fit_json_report_and_calibration_file(paper_campaign: Path, tmp_path
     assert main(["fit", str(campaign), "-o", str(calibration), "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert sorted(report) == ["ADX355-A001", "ADX355-A002", "ADX355-A003", "ADX355-A004"]
-    for sensor in report.values():
+    for dut in report.values():
+        sensor = dut["channels"]["accel"]
         for key in ("rmse_before_mg", "rmse_after_mg", "rmse_by_setpoint", "drift_before_mg", "drift_after_mg",
                     "noise_floor_mg", "truth_error"):
             assert key in sensor
@@ -386,7 +387,7 @@ def test_rig_export_writes_each_format(fitted_paper_campaign: tuple[Path, Path],
     assert (tmp_path / "cal.csv").read_text().count("\n") == 1 + 4 * 12
     assert "accelcal_apply(" in (tmp_path / "cal.h").read_text()
     assert main(["export", str(calibration), "--format", "csv"]) == 0  # standard output
-    assert capsys.readouterr().out.startswith("serial,parameter,")
+    assert capsys.readouterr().out.startswith("serial,channel,model,unit,parameter,")
 
 
 def test_rig_export_of_a_broken_calibration_is_one_line(tmp_path: Path, capsys) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import ConfigDict, Field, field_validator, model_validator
+from pydantic import ConfigDict, Field, ModelWrapValidatorHandler, PrivateAttr, field_validator, model_validator
 
 from accelcal_rig.config.bounds import Real, StrictModel, TemperatureC
 from accelcal_rig.config.schedule import Schedule
@@ -101,6 +101,22 @@ class Acceptance(StrictModel):
     guard_band_factor: Real = Field(1.0, gt=0, le=3, description="guarded acceptance: the guard band in "
                                                                  "expanded uncertainties (k = 2)")
 
+    #: Whether the accelerometer's limits stood at the top of `acceptance` (how a message names them).
+    _before_channels_written: bool = PrivateAttr(False)
+
+    @model_validator(mode="wrap")
+    @classmethod
+    def _remember_layout(cls, data: Any, handler: ModelWrapValidatorHandler[Acceptance]) -> Acceptance:
+        written = isinstance(data, dict) and any(key in data for key in _BEFORE_CHANNELS)
+        model = handler(data)
+        model._before_channels_written = written
+        return model
+
+    def written(self, channel: str, key: str) -> str:
+        """A channel's limit as the procedure wrote it under `acceptance.`: `accel.max_drift_mg`, or
+        `max_drift_mg` where the accelerometer's limits stand at the top."""
+        return key if self._before_channels_written and channel == _BEFORE_CHANNELS_CHANNEL else f"{channel}.{key}"
+
     @model_validator(mode="before")
     @classmethod
     def _before_channels(cls, data: Any) -> Any:
@@ -130,5 +146,5 @@ class Acceptance(StrictModel):
         return any(limits.figure_limits() or limits.parameters is not None for limits in self.channels.values())
 
     def verification_limits(self) -> list[str]:
-        """Every figure limit (judged on verification records) as `<channel>.<key>`."""
-        return [f"{channel}.{key}" for channel, limits in self.channels.items() for key in limits.figure_limits()]
+        """Every figure limit (judged on verification records) as the procedure wrote it (`written`)."""
+        return [self.written(channel, key) for channel, limits in self.channels.items() for key in limits.figure_limits()]

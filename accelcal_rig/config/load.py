@@ -131,6 +131,19 @@ def _range_key(procedure: LoadedConfig[Procedure], channel: str) -> KeyPath:
     return ("acquisition", "ranges", channel)
 
 
+def with_part_ranges(procedure: LoadedConfig[Procedure], rig: LoadedConfig[RigConfig]) -> LoadedConfig[Procedure]:
+    """The procedure with each fixture channel's range the procedure leaves unset at its part's default
+    (`Channel.default_range`): what the campaign configures, records and reports."""
+    acquisition = procedure.model.acquisition
+    defaults = {c.name: c.default_range for s in rig.model.fixture.sensors for c in part(s.part).channels
+                if c.name not in acquisition.ranges and c.default_range is not None}
+    if not defaults:
+        return procedure
+    ranges = {**acquisition.ranges, **defaults}
+    model = procedure.model.model_copy(update={"acquisition": acquisition.model_copy(update={"ranges": ranges})})
+    return replace(procedure, model=model)
+
+
 def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedConfig[RigConfig]) -> None:
     """Cross-file checks that neither file can make alone: setpoints and angles inside the rig's limits, the
     range and data rate among those of every DUT's part."""
@@ -141,11 +154,12 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
         dut_part = part(sensor.part)
         for channel in dut_part.channels:  # every channel of every DUT's part needs its range, and one it has
             key = _range_key(procedure, channel.name)
-            if channel.name not in ranges:
+            range_ = ranges.get(channel.name, channel.default_range)
+            if range_ is None:
                 raise procedure.error(key, f"not set: sensor {sensor.serial} of {rig.path} is an "
                                                              f"{dut_part.label}, whose {channel.name} channel needs "
                                                              f"its ± full scale in {channel.unit}")
-            problem = channel.range_problem(ranges[channel.name], dut_part.label)
+            problem = channel.range_problem(range_, dut_part.label)
             if problem:
                 raise procedure.error(key, f"{problem}: sensor {sensor.serial} of {rig.path}")
         problem = dut_part.rate_problem(acquisition.odr_hz)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Annotated, Any, Literal
 
 import numpy as np
@@ -82,8 +83,14 @@ class Acquisition(StrictModel):
         {_RANGE_G_CHANNEL: _RANGE_G_DEFAULT}, max_length=16,
         description="± full scale of each channel by the channel's name, in its unit (accel: 2 g, gyro: 2000 °/s), one "
                     "of every DUT part's ranges for it; accel 2 g unless given")
-    odr_hz: Real = Field(125.0, gt=0, le=100_000, description="output data rate, one of every DUT part's")
+    odr_hz: Real = Field(125.0, gt=0, le=100_000,
+                         description="output data rate; a DUT part without it runs at its next faster rate")
     settle_s: Real = Field(5.0, ge=0, le=3600, description="wait after the turntable is in position")
+
+    def block_s(self, rates_hz: Sequence[float] = ()) -> float:
+        """How long a pose's samples take: at the slowest of the DUTs' rates `rates_hz`, at `odr_hz` when they are
+        not known (no DUT runs slower than that)."""
+        return self.samples_per_pose / min(rates_hz, default=self.odr_hz)
 
     @model_validator(mode="before")
     @classmethod
@@ -241,7 +248,7 @@ class Procedure(StrictModel):
         """Blocks of `samples_per_pose` samples a noise record takes at each setpoint."""
         if self.noise is None:
             return 0
-        block_s = self.acquisition.samples_per_pose / self.acquisition.odr_hz
+        block_s = self.acquisition.block_s()
         return max(1, int(np.ceil(self.noise.duration_s / block_s - 1e-9)))
 
     @model_validator(mode="after")
@@ -272,7 +279,7 @@ class Procedure(StrictModel):
         if self.cooldown is not None:
             if len(self.setpoints_c) != 1:
                 raise ValueError("a cool-down procedure has one setpoint: the temperature it cools from")
-            block_s = self.acquisition.settle_s + self.acquisition.samples_per_pose / self.acquisition.odr_hz
+            block_s = self.acquisition.settle_s + self.acquisition.block_s()
             if self.cooldown.record_every_s < block_s:
                 raise ValueError(f"cooldown.record_every_s must be at least one record's {block_s:g} s (settle "
                                  "and samples)")
@@ -307,7 +314,8 @@ class Procedure(StrictModel):
         low, high = min(self.setpoints_c), max(self.setpoints_c)
         for channel, limits in self.acceptance.channels.items():
             if limits.parameters is not None and not low <= limits.parameters.at_c <= high:
-                raise ValueError(f"acceptance.{channel}.parameters.at_c: {limits.parameters.at_c:g} °C is outside the "
+                raise ValueError(f"acceptance.{self.acceptance.written(channel, 'parameters')}.at_c: "
+                                 f"{limits.parameters.at_c:g} °C is outside the "
                                  f"calibrated range {low:g} … {high:g} °C")
         return self
 

@@ -39,6 +39,7 @@ from accelcal_rig.engine.thermal_steps import SetpointSkipped
 from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, TransientInstrumentError
 from accelcal_rig.instruments.capabilities import controller_limits
 from accelcal_rig.instruments.interfaces import DeviceIdentity, Sensor
+from accelcal_rig.parts.part import odr_hz_of
 from accelcal_rig.plan.compile import Plan, setpoint_label
 from accelcal_rig.plan.composition import plan_composition
 from accelcal_rig.plan.steps import Measurement
@@ -265,13 +266,15 @@ class CampaignRunner:
         acquisition = self.procedure.acquisition
         for sensor in run.sensors:
             identity = run.retrier.call(partial(_checked_identity, sensor))
+            odr_hz = odr_hz_of(sensor.part, acquisition.odr_hz)
             sensor.reset()
             sensor.standby()
-            sensor.configure(acquisition.ranges, acquisition.odr_hz)
+            sensor.configure(acquisition.ranges, odr_hz)
             sensor.start_measurement()
+            asked = "" if odr_hz == acquisition.odr_hz else f" (its next rate above the {acquisition.odr_hz:g} Hz asked)"
             events.info("preflight", f"sensor {sensor.serial}: {identity.describe(sensor.part.label)} "
                                      f"({sensor.part.describe_identity(identity.registers)}), "
-                                     f"{sensor.part.describe_ranges(acquisition.ranges)}, {acquisition.odr_hz:g} Hz")
+                                     f"{sensor.part.describe_ranges(acquisition.ranges)}, {odr_hz:g} Hz{asked}")
 
     def _check_controller_limits(self, run: RunContext) -> None:
         """Every setpoint the campaign will write within what the controller itself accepts, or a fault now

@@ -18,6 +18,7 @@ from accelcal_rig.engine.connection import ConnectedRig
 from accelcal_rig.engine.preparation import PreparedCampaign
 from accelcal_rig.fit.recorded_options import options_attrs
 from accelcal_rig.instruments.interfaces import RigInstruments
+from accelcal_rig.parts.part import odr_hz_of
 from accelcal_rig.plan.compile import Plan
 from accelcal_rig.plan.steps import Measurement
 from accelcal_rig.store.records import ChannelInfo, StoredPlan
@@ -63,14 +64,14 @@ def create_campaign_file(prepared: PreparedCampaign, output: Path, connected: Co
     mounts = {s.serial: s for s in rig.model.fixture.sensors}
     duts = [
         {"serial": s.serial, "name": mounts[s.serial].name, "mount_euler_deg": list(mounts[s.serial].mount_euler_deg),
-         "part": s.part.name, "odr_hz": acquisition.odr_hz, "driver": type(s).__name__, "endpoint": s.endpoint,
+         "part": s.part.name, "odr_hz": odr_hz_of(s.part, acquisition.odr_hz), "driver": type(s).__name__, "endpoint": s.endpoint,
          **receipt_info(mounts[s.serial], prepared.receipt)}
         for s in instruments.sensors
     ]
     ranges = acquisition.ranges
     channels = {s.serial: tuple(ChannelInfo(c.name, c.quantity, c.unit, c.axes, ranges[c.name], c.lsb(ranges[c.name]))
                                 for c in s.part.channels) for s in instruments.sensors}
-    truth = ({s.serial: instruments.truth.describe(s.serial, acquisition.odr_hz) for s in instruments.sensors}
+    truth = ({s.serial: instruments.truth.describe(s.serial, odr_hz_of(s.part, acquisition.odr_hz)) for s in instruments.sensors}
              if instruments.truth is not None else {})
     lab = rig.model.lab
     attrs = {"procedure_name": procedure.name, "procedure_version": procedure.version,

@@ -27,7 +27,7 @@ __all__ = ["DurationEstimate", "SetpointEstimate", "estimate_duration"]
 
 def estimate_duration(procedure: Procedure, rig: RigConfig, plan: Plan) -> DurationEstimate:
     """Each setpoint with poses, its entry and body played in order; a ramp past its deadline ends it."""
-    played = PlayedRig.of(procedure, rig, [part(s.part).temperature for s in rig.fixture.sensors])
+    played = PlayedRig.of(procedure, rig, [part(s.part) for s in rig.fixture.sensors])
     rows = []
     for stage in plan.stages:
         n_poses = sum(1 for s in stage.body if isinstance(s, Measurement))

@@ -17,7 +17,7 @@ from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.thermal import ThermalModel
 from accelcal_rig.core.waits import MOVE_POLL_S
-from accelcal_rig.parts.part import TemperatureFormat
+from accelcal_rig.parts.part import Part, TemperatureFormat, odr_hz_of
 
 
 @dataclass(frozen=True)
@@ -110,6 +110,8 @@ class PlayedRig:
     speeds_deg_s: np.ndarray
     #: A pose's time besides its travel: the table's settling found half a poll late, the settle time, the samples.
     pose_fixed_s: float
+    #: A pose's samples: at the slowest DUT's rate.
+    block_s: float
     table_deg: np.ndarray
     t_s: float = 0.0
     software_ramp: SoftwareRampPlayed | None = None
@@ -119,7 +121,8 @@ class PlayedRig:
     tally: SetpointTally = field(default_factory=lambda: SetpointTally(float("nan"), 0))
 
     @classmethod
-    def of(cls, procedure: Procedure, rig: RigConfig, readers: list[TemperatureFormat]) -> PlayedRig:
+    def of(cls, procedure: Procedure, rig: RigConfig, parts: list[Part]) -> PlayedRig:
+        """The rig at rest before the plan; `parts` are the fixture's DUTs' parts, in its order."""
         sim = rig.simulation
         constants = rig.estimate_thermal()  # the rig's own (thermal:), defaults where it has none
         thermal = ThermalModel(
@@ -134,8 +137,10 @@ class PlayedRig:
         # The table reports in position its settling time after arriving; the engine's position polls find
         # that moment half a polling interval late on average.
         in_position_s = sim.turntable_settle_s + MOVE_POLL_S / 2
-        pose_fixed_s = in_position_s + acquisition.settle_s + acquisition.samples_per_pose / acquisition.odr_hz
-        return cls(procedure, rig, thermal, readers, speeds, pose_fixed_s, np.zeros(len(speeds)))
+        block_s = acquisition.block_s([odr_hz_of(p, acquisition.odr_hz) for p in parts])
+        pose_fixed_s = in_position_s + acquisition.settle_s + block_s
+        return cls(procedure, rig, thermal, [p.temperature for p in parts], speeds, pose_fixed_s, block_s,
+                   np.zeros(len(speeds)))
 
     def begin_setpoint(self, setpoint_c: float, n_poses: int) -> None:
         self.tally = SetpointTally(setpoint_c, n_poses)

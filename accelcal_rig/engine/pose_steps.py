@@ -67,7 +67,7 @@ def acquire_and_store(step: Measurement, run: RunContext, commanded: np.ndarray)
     chamber_after = run.read_chamber_c()
     run.machine.go(State.STORE, step.key)
     gravity_fixture = np.array(step.pose.gravity_fixture)
-    at = PoseInstant(step, measured, acquisition.samples_per_pose / acquisition.odr_hz)
+    at = PoseInstant(step, measured, run.block_s)
     record = PoseRecord(
         step_key=step.key, setpoint_c=step.setpoint_c, pose_number=step.pose.number,
         commanded_angles_deg=commanded, measured_angles_deg=measured, gravity_fixture=gravity_fixture,

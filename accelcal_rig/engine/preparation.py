@@ -17,13 +17,16 @@ from accelcal_rig.config.load import (
     resolve_rig_path,
     with_chamber_profile,
     with_faults,
+    with_part_ranges,
 )
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.geometry import fixture_to_dut
 from accelcal_rig.engine.pose_steps import REFERENCE_NEEDS, REFERENCES
+from accelcal_rig.fit.acceptance import unknown_limit
+from accelcal_rig.fit.channel_models import model_for_quantity
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem
-from accelcal_rig.parts.registry import part
+from accelcal_rig.parts.registry import known_parts, part
 from accelcal_rig.plan.compile import CooldownPoseMissing, Plan, VerificationSeenByFit, compile_plan
 from accelcal_rig.plan.gyro_steps import NoRateAxis
 from accelcal_rig.plan.kinematics import UnreachablePose
@@ -62,7 +65,9 @@ def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str 
     rig = with_chamber_profile(with_faults(load_rig(resolve_rig_path(procedure, rig_override)), faults),
                                chamber_profile)
     check_procedure_against_rig(procedure, rig)
+    procedure = with_part_ranges(procedure, rig)
     _check_every_channel_has_a_reference(rig)
+    _check_acceptance_is_judged(procedure, rig)
     try:
         plan = compile_plan(procedure.model, rig.model)
     except UnreachablePose as exc:
@@ -91,6 +96,45 @@ def _check_every_channel_has_a_reference(rig: LoadedConfig[RigConfig]) -> None:
                 raise rig.error(("fixture", "sensors", index, "part"),
                                 f"the {part(sensor.part).label}'s {channel.name} channel measures {channel.quantity}, "
                                 f"whose reference at each pose is {what}: state {key} in {rig.path}")
+
+
+def _check_acceptance_is_judged(procedure: LoadedConfig[Procedure], rig: LoadedConfig[RigConfig]) -> None:
+    """Refuse a limit no channel model would judge (a misspelt key is a limit silently not judged): each channel's
+    limits checked against its quantity's model, as the fixture's parts (else any known part) name the channel."""
+    on_fixture = {c.name: c.quantity for s in rig.model.fixture.sensors for c in part(s.part).channels}
+    anywhere = {c.name: c.quantity for p in known_parts().values() for c in p.channels}
+    acceptance = procedure.model.acceptance
+    for channel, limits in acceptance.channels.items():
+        where: tuple[str, ...] = ("acceptance",) if _before_channels(procedure, channel) else ("acceptance", channel)
+        quantity = on_fixture.get(channel, anywhere.get(channel))
+        if quantity is None:
+            raise procedure.error(where, f"no part has a channel {channel!r} (the parts' channels: "
+                                         f"{', '.join(sorted(anywhere))})")
+        model = model_for_quantity(quantity)
+        if model is None:
+            continue  # _check_every_channel_has_a_reference refused it on the fixture; elsewhere it judges nothing
+        problem = unknown_limit(model, limits.figure_limits())
+        if problem:
+            raise procedure.error((*where, problem.split(" ", 1)[0]), problem)
+        temperatures = procedure.model.verification_temperatures()
+        for spec in model.limits:
+            if spec.key in limits.figure_limits() and temperatures < spec.needs_temperatures:
+                raise procedure.error((*where, spec.key), f"acceptance.{acceptance.written(channel, spec.key)} is judged "
+                                      f"across verification temperatures: verify at "
+                                      f"{_WORDS.get(spec.needs_temperatures, spec.needs_temperatures)} or more")
+        if limits.parameters is not None:
+            problem = unknown_limit(model, limits.parameters.limits(), parameters=True)
+            if problem:
+                raise procedure.error((*where, "parameters", problem.split(" ", 1)[0]), problem)
+
+
+_WORDS = {2: "two", 3: "three"}
+
+
+def _before_channels(procedure: LoadedConfig[Procedure], channel: str) -> bool:
+    """Whether the channel's limits stand at the top of `acceptance`, as before limits were keyed by channel."""
+    return (("acceptance", channel) not in procedure.lines
+            and any(key[:1] == ("acceptance",) and len(key) == 2 for key in procedure.lines))
 
 
 def _check_design_identifies_fit(procedure: LoadedConfig[Procedure], rig: RigConfig, plan: Plan) -> None:

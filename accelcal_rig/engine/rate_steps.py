@@ -80,11 +80,10 @@ class RateStepHandler:
         if played.turning_in != step.pose.angles_deg:
             travel_s = abs(played.rate_dps) / acceleration + played.travel_to(step.pose.angles_deg)
             played.rate_dps = 0.0
-        acquisition = played.procedure.acquisition
         change_s = abs(step.rate_dps - played.rate_dps) / acceleration
         played.rate_dps, played.turning_in = step.rate_dps, step.pose.angles_deg
         played.wait("poses", travel_s + change_s + procedure_rates.settle_s + MOVE_POLL_S / 2
-                    + acquisition.samples_per_pose / acquisition.odr_hz)
+                    + played.block_s)
 
 
 def stop_turning(run: RunContext, axis: int, acceleration_dps2: float) -> None:
@@ -142,11 +141,10 @@ class NoiseBlockHandler:
         run.table.angles_deg = np.array(step.pose.angles_deg)
 
     def estimate(self, step: NoiseBlock, played: PlayedRig) -> None:
-        acquisition = played.procedure.acquisition
         if step.number == 1:
             played.wait("poses", played.travel_to(step.pose.angles_deg) + played.pose_fixed_s)
         else:
-            played.wait("poses", acquisition.samples_per_pose / acquisition.odr_hz)
+            played.wait("poses", played.block_s)
 
 
 RATE_STEP: StepHandler[RateStep] = RateStepHandler()

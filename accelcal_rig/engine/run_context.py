@@ -20,6 +20,7 @@ from accelcal_rig.errors import InstrumentError
 from accelcal_rig.fit.early_check import dropped
 from accelcal_rig.instruments.capabilities import alarm_active
 from accelcal_rig.instruments.interfaces import Chamber, RigInstruments, Sensor, TruthSource, Turntable
+from accelcal_rig.parts.part import odr_hz_of
 from accelcal_rig.plan.compile import Plan
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.store.writer import CampaignWriter
@@ -126,6 +127,12 @@ class RunContext:
     @property
     def sensors(self) -> list[Sensor]:
         return self.instruments.sensors
+
+    @property
+    def block_s(self) -> float:
+        """How long a pose's samples take: at the slowest DUT's rate."""
+        acquisition = self.procedure.acquisition
+        return acquisition.block_s([odr_hz_of(s.part, acquisition.odr_hz) for s in self.sensors])
 
     @property
     def truth(self) -> TruthSource | None:

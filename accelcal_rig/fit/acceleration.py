@@ -40,6 +40,7 @@ ACCELERATION = VectorQuantity(
     quantity="acceleration", sensor="accelerometer", unit="g", milli="mg", magnitude_label="|g|",
     reference_label="gravity", magnitude_figure=("gravity_m_s2", STANDARD_GRAVITY_M_S2), angle="tilt",
     site=site_gravity, truth=_stored_truth, method=METHOD, micro="µg", magnitude_source="site's gravity",
+    size_source="gravity",
     angle_label="largest tilt error (Eq. 10)",
     result_digits={"bias": "+.3f", "non-orthogonality": "+.4f", "misalignment": "+.4f"},
     noise=NoiseFigures("vrw_m_s_per_rthr", "velocity random walk", "m/s/√h", STANDARD_GRAVITY_M_S2 * 60.0,

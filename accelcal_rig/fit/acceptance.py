@@ -12,7 +12,7 @@ fails unless the procedure allows it.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -100,7 +100,7 @@ def judge(model: ChannelModel, channel: str, fitted: ChannelFit, acceptance: Acc
         checks, missing = _figure_checks(model, channel, limits.figure_limits(), verification, rule)
         if limits.parameters is not None:
             stated = limits.parameters.limits()
-            _known_keys(model, channel, stated)
+            _known_keys(model, channel, stated, parameters=True)
             groups, unjudged = model.judged_groups(fitted.calibration)
             checks += parameter_checks(fitted.thermal, limits.parameters.at_c, fitted.parameter_u, model,
                                        [g for g in groups if g.key in stated], stated, rule, channel)
@@ -149,14 +149,24 @@ def _figure_checks(model: ChannelModel, channel: str, stated: dict[str, float], 
 _COUNTS = {2: "two", 3: "three"}
 
 
-def _known_keys(model: ChannelModel, channel: str, stated: dict[str, float]) -> None:
+def unknown_limit(model: ChannelModel, stated: Mapping[str, float], parameters: bool = False) -> str | None:
+    """Why the first of the `stated` limits is not one the channel's model judges (a figure limit, or with
+    `parameters` a kind of parameter); None when it judges them all."""
+    known = sorted(group.key for group in model.parameter_groups) if parameters else sorted(s.key for s in model.limits)
+    unknown = [key for key in stated if key not in known]
+    if not unknown:
+        return None
+    what = "kind of parameter" if parameters else "figure limit"
+    return f"{unknown[0]} is not a {what} of the {model.sensor} model (its: {', '.join(known) or 'none'})"
+
+
+def _known_keys(model: ChannelModel, channel: str, stated: dict[str, float], parameters: bool = False) -> None:
     """A limit its channel's model does not know is the procedure's mistake (the run's preparation refuses it; a
     campaign stored before a model changed may still hold one)."""
-    known = {spec.key for spec in model.limits} | {group.key for group in model.parameter_groups}
-    unknown = [key for key in stated if key not in known]
-    if unknown:
-        raise ConfigError(f"acceptance.{channel}: {unknown[0]} is not a limit of the {model.sensor} model (its limits: "
-                          f"{', '.join(sorted(known))})")
+    problem = unknown_limit(model, stated, parameters)
+    if problem:
+        where = f"acceptance.{channel}.parameters" if parameters else f"acceptance.{channel}"
+        raise ConfigError(f"{where}: {problem}")
 
 
 def _partial(partial: str, allowed: bool) -> tuple[bool, str] | None:

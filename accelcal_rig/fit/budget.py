@@ -176,7 +176,7 @@ def smoothed_temperature_u_c(t_s: np.ndarray, groups: list[np.ndarray], scatter_
 
 
 def budget(poses: VectorPoses, covariance: CoefficientCovariance, thermal: ThermalModel, temperatures: np.ndarray,
-           scatter_c: float, milli: str = "mg") -> dict[str, Any]:
+           scatter_c: float, milli: str = "mg", size_source: str = "gravity") -> dict[str, Any]:
     """The budget of a reading like a calibration pose at each calibration temperature and the worst case
     over the range, per axis, in thousandths of the channel's unit (`milli`: mg for an accelerometer): each
     source's largest value over every orientation, and the combined."""
@@ -186,7 +186,7 @@ def budget(poses: VectorPoses, covariance: CoefficientCovariance, thermal: Therm
     raw = distort(np.tile(directions, (len(grid), 1)), thermal.parameters_at(t, "extrapolate"))
     reading = np.median(poses.stderr, axis=0)
     sources = output_uncertainty(raw, t, thermal, covariance, np.tile(reading, (len(t), 1)), np.full(len(t), scatter_c),
-                                 poses.magnitude_u / poses.magnitude)
+                                 poses.magnitude_u / poses.magnitude, size_source=size_source)
     standard = combined(sources)
 
     def worst(values: np.ndarray, at: np.ndarray) -> list[float]:

@@ -26,7 +26,9 @@ def expected_reference_rmse_mg(jacobian: np.ndarray, reference_g: np.ndarray, st
     # The noise each pose's whitened residual carries: its samples' (diagonal) and a small rotation's.
     noise = np.einsum("na,ab->nab", stderr_g**2, np.eye(3)) + pointing_covariance_g2(reference_g, accuracy_rad)
     noise /= sigma_g[:, :, None] * sigma_g[:, None, :]
-    projection = reference_g * sigma_g                              # |g| residual = projection · whitened
+    # |g| residual = projection · whitened: the residual along the reference's direction (a unit vector: a
+    # magnetometer's reference is half a gauss, not one).
+    projection = reference_g / np.linalg.norm(reference_g, axis=1, keepdims=True) * sigma_g
     q, _ = np.linalg.qr(jacobian)
     q = q.reshape(n, 3, -1)                                         # each pose's rows of Q, H = Q Qᵀ
     # u = P (I − Q Qᵀ) ε with P one 3-block per pose and ε's covariance block-diagonal, so the diagonal of

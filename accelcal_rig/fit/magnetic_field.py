@@ -59,7 +59,7 @@ def _described_truth(campaign: Campaign, serial: str, channel: str,
 
 
 def _statements(figures: Mapping[str, Any]) -> list[tuple[str, str]]:
-    field = figures.get("site_field")
+    field = figures.get("site_magnetic_field")
     if not isinstance(field, dict):
         return []
     text = (f"F = {field['total_intensity_nt']:.0f} nT, inclination {field['inclination_deg']:g}°, declination "
@@ -73,7 +73,8 @@ MAGNETIC_FIELD = VectorQuantity(
     quantity="magnetic field", sensor="magnetometer", unit="gauss", milli="mgauss", magnitude_label="|B|",
     reference_label="field", magnitude_figure=("field_gauss", 1.0), angle="direction", site=site_field,
     truth=_described_truth, method="Eq. 1, B = M·C·S·(U − b): b the hard-iron offset, M·C·S the soft-iron matrix",
-    micro="µgauss", magnitude_source="site's field intensity", angle_label="largest direction error",
+    micro="µgauss", magnitude_source="site's field intensity",
+    size_source="field_intensity", angle_label="largest direction error",
     statements=_statements, c_token="mag", direction_known=direction_known, site_description=_recorded_field,
 )
 

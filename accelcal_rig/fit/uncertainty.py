@@ -172,8 +172,10 @@ def residual_sigma(temperatures_c: np.ndarray, sigma: np.ndarray, n_powers: int)
 
 def output_uncertainty(raw_g: np.ndarray, temperature_c: np.ndarray, model: ThermalModel,
                        covariance: CoefficientCovariance, reading_stderr_g: np.ndarray, temperature_u_c: np.ndarray,
-                       gravity_relative_u: float, out_of_range: OutOfRange = "extrapolate") -> dict[str, np.ndarray]:
-    """Per source, the standard uncertainty (n, 3) in g of `raw_g` (n, 3) compensated at `temperature_c` (n,)."""
+                       gravity_relative_u: float, out_of_range: OutOfRange = "extrapolate",
+                       size_source: str = "gravity") -> dict[str, np.ndarray]:
+    """Per source, the standard uncertainty (n, 3) in g of `raw_g` (n, 3) compensated at `temperature_c` (n,);
+    `size_source` names the reference size's (its relative uncertainty `gravity_relative_u`)."""
     raw_g = np.asarray(raw_g, dtype=float)
     temperature_c = np.asarray(temperature_c, dtype=float)
     params = model.parameters_at(temperature_c, out_of_range)            # (n, 12)
@@ -210,7 +212,7 @@ def output_uncertainty(raw_g: np.ndarray, temperature_c: np.ndarray, model: Ther
     if covariance.hysteresis is not None:  # not measured is not zero: budget.not_included says so
         sources["hysteresis"] = np.sqrt(np.einsum("nab,b,nab->na", gain, covariance.hysteresis**2, gain))
     sources["temperature"] = np.abs(by_temperature) * np.asarray(temperature_u_c, dtype=float)[:, None]
-    sources["gravity"] = np.abs(output) * gravity_relative_u
+    sources[size_source] = np.abs(output) * gravity_relative_u
     return sources
 
 

@@ -93,6 +93,7 @@ class VectorQuantity:
     method: str                        #: the method a certificate cites
     micro: str                         #: millionths of `unit`, how a certificate states small figures: "µg"
     magnitude_source: str              #: what the reference's size comes from, as a certificate says it
+    size_source: str                   #: the budget's source of the reference size's uncertainty, "gravity"
     angle_label: str                   #: the angle figure as a certificate names it
     #: a certificate's format of each parameter kind's results (by its label), where not the group's own
     result_digits: Mapping[str, str] = field(default_factory=dict)
@@ -458,7 +459,7 @@ def _fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity) 
     covariance = calibration_covariance(poses, groups, fits, thermal, temperatures, pose_temperatures, options.mode,
                                         joint, terms)
     scatter_c = temperature_scatter_c(poses, pose_temperatures, len(groups))
-    metrics["uncertainty_budget"] = budget(poses, covariance, thermal, temperatures, scatter_c, m)
+    metrics["uncertainty_budget"] = budget(poses, covariance, thermal, temperatures, scatter_c, m, spec.size_source)
     metrics[f"expanded_uncertainty_{m}"] = metrics["uncertainty_budget"][f"expanded_{m}"]
     parameter_u = of_sensor(thermal, covariance, poses.magnitude_u / poses.magnitude)
     metrics["parameter_uncertainty"] = parameter_u.expanded_table(certificate_temperatures(thermal.domain_c),

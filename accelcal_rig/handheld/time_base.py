@@ -1,5 +1,5 @@
 """Whether a recording's time base can be what it says: the sampling rate its time column gives must lie within
-the data rates a MEMS part runs at — the part's own (`--part`), else any known part's — with a margin for a
+the data rates a MEMS part runs at — the part's own (`--part`), else any known accelerometer's — with a margin for a
 logger's clock and for a logger keeping every other sample. A sample-index column read as seconds gives 1 Hz
 (9414 samples over 2.6 hours); one in milliseconds read as seconds, a thousandth of the rate: a fit of either
 finds "static intervals" that span motion, so the recording is refused before it is fitted."""
@@ -11,6 +11,7 @@ import numpy as np
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.registry import known_parts
 
+ACCELERATION = "acceleration"
 #: How far below the slowest and above the fastest data rate a recording's rate may lie.
 RATE_MARGIN = 2.0
 #: What to check, by the unit the time column was read in.
@@ -25,8 +26,10 @@ def plausible_rates_hz(part_name: str) -> tuple[float, float, str]:
     parts = known_parts()
     if part_name in parts:
         rates, whose = parts[part_name].output_data_rates_hz, f"the {parts[part_name].label}'s data rates"
-    else:
-        rates, whose = tuple(r for p in parts.values() for r in p.output_data_rates_hz), "any known part's data rates"
+    else:  # a handheld recording is an accelerometer's (a magnetometer's slowest rates are no bound for it)
+        rates = tuple(r for p in parts.values() if any(c.quantity == ACCELERATION for c in p.channels)
+                      for r in p.output_data_rates_hz)
+        whose = "any known accelerometer's data rates"
     return min(rates) / RATE_MARGIN, max(rates) * RATE_MARGIN, whose
 
 

@@ -27,7 +27,8 @@ LIS3MDL = Part(
     # Noise density: the data sheet gives 3.2 mgauss RMS (x, y) in ultra-high-performance mode and no density;
     # this one makes the simulation's white noise that RMS at 155 Hz (density × √(π/2 × ODR/4)).
     channels=(Channel(name="mag", quantity="magnetic field", unit="gauss", lsb_per_unit=_LSB_PER_GAUSS,
-                      range_codes=_FS, code_bits=16, noise_density_micro_per_rthz=410.0, zero_offset=1.0),),
+                      range_codes=_FS, code_bits=16, noise_density_micro_per_rthz=410.0, zero_offset=1.0,
+                      default_range=4.0),),  # CTRL_REG2's reset value 0x00: ±4 gauss (the Earth's is below 0.7)
     output_data_rates_hz=OUTPUT_DATA_RATES_HZ,
     odr_codes=ODR_CODES,
     # TEMP_OUT_H/L, signed: °C = TEMP_OUT / 8 + 25 (8 LSB/°C; the zero at 25 °C is ST's driver's).

@@ -53,6 +53,9 @@ class Channel:
     noise_density_micro_per_rthz: float        #: typical, in µ(unit)/√Hz (µg/√Hz, µ°/s/√Hz), most sensitive range
     axes: tuple[str, ...] = ("x", "y", "z")
     zero_offset: float | None = None           #: the data sheet's ± range of the zero offset at 25 °C, in unit
+    #: The range a procedure that names none runs the channel at: the part's own power-on range where a channel
+    #: has one the whole fixture can share (a magnetometer's beside accelerometers); None: the procedure names it.
+    default_range: float | None = None
 
     @property
     def ranges(self) -> tuple[float, ...]:
@@ -148,16 +151,25 @@ class Part:
     def has_rate(self, odr_hz: float) -> bool:
         return any(abs(odr_hz - rate) < 1e-3 for rate in self.output_data_rates_hz)
 
+    def rate_for(self, odr_hz: float) -> float | None:
+        """The rate this part runs at when a procedure asks for `odr_hz`: that rate where the part has it, else its
+        next faster one (a mixed fixture's parts rarely share every rate; sampling faster only shortens a pose's
+        block); None when the part has no rate that fast."""
+        if self.has_rate(odr_hz):
+            return odr_hz
+        faster = [rate for rate in self.output_data_rates_hz if rate > odr_hz]
+        return min(faster) if faster else None
+
     def range_problem(self, channel: str, range_: float) -> str | None:
         """Why ±`range_` is not a range of the part's `channel`; None when it is."""
         return self.channel(channel).range_problem(range_, self.label)
 
     def rate_problem(self, odr_hz: float) -> str | None:
-        """Why `odr_hz` is not an output data rate of this part; None when it is."""
-        if self.has_rate(odr_hz):
+        """Why the part cannot run at `odr_hz` or its next faster rate; None when it can."""
+        if self.rate_for(odr_hz) is not None:
             return None
         rates = ", ".join(f"{r:g}" for r in self.output_data_rates_hz)
-        return f"{odr_hz:g} Hz is not an {self.label} output data rate ({rates})"
+        return f"{odr_hz:g} Hz is faster than every {self.label} output data rate ({rates})"
 
     def describe_identity(self, found: tuple[int, ...]) -> str:
         """Identification registers as the data sheet names them: "DEVID_AD 0xAD, DEVID_MST 0x1D, …"."""
@@ -176,3 +188,12 @@ class Part:
 
 def _hex(values: tuple[int, ...]) -> str:
     return "/".join(f"{v:02X}" for v in values)
+
+
+def odr_hz_of(part: Part, asked_hz: float) -> float:
+    """The rate `part` runs at when a procedure asks for `asked_hz` (`Part.rate_for`); the procedure's check
+    refused a rate no DUT part reaches before anything runs."""
+    rate = part.rate_for(asked_hz)
+    if rate is None:
+        raise ValueError(part.rate_problem(asked_hz))
+    return rate

@@ -218,7 +218,8 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
     style = (STYLE + certificate_decision.STYLE + (DRY_RUN_PAGES if attrs.get("dry_run") else "")
              + (SEVERAL_STYLE if several else ""))
     sensors = [model.sensor for model in models.values()]
-    item = f"MEMS {' and '.join(sensors)}{' channel' if uncalibrated and not several else ''}"
+    named = ", ".join(sensors[:-1]) + " and " + sensors[-1] if several else sensors[0]
+    item = f"MEMS IMU: {named}" if several else f"MEMS {named}{' channel' if uncalibrated else ''}"
     parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Calibration certificate {_e(number)}"
              f"</title><style>{style}</style><style>{certificate_lab.LAB_STYLE}</style></head><body>",
              certificate_lab.header_html(campaign),

@@ -43,7 +43,7 @@ FIGURES = {
     "soaks": "soak_traces.png",
 }
 #: Drawn only where the campaign has them: a calibrated gyroscope, a still noise record.
-GYRO_FIGURES = {"gyro_parameters": "gyro_parameters.png", "allan": "allan_deviation.png"}
+GYRO_FIGURES = {"allan": "allan_deviation.png"}
 #: A verdict's row style: a failed DUT highlighted, a CONDITIONAL one (inside a guard band) in amber.
 _VERDICT_ROWS = {"FAIL": "warning", "CONDITIONAL": "conditional"}
 
@@ -70,7 +70,10 @@ def _table(header: list[str] | None, rows: Sequence[Sequence[object]], text_colu
 
 
 def _figure(name: str, caption: str) -> str:
-    file = FIGURES.get(name) or GYRO_FIGURES[name]
+    return _image(FIGURES.get(name) or GYRO_FIGURES[name], caption)
+
+
+def _image(file: str, caption: str) -> str:
     return f'<figure><img src="figures/{file}" alt="{_e(caption)}"><figcaption class="note">{_e(caption)}' \
            "</figcaption></figure>"
 
@@ -209,11 +212,12 @@ def _parameters_figure(quantity: str) -> str:
 
 
 def _channels_section(data: CampaignData) -> list[str]:
-    """Every calibrated channel, a table per quantity: each DUT's verdict and its model's figures (in-sample and on
-    the records the fit never saw); and, for a quantity the report's figures do not draw, its parameters over
-    temperature."""
+    """Every calibrated channel of a quantity the report's sections above do not draw in detail, a table per
+    quantity: each DUT's verdict and its model's figures (in-sample and on the records the fit never saw), and its
+    parameters over temperature."""
     parts = []
-    quantities = list(dict.fromkeys(c.model.quantity for channels in data.channels.values() for c in channels.values()))
+    quantities = list(dict.fromkeys(c.model.quantity for channels in data.channels.values() for c in channels.values()
+                                    if c.model.quantity != DRAWN_QUANTITY))
     for quantity in quantities:
         fitted = [(serial, name, c) for serial, channels in data.channels.items() for name, c in channels.items()
                   if c.model.quantity == quantity]
@@ -229,12 +233,11 @@ def _channels_section(data: CampaignData) -> list[str]:
                   "<p class='note'>Fitted from the campaign for this report with the options it records, as rig fit "
                   "does; a per-axis figure shows its largest axis; verification figures are on records the fit never "
                   "saw.</p>"]
-        if quantity != DRAWN_QUANTITY:
-            parts += [f"<h2>{_e(model.sensor.capitalize())} parameters over temperature</h2>",
-                      _figure(_parameters_figure(quantity).removesuffix(".png"),
-                              f"Each {model.sensor}'s {model.parameter_groups[0].label} and "
-                              f"{model.parameter_groups[1].label} per axis fitted at each setpoint (±1σ) and its "
-                              "polynomial over the sensor temperature.")]
+        parts += [f"<h2>{_e(model.sensor.capitalize())} parameters over temperature</h2>",
+                  _image(_parameters_figure(quantity),
+                         f"Each {model.sensor}'s {model.parameter_groups[0].label} and "
+                         f"{model.parameter_groups[1].label} per axis fitted at each setpoint (±1σ) and its "
+                         "polynomial over the sensor temperature.")]
     return parts
 
 

@@ -8,6 +8,8 @@ from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.engine.estimate import DurationEstimate
 from accelcal_rig.engine.preparation import PreparedCampaign
+from accelcal_rig.parts.part import odr_hz_of
+from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.compile import setpoint_label
 from accelcal_rig.plan.steps import RateStep
 from accelcal_rig.store.space import START_MARGIN, megabytes
@@ -103,7 +105,10 @@ def _poses_line(prepared: PreparedCampaign) -> str:
     procedure, plan = prepared.procedure.model, prepared.plan
     acquisition, cooldown = procedure.acquisition, procedure.cooldown
     ranges = ", ".join(f"{channel} ±{value:g}" for channel, value in acquisition.ranges.items())
-    samples = (f"{acquisition.samples_per_pose} samples at {acquisition.odr_hz:g} Hz, {ranges}, "
+    faster = {p.label: odr_hz_of(p, acquisition.odr_hz) for p in (part(s.part) for s in prepared.rig.model.fixture.sensors)
+              if odr_hz_of(p, acquisition.odr_hz) != acquisition.odr_hz}
+    rates = "".join(f" ({label} at {rate:g} Hz, its next rate above)" for label, rate in faster.items())
+    samples = (f"{acquisition.samples_per_pose} samples at {acquisition.odr_hz:g} Hz{rates}, {ranges}, "
                f"settle {acquisition.settle_s:g} s")
     if cooldown is not None:
         return (f"records    {len(plan.pose_steps)} at pose {cooldown.pose} of the {procedure.schedule.kind} schedule, "
@@ -157,9 +162,11 @@ def _verification_lines(prepared: PreparedCampaign) -> list[str]:
     limits = procedure.acceptance
     judged = []
     for channel, stated in limits.channels.items():
-        judged += [f"{channel} {name} {value:g}" for name, value in stated.figure_limits().items()]
+        # Limits at the top of `acceptance` (the accelerometer's, as before they were keyed by channel) unprefixed.
+        named = "" if limits.written(channel, "") == "" else f"{channel} "
+        judged += [f"{named}{name} {value:g}" for name, value in stated.figure_limits().items()]
         if stated.parameters is not None:
-            judged += [f"{channel} {name} {value:g} at {stated.parameters.at_c:g} °C"
+            judged += [f"{named}{name} {value:g} at {stated.parameters.at_c:g} °C"
                        for name, value in stated.parameters.limits().items()]
     rule = ("" if not judged else f"; {limits.decision_rule} acceptance" + (
         f", guard band {limits.guard_band_factor:g} × U" if limits.decision_rule == "guarded" else "")

@@ -35,7 +35,7 @@ from accelcal_rig.sim.truth import (
 from accelcal_rig.sim.turntable_motion import TurntableMotion
 
 #: The quantity the lab's magnetometers measure (a part's channel of it is fed the site's field).
-MAGNETIC_FIELD = "magnetic field"
+MAGNETIC_FIELD, ACCELERATION = "magnetic field", "acceleration"
 
 
 class SimulatedDut:
@@ -45,12 +45,15 @@ class SimulatedDut:
                  dut_part: Part) -> None:
         self.serial = serial
         self.part = dut_part
-        self.truth: DutTruth = truth_for_serial(serial)
         #: A gyroscope's hidden truth, where the part has one (its own seed: the acceleration truth is unchanged).
         self.gyro_truth: DutTruth | None = gyro_truth_for_serial(serial) if "gyro" in dut_part.channel_names else None
         #: A magnetometer's hidden truth (Eq. 1: hard iron, soft iron), where the part has one.
         self.mag_truth: DutTruth | None = (mag_truth_for_serial(serial) if any(
             c.quantity == MAGNETIC_FIELD for c in dut_part.channels) else None)
+        #: The hidden Eq. 1 truth of its first channel, what the campaign file's truth records pose by pose: its
+        #: accelerometer's, a magnetometer's where the part has no accelerometer.
+        accelerometer = any(c.quantity == ACCELERATION for c in dut_part.channels)
+        self.truth: DutTruth = truth_for_serial(serial) if accelerometer or self.mag_truth is None else self.mag_truth
         #: Fixture frame → DUT frame.
         self.fixture_to_dut = fixture_to_dut(mount_euler_deg)
         self.tau_s = tau_s
@@ -255,9 +258,11 @@ class VirtualLab:
         temperature = float(instant.temperature_c[index])
         field = dut.fixture_to_dut @ self.kinematics.world_in_fixture(self.motion.position_deg(self.clock.now()),
                                                                       self.field_world_gauss)
-        reading = distort(field, dut.mag_truth.parameters_at(temperature))
+        parameters = dut.mag_truth.parameters_at(temperature)
+        reading = distort(field, parameters)
         noise = self.mag_rngs[index].normal(0.0, self.mag_noise_gauss(index, odr_hz), (n_samples, 3))
-        dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, instant.parameters[index].copy(),
+        # The truth's parameters are the DUT's first channel's (its magnetometer's: it has no accelerometer).
+        dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, parameters,
                               instant.gravity_g[index].copy(), temperature))
         channel = next(c for c in dut.part.channels if c.quantity == MAGNETIC_FIELD)
         return channel.quantise(reading + noise, range_gauss)
@@ -311,4 +316,4 @@ class VirtualLab:
 
 def _accelerometer_noise(dut_part: Part) -> float:
     """A part's accelerometer's noise density, µg/√Hz (0 for a part without one)."""
-    return next((c.noise_density_micro_per_rthz for c in dut_part.channels if c.quantity == "acceleration"), 0.0)
+    return next((c.noise_density_micro_per_rthz for c in dut_part.channels if c.quantity == ACCELERATION), 0.0)

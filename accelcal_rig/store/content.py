@@ -18,7 +18,6 @@ from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
 from accelcal_rig.store.records import CampaignHeader, ChannelInfo, PoseRecord, RunStart, SoakTrace, StoredEvent
 
 #: The acceleration channel's fields under their names in formats 1 and 2.
-_ACCELERATION_NAMES = {"raw_codes": "raw_codes", "mean_g": "mean", "stderr_g": "stderr", "gravity_reference_g": "reference"}
 #: A channel's fields, per pose.
 CHANNEL_FIELDS = ("raw_codes", "mean", "stderr", "reference")
 POSE_FIELDS = ("step_key", "setpoint_c", "pose_number", "commanded_angles_deg", "measured_angles_deg",
@@ -114,11 +113,8 @@ class Campaign:
         return self._columns[key]
 
     def dut_column(self, serial: str, name: str) -> np.ndarray:
-        """One of a DUT's own fields over the stored poses (`temperature_c`, `temperature_in_band`), or its
-        acceleration channel's under the names of formats 1 and 2 (`raw_codes`, `mean_g`, `stderr_g`,
-        `gravity_reference_g`), for the readers that handle only that channel."""
-        if name in _ACCELERATION_NAMES:
-            return self.channel_column(serial, "accel", _ACCELERATION_NAMES[name])
+        """One of a DUT's own fields over the stored poses: `temperature_c`, `temperature_in_band` (its channels'
+        are `channel_column`'s)."""
         key = f"duts/{serial}/{name}"
         if key not in self._columns:
             index = self.serials.index(serial)
@@ -227,18 +223,18 @@ def take_what_the_file_kept(campaign: Campaign, from_file: Campaign, journal_nam
 
 def measurements_sha256(campaign: Campaign) -> str:
     """Digest of the measured data (pose keys, raw codes, temperatures, references), not of a file: the
-    same campaign read from its journal or its HDF5 file has the same digest. The acceleration channel
-    first, as formats 1 and 2 digested it, then any other channel: an accelerometer's campaign keeps its
+    same campaign read from its journal or its HDF5 file has the same digest. Each DUT's first channel with
+    its temperatures between its codes and its references, then its other channels: the order formats 1 and 2
+    digested an accelerometer's campaign in (its acceleration channel first), so such a campaign keeps its
     digest in every format."""
     digest = hashlib.sha256()
     digest.update(b"".join(p.step_key.encode() for p in campaign.poses))
     for serial in sorted(campaign.serials):
-        for name in ("raw_codes", "temperature_c", "gravity_reference_g"):
-            digest.update(np.ascontiguousarray(campaign.dut_column(serial, name)).tobytes())
-        for info in campaign.header.dut_channels(serial):
-            if info.name != "accel":
-                for name in ("raw_codes", "reference"):
-                    digest.update(np.ascontiguousarray(campaign.channel_column(serial, info.name, name)).tobytes())
+        for index, info in enumerate(campaign.header.dut_channels(serial)):
+            digest.update(np.ascontiguousarray(campaign.channel_column(serial, info.name, "raw_codes")).tobytes())
+            if index == 0:
+                digest.update(np.ascontiguousarray(campaign.dut_column(serial, "temperature_c")).tobytes())
+            digest.update(np.ascontiguousarray(campaign.channel_column(serial, info.name, "reference")).tobytes())
     return digest.hexdigest()
 
 

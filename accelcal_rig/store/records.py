@@ -83,23 +83,6 @@ class DutPoseRecord:
     temperature_in_band: bool        # within the soak band of the temperature the soak settled at
     truth: dict[str, np.ndarray] | None = None
 
-    # The acceleration channel's fields, for the readers that handle only it.
-    @property
-    def raw_codes(self) -> np.ndarray:
-        return self.channels["accel"].raw_codes
-
-    @property
-    def mean_g(self) -> np.ndarray:
-        return self.channels["accel"].mean
-
-    @property
-    def stderr_g(self) -> np.ndarray:
-        return self.channels["accel"].stderr
-
-    @property
-    def gravity_reference_g(self) -> np.ndarray:
-        return self.channels["accel"].reference
-
 
 @dataclass(frozen=True)
 class PoseRecord:

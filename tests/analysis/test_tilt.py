@@ -58,7 +58,7 @@ def test_the_table_and_a_foreign_calibration(tilt_campaign: Path, fitted_paper_c
     foreign = tmp_path / "other.yaml"
     foreign.write_text(calibration.read_text().replace("ADX355-A003", "ADX355-Z999"))
     assert main(["analyze", "tilt", str(tilt_campaign), "--calibration", str(foreign)]) == 2
-    assert "no calibration for ADX355-A003" in capsys.readouterr().err
+    assert "no accelerometer calibration for ADX355-A003" in capsys.readouterr().err
 
 
 def test_rig_fit_asks_for_a_mode_on_a_measure_only_campaign(tilt_campaign: Path, tmp_path: Path, capsys) -> None:

@@ -24,9 +24,13 @@ def with_imus(workdir: Path, count: int = 2) -> None:
 
 
 def test_ranges_hold_the_gyro_only_when_given() -> None:
-    assert Acquisition().ranges() == {"accel": 2}
-    assert Acquisition(range_dps=2000).ranges() == {"accel": 2, "gyro": 2000}
-    assert Acquisition(range_dps=15.625).ranges()["gyro"] == 15.625
+    assert Acquisition().ranges == {"accel": 2}
+    assert Acquisition(range_dps=2000).ranges == {"accel": 2, "gyro": 2000}
+    assert Acquisition(range_dps=15.625).ranges["gyro"] == 15.625
+    assert Acquisition(ranges={"accel": 4, "gyro": 250}).ranges == {"accel": 4, "gyro": 250}
+    assert Acquisition(ranges={"mag": 4}).ranges == {"accel": 2, "mag": 4}     # the accelerometer's 2 g unless given
+    with pytest.raises(ValueError, match="range_g"):
+        Acquisition(range_g=2, ranges={"accel": 4})
 
 
 def test_an_adxl355_procedure_is_unchanged_by_a_range_dps(write) -> None:
@@ -41,7 +45,7 @@ def test_an_imu_rig_needs_range_dps_named_in_one_line(write, workdir: Path) -> N
         prepare(path)
     message = str(raised.value)
     assert "\n" not in message
-    assert message.startswith(f"{path}:6: acquisition.range_dps: not set: sensor ADX355-A001 of ")
+    assert message.startswith(f"{path}:6: acquisition.ranges.gyro: not set: sensor ADX355-A001 of ")
     assert message.endswith("is an ICM-42688-P, whose gyro channel needs its ± full scale in dps")
 
 
@@ -49,7 +53,8 @@ def test_an_imu_rig_needs_range_dps_named_in_one_line(write, workdir: Path) -> N
     ("range_dps: 3000", r"tiny.yaml:6: acquisition.range_dps: ±3000 dps is not a range of the ICM-42688-P "
                         r"\(±15.625/31.25/62.5/125/250/500/1000/2000 dps\): sensor ADX355-A001"),
     ("range_dps: 2000, range_g: 3", r"acquisition.range_g: ±3 g is not a range of the ICM-42688-P \(±2/4/8/16 g\)"),
-    ("range_dps: 2000, odr_hz: 125", r"acquisition.odr_hz: 125 Hz is not an ICM-42688-P output data rate"),
+    ("range_dps: 2000, odr_hz: 40000", r"acquisition.odr_hz: 40000 Hz is faster than every ICM-42688-P output data "
+                                       r"rate"),
 ])
 def test_every_channel_of_an_imu_is_checked(write, workdir: Path, acquisition: str, expected: str) -> None:
     with_imus(workdir)

@@ -25,7 +25,8 @@ def test_setpoint_range_shorthand_expands() -> None:
     ("replace", "by", "expected"),
     [
         ("samples_per_pose: 20", "samples_per_pose: 1", r"tiny.yaml:6: acquisition.samples_per_pose: .*greater than or equal to 2"),
-        ("odr_hz: 125", "odr_hz: 100", r"tiny.yaml:6: acquisition.odr_hz: 100 Hz is not an ADXL355 output data rate"),
+        ("odr_hz: 125", "odr_hz: 5000", r"tiny.yaml:6: acquisition.odr_hz: 5000 Hz is faster than every ADXL355 output "
+                                        r"data rate"),
         ("range_g: 2", "range_g: 3", r"tiny.yaml:6: acquisition.range_g: "),
         ("kind: six-position", "kind: seven-position", r"tiny.yaml:5: schedule: "),
         ("kind: six-position", "kind: sphere", r"tiny.yaml:5: schedule.count: Field required"),
@@ -118,7 +119,7 @@ SETPOINTS = TINY_PROCEDURE.replace("setpoints_c: [30]", "setpoints_c: [20, 40]")
         (SETPOINTS + "verify: {schedule: {kind: sphere, count: 8}, at_setpoints: false}\n",
          r"verify: .*verification needs at_setpoints: true or setpoints_c"),
         (SETPOINTS + "acceptance: {max_verification_rmse_mg: 0.05}\n",
-         r"acceptance.max_verification_rmse_mg is judged on verification poses: add a verify: section"),
+         r"acceptance.max_verification_rmse_mg is judged on verification records: add a verify: section"),
         (SETPOINTS + "acceptance: {parameters: {at_c: 0, bias_mg: 25}}\n",
          r"acceptance.parameters.at_c: 0 °C is outside the calibrated range 20 … 40 °C"),
         (SETPOINTS + "acceptance: {max_tilt_error_deg: 0}\n", r"tiny.yaml:\d+: acceptance.max_tilt_error_deg: .*greater than 0"),

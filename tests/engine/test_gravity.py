@@ -30,17 +30,18 @@ def test_a_site_with_stronger_gravity_reads_more_than_1_g_and_is_fitted_to_it(wr
     output = campaign_at(write, workdir, "gravity_m_s2: 9.8123\n", f"site-{mode}")
     campaign = load_campaign(output)
     site_g = 9.8123 / STANDARD_GRAVITY_M_S2
-    references = np.linalg.norm(campaign.dut_column(campaign.serials[0], "gravity_reference_g"), axis=1)
+    references = np.linalg.norm(campaign.channel_column(campaign.serials[0], "accel", "reference"), axis=1)
     truths = np.linalg.norm(campaign.truth_column(campaign.serials[0], "gravity_g"), axis=1)
     np.testing.assert_allclose(references, site_g, rtol=1e-12)
     np.testing.assert_allclose(truths, site_g, rtol=1e-9)  # no uncertainty stated: the site is as stated
     assert campaign.unusable_reasons() == []  # references as long as the site's gravity are plausible, not damage
     free = "all" if mode == "reference" else "bias-scale"  # six poses: norm-only sees bias and scale only
     _, report = fit_campaign(campaign, FitOptions(mode=mode, degree=0, free=free), {"campaign": str(output)})
-    for r in report.values():  # 0.29 mg of |g| would remain if the fit aimed at 1 g
+    for dut in report.values():  # 0.29 mg of |g| would remain if the fit aimed at 1 g
+        r = dut["channels"]["accel"]
         assert r["rmse_after_mg"] < 2 * r["noise_floor_mg"] < 0.1 and r["gravity_m_s2"] == pytest.approx(9.8123)
     sensor = load_calibration(workdir / f"site-{mode}.cal.yaml").channel(campaign.serials[0], "accel")
-    raw = campaign.dut_column(campaign.serials[0], "mean_g")
+    raw = campaign.channel_column(campaign.serials[0], "accel", "mean")
     temperature = campaign.dut_column(campaign.serials[0], "temperature_c").mean(axis=1)
     compensated = np.linalg.norm(apply(sensor, raw, np.clip(temperature, *sensor.validity_c)), axis=1)
     assert np.mean(compensated) == pytest.approx(site_g, abs=2e-5)

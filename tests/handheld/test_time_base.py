@@ -93,5 +93,5 @@ def test_the_refusal_says_what_to_check_for_the_unit_given(tmp_path: Path, capsy
         recording, options = _sample_index_recording(tmp_path / "session.csv"), ["--time-unit", unit, "--rate-hz", "0.5"]
     code, output, _ = _fit(tmp_path, recording, "--columns", "time_s,ax,ay,az,temp_c", *options)
     err = capsys.readouterr().err.strip()
-    assert code == 2 and len(err.splitlines()) == 1 and f"{pace} than any known part's data rates" in err
+    assert code == 2 and len(err.splitlines()) == 1 and f"{pace} than any known accelerometer's data rates" in err
     assert hint in err.split("; ")[-1] and not output.exists()

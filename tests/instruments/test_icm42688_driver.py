@@ -198,7 +198,7 @@ def test_a_link_too_slow_for_the_rate_is_a_fault_naming_it() -> None:
 def test_a_part_that_never_says_data_ready_is_a_fault() -> None:
     stale = burst(0, (0, 0, 16384), (0, 0, 0), 0x00)
     driver, _, _ = configured([("R", 0x1D, 17, stale)] * 17)
-    with pytest.raises(InstrumentError, match="DATA_RDY never set"):
+    with pytest.raises(InstrumentError, match="data-ready status never set"):
         driver.acquire(1)
 
 

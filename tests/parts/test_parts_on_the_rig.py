@@ -34,9 +34,10 @@ def test_a_dry_run_of_adxl357_and_adxl359_duts_simulates_those_parts(write, work
     output = workdir / "run.h5"
     run_campaign(prepare(procedure), output, dry_run=True, seed=3, overwrite=False)
     campaign = load_campaign(output)
-    assert [(d["part"], d["lsb_g"]) for d in campaign.header.duts] == [("adxl357", 1 / 51_200), ("adxl359", 1 / 51_200)]
+    assert [(d["part"], campaign.channel_info(d["serial"], "accel").lsb) for d in campaign.header.duts] == [
+        ("adxl357", 1 / 51_200), ("adxl359", 1 / 51_200)]
     for index, part in enumerate((ADXL357, ADXL359)):
-        codes = np.stack([p.duts[index].raw_codes for p in campaign.poses])        # (poses, samples, 3)
+        codes = np.stack([p.duts[index].channels["accel"].raw_codes for p in campaign.poses])        # (poses, samples, 3)
         norm_g = np.linalg.norm(codes.mean(axis=1), axis=1) * part.channel("accel").lsb(10)
         assert np.all(np.abs(norm_g - 1.0) < 0.05)                                  # 1 g at 51 200 LSB/g
         # Per-sample noise at 125 Hz: 80 µg/√Hz × √(π/2 · 125/4) ≈ 0.56 mg (an ADXL355 would give 0.18 mg).

@@ -51,7 +51,7 @@ def test_an_imu_certificate_states_its_gyroscope_as_its_calibration_holds_it(imu
         for value in (*budget["at_rest"]["expanded_dps"], *budget["at_largest_rate"]["expanded_dps"]):
             assert f"<td>{value:.5f}</td>" in page
         assert "table pointing" in page and "at ±1000 °/s" in page
-        assert gyro.earth_rate in page.replace("&#x27;", "'") and "the fixture frame as the rate table realises it" in page
+        assert gyro.statements["earth_rate"] in page.replace("&#x27;", "'") and "the fixture frame as the rate table realises it" in page
         bias_x = gyro.parameters_at(25.0)[0]
         assert f"{bias_x:+.4f} ± " in page  # the bias at the reference temperature with its expanded uncertainty
         arw = gyro.metrics["allan"]["arw_deg_per_rthr"][0]["value"]
@@ -110,23 +110,26 @@ def test_the_report_has_the_gyroscope_section_and_figures(imu: tuple[Path, Path]
     page = write_report(campaign, tmp_path / "report")
     text = page.read_text(encoding="utf-8")
     calibration = load_calibration(calibration_path)
-    for heading in ("Gyroscope calibration", "Gyroscope parameters over temperature", "Noise: Allan deviation"):
+    for heading in ("Calibration of every gyroscope (angular rate)", "Gyroscope parameters over temperature",
+                    "Noise: Allan deviation"):
         assert f"<h2>{heading}</h2>" in text
-    assert "Not calibrated:" not in text and "the calibration file beside the campaign (imu.calibration.yaml)" in text
-    section = text.split("<h2>Gyroscope calibration</h2>")[1].split("<h2>")[0]
-    for serial, gyro in calibration.of_quantity("angular rate").items():
-        row = re.search(rf"<tr[^>]*><td class=\"text\">{serial}</td><td class=\"text\">(PASS|FAIL)</td>.*?</tr>", section)
+    assert "Not calibrated:" not in text and "Fitted from the campaign for this report" in text
+    section = text.split("<h2>Calibration of every gyroscope (angular rate)</h2>")[1].split("<h2>")[0]
+    for serial, gyro in calibration.of_quantity("angular rate").items():  # the same fit as the file's
+        row = re.search(rf"<tr[^>]*><td class=\"text\">{serial}</td><td class=\"text\">gyro</td>"
+                        rf"<td class=\"text\">(PASS|FAIL)</td>.*?</tr>", section)
         assert row is not None and row.group(1) == gyro.verdict
         assert f"<td>{gyro.metrics['verification']['rmse_dps']:.4f}</td>" in row.group(0)
         assert f"<td>{gyro.metrics['rmse_after_dps']:.4f}</td>" in row.group(0)
-    assert sorted(referenced_files(page)) == sorted(f"figures/{n}" for n in {**FIGURES, **GYRO_FIGURES}.values())
-    for name in GYRO_FIGURES.values():
+    drawn = [*FIGURES.values(), *GYRO_FIGURES.values(), "angular_rate_parameters.png"]
+    assert sorted(referenced_files(page)) == sorted(f"figures/{n}" for n in drawn)
+    for name in drawn[len(FIGURES):]:
         width, height = png_size(page.parent / "figures" / name)
         assert width >= 600 and height >= 400 and (page.parent / "figures" / name).stat().st_size > 20_000
-    assert text.count("ARW (°/√h)") == 4 and text.count("VRW (m/s/√h)") == 4
+    assert text.count(">angle random walk (°/√h)<") == 4 and text.count(">velocity random walk (m/s/√h)<") == 4
 
 
-def test_without_a_calibration_beside_it_the_report_fits_the_gyroscope_itself(imu: tuple[Path, Path],
+def test_without_a_calibration_beside_it_the_report_fits_the_gyroscope_alike(imu: tuple[Path, Path],
                                                                               tmp_path: Path) -> None:
     import shutil
 
@@ -137,6 +140,7 @@ def test_without_a_calibration_beside_it_the_report_fits_the_gyroscope_itself(im
     shutil.copy(campaign, alone)
     shutil.copy(journal_path(campaign), journal_path(alone))
     text = write_report(alone, tmp_path / "report").read_text(encoding="utf-8")
-    assert "fitted from the campaign for this report" in text and "<h2>Gyroscope calibration</h2>" in text
+    assert "Fitted from the campaign for this report" in text
+    assert "<h2>Calibration of every gyroscope (angular rate)</h2>" in text
     expected = load_calibration(calibration).channel("IMU-A001", "gyro").metrics["verification"]["rmse_dps"]
     assert f"<td>{expected:.4f}</td>" in text  # the same fit as rig fit's

@@ -76,7 +76,7 @@ def test_the_norm_figure_names_the_gravity_it_used(data, tmp_path: Path, monkeyp
 
 
 def test_the_uncertainty_caption_gives_every_duts_reading_figures(page: str, data) -> None:
-    budgets = [d.fit.metrics["uncertainty_budget"] for d in data.duts.values() if d.fit is not None]
+    budgets = [d.fit.figures["uncertainty_budget"] for d in data.duts.values() if d.fit is not None]
     stderr = [v for b in budgets for v in b["reading_stderr_mg"]]
     temperature = [b["temperature_u_c"] for b in budgets]
     assert len({round(v, 4) for v in stderr}) > 1  # the DUTs differ: one DUT's figures would not be all's

@@ -26,7 +26,7 @@ def test_layout_shapes_and_units(campaign: Path) -> None:
         for serial, dut in f["duts"].items():
             assert dut["accel/raw_codes"].shape == (6, 20, 3) and dut["accel/raw_codes"].dtype == np.int32
             assert dut["accel/mean"].attrs["unit"] == "g"
-            np.testing.assert_allclose(dut["accel/mean"][:], dut["accel/raw_codes"][:].mean(axis=1) * dut.attrs["lsb_g"])
+            np.testing.assert_allclose(dut["accel/mean"][:], dut["accel/raw_codes"][:].mean(axis=1) * dut["accel"].attrs["lsb"])
             settled = f["soaks/T30/settled_dut_c"][list(f["duts"]).index(serial)]
             drift = np.abs(dut["temperature_c"][:] - settled).max(axis=1)
             np.testing.assert_array_equal(dut["temperature_in_band"][:], drift <= 0.3)

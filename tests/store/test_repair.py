@@ -125,7 +125,7 @@ def test_a_lone_campaign_file_keeps_each_dut_its_own_data_when_it_gets_a_journal
     with pytest.raises(CampaignAborted):
         run(procedure, output, fail_at_pose=6)
     def by_serial(path: Path) -> dict[tuple[str, str], bytes]:
-        return {(p.step_key, d.serial): d.mean_g.tobytes() + d.raw_codes.tobytes()
+        return {(p.step_key, d.serial): d.channels["accel"].mean.tobytes() + d.channels["accel"].raw_codes.tobytes()
                 for p in load_campaign(path).poses for d in p.duts}
     before = by_serial(output)
     journal_path(output).unlink()
@@ -138,7 +138,8 @@ def test_a_lone_campaign_file_keeps_each_dut_its_own_data_when_it_gets_a_journal
         true = truth_for_serial(serial).parameters_at(campaign.truth_column(serial, "temperature_c"))
         np.testing.assert_allclose(campaign.truth_column(serial, "parameters"), true, atol=1e-9)
         expected = distort(campaign.truth_column(serial, "gravity_g"), true)
-        error = np.abs(campaign.dut_column(serial, "mean_g") - expected) / campaign.dut_column(serial, "stderr_g")
+        error = (np.abs(campaign.channel_column(serial, "accel", "mean") - expected)
+                 / campaign.channel_column(serial, "accel", "stderr"))
         assert error.max() < 6, serial
     with h5py.File(output, "r") as f:
         soak = f["soaks/T20"]
