@@ -92,7 +92,7 @@ def test_status_of_a_missing_or_foreign_file(tmp_path: Path, capsys, content: by
 def test_every_command_has_help_with_an_example(capsys) -> None:
     import argparse
 
-    from accelcal_rig.cli_parser import build_parser as _build_parser
+    from accelcal_rig.cli.parser import build_parser as _build_parser
 
     commands = next(a for a in _build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices
     assert {"run", "plan", "resume", "status", "check", "sim", "fit", "report", "export"} <= set(commands)

@@ -53,7 +53,7 @@ def test_an_interrupt_while_the_last_word_is_published_is_one_line(tmp_path: Pat
     and the command's own outcome stands (nothing raised out of it)."""
     from types import SimpleNamespace
 
-    from accelcal_rig import cli_campaign
+    from accelcal_rig.cli import campaign as cli_campaign
     from accelcal_rig.registry import publisher
 
     class Interrupted:

@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 
 from accelcal_rig.cli import main
-from accelcal_rig.status_text import status_lines
+from accelcal_rig.cli.status_text import status_lines
 from tests.conftest import REPO
 
 RIG = str(Path(sys.executable).parent / "rig")

@@ -1,25 +1,22 @@
 """One pose of a campaign: move the turntable, let it settle, read every DUT at once, store the pose — each
-DUT's channels (their means in the channel's unit, standard errors and what they should read: the gravity
-its mount sees, the table's rate), and its temperatures against the band its soak settled in."""
+DUT's channels (their means in the channel's unit, standard errors and what they should read: their quantity's
+reference, engine/references.py), and its temperatures against the band its soak settled in."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
 
-from accelcal_rig.core.earth import earth_rate_world_dps
 from accelcal_rig.core.waits import MOVE_POLL_S, wait_until
 from accelcal_rig.engine.acquisition import acquire_together
 from accelcal_rig.engine.played import PlayedRig
+from accelcal_rig.engine.references import REFERENCES, PoseInstant
 from accelcal_rig.engine.run_context import RunContext
 from accelcal_rig.engine.states import State
 from accelcal_rig.engine.step_handler import StepHandler
 from accelcal_rig.instruments.interfaces import SampleBlock
-from accelcal_rig.parts.part import Channel
-from accelcal_rig.plan.steps import Measurement, RateStep
+from accelcal_rig.plan.steps import Measurement
 from accelcal_rig.store.records import ChannelPoseRecord, DutPoseRecord, PoseRecord
 
 #: A move's deadline is 1.5 × its travel time at the configured speeds plus this margin.
@@ -81,16 +78,6 @@ def acquire_and_store(step: Measurement, run: RunContext, commanded: np.ndarray)
     run.report.publish(run.machine.state)
 
 
-@dataclass(frozen=True)
-class PoseInstant:
-    """Where the table was while a record's samples were taken: the step (its pose, its rate), the angles
-    read as the samples began, and how long they took."""
-
-    step: Measurement
-    measured_angles_deg: np.ndarray
-    duration_s: float
-
-
 def move_to(run: RunContext, commanded: np.ndarray) -> None:
     """Move the table to `commanded` and wait until it is there, settled, within the position tolerance."""
     turntable = run.turntable
@@ -132,57 +119,6 @@ def _dut_record(run: RunContext, index: int, block: SampleBlock, at: PoseInstant
         serial=sensor.serial, channels=channels, temperature_c=block.temperature_c, temperature_in_band=in_band,
         truth=run.truth.block_truth(sensor.serial, block) if run.truth is not None else None,
     )
-
-
-def _gravity_reference(run: RunContext, serial: str, channel: Channel, at: PoseInstant) -> np.ndarray:
-    """The site's gravity (in standard g) in the DUT's frame: the commanded pose, the nominal mount. A rate
-    step's turn about the vertical changes it not; the centripetal acceleration of a DUT off the rate axis is
-    not in it (its radius is not known): no accelerometer fit uses a rate step."""
-    return run.rig.gravity_g * (run.fixture_to_dut[serial] @ np.array(at.step.pose.gravity_fixture))
-
-
-def _rate_reference(run: RunContext, serial: str, channel: Channel, at: PoseInstant) -> np.ndarray:
-    """The true angular rate in the DUT's frame, °/s: the table's (zero through a pose, the commanded rate
-    about the fixture axis through a rate step) and the Earth's as far as the rig config places it."""
-    table = np.array(at.step.rate_fixture_dps)
-    return run.fixture_to_dut[serial] @ (table + _earth_rate_fixture_dps(run, at))
-
-
-#: Points over a record's samples at which a turning table's Earth rate is averaged.
-_EARTH_POINTS = 64
-
-
-def _earth_rate_fixture_dps(run: RunContext, at: PoseInstant) -> np.ndarray:
-    """The Earth's rate in the fixture frame over the record's samples: nothing where the rig config states no
-    latitude; its vertical component always, along "up" whatever turns about the vertical; its horizontal one
-    (with a heading) turns with a rate step's axis, averaged over the samples from the angles read as they
-    began."""
-    if run.rig.latitude_deg is None:
-        return np.zeros(3)
-    world = earth_rate_world_dps(run.rig.latitude_deg, run.rig.heading_deg)
-    angles = np.broadcast_to(np.asarray(at.measured_angles_deg, dtype=float),
-                             (_EARTH_POINTS, len(at.measured_angles_deg))).copy()
-    if isinstance(at.step, RateStep):
-        times = (np.arange(_EARTH_POINTS) + 0.5) / _EARTH_POINTS * at.duration_s
-        angles[:, at.step.rate_axis] += at.step.rate_dps * times
-    return run.kinematics.world_in_fixture(angles, world).mean(axis=0)
-
-
-def _field_reference(run: RunContext, serial: str, channel: Channel, at: PoseInstant) -> np.ndarray:
-    """The site's magnetic field in the DUT's frame, gauss: the rig config's field at the commanded pose through
-    the table's heading and the nominal mount. Without the heading its direction about the vertical is not known
-    (taken as 0: only the field's size is then a reference, and the magnetometer's model fits against that)."""
-    field = run.rig.magnetic_field
-    assert field is not None, "preparation refuses a magnetometer on a rig that states no magnetic_field"
-    world = field.world_gauss(run.rig.heading_deg if run.rig.heading_deg is not None else 0.0)
-    return run.fixture_to_dut[serial] @ run.kinematics.world_in_fixture(np.array(at.step.pose.angles_deg), world)
-
-
-#: What a channel should read at a pose, by the quantity it measures.
-REFERENCES: dict[str, Callable[[RunContext, str, Channel, PoseInstant], np.ndarray]] = {
-    "acceleration": _gravity_reference, "angular rate": _rate_reference, "magnetic field": _field_reference}
-#: What of the rig config a quantity's reference needs (a key that must be stated), and what it is.
-REFERENCE_NEEDS: dict[str, tuple[str, str]] = {"magnetic field": ("magnetic_field", "the site's magnetic field")}
 
 
 def _angle_difference(a_deg: np.ndarray, b_deg: np.ndarray) -> np.ndarray:

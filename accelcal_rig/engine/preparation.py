@@ -22,7 +22,7 @@ from accelcal_rig.config.load import (
 from accelcal_rig.config.procedure import Procedure
 from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.geometry import fixture_to_dut
-from accelcal_rig.engine.pose_steps import REFERENCE_NEEDS, REFERENCES
+from accelcal_rig.engine.references import REFERENCE_NEEDS, REFERENCES
 from accelcal_rig.fit.acceptance import unknown_limit
 from accelcal_rig.fit.channel_models import model_for_quantity
 from accelcal_rig.fit.lm import DegenerateDesign, fit_sfem

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from accelcal_rig.cli_grammar.common import SEED, TEMPERATURE, Commands, command, number
+from accelcal_rig.cli.grammar.common import SEED, TEMPERATURE, Commands, command, number
 
 
 def add_analysis_commands(commands: Commands) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from accelcal_rig.cli_grammar.common import (
+from accelcal_rig.cli.grammar.common import (
     CHAMBER_PROFILE_HELP,
     FAULTS_HELP,
     SEED,

@@ -1,8 +1,9 @@
 """`rig`: the command line. Every failure a user can cause is one line on stderr and a non-zero exit.
 
-Each command parses (the grammar: cli_parser), calls one function and prints what it returns, formatted beside
-what it formats (status_text, cli_format_*); the work of a command lives below it (cli_campaign,
-cli_recording, cli_serve, cli_registry, cli_analyze, the assembly, the engine)."""
+Each command parses (the grammar: `parser.py`, `grammar/`), calls one function and prints what it returns,
+formatted beside what it formats (`status_text.py`, `format_*.py`); the work of a command lives below it
+(`run_end.py`, `campaign.py`, `recording.py`, `serve.py`, `registry.py`, `analyze.py`, the assembly, the
+engine)."""
 
 from __future__ import annotations
 
@@ -14,34 +15,23 @@ import os
 import signal
 import sys
 from collections.abc import Callable
-from dataclasses import replace
-from pathlib import Path
 from typing import TYPE_CHECKING
 
-from accelcal_rig.cli_parser import build_parser
+from accelcal_rig.cli.outcome import EXIT_CHECK_FAILED, EXIT_INTERNAL, EXIT_INTERRUPTED, one_line
+from accelcal_rig.cli.parser import build_parser
+from accelcal_rig.cli.run_end import certify, execute, record, rejected_exit
 from accelcal_rig.core.signals import TerminationRequested
 from accelcal_rig.errors import CampaignAborted, ConfigError, RigError
 
 if TYPE_CHECKING:
     from accelcal_rig.engine.preparation import PreparedCampaign
-    from accelcal_rig.engine.session import NothingToResume, RunResult
-    from accelcal_rig.follow_up import FollowUp
-
-EXIT_INTERRUPTED = 130
-#: A failure the program did not foresee (a bug): one line, and this code.
-EXIT_INTERNAL = 70
-#: `--fail-on-reject`: the campaign and the fit went through, and at least one DUT failed its limits.
-EXIT_REJECTED = 3
-#: `rig check`: an instrument failed its check (as an instrument's error is).
-EXIT_CHECK_FAILED = 2
-
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_campaign import prepare_run
+    from accelcal_rig.cli.campaign import prepare_run
 
     prepared, resume = prepare_run(args)
     _warn_of_references(prepared, args)
-    return _execute(prepared, args.output, args, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite,
+    return execute(prepared, args.output, args, dry_run=args.dry_run, seed=args.seed, overwrite=args.overwrite,
                     resume=resume)
 
 
@@ -61,11 +51,11 @@ def _cmd_plan(args: argparse.Namespace) -> int:
 
 
 def _cmd_resume(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_campaign import prepare_resume
+    from accelcal_rig.cli.campaign import prepare_resume
 
     prepared, dry_run, seed = prepare_resume(args)
     _warn_of_references(prepared, args)
-    return _execute(prepared, args.campaign, args, dry_run=dry_run, seed=seed, overwrite=False, resume=True)
+    return execute(prepared, args.campaign, args, dry_run=dry_run, seed=seed, overwrite=False, resume=True)
 
 
 def _warn_of_references(prepared: PreparedCampaign, args: argparse.Namespace) -> None:
@@ -77,142 +67,9 @@ def _warn_of_references(prepared: PreparedCampaign, args: argparse.Namespace) ->
         print(f"rig: warning: {line}", file=sys.stderr)
 
 
-def _execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace, *, dry_run: bool, seed: int,
-             overwrite: bool, resume: bool) -> int:
-    """Run or resume under the CLI's signal handling and logging, the campaign locked before anything of it
-    changes (the log included); print the summary, then finish the campaign's follow-up."""
-    from accelcal_rig.assembly import run_campaign
-    from accelcal_rig.cli_campaign import campaign_session, follow_up_of, live_publishing, stop_on_first_signal
-    from accelcal_rig.engine.session import NothingToResume
-    from accelcal_rig.report.live import listeners
-
-    follow_up = follow_up_of(args, output, resume and not overwrite)
-    prepared = replace(prepared, follow_up=follow_up.to_json())
-    with live_publishing(prepared, output, follow_up, dry_run=dry_run, fresh=not resume,
-                         enabled=not args.no_publish) as publisher:
-        with stop_on_first_signal():
-            try:
-                with campaign_session(prepared, output, verbose=args.verbose, quiet=args.quiet, dry_run=dry_run,
-                                      overwrite=overwrite, resume=resume) as progress:
-                    watched = listeners(progress, publisher) if publisher is not None else progress
-                    result = run_campaign(prepared, output, dry_run=dry_run, seed=seed, overwrite=overwrite,
-                                          calibration=follow_up.calibration, resume=resume, progress=watched)
-            except NothingToResume as done:
-                print(done)
-                return _complete_campaign_verdicts(done, output, follow_up, args)
-        code = _after_campaign(prepared, result, output, follow_up, args, dry_run)
-        if publisher is not None:  # the run's own account: its file need not be read again
-            summary = result.summary
-            publisher.finish(summary.state, summary.poses_done, {
-                serial: {"verdict": verdict, "reasons": list(reasons)} for serial, (verdict, reasons) in summary.verdicts.items()})
-        return code
-
-
-def _after_campaign(prepared: PreparedCampaign, result: RunResult, output: Path, follow_up: FollowUp,
-                    args: argparse.Namespace, dry_run: bool) -> int:
-    """The summary; after a fit, the certificates and the registry. A signal now only cuts the printing short."""
-    try:
-        code = _print_summary(prepared, result, dry_run, args.fail_on_reject)
-        if result.summary.fit and not result.summary.fit_failed:
-            code = max(code, _finish_follow_up(output, follow_up))
-        return code
-    except (KeyboardInterrupt, TerminationRequested):
-        print(f"rig: interrupted after the campaign ended ({result.summary.state}); {result.output} holds all of it",
-              file=sys.stderr)
-        return EXIT_INTERRUPTED
-
-
-def _print_summary(prepared: PreparedCampaign, result: RunResult, dry_run: bool, fail_on_reject: bool) -> int:
-    from accelcal_rig.cli_format_campaign import run_summary_lines
-
-    summary = result.summary
-    print("\n".join(run_summary_lines(prepared, result, dry_run)))
-    if summary.fit_failed:
-        print(f"rig: campaign done but the fit failed: {_one_line(Exception(summary.fit))}", file=sys.stderr)
-        return 1
-    if result.problems:
-        print(f"rig: error: campaign done, but {result.problems[0]}", file=sys.stderr)
-        return 1
-    return _rejected_exit(summary.rejected, fail_on_reject)
-
-
-def _complete_campaign_verdicts(done: NothingToResume, output: Path, follow_up: FollowUp,
-                                args: argparse.Namespace) -> int:
-    """A complete campaign resumed: the verdicts of the fit this resume did (and its warnings), else those of
-    its calibration file; then whatever of its certificates and registry rows is missing; `--fail-on-reject`
-    either way."""
-    from accelcal_rig.cli_format_campaign import verdict_lines, warning_lines
-    from accelcal_rig.fit.campaign_file import calibration_verdicts
-
-    fit = done.fit
-    if fit is not None:
-        verdicts = fit.verdicts
-        for line in warning_lines(fit.warnings):
-            print(line)
-    else:
-        judged = calibration_verdicts(output, follow_up.calibration)["verdicts"] or {}
-        verdicts = {serial: (str(v["verdict"]), tuple(v["reasons"])) for serial, v in judged.items()}
-    for line in verdict_lines(verdicts):
-        print(line)
-    code = _finish_follow_up(output, follow_up) if follow_up.calibration.is_file() else 0
-    rejected = [serial for serial, (verdict, _) in verdicts.items() if verdict == "FAIL"]
-    return max(code, _rejected_exit(rejected, args.fail_on_reject))
-
-
-def _finish_follow_up(output: Path, follow_up: FollowUp) -> int:
-    """The certificates and the registry rows of a fitted campaign, each written only if it is not there and
-    current (follow_up.state): a run's, or what a kill left undone of one."""
-    from accelcal_rig import follow_up as follow
-    from accelcal_rig.cli_registry import campaign_entries
-    from accelcal_rig.registry.location import campaign_rig_registry
-
-    parts = {p.part: p for p in follow.state(output, follow_up)}
-    calibration = parts.get("calibration")
-    if calibration is None or calibration.state != follow.DONE:  # nothing to certify or record from
-        if calibration is not None and calibration.state != follow.NOT_DUE:
-            print(f"rig: error: no certificates or registry rows: calibration {calibration.state}: "
-                  f"{calibration.detail}", file=sys.stderr)
-            return 1
-        return 0
-    code = 0
-    if parts["certificates"].state != follow.DONE:
-        code = _certify_after_run(output, follow_up)
-    if parts["registry"].state == follow.DONE:
-        print(f"registry   {parts['registry'].detail} already")
-    else:
-        _record(follow_up.registry, campaign_rig_registry(output), output,
-                lambda: campaign_entries(output, follow_up.calibration),
-                later=f"rig resume {output}, or rig registry add {output}")
-    return code
-
-
-def _record(flag: str | None, configured: str | None, source: Path, entries: Callable[[], list],
-            json_output: bool = False, later: str | None = None) -> None:
-    """Record a finished fit in the registry (a dry run's in the dry runs' own); a registry that cannot take it
-    is a warning naming how to record it later, never a loss: the calibration file is written already. Beside
-    a JSON report the line goes to stderr, so stdout stays one JSON object."""
-    from alembic.util.exc import CommandError
-    from sqlalchemy.exc import SQLAlchemyError
-
-    from accelcal_rig.cli_registry import register
-
-    try:
-        print(register(flag, configured, entries()), file=sys.stderr if json_output else sys.stdout)
-    except (RigError, SQLAlchemyError, OSError, CommandError) as exc:
-        print(f"rig: warning: not recorded in the registry: {_one_line(exc)} (record it later: "
-              f"{later or f'rig registry add {source}'})", file=sys.stderr)
-
-
-def _rejected_exit(rejected: list[str], fail_on_reject: bool) -> int:
-    if rejected and fail_on_reject:
-        print(f"rig: {len(rejected)} DUT(s) failed their acceptance limits: {', '.join(rejected)}", file=sys.stderr)
-        return EXIT_REJECTED
-    return 0
-
-
 def _cmd_status(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_campaign import campaign_status
-    from accelcal_rig.status_text import status_lines
+    from accelcal_rig.cli.campaign import campaign_status
+    from accelcal_rig.cli.status_text import status_lines
 
     if args.watch:
         return _watch_status(args)
@@ -225,8 +82,8 @@ def _watch_status(args: argparse.Namespace) -> int:
     """`rig status --watch`: again every so many seconds, until the campaign ends or Ctrl-C."""
     import time
 
-    from accelcal_rig.cli_campaign import campaign_status
-    from accelcal_rig.status_text import watch_text
+    from accelcal_rig.cli.campaign import campaign_status
+    from accelcal_rig.cli.status_text import watch_text
 
     try:
         while True:
@@ -249,7 +106,7 @@ def _cmd_repair(args: argparse.Namespace) -> int:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from accelcal_rig.assembly import checked
-    from accelcal_rig.cli_format_campaign import check_closing_line, check_failed_line, check_line, check_names
+    from accelcal_rig.cli.format_campaign import check_closing_line, check_failed_line, check_line, check_names
     from accelcal_rig.config.load import load_rig, load_rig_for_check, with_faults
 
     only = frozenset(args.only or ("chamber", "turntable", "sensors"))
@@ -268,7 +125,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
 
 
 def _cmd_characterise(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_characterise import characterise, characterise_json, characterise_lines
+    from accelcal_rig.cli.characterise import characterise, characterise_json, characterise_lines
     from accelcal_rig.config.write_thermal import write_thermal
 
     result = characterise(args.campaign)
@@ -285,8 +142,8 @@ def _cmd_characterise(args: argparse.Namespace) -> int:
 
 def _cmd_sim(args: argparse.Namespace) -> int:
     from accelcal_rig.assembly import served_rig
-    from accelcal_rig.cli_campaign import until_signalled
-    from accelcal_rig.cli_format_campaign import sim_stopped_line
+    from accelcal_rig.cli.campaign import until_signalled
+    from accelcal_rig.cli.format_campaign import sim_stopped_line
     from accelcal_rig.config.load import load_rig, with_chamber_profile, with_faults
     from accelcal_rig.core.clock import RealClock
 
@@ -305,8 +162,8 @@ def _cmd_sim(args: argparse.Namespace) -> int:
 
 
 def _cmd_fit(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_format_fit import fit_lines
-    from accelcal_rig.cli_registry import campaign_entries, stored_rig_registry
+    from accelcal_rig.cli.format_fit import fit_lines
+    from accelcal_rig.cli.registry_access import campaign_entries, stored_rig_registry
     from accelcal_rig.fit.campaign_file import fit_campaign_file
 
     outcome = fit_campaign_file(args.campaign, args.output, mode=args.mode, degree=args.degree, free=args.parameters,
@@ -314,36 +171,36 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     for warning in outcome.warnings:
         print(f"rig: warning: {warning}", file=sys.stderr)
     print(json.dumps(outcome.report) if args.json else "\n".join(fit_lines(outcome.report, args.output)))
-    _record(args.registry, stored_rig_registry(args.campaign), args.campaign,
+    record(args.registry, stored_rig_registry(args.campaign), args.campaign,
             lambda: campaign_entries(args.campaign, args.output), args.json)
     rejected = [serial for serial, r in outcome.report.items() if r["verdict"] == "FAIL"]
-    return _rejected_exit(rejected, args.fail_on_reject)
+    return rejected_exit(rejected, args.fail_on_reject)
 
 
 def _cmd_fit_recording(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_format_fit import recording_lines
-    from accelcal_rig.cli_recording import calibrate_recording
-    from accelcal_rig.cli_registry import recording_entries
+    from accelcal_rig.cli.format_fit import recording_lines
+    from accelcal_rig.cli.recording import calibrate_recording
+    from accelcal_rig.cli.registry_access import recording_entries
 
     recording, result = calibrate_recording(args)
     print(json.dumps(result.report) if args.json else "\n".join(recording_lines(
         result.report, recording.source, threshold_factor=args.threshold_factor, init_s=args.init_s,
         output=args.output, parameters=args.parameters)))
-    _record(args.registry, None, args.recording,
+    record(args.registry, None, args.recording,
             lambda: recording_entries(args.recording, result.calibration, args.part, recording.simulated),
             json_output=args.json, later="run this rig fit-recording again once the registry is reachable")
     return 0
 
 
 def _cmd_completion(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_parser import bash_completion
+    from accelcal_rig.cli.parser import bash_completion
 
     sys.stdout.write(bash_completion(build_parser()))
     return 0
 
 
 def _cmd_serve(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_serve import open_dashboard, stopped_line, stops_ignored
+    from accelcal_rig.cli.serve import open_dashboard, stopped_line, stops_ignored
 
     dashboard = None
     try:
@@ -358,19 +215,19 @@ def _cmd_serve(args: argparse.Namespace) -> int:
 
 
 def _cmd_registry(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_registry import registry_command
+    from accelcal_rig.cli.registry import registry_command
 
     return registry_command(args)
 
 
 def _cmd_approve(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_approval import approve_command
+    from accelcal_rig.cli.approval import approve_command
 
     return approve_command(args)
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_analyze import analyze
+    from accelcal_rig.cli.analyze import analyze
 
     return analyze(args)
 
@@ -394,31 +251,8 @@ def _cmd_certificate(args: argparse.Namespace) -> int:
                           "--calibration")
     if args.output.exists() and not args.output.is_dir():
         raise ConfigError(f"{args.output}: exists and is not a folder")
-    _certify(args.campaign, calibration, args.output, args.operator, not args.no_pdf)
+    certify(args.campaign, calibration, args.output, args.operator, not args.no_pdf)
     return 0
-
-
-def _certify_after_run(output: Path, follow_up: FollowUp) -> int:
-    """The certificates at the end of a run; one that cannot be written is one line, the campaign stands."""
-    try:
-        _certify(output, follow_up.calibration, follow_up.certificates, follow_up.operator, follow_up.pdf)
-    except (RigError, OSError) as exc:
-        print(f"rig: error: campaign done, but no certificates: {_one_line(exc)}", file=sys.stderr)
-        return 1
-    return 0
-
-
-def _certify(campaign: Path, calibration: Path, folder: Path, operator: str, pdf: bool) -> None:
-    from accelcal_rig.cli_format_campaign import certificate_line
-    from accelcal_rig.report.certificate import write_certificates
-
-    written, warnings = write_certificates(campaign, calibration, folder, operator, pdf)
-    for warning in warnings:
-        print(f"rig: warning: {warning}", file=sys.stderr)
-    for w in written:
-        print(certificate_line(w))
-    if written:  # a draft until a person approves it
-        print(f"certificates are drafts until approved: rig approve {campaign} --as USER")
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
@@ -437,11 +271,6 @@ def _cmd_export(args: argparse.Namespace) -> int:
     exported = export(calibration, args.format, StackOptions(args.calibration, args.serial, args.instance,
                                                              args.device_id))
     return write_export(exported, args.format, args.output)
-
-
-def _one_line(error: BaseException) -> str:
-    """An error's message as one line, whatever text from a file it quotes."""
-    return " ".join(str(error).splitlines())
 
 
 #: Commands a signal is the way to end (what they serve stops: exit 0), not a campaign interrupted.
@@ -498,11 +327,11 @@ def main(argv: list[str] | None = None, today: Callable[[], dt.date] = dt.date.t
     except CampaignAborted as exc:
         campaign = args.output if args.command == "run" else getattr(args, "campaign", None)
         resume = f"; continue it with: rig resume {campaign}" if campaign is not None else ""
-        print(f"rig: campaign aborted, rig in safe state: {_one_line(exc)}{resume}", file=sys.stderr)
+        print(f"rig: campaign aborted, rig in safe state: {one_line(exc)}{resume}", file=sys.stderr)
         interrupted = isinstance(exc.__cause__, (KeyboardInterrupt, TerminationRequested))
         return EXIT_INTERRUPTED if interrupted else exc.exit_code
     except RigError as exc:
-        print(f"rig: error: {_one_line(exc)}", file=sys.stderr)
+        print(f"rig: error: {one_line(exc)}", file=sys.stderr)
         return exc.exit_code
     except (KeyboardInterrupt, TerminationRequested):
         return _interrupted(args.command)

@@ -15,7 +15,7 @@ from accelcal_rig.errors import ConfigError
 
 
 def approve_command(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_registry import campaign_entries, open_registry
+    from accelcal_rig.cli.registry_access import campaign_entries, open_registry
     from accelcal_rig.registry.approvals import Approvals, IssuedCertificate
     from accelcal_rig.report.certificate import render_certificate
 
@@ -114,7 +114,7 @@ def _write_beside(campaign: Path, serial: str, issued: Any, only_missing: bool =
 
 
 def user_command(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_registry import open_registry
+    from accelcal_rig.cli.registry_access import open_registry
     from accelcal_rig.registry.approvals import Approvals
 
     approvals = Approvals(open_registry(args, upgrade=True))
@@ -163,7 +163,7 @@ def _new_password(from_stdin: bool, name: str) -> str:
 
 
 def audit_command(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_registry import open_registry
+    from accelcal_rig.cli.registry_access import open_registry
     from accelcal_rig.registry.approvals import Approvals
 
     trail = Approvals(open_registry(args)).trail(serial=args.serial)
@@ -181,7 +181,7 @@ def audit_command(args: argparse.Namespace) -> int:
 
 
 def certificate_command(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_registry import open_registry
+    from accelcal_rig.cli.registry_access import open_registry
     from accelcal_rig.durable import write_atomically
     from accelcal_rig.registry.approvals import Approvals
 

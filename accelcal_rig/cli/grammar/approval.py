@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from accelcal_rig.cli_grammar.common import Commands, command, number, registry_option
+from accelcal_rig.cli.grammar.common import Commands, command, number, registry_option
 
 
 def add_approve_command(commands: Commands) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from accelcal_rig.cli_grammar.common import Commands, certificate_options, command, number
+from accelcal_rig.cli.grammar.common import Commands, certificate_options, command, number
 
 
 def add_document_commands(commands: Commands) -> None:

@@ -20,10 +20,10 @@ from accelcal_rig.core.signals import TerminationRequested, stop_when_safe
 from accelcal_rig.errors import ConfigError
 
 if TYPE_CHECKING:
+    from accelcal_rig.cli.follow_up import FollowUp
     from accelcal_rig.config.lab import Receipt
     from accelcal_rig.engine.preparation import PreparedCampaign
     from accelcal_rig.engine.progress import Progress, ProgressListener
-    from accelcal_rig.follow_up import FollowUp
     from accelcal_rig.registry.publisher import LivePublisher
 
 
@@ -91,7 +91,7 @@ def calibration_path(given: Path | None, output: Path) -> Path:
 def follow_up_of(args: argparse.Namespace, output: Path, continuing: bool) -> FollowUp:
     """Where this command writes the campaign's follow-up: a new campaign's from its flags (recorded in it), a
     continued one's as its `rig run` recorded, each part a flag names now instead."""
-    from accelcal_rig import follow_up
+    from accelcal_rig.cli import follow_up
     from accelcal_rig.store.paths import journal_path
     from accelcal_rig.store.read import load_campaign
 
@@ -267,7 +267,7 @@ def campaign_status(campaign: Path, calibration: Path | None) -> dict[str, Any]:
     """`rig status --json`: the campaign's state and progress, its DUTs' verdicts from its calibration, each
     part of its follow-up (calibration, certificates, registry) with what is missing, and every DUT the early
     check flagged (`early_check`: serial, setpoint_c, finding, value, limit, action, and a dead axis's axis)."""
-    from accelcal_rig import follow_up
+    from accelcal_rig.cli import follow_up
     from accelcal_rig.fit.campaign_file import calibration_verdicts
     from accelcal_rig.fit.early_check import logged_findings
     from accelcal_rig.fit.recorded_options import NO_FIT, requested_mode

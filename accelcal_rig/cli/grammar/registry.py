@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from accelcal_rig.cli_grammar.approval import add_approval_actions
-from accelcal_rig.cli_grammar.common import Commands, command, number, registry_option
+from accelcal_rig.cli.grammar.approval import add_approval_actions
+from accelcal_rig.cli.grammar.common import Commands, command, number, registry_option
 
 
 def add_registry_commands(commands: Commands) -> None:

@@ -10,86 +10,20 @@ from datetime import date, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from accelcal_rig.cli_format_registry import calibration_table, lot_lines, public, sensor_lines, trend_lines
+from accelcal_rig.cli.format_registry import calibration_table, lot_lines, public, sensor_lines, trend_lines
+from accelcal_rig.cli.registry_access import campaign_entries, from_config, open_registry
 from accelcal_rig.errors import ConfigError
 
 if TYPE_CHECKING:
-    from accelcal_rig.fit.calibration import CalibrationFile
+    pass
 
 
 def registry_command(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_approval import audit_command, certificate_command, user_command
+    from accelcal_rig.cli.approval import audit_command, certificate_command, user_command
 
     return {"add": _add, "list": _list, "show": _show, "trend": _trend, "stats": _stats,
             "export": _export, "user": user_command, "audit": audit_command,
             "certificate": certificate_command}[args.registry_command](args)
-
-
-def open_registry(args: argparse.Namespace, upgrade: bool = False):  # noqa: ANN201 - imported late (SQLAlchemy)
-    """The registry the command names: --registry, else the rig config's (--config), else the environment's,
-    else the default file. Only a recording command (`upgrade`) creates one or migrates an older schema; the
-    others read it read-only (a registry on a read-only mount included)."""
-    from accelcal_rig.registry.database import Registry
-    from accelcal_rig.registry.location import registry_url
-
-    return Registry.open(registry_url(args.registry, _from_config(args)), upgrade=upgrade, create=upgrade,
-                         read_only=not upgrade)
-
-
-def _from_config(args: argparse.Namespace) -> str | None:
-    """The `registry:` of the rig config `--config` names, if it does."""
-    if getattr(args, "config", None) is None:
-        return None
-    from accelcal_rig.config.load import load_rig
-    from accelcal_rig.registry.location import configured
-
-    rig = load_rig(args.config)
-    return configured(rig.model.registry, rig.path)
-
-
-def register(flag: str | None, configured: str | None, entries: list[dict[str, Any]]) -> str:
-    """Record entries in the registry they belong to: the one `--registry` (`flag`) names, else a dry run's in
-    the dry runs' own and a real one's in the rig config's (`configured`) or the lab's; one line saying what
-    happened (for `rig run`/`rig fit`/`rig fit-recording`)."""
-    from accelcal_rig.registry.database import Registry
-    from accelcal_rig.registry.location import described, recording_url
-
-    simulated = any(entry["simulated"] for entry in entries)
-    url = recording_url(flag, configured, simulated)
-    added, already = Registry.open(url, upgrade=True).add(entries)
-    tail = f", {already} registered already" if already else ""
-    apart = " (a dry run: kept apart from the lab's registry)" if simulated and flag is None else ""
-    return (f"registry   {len(added)} calibration{'s' if len(added) != 1 else ''} recorded in {described(url)}"
-            f"{tail}{apart}")
-
-
-def campaign_entries(campaign: Path, calibration: Path | None) -> list[dict[str, Any]]:
-    """What the registry records of a fitted campaign (read when it is recorded)."""
-    from accelcal_rig.registry.entries import campaign_entries as entries
-
-    return entries(campaign, calibration)
-
-
-def recording_entries(recording: Path, calibration: CalibrationFile, part: str,
-                      simulated: bool = False) -> list[dict[str, Any]]:
-    """What the registry records of a hand-held recording's fit (`simulated`: of a dry run's campaign file)."""
-    from accelcal_rig.registry.entries import recording_entries as entries
-
-    return entries(recording, calibration, part, simulated)
-
-
-def rig_registry(value: str | None, rig_path: Path) -> str | None:
-    """A rig config's `registry:` (relative to the config's folder)."""
-    from accelcal_rig.registry.location import configured
-
-    return configured(value, rig_path)
-
-
-def stored_rig_registry(campaign: Path) -> str | None:
-    """The `registry:` of the rig config a campaign was run with (as it stored it)."""
-    from accelcal_rig.registry.location import campaign_rig_registry
-
-    return campaign_rig_registry(campaign)
 
 
 def _add(args: argparse.Namespace) -> int:
@@ -98,7 +32,7 @@ def _add(args: argparse.Namespace) -> int:
     from accelcal_rig.registry.database import Registry
     from accelcal_rig.registry.location import described, recording_url
 
-    named = args.registry or _from_config(args)  # a registry named here takes dry runs too
+    named = args.registry or from_config(args)  # a registry named here takes dry runs too
     opened: dict[str, Registry] = {}
     for path in args.files:
         entries = campaign_entries(path, args.calibration)
@@ -117,7 +51,7 @@ def _list(args: argparse.Namespace) -> int:
     from accelcal_rig.registry.location import described, recording_url, registry_url
 
     since = _since(args.since) if args.since else None
-    url = registry_url(args.registry, _from_config(args))
+    url = registry_url(args.registry, from_config(args))
     registry = None if _not_made(url) else open_registry(args)
     rows = [] if registry is None else registry.calibrations(
         serial=args.serial, part=args.part, since=since, verdict=args.verdict, limit=args.limit,

@@ -1,5 +1,5 @@
 """The `rig` command line's grammar, assembled: the commands in the order `rig --help` lists them, each group's
-in its module of accelcal_rig.cli_grammar; and the bash completion script made from it.
+in its module of accelcal_rig.cli.grammar; and the bash completion script made from it.
 
 Parsing imports nothing heavy: `rig --help` and a mistyped option answer at once.
 """
@@ -9,14 +9,14 @@ from __future__ import annotations
 import argparse
 
 from accelcal_rig import __version__
-from accelcal_rig.cli_grammar.analysis import add_analysis_commands
-from accelcal_rig.cli_grammar.approval import add_approve_command
-from accelcal_rig.cli_grammar.campaign import add_campaign_commands
-from accelcal_rig.cli_grammar.common import Parser
-from accelcal_rig.cli_grammar.documents import add_document_commands
-from accelcal_rig.cli_grammar.fitting import add_fit_commands
-from accelcal_rig.cli_grammar.registry import add_registry_commands
-from accelcal_rig.cli_grammar.service import add_completion_command, add_serve_command
+from accelcal_rig.cli.grammar.analysis import add_analysis_commands
+from accelcal_rig.cli.grammar.approval import add_approve_command
+from accelcal_rig.cli.grammar.campaign import add_campaign_commands
+from accelcal_rig.cli.grammar.common import Parser
+from accelcal_rig.cli.grammar.documents import add_document_commands
+from accelcal_rig.cli.grammar.fitting import add_fit_commands
+from accelcal_rig.cli.grammar.registry import add_registry_commands
+from accelcal_rig.cli.grammar.service import add_completion_command, add_serve_command
 
 
 def build_parser() -> argparse.ArgumentParser:

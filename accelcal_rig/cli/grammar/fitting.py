@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from accelcal_rig.cli_grammar.common import TEMPERATURE, Commands, command, fail_on_reject, number, registry_option
+from accelcal_rig.cli.grammar.common import TEMPERATURE, Commands, command, fail_on_reject, number, registry_option
 
 
 def add_fit_commands(commands: Commands) -> None:

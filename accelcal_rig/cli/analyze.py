@@ -24,7 +24,7 @@ def analyze(args: argparse.Namespace) -> int:
 
 
 def _analyze_cooldown(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_format_analysis import cooldown_json, cooldown_lines
+    from accelcal_rig.cli.format_analysis import cooldown_json, cooldown_lines
 
     results = cooldown_results(args.campaign, args.calibration, args.setpoint, args.figure)
     print(json.dumps(cooldown_json(args.calibration, results)) if args.json
@@ -33,7 +33,7 @@ def _analyze_cooldown(args: argparse.Namespace) -> int:
 
 
 def _analyze_tilt(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_format_analysis import tilt_json, tilt_lines
+    from accelcal_rig.cli.format_analysis import tilt_json, tilt_lines
 
     setpoint, rows, outside = tilt_results(args.campaign, args.calibration, args.setpoint)
     print(json.dumps(tilt_json(setpoint, args.calibration, outside, rows)) if args.json
@@ -42,7 +42,7 @@ def _analyze_tilt(args: argparse.Namespace) -> int:
 
 
 def _analyze_positions(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli_format_analysis import positions_json, positions_lines
+    from accelcal_rig.cli.format_analysis import positions_json, positions_lines
 
     setpoint, mode, rows, floors = positions_results(args)
     print(json.dumps(positions_json(setpoint, mode, floors, rows)) if args.json

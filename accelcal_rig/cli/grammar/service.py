@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from accelcal_rig.cli_grammar.common import Commands, command, number, registry_option
+from accelcal_rig.cli.grammar.common import Commands, command, number, registry_option
 
 
 def add_completion_command(commands: Commands) -> None:
