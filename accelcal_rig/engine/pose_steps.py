@@ -11,7 +11,7 @@ import numpy as np
 from accelcal_rig.core.waits import MOVE_POLL_S, wait_until
 from accelcal_rig.engine.acquisition import acquire_together
 from accelcal_rig.engine.played import PlayedRig
-from accelcal_rig.engine.references import REFERENCES, PoseInstant
+from accelcal_rig.engine.references import REFERENCES, SATURATES_TURNING, PoseInstant
 from accelcal_rig.engine.run_context import RunContext
 from accelcal_rig.engine.states import State
 from accelcal_rig.engine.step_handler import StepHandler
@@ -54,11 +54,10 @@ def acquire_and_store(step: Measurement, run: RunContext, commanded: np.ndarray)
     # A turning axis: where it stands is a reading of the moment only.
     run.table.angles_deg = None if any(step.rate_fixture_dps) else measured
     chamber_before = run.chamber.read_temperature_c()  # the alarm is checked once per pose, after it
-    # On a turning table a DUT off the axis feels its centripetal acceleration (1.5 g at 5 cm and 1000 °/s): its
-    # accelerometer may saturate there, and nothing uses it there.
+    # On a turning table some channels may saturate (engine/references.py says which): nothing uses them there.
     turning = any(step.rate_fixture_dps)
     may_saturate = frozenset(c.name for s in run.sensors for c in s.part.channels
-                             if turning and c.quantity == "acceleration")
+                             if turning and c.quantity in SATURATES_TURNING)
     blocks = run.retrier.call(partial(acquire_together, run.sensors, acquisition.samples_per_pose, run.clock,
                                       acquisition.ranges, may_saturate))
     chamber_after = run.read_chamber_c()

@@ -80,3 +80,6 @@ REFERENCES: dict[str, Callable[[RunContext, str, Channel, PoseInstant], np.ndarr
     "acceleration": _gravity_reference, "angular rate": _rate_reference, "magnetic field": _field_reference}
 #: What of the rig config a quantity's reference needs (a key that must be stated), and what it is.
 REFERENCE_NEEDS: dict[str, tuple[str, str]] = {"magnetic field": ("magnetic_field", "the site's magnetic field")}
+#: Quantities a DUT off the rate axis may read beyond its range on a turning table (its centripetal
+#: acceleration, 1.5 g at 5 cm and 1000 °/s): a saturated block there is expected, and nothing uses it.
+SATURATES_TURNING = frozenset({"acceleration"})

@@ -229,7 +229,7 @@ class Registry:
             return _with_figures(connection, [dict(row._mapping)])[0]
 
     @reads
-    def current(self, serial: str, simulated: bool = False, channel: str = "accel") -> dict[str, Any] | None:
+    def current(self, serial: str, simulated: bool = False, *, channel: str) -> dict[str, Any] | None:
         """The valid calibration of a serial's channel: its newest approved real calibration, unless a newer
         one failed its acceptance limits and was not rejected (the sensor is out of tolerance now: none is
         valid; an approved FAIL confirms it). A calibration awaiting approval is not valid yet; a rejected one
@@ -248,7 +248,7 @@ class Registry:
         return None
 
     @reads
-    def why_not_valid(self, serial: str, channel: str = "accel") -> str:
+    def why_not_valid(self, serial: str, channel: str) -> str:
         """Why a serial's channel has no valid calibration (current() is None), in a few words."""
         rows = [r for r in self.calibrations(serial=serial, channel=channel) if not r["simulated"]]
         if not rows:

@@ -101,15 +101,15 @@ def test_only_an_approved_real_calibration_is_valid(book: Approvals, quick_campa
                      "verdict": "FAIL"}
     (first,), _ = registry.add([base])
     serial, jdoe = base["serial"], book.user("jdoe")
-    assert registry.current(serial) is None                          # awaiting approval: not valid yet
+    assert registry.current(serial, channel="accel") is None                          # awaiting approval: not valid yet
     book.record(first, "approve", jdoe, "test", certificate=issued(1))
-    assert registry.current(serial)["id"] == first
+    assert registry.current(serial, channel="accel")["id"] == first
     (second,), _ = registry.add([newer])
-    assert registry.current(serial)["id"] == first                   # the newer one awaits: the approved stays
+    assert registry.current(serial, channel="accel")["id"] == first                   # the newer one awaits: the approved stays
     book.record(second, "reject", jdoe, "test", "wrong fixture")
-    assert registry.current(serial)["id"] == first                   # rejected: never valid
+    assert registry.current(serial, channel="accel")["id"] == first                   # rejected: never valid
     (third,), _ = registry.add([failed])
-    assert registry.current(serial) is None                          # out of tolerance now
-    assert "out of tolerance" in registry.why_not_valid(serial)
+    assert registry.current(serial, channel="accel") is None                          # out of tolerance now
+    assert "out of tolerance" in registry.why_not_valid(serial, "accel")
     book.record(third, "reject", jdoe, "test", "the chamber's sensor was out of calibration")
-    assert registry.current(serial)["id"] == first                   # a rejected measurement says nothing
+    assert registry.current(serial, channel="accel")["id"] == first                   # a rejected measurement says nothing

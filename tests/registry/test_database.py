@@ -70,23 +70,23 @@ def test_filters_and_the_valid_calibration(registry_url: str, quick_campaign) ->
     other_part = base | {"fit_sha256": "3" * 64, "serial": "X-1", "part": "adxl357"}
     added, _ = registry.add([older, base, other_part])
     serial = base["serial"]
-    assert registry.current(serial) is None                   # awaiting approval: not valid yet
+    assert registry.current(serial, channel="accel") is None                   # awaiting approval: not valid yet
     approve(registry, added)                                  # (tests/registry/test_approvals.py: the rules)
-    current = registry.current(serial)
+    current = registry.current(serial, channel="accel")
     assert current is not None and current["calibrated_at"] == base["calibrated_at"]  # the newest approved
     registry.add([rehearsal])
-    assert registry.current(serial)["calibrated_at"] == base["calibrated_at"]  # a dry run is no calibration
-    assert registry.current(serial, simulated=True)["calibrated_at"] == rehearsal["calibrated_at"]
+    assert registry.current(serial, channel="accel")["calibrated_at"] == base["calibrated_at"]  # a dry run is no calibration
+    assert registry.current(serial, simulated=True, channel="accel")["calibrated_at"] == rehearsal["calibrated_at"]
     registry.add([failed])
     # The quick procedure states no limits: NOT JUDGED, registered with no verdict (counted in no yield).
     assert [r["verdict"] for r in registry.calibrations(serial=serial)] == [None, "FAIL", None, None]
-    assert registry.current(serial) is None  # the newest real one failed: the sensor is out of tolerance now
+    assert registry.current(serial, channel="accel") is None  # the newest real one failed: the sensor is out of tolerance now
     assert [r["serial"] for r in registry.calibrations(part="adxl357")] == ["X-1"]
     assert len(registry.calibrations(since=base["calibrated_at"] - timedelta(days=1))) == 4
     assert len(registry.calibrations(verdict="FAIL")) == 1
     assert registry.parts() == ["adxl355", "adxl357"]
     assert len(registry.calibrations(limit=2)) == 2
-    assert registry.current("NOBODY") is None
+    assert registry.current("NOBODY", channel="accel") is None
     with pytest.raises(ConfigError, match="no calibration 999"):
         registry.calibration(999)
 
