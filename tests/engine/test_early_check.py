@@ -8,12 +8,12 @@ from pathlib import Path
 
 from accelcal_rig.assembly import run_campaign
 from accelcal_rig.cli.campaign import campaign_status
+from accelcal_rig.cli.status_text import status_lines
 from accelcal_rig.engine.notify import Notification
 from accelcal_rig.engine.preparation import prepare
 from accelcal_rig.fit.calibration import load_calibration
 from accelcal_rig.plan.compile import compile_plan
 from accelcal_rig.plan.steps import CheckSetpoint, MeasurePose, VerifyPose
-from accelcal_rig.cli.status_text import status_lines
 from accelcal_rig.store.read import load_campaign
 from tests.engine.test_campaign import events
 
