@@ -87,7 +87,7 @@ def test_ctrl_c_once_it_answers_says_the_server_stopped_and_a_second_changes_not
 def test_a_signal_before_rig_serve_handles_it_says_the_server_stopped(monkeypatch, capsys) -> None:
     """A Ctrl-C the command's own handling did not catch (arriving as it starts or ends) ends a dashboard too:
     it stopped, exit 0, not "interrupted before the campaign started"."""
-    from accelcal_rig.cli import main as cli
+    from accelcal_rig.cli import commands as cli
 
     def interrupted(args: object) -> int:
         raise KeyboardInterrupt

@@ -234,9 +234,10 @@ def _capture_capacity(greeting: str) -> int:
 
 
 class SpidevBus:
-    """Linux spidev (optional extra `spidev`): mode 0, the command byte framed as the part says (an ADXL355:
-    (addr << 1) | 1 reads, addr << 1 writes; an ICM-42688-P: addr | 0x80 reads, addr writes). The host is on
-    the SPI bus itself and reads in time: no capture of its own."""
+    """Linux spidev (optional extra `spidev`): the SPI mode and the command byte framed as the part says (an
+    ADXL355: mode 0, (addr << 1) | 1 reads, addr << 1 writes; an ICM-42688-P: mode 0, addr | 0x80 reads, addr
+    writes; an LIS3MDL: mode 3, addr | 0x80 reads, 0x40 more for a burst). The host is on the SPI bus itself
+    and reads in time: no capture of its own."""
 
     capture_capacity_samples = 0
 
@@ -257,7 +258,7 @@ class SpidevBus:
             device.open(bus, chip_select)
         except OSError as exc:
             raise InstrumentError(f"sensor (spidev {bus}.{chip_select}): cannot open: {exc}") from None
-        device.mode = 0
+        device.mode = framing.mode
         device.max_speed_hz = speed_hz
         return cls(device, f"spidev {bus}.{chip_select}", framing)
 

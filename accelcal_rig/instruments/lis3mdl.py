@@ -33,6 +33,8 @@ RESERVED = frozenset({*range(0x00, 0x05), *range(0x0B, 0x0F), *range(0x10, 0x20)
 RESET_VALUES = {REG_WHO_AM_I: 0x3D, REG_CTRL1: 0x10, REG_CTRL3: 0x03, REG_INT_CFG: 0xE8}
 
 CTRL1_TEMP_EN = 0x80
+#: CTRL_REG5 BDU (bit 6): the output registers not updated until both bytes of a sample were read.
+CTRL5_BDU = 0x40
 CTRL2_SOFT_RST = 0x04
 #: CTRL_REG3 MD (bits 1:0): 00 continuous conversion; 11 (or 10) power-down, the reset state.
 CTRL3_CONTINUOUS = 0x00

@@ -62,7 +62,8 @@ class Lis3mdl:
             raise InstrumentError(str(exc)) from None
 
     def configure(self, ranges: Mapping[str, float], odr_hz: float) -> None:
-        """Full scale and output data rate, the temperature sensor on, the z axis in the x and y axes' mode;
+        """Full scale and output data rate, the temperature sensor on, the z axis in the x and y axes' mode, block
+        data update (a sample's low and high bytes from one conversion, as ST's polling example sets it);
         written and read back."""
         if self._channel.name not in ranges:
             raise self._fault(f"no range given for its {self._channel.name} channel")
@@ -72,9 +73,11 @@ class Lis3mdl:
         self._bus.write(regs.REG_CTRL1, wanted[0])
         self._bus.write(regs.REG_CTRL2, wanted[1])
         self._bus.write(regs.REG_CTRL4, wanted[3])
-        readback = tuple(self._bus.read(regs.REG_CTRL1, 4))
+        self._bus.write(regs.REG_CTRL5, regs.CTRL5_BDU)
+        wanted = (*wanted, regs.CTRL5_BDU)
+        readback = tuple(self._bus.read(regs.REG_CTRL1, 5))
         if readback != wanted:
-            raise self._fault("CTRL_REG1…4 read back " + "/".join(f"{v:02X}" for v in readback) + ", not "
+            raise self._fault("CTRL_REG1…5 read back " + "/".join(f"{v:02X}" for v in readback) + ", not "
                               + "/".join(f"{v:02X}" for v in wanted))
         self._odr_hz = odr_hz
 

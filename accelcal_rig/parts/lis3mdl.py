@@ -36,5 +36,7 @@ LIS3MDL = Part(
     source="LIS3MDL data sheet DS9463 Rev 7; ST lis3mdl-pid driver",
     device="accelcal_rig.instruments.lis3mdl_driver:Lis3mdl",
     simulator="accelcal_rig.sim.lis3mdl_bridge_server:serve_bridge",
-    spi=SpiFraming(address_shift=0, read_bit=0x80, burst_bit=0x40),  # RW bit 7, MS (auto-increment) bit 6
+    # RW bit 7, MS (auto-increment) bit 6; the clock idles high and data are captured on its rising edge: mode 3
+    # (DS9463 §5.2, Figure 4).
+    spi=SpiFraming(address_shift=0, read_bit=0x80, burst_bit=0x40, mode=3),
 )

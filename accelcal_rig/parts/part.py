@@ -96,6 +96,8 @@ class SpiFraming:
     read_bit: int
     #: set in the command byte of a read of more than one register (0: every burst increments)
     burst_bit: int = 0
+    #: the SPI mode (clock polarity and phase) the part's data sheet draws: 0 (clock idle low), 3 (idle high)
+    mode: int = 0
 
     def read_command(self, address: int, count: int = 1) -> int:
         return (address << self.address_shift) | self.read_bit | (self.burst_bit if count > 1 else 0)

@@ -62,5 +62,8 @@ def test_the_journal_and_the_campaign_file_hold_the_same_measurements(paper_camp
     assert from_journal.source == "journal" and from_file.source == "file"
     assert measurements_sha256(from_journal) == measurements_sha256(from_file)
     for serial in from_journal.serials:
-        for name in ("mean_g", "stderr_g", "temperature_c", "gravity_reference_g"):
+        for name in ("temperature_c", "temperature_in_band"):
             np.testing.assert_array_equal(from_journal.dut_column(serial, name), from_file.dut_column(serial, name))
+        for name in ("raw_codes", "mean", "stderr", "reference"):
+            np.testing.assert_array_equal(from_journal.channel_column(serial, "accel", name),
+                                          from_file.channel_column(serial, "accel", name))

@@ -146,3 +146,38 @@ def test_a_misspelt_magnetometer_limit_is_refused_before_anything_moves(tmp_path
     with pytest.raises(ConfigError, match=r"acceptance\.mag\.max_rmse_mgauss: max_rmse_mgauss is not a figure "
                                           r"limit of the magnetometer model \(its: max_axis_error_mgauss"):
         prepare(procedure)
+
+
+def test_the_c_header_compensates_the_magnetometer_as_apply_does(mixed, tmp_path: Path) -> None:
+    """The header's magnetometer section, compiled: readings as gauss and as codes, inside and outside the
+    calibrated range, give what `apply` gives."""
+    import subprocess
+    import warnings
+
+    from accelcal_rig.export.c_header import to_c_header
+    from accelcal_rig.fit.calibration import CalibrationRangeWarning, apply_codes
+    from tests.export.test_c_header import PROGRAM, compiler
+
+    calibration = load_calibration(mixed[1])
+    channel = calibration.channel(MAG, "mag")
+    header = to_c_header(calibration)
+    assert "#define ACCELCAL_MAG_LIS3MDL_M001 0" in header and "accelcal_apply(" in header  # the ADXL355's too
+    (tmp_path / "calibration.h").write_text(header)
+    program = (PROGRAM.replace("accelcal_apply_codes(&ACCELCAL_SENSORS", "accelcal_apply_mag_codes(&ACCELCAL_MAGS")
+               .replace("accelcal_apply(&ACCELCAL_SENSORS", "accelcal_apply_mag(&ACCELCAL_MAGS"))
+    (tmp_path / "main.c").write_text(program)
+    subprocess.run([compiler(), "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2", "-o",
+                    str(tmp_path / "mag"), str(tmp_path / "main.c"), "-lm"], check=True, capture_output=True)
+    rng = np.random.default_rng(3)
+    temperature = rng.uniform(-20.0, 80.0, 200)                      # calibrated 0…60 °C
+    reading = rng.normal(0.0, 0.3, (200, 3))
+    codes = rng.random(200) < 0.5
+    reading[codes] = np.rint(reading[codes] / channel.lsb)
+    stdin = "".join(f"0 {float(t)!r} {float(a)!r} {float(b)!r} {float(c)!r} {int(k)}\n"
+                    for t, (a, b, c), k in zip(temperature, reading, codes))
+    out = subprocess.run([str(tmp_path / "mag")], input=stdin, check=True, capture_output=True, text=True).stdout
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationRangeWarning)
+        expected = np.array([(apply_codes if k else apply)(channel, r, t) for t, r, k in zip(temperature, reading, codes)])
+    assert np.max(np.abs(np.loadtxt(out.splitlines()) - expected)) < 1e-12   # gauss
+    assert np.max(np.abs(expected - reading * np.where(codes, channel.lsb, 1.0)[:, None])) > 0.05  # hard iron off

@@ -61,18 +61,18 @@ def test_a_reset_that_never_clears_is_a_fault_within_its_deadline() -> None:
     (16, 1000, 0x82, 0x60, 0x00),    # low power, FAST_ODR; FS 11; OMZ 00
     (8, 300, 0xC2, 0x20, 0x08),      # high performance, FAST_ODR; FS 01; OMZ 10
 ])
-def test_configure_writes_ctrl_reg1_2_4_keeps_the_mode_and_reads_all_four_back(range_gauss, odr_hz, ctrl1, ctrl2,
+def test_configure_writes_ctrl_reg1_2_4_5_keeps_the_mode_and_reads_all_five_back(range_gauss, odr_hz, ctrl1, ctrl2,
                                                                                ctrl4) -> None:
     driver, bus, _ = driver_on([("R", 0x22, 1, b"\x03"), ("W", 0x20, ctrl1), ("W", 0x21, ctrl2), ("W", 0x23, ctrl4),
-                                ("R", 0x20, 4, bytes([ctrl1, ctrl2, 0x03, ctrl4]))])
+                                ("W", 0x24, 0x40), ("R", 0x20, 5, bytes([ctrl1, ctrl2, 0x03, ctrl4, 0x40]))])
     driver.configure({"mag": range_gauss}, odr_hz)
     assert bus.done
 
 
 def test_a_configuration_that_does_not_read_back_is_a_fault() -> None:
     driver, _, _ = driver_on([("R", 0x22, 1, b"\x03"), ("W", 0x20, 0xE2), ("W", 0x21, 0x00), ("W", 0x23, 0x0C),
-                              ("R", 0x20, 4, b"\xe2\x20\x03\x0c")])
-    with pytest.raises(InstrumentError, match="CTRL_REG1…4 read back E2/20/03/0C, not E2/00/03/0C"):
+                              ("W", 0x24, 0x40), ("R", 0x20, 5, b"\xe2\x20\x03\x0c\x40")])
+    with pytest.raises(InstrumentError, match="CTRL_REG1…5 read back E2/20/03/0C/40, not E2/00/03/0C/40"):
         driver.configure({"mag": 4}, 155)
 
 
@@ -107,8 +107,8 @@ def test_temperature_is_one_burst_of_temp_out() -> None:
 def test_acquire_polls_one_burst_per_sample_and_takes_only_new_ones() -> None:
     """At 155 Hz: a burst to clear STATUS, then each sample read once ZYXDA says it is new (a burst without it is
     polled again an eighth of a period later)."""
-    configure = [("R", 0x22, 1, b"\x00"), ("W", 0x20, 0xE2), ("W", 0x21, 0x00), ("W", 0x23, 0x0C),
-                 ("R", 0x20, 4, b"\xe2\x00\x00\x0c")]
+    configure = [("R", 0x22, 1, b"\x00"), ("W", 0x20, 0xE2), ("W", 0x21, 0x00), ("W", 0x23, 0x0C), ("W", 0x24, 0x40),
+                 ("R", 0x20, 5, b"\xe2\x00\x00\x0c\x40")]
     bursts = [("R", 0x27, 9, sample(0xFF, (0, 0, 0), 0)),             # read first: clears STATUS
               ("R", 0x27, 9, sample(0x0F, (100, -200, 3000), 40)),
               ("R", 0x27, 9, sample(0x00, (100, -200, 3000), 40)),   # not new yet
@@ -120,7 +120,7 @@ def test_acquire_polls_one_burst_per_sample_and_takes_only_new_ones() -> None:
     np.testing.assert_array_equal(block.codes["mag"], [[100, -200, 3000], [101, -201, 3001]])
     assert block.temperature_c == (30.0, 31.0)
     assert block.t_end_s - block.t_start_s == pytest.approx(1 / 155)
-    assert np.diff(bus.at[5:]) == pytest.approx([1 / 155, 1 / 155, 1 / 155 / 8])
+    assert np.diff(bus.at[6:]) == pytest.approx([1 / 155, 1 / 155, 1 / 155 / 8])
 
 
 def test_the_bridge_frames_a_burst_with_the_read_and_auto_increment_bits() -> None:
@@ -129,3 +129,31 @@ def test_the_bridge_frames_a_burst_with_the_read_and_auto_increment_bits() -> No
     assert spi is not None
     assert spi.read_command(0x0F, 1) == 0x8F and spi.read_command(0x27, 9) == 0xE7
     assert spi.write_command(0x21) == 0x21
+    assert spi.mode == 3                                       # SPC idles high, data captured on its rising edge
+
+
+def test_spidev_opens_the_bus_in_the_parts_mode_and_frames_its_bursts(monkeypatch) -> None:
+    """Over Linux spidev (a stand-in SpiDev: no kernel bus here): mode 3 and the MS bit on a burst."""
+    import sys
+    import types
+
+    from accelcal_rig.instruments.adxl355_transport import SpidevBus
+
+    class FakeSpiDev:
+        def __init__(self) -> None:
+            self.mode, self.max_speed_hz, self.sent = None, None, []
+
+        def open(self, bus: int, chip_select: int) -> None:
+            pass
+
+        def xfer2(self, data: list[int]) -> list[int]:
+            self.sent.append(list(data))
+            return [0xFF] + [0x3D] * (len(data) - 1)
+
+    monkeypatch.setitem(sys.modules, "spidev", types.SimpleNamespace(SpiDev=FakeSpiDev))
+    bus = SpidevBus.open(0, 1, framing=LIS3MDL.spi)
+    device = bus._device
+    assert device.mode == 3
+    assert bus.read(0x0F, 1) == b"\x3d" and bus.read(0x27, 9) == b"\x3d" * 9
+    bus.write(0x24, 0x40)
+    assert device.sent == [[0x8F, 0], [0xE7] + [0] * 9, [0x24, 0x40]]

@@ -43,5 +43,6 @@ def test_identity_tells_the_adxl359_from_the_others_but_not_the_adxl357_from_the
 def test_range_and_rate_problems_name_the_part_and_what_it_offers() -> None:
     assert ADXL357.range_problem("accel", 20) is None and ADXL357.rate_problem(125) is None
     assert ADXL357.range_problem("accel", 2) == "±2 g is not a range of the ADXL357 (±10/20/40 g)"
-    assert ADXL355.rate_problem(100).startswith("100 Hz is not an ADXL355 output data rate (4000, 2000, ")
+    assert ADXL355.rate_problem(100) is None and ADXL355.rate_for(100) == 125   # its next faster rate
+    assert ADXL355.rate_problem(5000).startswith("5000 Hz is faster than every ADXL355 output data rate (4000, 2000, ")
     assert ADXL355.odr_code(125.0) == 5 and ADXL355.odr_code(3.906) == 10

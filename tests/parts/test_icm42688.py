@@ -48,7 +48,8 @@ def test_odr_codes_are_the_registers_not_the_index() -> None:
     assert ICM42688P.odr_for_code(15) == 500 and ICM42688P.odr_for_code(8) == 100
     assert ICM42688P.odr_for_code(0) is None and ICM42688P.odr_for_code(12) is None
     assert ICM42688P.has_rate(200) and not ICM42688P.has_rate(125)
-    assert "125 Hz is not an ICM-42688-P output data rate" in ICM42688P.rate_problem(125)
+    assert ICM42688P.rate_for(125) == 200 and ICM42688P.rate_problem(125) is None   # its next faster rate
+    assert "64000 Hz is faster than every ICM-42688-P output data rate" in ICM42688P.rate_problem(64000)
 
 
 def test_temperature_is_signed_132_48_lsb_per_degree_from_25() -> None:
