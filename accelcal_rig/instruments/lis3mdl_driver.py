@@ -69,12 +69,11 @@ class Lis3mdl:
             raise self._fault(f"no range given for its {self._channel.name} channel")
         code = self.part.odr_code(odr_hz)
         wanted = (regs.ctrl1(code), regs.ctrl2(self._channel.range_codes[ranges[self._channel.name]]),
-                  regs.ctrl3_current(self._bus.read(regs.REG_CTRL3, 1)[0]), regs.ctrl4(code))
+                  regs.ctrl3_current(self._bus.read(regs.REG_CTRL3, 1)[0]), regs.ctrl4(code), regs.CTRL5_BDU)
         self._bus.write(regs.REG_CTRL1, wanted[0])
         self._bus.write(regs.REG_CTRL2, wanted[1])
         self._bus.write(regs.REG_CTRL4, wanted[3])
-        self._bus.write(regs.REG_CTRL5, regs.CTRL5_BDU)
-        wanted = (*wanted, regs.CTRL5_BDU)
+        self._bus.write(regs.REG_CTRL5, wanted[4])
         readback = tuple(self._bus.read(regs.REG_CTRL1, 5))
         if readback != wanted:
             raise self._fault("CTRL_REG1…5 read back " + "/".join(f"{v:02X}" for v in readback) + ", not "
