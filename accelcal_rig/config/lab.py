@@ -77,6 +77,7 @@ REFERENCE_LABELS = {
     "turntable_angle": "turntable angle (every pose's reference gravity direction)",
     "turntable_rate": "turntable rate (every rate step's reference rate)",
     "site_gravity": "site gravity (gravity_m_s2)",
+    "site_magnetic_field": "site magnetic field (magnetic_field: every magnetometer's reference)",
     "temperature": "temperature (the chamber's air temperature)",
 }
 
@@ -89,6 +90,9 @@ class References(StrictModel):
     turntable_rate: ReferenceConfig | None = Field(None, description="the table's rate (a table with a rate mode)")
     site_gravity: ReferenceConfig | None = Field(None, description="the determination of the site's gravity "
                                                  "(a gravimeter survey's report)")
+    site_magnetic_field: ReferenceConfig | None = Field(None, description="the determination of the site's "
+                                                        "magnetic field where the fixture is (a survey's report, "
+                                                        "the reference magnetometer's certificate)")
     temperature: ReferenceConfig | None = Field(None, description="the temperature reference the chamber's "
                                                 "readings are traced to (a reference thermometer)")
 

@@ -14,10 +14,11 @@ from accelcal_rig.errors import ConfigError
 
 
 def expected_references(rig: RigConfig) -> list[str]:
-    """The references the rig's campaigns rely on: the table's rate only where an axis has a rate mode."""
+    """The references the rig's campaigns rely on: the table's rate only where an axis has a rate mode, the
+    site's magnetic field only where the rig states one (its magnetometers' reference)."""
     rate_mode = any(axis.has_rate_mode for axis in rig.turntable.axes)
-    return [key for key in REFERENCE_LABELS if key != "turntable_rate" or rate_mode
-            or rig.references.turntable_rate is not None]
+    relied_on = {"turntable_rate": rate_mode, "site_magnetic_field": rig.magnetic_field is not None}
+    return [key for key in REFERENCE_LABELS if relied_on.get(key, True) or getattr(rig.references, key) is not None]
 
 
 @dataclass(frozen=True)

@@ -107,6 +107,8 @@ class VectorQuantity:
     statements: Callable[[Mapping[str, Any]], list[tuple[str, str]]] = lambda figures: []
     #: whether the campaign places the reference's direction (else only its size is known: fitted norm-only)
     direction_known: Callable[[Campaign], bool] = lambda campaign: True
+    #: how its method departs from the paper's (an accelerometer's paper), said after the paper on a certificate
+    paper_departure: str = ""
     #: the site's reference as the campaign recorded it, kept with the figures (`site_<quantity>`; None: none)
     site_description: Callable[[Campaign], dict[str, Any] | None] = lambda campaign: None
 
@@ -237,7 +239,7 @@ class Eq1Model:
         setpoints = len(calibration.setpoints)
         return (f"Eq. 1 sensor frame error model, {calibration.mode} fit of {len(calibration.free_parameters)} "
                 f"parameters at each of {setpoints} setpoint{'s' if setpoints != 1 else ''}, polynomials of degree "
-                f"{calibration.polynomial.degree} in temperature, after {PAPER}")
+                f"{calibration.polynomial.degree} in temperature, after {PAPER}{self.spec.paper_departure}")
 
     def reference_statements(self, figures: Mapping[str, Any]) -> list[tuple[str, str]]:
         return self.spec.statements(figures)
