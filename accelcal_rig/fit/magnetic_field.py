@@ -73,10 +73,10 @@ MAGNETIC_FIELD = VectorQuantity(
     quantity="magnetic field", sensor="magnetometer", unit="gauss", milli="mgauss", magnitude_label="|B|",
     reference_label="field", magnitude_figure=("field_gauss", 1.0), angle="direction", site=site_field,
     truth=_described_truth, method="Eq. 1, B = M·C·S·(U − b): b the hard-iron offset, M·C·S the soft-iron matrix",
-    micro="µgauss", magnitude_source="site's field intensity",
-    size_source="field_intensity", angle_label="largest direction error",
-    statements=_statements, c_token="mag",
-    paper_departure=", its method applied against the site's magnetic field instead of gravity", direction_known=direction_known, site_description=_recorded_field,
+    micro="µgauss", magnitude_source="site's field intensity", size_source="field_intensity",
+    angle_label="largest direction error", statements=_statements, c_token="mag",
+    paper_departure=", its method applied against the site's magnetic field instead of gravity",
+    direction_known=direction_known, site_description=_recorded_field,
 )
 
 MODEL = Eq1Model(MAGNETIC_FIELD)
