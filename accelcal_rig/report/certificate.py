@@ -228,7 +228,7 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
              f"{'issued ' + _e(approval.date) if approval else 'draft of ' + _e(utc_now()[:10])} by accelcal-rig "
              f"{_e(__version__)}</p>",
              *(f"<div class='banner'>{_e(b)}</div>" for b in banners)]
-    configured = "; ".join(f"{name} ±{c.range:g} {c.unit}, {c.lsb:.4g} {c.unit} per code" for name, c in channels.items())
+    configured = "; ".join(f"{name} ±{c.range:g} {c.unit}, {_per_code(c.lsb, c.unit)} per code" for name, c in channels.items())
     parts += ["<div class='front'>", "<h2>Item calibrated</h2>", _rows([
         ("serial", serial),
         ("part", f"{dut.get('part', '?')}: {_identity(campaign, serial)}"),
@@ -323,3 +323,9 @@ def _identity(campaign: Campaign, serial: str) -> str:
     prefix = f"sensor {serial}: "
     found = [e.message[len(prefix):] for e in campaign.events if e.kind == "preflight" and e.message.startswith(prefix)]
     return found[-1] if found else "identity not recorded"
+
+
+def _per_code(lsb: float, unit: str) -> str:
+    """A code's size in millionths or thousandths of its unit, as a data sheet states it: 61.04 µg, 61.04 mdps."""
+    factor, prefix = (1e6, "µ") if lsb < 1e-3 else (1e3, "m") if lsb < 1.0 else (1.0, "")
+    return f"{lsb * factor:.4g} {prefix}{unit}"
