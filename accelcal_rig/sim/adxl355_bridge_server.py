@@ -15,12 +15,11 @@ from accelcal_rig.config.rig import SensorConfig
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import BRIDGE_GREETING
 from accelcal_rig.sim.bridge_capture import CaptureRequests
-from accelcal_rig.sim.bridge_lines import LINE_ENCODING, STALE_LINE_S, overlong_line
 from accelcal_rig.sim.bridge_registers import RegisterMap, RegisterRequests
 from accelcal_rig.sim.bridge_requests import BridgeRequests
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
-from accelcal_rig.sim.pty_line_server import PtyLineServer
+from accelcal_rig.sim.register_bridge_server import BridgeOnPty
 
 _FIFO_REGISTERS = frozenset({adxl355.REG_STATUS, adxl355.REG_FIFO_ENTRIES, adxl355.REG_FIFO_DATA})  # ID, status, data and FIFO registers
 _SAMPLES_IN_FIFO = adxl355.FIFO_CAPACITY_ENTRIES // 3
@@ -218,7 +217,7 @@ class SimulatedAdxl355:
         return count
 
 
-class SimulatedBridgeServer:
+class SimulatedBridgeServer(BridgeOnPty):
     """The bridge line protocol on a pseudo-terminal, in front of one simulated ADXL355: version 3 as the
     reference firmware speaks it (`part=adxl355`, as it names any part whose DEVID_AD is 0xAD), or version 2
     (its greeting without `part=`) or 1 (no capture)."""
@@ -226,39 +225,18 @@ class SimulatedBridgeServer:
     def __init__(self, lab: VirtualLab, index: int, protocol_version: int = 3, faults: ReplyFaults | None = None,
                  wrong_part_id: bool = False, stuck_after_s: float | None = None,
                  temperature_tear_rate: float = 0.0) -> None:
-        self._lab = lab
         self._version = protocol_version
         self.device = SimulatedAdxl355(lab, index, wrong_part_id, stuck_after_s, temperature_tear_rate)
         device = self.device
         capture = CaptureRequests(device, CAPTURE_CAPACITY_SAMPLES) if protocol_version >= 2 else None
         registers = RegisterRequests(device, REGISTER_MAP, lambda: not device.measuring, capture)
-        self._requests = BridgeRequests(self._greeting, registers, "adxl355", capture,
-                                        verbs="?RWCG" if capture is not None else "?RW")
-        self._server = PtyLineServer(self._handle, b"\n", f"simulated-bridge-{lab.duts[index].serial}", faults,
-                                     encoding=LINE_ENCODING, overlong=overlong_line, strip=False,
-                                     stale_after_s=STALE_LINE_S)
-        self.path = self.endpoint = self._server.path
+        super().__init__(lab, index, BridgeRequests(self._greeting, registers, "adxl355", capture,
+                                                    verbs="?RWCG" if capture is not None else "?RW"), faults)
 
     @property
     def version(self) -> int:
         """The bridge protocol version it speaks."""
         return self._version
-
-    @property
-    def session(self) -> int:
-        """How many times a client has come or gone, as the bridge saw it (tests wait on it, not on time)."""
-        return self._server.session
-
-    def start(self) -> SimulatedBridgeServer:
-        self._server.start()
-        return self
-
-    def stop(self) -> None:
-        self._server.stop()
-
-    def _handle(self, line: str) -> str | None:
-        with self._lab.lock:
-            return self._requests.answer(line)
 
     def _greeting(self) -> str:
         part = " part=adxl355" if self._version >= 3 else ""

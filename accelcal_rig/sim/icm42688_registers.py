@@ -14,12 +14,11 @@ is ±16 g.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from accelcal_rig.instruments import icm42688 as regs
 from accelcal_rig.sim.lab import VirtualLab
+from accelcal_rig.sim.sample_ticks import SampleTicks
 
 _DATA = range(regs.REG_TEMP_DATA1, regs.REG_GYRO_DATA_Z0 + 1)
 #: Reset values (data sheet register map): both CONFIG0 registers FS_SEL 0, ODR code 6 (1 kHz).
@@ -29,8 +28,6 @@ _CONFIG0_RESET = 0x06
 _OTHER_ODR_HZ = {0: 1000.0, 12: 6.25, 13: 3.125, 14: 1.5625}
 #: The accelerometer's reserved FS_SEL codes (4…7) taken as ±16 g (FS_SEL 0).
 _ACCEL_FS_SEL_RESERVED = 4
-#: A read exactly at a sample instant sees that sample (in samples: far above the clock's rounding).
-_TICK_EPS = 1e-6
 
 
 class SimulatedIcm42688:
@@ -48,8 +45,7 @@ class SimulatedIcm42688:
         self._regs[regs.REG_WHO_AM_I] = self._who_am_i
         self._regs[regs.REG_GYRO_CONFIG0] = self._regs[regs.REG_ACCEL_CONFIG0] = _CONFIG0_RESET
         self._regs[regs.REG_INT_STATUS] = regs.INT_STATUS_RESET_DONE
-        self._on_since: float | None = None
-        self._last_tick = 0
+        self._ticks = SampleTicks()
         self._sample = self._invalid()
 
     def read(self, address: int, count: int) -> bytes:
@@ -78,11 +74,13 @@ class SimulatedIcm42688:
         was_on = self._measuring
         self._regs[address] = value
         if address == regs.REG_PWR_MGMT0 and was_on != self._measuring:
-            self._on_since = self._lab.clock.now() if self._measuring else None
-            self._last_tick = 0
+            if self._measuring:
+                self._ticks.start(self._lab.clock.now())
+            else:
+                self._ticks.stop()
             self._sample = self._invalid()
-        elif address in (regs.REG_GYRO_CONFIG0, regs.REG_ACCEL_CONFIG0) and self._on_since is not None:
-            self._on_since, self._last_tick = self._lab.clock.now(), 0  # a new rate starts counting afresh
+        elif address in (regs.REG_GYRO_CONFIG0, regs.REG_ACCEL_CONFIG0):
+            self._ticks.restart(self._lab.clock.now())
 
     @property
     def _measuring(self) -> bool:
@@ -108,14 +106,11 @@ class SimulatedIcm42688:
     def _update_data(self) -> None:
         """The newest sample due by the clock, made when first looked at (a sample nobody reads costs nothing);
         DATA_RDY set when it is new."""
-        if self._on_since is None:
+        odr = self._odr_hz if self._ticks.running else 0.0
+        newest = self._ticks.newest(self._lab.clock.now(), odr)
+        if newest is None:
             return
-        odr = self._odr_hz
-        tick = math.floor((self._lab.clock.now() - self._on_since) * odr + _TICK_EPS)
-        if tick <= self._last_tick:
-            return
-        self._last_tick = tick
-        t_sample = self._on_since + tick / odr
+        t_sample = newest[0]
         accel = self._lab.dut_samples(self._index, t_sample, 1, odr, self._range("accel", regs.REG_ACCEL_CONFIG0))
         gyro = self._lab.dut_gyro_samples(self._index, t_sample, 1, odr, self._range("gyro", regs.REG_GYRO_CONFIG0))
         self._sample = regs.encode_sample(0, accel[0], gyro[0])

@@ -12,16 +12,13 @@ FAST_READ and the interrupt generator hold what is written and do nothing.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from accelcal_rig.instruments import lis3mdl as regs
 from accelcal_rig.sim.lab import VirtualLab
+from accelcal_rig.sim.sample_ticks import SampleTicks
 
 _DATA = range(regs.REG_OUT_X_L, regs.REG_OUT_X_L + 6)
-#: A read exactly at a sample instant sees that sample (in samples: far above the clock's rounding).
-_TICK_EPS = 1e-6
 
 
 class SimulatedLis3mdl:
@@ -40,8 +37,7 @@ class SimulatedLis3mdl:
         for address, value in regs.RESET_VALUES.items():
             self._regs[address] = value
         self._regs[regs.REG_WHO_AM_I] = self._who_am_i
-        self._on_since: float | None = None
-        self._last_tick = 0
+        self._ticks = SampleTicks()
         self._sample = np.zeros(3, dtype=np.int32)
 
     def read(self, address: int, count: int) -> bytes:
@@ -70,10 +66,12 @@ class SimulatedLis3mdl:
         was_on = self._measuring
         self._regs[address] = value
         if address == regs.REG_CTRL3 and was_on != self._measuring:
-            self._on_since = self._lab.clock.now() if self._measuring else None
-            self._last_tick = 0
-        elif address == regs.REG_CTRL1 and self._on_since is not None:
-            self._on_since, self._last_tick = self._lab.clock.now(), 0  # a new rate starts counting afresh
+            if self._measuring:
+                self._ticks.start(self._lab.clock.now())
+            else:
+                self._ticks.stop()
+        elif address == regs.REG_CTRL1:
+            self._ticks.restart(self._lab.clock.now())
 
     @property
     def _measuring(self) -> bool:
@@ -95,14 +93,11 @@ class SimulatedLis3mdl:
     def _update_data(self) -> None:
         """The newest sample due by the clock, made when first looked at; ZYXDA set when it is new, ZYXOR when
         one before it went by unread."""
-        if self._on_since is None:
+        odr = self._odr_hz if self._ticks.running else 0.0
+        newest = self._ticks.newest(self._lab.clock.now(), odr)
+        if newest is None:
             return
-        odr = self._odr_hz
-        tick = math.floor((self._lab.clock.now() - self._on_since) * odr + _TICK_EPS)
-        if tick <= self._last_tick:
-            return
-        unread = bool(self._regs[regs.REG_STATUS] & regs.STATUS_ZYXDA) or tick > self._last_tick + 1
-        self._last_tick = tick
-        t_sample = self._on_since + tick / odr
+        t_sample, came = newest
+        unread = bool(self._regs[regs.REG_STATUS] & regs.STATUS_ZYXDA) or came > 1
         self._sample = self._lab.dut_field_samples(self._index, t_sample, 1, odr, self._range())[0]
         self._regs[regs.REG_STATUS] = regs.STATUS_ZYXDA | 0x07 | ((regs.STATUS_ZYXOR | 0x70) if unread else 0)
