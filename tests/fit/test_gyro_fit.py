@@ -36,6 +36,8 @@ RIG = REPO / "configs" / "sim-imu.yaml"
 def gyro_records(campaign: Campaign, serial: str) -> GyroRecords:
     """The DUT's gyroscope records, the specific force beside them, as its channel model reads them."""
     return read_gyro_records(campaign, serial, "gyro", specific_force_g(campaign, serial))
+
+
 PROCEDURE = {
     "name": "imu-small", "rig": str(RIG), "setpoints_c": [0, 20, 40],
     "soak": {"criterion": "settling", "min_dwell_min": 10, "window_min": 10, "poll_s": 60},
