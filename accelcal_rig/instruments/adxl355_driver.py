@@ -4,25 +4,22 @@ numpy, not per sample) — captured by the bridge where it can, else drained fro
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
-from typing import TypeVar
+from collections.abc import Mapping
 
 import numpy as np
 
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.waits import wait_until
-from accelcal_rig.errors import InstrumentError, TransientInstrumentError, WaitTimeout
+from accelcal_rig.errors import InstrumentError, WaitTimeout
 from accelcal_rig.instruments import adxl355
-from accelcal_rig.instruments.adxl355_transport import BlockCapture, PostedRequests, RegisterTransport
+from accelcal_rig.instruments.adxl355_transport import PostedRequests, RegisterTransport
+from accelcal_rig.instruments.bridge_block import BridgeCapturing, Decoded
 from accelcal_rig.instruments.capabilities import Reconnecting
 from accelcal_rig.instruments.capture import OVERFLOW_ATTEMPTS, capture_together
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
 from accelcal_rig.instruments.retrying import RetryCall, RetryingTransport
 from accelcal_rig.parts.adxl35x import ADXL355
 from accelcal_rig.parts.part import Part
-
-T = TypeVar("T")
 
 #: Samples to let accumulate between FIFO bursts: under its 32, so a burst is never late.
 DRAIN_EVERY_SAMPLES = 30
@@ -35,20 +32,7 @@ TEMPERATURE_READS = 10
 AGREED_FRESH_S = 60.0
 
 
-@dataclass
-class _Capture:
-    """A block being captured by the bridge: what is known so far."""
-
-    n_samples: int
-    t_start_s: float
-    temperature_before_c: float
-    blocks: list[np.ndarray] = field(default_factory=list)
-    have: int = 0
-    carried: bytes = b""
-    temperature_after_c: float | None = None
-
-
-class Adxl355:
+class Adxl355(BridgeCapturing):
     def __init__(self, transport: RegisterTransport, serial: str, clock: Clock,
                  part: Part = ADXL355) -> None:
         self.part = part
@@ -60,17 +44,8 @@ class Adxl355:
         self.endpoint = transport.endpoint
         self._clock = clock
         self._odr_hz = 125.0
-        self._capture: _Capture | None = None
-        #: Clock time the last capture request was posted: when the bridge started it, however much later
-        #: its reply is read (after another DUT's retries, say).
-        self._capture_posted_s: float | None = None
         #: (clock time, raw code) of the last temperature that two reads agreed on.
         self._agreed: tuple[float, int] | None = None
-
-    @property
-    def capture_capacity_samples(self) -> int:
-        """The largest block the bridge captures itself (0: none; the host drains the FIFO)."""
-        return self._bus.capture_capacity_samples
 
     # ------------------------------------------------------------------ the Sensor interface
     def identify(self) -> DeviceIdentity:
@@ -183,93 +158,10 @@ class Adxl355:
         if isinstance(self._fifo_bus, Reconnecting):
             self._fifo_bus.reconnect()
 
-    # ------------------------------------------------------------------ bridge-side capture
-    def post_capture(self, n_samples: int) -> bool:
-        """Send the capture request without waiting for its reply (False: not sent; `begin_capture` asks)."""
-        self._capture_posted_s = self._clock.now()
-        return self._posted(lambda bridge: bridge.post_capture(n_samples))
-
-    def begin_capture(self, n_samples: int, posted: bool = False) -> None:
-        """The bridge starts capturing the next `n_samples` (and says the temperature then). `posted`: the
-        request went out with `post_capture`; its reply is read here, or the request retried if it failed.
-        The block starts when the bridge heard the request that started it, not when its reply was read:
-        the replies of posted requests are read one DUT after another, after any retries of those before."""
-        raw = self._received(posted, lambda bridge: bridge.receive_capture(n_samples))
-        if raw is not None and self._capture_posted_s is not None:
-            started_s = self._capture_posted_s
-        else:  # not posted, or its reply lost: a capture started again now, by the retried request
-            raw = self._capturing_bus().start_capture(n_samples)
-            started_s = self._clock.now()
-        self._capture_posted_s = None
-        self._capture = _Capture(n_samples, started_s, float(self.part.temperature.celsius(raw)))
-
-    def capture_wait_s(self) -> float:
-        """Clock time until the rest of the block has been captured."""
-        assert self._capture is not None
-        return (self._capture.n_samples - self._capture.have) / self._odr_hz
-
-    def post_fetch(self) -> bool:
-        """Send the next fetch without waiting for its reply (False: not sent; `fetch_capture` asks)."""
-        assert self._capture is not None
-        have = self._capture.have
-        return self._posted(lambda bridge: bridge.post_fetch(have))
-
-    def fetch_capture(self, posted: bool = False) -> bool:
-        """Fetch what the bridge has captured since the last fetch (asked for by index, so a retry after
-        a lost reply loses nothing); True once the block is complete. A capture that lost samples raises
-        CaptureOverflow; one that stalls past its deadline is a fault. `posted`: as for `begin_capture`."""
-        capture = self._capture
-        assert capture is not None
-        fetched = self._received(posted, lambda bridge: bridge.receive_fetch(capture.have))
-        raw, temperature_raw = fetched if fetched is not None else self._capturing_bus().fetch_capture(capture.have)
-        codes, capture.carried = adxl355.decode_fifo(raw, capture.carried)
-        capture.blocks.append(codes)
-        capture.have += len(codes)
-        if temperature_raw is not None:
-            capture.temperature_after_c = float(self.part.temperature.celsius(temperature_raw))
-        done = capture.have >= capture.n_samples
-        if not done and self._clock.now() > capture.t_start_s + 2.0 * capture.n_samples / self._odr_hz + 1.0:
-            raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {capture.have} of {capture.n_samples} "
-                                  "samples before the deadline: is it measuring?")
-        return done
-
-    def _capturing_bus(self) -> BlockCapture:
-        """The (retried) transport, as one that captures blocks: only such a one has a capture capacity."""
-        bus = self._bus
-        if not isinstance(bus, BlockCapture):
-            raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): its transport captures no blocks")
-        return bus
-
-    def _posted(self, send: Callable[[PostedRequests], None]) -> bool:
-        """Send a request with `send` on the bare transport, if it posts requests (no retry: a failure is
-        retried whole by the exchange that follows)."""
-        if self._poster is None:
-            return False
-        try:
-            send(self._poster)
-        except TransientInstrumentError:
-            return False
-        return True
-
-    def _received(self, posted: bool, receive: Callable[[PostedRequests], T]) -> T | None:
-        """The reply to a posted request; None when none was posted or it failed transiently (ask again)."""
-        if not posted or self._poster is None:
-            return None
-        try:
-            return receive(self._poster)
-        except TransientInstrumentError:
-            return None
-
-    def end_capture(self) -> SampleBlock:
-        """The completed block, with the temperature the bridge read as it completed."""
-        capture = self._capture
-        assert capture is not None and capture.have >= capture.n_samples
-        self._capture = None
-        if capture.temperature_after_c is None:
-            raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): the bridge completed a capture "
-                                  "without its end temperature")
-        return self._block(capture.blocks, capture.n_samples, capture.t_start_s,
-                           (capture.temperature_before_c, capture.temperature_after_c))
+    # ------------------------------------------------------------------ bridge-side capture (instruments/bridge_block.py)
+    def _decode_fifo(self, raw: bytes, carried: bytes) -> Decoded:
+        codes, carried = adxl355.decode_fifo(raw, carried)
+        return {"accel": codes}, carried
 
     # ------------------------------------------------------------------ host-drained FIFO
 
@@ -281,7 +173,8 @@ class Adxl355:
         self._burst(b"")  # stale samples from before this block
         t_start = self._clock.now()
         _, temperature_before = self._status_and_temperature()
-        blocks, have, carried = [], 0, b""
+        pieces: list[dict[str, np.ndarray]] = []
+        have, carried = 0, b""
         deadline = t_start + 2.0 * n_samples / self._odr_hz + 1.0
         while have < n_samples:
             if self._clock.now() > deadline:
@@ -289,17 +182,12 @@ class Adxl355:
                                       "before the deadline: is it measuring?")
             self._clock.sleep(min(DRAIN_EVERY_SAMPLES, n_samples - have) / self._odr_hz)
             codes, carried = self._burst(carried)
-            blocks.append(codes)
+            pieces.append({"accel": codes})
             have += len(codes)
         status, temperature_after = self._status_and_temperature()
         if status & adxl355.STATUS_FIFO_OVR:
             return None
-        return self._block(blocks, n_samples, t_start, (temperature_before, temperature_after))
-
-    def _block(self, blocks: list[np.ndarray], n_samples: int, t_start: float,
-               temperature_c: tuple[float, float]) -> SampleBlock:
-        codes = np.concatenate(blocks)[:n_samples]
-        return SampleBlock({"accel": codes}, t_start, t_start + (n_samples - 1) / self._odr_hz, temperature_c)
+        return self._block(pieces, n_samples, t_start, (temperature_before, temperature_after))
 
     def _burst(self, carried: bytes) -> tuple[np.ndarray, bytes]:
         """Read the whole FIFO in one burst."""

@@ -8,8 +8,9 @@ The bridge protocol (docs/instruments.md): one ASCII request per line, one reply
     C <count>            → `=<TEMP2 TEMP1>` (version 2) empty the FIFO, then capture the next `count`
                                             samples into the bridge's own memory, draining the FIFO
                                             itself; the reply is the temperature as the capture starts
-    G <first>            → `=<hex bytes>`   (version 2) the captured samples from index `first` on, 9 bytes
-                                            each in FIFO format; once the capture is complete the reply
+    G <first>            → `=<hex bytes>`   (version 2) the captured samples from index `first` on, as the
+                                            part's FIFO gives them (an ADXL35x: 9 bytes each; an
+                                            ICM-42688-P: 16-byte packets); once the capture is complete the reply
                                             ends in `T<TEMP2 TEMP1>`, the temperature as the last sample
                                             came; `!overflow …` if the capture lost samples. The capture
                                             stays until the next `C`, so a lost reply is asked for again
@@ -19,7 +20,8 @@ A version 2 bridge greets with `capture=<samples>`, its buffer and the largest `
 a host behind USB serial cannot drain a 32-sample FIFO in time (at 4 kHz it fills in 8 ms); the bridge's
 firmware can. A version 3 bridge names the part behind it (`part=<name>`, e.g. `part=icm42688p`): `R` and `W`
 are register-generic (the bridge frames them for its part's SPI), `C` and `G` exist only where it greets with
-`capture=`. A bridge that names no part (versions 1 and 2) has an ADXL355, ADXL357 or ADXL359 behind it.
+`capture=`. A bridge that names no part (versions 1 and 2) has an ADXL355, ADXL357 or ADXL359 behind it. The
+temperatures `C` and `G` return are the part's two temperature registers, read as its part table says.
 """
 
 from __future__ import annotations
@@ -28,10 +30,10 @@ from collections.abc import Callable
 from typing import Any, Protocol, runtime_checkable
 
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
-from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.line_port import LinePort
+from accelcal_rig.parts import registry as parts
 from accelcal_rig.parts.adxl35x import ADXL355
-from accelcal_rig.parts.part import SpiFraming
+from accelcal_rig.parts.part import Part, SpiFraming
 
 BRIDGE_GREETING = "ADXL355-BRIDGE"
 #: The newest bridge protocol version this driver speaks (1: registers; 2: capture; 3: names its part).
@@ -61,7 +63,7 @@ class BlockCapture(Protocol):
     """A transport that captures gap-free blocks itself (a version 2 serial bridge)."""
 
     def start_capture(self, n_samples: int) -> int:
-        """Start capturing; returns the raw 12-bit temperature as the capture starts."""
+        """Start capturing; returns the part's raw temperature code as the capture starts."""
 
     def fetch_capture(self, first: int) -> tuple[bytes, int | None]:
         """(captured FIFO bytes from sample `first` on, raw temperature at the end once it is complete)."""
@@ -89,6 +91,9 @@ class SerialBridge:
         self.capture_capacity_samples = 0
         #: The part the bridge says is behind it (version 3), None where it does not say.
         self.part_name: str | None = None
+        #: The part whose FIFO samples and temperature registers a capture returns: the one the bridge names
+        #: (where this program knows it), else an ADXL355 (versions 1 and 2 have one behind them).
+        self._capture_part: Part = ADXL355
 
     @classmethod
     def open(cls, endpoint: str, baudrate: int = 921600, timeout_s: float = 1.0,
@@ -116,6 +121,8 @@ class SerialBridge:
                                   f"driver 1…{PROTOCOL_VERSION} (answers {greeting!r})")
         bridge.capture_capacity_samples = _capture_capacity(greeting)
         bridge.part_name = _greeting_value(greeting, "part") if version is not None and version >= 3 else None
+        if bridge.part_name in parts.known_parts():
+            bridge._capture_part = parts.part(bridge.part_name)
         return bridge
 
     def read(self, address: int, count: int) -> bytes:
@@ -155,7 +162,7 @@ class SerialBridge:
     def receive_capture(self, n_samples: int) -> int:
         request = f"C {n_samples}"
         reply = self._refusal_raised(request, self._line.receive(request))
-        temperature = _raw_temperature(reply[1:]) if reply.startswith("=") else None
+        temperature = _raw_temperature(reply[1:], self._capture_part) if reply.startswith("=") else None
         if temperature is None:
             raise TransientInstrumentError(f"sensor bridge ({self.endpoint}): capture of {n_samples} answered "
                                            f"{reply[:40]!r}")
@@ -176,12 +183,13 @@ class SerialBridge:
             raise CaptureOverflow(f"sensor bridge ({self.endpoint}): {reply[1:]}")
         reply = self._refusal_raised(request, reply)
         samples, end_marker, temperature_hex = reply[1:].partition("T")
-        temperature = _raw_temperature(temperature_hex) if end_marker else None
+        temperature = _raw_temperature(temperature_hex, self._capture_part) if end_marker else None
         try:
             data = bytes.fromhex(samples)
         except ValueError:
             data = b"?"
-        if not reply.startswith("=") or len(data) % 9 or (end_marker and temperature is None):
+        if not reply.startswith("=") or len(data) % self._capture_part.fifo_sample_bytes \
+                or (end_marker and temperature is None):
             raise TransientInstrumentError(f"sensor bridge ({self.endpoint}): garbled capture {reply[:40]!r}")
         return data, temperature
 
@@ -200,13 +208,14 @@ class SerialBridge:
         return reply
 
 
-def _raw_temperature(hex_digits: str) -> int | None:
-    """TEMP2, TEMP1 as 4 hex digits → the 12-bit raw temperature; None if malformed."""
+def _raw_temperature(hex_digits: str, part: Part) -> int | None:
+    """The part's two temperature registers as 4 hex digits (an ADXL355's TEMP2, TEMP1) → its raw temperature
+    code; None if malformed."""
     try:
         high, low = bytes.fromhex(hex_digits)
     except ValueError:
         return None
-    return adxl355.raw_temperature(high, low)
+    return part.temperature.from_registers(high, low)
 
 
 def _version(greeting: str) -> int | None:

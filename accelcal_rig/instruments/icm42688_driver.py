@@ -1,7 +1,8 @@
 """A TDK ICM-42688-P at register level over any RegisterTransport (a serial bridge, spidev): bring-up, both
-sensors' full scale and rate, temperature, and blocks of samples read from the data registers at the output
-data rate on the injected clock (instruments/polled_block.py) — one burst per sample, TEMP_DATA1 up to
-INT_STATUS, whose DATA_RDY says the sample is new. Register facts: `instruments/icm42688.py`; the part's: `parts/icm42688.py`."""
+sensors' full scale and rate, its FIFO in packets of both sensors (stop-on-full), temperature, and gap-free blocks
+from the FIFO — captured by the bridge where it can (instruments/bridge_block.py), else read by the host in bursts
+of whole packets, FIFO_FULL checked at every read so a block that lost a sample is taken again, never returned
+short. Register facts: `instruments/icm42688.py`; the part's: `parts/icm42688.py`."""
 
 from __future__ import annotations
 
@@ -13,10 +14,11 @@ from accelcal_rig.core.clock import Clock
 from accelcal_rig.core.waits import wait_until
 from accelcal_rig.errors import InstrumentError, WaitTimeout
 from accelcal_rig.instruments import icm42688 as regs
-from accelcal_rig.instruments.adxl355_transport import RegisterTransport
+from accelcal_rig.instruments.adxl355_transport import PostedRequests, RegisterTransport
+from accelcal_rig.instruments.bridge_block import BridgeCapturing, Decoded
 from accelcal_rig.instruments.capabilities import Reconnecting
+from accelcal_rig.instruments.capture import OVERFLOW_ATTEMPTS, capture_together
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
-from accelcal_rig.instruments.polled_block import poll_block
 from accelcal_rig.instruments.retrying import RetryCall, RetryingTransport
 from accelcal_rig.parts.icm42688 import ICM42688P
 from accelcal_rig.parts.part import Part
@@ -26,17 +28,22 @@ RESET_TIMEOUT_S = 0.1
 RESET_POLL_S = 0.001
 #: After PWR_MGMT0 turns the gyroscope on, its data are not valid for this long (the Linux driver waits 60 ms).
 GYRO_STARTUP_S = 0.06
+#: Packets to let gather between the host's reads of the FIFO: half its 128, so a read is never late.
+DRAIN_EVERY_PACKETS = 64
+#: Packets in one burst of FIFO_DATA: the bridge's longest read (288 bytes) holds 18 whole packets.
+BURST_PACKETS = 18
 
 
-class Icm42688:
+class Icm42688(BridgeCapturing):
     """The Sensor of an ICM-42688-P DUT: channels `accel` (g) and `gyro` (°/s), 16-bit codes."""
-
-    capture_capacity_samples = 0  # no bridge-side capture: the host polls the data registers
 
     def __init__(self, transport: RegisterTransport, serial: str, clock: Clock, part: Part = ICM42688P) -> None:
         self.part = part
         self._bare: RegisterTransport = transport
         self._bus: RegisterTransport = transport
+        #: The bare transport where it posts requests; FIFO bursts go there too, never retried alone (a lost
+        #: reply took packets with it: the block is taken again whole).
+        self._poster = transport if isinstance(transport, PostedRequests) else None
         self.serial = serial
         self.endpoint = transport.endpoint
         self._clock = clock
@@ -63,7 +70,8 @@ class Icm42688:
             raise InstrumentError(str(exc)) from None
 
     def configure(self, ranges: Mapping[str, float], odr_hz: float) -> None:
-        """Both sensors' full scale and the one output data rate, written and read back."""
+        """Both sensors' full scale and the one output data rate, and the FIFO (packets of both sensors and the
+        temperature, stop-on-full), written and read back; in standby, as the data sheet asks of the FIFO's set-up."""
         missing = [c.name for c in self.part.channels if c.name not in ranges]
         if missing:
             raise self._fault(f"no range given for its {', '.join(missing)} channel")
@@ -76,6 +84,12 @@ class Icm42688:
         if readback != (gyro, accel):
             raise self._fault(f"GYRO_CONFIG0/ACCEL_CONFIG0 read back {readback[0]:02X}/{readback[1]:02X}, "
                               f"not {gyro:02X}/{accel:02X}")
+        self._bus.write(regs.REG_FIFO_CONFIG1, regs.FIFO_CONFIG1_ACCEL_GYRO_TEMP)
+        self._bus.write(regs.REG_FIFO_CONFIG, regs.FIFO_MODE_STOP_ON_FULL)
+        fifo = self._bus.read(regs.REG_FIFO_CONFIG, 1)[0], self._bus.read(regs.REG_FIFO_CONFIG1, 1)[0]
+        if fifo != (regs.FIFO_MODE_STOP_ON_FULL, regs.FIFO_CONFIG1_ACCEL_GYRO_TEMP):
+            raise self._fault(f"FIFO_CONFIG/FIFO_CONFIG1 read back {fifo[0]:02X}/{fifo[1]:02X}, not "
+                              f"{regs.FIFO_MODE_STOP_ON_FULL:02X}/{regs.FIFO_CONFIG1_ACCEL_GYRO_TEMP:02X}")
         self._odr_hz = odr_hz
 
     def start_measurement(self) -> None:
@@ -111,14 +125,15 @@ class Icm42688:
         return float(self.part.temperature.celsius(raw))
 
     def acquire(self, n_samples: int) -> SampleBlock:
-        """`n_samples` consecutive samples, each read once DATA_RDY says it is new (instruments/polled_block.py)."""
-        raw, t_start = poll_block(self._clock, self._odr_hz, n_samples, self._read_sample, self._fault)
-        temperature, accel, gyro = regs.decode_samples(raw)
-        if np.any(accel == regs.DATA_INVALID) or np.any(gyro == regs.DATA_INVALID):
-            raise self._fault("a data register holds no reading (is the part measuring?)")
-        celsius = self.part.temperature.celsius
-        return SampleBlock({"accel": accel, "gyro": gyro}, t_start, t_start + (n_samples - 1) / self._odr_hz,
-                           (float(celsius(int(temperature[0]))), float(celsius(int(temperature[-1])))))
+        """`n_samples` consecutive samples of both sensors from the FIFO: captured by the bridge where it can, else
+        read by the host; a block that lost a sample is taken again, OVERFLOW_ATTEMPTS times at most."""
+        if 0 < n_samples <= self.capture_capacity_samples:
+            return capture_together([self], n_samples, self._clock)[0]
+        for _ in range(OVERFLOW_ATTEMPTS):
+            block = self._try_drain(n_samples)
+            if block is not None:
+                return block
+        raise self._fault(f"FIFO full in {OVERFLOW_ATTEMPTS} attempts: the link cannot keep up with {self._odr_hz:g} Hz")
 
     def close(self) -> None:
         self._bus.close()
@@ -132,8 +147,45 @@ class Icm42688:
         if isinstance(self._bare, Reconnecting):
             self._bare.reconnect()
 
-    # ------------------------------------------------------------------ polling the data registers
-    def _read_sample(self) -> tuple[bytes, bool]:
-        """One burst TEMP_DATA1…INT_STATUS: (the sample's 14 bytes, INT_STATUS's DATA_RDY, which the read clears)."""
-        raw = self._bus.read(regs.REG_TEMP_DATA1, regs.SAMPLE_AND_STATUS_BYTES)
-        return raw[:regs.SAMPLE_BYTES], bool(raw[-1] & regs.INT_STATUS_DATA_RDY)
+    # ------------------------------------------------------------------ the FIFO
+    def _decode_fifo(self, raw: bytes, carried: bytes) -> Decoded:
+        """Whole packets (a bridge's capture, a burst of whole packets): both channels' codes; nothing carried."""
+        try:
+            accel, gyro, _ = regs.decode_packets(carried + raw)
+        except ValueError as exc:
+            raise self._fault(f"FIFO: {exc}") from None
+        if np.any(np.all(accel == regs.DATA_INVALID, axis=1)) or np.any(np.all(gyro == regs.DATA_INVALID, axis=1)):
+            raise self._fault("a FIFO packet holds no reading (is the part measuring?)")
+        return {"accel": accel, "gyro": gyro}, b""
+
+    def _try_drain(self, n_samples: int) -> SampleBlock | None:
+        """One attempt read by the host: the FIFO flushed, then every DRAIN_EVERY_PACKETS samples its count and
+        that many whole packets; None where INT_STATUS's FIFO_FULL (cleared by reading it) says a sample may have
+        been dropped since the read before."""
+        self._bus.write(regs.REG_SIGNAL_PATH_RESET, regs.SIGNAL_PATH_RESET_FIFO_FLUSH)
+        self._status_and_count()  # clears a stale FIFO_FULL; the data sheet's first count after a flush is 0
+        t_start = self._clock.now()
+        temperature_before = self.read_temperature_c()
+        pieces: list[dict[str, np.ndarray]] = []
+        have = 0
+        deadline = t_start + 2.0 * n_samples / self._odr_hz + 1.0
+        while have < n_samples:
+            if self._clock.now() > deadline:
+                raise self._fault(f"{have} of {n_samples} samples before the deadline: is it measuring?")
+            self._clock.sleep(min(DRAIN_EVERY_PACKETS, n_samples - have) / self._odr_hz)
+            status, count = self._status_and_count()
+            if status & regs.INT_STATUS_FIFO_FULL:
+                return None
+            packets = count // regs.PACKET_BYTES
+            while packets:
+                burst = min(packets, BURST_PACKETS)
+                codes, _ = self._decode_fifo(self._bare.read(regs.REG_FIFO_DATA, burst * regs.PACKET_BYTES), b"")
+                pieces.append(codes)
+                have += burst
+                packets -= burst
+        return self._block(pieces, n_samples, t_start, (temperature_before, self.read_temperature_c()))
+
+    def _status_and_count(self) -> tuple[int, int]:
+        """INT_STATUS (read-to-clear) and FIFO_COUNT in bytes, in one burst from INT_STATUS: COUNTH read first."""
+        status, high, low = self._bus.read(regs.REG_INT_STATUS, 3)
+        return status, high << 8 | low

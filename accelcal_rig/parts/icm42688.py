@@ -43,4 +43,5 @@ ICM42688P = Part(
     device="accelcal_rig.instruments.icm42688_driver:Icm42688",
     simulator="accelcal_rig.sim.icm42688_bridge_server:serve_bridge",
     spi=SpiFraming(address_shift=0, read_bit=0x80),  # bit 7 set reads (docs/instruments.md, TDK ICM-42688-P)
+    fifo_sample_bytes=16,  # packet 3: header, accelerometer, gyroscope, temperature, timestamp
 )

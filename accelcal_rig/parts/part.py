@@ -29,6 +29,12 @@ class TemperatureFormat:
         """Raw reading → °C."""
         return self.reference_c + (np.asarray(raw, dtype=float) - self.intercept_lsb) / self.slope_lsb_per_c
 
+    def from_registers(self, high: int, low: int) -> int:
+        """The code its two temperature registers hold (high byte first): the low `bits` of the pair, sign-extended
+        where the code is signed (an ADXL355's TEMP2 nibble and TEMP1; an ICM-42688-P's TEMP_DATA1, TEMP_DATA0)."""
+        code = ((high << 8) | low) & ((1 << self.bits) - 1)
+        return code - (1 << self.bits) if self.signed and code >> (self.bits - 1) else code
+
     def raw(self, temperature_c: np.ndarray | float) -> np.ndarray:
         """°C → what the part reports: rounded and clipped to its code width."""
         raw = self.intercept_lsb + self.slope_lsb_per_c * (np.asarray(temperature_c, dtype=float) - self.reference_c)
@@ -128,6 +134,9 @@ class Part:
     simulator: str = "accelcal_rig.sim.adxl355_bridge_server:serve_bridge"
     #: Its SPI command framing, for a host on the bus itself (spidev); the ADXL35x's by default.
     spi: SpiFraming = SpiFraming(address_shift=1, read_bit=0x01)
+    #: Bytes of one sample as its FIFO gives it, which a bridge's capture returns as read (an ADXL35x's three
+    #: 3-byte entries; an ICM-42688-P's 16-byte packet).
+    fifo_sample_bytes: int = 9
 
     def channel(self, name: str) -> Channel:
         """The channel called `name`; KeyError naming the ones the part has."""

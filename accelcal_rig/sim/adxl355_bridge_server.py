@@ -14,7 +14,7 @@ import numpy as np
 from accelcal_rig.config.rig import SensorConfig
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import BRIDGE_GREETING
-from accelcal_rig.sim.bridge_capture import CaptureRequests
+from accelcal_rig.sim.bridge_capture import CaptureRequests, CaptureRules
 from accelcal_rig.sim.bridge_registers import RegisterMap, RegisterRequests
 from accelcal_rig.sim.bridge_requests import BridgeRequests
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
@@ -27,6 +27,8 @@ _SAMPLES_IN_FIFO = adxl355.FIFO_CAPACITY_ENTRIES // 3
 _SLOWEST_ODR_CODE = 10
 #: Samples the simulated bridge's capture buffer holds (9 bytes each: 36 kB, a small microcontroller's RAM).
 CAPTURE_CAPACITY_SAMPLES = 4096
+#: Writes that end a running capture (RANGE and FILTER would too, but they are written only in standby).
+_STREAM_REGISTERS = frozenset({adxl355.REG_FIFO_SAMPLES, adxl355.REG_POWER_CTL, adxl355.REG_RESET})
 #: The register map as the bridge enforces it (ADXL355, ADXL357, ADXL359 alike).
 REGISTER_MAP = RegisterMap(last=adxl355.REG_LAST, read_only=adxl355.READ_ONLY_REGISTERS,
                            burst_stays=adxl355.REG_FIFO_DATA, standby_only=adxl355.STANDBY_ONLY_REGISTERS)
@@ -217,6 +219,11 @@ class SimulatedAdxl355:
         return count
 
 
+def capture_rules() -> CaptureRules:
+    """The ADXL355's capture: its FIFO_DATA, the writes that end it; ready whenever it measures."""
+    return CaptureRules(adxl355.REG_FIFO_DATA, _STREAM_REGISTERS, lambda: None)
+
+
 class SimulatedBridgeServer(BridgeOnPty):
     """The bridge line protocol on a pseudo-terminal, in front of one simulated ADXL355: version 3 as the
     reference firmware speaks it (`part=adxl355`, as it names any part whose DEVID_AD is 0xAD), or version 2
@@ -228,7 +235,7 @@ class SimulatedBridgeServer(BridgeOnPty):
         self._version = protocol_version
         self.device = SimulatedAdxl355(lab, index, wrong_part_id, stuck_after_s, temperature_tear_rate)
         device = self.device
-        capture = CaptureRequests(device, CAPTURE_CAPACITY_SAMPLES) if protocol_version >= 2 else None
+        capture = CaptureRequests(device, CAPTURE_CAPACITY_SAMPLES, capture_rules()) if protocol_version >= 2 else None
         registers = RegisterRequests(device, REGISTER_MAP, lambda: not device.measuring, capture)
         super().__init__(lab, index, BridgeRequests(self._greeting, registers, "adxl355", capture,
                                                     verbs="?RWCG" if capture is not None else "?RW"), faults)

@@ -44,8 +44,13 @@ def standby_only(address: int) -> str:
     return f"register 0x{address:02X} changes only in standby"
 
 
-def capture_stopped(have: int, wanted: int) -> str:
-    return f"capture stopped: FIFO_SAMPLES, POWER_CTL or RESET written after {have} of {wanted} samples"
+def capture_stopped(register: int, have: int, wanted: int) -> str:
+    return f"capture stopped: register 0x{register:02X} written after {have} of {wanted} samples"
+
+
+def fifo_not_in_packets(fifo_config: int, fifo_config1: int) -> str:
+    """An ICM-42688-P's FIFO off, or not in packets of both sensors (FIFO_CONFIG, FIFO_CONFIG1 as read)."""
+    return f"capture needs the FIFO on with both sensors (FIFO_CONFIG {fifo_config:02X}, FIFO_CONFIG1 {fifo_config1:02X})"
 
 
 def capture_not_supported(part: str) -> str:

@@ -61,4 +61,10 @@ class SimulatedRegisterBridge(BridgeOnPty):
                                                     self._part.name), faults)
 
     def _greeting(self) -> str:
-        return f"{BRIDGE_GREETING} {PROTOCOL_VERSION} part={self._part.name} accelcal-rig simulated bridge"
+        return bridge_greeting(self._part.name)
+
+
+def bridge_greeting(part: str, capture_samples: int = 0) -> str:
+    """A version 3 bridge's greeting naming its part, and its capture buffer where it captures blocks."""
+    capture = f" capture={capture_samples}" if capture_samples else ""
+    return f"{BRIDGE_GREETING} {PROTOCOL_VERSION} part={part}{capture} accelcal-rig simulated bridge"

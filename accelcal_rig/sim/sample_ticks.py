@@ -22,6 +22,11 @@ class SampleTicks:
     def running(self) -> bool:
         return self._since is not None
 
+    @property
+    def since_s(self) -> float | None:
+        """When the part began converting (or changed its rate); None while it does not."""
+        return self._since
+
     def start(self, now_s: float) -> None:
         """Converting from `now_s`: the first sample one period later."""
         self._since, self._last = now_s, 0

@@ -9,7 +9,7 @@ from accelcal_rig.config.load import load_rig
 from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.parts.adxl35x import ADXL355
-from accelcal_rig.sim.adxl355_bridge_server import CAPTURE_CAPACITY_SAMPLES, SimulatedAdxl355
+from accelcal_rig.sim.adxl355_bridge_server import CAPTURE_CAPACITY_SAMPLES, SimulatedAdxl355, capture_rules
 from accelcal_rig.sim.bridge_capture import CaptureRequests
 from accelcal_rig.sim.bridge_refusals import Refusal
 from accelcal_rig.sim.lab import VirtualLab
@@ -79,7 +79,7 @@ def test_a_capture_delivers_consecutive_samples_in_pieces(part) -> None:
 
 def test_a_capture_larger_than_the_buffer_is_refused_by_the_bridge(part) -> None:
     device, _ = part
-    capture = CaptureRequests(device, CAPTURE_CAPACITY_SAMPLES)
+    capture = CaptureRequests(device, CAPTURE_CAPACITY_SAMPLES, capture_rules())
     with pytest.raises(Refusal, match=rf"^bad count \(decimal 1\.\.{CAPTURE_CAPACITY_SAMPLES}\)$"):
         capture.start(str(CAPTURE_CAPACITY_SAMPLES + 1))
     assert capture.start(str(CAPTURE_CAPACITY_SAMPLES)).startswith("=")
@@ -91,7 +91,7 @@ def test_standby_refuses_a_capture_and_clears_the_fifo(part) -> None:
     device.write(adxl355.REG_POWER_CTL, adxl355.POWER_CTL_STANDBY)
     assert status_and_entries(device)[1] == 0
     with pytest.raises(Refusal, match="^capture needs the part measuring$"):
-        CaptureRequests(device, CAPTURE_CAPACITY_SAMPLES).start("10")
+        CaptureRequests(device, CAPTURE_CAPACITY_SAMPLES, capture_rules()).start("10")
 
 
 def test_writes_the_part_ignores_change_nothing(part) -> None:

@@ -3,6 +3,8 @@ both sensors, and the driver through a version 3 serial bridge on a pseudo-termi
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -99,6 +101,110 @@ def test_data_registers_hold_a_new_sample_each_period_with_data_ready() -> None:
     assert device.read(regs.REG_TEMP_DATA1, regs.SAMPLE_AND_STATUS_BYTES)[-1] & regs.INT_STATUS_DATA_RDY
 
 
+def measuring_with_fifo(lab: VirtualLab, mode: int = regs.FIFO_MODE_STOP_ON_FULL) -> SimulatedIcm42688:
+    """DUT 0 at ±2 g, ±2000 °/s, 100 Hz, its FIFO on in packets (in `mode`), measuring from now."""
+    device = SimulatedIcm42688(lab, 0)
+    device.write(regs.REG_GYRO_CONFIG0, 0x08)
+    device.write(regs.REG_ACCEL_CONFIG0, 0x68)
+    device.write(regs.REG_FIFO_CONFIG1, regs.FIFO_CONFIG1_ACCEL_GYRO_TEMP)
+    device.write(regs.REG_FIFO_CONFIG, mode)
+    device.write(regs.REG_PWR_MGMT0, regs.PWR_MGMT0_LOW_NOISE)
+    return device
+
+
+def fifo_count(device: SimulatedIcm42688) -> tuple[int, int]:
+    """(INT_STATUS, FIFO_COUNT in bytes) in one burst from INT_STATUS, as the driver reads them."""
+    status, high, low = device.read(regs.REG_INT_STATUS, 3)
+    return status, high << 8 | low
+
+
+def test_the_fifo_fills_with_a_packet_of_both_sensors_each_period() -> None:
+    lab, clock = imu_lab()
+    device = SimulatedIcm42688(lab, 0)
+    assert device.read(regs.REG_INTF_CONFIG0, 1) == b"\x30"          # counts in bytes, big-endian
+    device = measuring_with_fifo(lab)
+    clock.sleep(0.035)
+    assert fifo_count(device)[1] == 3 * 16
+    accel, gyro, temperature = regs.decode_packets(device.read(regs.REG_FIFO_DATA, 48))
+    assert accel.shape == gyro.shape == (3, 3)
+    assert np.all(np.abs(accel[:, 2] - 16384) < 2000)                  # about 1 g on some axis, no invalid code
+    assert np.all(temperature == temperature[0])
+    assert fifo_count(device)[1] == 0
+    assert device.read(regs.REG_FIFO_DATA, 16) == b"\xff" * 16         # empty: header bit 7 set
+    packet = device.read(regs.REG_FIFO_DATA, 1)
+    assert packet == b"\xff"
+    clock.sleep(0.02)
+    raw = device.read(regs.REG_FIFO_DATA, 32)
+    first_ts, second_ts = (int.from_bytes(raw[i * 16 + 14:i * 16 + 16], "big") for i in range(2))
+    assert second_ts - first_ts == round(10_000 * 30 / 32)             # the timestamp: 30/32 µs ticks per µs
+
+
+def test_a_full_fifo_stops_sets_fifo_full_and_a_flush_empties_it() -> None:
+    lab, clock = imu_lab()
+    device = measuring_with_fifo(lab)
+    clock.sleep(1.275)                                                  # 127 samples
+    status, count = fifo_count(device)
+    assert count == 127 * 16 and not status & regs.INT_STATUS_FIFO_FULL
+    clock.sleep(0.05)
+    status, count = fifo_count(device)
+    assert count == 2048 and status & regs.INT_STATUS_FIFO_FULL        # stop-on-full: the newest dropped
+    assert not fifo_count(device)[0] & regs.INT_STATUS_FIFO_FULL       # cleared by reading INT_STATUS
+    first = device.read(regs.REG_FIFO_DATA, 16)
+    assert int.from_bytes(first[14:16], "big") == round(10_000 * 30 / 32)   # the oldest, sample 1, kept
+    device.write(regs.REG_SIGNAL_PATH_RESET, regs.SIGNAL_PATH_RESET_FIFO_FLUSH)
+    assert fifo_count(device)[1] == 0
+    assert device.read(regs.REG_SIGNAL_PATH_RESET, 1) == b"\x00"      # its bits clear themselves
+
+
+def test_in_stream_mode_a_full_fifo_keeps_the_newest() -> None:
+    lab, clock = imu_lab()
+    device = measuring_with_fifo(lab, mode=0x40)
+    clock.sleep(1.505)                                                  # 150 samples
+    status, count = fifo_count(device)
+    assert count == 2048 and status & regs.INT_STATUS_FIFO_FULL
+    first = device.read(regs.REG_FIFO_DATA, 16)
+    assert int.from_bytes(first[14:16], "big") == (round(23 * 10_000 * 30 / 32) & 0xFFFF)  # 22 dropped
+
+
+def test_a_fifo_that_is_off_or_a_sensor_that_is_off_fills_nothing() -> None:
+    lab, clock = imu_lab()
+    device = measuring_with_fifo(lab, mode=regs.FIFO_MODE_BYPASS)
+    clock.sleep(0.1)
+    assert fifo_count(device)[1] == 0
+    device.write(regs.REG_FIFO_CONFIG, regs.FIFO_MODE_STOP_ON_FULL)
+    device.write(regs.REG_PWR_MGMT0, regs.PWR_MGMT0_OFF)
+    clock.sleep(0.1)
+    assert fifo_count(device)[1] == 0
+
+
+def test_the_bridge_captures_packets_and_refuses_a_fifo_that_is_off() -> None:
+    lab, clock = imu_lab()
+    bridge = SimulatedIcm42688Bridge(lab, 0)
+    answer = bridge._requests.answer  # noqa: SLF001 - the request handler, without a pseudo-terminal
+    assert answer("?") == "ADXL355-BRIDGE 3 part=icm42688p capture=4096 accelcal-rig simulated bridge"
+    for request in ("W 4F 08", "W 50 68", "W 4E 0F"):
+        assert answer(request) == "="
+    assert answer("C 10") == "!capture needs the FIFO on with both sensors (FIFO_CONFIG 00, FIFO_CONFIG1 00)"
+    for request in ("W 5F 07", "W 16 80"):
+        assert answer(request) == "="
+    assert answer("C 10").startswith("=") and len(answer("C 10")) == 5
+    assert answer("R 30 16") == "!FIFO_DATA is being captured (fetch with G)"
+    assert answer("R 2D 4") == "!FIFO_DATA is being captured (fetch with G)"
+    assert answer("R 1D 16").startswith("=")                             # the data registers are the host's
+    clock.sleep(0.055)
+    partial = answer("G 0")
+    assert len(partial) == 1 + 5 * 32 and "T" not in partial
+    clock.sleep(0.05)
+    complete = answer("G 3")
+    assert len(complete) == 1 + 7 * 32 + 5 and complete[-5] == "T"
+    accel, _, _ = regs.decode_packets(bytes.fromhex(complete[1:-5]))
+    assert accel.shape == (7, 3)
+    assert answer("C 100").startswith("=")
+    clock.sleep(0.125)
+    assert answer("W 4E 00") == "="
+    assert re.fullmatch(r"!capture stopped: register 0x4E written after 1[23] of 100 samples", answer("G 0"))
+
+
 def connected(lab: VirtualLab, clock: VirtualClock, index: int = 0):
     server = SimulatedIcm42688Bridge(lab, index).start()
     bridge = SerialBridge.open(server.path)
@@ -109,7 +215,7 @@ def test_the_driver_through_a_version_3_bridge_reads_both_sensors_truth() -> Non
     lab, clock = imu_lab(seed=7)
     driver, bridge, server = connected(lab, clock)
     try:
-        assert bridge.part_name == "icm42688p" and bridge.capture_capacity_samples == 0
+        assert bridge.part_name == "icm42688p" and bridge.capture_capacity_samples == 4096
         assert ICM42688P.wrong_identity(driver.identify().registers) is None
         driver.reset()
         driver.standby()
@@ -123,7 +229,7 @@ def test_the_driver_through_a_version_3_bridge_reads_both_sensors_truth() -> Non
     accel, gyro = block.codes["accel"], block.codes["gyro"]
     assert accel.shape == gyro.shape == (400, 3)
     assert block.t_end_s - block.t_start_s == pytest.approx(3.99)
-    assert len({tuple(row) for row in accel}) > 300                  # a new sample each read, not one re-read
+    assert len({tuple(row) for row in accel}) > 300                  # a new sample each packet
     dut = lab.duts[0]
     temperature = lab.dut_true_c(0)
     # The accelerometer sees gravity through its own truth (noise 70 µg/√Hz × √(π/2·25 Hz) ≈ 0.44 mg).
@@ -140,6 +246,22 @@ def test_the_driver_through_a_version_3_bridge_reads_both_sensors_truth() -> Non
     assert gyro.mean(axis=0) / 16.4 == pytest.approx(expected_dps, abs=0.01)
     assert np.all(np.abs(bias_dps) < 1.0) and np.any(np.abs(bias_dps) > 0.05)
     assert block.temperature_c[0] == pytest.approx(temperature, abs=0.2)
+
+
+def test_a_block_longer_than_the_capture_is_read_from_the_fifo_by_the_host() -> None:
+    lab, clock = imu_lab(seed=3)
+    driver, _, server = connected(lab, clock)
+    try:
+        driver.reset()
+        driver.configure({"accel": 2, "gyro": 2000}, 100)
+        driver.start_measurement()
+        block = clock.run_concurrently([lambda: driver.acquire(4200)])[0]
+    finally:
+        driver.close()
+        server.stop()
+    assert block.codes["accel"].shape == block.codes["gyro"].shape == (4200, 3)
+    assert len({tuple(row) for row in block.codes["accel"]}) > 3500   # new noise in each (7 LSB on each axis)
+    assert block.t_end_s - block.t_start_s == pytest.approx(41.99)
 
 
 def test_a_wrong_who_am_i_is_what_the_identity_check_catches() -> None:
