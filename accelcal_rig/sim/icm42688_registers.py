@@ -11,12 +11,14 @@ and ignores writes); a read-only register ignores a write; TEMP_DATA reads the D
 mode; a sensor off reads DATA_INVALID (-32768) in its data registers; the first sample comes one period after
 PWR_MGMT0 turns the sensors on; both sensors sample at ACCEL_CONFIG0's rate, whose code may be one the part's
 table does not offer (a low-power rate, or the reserved 0: taken as 1 kHz); a reserved accelerometer FS_SEL (4…7)
-is ±16 g. The FIFO: filled only while both sensors measure and FIFO_CONFIG1 enables the accelerometer or the
-gyroscope, always in packet 3 (INTF_CONFIG0's reset setting: counts in bytes, big-endian; HIRES not modelled);
+is ±16 g. The FIFO: filled only while both sensors measure, FIFO_CONFIG is not bypass and FIFO_CONFIG1 enables
+the accelerometer and the gyroscope (not HIRES), always in packet 3, its temperature TEMP_DATA's reading when the
+packet is made in the packet's 8 bits (INTF_CONFIG0 only at its reset setting: counts in bytes, big-endian);
 it holds 128 packets; stop-on-full drops new samples, stream mode (whose overflow the data sheet does not
 describe) drops the oldest; an empty FIFO reads 0xFF (FIFO_DATA's reset value; the data sheet says only that
-header bit 7 means empty); a packet's timestamp counts 30/32 µs per µs since the sensors came on (the data
-sheet's ×32/30 for the internal clock).
+header bit 7 means empty), and so does FIFO_DATA within a burst from below it; a packet's timestamp is sample
+k's time since the sensors came on, (k + 1) periods, in ticks of 32/30 µs (the data sheet's ×32/30 for the
+internal clock), its low 16 bits — as the reference firmware's C model of the part makes them.
 """
 
 from __future__ import annotations
@@ -39,10 +41,8 @@ _OTHER_ODR_HZ = {0: 1000.0, 12: 6.25, 13: 3.125, 14: 1.5625}
 _ACCEL_FS_SEL_RESERVED = 4
 #: FIFO_CONFIG1's sensor bits: accelerometer (bit 0), gyroscope (bit 1).
 _FIFO_SENSORS = 0x03
-#: The timestamp's ticks per µs with the internal clock.
-_TIMESTAMP_TICKS_PER_US = 30.0 / 32.0
-#: Samples the bridge's capture buffer holds (16 bytes each: 64 kB).
-CAPTURE_CAPACITY_SAMPLES = 4096
+#: Samples the bridge's capture buffer holds: its 36 kB (the reference firmware's) in 16-byte packets.
+CAPTURE_CAPACITY_SAMPLES = 36864 // regs.PACKET_BYTES
 
 
 class SimulatedIcm42688:
@@ -258,9 +258,10 @@ class SimulatedIcm42688:
         """`count` FIFO packets of both sensors from `first_s` on, from the lab's truth now."""
         accel, gyro = self._codes(first_s, count, odr)
         since = self._ticks.since_s
-        t_us = (first_s - (since if since is not None else first_s) + np.arange(count) / odr) * 1e6
-        temperature = np.full(count, self._temperature_raw())
-        return regs.encode_packets(accel, gyro, temperature, np.floor(t_us * _TIMESTAMP_TICKS_PER_US))
+        first_tick = round((first_s - since) * odr) if since is not None else 1  # sample k is tick k + 1
+        period_ns = round(1e9 / odr)
+        ticks = (first_tick + np.arange(count, dtype=np.int64)) * period_ns * 30 // 32_000
+        return regs.encode_packets(accel, gyro, np.full(count, self._temperature_raw()), ticks)
 
     def _codes(self, first_s: float, count: int, odr: float) -> tuple[np.ndarray, np.ndarray]:
         accel = self._lab.dut_samples(self._index, first_s, count, odr, self._range("accel", regs.REG_ACCEL_CONFIG0))

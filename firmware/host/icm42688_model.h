@@ -30,9 +30,19 @@
  *     (6k + word + seed), word 0..2 the accelerometer's x, y, z and 3..5 the gyroscope's (as
  *     icm_model_noise_lsb), so a test can recompute every sample;
  *   - temperature: TEMP_DATA = round((T - 25) * 132.48) for the configured T, plus -1, 0 or +1 LSB,
- *     whatever the power mode.
- * Not modelled: the FIFO, interrupts, FSYNC and timestamps, filters, offsets, self test, the
- * low-power modes' behaviour, the gyroscope's start-up time, I2C, banks 1..4.
+ *     whatever the power mode;
+ *   - the FIFO: while both sensors are on, FIFO_CONFIG (0x16) is not bypass and FIFO_CONFIG1 (0x5F) enables
+ *     the accelerometer and the gyroscope (not HIRES), sample k also goes to the FIFO as packet 3 (16 bytes:
+ *     header 0x68, the sample's six words as the data registers would hold them, the temperature as
+ *     round((T - 25) * 132.48 / 64) without the read noise, the timestamp (k + 1) * period * 30/32 in us
+ *     ticks, low 16 bits); it holds 128 packets; stop-on-full (FIFO_MODE 10 or 11) drops new samples once
+ *     full, stream (01) the oldest; FIFO_FULL (INT_STATUS bit 1) is set when it is full as a sample comes, and
+ *     cleared by reading INT_STATUS; FIFO_COUNTH/L (0x2E/0x2F) the bytes held, big-endian (INTF_CONFIG0 0x4C
+ *     at its reset value 0x30; other values not modelled); a burst from FIFO_DATA (0x30) stays on it and
+ *     reads packet bytes in order, 0xFF once empty (within a burst from below it, 0xFF); SIGNAL_PATH_RESET
+ *     (0x4B) bit 1 flushes it and reads 0. TEMP_DATA1..FIFO_DATA are read-only.
+ * Not modelled: interrupts, FSYNC, filters, offsets, self test, the low-power modes' behaviour, the
+ * gyroscope's start-up time, 20-bit packets, I2C, banks 1..4.
  */
 #ifndef ICM42688_MODEL_H
 #define ICM42688_MODEL_H

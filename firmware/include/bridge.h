@@ -2,12 +2,13 @@
  * The sensor serial bridge, protocol version 3: the core's entry points for a board's main loop.
  *
  * The protocol (one ASCII request per line, one reply per request, lines end in '\n'):
- *   ?              -> ADXL355-BRIDGE 3 part=<part> [capture=4096] <text>
+ *   ?              -> ADXL355-BRIDGE 3 part=<part> [capture=<samples>] <text>
  *                     part: adxl355, icm42688p (found on SPI by its identity register), or none
  *   R <addr> <n>   -> =<2n hex digits>     n registers from addr in one SPI burst, framed for the part
  *   W <addr> <v>   -> =                    one register
- *   C <n>          -> =<TEMP2><TEMP1>      empty the FIFO, capture the next n samples (adxl355 only)
- *   G <first>      -> =<hex>[T<TEMP2><TEMP1>]  captured samples from index first on (adxl355 only)
+ *   C <n>          -> =<T high><T low>     empty the FIFO, capture the next n samples
+ *   G <first>      -> =<hex>[T<T high><T low>]  captured samples from index first on, as the part's FIFO
+ *                     gives them (adxl355: 9 bytes each, capture=4096; icm42688p: 16-byte packets, capture=2304)
  *   anything that fails -> !<message>
  * addr and v are hexadecimal, n and first decimal. What each request that fails is answered, and the line
  * rules: docs/instruments.md, "The serial bridge protocol".
@@ -18,11 +19,11 @@
 #include <stdbool.h>
 
 #define BRIDGE_PROTOCOL_VERSION 3
-#define BRIDGE_FIRMWARE_VERSION "1.2"
+#define BRIDGE_FIRMWARE_VERSION "1.3"
 
-/* The capture buffer: 4096 samples of 9 bytes (X, Y, Z FIFO entries of 3 bytes) = 36 kB. */
-#define BRIDGE_CAPTURE_SAMPLES 4096u
-#define BRIDGE_SAMPLE_BYTES 9u
+/* The capture buffer, 36 kB: 4096 ADXL355 samples of 9 bytes (X, Y, Z FIFO entries of 3 bytes), or 2304
+ * ICM-42688-P packets of 16 bytes. */
+#define BRIDGE_CAPTURE_BYTES 36864u
 
 /* The longest register burst `R` takes: the whole FIFO, 96 entries of 3 bytes. */
 #define BRIDGE_MAX_READ 288u

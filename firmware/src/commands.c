@@ -1,5 +1,5 @@
 /* The requests ?, R, W, C and G: parsed strictly, answered with exactly one line. R and W are framed for
- * the part found on SPI (sensor.h); C and G exist for a part the bridge captures (the ADXL355).
+ * the part found on SPI (sensor.h); C and G exist for a part the bridge captures (the ADXL355, the ICM-42688-P).
  *
  * Each request is checked in the order docs/instruments.md gives ("The serial bridge protocol", its table of
  * refusals): the verb and its number of words; a part that has the request; the arguments; the part's
@@ -19,7 +19,7 @@
 
 #define MAX_WORDS 3u
 
-/* ADXL355-BRIDGE 3 part=<name>[ capture=4096] <free text>: capture= only where C and G work. The part is
+/* ADXL355-BRIDGE 3 part=<name>[ capture=<samples>] <free text>: capture= only where C and G work. The part is
  * looked for again on every greeting (a sensor powered after the board, or another one plugged in). */
 static void greet(char *const *arguments)
 {
@@ -35,7 +35,7 @@ static void greet(char *const *arguments)
     reply_text(part.name);
     if (part.captures) {
         reply_text(" capture=");
-        reply_decimal(BRIDGE_CAPTURE_SAMPLES);
+        reply_decimal(capture_capacity());
     }
     reply_text(" accelcal-rig reference firmware " BRIDGE_FIRMWARE_VERSION " (");
     reply_text(bridge_hal_board_name());
@@ -116,24 +116,15 @@ static void read_registers(char *const *arguments)
         return;
     }
     /* A burst from FIFO_DATA takes samples out of the FIFO: during a capture they belong to it. */
-    if (capture_running() && covers(address, count, SENSOR_REG_FIFO_DATA)) {
+    if (capture_running() && covers(address, count, sensor_fifo_data())) {
         reply_error("FIFO_DATA is being captured (fetch with G)");
         return;
     }
     sensor_read(address, data, count);
-    if (covers(address, count, SENSOR_REG_STATUS)) {
-        capture_saw_status(data[SENSOR_REG_STATUS - address]);
-    }
+    capture_saw_status(address, count, data);
     reply_char('=');
     reply_hex(data, count);
     reply_end();
-}
-
-/* Registers whose write ends the stream a running capture is taking (RANGE and FILTER too, but those are
- * written only in standby, and a capture runs only while the part measures). */
-static bool changes_the_stream(uint8_t address)
-{
-    return address == SENSOR_REG_FIFO_SAMPLES || address == SENSOR_REG_POWER_CTL || address == SENSOR_REG_RESET;
 }
 
 static void write_register(char *const *arguments)
@@ -160,8 +151,8 @@ static void write_register(char *const *arguments)
         refuse_register("register", address, " changes only in standby");
         return;
     }
-    if (capture_running() && changes_the_stream(address)) {
-        capture_stop("capture stopped: FIFO_SAMPLES, POWER_CTL or RESET written");
+    if (capture_running() && sensor_changes_the_stream(address)) {
+        capture_stop(address);
     }
     sensor_write(address, value);
     reply_char('=');
@@ -177,8 +168,12 @@ static void start_capture(char *const *arguments)
         return;
     }
     capture_reset(); /* a C forgets the capture before it, even when it is refused */
-    if (!parse_decimal(arguments[0], BRIDGE_CAPTURE_SAMPLES, &count) || count == 0) {
-        reply_error("bad count (decimal 1..4096)");
+    if (!parse_decimal(arguments[0], capture_capacity(), &count) || count == 0) {
+        reply_char('!');
+        reply_text("bad count (decimal 1..");
+        reply_decimal(capture_capacity());
+        reply_char(')');
+        reply_end();
         return;
     }
     const char *refusal = capture_start(count, temperature);
@@ -213,8 +208,12 @@ static void fetch_capture(char *const *arguments)
     if (!part_captures()) {
         return;
     }
-    if (!parse_decimal(arguments[0], BRIDGE_CAPTURE_SAMPLES, &first)) {
-        reply_error("bad first (decimal 0..4096)");
+    if (!parse_decimal(arguments[0], capture_capacity(), &first)) {
+        reply_char('!');
+        reply_text("bad first (decimal 0..");
+        reply_decimal(capture_capacity());
+        reply_char(')');
+        reply_end();
         return;
     }
     capture_get(&view);
@@ -232,7 +231,7 @@ static void fetch_capture(char *const *arguments)
     }
     reply_char('=');
     if (first < view.have) {
-        reply_hex(&view.samples[first * BRIDGE_SAMPLE_BYTES], (size_t)(view.have - first) * BRIDGE_SAMPLE_BYTES);
+        reply_hex(&view.samples[first * view.sample_bytes], (size_t)(view.have - first) * view.sample_bytes);
     }
     if (view.state == CAPTURE_COMPLETE) {
         reply_char('T');

@@ -22,6 +22,8 @@ typedef struct {
  */
 typedef struct {
     sensor_identity identity;
+    sensor_fifo fifo;
+    uint8_t stream_registers[9]; /* writes that end a running capture (NONE: unused) */
     uint8_t shift;
     uint8_t read_flag;
     uint8_t identity_register;
@@ -43,9 +45,15 @@ typedef struct {
  * address space, as its data sheet's map pages were not read).
  */
 static const sensor_part_entry parts[] = {
-    {{"icm42688p", true, false}, 0u, 0x80u, 0x75u, 0x47u, 0x76u, /* WHO_AM_I; REG_BANK_SEL */
-     0x7Fu, NONE, {{0x1Du, 0x2Du}, {0x75u, 0x75u}}, {NONE, NONE}, NONE, 0u},
-    {{"adxl355", true, true}, 1u, 0x01u, 0x00u, 0xADu, 0x00u, /* DEVID_AD */
+    {{"icm42688p", true, true}, SENSOR_FIFO_ICM42688,
+     {SENSOR_ICM_REG_DEVICE_CONFIG, SENSOR_ICM_REG_FIFO_CONFIG, SENSOR_ICM_REG_SIGNAL_PATH_RESET,
+      SENSOR_ICM_REG_INTF_CONFIG0, SENSOR_ICM_REG_PWR_MGMT0, SENSOR_ICM_REG_GYRO_CONFIG0, SENSOR_ICM_REG_ACCEL_CONFIG0,
+      SENSOR_ICM_REG_FIFO_CONFIG1, SENSOR_ICM_REG_BANK_SEL},
+     0u, 0x80u, 0x75u, 0x47u, 0x76u, /* WHO_AM_I; REG_BANK_SEL */
+     0x7Fu, SENSOR_ICM_REG_FIFO_DATA, {{0x1Du, SENSOR_ICM_REG_FIFO_DATA}, {0x75u, 0x75u}}, {NONE, NONE}, NONE, 0u},
+    {{"adxl355", true, true}, SENSOR_FIFO_ADXL355,
+     {SENSOR_REG_FIFO_SAMPLES, SENSOR_REG_POWER_CTL, SENSOR_REG_RESET, NONE, NONE, NONE, NONE, NONE, NONE},
+     1u, 0x01u, 0x00u, 0xADu, 0x00u, /* DEVID_AD */
      0x2Fu, SENSOR_REG_FIFO_DATA, {{0x00u, 0x1Du}, {NONE, NONE}},
      {SENSOR_REG_FILTER, SENSOR_REG_RANGE}, SENSOR_REG_POWER_CTL, SENSOR_POWER_CTL_STANDBY},
 };
@@ -92,6 +100,41 @@ bool sensor_detect(void)
 sensor_identity sensor_part(void)
 {
     return found != NULL ? found->identity : nothing;
+}
+
+sensor_fifo sensor_fifo_kind(void)
+{
+    return found != NULL ? found->fifo : SENSOR_FIFO_NONE;
+}
+
+uint32_t sensor_fifo_sample_bytes(void)
+{
+    switch (sensor_fifo_kind()) {
+    case SENSOR_FIFO_ADXL355:
+        return SENSOR_ADXL_SAMPLE_BYTES;
+    case SENSOR_FIFO_ICM42688:
+        return SENSOR_ICM_PACKET_BYTES;
+    default:
+        return 0u;
+    }
+}
+
+uint8_t sensor_fifo_data(void)
+{
+    return sensor_fifo_kind() == SENSOR_FIFO_ICM42688 ? SENSOR_ICM_REG_FIFO_DATA : SENSOR_REG_FIFO_DATA;
+}
+
+bool sensor_changes_the_stream(uint8_t address)
+{
+    if (found == NULL) {
+        return false;
+    }
+    for (size_t i = 0; i < sizeof found->stream_registers; ++i) {
+        if (found->stream_registers[i] != NONE && found->stream_registers[i] == address) {
+            return true;
+        }
+    }
+    return false;
 }
 
 void sensor_read(uint8_t address, uint8_t *dst, size_t count)

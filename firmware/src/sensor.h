@@ -26,6 +26,28 @@
 
 #define SENSOR_STATUS_FIFO_OVR 0x04u
 #define SENSOR_POWER_CTL_STANDBY 0x01u
+#define SENSOR_ADXL_SAMPLE_BYTES 9u
+
+/* ICM-42688-P registers (bank 0) and bits its capture uses (docs/instruments.md, "TDK ICM-42688-P"). */
+#define SENSOR_ICM_REG_DEVICE_CONFIG 0x11u
+#define SENSOR_ICM_REG_FIFO_CONFIG 0x16u
+#define SENSOR_ICM_REG_TEMP_DATA1 0x1Du
+#define SENSOR_ICM_REG_INT_STATUS 0x2Du
+#define SENSOR_ICM_REG_FIFO_DATA 0x30u
+#define SENSOR_ICM_REG_SIGNAL_PATH_RESET 0x4Bu
+#define SENSOR_ICM_REG_INTF_CONFIG0 0x4Cu
+#define SENSOR_ICM_REG_PWR_MGMT0 0x4Eu
+#define SENSOR_ICM_REG_GYRO_CONFIG0 0x4Fu
+#define SENSOR_ICM_REG_ACCEL_CONFIG0 0x50u
+#define SENSOR_ICM_REG_FIFO_CONFIG1 0x5Fu
+#define SENSOR_ICM_REG_BANK_SEL 0x76u
+#define SENSOR_ICM_PWR_LOW_NOISE 0x0Fu
+#define SENSOR_ICM_FIFO_FLUSH 0x02u
+#define SENSOR_ICM_INT_FIFO_FULL 0x02u
+/* Packet 3: header, accelerometer, gyroscope, temperature, timestamp; its header 0b0110_10xx. */
+#define SENSOR_ICM_PACKET_BYTES 16u
+#define SENSOR_ICM_PACKET3_HEADER 0x68u
+#define SENSOR_ICM_PACKET3_MASK 0xFCu
 
 /* A FIFO entry is one axis: 3 bytes, the 20-bit value left-justified, flags in the low nibble. */
 #define SENSOR_FIFO_ENTRIES 96u
@@ -45,6 +67,13 @@ typedef struct {
     bool captures;
 } sensor_identity;
 
+/* The FIFO a capture drains: none, the ADXL355's (one axis an entry), the ICM-42688-P's (16-byte packets). */
+typedef enum {
+    SENSOR_FIFO_NONE,
+    SENSOR_FIFO_ADXL355,
+    SENSOR_FIFO_ICM42688
+} sensor_fifo;
+
 /*
  * Which part is on the bus: the ICM-42688-P's WHO_AM_I (0x75 = 0x47, read as 0xF5), then the ADXL355's
  * DEVID_AD (0x00 = 0xAD, read as 0x01). In that order because the ICM probe reaches an ADXL355 as a read
@@ -56,6 +85,14 @@ bool sensor_detect(void);
 
 /* The part found by the last sensor_detect() ("none" before the first). */
 sensor_identity sensor_part(void);
+
+/* The FIFO of the part found, and the bytes of one sample as it gives them (0: none). */
+sensor_fifo sensor_fifo_kind(void);
+uint32_t sensor_fifo_sample_bytes(void);
+/* The register a burst of which takes samples out of the part's FIFO (a capture's own), and whether a write to
+ * `address` changes what the FIFO holds (so it ends a running capture). Only with a part that captures. */
+uint8_t sensor_fifo_data(void);
+bool sensor_changes_the_stream(uint8_t address);
 
 /*
  * The register map of the part found, as the bridge enforces it (docs/instruments.md, "The serial bridge

@@ -4,8 +4,9 @@ driven by the project's own ICM-42688-P driver (`Icm42688` over `SerialBridge`) 
 would be; and the SPI bytes the firmware sends for each request, as the host build records them
 (`--spi-log`). The firmware finds the part by its WHO_AM_I at start and on every `?`, greets with protocol
 version 3 and `part=icm42688p`, and frames `R`/`W` for it: a read is one command byte `addr | 0x80`, a write
-`addr` then the value. It captures no blocks of this part (`C`/`G` refused): the driver polls the data
-registers. Runs on the board clock, as test_bridge_firmware.py explains."""
+`addr` then the value. It captures blocks of this part's FIFO packets (`capture=2304`, `C`/`G`), which the driver
+set up; a block longer than that the driver reads from the FIFO itself. Runs on the board clock, as
+test_bridge_firmware.py explains."""
 
 from __future__ import annotations
 
@@ -129,13 +130,18 @@ class SpiLog:
         return fresh
 
 
-def test_the_greeting_names_protocol_3_and_the_icm42688p_without_capture(imu: Opened) -> None:
-    """The firmware found the part by WHO_AM_I; it offers no capture of it, so the greeting has no capture=."""
+def test_the_greeting_offers_a_capture_of_2304_packets_once_the_fifo_is_set_up(imu: Opened) -> None:
+    """The firmware found the part by WHO_AM_I and offers its capture: 36 kB of 16-byte packets. A capture needs
+    the sensors measuring and the FIFO in packets of both, which the driver's set-up gives it."""
     assert imu.bridge.part_name == "icm42688p"
-    assert imu.bridge.capture_capacity_samples == 0
-    with pytest.raises(InstrumentError, match=r"'C 100' refused: capture: not supported for icm42688p"):
+    assert imu.bridge.capture_capacity_samples == 2304
+    with pytest.raises(InstrumentError, match=r"'C 100' refused: capture needs the part measuring"):
         imu.bridge.start_capture(100)
-    with pytest.raises(InstrumentError, match=r"'G 0' refused: capture: not supported for icm42688p"):
+    imu.bridge.write(regs.REG_PWR_MGMT0, regs.PWR_MGMT0_LOW_NOISE)
+    with pytest.raises(InstrumentError, match=r"'C 100' refused: capture needs the FIFO on with both sensors "
+                                              r"\(FIFO_CONFIG 00, FIFO_CONFIG1 00\)"):
+        imu.bridge.start_capture(100)
+    with pytest.raises(InstrumentError, match=r"'G 0' refused: no capture"):
         imu.bridge.fetch_capture(0)
 
 
@@ -158,34 +164,46 @@ def test_identity_reset_configure_and_read_back(imu: Opened) -> None:
     assert driver.read_temperature_c() == pytest.approx(TEMPERATURE_C, abs=0.02)  # 1 LSB is 0.0075 °C
 
 
-def test_a_block_of_both_channels_is_the_models_samples(imu: Opened) -> None:
-    """60 samples at 25 Hz, polled by the driver one 17-byte burst each: every sample is one the model made,
-    each after the one before (none read twice: DATA_RDY through the firmware works), both channels decode to
-    the model's gravity and its near-zero rate, and the temperatures are the model's. At 25 Hz, as the driver
-    starts a block again when a read comes more than 1.5 periods after the one before, and on a busy machine
-    its own process can be late by more than the 5 ms that leaves at 100 Hz (seen: three late attempts).
-
-    Not asserted: that the samples are consecutive. The driver paces its reads from the block's first (no
-    drift), but it accepts a read up to 1.5 periods after the one before, so a host delayed by more than a
-    period lets a sample go by unread while the block's times say consecutive periods: polling registers
-    over a serial line cannot promise more; a bridge-side capture for this part would."""
-    driver = imu.driver
+def bring_up(driver: Icm42688, odr_hz: float) -> None:
     driver.reset()
     driver.standby()
-    driver.configure({"accel": 2, "gyro": 2000}, 25.0)
+    driver.configure({"accel": 2, "gyro": 2000}, odr_hz)
     driver.start_measurement()
-    block = driver.acquire(60)
-    accel, gyro = block.codes["accel"], block.codes["gyro"]
-    assert accel.shape == gyro.shape == (60, 3)
+
+
+def assert_the_models_consecutive_samples(accel: np.ndarray, gyro: np.ndarray) -> None:
+    """Every sample one the model made, each the one after the one before (none lost, none read twice), both
+    channels decoding to the model's gravity and its near-zero rate."""
     indices = model_indices(accel, gyro, 2, 2000)
-    assert np.all(np.diff(indices) >= 1)
+    assert np.all(np.diff(indices) == 1)
     accel_g = accel / ICM42688P.channel("accel").lsb_per_unit[2]
     gyro_dps = gyro / ICM42688P.channel("gyro").lsb_per_unit[2000]
     np.testing.assert_allclose(accel_g.mean(axis=0), GRAVITY_UG * 1e-6, atol=4e-4)  # noise ±1 mg: σ 0.07 mg over 60
     assert np.linalg.norm(accel_g.mean(axis=0)) == pytest.approx(1.0, abs=0.01)
     np.testing.assert_allclose(gyro_dps.mean(axis=0), RATE_MDPS * 1e-3, atol=0.1)
     assert np.all(np.abs(gyro_dps) < 0.5)  # at rest: the offset and the noise, no rotation
+
+
+def test_a_block_the_bridge_captures_is_the_models_consecutive_samples(imu: Opened) -> None:
+    """60 samples at 100 Hz captured by the firmware from the FIFO (packet 3, header checked): every one the model
+    made, consecutive (gap-free whatever the host's latency: the bridge drains the FIFO), and the temperatures the
+    model's, read as TEMP_DATA when the capture starts and ends."""
+    bring_up(imu.driver, 100.0)
+    block = imu.driver.acquire(60)
+    assert block.codes["accel"].shape == block.codes["gyro"].shape == (60, 3)
+    assert_the_models_consecutive_samples(block.codes["accel"], block.codes["gyro"])
     assert block.temperature_c == pytest.approx((TEMPERATURE_C, TEMPERATURE_C), abs=0.02)
+
+
+def test_a_block_the_host_reads_from_the_fifo_is_the_models_consecutive_samples(imu: Opened) -> None:
+    """The same through `R` alone (as for a block longer than the capture, or a bridge without one): the FIFO
+    flushed, its count and whole packets read in bursts of 18 every 64 samples; 150 samples at 100 Hz, so the
+    count crosses the burst size and the read interval."""
+    imu.bridge.capture_capacity_samples = 0  # the driver asks the transport whether it captures
+    bring_up(imu.driver, 100.0)
+    block = imu.driver.acquire(150)
+    assert block.codes["accel"].shape == (150, 3)
+    assert_the_models_consecutive_samples(block.codes["accel"], block.codes["gyro"])
 
 
 def test_the_spi_bytes_of_an_icm42688p_read_and_write(bridge_host: Path, tmp_path: Path) -> None:
@@ -208,9 +226,16 @@ def test_the_spi_bytes_of_an_icm42688p_read_and_write(bridge_host: Path, tmp_pat
         assert line.ask("?").startswith("ADXL355-BRIDGE 3 part=icm42688p ")
         assert log.new() == ["7600:", "F5:47"]
         assert line.ask("R 75 1") == "=47"
-        assert line.ask("C 10") == "!capture: not supported for icm42688p"
         log.new()
-        assert log.new() == []  # a refused capture touches no register
+        assert line.ask("C 10") == "!capture needs the FIFO on with both sensors (FIFO_CONFIG 00, FIFO_CONFIG1 00)"
+        assert log.new() == ["CE:0F", "96:00", "DF:00"]  # PWR_MGMT0, FIFO_CONFIG, FIFO_CONFIG1 read; nothing written
+        assert line.ask("W 5F 07") == "=" and line.ask("W 16 80") == "="
+        log.new()
+        assert line.ask("C 10").startswith("=")
+        flush, status, temperature = log.new()[3:6]
+        assert flush == "4B02:"                         # FIFO_FLUSH
+        assert status.startswith("AD:") and len(status) == 3 + 6   # INT_STATUS, FIFO_COUNTH, FIFO_COUNTL in one burst
+        assert temperature.startswith("9D:")            # TEMP_DATA1, TEMP_DATA0
 
 
 def test_the_spi_bytes_of_an_adxl355_are_as_before(bridge_host: Path, tmp_path: Path) -> None:

@@ -18,7 +18,7 @@ GREETING_PLACEHOLDER = re.compile("<greeting>")
 
 GREETING = {
     "adxl355": re.compile(r"ADXL355-BRIDGE 3 part=adxl355 capture=4096 accelcal-rig .+"),
-    "icm42688p": re.compile(r"ADXL355-BRIDGE 3 part=icm42688p accelcal-rig .+"),
+    "icm42688p": re.compile(r"ADXL355-BRIDGE 3 part=icm42688p capture=2304 accelcal-rig .+"),
 }
 
 
@@ -102,7 +102,9 @@ def request_rows() -> list[Exchange]:
 
 def adxl355_rows() -> list[Exchange]:
     """The ADXL355's register map (0x00…0x2F; 0x00…0x1D read-only), its standby rule and the bridge's capture."""
-    stopped = re.compile(r"!capture stopped: FIFO_SAMPLES, POWER_CTL or RESET written after \d+ of 100 samples")
+    def stopped(register: int) -> re.Pattern[str]:
+        return re.compile(rf"!capture stopped: register 0x{register:02X} written after \d+ of 100 samples")
+
     return [
         _row("R 00 4", "=AD1DED01", "identity: DEVID_AD, DEVID_MST, PARTID, REVID"),
         _row("R 0 1", "=AD", "one hex digit is an address"),
@@ -145,26 +147,26 @@ def adxl355_rows() -> list[Exchange]:
         _row("R 00 18", "!FIFO_DATA is being captured (fetch with G)", "so is a burst that covers it"),
         _row("R 00 4", "=AD1DED01", "other registers are not"),
         _row("W 29 60", "=", "FIFO_SAMPLES written during a capture"),
-        _row("G 0", stopped, "ends it, and G says so"),
+        _row("G 0", stopped(0x29), "ends it, and G says so"),
         _row("R 11 9", _hex(18), "the FIFO is free again"),
         _row("C 0", "!bad count (decimal 1..4096)", "a refused C…"),
         _row("G 0", "!no capture (start one with C)", "…forgets the capture before it"),
         _row("C 100", _hex(4), "a new capture"),
         _row("W 2D 01", "=", "standby during it"),
-        _row("G 0", stopped, "ends it"),
+        _row("G 0", stopped(0x2D), "ends it"),
         _row("W 2F 00", "=", "RESET with any code but 0x52 is passed on (the part ignores it)"),
         _row("R 2C 2", "=8201", "nothing was reset"),
         _row("W 2F 52", "=", "RESET"),
         _row("R 2C 2", "=8101", "RANGE and POWER_CTL at their reset values"),
-        _row("G 0", stopped, "a reset forgets no capture's end"),
+        _row("G 0", stopped(0x2D), "a reset forgets no capture's end"),
         _row("C 10", "!capture needs the part measuring", "standby after the reset"),
         _row("G 0", "!no capture (start one with C)", "the refused C forgot it"),
     ]
 
 
 def icm42688p_rows() -> list[Exchange]:
-    """The ICM-42688-P's bank 0 (0x00…0x7F as modelled; read-only TEMP_DATA1…INT_STATUS and WHO_AM_I), bank
-    selection, and no capture."""
+    """The ICM-42688-P's bank 0 (0x00…0x7F as modelled; read-only TEMP_DATA1…FIFO_DATA and WHO_AM_I), bank
+    selection, and the bridge's capture of its FIFO packets."""
     return [
         _row("R 75 1", "=47", "WHO_AM_I"),
         _row("R 4f 2", "=0606", "lower-case hex: both CONFIG0 at their reset values"),
@@ -176,6 +178,10 @@ def icm42688p_rows() -> list[Exchange]:
         _row("W 75 00", "!read-only register 0x75", "WHO_AM_I is read-only"),
         _row("W 1D 00", "!read-only register 0x1D", "TEMP_DATA1 is read-only"),
         _row("W 2D 00", "!read-only register 0x2D", "INT_STATUS is read-only"),
+        _row("W 2E 00", "!read-only register 0x2E", "FIFO_COUNTH is read-only"),
+        _row("W 30 00", "!read-only register 0x30", "FIFO_DATA is read-only"),
+        _row("R 4C 1", "=30", "INTF_CONFIG0 at reset: the FIFO count in bytes, big-endian"),
+        _row("R 30 288", "=" + "FF" * 288, "a burst from FIFO_DATA stays there: an empty FIFO reads 0xFF"),
         _row("W 50 6C", "=", "ACCEL_CONFIG0 with a low-power ODR code is passed on"),
         _row("W 50 E0", "=", "and a reserved FS_SEL and ODR code"),
         _row("R 50 1", "=E0", "the part holds what was written"),
@@ -191,10 +197,31 @@ def icm42688p_rows() -> list[Exchange]:
         _row("W 76 01", "=", "bank 1 again"),
         _row("W 76 00", "=", "bank 0 by hand"),
         _row("R 75 1", "=47", "WHO_AM_I"),
-        _row("C 10", "!capture: not supported for icm42688p", "no capture of this part"),
-        _row("G 0", "!capture: not supported for icm42688p", "nor fetch"),
-        _row("C 0", "!capture: not supported for icm42688p", "the part is checked before the count"),
-        _row("C", "!usage: C <count>", "the words before the part"),
+        _row("G 0", "!no capture (start one with C)", "G before any C"),
+        _row("C 10", "!capture needs the FIFO on with both sensors (FIFO_CONFIG 00, FIFO_CONFIG1 00)",
+             "measuring, but the FIFO is off"),
+        _row("C 0", "!bad count (decimal 1..2304)", "a capture of nothing"),
+        _row("C 2305", "!bad count (decimal 1..2304)", "more than the buffer (capture=2304: 36 kB of 16-byte packets)"),
+        _row("G 2305", "!bad first (decimal 0..2304)", "past the buffer"),
+        _row("W 50 6B", "=", "ACCEL_CONFIG0 12.5 Hz (slow: a capture stays running through the table)"),
+        _row("W 4F 0B", "=", "GYRO_CONFIG0 the same rate"),
+        _row("W 5F 08", "=", "FIFO_CONFIG1 with a timestamp/FSYNC bit but neither sensor"),
+        _row("W 16 80", "=", "FIFO_CONFIG stop-on-full"),
+        _row("C 10", "!capture needs the FIFO on with both sensors (FIFO_CONFIG 80, FIFO_CONFIG1 08)",
+             "the FIFO on, but not in packets of both sensors"),
+        _row("W 5F 07", "=", "FIFO_CONFIG1: accelerometer, gyroscope, temperature (packet 3)"),
+        _row("R 16 1", "=80", "FIFO_CONFIG holds what was written"),
+        _row("C 100", _hex(4), "C answers TEMP_DATA1, TEMP_DATA0 as it starts"),
+        _row("G 0", re.compile(r"=([0-9A-F]{32})*"), "G while capturing: the packets so far, no T yet"),
+        _row("G 2304", "=", "from past the packets so far: none"),
+        _row("R 30 16", "!FIFO_DATA is being captured (fetch with G)", "the FIFO is the capture's"),
+        _row("R 2D 4", "!FIFO_DATA is being captured (fetch with G)", "so is a burst that covers it"),
+        _row("R 1D 16", _hex(32), "the data registers are not"),
+        _row("W 4E 00", "=", "both sensors off during it"),
+        _row("G 0", re.compile(r"!capture stopped: register 0x4E written after \d+ of 100 samples"), "ends it"),
+        _row("C 10", "!capture needs the part measuring", "the sensors are off"),
+        _row("G 0", "!no capture (start one with C)", "the refused C forgot it"),
+        _row("C", "!usage: C <count>", "the words before anything else"),
         _row("W 11 01", "=", "soft reset"),
         _row("R 4F 2", "=0606", "CONFIG0 at their reset values"),
     ]

@@ -181,7 +181,7 @@ def test_the_bridge_captures_packets_and_refuses_a_fifo_that_is_off() -> None:
     lab, clock = imu_lab()
     bridge = SimulatedIcm42688Bridge(lab, 0)
     answer = bridge._requests.answer  # noqa: SLF001 - the request handler, without a pseudo-terminal
-    assert answer("?") == "ADXL355-BRIDGE 3 part=icm42688p capture=4096 accelcal-rig simulated bridge"
+    assert answer("?") == "ADXL355-BRIDGE 3 part=icm42688p capture=2304 accelcal-rig simulated bridge"
     for request in ("W 4F 08", "W 50 68", "W 4E 0F"):
         assert answer(request) == "="
     assert answer("C 10") == "!capture needs the FIFO on with both sensors (FIFO_CONFIG 00, FIFO_CONFIG1 00)"
@@ -215,7 +215,7 @@ def test_the_driver_through_a_version_3_bridge_reads_both_sensors_truth() -> Non
     lab, clock = imu_lab(seed=7)
     driver, bridge, server = connected(lab, clock)
     try:
-        assert bridge.part_name == "icm42688p" and bridge.capture_capacity_samples == 4096
+        assert bridge.part_name == "icm42688p" and bridge.capture_capacity_samples == 2304
         assert ICM42688P.wrong_identity(driver.identify().registers) is None
         driver.reset()
         driver.standby()
