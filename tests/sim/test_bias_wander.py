@@ -32,3 +32,18 @@ def test_no_bias_instability_draws_nothing() -> None:
     state = rng.bit_generator.state
     assert not BiasWander(0.0, rng).at(np.arange(100.0)).any()
     assert rng.bit_generator.state == state
+
+
+def test_a_block_at_one_rate_is_the_same_wander_as_steps_one_instant_at_a_time() -> None:
+    """The filter that runs a block at one rate (what each FIFO read asks for) gives the numbers the step-by-step
+    recursion gives from the same stream, and leaves the same state for the next block."""
+    def blocks(one_at_a_time: bool) -> np.ndarray:
+        wander = BiasWander(5.0 / 3600.0, np.random.default_rng(11))
+        out = []
+        for start in (0.0, 2.5, 3600.0):
+            t = start + np.arange(200) / 100.0
+            out.append(np.concatenate([wander.at(t[i:i + 1]) for i in range(len(t))]) if one_at_a_time
+                       else wander.at(t))
+        return np.concatenate(out)
+
+    np.testing.assert_allclose(blocks(False), blocks(True), rtol=1e-9, atol=1e-12)  # the wander is ~1e-3 °/s
