@@ -30,6 +30,8 @@ from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.sample_ticks import SampleTicks
 
 _DATA = range(regs.REG_TEMP_DATA1, regs.REG_GYRO_DATA_Z0 + 1)
+#: The sensors' data registers (a read of TEMP_DATA alone makes no sample).
+_SENSOR_DATA = range(regs.REG_ACCEL_DATA_X1, regs.REG_GYRO_DATA_Z0 + 1)
 #: Registers whose read looks at the newest samples (data, INT_STATUS, the FIFO's count and port).
 _SAMPLED = frozenset({*_DATA, regs.REG_INT_STATUS, regs.REG_FIFO_COUNTH, regs.REG_FIFO_COUNTH + 1, regs.REG_FIFO_DATA})
 #: Reset values (data sheet register map): both CONFIG0 registers FS_SEL 0, ODR code 6 (1 kHz).
@@ -133,7 +135,7 @@ class SimulatedIcm42688:
         if _SAMPLED.isdisjoint(span):
             return bytes(self._regs[address:address + count])
         self._advance()
-        if not set(span).isdisjoint(_DATA) or regs.REG_INT_STATUS in span:
+        if not set(span).isdisjoint(_SENSOR_DATA):
             self._make_data()
         self._regs[regs.REG_TEMP_DATA1:regs.REG_TEMP_DATA1 + 2] = self._temperature_raw().to_bytes(2, "big", signed=True)
         self._regs[regs.REG_ACCEL_DATA_X1:regs.REG_GYRO_DATA_Z0 + 1] = self._sample[2:]
