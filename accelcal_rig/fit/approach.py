@@ -15,6 +15,12 @@ LOOKBACK_S = 600.0
 MOVED_C = 0.3
 #: A pose's rate of change is the slope of its DUT's readings this far either side of it.
 RATE_HALF_WINDOW_S = 150.0
+#: The spans of travel over which a hysteresis may swing from one branch to the other that the joint fit tries
+#: beside the sign of the last change (a swing at once): it keeps the one its poses fit best.
+HYSTERESIS_SPANS_C = (2.5, 5.0, 10.0, 20.0, 40.0)
+#: The readings are averaged this far either side before the swing is followed (their noise and 0.11 °C steps
+#: would otherwise walk it at rest).
+STATE_HALF_WINDOW_S = 60.0
 
 
 def temperature_rates_c_per_min(t_s: np.ndarray, temperature_c: np.ndarray, history_t_s: np.ndarray,
@@ -58,3 +64,27 @@ def approach_directions(t_s: np.ndarray, temperature_c: np.ndarray, history_t_s:
     started = first[first != 0]
     directions[directions == 0] = started[0] if len(started) else 1.0  # before it first moved: as it then did
     return directions
+
+
+def hysteresis_states(t_s: np.ndarray, temperature_c: np.ndarray, history_t_s: np.ndarray, history_c: np.ndarray,
+                      spans_c: tuple[float, ...] = HYSTERESIS_SPANS_C) -> np.ndarray:
+    """(S, N) each pose's hysteresis state in −1…+1 for each span of `spans_c`: a stop operator on the DUT's own
+    temperature history (its readings, averaged within STATE_HALF_WINDOW_S either side), moving by 2 × the
+    temperature's change / span and held at ±1 (+1 after warming through the whole span, −1 after cooling).
+    A sign of the last change (`approach_directions`) is the limit of a span of zero; a real sensor's package
+    and die attach change state over some travel, so after a turn it passes through the middle."""
+    times, readings = _history(t_s, temperature_c, history_t_s, history_c)
+    start = np.searchsorted(times, times - STATE_HALF_WINDOW_S, side="left")
+    stop = np.searchsorted(times, times + STATE_HALF_WINDOW_S, side="right")
+    sums = np.concatenate([[0.0], np.cumsum(readings)])
+    smooth = (sums[stop] - sums[start]) / (stop - start)
+    change = np.diff(smooth, prepend=smooth[:1])
+    states = np.empty((len(spans_c), len(times)))
+    moved = np.flatnonzero(np.abs(smooth - smooth[0]) > MOVED_C) if len(smooth) else np.zeros(0, int)
+    first = float(np.sign(smooth[moved[0]] - smooth[0])) if len(moved) else 1.0
+    for k, span in enumerate(spans_c):
+        state = first  # before it first moved: as it then did
+        for i, step in enumerate(change):
+            state = min(1.0, max(-1.0, state + 2.0 * step / span))
+            states[k, i] = state
+    return np.array([np.interp(t_s, times, row) for row in states]).reshape(len(spans_c), len(t_s))

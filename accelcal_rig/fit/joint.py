@@ -17,16 +17,22 @@ from accelcal_rig.fit.sfem import correct
 from accelcal_rig.fit.thermal import ThermalModel
 
 
-def fit_joint(start: ThermalModel, free: np.ndarray, temperature_c: np.ndarray, mean_g: np.ndarray,
-              stderr_g: np.ndarray, reference_g: np.ndarray | None, mode: FitMode,
-              reference_accuracy_rad: float = 0.0, gravity_g: float = 1.0,
-              approach: np.ndarray | None = None,
-              rate_c_per_min: np.ndarray | None = None) -> tuple[ThermalModel, np.ndarray, np.ndarray]:
+def fit_joint(*args, **kwargs) -> tuple[ThermalModel, np.ndarray, np.ndarray]:
+    """`fit_joint_cost` without its cost."""
+    return fit_joint_cost(*args, **kwargs)[:3]
+
+
+def fit_joint_cost(start: ThermalModel, free: np.ndarray, temperature_c: np.ndarray, mean_g: np.ndarray,
+                   stderr_g: np.ndarray, reference_g: np.ndarray | None, mode: FitMode,
+                   reference_accuracy_rad: float = 0.0, gravity_g: float = 1.0,
+                   approach: np.ndarray | None = None,
+                   rate_c_per_min: np.ndarray | None = None) -> tuple[ThermalModel, np.ndarray, np.ndarray, float]:
     """Refine `start`'s coefficients of the `free` parameters against every pose; fixed ones keep theirs.
-    With `approach` (±1 per pose: warming, cooling) each pose's reading also carries a bias of
-    approach × h, and with `rate_c_per_min` one of rate × c, h and c per axis fitted with the rest (a
-    hysteresis, which stays at rest, and what follows the rate of change, which does not): (the model,
-    h in g, c in g per °C/min; zeros for a term not fitted)."""
+    With `approach` (its hysteresis state per pose: ±1 warming, cooling, or between them while it swings) each
+    pose's reading also carries a bias of approach × h, and with `rate_c_per_min` one of rate × c, h and c per
+    axis fitted with the rest (a hysteresis, which stays at rest, and what follows the rate of change, which does not): (the model,
+    h in g, c in g per °C/min; zeros for a term not fitted) and the fit's χ² (its whitened residuals' sum of
+    squares)."""
     x = start.scaled(temperature_c)
     powers = np.vander(x, start.coefficients.shape[1], increasing=True)  # (n, degree + 1)
     stderr_g = np.maximum(np.asarray(stderr_g, dtype=float), 1e-9)
@@ -63,4 +69,4 @@ def fit_joint(start: ThermalModel, free: np.ndarray, temperature_c: np.ndarray, 
     refined = ThermalModel(start.domain_c, coefficients, np.empty((0, 12)), start.degree, list(start.warnings))
     extra = iter(result.x[n_coefficients:].reshape(-1, 3))
     fitted = [next(extra) if v is not None else np.zeros(3) for v in (approach, rate_c_per_min)]
-    return refined, fitted[0], fitted[1]
+    return refined, fitted[0], fitted[1], float(2.0 * result.cost)

@@ -17,7 +17,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from accelcal_rig.fit.approach import approach_directions, temperature_rates_c_per_min
+from accelcal_rig.fit.approach import (
+    HYSTERESIS_SPANS_C,
+    approach_directions,
+    hysteresis_states,
+    temperature_rates_c_per_min,
+)
 from accelcal_rig.fit.budget import (
     FittedTerms,
     budget,
@@ -42,7 +47,7 @@ from accelcal_rig.fit.channel_model import (
 )
 from accelcal_rig.fit.eq1_c import eq1_c_export
 from accelcal_rig.fit.expected import expected_norm_rmse_mg, expected_reference_rmse_mg, thermal_jacobian
-from accelcal_rig.fit.joint import fit_joint
+from accelcal_rig.fit.joint import fit_joint_cost
 from accelcal_rig.fit.lm import SfemFit, fit_sfem, norm_sigma
 from accelcal_rig.fit.metrics import drift_mg, noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.options import FitOptions
@@ -431,10 +436,20 @@ def _fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity) 
     approach = _both_ways(poses) if options.hysteresis == "on" and options.temperature_model == "joint" else None
     rate = poses.rate_c_per_min if approach is not None else None
     hysteresis, rate_term = np.zeros(3), np.zeros(3)
+    span_c: float | None = None
     if options.temperature_model == "joint":
-        thermal, hysteresis, rate_term = fit_joint(thermal, free, pose_temperatures, poses.mean, poses.stderr,
-                                                   reference, options.mode, accuracy_rad, poses.magnitude, approach,
-                                                   rate)
+        # The hysteresis state: the sign of the last change, or a swing over each span of HYSTERESIS_SPANS_C;
+        # the one the calibration poses fit best (least χ², the same parameters for each) is kept.
+        candidates: list[tuple[float, np.ndarray | None]] = [(0.0, approach)]
+        if approach is not None and poses.hysteresis_states is not None:
+            candidates += list(zip(HYSTERESIS_SPANS_C, poses.hysteresis_states))
+        start, best = thermal, np.inf
+        for span, state in candidates:
+            found = fit_joint_cost(start, free, pose_temperatures, poses.mean, poses.stderr, reference, options.mode,
+                                   accuracy_rad, poses.magnitude, state, rate)
+            if found[3] < best:
+                (thermal, hysteresis, rate_term, best), approach, span_c = found, state, span
+        span_c = span_c if approach is not None else None
     # In-sample: the fit as fitted (its hysteresis and rate terms removed); the calibration delivered, and
     # so the verification, knows neither: it is the sensor at rest, the mean of both directions.
     unhysteretic = poses.mean
@@ -446,6 +461,7 @@ def _fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity) 
     if approach is not None:  # warming minus cooling, per axis: what the calibration (their mean) leaves ± half of
         metrics[f"hysteresis_{m}"] = (2e3 * hysteresis).tolist()
         metrics[f"rate_bias_{m}_per_c_per_min"] = (1e3 * rate_term).tolist()
+        metrics["hysteresis_span_c"] = span_c
     elif options.hysteresis == "on":
         thermal.warnings.append("fit.hysteresis not fitted: " + (
             "the temperature model is not joint" if options.temperature_model != "joint" else
@@ -468,7 +484,19 @@ def _fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity) 
                                                                   list(spec.parameter_names))
     if stored.verification.any():
         checks = stored.subset(stored.verification)
-        metrics["verification"], coverage = _verification(checks, thermal, options, covariance, scatter_c, spec)
+        shift = None
+        if terms is not None and checks.rate_c_per_min is not None:
+            # The sensor's own state at each check, read off its temperature history as at every calibration
+            # pose: the fitted model judged on poses it never saw. The calibration alone (as `apply` uses it,
+            # the middle of both branches) beside it: on one branch it is off by up to ±h, the budget's
+            # hysteresis.
+            state = checks.approach if span_c == 0.0 or checks.hysteresis_states is None else \
+                checks.hysteresis_states[list(HYSTERESIS_SPANS_C).index(span_c)]
+            shift = state[:, None] * hysteresis + checks.rate_c_per_min[:, None] * rate_term
+            metrics["verification_as_applied"], _ = _verification(checks, thermal, options, covariance, scatter_c,
+                                                                  spec)
+        metrics["verification"], coverage = _verification(checks, thermal, options, covariance, scatter_c, spec,
+                                                          shift)
         if coverage is not None:
             metrics["truth_coverage_k2"] = coverage
     names = spec.parameter_names
@@ -519,13 +547,16 @@ def _expected_rmse(poses: VectorPoses, groups: list[np.ndarray], fits: list[Sfem
 
 
 def _verification(checks: VectorPoses, thermal: ThermalModel, options: FitOptions, covariance: CoefficientCovariance,
-                  scatter_c: float, spec: VectorQuantity) -> tuple[dict[str, Any], float | None]:
+                  scatter_c: float, spec: VectorQuantity,
+                  shift: np.ndarray | None = None) -> tuple[dict[str, Any], float | None]:
     """The figures on poses the fit never saw, compensated as `apply` would (the calibration's out-of-range
-    rule), each at its own smoothed temperature; and in a dry run the share of their axis errors against
-    the truth inside the expanded uncertainty."""
+    rule), each at its own smoothed temperature, after taking off `shift` (N, 3) where given (a hysteresis
+    fit's terms at each check); and in a dry run the share of their axis errors against the truth inside the
+    expanded uncertainty."""
     groups = [np.flatnonzero(checks.setpoint_c == s) for s in dict.fromkeys(checks.setpoint_c.tolist())]
     temperatures = smoothed_temperatures(checks, groups)
-    compensated = correct(checks.mean, thermal.parameters_at(temperatures, options.out_of_range))
+    reading = checks.mean if shift is None else checks.mean - shift
+    compensated = correct(reading, thermal.parameters_at(temperatures, options.out_of_range))
     references = ReferenceUncertainty(np.radians(checks.reference_accuracy_arcsec / 3600),
                                       checks.magnitude_u / checks.magnitude)
     figures = pose_figures(compensated, checks.reference, checks.stderr, checks.setpoint_c, temperatures,
@@ -607,4 +638,5 @@ def with_approach(campaign: Campaign, poses: VectorPoses) -> VectorPoses:
             history_c.append(np.asarray(soak.dut_c, dtype=float)[:, serials.index(poses.serial)])
     history = (poses.t_s, poses.temperature_c, np.concatenate(history_t or [np.zeros(0)]),
                np.concatenate(history_c or [np.zeros(0)]))
-    return replace(poses, approach=approach_directions(*history), rate_c_per_min=temperature_rates_c_per_min(*history))
+    return replace(poses, approach=approach_directions(*history), rate_c_per_min=temperature_rates_c_per_min(*history),
+                   hysteresis_states=hysteresis_states(*history))

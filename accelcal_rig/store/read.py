@@ -275,6 +275,8 @@ class VectorPoses:
     magnitude_u: float = 0.0          # the magnitude's standard uncertainty, in the channel's unit
     approach: np.ndarray | None = None  # (N,) +1 warming, −1 cooling towards each pose (fit.hysteresis)
     rate_c_per_min: np.ndarray | None = None  # (N,) each pose's rate of temperature change (fit.hysteresis)
+    #: (S, N) each pose's hysteresis state for each span the joint fit tries (fit.hysteresis; fit/approach.py)
+    hysteresis_states: np.ndarray | None = None
 
     def subset(self, rows: np.ndarray) -> VectorPoses:
         """These poses only (a boolean mask or indices)."""
@@ -285,7 +287,8 @@ class VectorPoses:
                        mean=self.mean[rows], stderr=self.stderr[rows], reference=self.reference[rows],
                        verification=self.verification[rows], rows=self.rows[rows],
                        truth_parameters=taken(self.truth_parameters), truth_reference=taken(self.truth_reference),
-                       approach=taken(self.approach), rate_c_per_min=taken(self.rate_c_per_min))
+                       approach=taken(self.approach), rate_c_per_min=taken(self.rate_c_per_min),
+                       hysteresis_states=None if self.hysteresis_states is None else self.hysteresis_states[:, rows])
 
 
 def dut_description(campaign: Campaign, serial: str) -> dict[str, Any]:
