@@ -142,6 +142,10 @@ def figures(method: str, duts: int, seed: int) -> dict[str, Any]:
         "rig_hours": rig_hours, "rig_hours_per_dut": rig_hours / duts,
         "lower_bound_hours": lower_bound_s(prepared) / 3600,
         "verification_rmse_mg": max(v["rmse_mg"] for v in verification),
+        # A hysteresis fit's checks judge the model at each check's own state; the calibration alone, as `apply`
+        # uses it (the middle of both branches), is off by up to ±h at a soaked end (docs/calibration.md).
+        "verification_as_applied_rmse_mg": max(m.get("verification_as_applied", m["verification"])["rmse_mg"]
+                                               for m in metrics),
         "expected_fit_rmse_mg": max(m["expected_fit_rmse_mg"] for m in metrics),
         "noise_floor_mg": max(v["noise_floor_mg"] for v in verification),
         "residual_drift_mg": max(max(v["drift_mg"]) for v in verification),
@@ -191,7 +195,8 @@ def main() -> None:
         print(f"  {r['method']:>18}: rig {r['rig_hours']:.2f} h ({r['rig_hours_per_dut']:.3f} h/DUT; lower bound "
               f"{r['lower_bound_hours']:.2f} h, ×{r['rig_time_over_lower_bound']:.2f}); verification RMSE "
               f"{r['verification_rmse_mg']:.4f} mg (expected {r['expected_fit_rmse_mg']:.4f}, "
-              f"×{r['verification_over_expected']:.2f}; floor {r['noise_floor_mg']:.4f}); residual drift "
+              f"×{r['verification_over_expected']:.2f}; floor {r['noise_floor_mg']:.4f}; as applied "
+              f"{r['verification_as_applied_rmse_mg']:.4f}); residual drift "
               f"{r['residual_drift_mg']:.4f} mg; hysteresis {hysteresis}; at rest: RMSE {r['at_rest_rmse_mg']:.4f} mg, "
               f"drift {r['at_rest_drift_mg']:.4f} mg over {r['calibrated_range_c'][0]:.1f}…{r['calibrated_range_c'][1]:.1f} °C; "
               f"wall {r['wall_s']:.0f} s")

@@ -79,6 +79,20 @@ _NO_POSES = "no verification poses stored"
 BIAS, SCALE, NONORTH, MISALIGN = slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12)
 
 
+# A VectorQuantity's defaults are module-level functions, not lambdas: a large fixture's jobs carry it to fit
+# worker processes (fit/fixture_pool.py), and a lambda in a class body cannot be pickled.
+def _no_statements(figures: Mapping[str, Any]) -> list[tuple[str, str]]:
+    return []
+
+
+def _direction_always_known(campaign: Campaign) -> bool:
+    return True
+
+
+def _no_site_description(campaign: Campaign) -> dict[str, Any] | None:
+    return None
+
+
 @dataclass(frozen=True)
 class VectorQuantity:
     """What one quantity's Eq. 1 channel model says of itself; everything else is the shared model's."""
@@ -109,13 +123,13 @@ class VectorQuantity:
     #: whether the early check judges it after each setpoint (its reference's direction always known)
     setpoint_check: bool = False
     #: what its references were, from a calibration's figures: (what, statement) rows of a certificate
-    statements: Callable[[Mapping[str, Any]], list[tuple[str, str]]] = lambda figures: []
+    statements: Callable[[Mapping[str, Any]], list[tuple[str, str]]] = _no_statements
     #: whether the campaign places the reference's direction (else only its size is known: fitted norm-only)
-    direction_known: Callable[[Campaign], bool] = lambda campaign: True
+    direction_known: Callable[[Campaign], bool] = _direction_always_known
     #: how its method departs from the paper's (an accelerometer's paper), said after the paper on a certificate
     paper_departure: str = ""
     #: the site's reference as the campaign recorded it, kept with the figures (`site_<quantity>`; None: none)
-    site_description: Callable[[Campaign], dict[str, Any] | None] = lambda campaign: None
+    site_description: Callable[[Campaign], dict[str, Any] | None] = _no_site_description
 
     @property
     def parameter_names(self) -> tuple[str, ...]:

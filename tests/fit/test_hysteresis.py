@@ -106,3 +106,16 @@ def test_a_poses_rate_of_change_is_centred_on_it_and_does_not_lag_at_a_turn() ->
     poses = np.array([1500.0, 3300.0, 5400.0])
     rates = temperature_rates_c_per_min(poses, np.interp(poses, t, temperature), t, temperature)
     np.testing.assert_allclose(rates, [-2.0, 0.0, 1.0], atol=1e-9)  # mid-hold: 0, though cooled 10 min before
+
+
+def test_hysteresis_state_swings_over_its_span():
+    """The stop operator: +1 after warming through the span, −1 after cooling through it, half-way between
+    5 °C after a turn for a span of 10 °C, held at ±1 at rest."""
+    from accelcal_rig.fit.approach import hysteresis_states
+
+    t = np.arange(0.0, 9000.0, 30.0)
+    temperature = np.interp(t, [0, 1800, 3600, 6000, 9000], [20, 60, 60, 20, 20])  # warm, rest, cool, rest
+    poses_t = np.array([3000.0, 3600.0 + 5 / 40 * 2400 + 60, 5900.0, 8000.0])
+    states = hysteresis_states(poses_t, np.interp(poses_t, t, temperature), t, temperature, (10.0,))[0]
+    assert states[0] == 1.0 and states[2] == -1.0 and states[3] == -1.0
+    assert abs(states[1]) < 0.2  # 5 °C of cooling after the turn (the readings averaged ±60 s)
