@@ -17,16 +17,11 @@ from accelcal_rig.fit.sfem import correct
 from accelcal_rig.fit.thermal import ThermalModel
 
 
-def fit_joint(*args, **kwargs) -> tuple[ThermalModel, np.ndarray, np.ndarray]:
-    """`fit_joint_cost` without its cost."""
-    return fit_joint_cost(*args, **kwargs)[:3]
-
-
-def fit_joint_cost(start: ThermalModel, free: np.ndarray, temperature_c: np.ndarray, mean_g: np.ndarray,
-                   stderr_g: np.ndarray, reference_g: np.ndarray | None, mode: FitMode,
-                   reference_accuracy_rad: float = 0.0, gravity_g: float = 1.0,
-                   approach: np.ndarray | None = None,
-                   rate_c_per_min: np.ndarray | None = None) -> tuple[ThermalModel, np.ndarray, np.ndarray, float]:
+def fit_joint(start: ThermalModel, free: np.ndarray, temperature_c: np.ndarray, mean_g: np.ndarray,
+              stderr_g: np.ndarray, reference_g: np.ndarray | None, mode: FitMode,
+              reference_accuracy_rad: float = 0.0, gravity_g: float = 1.0,
+              approach: np.ndarray | None = None,
+              rate_c_per_min: np.ndarray | None = None) -> tuple[ThermalModel, np.ndarray, np.ndarray, float]:
     """Refine `start`'s coefficients of the `free` parameters against every pose; fixed ones keep theirs.
     With `approach` (its hysteresis state per pose: ±1 warming, cooling, or between them while it swings) each
     pose's reading also carries a bias of approach × h, and with `rate_c_per_min` one of rate × c, h and c per

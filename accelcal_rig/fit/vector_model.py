@@ -47,7 +47,7 @@ from accelcal_rig.fit.channel_model import (
 )
 from accelcal_rig.fit.eq1_c import eq1_c_export
 from accelcal_rig.fit.expected import expected_norm_rmse_mg, expected_reference_rmse_mg, thermal_jacobian
-from accelcal_rig.fit.joint import fit_joint_cost
+from accelcal_rig.fit.joint import fit_joint
 from accelcal_rig.fit.lm import SfemFit, fit_sfem, norm_sigma
 from accelcal_rig.fit.metrics import drift_mg, noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.options import FitOptions
@@ -459,8 +459,8 @@ def _fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity) 
             candidates += list(zip(HYSTERESIS_SPANS_C, poses.hysteresis_states))
         start, best = thermal, np.inf
         for span, state in candidates:
-            found = fit_joint_cost(start, free, pose_temperatures, poses.mean, poses.stderr, reference, options.mode,
-                                   accuracy_rad, poses.magnitude, state, rate)
+            found = fit_joint(start, free, pose_temperatures, poses.mean, poses.stderr, reference, options.mode,
+                               accuracy_rad, poses.magnitude, state, rate)
             if found[3] < best:
                 (thermal, hysteresis, rate_term, best), approach, span_c = found, state, span
         span_c = span_c if approach is not None else None
@@ -504,8 +504,10 @@ def _fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity) 
             # pose: the fitted model judged on poses it never saw. The calibration alone (as `apply` uses it,
             # the middle of both branches) beside it: on one branch it is off by up to ±h, the budget's
             # hysteresis.
-            state = checks.approach if span_c == 0.0 or checks.hysteresis_states is None else \
-                checks.hysteresis_states[list(HYSTERESIS_SPANS_C).index(span_c)]
+            swinging = checks.hysteresis_states is not None and span_c in HYSTERESIS_SPANS_C
+            state = checks.hysteresis_states[HYSTERESIS_SPANS_C.index(span_c)] \
+                if swinging and checks.hysteresis_states is not None and span_c is not None else checks.approach
+            assert state is not None  # a hysteresis fit has each pose's approach
             shift = state[:, None] * hysteresis + checks.rate_c_per_min[:, None] * rate_term
             metrics["verification_as_applied"], _ = _verification(checks, thermal, options, covariance, scatter_c,
                                                                   spec)

@@ -44,9 +44,9 @@ def test_the_joint_fit_finds_the_hysteresis_and_the_mean_of_both_directions() ->
     truth, start, temperature, readings, reference, approach = synthetic_ramp(h_g, seed=1)
     stderr = np.full(readings.shape, 5e-6)
     free = np.ones(12, dtype=bool)
-    fitted, found_h, _ = fit_joint(start, free, temperature, readings, stderr, reference, "reference", 0.0, 1.0, approach)
+    fitted, found_h, _, _ = fit_joint(start, free, temperature, readings, stderr, reference, "reference", 0.0, 1.0, approach)
     np.testing.assert_allclose(found_h, h_g, atol=3e-6)
-    blind, none_h, _ = fit_joint(start, free, temperature, readings, stderr, reference, "reference", 0.0, 1.0)
+    blind, none_h, _, _ = fit_joint(start, free, temperature, readings, stderr, reference, "reference", 0.0, 1.0)
     assert np.array_equal(none_h, np.zeros(3))
     truth_bias = truth.parameters_at(temperature)[:, :3]  # the blind fit's bias is pulled towards ±h
     aware_error = np.abs(fitted.parameters_at(temperature)[:, :3] - truth_bias).max()
@@ -91,7 +91,7 @@ def test_the_rate_term_tells_what_follows_the_rate_from_a_hysteresis_that_stays_
     h_g, c_g = np.array([0.05e-3, -0.1e-3, 0.08e-3]), np.array([0.1e-3, 0.05e-3, -0.12e-3])
     readings = readings + approach[:, None] * h_g + rate[:, None] * c_g
     stderr = np.full(readings.shape, 5e-6)
-    fitted, found_h, found_c = fit_joint(start, np.ones(12, dtype=bool), temperature, readings, stderr, reference,
+    fitted, found_h, found_c, _ = fit_joint(start, np.ones(12, dtype=bool), temperature, readings, stderr, reference,
                                          "reference", 0.0, 1.0, approach, rate)
     np.testing.assert_allclose(found_h, h_g, atol=5e-6)
     np.testing.assert_allclose(found_c, c_g, atol=3e-6)
