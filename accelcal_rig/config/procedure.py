@@ -227,16 +227,18 @@ class Procedure(StrictModel):
     verify: Verification | None = Field(None, description="verification poses the fit never sees")
     acceptance: Acceptance = Acceptance()
     frost: Frost = Field(Frost(), description="dry-air purge and the dew point requirement")
-    rates: RateSteps | None = Field(None, description="a gyroscope's rate steps at every setpoint (a rate table)")
-    noise: NoiseRecord | None = Field(None, description="a still record at every setpoint (Allan deviation)")
+    rates: RateSteps | None = Field(None, description="a gyroscope's rate steps at every setpoint (a rate table); "
+                                                      "the ramp method: in every band, each way")
+    noise: NoiseRecord | None = Field(None, description="a still record at every setpoint where the DUTs are soaked "
+                                                        "(Allan deviation)")
     early_check: EarlyCheck = Field(EarlyCheck(), description="every DUT checked after each setpoint's poses")
 
     @model_validator(mode="after")
     def _gyroscope_steps_fit(self) -> Procedure:
         if self.rates is None and self.noise is None:
             return self
-        if self.method != "soak" or self.cooldown is not None:
-            raise ValueError("rates and noise are measured at rest at each setpoint: method: soak, no cool-down")
+        if self.cooldown is not None:
+            raise ValueError("rates and noise are a calibration's steps: a cool-down procedure has neither")
         if self.rates is not None and self.rates.verify_rates_dps and self.verify is None:
             raise ValueError("rates.verify_rates_dps are measured where the verification poses are: add a verify: "
                              "section")

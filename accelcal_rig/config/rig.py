@@ -281,6 +281,12 @@ class FaultInjection(StrictModel):
     sensor_dead_axis: str | None = Field(None, max_length=64, description="serial of a DUT with a dead axis (it "
                                          "reads its bias whatever the pose)")
     sensor_dead_axis_name: Literal["x", "y", "z"] = Field("x", description="which of its axes is dead")
+    sensor_out_of_spec: str | None = Field(None, max_length=64, description="serial of a DUT whose part is beyond its "
+                                           "data sheet (a bias or a scale a healthy part does not have)")
+    sensor_out_of_spec_channel: str = Field("accel", max_length=32, description="that DUT's channel which is")
+    sensor_out_of_spec_bias: Real = Field(0.0, ge=-1e6, le=1e6, description="added to each axis's bias, in the "
+                                          "channel's unit (g, °/s, gauss)")
+    sensor_out_of_spec_scale_pct: Real = Field(0.0, ge=-50, le=50, description="added to each axis's scale factor, %")
     sensor_temperature_tear_rate: Real = Field(
         0.0, ge=0, le=1, description="share of every DUT's TEMP2/TEMP1 reads that straddle an update of the high "
                                      "nibble (not double-buffered on a real ADXL355): off by 256 LSB, about 28 °C")

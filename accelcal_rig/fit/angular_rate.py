@@ -106,7 +106,8 @@ class AngularRateModel:
     def fit(self, records: Any, options: FitOptions, allan: dict[str, Any] | None) -> ChannelFit:
         gyro_records, site = records
         try:
-            return fit_gyro(gyro_records, options.degree, options.out_of_range, site, allan)
+            return fit_gyro(gyro_records, options.degree, options.out_of_range, site, allan,
+                            joint=options.temperature_model == "joint")
         except GyroDesignError as exc:
             raise NotCalibrated(f"not calibrated: {exc}") from None
 

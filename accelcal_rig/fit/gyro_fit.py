@@ -12,7 +12,7 @@ stated beside each scale factor's 1σ, never a weight.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -25,7 +25,8 @@ from accelcal_rig.fit import gyro_model
 from accelcal_rig.fit.allan import FLICKER_FLOOR
 from accelcal_rig.fit.calibration import ChannelCalibration, PolynomialModel, SetpointFit, plain
 from accelcal_rig.fit.channel_model import ChannelFit
-from accelcal_rig.fit.gyro_budget import gyro_budget, truth_coverage
+from accelcal_rig.fit.gyro_budget import gyro_budget, sources_dps, truth_coverage
+from accelcal_rig.fit.gyro_joint import fit_gyro_joint
 from accelcal_rig.fit.parameter_uncertainty import certificate_temperatures, of_gyro
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
 from accelcal_rig.fit.uncertainty import COVERAGE_FACTOR
@@ -165,9 +166,11 @@ GAUGE = ("the fixture frame as the rate table realises it: turning about each fi
 
 
 def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: dict[str, Any],
-             allan: dict[str, Any] | None = None) -> ChannelFit:
+             allan: dict[str, Any] | None = None, joint: bool = False) -> ChannelFit:
     """Fit each setpoint, the polynomials over temperature, and the figures of the calibration. `allan`: the
-    noise record's figures (fit/noise_record.py), whose bias instability bounds how well a bias holds."""
+    noise record's figures (fit/noise_record.py), whose bias instability bounds how well a bias holds. `joint`
+    (`fit.temperature_model: joint`, the ramp method): the polynomials then refined against every record at its
+    own temperature (fit/gyro_joint.py); the per-setpoint fits still give the uncertainty budget its parts."""
     calibrating = records.rows(*CALIBRATION_KINDS)
     if not records.rows("rate").any():
         raise GyroDesignError(f"sensor {records.serial}: no rate steps stored, the gyroscope cannot be calibrated")
@@ -188,6 +191,12 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
     temperatures = np.array([records.temperature_c[g].mean() for g in groups])
     estimates, sigmas = np.array([f.parameters for f in fits]), np.array([f.sigma for f in fits])
     thermal = fit_thermal(temperatures, estimates, sigmas, np.ones(gyro_model.N_PARAMETERS, dtype=bool), degree)
+    if joint:
+        rows = np.concatenate(groups)
+        refined = fit_gyro_joint(thermal, records.temperature_c[rows], records.mean_dps[rows],
+                                 records.stderr_dps[rows], records.reference_dps[rows], records.force_g[rows],
+                                 STDERR_FLOOR_DPS)
+        thermal = replace(refined, residuals=estimates - refined.parameters_at(temperatures, "extrapolate"))
     # A setpoint whose records do not determine the model (a campaign stopped in its rate steps) is left out,
     # said so: the others still calibrate the gyroscope over their range.
     thermal.warnings.extend(f"gyroscope setpoint left out: {why}" for why in skipped)
@@ -216,6 +225,15 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
     metrics["uncertainty_budget"] = gyro_budget(thermal, temperatures, covariances, sigmas, temperature_u_c,
                                                 systematic, round(largest))
     metrics["expanded_uncertainty_dps"] = metrics["uncertainty_budget"]["at_largest_rate"]["expanded_dps"]
+    steps = records.rows("verify-rate")
+    if steps.any():
+        # What the verification rate steps' RMS error would be from noise alone: each reading's own, and the
+        # fit's (its parameters' noise carried to the step's rate, force and temperature); the table's errors,
+        # shared by calibration and checks, and the thermal model's are not noise.
+        fit_u = sources_dps(records.reference_dps[steps], records.force_g[steps], records.temperature_c[steps],
+                            thermal, temperatures, covariances, sigmas, temperature_u_c, systematic,
+                            out_of_range)["fit"]
+        metrics["expected_fit_rmse_dps"] = float(np.sqrt(np.mean(records.stderr_dps[steps] ** 2 + fit_u**2)))
     if records.truth_parameters is not None:
         metrics["truth_error"] = _truth_error(records, setpoints, groups, fits, systematic)
         checks = records.rows(*VERIFICATION_KINDS)

@@ -183,10 +183,11 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
         verified = verify is not None and verify.at_setpoints and (at_rest or verify.on_ramp)
         if verified:
             measure.extend(_verification(setpoint, checks))
-        if procedure.method == "ramp":
-            body: tuple[Step, ...] = tuple(step for m in measure for step in (AdvanceRamp(setpoint), m))
+        gyroscope = _gyroscope(procedure, rig, setpoint, spun, poses, calibrate=True, verify=verified, noise=at_rest)
+        if procedure.method == "ramp":  # the ramp's setpoint written before each step taken on it
+            body: tuple[Step, ...] = tuple(step for m in (*measure, *gyroscope) for step in (AdvanceRamp(setpoint), m))
         else:
-            body = (*measure, *_gyroscope(procedure, rig, setpoint, spun, poses, calibrate=True, verify=verified))
+            body = (*measure, *gyroscope)
         if at_rest and procedure.early_check.action != "none":
             body = _checked_after_poses(body, setpoint)
         stages.append(Stage(setpoint, entry, body, restart))
@@ -209,14 +210,15 @@ def _checked_after_poses(body: tuple[Step, ...], setpoint_c: float) -> tuple[Ste
 
 
 def _gyroscope(procedure: Procedure, rig: RigConfig, setpoint_c: float, spun: dict[str, Pose],
-               poses: tuple[Pose, ...], calibrate: bool, verify: bool) -> list[Step]:
+               poses: tuple[Pose, ...], calibrate: bool, verify: bool, noise: bool = True) -> list[Step]:
     """A gyroscope's steps after the poses: the rate steps (calibration, verification or both), then, at a
-    calibration setpoint, the still noise record."""
+    calibration setpoint where the DUTs are soaked (`noise`: not a band taken on a ramp, whose moving
+    temperature a still record's bias would follow), the still noise record."""
     label = setpoint_label(setpoint_c)
     steps: list[Step] = []
     if procedure.rates is not None:
         steps += rate_steps(label, setpoint_c, procedure.rates, rig, spun, calibrate, verify)
-    if procedure.noise is not None and calibrate:
+    if procedure.noise is not None and calibrate and noise:
         held = next(p for p in poses if p.number == procedure.noise.pose)
         steps += noise_blocks(label, setpoint_c, procedure, held)
     return steps

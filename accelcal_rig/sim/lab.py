@@ -17,6 +17,7 @@ from accelcal_rig.core.geometry import fixture_to_dut
 from accelcal_rig.core.humidity import relative_humidity_pct
 from accelcal_rig.core.thermal import TEMPERATURE_READ_NOISE_C, ThermalModel
 from accelcal_rig.core.units import site_gravity_g
+from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.gyro_model import distort_rate
 from accelcal_rig.fit.sfem import distort
 from accelcal_rig.parts.part import Part
@@ -67,6 +68,28 @@ class SimulatedDut:
         #: (t_start, t_end, n, parameters, gravity, temperature) of recently generated sample chunks.
         self.truth_log: deque[tuple] = deque(maxlen=4096)
 
+    def put_out_of_spec(self, channel: str, bias: float, scale_pct: float) -> None:
+        """Make this part's `channel` beyond its data sheet (`simulation.faults.sensor_out_of_spec`): `bias` (in the
+        channel's unit) added to each axis's bias and `scale_pct` % to each scale factor, at every temperature.
+        Both models put the bias first and the scale factors next (Eq. 1's and the rate-table model's)."""
+        if channel not in self.part.channel_names:
+            raise ConfigError(f"simulation.faults.sensor_out_of_spec_channel: {channel!r}: {self.serial}'s "
+                              f"{self.part.label} has {', '.join(self.part.channel_names)}")
+        quantity = self.part.channel(channel).quantity
+        truth = self.gyro_truth if quantity == "angular rate" else self.mag_truth if quantity == MAGNETIC_FIELD \
+            else self.truth
+        assert truth is not None
+        coefficients = truth.coefficients.copy()
+        coefficients[0:3, 0] += bias
+        coefficients[3:6, 0] *= 1.0 + scale_pct / 100.0
+        changed = DutTruth(truth.serial, coefficients)
+        if quantity == "angular rate":
+            self.gyro_truth = changed
+        elif quantity == MAGNETIC_FIELD:
+            self.mag_truth = changed
+        if truth is self.truth:
+            self.truth = changed
+
 
 @dataclass(frozen=True)
 class _Instant:
@@ -104,6 +127,10 @@ class VirtualLab:
         serials = [s.serial for s in rig.fixture.sensors]
         self.duts = [SimulatedDut(s.serial, s.mount_euler_deg, tau_s, part(s.part))
                      for s, tau_s in zip(rig.fixture.sensors, sim.fixture_time_constants_s(serials))]
+        for dut in self.duts:
+            if dut.serial == sim.faults.sensor_out_of_spec:
+                dut.put_out_of_spec(sim.faults.sensor_out_of_spec_channel, sim.faults.sensor_out_of_spec_bias,
+                                    sim.faults.sensor_out_of_spec_scale_pct)
         #: Each DUT's accelerometer's noise density: the rig config's, or its part's (none without an accelerometer).
         self.noise_density_g_per_rthz = [1e-6 * (_accelerometer_noise(d.part) if sim.noise_density_ug_per_rthz
                                                  is None else sim.noise_density_ug_per_rthz) for d in self.duts]
