@@ -23,6 +23,7 @@ from accelcal_rig.fit.channel_model import (
     Section,
     StoredFigure,
     Table,
+    consistency_notes,
     noise_stored,
 )
 from accelcal_rig.fit.gyro_c import gyro_c_export
@@ -254,10 +255,8 @@ class AngularRateModel:
         rows += (("combined standard uncertainty", *cells(rest["standard_dps"]), *cells(turning["standard_dps"])),
                  (f"expanded uncertainty (k = {budget['coverage_factor']:g}, about 95 %)",
                   *cells(rest["expanded_dps"]), *cells(turning["expanded_dps"])))
-        coverage = calibration.metrics.get("truth_coverage_k2")
-        notes = () if coverage is None else (
-            f"Checked against the simulation truth: {coverage * 100:.1f} % of the verification records' axis errors "
-            "lie inside their expanded uncertainty.",)
+        notes = consistency_notes(calibration.metrics, "records", "the calibration's errors at the verification "
+                                  "records, their readings' noise taken out")
         return Section("Uncertainty of a compensated rate",
                        (f"For {budget['reading']}: each source's largest standard uncertainty over the calibrated range "
                         f"and gravity along ±x, ±y, ±z, at rest and at ±{rate} °/s (the largest calibrated rate) about "

@@ -325,3 +325,23 @@ def noise_stored(noise: NoiseFigures | None, metrics: Mapping[str, Any], lot: bo
             kept.append(StoredFigure(label.replace(" ", "_"), label, unit, tuple(float(e["value"]) for e in allan[key]),
                                      lot=lot))
     return kept
+
+
+def consistency_notes(metrics: Mapping[str, Any], records: str, truth_errors: str) -> tuple[str, ...]:
+    """A budget section's notes on how its expanded uncertainty held on the verification `records` ("poses",
+    "records"): the E_n check a lab can repeat (`verification.consistency_k2`: each axis error against the
+    calibration's U with the verification measurement's), and in a dry run the check against the simulation's
+    truth, saying which errors it counts (`truth_errors`) so that it compares what the budget covers."""
+    notes = []
+    check = (metrics.get("verification") or {}).get("consistency_k2")
+    if check:
+        notes.append(f"Verification: {check['within_share'] * 100:.1f} % of the {check['axis_errors']} axis errors of the "
+                     f"verification {records} against their references lie within their combined expanded "
+                     "uncertainty, this calibration's (above, at each of them) with the verification measurement's "
+                     "(the reading's noise, the reference's uncertainty): E_n ≤ 1 (ISO 13528); about 95 % are "
+                     f"expected of an uncertainty that covers what it states (largest E_n {check['largest_e_n']:.2f}).")
+    coverage = metrics.get("truth_coverage_k2")
+    if coverage is not None:
+        notes.append(f"Dry run, against the simulation's hidden truth: {coverage * 100:.1f} % of {truth_errors}, lie "
+                     "within the expanded uncertainty that covers them.")
+    return tuple(notes)

@@ -27,6 +27,7 @@ covariances of each pose propagate separately, so the budget can say what each c
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy.stats import chi2
@@ -219,3 +220,14 @@ def output_uncertainty(raw_g: np.ndarray, temperature_c: np.ndarray, model: Ther
 def combined(sources: dict[str, np.ndarray]) -> np.ndarray:
     """The combined standard uncertainty: the sources in quadrature (taken as uncorrelated)."""
     return np.sqrt(sum(u**2 for u in sources.values()))
+
+
+def consistency(errors: np.ndarray, calibration_u: np.ndarray, measurement_u: np.ndarray) -> dict[str, Any]:
+    """The verification records' axis errors against their combined expanded uncertainty, the calibration's (the
+    budget's, at each record) with the verification measurement's (its noise, its reference): the share with
+    E_n = |error| / U ≤ 1 (ISO 13528's E_n), where about 95 % are expected of an uncertainty that covers what it
+    states. What a lab can check without a truth: both parts are stated on the certificate."""
+    expanded = COVERAGE_FACTOR * np.hypot(calibration_u, measurement_u)
+    e_n = np.abs(errors) / np.maximum(expanded, 1e-15)
+    return {"axis_errors": int(e_n.size), "within_share": float(np.mean(e_n <= 1.0)),
+            "largest_e_n": float(e_n.max())}

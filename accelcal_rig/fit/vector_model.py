@@ -43,6 +43,7 @@ from accelcal_rig.fit.channel_model import (
     Section,
     StoredFigure,
     Table,
+    consistency_notes,
     noise_stored,
 )
 from accelcal_rig.fit.eq1_c import eq1_c_export
@@ -60,7 +61,7 @@ from accelcal_rig.fit.parameter_uncertainty import (
 )
 from accelcal_rig.fit.sfem import correct, norm_only_gauge
 from accelcal_rig.fit.thermal import ThermalModel, fit_thermal
-from accelcal_rig.fit.uncertainty import CoefficientCovariance
+from accelcal_rig.fit.uncertainty import CoefficientCovariance, combined, consistency, output_uncertainty
 from accelcal_rig.fit.verification import AngleFigure, ReferenceUncertainty, pose_figures
 from accelcal_rig.store.read import VectorPoses, read_vector_poses
 
@@ -339,10 +340,8 @@ class Eq1Model:
         rows += (("combined standard uncertainty", *(f"{u * 1e3:.1f}" for u in budget_[f"standard_{m}"])),
                  (f"expanded uncertainty (k = {budget_['coverage_factor']:g}, about 95 %)",
                   *(f"{u * 1e3:.1f}" for u in budget_[f"expanded_{m}"])))
-        coverage = calibration.metrics.get("truth_coverage_k2")
-        notes = () if coverage is None else (
-            f"Checked against the simulation truth: {coverage * 100:.1f} % of the verification poses' axis errors "
-            "lie inside their expanded uncertainty.",)
+        notes = consistency_notes(calibration.metrics, "poses", "the compensated verification readings' errors (their "
+                                  "noise in them as in the uncertainty)")
         return Section("Uncertainty of a compensated reading",
                        (f"For {budget_['reading']}: each source's largest standard uncertainty over every orientation "
                         "and the calibrated range, per axis (GUM, sources uncorrelated).",),
@@ -577,9 +576,28 @@ def _verification(checks: VectorPoses, thermal: ThermalModel, options: FitOption
                                       checks.magnitude_u / checks.magnitude)
     figures = pose_figures(compensated, checks.reference, checks.stderr, checks.setpoint_c, temperatures,
                            options.mode == "norm-only", checks.magnitude, references, spec.milli, spec.angle)
-    coverage = truth_coverage(checks, covariance, thermal, compensated, temperatures,
-                              smoothed_temperature_u_c(checks.t_s, groups, scatter_c), options.mode, options.out_of_range)
+    temperature_u_c = smoothed_temperature_u_c(checks.t_s, groups, scatter_c)
+    if options.mode == "reference":
+        figures["consistency_k2"] = _consistency(checks, compensated, temperatures, temperature_u_c, thermal,
+                                                 covariance, options)
+    coverage = truth_coverage(checks, covariance, thermal, compensated, temperatures, temperature_u_c, options.mode,
+                              options.out_of_range)
     return figures, coverage
+
+
+def _consistency(checks: VectorPoses, compensated: np.ndarray, temperatures: np.ndarray, temperature_u_c: np.ndarray,
+                 thermal: ThermalModel, covariance: CoefficientCovariance, options: FitOptions) -> dict[str, Any]:
+    """The verification poses' axis errors against the reference, each against its combined expanded uncertainty:
+    the calibration's at the pose (the budget's sources) with the verification measurement's (the reading's noise,
+    the table's pointing across the reference, its size's uncertainty along it): the share with E_n ≤ 1 (the
+    gyroscope's likewise)."""
+    sources = output_uncertainty(checks.mean, temperatures, thermal, covariance, checks.stderr, temperature_u_c,
+                                 0.0, options.out_of_range)
+    pointing = np.radians(checks.reference_accuracy_arcsec / 3600)
+    size = np.linalg.norm(checks.reference, axis=1, keepdims=True)
+    reference_u = np.sqrt((pointing * np.sqrt(np.maximum(size**2 - checks.reference**2, 0.0))) ** 2
+                          + (checks.reference * checks.magnitude_u / checks.magnitude) ** 2)
+    return consistency(compensated - checks.reference, combined(sources), reference_u)
 
 
 def _metrics(poses: VectorPoses, setpoints: np.ndarray, groups: list[np.ndarray], temperatures: np.ndarray,

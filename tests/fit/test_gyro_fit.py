@@ -170,9 +170,10 @@ def test_the_noise_record_gives_each_axis_its_random_walk(fitted: tuple[Path, di
             assert 0 <= axis["low"] <= axis["value"] <= axis["high"] and axis["high"] > 0
         bounds.extend(max(a["value"], a["high"]) for a in allan["bias_instability_dph"])
     # A 20 s record reads the bias instability at a few seconds, where the 5 °/h flicker floor barely shows
-    # above the white noise: its upper ends lie about it, not orders away.
+    # above the white noise: its upper ends lie about it, not orders away (12 axes: their median scatters by
+    # a factor of two or so from one run's noise to another's).
     truth = campaign.header.truth[campaign.serials[0]]["gyro_bias_instability_dph"]
-    assert truth == 5.0 and 0.5 * truth < float(np.median(bounds)) < 3 * truth
+    assert truth == 5.0 and 0.5 * truth < float(np.median(bounds)) < 4 * truth
 
 
 @pytest.mark.parametrize(("changes", "key", "message"), [
@@ -252,6 +253,26 @@ def test_the_budget_covers_the_truth_as_its_coverage_factor_says(fitted: tuple[P
         assert budget["at_largest_rate"]["sources_dps"]["earth rate"] == [0.0, 0.0, 0.0]   # placed: taken out
 
 
+def test_each_verification_axis_error_is_checked_against_the_uncertainty_the_certificate_states(
+        fitted: tuple[Path, dict]) -> None:
+    """The check a lab can repeat: each verification record's axis error against its reference, over the
+    calibration's U (the budget's, at the record) combined with the verification measurement's (noise, the
+    mean's quantisation, the reference): E_n ≤ 1 for about 95 %. The certificate states it beside the budget, and
+    the dry run's truth check says which errors it counts."""
+    path, report = fitted
+    shares = []
+    for dut in report.values():
+        check = dut["channels"]["gyro"]["verification"]["consistency_k2"]
+        assert check["axis_errors"] == 3 * (24 + 12)   # 24 verification rate steps and 12 poses, 3 axes each
+        shares.append(check["within_share"])
+    assert 0.85 <= float(np.mean(shares)) <= 1.0
+    calibration = load_calibration(path)
+    serial = next(iter(report))
+    notes = GYRO_MODEL.sections(calibration.channel(serial, "gyro"))
+    text = " ".join(note for section in notes for note in section.notes)
+    assert "E_n ≤ 1 (ISO 13528)" in text and "their readings' noise taken out" in text
+
+
 def test_a_table_left_turning_is_brought_to_rest_before_anything_moves(tmp_path: Path) -> None:
     """A run that finds the rate axis turning (a safe state that could not reach the table, a controller
     left turning by hand) holds it first, and says so."""
@@ -275,3 +296,45 @@ def test_a_table_left_turning_is_brought_to_rest_before_anything_moves(tmp_path:
     warned = [e.message for e in campaign.events if e.kind == "preflight" and "turning at" in e.message]
     assert len(warned) == 1 and "brought to rest first" in warned[0]
     assert campaign.state == "done" and {"rate", "pose"} <= set(campaign.header.plan.kind)
+
+
+def test_the_joint_thermal_fit_follows_a_drift_the_per_band_fit_blurs() -> None:
+    """Records of a ramp: five bands whose records spread ±5 °C about the band's mean, from a truth whose bias
+    drifts 0.5 °/s over the range. The per-band fit takes each band at its mean temperature and misses the drift
+    within it; the joint fit (fit/gyro_joint.py) puts every record at its own temperature and recovers the truth
+    to its noise."""
+    from accelcal_rig.fit import gyro_model
+    from accelcal_rig.fit.gyro_fit import fit_gyro_setpoint
+    from accelcal_rig.fit.gyro_joint import fit_gyro_joint
+    from accelcal_rig.fit.thermal import fit_thermal
+    from accelcal_rig.sim.truth import gyro_truth_for_serial
+
+    truth = gyro_truth_for_serial("IMU-J001")
+    rng = np.random.default_rng(4)
+    rates = [s * r * np.eye(3)[a] for a in range(3) for r in (10.0, 100.0, 1000.0) for s in (1, -1)]
+    forces = [s * np.eye(3)[a] for a in range(3) for s in (1, -1)]
+    design_rate = np.array(rates + [np.zeros(3)] * 6)
+    design_force = np.array([np.array([0.0, 0.0, 1.0])] * 18 + forces)
+    noise_dps = 1e-4
+    temperature, rate, force, reading = [], [], [], []
+    estimates, band_means = [], []
+    for mean_c in (-40.0, -15.0, 10.0, 35.0, 60.0):
+        t = mean_c + np.linspace(-5.0, 5.0, len(design_rate))
+        read = gyro_model.distort_rate(design_rate, design_force, truth.parameters_at(t))
+        read = read + rng.normal(0.0, noise_dps, read.shape)
+        estimates.append(fit_gyro_setpoint(read, np.full_like(read, noise_dps), design_rate, design_force))
+        band_means.append(t.mean())
+        temperature.append(t), rate.append(design_rate), force.append(design_force), reading.append(read)
+    temperature_c, rate_dps, force_g, mean_dps = (np.concatenate(v) for v in (temperature, rate, force, reading))
+    start = fit_thermal(np.array(band_means), np.array([f.parameters for f in estimates]),
+                        np.array([f.sigma for f in estimates]), np.ones(gyro_model.N_PARAMETERS, dtype=bool), 3)
+    joint = fit_gyro_joint(start, temperature_c, mean_dps, np.full_like(mean_dps, noise_dps), rate_dps, force_g, 1e-5)
+    assert joint.domain_c == (temperature_c.min(), temperature_c.max())   # fitted where the records are
+    grid = np.linspace(-40.0, 60.0, 21)
+    bias = slice(0, 3)
+
+    def worst_bias_error(model) -> float:
+        return float(np.max(np.abs(model.parameters_at(grid, "extrapolate")[:, bias] - truth.parameters_at(grid)[:, bias])))
+
+    assert worst_bias_error(joint) < 2e-3                                # the truth's cubic, to its noise
+    assert worst_bias_error(joint) < 0.5 * worst_bias_error(start)       # the per-band fit blurs the drift

@@ -68,3 +68,17 @@ def test_temperature_and_gravity_terms_are_their_derivatives_times_their_uncerta
     np.testing.assert_allclose(sources["temperature"][0], [0, 0, 1e-3 * 0.02], atol=1e-12)
     np.testing.assert_allclose(sources["gravity"][0], [0, 0, 3e-5], rtol=1e-9)
     assert not sources["calibration_noise"].any() and not sources["thermal_model"].any()
+
+
+def test_the_consistency_check_finds_95_percent_within_an_uncertainty_that_covers_and_fewer_within_one_that_does_not() -> None:
+    """E_n = |error| / (k × √(u_cal² + u_meas²)): errors drawn with exactly the stated uncertainties fall within
+    about 95 % of the time (k = 2); halve what is stated and the share drops to about 68 %."""
+    from accelcal_rig.fit.uncertainty import consistency
+
+    rng = np.random.default_rng(8)
+    calibration_u, measurement_u = np.full((4000, 3), 0.003), np.full((4000, 3), 0.004)
+    errors = rng.normal(0.0, 0.005, (4000, 3))
+    covered = consistency(errors, calibration_u, measurement_u)
+    assert covered["axis_errors"] == 12000 and 0.945 < covered["within_share"] < 0.96
+    short = consistency(errors, calibration_u / 2, measurement_u / 2)
+    assert 0.66 < short["within_share"] < 0.70 and short["largest_e_n"] > 2.0

@@ -11,6 +11,7 @@ from accelcal_rig.plan.steps import (
     MeasurePose,
     Ramp,
     RampSegment,
+    RateStep,
     Soak,
     StartSoftwareRamp,
     VerifyPose,
@@ -74,6 +75,26 @@ def test_a_bidirectional_ramp_turns_at_the_last_setpoint_and_measures_half_way_b
     assert verified == ["T-40", "T60"]  # verify.on_ramp: false: at rest only, where the DUTs were soaked
     estimate = estimate_duration(prepared.procedure.model, prepared.rig.model, plan)
     assert [r.soak_outcome for r in estimate.setpoints].count("stable") == 2  # the start and the turn only
+
+
+def test_the_imu_fast_method_turns_rate_steps_in_every_band_and_records_noise_only_where_soaked() -> None:
+    """procedures/imu-fast.yaml: in each band each way, the ramp's setpoint written before every pose and every
+    rate step (24: four rates both ways about three axes); the still noise record and the verification rates
+    only where the DUTs were soaked (the start and the turn); `rig plan` times every step."""
+    prepared = prepare(REPO / "procedures" / "imu-fast.yaml")
+    plan = prepared.plan
+    stages = {stage.setpoint_c: stage for stage in plan.stages}
+    for setpoint in (50.0, -25.0):
+        body = stages[setpoint].body
+        steps = body[1::2]
+        assert all(isinstance(step, AdvanceRamp) for step in body[0::2])
+        assert [type(s) for s in steps[:12]] == [MeasurePose] * 12
+        assert [type(s) for s in steps[12:]].count(RateStep) == 24   # the table stopped between the axes
+    keys = [s.key for s in plan.records]
+    assert sorted({k.split("/")[0] for k in keys if "/noise" in k}) == ["T-40", "T60"]
+    assert sorted({k.split("/")[0] for k in keys if "/verify" in k}) == ["T-40", "T60"]
+    estimate = estimate_duration(prepared.procedure.model, prepared.rig.model, plan)
+    assert 3.0 < estimate.total_s / 3600 < 6.0   # sixteen IMUs in one cycle: the issue's ≤ 6 h of rig time
 
 
 def test_cooldown_plan_soaks_once_then_numbers_its_records_at_the_held_pose() -> None:
