@@ -566,8 +566,9 @@ def _verification(checks: VectorPoses, thermal: ThermalModel, options: FitOption
                   shift: np.ndarray | None = None) -> tuple[dict[str, Any], float | None]:
     """The figures on poses the fit never saw, compensated as `apply` would (the calibration's out-of-range
     rule), each at its own smoothed temperature, after taking off `shift` (N, 3) where given (a hysteresis
-    fit's terms at each check); and in a dry run the share of their axis errors against the truth inside the
-    expanded uncertainty."""
+    fit's terms at each check: then the uncertainty they are checked against has no hysteresis source, as they
+    have none left); and in a dry run the share of their axis errors against the truth inside the expanded
+    uncertainty."""
     groups = [np.flatnonzero(checks.setpoint_c == s) for s in dict.fromkeys(checks.setpoint_c.tolist())]
     temperatures = smoothed_temperatures(checks, groups)
     reading = checks.mean if shift is None else checks.mean - shift
@@ -577,6 +578,8 @@ def _verification(checks: VectorPoses, thermal: ThermalModel, options: FitOption
     figures = pose_figures(compensated, checks.reference, checks.stderr, checks.setpoint_c, temperatures,
                            options.mode == "norm-only", checks.magnitude, references, spec.milli, spec.angle)
     temperature_u_c = smoothed_temperature_u_c(checks.t_s, groups, scatter_c)
+    if shift is not None:  # each check's own state taken off: what is left of the hysteresis is not a source
+        covariance = replace(covariance, hysteresis=None)
     if options.mode == "reference":
         figures["consistency_k2"] = _consistency(checks, compensated, temperatures, temperature_u_c, thermal,
                                                  covariance, options)
