@@ -2,8 +2,9 @@
 pseudo-terminal: the bridge line protocol's register requests (`R`, `W`) in front of the part's register model,
 answered as the reference firmware answers them (sim/bridge_requests.py). The greeting is version 3 and names
 the part behind the bridge (`ADXL355-BRIDGE 3 part=… …`); `C`/`G` are refused: the host polls the data
-registers. The ICM-42688-P's and the LIS3MDL's simulators are this bridge in front of their register models;
-its pseudo-terminal plumbing (`BridgeOnPty`) is every simulated bridge's, the ADXL355's with its capture too."""
+registers. The LIS3MDL's simulator is this bridge in front of its register model; its pseudo-terminal plumbing
+(`BridgeOnPty`) and its greeting (`bridge_greeting`) are every simulated bridge's, the ADXL355's and the
+ICM-42688-P's with their captures too."""
 
 from __future__ import annotations
 
