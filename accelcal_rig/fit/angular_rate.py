@@ -255,8 +255,8 @@ class AngularRateModel:
         rows += (("combined standard uncertainty", *cells(rest["standard_dps"]), *cells(turning["standard_dps"])),
                  (f"expanded uncertainty (k = {budget['coverage_factor']:g}, about 95 %)",
                   *cells(rest["expanded_dps"]), *cells(turning["expanded_dps"])))
-        notes = consistency_notes(calibration.metrics, "records", "the calibration's errors at the verification "
-                                  "records, their readings' noise taken out")
+        notes = consistency_notes(calibration.metrics, "records", "the calibration's errors (the readings' noise "
+                                  "taken out)")
         return Section("Uncertainty of a compensated rate",
                        (f"For {budget['reading']}: each source's largest standard uncertainty over the calibrated range "
                         f"and gravity along ±x, ±y, ±z, at rest and at ±{rate} °/s (the largest calibrated rate) about "

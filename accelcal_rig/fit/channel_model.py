@@ -335,13 +335,10 @@ def consistency_notes(metrics: Mapping[str, Any], records: str, truth_errors: st
     notes = []
     check = (metrics.get("verification") or {}).get("consistency_k2")
     if check:
-        notes.append(f"Verification: {check['within_share'] * 100:.1f} % of the {check['axis_errors']} axis errors of the "
-                     f"verification {records} against their references lie within their combined expanded "
-                     "uncertainty, this calibration's (above, at each of them) with the verification measurement's "
-                     "(the reading's noise, the reference's uncertainty): E_n ≤ 1 (ISO 13528); about 95 % are "
-                     f"expected of an uncertainty that covers what it states (largest E_n {check['largest_e_n']:.2f}).")
+        notes.append(f"Verification: {check['within_share'] * 100:.1f} % of the {check['axis_errors']} axis errors of "
+                     f"the verification {records} lie within this U combined with their measurement's (noise, "
+                     "reference): E_n ≤ 1 (ISO 13528), about 95 % expected.")
     coverage = metrics.get("truth_coverage_k2")
     if coverage is not None:
-        notes.append(f"Dry run, against the simulation's hidden truth: {coverage * 100:.1f} % of {truth_errors}, lie "
-                     "within the expanded uncertainty that covers them.")
+        notes.append(f"Dry run: {coverage * 100:.1f} % of {truth_errors} against the simulation truth lie within U.")
     return tuple(notes)

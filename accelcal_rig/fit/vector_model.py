@@ -340,8 +340,8 @@ class Eq1Model:
         rows += (("combined standard uncertainty", *(f"{u * 1e3:.1f}" for u in budget_[f"standard_{m}"])),
                  (f"expanded uncertainty (k = {budget_['coverage_factor']:g}, about 95 %)",
                   *(f"{u * 1e3:.1f}" for u in budget_[f"expanded_{m}"])))
-        notes = consistency_notes(calibration.metrics, "poses", "the compensated verification readings' errors (their "
-                                  "noise in them as in the uncertainty)")
+        notes = consistency_notes(calibration.metrics, "poses", "the verification readings' errors (their noise in "
+                                  "them as in U)")
         return Section("Uncertainty of a compensated reading",
                        (f"For {budget_['reading']}: each source's largest standard uncertainty over every orientation "
                         "and the calibrated range, per axis (GUM, sources uncorrelated).",),

@@ -270,7 +270,7 @@ def test_each_verification_axis_error_is_checked_against_the_uncertainty_the_cer
     serial = next(iter(report))
     notes = GYRO_MODEL.sections(calibration.channel(serial, "gyro"))
     text = " ".join(note for section in notes for note in section.notes)
-    assert "E_n ≤ 1 (ISO 13528)" in text and "their readings' noise taken out" in text
+    assert "E_n ≤ 1 (ISO 13528)" in text and "the readings' noise taken out" in text
 
 
 def test_a_table_left_turning_is_brought_to_rest_before_anything_moves(tmp_path: Path) -> None:
