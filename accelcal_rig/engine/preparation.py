@@ -71,7 +71,7 @@ def prepare(procedure_path: Path, rig_override: Path | None = None, faults: str 
     try:
         plan = compile_plan(procedure.model, rig.model)
     except UnreachablePose as exc:
-        raise procedure.error(("schedule",), f"{exc} of {rig.path}") from None
+        raise procedure.error(("schedule",), f"{exc} (the turntable of {rig.path})") from None
     except CooldownPoseMissing as exc:
         raise procedure.error(("cooldown", "pose"), str(exc)) from None
     except VerificationSeenByFit as exc:

@@ -111,10 +111,25 @@ class TurntableKinematics:
                 best = final.x
                 break  # starts come nearest first: the first exact solution is the least-travel one
         if best is None:
-            raise UnreachablePose(
-                f"gravity direction {np.round(target, 4).tolist()} is out of reach of the turntable's axis limits"
-            )
+            raise UnreachablePose(f"gravity direction {np.round(target, 4).tolist()} is out of reach of the "
+                                  + (self._geometry_limit(target) or "turntable's axis limits"))
         return self.wrap(np.rad2deg(best))
+
+    def _geometry_limit(self, target: np.ndarray) -> str | None:
+        """Why no angles at all reach `target`, where the table's geometry (not its limits) is the reason: a table
+        whose only axes are a vertical one and one more turns gravity in the fixture frame only about that second
+        axis, keeping its angle to it; None where the geometry is not the reason this tells."""
+        if len(self.axes) != 2 or abs(abs(self._directions[0] @ np.array([0.0, 0.0, 1.0])) - 1.0) > 1e-9:
+            return None
+        inner = self._directions[1] / np.linalg.norm(self._directions[1])  # the same in the fixture frame
+        allowed_deg = float(np.degrees(np.arccos(np.clip(inner[2], -1.0, 1.0))))
+        off_deg = abs(float(np.degrees(np.arccos(np.clip(target @ inner, -1.0, 1.0)))) - allowed_deg)
+        if off_deg < 1e-3:
+            return None
+        return (f"turntable's geometry: its two axes ({self.axes[0].name} vertical, {self.axes[1].name} about "
+                f"{np.round(inner, 4).tolist()}) bring only fixture directions {allowed_deg:g}° from the "
+                f"{self.axes[1].name} axis to gravity; this one is {off_deg:.1f}° off that circle (a third axis would "
+                "reach it)")
 
     def _starts(self, near: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> list[np.ndarray]:
         """Nearest first: the current angles, then one axis turned by ±90° or 180°, then a coarse grid.

@@ -68,3 +68,18 @@ def test_limited_axis_makes_the_lower_hemisphere_unreachable() -> None:
 def test_wrap_keeps_continuous_axes_in_range_only() -> None:
     k = gimbal(middle_limits=(-90, 90))
     np.testing.assert_allclose(k.wrap(np.array([190.0, 80.0, -540.0])), [-170.0, 80.0, -180.0])
+
+
+def test_a_two_axis_table_says_what_its_geometry_reaches() -> None:
+    """A vertical axis and a horizontal one turn gravity in the fixture frame about the horizontal axis only:
+    the fixture directions 90° from it, a great circle. A direction off it is refused by the geometry, in one
+    line saying which circle and how far off; one on it is reached."""
+    axes = (TurntableAxis(name="outer", axis=(0, 0, 1), min_deg=-180, max_deg=180, continuous=True),
+            TurntableAxis(name="middle", axis=(1, 0, 0), min_deg=-180, max_deg=180, continuous=True))
+    kinematics = TurntableKinematics(axes)
+    angles = kinematics.solve(np.array([0.0, 0.6, 0.8]), np.zeros(2))
+    np.testing.assert_allclose(kinematics.gravity_in_fixture(angles), [0.0, 0.6, 0.8], atol=1e-9)
+    with pytest.raises(UnreachablePose, match=r"turntable's geometry: its two axes \(outer vertical, middle about "
+                                              r"\[1.0, 0.0, 0.0\]\) bring only fixture directions 90° from the middle "
+                                              r"axis to gravity; this one is 45.0° off that circle"):
+        kinematics.solve(np.array([1.0, 1.0, 0.0]) / np.sqrt(2), np.zeros(2))
