@@ -15,7 +15,6 @@ from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import PostedRequests, RegisterTransport
 from accelcal_rig.instruments.bridge_block import BridgeCapturing, Decoded
 from accelcal_rig.instruments.capabilities import Reconnecting
-from accelcal_rig.instruments.capture import OVERFLOW_ATTEMPTS, capture_together
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
 from accelcal_rig.instruments.retrying import RetryCall, RetryingTransport
 from accelcal_rig.parts.adxl35x import ADXL355
@@ -134,17 +133,6 @@ class Adxl355(BridgeCapturing):
             previous = raw
         raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {TEMPERATURE_READS} temperature reads in a "
                               "row, no two consecutive ones agreeing (TEMP2/TEMP1 tearing)")
-
-    def acquire(self, n_samples: int) -> SampleBlock:
-        """`n_samples` consecutive samples, captured by the bridge if it can, else drained from the FIFO."""
-        if 0 < n_samples <= self.capture_capacity_samples:
-            return capture_together([self], n_samples, self._clock)[0]
-        for _ in range(OVERFLOW_ATTEMPTS):
-            block = self._try_drain(n_samples)
-            if block is not None:
-                return block
-        raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): FIFO overflowed in {OVERFLOW_ATTEMPTS} "
-                              f"attempts: the link cannot keep up with {self._odr_hz:g} Hz")
 
     def close(self) -> None:
         self._bus.close()

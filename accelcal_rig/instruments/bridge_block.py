@@ -1,7 +1,9 @@
-"""A block captured by a serial bridge itself (`C`, then `G` by index until complete), for any register-level
-driver whose part has a FIFO the bridge drains (the ADXL355's, the ICM-42688-P's): the driver says how its part's
-FIFO bytes decode; starting, fetching, retrying a lost reply and timing the block are the same for every part.
-Several DUTs are started together and fetched in rounds by one thread (`instruments/capture.py`)."""
+"""A block from a part's FIFO, for any register-level driver whose part has one (the ADXL355's, the
+ICM-42688-P's): captured by the serial bridge itself (`C`, then `G` by index until complete) where the block fits
+its buffer, else read by the host, the driver's own way; a block that lost samples is taken again. The driver
+says how its part's FIFO bytes decode and how the host reads its FIFO; starting, fetching, retrying a lost reply,
+retaking a lossy block and timing the block are the same for every part. Several DUTs are started together and
+fetched in rounds by one thread (`instruments/capture.py`)."""
 
 from __future__ import annotations
 
@@ -14,6 +16,7 @@ import numpy as np
 from accelcal_rig.core.clock import Clock
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.adxl355_transport import BlockCapture, PostedRequests, RegisterTransport
+from accelcal_rig.instruments.capture import OVERFLOW_ATTEMPTS, capture_together
 from accelcal_rig.instruments.interfaces import SampleBlock
 from accelcal_rig.parts.part import Part
 
@@ -36,9 +39,10 @@ class _Capture:
 
 
 class BridgeCapturing:
-    """The `BlockCapturing` side of a driver: its subclass sets `part`, `serial`, `endpoint`, `_bus` (the retried
-    transport), `_poster` (the bare one where it posts requests), `_clock` and `_odr_hz`, and decodes its FIFO
-    bytes in `_decode_fifo`."""
+    """A driver's blocks from its part's FIFO and its `BlockCapturing` side: its subclass sets `part`, `serial`,
+    `endpoint`, `_bus` (the retried transport), `_poster` (the bare one where it posts requests), `_clock`,
+    `_odr_hz` and `fifo_loss` (how its part says a sample was lost), decodes its FIFO bytes in `_decode_fifo` and
+    reads a block itself in `_try_drain` (None: it lost samples)."""
 
     part: Part
     serial: str
@@ -47,6 +51,8 @@ class BridgeCapturing:
     _poster: PostedRequests | None
     _clock: Clock
     _odr_hz: float
+    #: What the part's FIFO says when it lost samples, as the fault after the last attempt names it.
+    fifo_loss = "FIFO overflowed"
     _capture: _Capture | None = None
     #: Clock time the last capture request was posted: when the bridge started it, however much later its reply
     #: is read (after another DUT's retries, say).
@@ -54,6 +60,21 @@ class BridgeCapturing:
 
     def _decode_fifo(self, raw: bytes, carried: bytes) -> Decoded:
         raise NotImplementedError
+
+    def _try_drain(self, n_samples: int) -> SampleBlock | None:
+        raise NotImplementedError
+
+    def acquire(self, n_samples: int) -> SampleBlock:
+        """`n_samples` consecutive samples, captured by the bridge where it can, else read from the FIFO by the
+        host; a block that lost samples is taken again, OVERFLOW_ATTEMPTS times at most, then is a fault."""
+        if 0 < n_samples <= self.capture_capacity_samples:
+            return capture_together([self], n_samples, self._clock)[0]
+        for _ in range(OVERFLOW_ATTEMPTS):
+            block = self._try_drain(n_samples)
+            if block is not None:
+                return block
+        raise InstrumentError(f"sensor {self.serial} ({self.endpoint}): {self.fifo_loss} in {OVERFLOW_ATTEMPTS} "
+                              f"attempts: the link cannot keep up with {self._odr_hz:g} Hz")
 
     @property
     def capture_capacity_samples(self) -> int:

@@ -17,7 +17,6 @@ from accelcal_rig.instruments import icm42688 as regs
 from accelcal_rig.instruments.adxl355_transport import PostedRequests, RegisterTransport
 from accelcal_rig.instruments.bridge_block import BridgeCapturing, Decoded
 from accelcal_rig.instruments.capabilities import Reconnecting
-from accelcal_rig.instruments.capture import OVERFLOW_ATTEMPTS, capture_together
 from accelcal_rig.instruments.interfaces import DeviceIdentity, SampleBlock
 from accelcal_rig.instruments.retrying import RetryCall, RetryingTransport
 from accelcal_rig.parts.icm42688 import ICM42688P
@@ -36,6 +35,8 @@ BURST_PACKETS = 18
 
 class Icm42688(BridgeCapturing):
     """The Sensor of an ICM-42688-P DUT: channels `accel` (g) and `gyro` (°/s), 16-bit codes."""
+
+    fifo_loss = "FIFO full"
 
     def __init__(self, transport: RegisterTransport, serial: str, clock: Clock, part: Part = ICM42688P) -> None:
         self.part = part
@@ -124,17 +125,6 @@ class Icm42688(BridgeCapturing):
             raise self._fault("TEMP_DATA holds no reading (is the part powered down?)")
         return float(self.part.temperature.celsius(raw))
 
-    def acquire(self, n_samples: int) -> SampleBlock:
-        """`n_samples` consecutive samples of both sensors from the FIFO: captured by the bridge where it can, else
-        read by the host; a block that lost a sample is taken again, OVERFLOW_ATTEMPTS times at most."""
-        if 0 < n_samples <= self.capture_capacity_samples:
-            return capture_together([self], n_samples, self._clock)[0]
-        for _ in range(OVERFLOW_ATTEMPTS):
-            block = self._try_drain(n_samples)
-            if block is not None:
-                return block
-        raise self._fault(f"FIFO full in {OVERFLOW_ATTEMPTS} attempts: the link cannot keep up with {self._odr_hz:g} Hz")
-
     def close(self) -> None:
         self._bus.close()
 
@@ -186,6 +176,8 @@ class Icm42688(BridgeCapturing):
         return self._block(pieces, n_samples, t_start, (temperature_before, self.read_temperature_c()))
 
     def _status_and_count(self) -> tuple[int, int]:
-        """INT_STATUS (read-to-clear) and FIFO_COUNT in bytes, in one burst from INT_STATUS: COUNTH read first."""
-        status, high, low = self._bus.read(regs.REG_INT_STATUS, 3)
+        """INT_STATUS (read-to-clear) and FIFO_COUNT in bytes, in one burst from INT_STATUS: COUNTH read first. On
+        the bare transport, never retried alone: a reply lost after the read cleared FIFO_FULL would hide a loss
+        from its retry (the block is then taken again whole)."""
+        status, high, low = self._bare.read(regs.REG_INT_STATUS, 3)
         return status, high << 8 | low

@@ -14,7 +14,7 @@ import numpy as np
 from accelcal_rig.config.rig import SensorConfig
 from accelcal_rig.instruments import adxl355
 from accelcal_rig.instruments.adxl355_transport import BRIDGE_GREETING
-from accelcal_rig.sim.bridge_capture import CaptureRequests, CaptureRules
+from accelcal_rig.sim.bridge_capture import CaptureBuffer, CaptureRequests, CaptureRules
 from accelcal_rig.sim.bridge_registers import RegisterMap, RegisterRequests
 from accelcal_rig.sim.bridge_requests import BridgeRequests
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
@@ -62,9 +62,7 @@ class SimulatedAdxl355:
         self._fifo_pending = 0  # the newest samples in the FIFO, made only when FIFO_DATA is read
         self._overflow = False
         self._next_sample_s: float | None = None
-        self._capture_left = 0
-        self._captured = bytearray()
-        self._capture_end_temperature_raw: int | None = None
+        self._capture = CaptureBuffer(9)
 
     @property
     def measuring(self) -> bool:
@@ -80,13 +78,13 @@ class SimulatedAdxl355:
     def capturing(self) -> bool:
         """Whether the bridge's capture still wants samples (as of now on the clock)."""
         self._fill_fifo()
-        return self._capture_left > 0
+        return self._capture.left > 0
 
     @property
     def captured_samples(self) -> int:
         """Samples in the bridge's capture buffer now."""
         self._fill_fifo()
-        return len(self._captured) // 9
+        return self._capture.samples
 
     @property
     def _odr_hz(self) -> float:
@@ -140,7 +138,7 @@ class SimulatedAdxl355:
             self._fifo.clear()  # standby resets the FIFO; measuring starts a fresh one
             self._fifo_pending = 0
             self._overflow = False
-            self._capture_left = 0
+            self._capture.stop()
             self._next_sample_s = self._lab.clock.now() if self.measuring else None
 
     def start_capture(self, n_samples: int) -> int:
@@ -152,21 +150,19 @@ class SimulatedAdxl355:
         self._fifo.clear()
         self._fifo_pending = 0
         self._overflow = False
-        self._capture_left, self._captured = n_samples, bytearray()
-        self._capture_end_temperature_raw = None
+        self._capture.start(n_samples)
         return self._temperature_raw()
 
     def stop_capture(self) -> None:
         """The bridge ends its capture early (a write changed the stream): samples go to the FIFO again."""
         self._fill_fifo()
-        self._capture_left = 0
+        self._capture.stop()
 
     def fetch_capture(self, first: int) -> tuple[bytes, int | None]:
         """(the capture's samples from index `first` on, raw temperature at its end once it is complete).
         The capture stays until the next one starts, so a reply lost on the line can be asked for again."""
         self._fill_fifo()
-        taken = bytes(self._captured[9 * first:])
-        return taken, self._capture_end_temperature_raw if self._capture_left == 0 else None
+        return self._capture.fetch(first)
 
     def _fill_fifo(self) -> None:
         """Add the samples due since the last look: first to a capture under way, then to the FIFO, which
@@ -175,8 +171,8 @@ class SimulatedAdxl355:
             return
         now = self._lab.clock.now()
         due = math.floor((now - self._next_sample_s) * self._odr_hz + 1e-9)
-        if due > 0 and self._capture_left > 0:
-            due -= self._capture(min(due, self._capture_left))
+        if due > 0 and self._capture.left > 0:
+            due -= self._capture_next(min(due, self._capture.left))
         if due <= 0:
             return
         excess = self._samples_in_fifo() + due - _SAMPLES_IN_FIFO
@@ -208,13 +204,10 @@ class SimulatedAdxl355:
             self._fifo += adxl355.encode_fifo(self._samples(t_first, self._fifo_pending))
             self._fifo_pending = 0
 
-    def _capture(self, count: int) -> int:
+    def _capture_next(self, count: int) -> int:
         """Move the next `count` samples into the capture buffer; returns how many samples were due."""
         assert self._next_sample_s is not None
-        self._capture_left -= count
-        self._captured += adxl355.encode_fifo(self._samples(self._next_sample_s, count))
-        if self._capture_left == 0:
-            self._capture_end_temperature_raw = self._temperature_raw()
+        self._capture.take(adxl355.encode_fifo(self._samples(self._next_sample_s, count)), count, self._temperature_raw)
         self._next_sample_s += count / self._odr_hz
         return count
 

@@ -24,6 +24,40 @@ class CaptureRules:
     not_ready: Callable[[], str | None]
 
 
+class CaptureBuffer:
+    """A simulated bridge's capture buffer for one part: how many samples it still wants, the samples as the part's
+    FIFO gives them (`sample_bytes` each), and the part's temperature code as the last one came. It stays until
+    the next capture starts, so a reply lost on the line can be fetched again."""
+
+    def __init__(self, sample_bytes: int) -> None:
+        self._sample_bytes = sample_bytes
+        self.left = 0
+        self._data = bytearray()
+        self._end_temperature: int | None = None
+
+    def start(self, n_samples: int) -> None:
+        self.left, self._data, self._end_temperature = n_samples, bytearray(), None
+
+    def stop(self) -> None:
+        """Ended early (a write changed the stream): it wants no more samples."""
+        self.left = 0
+
+    @property
+    def samples(self) -> int:
+        return len(self._data) // self._sample_bytes
+
+    def take(self, raw: bytes, count: int, temperature: Callable[[], int]) -> None:
+        """`count` samples' bytes in; the temperature read as the last one wanted comes."""
+        self.left -= count
+        self._data += raw
+        if self.left == 0:
+            self._end_temperature = temperature()
+
+    def fetch(self, first: int) -> tuple[bytes, int | None]:
+        """(the samples from index `first` on, the end temperature once complete)."""
+        return bytes(self._data[self._sample_bytes * first:]), self._end_temperature if self.left == 0 else None
+
+
 class CapturingPart(Protocol):
     """A simulated part whose FIFO the bridge drains into its own buffer (SimulatedAdxl355, SimulatedIcm42688)."""
 

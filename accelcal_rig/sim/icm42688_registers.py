@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from accelcal_rig.instruments import icm42688 as regs
+from accelcal_rig.sim.bridge_capture import CaptureBuffer
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.sample_ticks import SampleTicks
 
@@ -70,9 +71,7 @@ class SimulatedIcm42688:
         self._data_due = False
         self._fifo = bytearray()
         self._fifo_pending: list[tuple[float, int]] = []  # (first sample's time, count) runs not yet made
-        self._capture_left = 0
-        self._captured = bytearray()
-        self._capture_end_temperature_raw: int | None = None
+        self._capture = CaptureBuffer(regs.PACKET_BYTES)
 
     # ------------------------------------------------------------------ what the bridge asks of its part
     @property
@@ -94,32 +93,30 @@ class SimulatedIcm42688:
     @property
     def capturing(self) -> bool:
         self._advance()
-        return self._capture_left > 0
+        return self._capture.left > 0
 
     @property
     def captured_samples(self) -> int:
         self._advance()
-        return len(self._captured) // regs.PACKET_BYTES
+        return self._capture.samples
 
     def start_capture(self, n_samples: int) -> int:
         """The bridge flushes the FIFO and captures the next `n_samples` packets itself; returns TEMP_DATA as it
         starts. The bridge has checked the part measures with the FIFO in packets (sim/bridge_capture.py)."""
         self._advance()
         self._flush()
-        self._capture_left, self._captured = n_samples, bytearray()
-        self._capture_end_temperature_raw = None
+        self._capture.start(n_samples)
         return self._temperature_raw()
 
     def stop_capture(self) -> None:
         """The bridge ends its capture early (a write changed the stream): samples go to the FIFO again."""
         self._advance()
-        self._capture_left = 0
+        self._capture.stop()
 
     def fetch_capture(self, first: int) -> tuple[bytes, int | None]:
         """(the captured packets from index `first` on, TEMP_DATA at the end once complete)."""
         self._advance()
-        taken = bytes(self._captured[regs.PACKET_BYTES * first:])
-        return taken, self._capture_end_temperature_raw if self._capture_left == 0 else None
+        return self._capture.fetch(first)
 
     # ------------------------------------------------------------------ registers
     def read(self, address: int, count: int) -> bytes:
@@ -168,7 +165,7 @@ class SimulatedIcm42688:
             else:
                 self._ticks.stop()
             self._sample, self._newest_s = self._invalid(), None
-            self._capture_left = 0
+            self._capture.stop()
         elif address in (regs.REG_GYRO_CONFIG0, regs.REG_ACCEL_CONFIG0):
             self._ticks.restart(self._lab.clock.now())
 
@@ -201,9 +198,9 @@ class SimulatedIcm42688:
         self._data_due = True
         self._regs[regs.REG_INT_STATUS] |= regs.INT_STATUS_DATA_RDY
         first_s = self._newest_s - (came - 1) / odr
-        if self._capture_left > 0:
-            taken = min(came, self._capture_left)
-            self._capture(first_s, taken, odr)
+        if self._capture.left > 0:
+            taken = min(came, self._capture.left)
+            self._capture.take(self._packets(first_s, taken, odr), taken, self._temperature_raw)
             first_s, came = first_s + taken / odr, came - taken
         if came > 0 and self.fifo_packets:
             self._to_fifo(first_s, came, odr)
@@ -249,12 +246,6 @@ class SimulatedIcm42688:
     def _flush(self) -> None:
         self._fifo.clear()
         self._fifo_pending.clear()
-
-    def _capture(self, first_s: float, count: int, odr: float) -> None:
-        self._capture_left -= count
-        self._captured += self._packets(first_s, count, odr)
-        if self._capture_left == 0:
-            self._capture_end_temperature_raw = self._temperature_raw()
 
     def _packets(self, first_s: float, count: int, odr: float) -> bytes:
         """`count` FIFO packets of both sensors from `first_s` on, from the lab's truth now."""
