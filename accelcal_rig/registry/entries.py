@@ -21,7 +21,7 @@ from accelcal_rig.fit.calibration import (
 )
 from accelcal_rig.fit.channel_models import model_of
 from accelcal_rig.fit.parameter_uncertainty import reference_c
-from accelcal_rig.store.content import measurements_sha256
+from accelcal_rig.store.content import Campaign, measurements_sha256
 from accelcal_rig.store.read import load_campaign
 
 #: Campaign states whose fit is final: a running campaign's file is still being written.
@@ -58,7 +58,7 @@ def campaign_entries(campaign_path: Path, calibration_path: Path | None = None) 
     source = {"kind": "campaign", "path": str(campaign_path.resolve()), "sha256": file_sha256(campaign_path),
               "procedure": str(campaign.attrs.get("procedure_name", "")), "rig": str(campaign.attrs.get("rig_name", "")),
               "simulated": bool(campaign.attrs.get("dry_run", False)),
-              "measured": campaign.finished or campaign.header.created}
+              "measured": measured_at(campaign)}
     return [{**_entry(calibration, channel, calibrated, parts.get(serial, "unknown"), source), "lot": lots.get(serial)}
             for serial, channel, calibrated in calibration.calibrated()]
 
@@ -95,6 +95,14 @@ def _entry(calibration: CalibrationFile, channel: str, sensor: ChannelCalibratio
                      "value": list(f.values), "expanded_u": None if f.expanded is None else list(f.expanded),
                      "trend": f.trend, "lot": f.lot} for f in model_of(sensor).stored_figures(sensor)],
     }
+
+
+def measured_at(campaign: Campaign) -> str:
+    """When the campaign's measurements ended: where the run went on to fit them (the journal's transition into
+    the fit stage), that moment, since the campaign is only marked finished after its fit; else its end."""
+    into_fit = [e.wall_time for e in campaign.events
+                if e.kind == "transition" and e.message.split(" (")[0].endswith("→ fit")]
+    return (into_fit[-1] if into_fit else "") or campaign.finished or campaign.header.created
 
 
 def _utc(timestamp: str) -> datetime:

@@ -250,7 +250,10 @@ int pty_hal_poll(struct pollfd *fds, nfds_t count, int timeout_ms)
 
 void bridge_hal_uart_write(const uint8_t *bytes, size_t len)
 {
-    const uint32_t client = bridge_hal_uart_session();
+    /* The session as the caller last saw it, not a fresh look: a client's going noticed here would flush the
+     * port and then send these bytes, the rest of its reply, to whoever opens it next. What is written before
+     * the next look is dropped by that look's flush. */
+    const uint32_t client = session;
 
     while (len > 0) {
         const ssize_t sent = write(master, bytes, len);

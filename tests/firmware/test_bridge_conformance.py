@@ -104,10 +104,13 @@ class RawClient:
         line, _, self._held = self._held.partition(b"\n")
         return line
 
-    def some(self) -> bytes:
-        """What one read brings (waiting for it), besides what is held: the start of a long reply, not all of it."""
-        got = read_within(self._fd, time.monotonic() + REPLY_DEADLINE_S)
-        some, self._held = self._held + (got or b""), b""
+    def some(self, most: int = 256) -> bytes:
+        """The first `most` bytes that arrive (waiting for them), besides what is held: the start of a long reply,
+        never all of it. (One unbounded read can take a whole 36 kB reply: a tty read goes on while its writer
+        keeps up.)"""
+        if not self._held and select.select([self._fd], [], [], REPLY_DEADLINE_S)[0]:
+            self._held = os.read(self._fd, most)
+        some, self._held = self._held, b""
         return some
 
     def pending(self, wait_s: float) -> bytes:
