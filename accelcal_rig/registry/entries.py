@@ -1,6 +1,6 @@
 """A registry entry per DUT of a finished fit: who (serial, part), what (the fit, its validity, verdict and
 figures), from what (the source file and its SHA-256, procedure, rig, software) and when: `calibrated_at`
-is when the sensor was measured (the campaign's end, a recording's time), `fitted_at` when the fit was made
+is when the sensor was measured (the end of the campaign's measurements, a recording's time), `fitted_at` when the fit was made
 (a refit of an old campaign is not a newer calibration)."""
 
 from __future__ import annotations
