@@ -69,17 +69,25 @@ def recording_lines(report: dict[str, Any], source: str, *, threshold_factor: fl
 
 
 def gyro_lines(gyro: dict[str, Any]) -> list[str]:
-    """The hand-held gyro fit (`HandheldGyroFit.report()`): bias and K with their 1σ, how the moves close."""
+    """The hand-held gyro fit (`HandheldGyroFit.report()`): bias, K and G with their 1σ, how the moves close;
+    what the recording did not determine said so."""
     def row(values: list[float], sigmas: list[float], fmt: str) -> str:
         return "  ".join(f"{v:{fmt}} ± {s:.2g}" for v, s in zip(values, sigmas))
 
-    lines = [f"gyro: {gyro['segments']} moves between static intervals, gravity misclosure RMS "
-             f"{gyro['residual_rms_before_deg']:.3f}° (K = I, bias from the still) → {gyro['residual_rms_after_deg']:.4f}°; "
-             f"rank {gyro['rank']} of 12, condition {gyro['condition']:.3g}",
-             f"  bias °/s   {row(gyro['bias_dps'], gyro['bias_sigma_dps'], '+.5f')}",
-             f"  scale      {row(gyro['scale'], gyro['scale_sigma'], '.5f')}"]
-    lines += [f"  K {'xyz'[i]}        {row(r, s, '+.5f')}" for i, (r, s) in enumerate(zip(gyro["matrix"],
-                                                                                            gyro["matrix_sigma"]))]
+    if gyro["k_determined"]:
+        lines = [f"gyro: {gyro['segments']} moves between static intervals, gravity misclosure RMS "
+                 f"{gyro['residual_rms_before_deg']:.3f}° (K = I, bias from the still) → "
+                 f"{gyro['residual_rms_after_deg']:.4f}°; rank {gyro['rank']}, condition {gyro['condition']:.3g}"]
+    else:
+        lines = ["gyro: bias from the static intervals; K not determined (nominal sensitivity kept): see the first note"]
+    lines.append(f"  bias °/s   {row(gyro['bias_dps'], gyro['bias_sigma_dps'], '+.5f')}")
+    if gyro["k_determined"]:
+        lines.append(f"  scale      {row(gyro['scale'], gyro['scale_sigma'], '.5f')}")
+        lines += [f"  K {'xyz'[i]}        {row(r, s, '+.5f')}" for i, (r, s) in enumerate(zip(gyro["matrix"],
+                                                                                                gyro["matrix_sigma"]))]
+    if gyro["gsens_fitted"]:
+        lines += [f"  G {'xyz'[i]} °/s/g  {row(r, s, '+.5f')}" for i, (r, s) in enumerate(zip(gyro["gsens_dps_per_g"],
+                                                                                                 gyro["gsens_sigma"]))]
     lines += [f"  note: {note}" for note in gyro["notes"]]
     return lines
 

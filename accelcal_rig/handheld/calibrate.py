@@ -1,7 +1,7 @@
 """A norm-only calibration from the static intervals of a recording, written as the same calibration
 file as `rig fit` (one temperature: every parameter a constant); and, when the recording has gyro columns,
-the gyroscope's bias and K from the moves between those intervals (handheld.gyro: in the report, not yet in
-the calibration file)."""
+the gyroscope's bias and g-sensitivity from those intervals and K from the moves between them (handheld.gyro),
+as the file's gyro channel."""
 
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ from accelcal_rig.fit.lm import DegenerateDesign, FreeParameters, SfemFit
 from accelcal_rig.fit.metrics import noise_floor_mg, norm_rmse_mg
 from accelcal_rig.fit.robust import fit_norm_only_with_floor
 from accelcal_rig.fit.sfem import correct
-from accelcal_rig.handheld.gyro import HandheldGyroFit, fit_handheld_gyro
+from accelcal_rig.handheld.gyro import GSENS_ALPHA, HandheldGyroFit, fit_handheld_gyro
 from accelcal_rig.handheld.recording import Recording, RecordingUnusable
 from accelcal_rig.handheld.static_intervals import Detection
 from accelcal_rig.store.records import utc_now
@@ -67,27 +67,41 @@ def missing_orientations(mean_g: np.ndarray) -> list[str]:
 ACCEL_CHANNEL, GYRO_CHANNEL = "accel", "gyro"
 #: Eq. 1's parameters as the accelerometer's model names them.
 PARAMETER_NAMES = acceleration.MODEL.parameter_names
-#: A hand-held recording determines the gyroscope's bias and K; the rest of the model holds its nominal value.
-HANDHELD_GYRO_PARAMETERS = tuple(gyro_model.PARAMETER_NAMES[i] for i in range(gyro_model.CROSS.stop))
+#: What a hand-held recording can determine of the gyroscope: its bias, K (from the moves) and G (from the still
+#: intervals, where they ask for it); the rest of the model holds its nominal value.
+HANDHELD_BIAS = tuple(gyro_model.PARAMETER_NAMES[gyro_model.BIAS])
+HANDHELD_K = tuple(gyro_model.PARAMETER_NAMES[gyro_model.SCALE.start:gyro_model.CROSS.stop])
+HANDHELD_GSENS = tuple(gyro_model.PARAMETER_NAMES[gyro_model.GSENS])
 
 
 def gyro_calibration(gyro: HandheldGyroFit, recording: Recording, serial: str, temperature_c: float,
                      validity_c: tuple[float, float]) -> ChannelCalibration:
-    """The hand-held gyroscope fit as the calibration file's `gyro` channel: bias and K constant over the
-    recording's temperature, every other term of the rate-table model at its nominal value (not determined)."""
+    """The hand-held gyroscope fit as the calibration file's `gyro` channel: what the recording determined (the
+    bias; K where the moves determined it; G where the still intervals asked for it) constant over its
+    temperature, every other term of the rate-table model at its nominal value and said to be."""
     parameters = gyro_model.IDENTITY_PARAMETERS.copy()
     sigma = np.full(gyro_model.N_PARAMETERS, np.nan)
     parameters[gyro_model.BIAS], sigma[gyro_model.BIAS] = gyro.bias_dps, gyro.bias_sigma_dps
-    parameters[gyro_model.SCALE], sigma[gyro_model.SCALE] = np.diag(gyro.matrix), np.diag(gyro.matrix_sigma)
-    for column, (i, j) in enumerate(gyro_model.CROSS_TERMS):
-        parameters[gyro_model.CROSS.start + column] = gyro.matrix[i, j]
-        sigma[gyro_model.CROSS.start + column] = gyro.matrix_sigma[i, j]
+    free = list(HANDHELD_BIAS)
+    if gyro.k_determined:
+        parameters[gyro_model.SCALE], sigma[gyro_model.SCALE] = np.diag(gyro.matrix), np.diag(gyro.matrix_sigma)
+        for column, (i, j) in enumerate(gyro_model.CROSS_TERMS):
+            parameters[gyro_model.CROSS.start + column] = gyro.matrix[i, j]
+            sigma[gyro_model.CROSS.start + column] = gyro.matrix_sigma[i, j]
+        free += HANDHELD_K
+    if gyro.gsens_fitted:
+        parameters[gyro_model.GSENS], sigma[gyro_model.GSENS] = gyro.gsens_dps_per_g.ravel(), gyro.gsens_sigma.ravel()
+        free += HANDHELD_GSENS
     names = gyro_model.PARAMETER_NAMES
     assert recording.gyro_dps is not None
     model = angular_rate.MODEL
+    held = ["asymmetry", "nonlinearity"] + ([] if gyro.gsens_fitted else ["g-sensitivity"])
+    k_said = ("the turns between still intervals define K relative to the gravity directions it measures"
+              if gyro.k_determined else "K is not determined by this recording (its moves say nothing of it): the "
+              "nominal sensitivity stands (scale 1, no cross-axis terms)")
     return ChannelCalibration(
         model=model.model_id, quantity=model.quantity, unit="dps", serial=serial, mode="hand-held",
-        free_parameters=list(HANDHELD_GYRO_PARAMETERS),
+        free_parameters=free,
         range=max(250.0, float(np.ceil(np.abs(recording.gyro_dps).max()))), lsb=recording.gyro_lsb_dps or 1.0,
         validity_c=validity_c, out_of_range="clamp",
         polynomial=PolynomialModel(domain_c=validity_c, degree=0,
@@ -97,13 +111,21 @@ def gyro_calibration(gyro: HandheldGyroFit, recording: Recording, serial: str, t
                                sigma=dict(zip(names, plain(sigma))))],
         statements={
             "earth_rate": "not taken out: a hand-held recording leaves the Earth's rate (up to 0.0042 °/s) in the bias",
-            "gauge": "the accelerometer's calibrated frame (its norm-only gauge): the turns between still intervals "
-                     "define K relative to the gravity directions it measures; asymmetry, nonlinearity and "
-                     "g-sensitivity are not determined (held at zero)"},
-        metrics=plain({"residual_rms_before_deg": float(np.sqrt(np.mean(gyro.residual_before_deg ** 2))),
-                       "residual_rms_after_deg": float(np.sqrt(np.mean(gyro.residual_after_deg ** 2))),
-                       "segments": gyro.segments, "rank": gyro.rank, "condition": gyro.condition}),
+            "gauge": f"the accelerometer's calibrated frame (its norm-only gauge): {k_said}; "
+                     f"{', '.join(held)} not determined (held at zero)",
+            "g_sensitivity": ("fitted to the still intervals' means against the compensated accelerometer"
+                              if gyro.gsens_fitted else "not fitted") + (
+                f" (F-test p = {gyro.gsens_p_value:.2g}, fitted below {GSENS_ALPHA:g})" if gyro.gsens_p_value is not None
+                else " (the intervals' forces cannot separate it from the bias)")},
+        metrics=plain({"residual_rms_before_deg": _rms_or_none(gyro.residual_before_deg),
+                       "residual_rms_after_deg": _rms_or_none(gyro.residual_after_deg),
+                       "segments": gyro.segments, "rank": gyro.rank, "condition": gyro.condition,
+                       "k_determined": gyro.k_determined, "gsens_fitted": gyro.gsens_fitted}),
         warnings=list(gyro.notes))
+
+
+def _rms_or_none(values: np.ndarray) -> float | None:
+    return float(np.sqrt(np.mean(values ** 2))) if len(values) else None
 
 
 def _refuse_implausible(recording: Recording, intervals: int, chi2_reduced: float | None) -> None:
@@ -170,7 +192,8 @@ def fit_recording(recording: Recording, detection: Detection, free: FreeParamete
         low, high = temperature - 0.5, temperature + 0.5  # one temperature: valid within ±0.5 °C of it
     compensated = correct(mean, fit.parameters)
     # The gyro after the accelerometer: its moves are judged against the compensated gravity directions.
-    gyro = (fit_handheld_gyro(recording, intervals, compensated, detection.rate_hz)
+    gyro = (fit_handheld_gyro(recording, intervals, compensated, detection.rate_hz,
+                              correct(recording.accel_g, fit.parameters))
             if recording.gyro_dps is not None else None)
     metrics = {
         "rmse_before_mg": norm_rmse_mg(mean, gravity_g), "rmse_after_mg": norm_rmse_mg(compensated, gravity_g),

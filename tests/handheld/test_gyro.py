@@ -18,7 +18,7 @@ from accelcal_rig.fit.calibration import apply, load_calibration
 from accelcal_rig.fit.sfem import distort, norm_only_gauge
 from accelcal_rig.handheld.calibrate import fit_recording
 from accelcal_rig.handheld.gyro import EARTH_RATE_DPS, fit_handheld_gyro, still_gyro_bias
-from accelcal_rig.handheld.recording import CsvLayout, RecordingUnusable, read_csv_recording
+from accelcal_rig.handheld.recording import CsvLayout, read_csv_recording
 from accelcal_rig.handheld.static_intervals import DetectorSettings, detect_static_intervals
 from accelcal_rig.sim.truth import truth_for_serial
 from tests.conftest import REPO
@@ -52,12 +52,13 @@ def _attitude(up_in_sensor: np.ndarray, heading_deg: float) -> Rotation:
 
 
 def gyro_session(rng: np.random.Generator, *, poses: int = 16, rate_hz: float = 200.0, about_gravity_only: bool = False,
-                 still_gyro: bool = False, gyro_noise_dps: float = 0.05, accel_noise_g: float = 2e-4) -> GyroSession:
+                 still_gyro: bool = False, gyro_noise_dps: float = 0.05, accel_noise_g: float = 2e-4,
+                 gsens_dps_per_g: np.ndarray | None = None) -> GyroSession:
     """Still poses joined by smooth (minimum-jerk) turns along the shortest rotation between them: every face
     up and down, tilted as a hand puts it, then random ones, each at a random heading, so the turns are about
     many axes, few about the vertical. `about_gravity_only`: one face up throughout, only the heading changes
     (every turn about the vertical). `still_gyro`: the gyro columns read bias and noise only, as if spliced from
-    another recording."""
+    another recording. `gsens_dps_per_g`: the gyro also reads G·f, f the specific force (g)."""
     faces = np.array([[0, 0, 1], [1, 0, 0], [0, -1, 0], [0, 0, -1], [-1, 0, 0], [0, 1, 0]], dtype=float)
     if about_gravity_only:
         ups = np.tile([0.2, -0.1, 1.0], (poses, 1))
@@ -87,6 +88,8 @@ def gyro_session(rng: np.random.Generator, *, poses: int = 16, rate_hz: float = 
         rate_dps = np.zeros_like(rate_dps)
     accel = distort(force_g, accel_truth) + rng.normal(0.0, accel_noise_g, force_g.shape)
     gyro = rate_dps @ TRUE_MATRIX.T + TRUE_BIAS_DPS + rng.normal(0.0, gyro_noise_dps, rate_dps.shape)
+    if gsens_dps_per_g is not None:
+        gyro = gyro + force_g @ np.asarray(gsens_dps_per_g).T
     return GyroSession(np.arange(len(force_g)) / rate_hz, accel, gyro, accel_truth)
 
 
@@ -157,31 +160,92 @@ def test_the_command_reports_the_gyro_and_keeps_the_calibration_file(tmp_path: P
     assert "gyro: 15 moves between static intervals" in out and "Earth's rate" in out
 
 
-def test_gyro_columns_without_rotations_are_refused_in_one_line(tmp_path: Path, capsys) -> None:
+def test_gyro_columns_without_rotations_give_the_bias_alone(tmp_path: Path, capsys) -> None:
+    """The gyro reads bias and noise while gravity turns (a splice, or another sensor's gyro): the moves cannot
+    say anything of K, so the gyro channel holds what the still intervals determine, its bias, with K nominal
+    and the reason in its warnings; the registry records it."""
     path = gyro_session(np.random.default_rng(25), still_gyro=True).write(tmp_path / "still.csv")
     argv = ["fit-recording", str(path), "--columns", COLUMNS, "--gyro-columns", GYRO_COLUMNS,
-            "-o", str(tmp_path / "cal.yaml")]
-    assert main(argv) == 2
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and str(path) in err, err
-    assert "no rotation between static intervals" in err and "leave out --gyro-columns" in err
-    assert not (tmp_path / "cal.yaml").exists()
+            "-o", str(tmp_path / "cal.yaml"), "--registry", str(tmp_path / "r.sqlite")]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "K not determined" in out and "no rotation between static intervals" in out
+    gyro = load_calibration(tmp_path / "cal.yaml").channel("still", "gyro")
+    assert gyro.free_parameters == ["bias_x_dps", "bias_y_dps", "bias_z_dps"]
+    assert "K is not determined" in gyro.statements["gauge"] and gyro.metrics["k_determined"] is False
+    assert any("spliced" in w for w in gyro.warnings)
+    bias = np.array([gyro.setpoints[0].parameters[f"bias_{a}_dps"] for a in "xyz"])
+    sigma = np.array([gyro.setpoints[0].sigma[f"bias_{a}_dps"] for a in "xyz"])
+    assert np.all(np.abs(bias - TRUE_BIAS_DPS) < 3 * sigma), (bias, sigma)
+    assert main(["registry", "list", "--registry", str(tmp_path / "r.sqlite"), "--json"]) == 0
+    channels = sorted(row["channel"] for row in json.loads(capsys.readouterr().out))
+    assert channels == ["accel", "gyro"]
 
 
 def test_turns_only_about_gravity_leave_the_matrix_undetermined(tmp_path: Path) -> None:
     """Every move changes the heading only: the gravity directions never change, so nothing tells K's
-    scale along the vertical, nor anything about the other axes, which never turn."""
+    scale along the vertical, nor anything about the other axes, which never turn: K is not fitted, and the
+    note names the terms."""
     path = gyro_session(np.random.default_rng(26), about_gravity_only=True).write(tmp_path / "yaw.csv")
     recording = read_csv_recording(path, CsvLayout.parse_columns(COLUMNS, gyro=GYRO_COLUMNS))
     detection = detect_static_intervals(recording.t_s, recording.accel_g, None, DetectorSettings(), recording.source)
     assert len(detection.intervals) == 16  # the moves are seen (the hand pushes), so the intervals are found
     gravity = np.array([i.mean_g for i in detection.intervals])
-    with pytest.raises(RecordingUnusable) as refused:
-        fit_handheld_gyro(recording, detection.intervals, gravity)
-    message = str(refused.value)
-    assert "\n" not in message and message.startswith(f"{path}: the 15 moves between static intervals do not "
-                                                      "determine the gyro's ")
+    fit = fit_handheld_gyro(recording, detection.intervals, gravity)
+    assert not fit.k_determined and np.array_equal(fit.matrix, np.eye(3)) and np.all(np.isnan(fit.matrix_sigma))
+    message = fit.notes[0]
+    assert "\n" not in message and "the 15 moves between static intervals do not determine the gyro's " in message
     assert "K_zz" in message and "turns about gravity" in message
+    # One face up throughout: the forces do not spread, so G cannot be told from the bias.
+    assert not fit.gsens_fitted and fit.gsens_p_value is None
+
+
+#: A g-sensitivity of a few hundredths of °/s per g, as MEMS gyros have (row: gyro axis, column: force axis).
+TRUE_GSENS = np.array([[0.030, -0.012, 0.008],
+                       [0.015, -0.025, 0.010],
+                       [-0.006, 0.020, 0.040]])
+
+
+@pytest.mark.parametrize("seed", [31, 32])
+def test_g_sensitivity_is_fitted_where_the_still_intervals_ask_for_it(tmp_path: Path, seed: int) -> None:
+    """The same session with and without G: with it, the F-test asks for G and the fit finds it within 3σ (bias
+    and K still within theirs); without it, G is not fitted. The calibration file holds G only when fitted."""
+    with_g = gyro_session(np.random.default_rng(seed), gsens_dps_per_g=TRUE_GSENS).write(tmp_path / "g.csv")
+    _, _, result = calibrate(with_g)
+    gyro = result.gyro
+    assert gyro is not None and gyro.k_determined and gyro.gsens_fitted
+    assert gyro.gsens_p_value is not None and gyro.gsens_p_value < 1e-3
+    z_gsens = (gyro.gsens_dps_per_g - TRUE_GSENS) / gyro.gsens_sigma
+    assert np.all(np.abs(z_gsens) < 3.0), z_gsens
+    assert np.all(np.abs((gyro.bias_dps - TRUE_BIAS_DPS) / gyro.bias_sigma_dps) < 3.0)
+    assert np.all(np.abs((gyro.matrix - TRUE_MATRIX) / gyro.matrix_sigma) < 3.0)
+    channel = result.calibration.channel("IMU-1", "gyro")
+    assert "gsens_zz_dps_per_g" in channel.free_parameters and "fitted" in channel.statements["g_sensitivity"]
+    raw = TRUE_MATRIX @ [10.0, -20.0, 30.0] + TRUE_BIAS_DPS + TRUE_GSENS @ [0.0, 0.0, 1.0]
+    np.testing.assert_allclose(apply(channel, raw[None, :], 25.0, {"acceleration": np.array([[0.0, 0.0, 1.0]])})[0],
+                               [10.0, -20.0, 30.0], atol=0.02)
+
+    without = gyro_session(np.random.default_rng(seed)).write(tmp_path / "none.csv")
+    _, _, result = calibrate(without)
+    assert result.gyro is not None and not result.gyro.gsens_fitted
+    assert result.gyro.gsens_p_value is not None and result.gyro.gsens_p_value >= 0.01
+    assert not any(n.startswith("gsens") for n in result.calibration.channel("IMU-1", "gyro").free_parameters)
+
+
+@pytest.mark.parametrize("nominal", [80.0, 90.0, 95.0, 100.0, 105.0, 125.0])
+def test_any_plausible_counts_per_dps_is_taken_and_k_absorbs_its_error(tmp_path: Path, nominal: float) -> None:
+    """Codes of a gyro with 100 codes per °/s, read with a nominal sensitivity up to 20 % off: the fit takes it,
+    and K is the true matrix times the ratio (what the nominal got wrong), within 3σ."""
+    session = gyro_session(np.random.default_rng(33))
+    data = np.column_stack([session.t_s, session.accel_g, np.full(len(session.t_s), 25.0),
+                            np.rint(session.gyro_dps * 100.0)])
+    path = tmp_path / "codes.csv"
+    np.savetxt(path, data, delimiter=",", header=f"{COLUMNS},{GYRO_COLUMNS}", comments="", fmt="%.8f")
+    _, _, result = calibrate(path, gyro_units="counts", counts_per_dps=nominal)
+    gyro = result.gyro
+    assert gyro is not None and gyro.k_determined
+    expected = TRUE_MATRIX * 100.0 / nominal
+    assert np.all(np.abs((gyro.matrix - expected) / gyro.matrix_sigma) < 3.0)
 
 
 @pytest.mark.parametrize("argv, expected", [
@@ -239,29 +303,30 @@ def _labelled_rows() -> tuple[list[str], np.ndarray, np.ndarray]:
             np.array([[float(r[f"gyr_{a}"]) for a in "xyz"] for r in rows]))
 
 
-def test_imucal_session_cannot_calibrate_the_gyro_and_says_why(tmp_path: Path, capsys) -> None:
+def test_imucal_session_calibrates_the_gyro_bias_alone_and_says_why(tmp_path: Path, capsys) -> None:
     """The six poses were cut from separate recordings and joined: gravity jumps by 90-180° between them with
     the gyro at rest. The three turns come after the last pose, each a full turn about the axis that points
     up (so about gravity, and ending where it began): invisible to the gravity directions whatever K is.
-    imucal's K_g (scale magnitudes) rests on knowing each turn is exactly 360°; nothing here determines it."""
+    imucal's K_g (scale magnitudes) rests on knowing each turn is exactly 360°; nothing here determines it, so
+    the gyro channel holds the bias alone, K nominal, the reason said, and the registry records it."""
     parts, accel, _ = _labelled_rows()
     for axis, name in enumerate("xyz"):
         up = accel[[p == f"{name}_rot" for p in parts]].mean(axis=0)
         assert abs(up[axis]) / np.linalg.norm(up) > 0.99, (name, up)  # each turn about the vertical
     output = tmp_path / "cal.yaml"
     argv = ["fit-recording", str(SESSION), *IMUCAL, "-o", str(output), "--registry", str(tmp_path / "r.sqlite")]
-    assert main(argv) == 2
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and str(SESSION) in err and "no rotation between static intervals" in err
-    assert "in the 5 moves between them" in err and "spliced" in err
-    assert not output.exists()
-    # Shorter static intervals bracket the x and z turns too: still refused, and the full turn is named.
-    assert main([*argv, "--min-interval-s", "0.3"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "a full turn ends where it began" in err, err
-    # Without the gyro the accelerometer's six-parameter fit goes through, as before.
-    assert main(argv[:argv.index("--gyro-columns")] + ["-o", str(output), "--registry", str(tmp_path / "r.sqlite")]) == 0
-    assert output.exists()
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "K not determined" in out and "in the 5 moves between them" in out and "spliced" in out
+    gyro = load_calibration(output).channel(SESSION.stem, "gyro")
+    assert gyro.free_parameters == ["bias_x_dps", "bias_y_dps", "bias_z_dps"]
+    # Six poses for bias + G (4 terms per axis, 6 degrees of freedom left): the F-test does not ask for G at 1 %.
+    assert "not fitted" in gyro.statements["g_sensitivity"]
+    # Shorter static intervals bracket the x and z turns too: still no K, and the full turn is named.
+    assert main([*argv, "--min-interval-s", "0.3", "-o", str(tmp_path / "short.yaml")]) == 0
+    assert "a full turn ends where it began" in capsys.readouterr().out
+    assert main(["registry", "list", "--registry", str(tmp_path / "r.sqlite"), "--json"]) == 0
+    assert {row["channel"] for row in json.loads(capsys.readouterr().out)} == {"accel", "gyro"}
 
 
 def test_imucal_session_gyro_bias_agrees_with_imucal() -> None:

@@ -44,10 +44,11 @@ def _add_fit_recording(commands: Commands) -> None:
         "calibration file as rig fit, for one temperature. The recording is a CSV file (one row per sample) "
         "or a campaign file's raw samples of one sensor at one setpoint. Record at least 9 orientations "
         "(12 or more, every axis up and down) for all 9 parameters, 6 for bias and scale alone. With "
-        "--gyro-columns, the gyroscope's bias (from the still intervals) and its scale and misalignment K (from "
-        "the turns between them, against the gravity directions) are fitted after and reported beside: turn the "
-        "sensor a quarter or half turn about tilted axes between poses (turns about the vertical, and full turns, "
-        "determine nothing).",
+        "--gyro-columns, the gyroscope's bias and g-sensitivity (from the still intervals, G where an F-test asks "
+        "for it) and its scale and misalignment K (from the turns between them, against the gravity directions) "
+        "are fitted after and written as its gyro channel: turn the sensor a quarter or half turn about tilted "
+        "axes between poses (turns about the vertical, and full turns, determine nothing: then K stays nominal "
+        "and the reason is said).",
         "rig fit-recording imu-session.csv --columns samples,ax,ay,az --time-unit samples --rate-hz 200 "
         "--units counts --counts-per-g 2048 --gyro-columns gx,gy,gz --gyro-units counts --counts-per-dps 16.4 "
         "-o imu.calibration.yaml")
@@ -86,7 +87,7 @@ def _csv_layout_options(recording: argparse.ArgumentParser) -> None:
                            help="code of 0 g: 0 for signed codes (default), 32768 for a 16-bit offset-binary ADC")
     recording.add_argument("--gyro-columns", metavar="GX,GY,GZ",
                            help="the gyroscope's x, y, z columns, named or numbered as --columns: calibrate it too "
-                                "(bias, scale and misalignment from the turns between the static intervals)")
+                                "(bias and g-sensitivity from the static intervals, scale and misalignment from the turns between them)")
     recording.add_argument("--gyro-units", choices=["dps", "rad/s", "counts"], default="dps",
                            help="of the gyro columns (default dps, °/s)")
     recording.add_argument("--counts-per-dps", type=number(1e-6, 1e12),
