@@ -170,6 +170,20 @@ def check_procedure_against_rig(procedure: LoadedConfig[Procedure], rig: LoadedC
         if gyroscope_steps and not gyroscopes:
             raise procedure.error((gyroscope_steps[0],), f"sensor {sensor.serial} of {rig.path} is an "
                                                          f"{dut_part.label}, which has no gyroscope")
+        for name, fine in acquisition.fine_ranges.items():
+            finer = next((c for c in dut_part.channels if c.name == name), None)
+            key = ("acquisition", "fine_ranges", name)
+            if finer is None or finer.quantity != RATE_QUANTITY:
+                raise procedure.error(key, f"sensor {sensor.serial} of {rig.path} is an {dut_part.label}, which has no "
+                                           f"{name} channel that measures {RATE_QUANTITY} (a finer range is for a "
+                                           "gyroscope's steps at rest and at low rates)")
+            problem = finer.range_problem(fine, dut_part.label)
+            if problem:
+                raise procedure.error(key, f"{problem}: sensor {sensor.serial} of {rig.path}")
+            if not fine < ranges.get(name, finer.default_range or 0.0):
+                raise procedure.error(key, f"±{fine:g} {finer.unit} is not finer than the channel's range "
+                                           f"(acquisition ranges.{name} ±{ranges.get(name, finer.default_range)} "
+                                           f"{finer.unit})")
         rates = procedure.model.rates
         for channel in gyroscopes if rates is not None else ():
             assert rates is not None

@@ -83,6 +83,11 @@ class Acquisition(StrictModel):
         {_RANGE_G_CHANNEL: _RANGE_G_DEFAULT}, max_length=16,
         description="± full scale of each channel by the channel's name, in its unit (accel: 2 g, gyro: 2000 °/s), one "
                     "of every DUT part's ranges for it; accel 2 g unless given")
+    fine_ranges: dict[Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]{0,31}$")], Annotated[Real, Field(gt=0, le=1e6)]] = (
+        Field({}, max_length=16,
+              description="a finer ± full scale per channel (gyro: 250 °/s) for the steps whose readings it holds with "
+                          "room (engine/step_ranges.py: a gyroscope's at rest, in noise records and at rate steps up to "
+                          "80 % of it); every other step at `ranges`. The calibration holds the scale of each range"))
     odr_hz: Real = Field(125.0, gt=0, le=100_000,
                          description="output data rate; a DUT part without it runs at its next faster rate")
     settle_s: Real = Field(5.0, ge=0, le=3600, description="wait after the turntable is in position")

@@ -275,6 +275,7 @@ class CampaignRunner:
             events.info("preflight", f"sensor {sensor.serial}: {identity.describe(sensor.part.label)} "
                                      f"({sensor.part.describe_identity(identity.registers)}), "
                                      f"{sensor.part.describe_ranges(acquisition.ranges)}, {odr_hz:g} Hz{asked}")
+        run.sensor_ranges = dict(acquisition.ranges)
 
     def _check_controller_limits(self, run: RunContext) -> None:
         """Every setpoint the campaign will write within what the controller itself accepts, or a fault now

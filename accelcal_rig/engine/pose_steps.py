@@ -15,6 +15,7 @@ from accelcal_rig.engine.references import REFERENCES, SATURATES_TURNING, PoseIn
 from accelcal_rig.engine.run_context import RunContext
 from accelcal_rig.engine.states import State
 from accelcal_rig.engine.step_handler import StepHandler
+from accelcal_rig.engine.step_ranges import set_ranges, step_ranges
 from accelcal_rig.instruments.interfaces import SampleBlock
 from accelcal_rig.plan.steps import Measurement
 from accelcal_rig.store.records import ChannelPoseRecord, DutPoseRecord, PoseRecord
@@ -58,8 +59,10 @@ def acquire_and_store(step: Measurement, run: RunContext, commanded: np.ndarray)
     turning = any(step.rate_fixture_dps)
     may_saturate = frozenset(c.name for s in run.sensors for c in s.part.channels
                              if turning and c.quantity in SATURATES_TURNING)
+    ranges = step_ranges(acquisition, step)
+    set_ranges(run, ranges)
     blocks = run.retrier.call(partial(acquire_together, run.sensors, acquisition.samples_per_pose, run.clock,
-                                      acquisition.ranges, may_saturate))
+                                      ranges, may_saturate))
     chamber_after = run.read_chamber_c()
     run.machine.go(State.STORE, step.key)
     gravity_fixture = np.array(step.pose.gravity_fixture)
@@ -69,7 +72,7 @@ def acquire_and_store(step: Measurement, run: RunContext, commanded: np.ndarray)
         commanded_angles_deg=commanded, measured_angles_deg=measured, gravity_fixture=gravity_fixture,
         t_start_s=min(b.t_start_s for b in blocks), t_end_s=max(b.t_end_s for b in blocks),
         chamber_temperature_c=(chamber_before, chamber_after),
-        duts=[_dut_record(run, i, block, at) for i, block in enumerate(blocks)],
+        duts=[_dut_record(run, i, block, at, ranges) for i, block in enumerate(blocks)],
     )
     run.writer.append_pose(record)
     run.report.pose_stored(chamber_after, tuple(float(np.mean(b.temperature_c)) for b in blocks))
@@ -97,17 +100,21 @@ def move_to(run: RunContext, commanded: np.ndarray) -> None:
                what=f"turntable ({turntable.endpoint}) reaching {np.round(commanded, 3).tolist()}°")
 
 
-def _dut_record(run: RunContext, index: int, block: SampleBlock, at: PoseInstant) -> DutPoseRecord:
-    """Each of the DUT's channels at the pose (its part's, in order), and its temperatures against the band."""
+def _dut_record(run: RunContext, index: int, block: SampleBlock, at: PoseInstant,
+                ranges: dict[str, float]) -> DutPoseRecord:
+    """Each of the DUT's channels at the pose (its part's, in order, at the step's ranges; a range other than the
+    campaign's recorded with it), and its temperatures against the band."""
     sensor, settled_c = run.sensors[index], run.dut.settled_c[index]
-    ranges = run.procedure.acquisition.ranges
+    campaign_ranges = run.procedure.acquisition.ranges
     channels = {}
     for channel in sensor.part.channels:
         codes = block.codes[channel.name]
-        lsb, n = channel.lsb(ranges[channel.name]), codes.shape[0]
+        range_ = ranges[channel.name]
+        lsb, n = channel.lsb(range_), codes.shape[0]
         reference = REFERENCES[channel.quantity](run, sensor.serial, channel, at)
         channels[channel.name] = ChannelPoseRecord(codes, codes.mean(axis=0) * lsb,
-                                                   codes.std(axis=0, ddof=1) * lsb / np.sqrt(n), reference)
+                                                   codes.std(axis=0, ddof=1) * lsb / np.sqrt(n), reference,
+                                                   None if range_ == campaign_ranges[channel.name] else range_)
     band = run.procedure.soak.band_c
     in_band = bool(np.all(np.abs(np.array(block.temperature_c) - settled_c) <= band))
     if not in_band and not run.dut.moving:

@@ -106,6 +106,8 @@ class RunContext:
     #: The DUTs the early check dropped (`early_check.action: drop`), by serial: measured on, not checked again,
     #: left out of the fit. A resumed run reads them from the campaign's events.
     dropped: set[str] = field(init=False)
+    #: The ranges the DUTs are configured at now (engine/step_ranges.py): `acquisition.ranges` from the preflight on.
+    sensor_ranges: dict[str, float] = field(default_factory=dict)
     #: Fixture frame → each DUT's frame, by serial.
     fixture_to_dut: dict[str, np.ndarray] = field(init=False)
     kinematics: TurntableKinematics = field(init=False)

@@ -34,6 +34,7 @@ from accelcal_rig.export.flight_stack import (
     number,
     offset_at,
     offset_cubic,
+    range_held,
     range_note,
     refit_note,
     select_sensor,
@@ -128,5 +129,5 @@ def _gyro_notes(gyro: ChannelCalibration, cubic: OffsetCubic, accel: OffsetCubic
              "ArduPilot removes only its change since T_cal; the gyro calibration it runs at every boot "
              f"(INS_GYR_CAL 1) measures the offset into {_gyro_offsets_name(n)} with the temperature correction off "
              f"and records T_cal in INS_GYR{n}_CALTEMP: keep the vehicle still at boot (what it measures also holds "
-             "the Earth's rate and the g-sensitivity at that attitude)", GYRO_AXES_NOTE]
+             "the Earth's rate and the g-sensitivity at that attitude)", range_held(gyro), GYRO_AXES_NOTE]
     return notes

@@ -77,6 +77,9 @@ def _section(c_export: CExport, channels: list[ChannelCalibration]) -> list[str]
     for channel in channels:
         low, high = channel.polynomial.domain_c
         lines += [
+            f"    /* {channel.serial}: coefficients at ±{channel.range:g} {channel.unit}"
+            + "".join(f"; at ±{o.range:g} {channel.unit} divide each axis's reading by "
+                      f"{{{', '.join(repr(float(v)) for v in o.scale)}}} first" for o in channel.range_scales) + " */",
             "    {",
             f"        \"{channel.serial}\", {channel.lsb!r}, {0.5 * (low + high)!r}, {0.5 * (high - low)!r},",
             f"        {channel.validity_c[0]!r}, {channel.validity_c[1]!r}, {int(channel.out_of_range == 'clamp')},",

@@ -197,6 +197,14 @@ def not_exported(sensor: ChannelCalibration, stack: str) -> str:
             f"{_spread(cross_mrad):.3f} mrad; together up to {left_mg:.3f} mg at 1 g left uncorrected")
 
 
+def range_held(gyro: ChannelCalibration) -> str:
+    """Which range the exported gyro offsets are the gyroscope's at (a bias in deg/s is the same at every range
+    to the calibration's range-to-range scales, stated)."""
+    others = "".join(f"; at +/-{o.range:g} deg/s it reads {max(abs(v - 1.0) for v in o.scale) * 1e6:.0f} ppm off that "
+                     "at most (the calibration file holds each axis's scale)" for o in gyro.range_scales)
+    return f"gyro offsets as the gyroscope reads at +/-{gyro.range:g} deg/s, the range the calibration holds{others}"
+
+
 def gyro_not_exported(gyro: ChannelCalibration, stack: str) -> str:
     """The gyroscope model's terms an offset-only thermal model cannot hold, over the calibrated range, and what
     leaving them out costs at full scale.

@@ -28,6 +28,7 @@ from accelcal_rig.export.flight_stack import (
     not_exported,
     number,
     offset_cubic,
+    range_held,
     range_note,
     refit_note,
     select_sensor,
@@ -119,7 +120,7 @@ def _gyro_notes(gyro: ChannelCalibration, cubic: OffsetCubic, n: int, device_id:
              "recalibrate the gyro with TC_G_ENABLE off)",
              f"PX4 renews the gyro offset only after the temperature moved more than {_REPUBLISH_STEP_C:g} degC: up "
              f"to {steepest_slope(cubic) / RAD_PER_DEG * _REPUBLISH_STEP_C:.5f} deg/s at this gyro's steepest bias "
-             "slope", GYRO_AXES_NOTE]
+             "slope", range_held(gyro), GYRO_AXES_NOTE]
     if device_id == 0:
         notes.append(f"TC_G{n}_ID is 0, which names no gyro: pass --device-id or set TC_G{n}_ID to the gyro's "
                      "CAL_GYRO<k>_ID before loading")

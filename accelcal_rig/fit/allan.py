@@ -121,12 +121,17 @@ def bias_instability(curve: AllanCurve, confidence: float = ONE_SIGMA) -> Estima
     """The bias instability B (the data's unit): √ of the noise model's flicker term over the flicker floor's
     factor √(2 ln 2 / π) ≈ 0.664. Its interval: the relative interval, for flicker noise, of the deviation at
     the curve's least readable point, where flicker dominates. Where the fit finds no flicker term (a record
-    too short for it to rise above the white noise) the value is 0 and the interval reaches up to what that
-    least deviation allows, its own upper end over 0.664: an upper bound, not a measurement."""
+    too short for it to rise above the white noise), or a flicker term smaller than the least deviation's own
+    uncertainty (its variance's interval there: the fit's split of that point between white and flicker is
+    then noise), the value is 0 and the interval reaches up to what that least deviation allows, its own upper
+    end over 0.664: an upper bound, not a measurement."""
     model, readable = noise_model(curve), _readable(curve)
     index = int(readable[np.argmin(curve.deviation[readable])])
     value = float(np.sqrt(model.flicker)) / FLICKER_FLOOR
     low, high = _relative_interval(curve, index, _FLICKER, confidence)
+    least_variance = float(curve.deviation[index]) ** 2
+    if model.flicker < least_variance * (high**2 - 1.0):
+        value = 0.0
     if value == 0.0:  # not resolved (white noise hides it): no flicker floor can lie above the least deviation
         return Estimate(0.0, 0.0, float(curve.deviation[index]) * high / FLICKER_FLOOR, float(curve.tau_s[index]),
                         confidence)

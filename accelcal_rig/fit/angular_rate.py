@@ -214,7 +214,8 @@ class AngularRateModel:
                         "where unplaced, the bias's wander); the full polynomials are in the calibration file.",),
             Table(("parameter", "gyro x", "gyro y", "gyro z"), rows),
             (f"Earth's rate: {statements.get('earth_rate', 'not stated')}. Gauge (the frame of K): "
-             f"{statements.get('gauge', 'not stated')}.",))
+             f"{statements.get('gauge', 'not stated')}." + (f" Ranges: {statements['ranges']}." if "ranges" in statements
+                                                            else ""),))
 
     def _verification(self, calibration: ChannelCalibration) -> Section:
         title = "Verification (rate steps the calibration never saw)"

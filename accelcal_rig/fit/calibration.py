@@ -102,6 +102,15 @@ def _version_3_entry(data: dict[str, Any]) -> dict[str, Any]:
     return data
 
 
+class ChannelRangeScale(StrictModel):
+    """Another range the channel was measured at: its readings are `scale` × (per axis) what the channel's own
+    range reads, so they are divided by it before the model."""
+
+    range: float = Field(gt=0, le=1e6, description="± full scale in the channel's unit")
+    scale: list[float] = Field(min_length=1, max_length=3)
+    sigma: list[float] = Field(min_length=1, max_length=3, description="1σ of each scale")
+
+
 class ChannelCalibration(StrictModel):
     """One channel of one DUT calibrated: its model's parameters as polynomials of the sensor's own
     temperature, the setpoint fits they came from, the figures, the verdict and the decision, and what its
@@ -121,6 +130,8 @@ class ChannelCalibration(StrictModel):
                                                                          "their nominal values")
     range: float = Field(gt=0, le=1e6, description="measuring range, ± in `unit`")
     lsb: float = Field(gt=0, le=100, description="`unit` per code, for compensating raw codes")
+    range_scales: list[ChannelRangeScale] = Field([], max_length=8, description="the other ranges it was measured "
+                                                  "at, each one's sensitivity relative to `range`")
     validity_c: tuple[TemperatureC, TemperatureC]
     out_of_range: Literal["clamp", "extrapolate"] = "clamp"
     polynomial: PolynomialModel
@@ -277,14 +288,22 @@ class CalibrationFile(StrictModel):
 
 
 def apply(calibration: ChannelCalibration, reading: np.ndarray, temperature_c: np.ndarray | float,
-          companions: Mapping[str, np.ndarray] | None = None) -> np.ndarray:
+          companions: Mapping[str, np.ndarray] | None = None, range_: float | None = None) -> np.ndarray:
     """Compensate raw readings (..., axes) in the channel's unit taken at the sensor's own temperatures (...) →
     the quantity in the DUT frame, as the channel's model does it. `companions`: the DUT's other channels'
-    compensated readings by quantity where the model needs them (a gyroscope's specific force)."""
+    compensated readings by quantity where the model needs them (a gyroscope's specific force). `range_`: the
+    range they were read at, when not the calibration's own: one of its `range_scales`, else refused."""
     from accelcal_rig.fit.channel_models import model_of
 
-    return model_of(calibration).compensate(calibration, np.asarray(reading, dtype=float), temperature_c,
-                                            companions or {})
+    reading = np.asarray(reading, dtype=float)
+    if range_ is not None and range_ != calibration.range:
+        scale = next((s for s in calibration.range_scales if s.range == range_), None)
+        if scale is None:
+            measured = "/".join(f"{r:g}" for r in [calibration.range, *(s.range for s in calibration.range_scales)])
+            raise ValueError(f"{calibration.quantity} of sensor {calibration.serial}: calibrated at ±{measured} "
+                             f"{calibration.unit}, not ±{range_:g}")
+        reading = reading / np.asarray(scale.scale)
+    return model_of(calibration).compensate(calibration, reading, temperature_c, companions or {})
 
 
 def apply_codes(calibration: ChannelCalibration, codes: np.ndarray, temperature_c: np.ndarray | float,

@@ -23,11 +23,12 @@ from scipy.stats import chi2
 from accelcal_rig.core.earth import EARTH_RATE_DPS
 from accelcal_rig.fit import gyro_model
 from accelcal_rig.fit.allan import FLICKER_FLOOR
-from accelcal_rig.fit.calibration import ChannelCalibration, PolynomialModel, SetpointFit, plain
+from accelcal_rig.fit.calibration import ChannelCalibration, ChannelRangeScale, PolynomialModel, SetpointFit, plain
 from accelcal_rig.fit.channel_model import ChannelFit
 from accelcal_rig.fit.gyro_budget import combined, gyro_budget, sources_dps, truth_coverage
 from accelcal_rig.fit.gyro_joint import fit_gyro_joint
 from accelcal_rig.fit.parameter_uncertainty import certificate_temperatures, of_gyro
+from accelcal_rig.fit.range_scale import RangeScale, RangeScaleError, fit_range_scales, to_own_range
 from accelcal_rig.fit.thermal import OutOfRange, ThermalModel, fit_thermal
 from accelcal_rig.fit.uncertainty import COVERAGE_FACTOR, consistency
 from accelcal_rig.store.content import Campaign
@@ -65,6 +66,14 @@ class GyroRecords:
     force_g: np.ndarray               # (N, 3) the specific force (gravity at the commanded pose)
     truth_parameters: np.ndarray | None  # (N, 27) the simulation's, at each record's true temperature
     samples_per_record: int = 0       # samples averaged in each record (0: not known)
+    range_dps: np.ndarray | None = None  # (N,) the ± full scale each record was taken at (None: all at info.range)
+    #: The simulation's true sensitivity of each other range relative to the channel's: ε by range.
+    truth_range_scale: dict[float, np.ndarray] | None = None
+
+    def lsb_dps(self) -> np.ndarray:
+        """(N, 1) each record's code size: the channel's, scaled by the record's range (codes of one width)."""
+        ranges = np.full(len(self.kind), self.info.range) if self.range_dps is None else self.range_dps
+        return (self.info.lsb * ranges / self.info.range)[:, None]
 
     def rows(self, *kinds: str) -> np.ndarray:
         return np.isin(self.kind, kinds)
@@ -76,8 +85,9 @@ def read_gyro_records(campaign: Campaign, serial: str, channel: str, force_g: np
     keys = campaign.pose_column("step_key")
     plan = campaign.header.plan
     kinds = dict(zip(plan.step_key, plan.kind))
+    info = campaign.channel_info(serial, channel)
     return GyroRecords(
-        serial=serial, info=campaign.channel_info(serial, channel),
+        serial=serial, info=info,
         kind=np.array([kinds.get(str(k), "") for k in keys]),
         setpoint_c=campaign.pose_column("setpoint_c"), t_s=campaign.pose_column("t_start_s"),
         temperature_c=campaign.dut_column(serial, "temperature_c").mean(axis=1),
@@ -85,9 +95,36 @@ def read_gyro_records(campaign: Campaign, serial: str, channel: str, force_g: np
         stderr_dps=campaign.channel_column(serial, channel, "stderr"),
         reference_dps=campaign.channel_column(serial, channel, "reference"),
         force_g=force_g,
-        truth_parameters=described_truth(campaign, serial, channel),
+        truth_parameters=_truth_at_own_range(campaign, serial, channel, info.range),
         samples_per_record=campaign.samples_per_pose,
+        range_dps=campaign.channel_ranges(serial, channel),
+        truth_range_scale=_truth_range_scale(campaign, serial, info.range),
     )
+
+
+def _described_range_scale(campaign: Campaign, serial: str) -> dict[float, np.ndarray]:
+    """The simulation's δ of each range (a gyroscope reads (1 + δ) × its truth there), where it describes them."""
+    table = campaign.header.truth.get(serial, {}).get("gyro_range_scale")
+    if table is None:
+        return {}
+    return {float(row[0]): np.asarray(row[1:4], dtype=float) for row in np.atleast_2d(np.asarray(table, dtype=float))}
+
+
+def _truth_at_own_range(campaign: Campaign, serial: str, channel: str, own_range: float) -> np.ndarray | None:
+    """The truth's parameters as the gyroscope reads at the channel's own range (the simulation describes them
+    at its widest)."""
+    truth = described_truth(campaign, serial, channel)
+    delta = _described_range_scale(campaign, serial).get(float(own_range))
+    return truth if truth is None or delta is None else gyro_model.read_at_scale(truth, 1.0 + delta)
+
+
+def _truth_range_scale(campaign: Campaign, serial: str, own_range: float) -> dict[float, np.ndarray] | None:
+    """The true ε of every range relative to the channel's own, where the simulation describes them."""
+    described = _described_range_scale(campaign, serial)
+    if float(own_range) not in described:
+        return None
+    own = 1.0 + described[float(own_range)]
+    return {r: (1.0 + d) / own - 1.0 for r, d in described.items()}
 
 
 @dataclass(frozen=True)
@@ -176,6 +213,17 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
     calibrating = records.rows(*CALIBRATION_KINDS)
     if not records.rows("rate").any():
         raise GyroDesignError(f"sensor {records.serial}: no rate steps stored, the gyroscope cannot be calibrated")
+    scales: list[RangeScale] = []
+    if records.range_dps is not None and np.any(records.range_dps != records.info.range):
+        try:
+            scales = fit_range_scales(records.mean_dps[calibrating], records.stderr_dps[calibrating],
+                                      records.reference_dps[calibrating], records.force_g[calibrating],
+                                      records.range_dps[calibrating], records.setpoint_c[calibrating],
+                                      records.info.range, STDERR_FLOOR_DPS)
+        except RangeScaleError as exc:
+            raise GyroDesignError(f"sensor {records.serial} gyroscope: {exc}") from None
+        mean, stderr = to_own_range(records.mean_dps, records.stderr_dps, records.range_dps, scales)
+        records = replace(records, mean_dps=mean, stderr_dps=stderr)
     fits, kept, skipped = [], [], []
     for setpoint in dict.fromkeys(records.setpoint_c[calibrating].tolist()):
         group = np.flatnonzero(calibrating & (records.setpoint_c == setpoint))
@@ -203,6 +251,8 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
     # said so: the others still calibrate the gyroscope over their range.
     thermal.warnings.extend(f"gyroscope setpoint left out: {why}" for why in skipped)
     metrics = _figures(records, thermal, out_of_range, calibrating)
+    if scales:
+        metrics["range_scales"] = _range_scale_figures(records, scales)
     metrics["chi2_reduced"] = [f.chi2_reduced for f in fits]
     metrics["temperature_range_c"] = [float(temperatures.min()), float(temperatures.max())]
     metrics["earth_rate"] = earth_rate_statement(site)
@@ -268,10 +318,35 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
                                parameters=dict(zip(gyro_model.PARAMETER_NAMES, plain(f.parameters))),
                                sigma=dict(zip(gyro_model.PARAMETER_NAMES, plain(f.sigma))))
                    for s, t, f in zip(setpoints, temperatures, fits)],
-        statements={"earth_rate": metrics["earth_rate"], "gauge": GAUGE},
+        statements={"earth_rate": metrics["earth_rate"], "gauge": GAUGE,
+                    **({"ranges": range_statement(records.info.range, scales)} if scales else {})},
+        range_scales=[ChannelRangeScale(range=s.range, scale=plain(s.scale), sigma=plain(s.sigma)) for s in scales],
         metrics={k: plain(v) for k, v in metrics.items() if k != "truth_error"}, warnings=thermal.warnings,
     )
     return ChannelFit(records.serial, calibration, plain(metrics), thermal, parameter_u)
+
+
+def range_statement(own_range: float, scales: list[RangeScale]) -> str:
+    """What the certificate and the file say of the ranges the gyroscope was measured at."""
+    others = "; ".join(f"±{s.range:g} °/s reads {', '.join(f'{v:.5f}' for v in s.scale)} × (x, y, z; 1σ "
+                       f"{max(s.sigma):.1g}), fitted at {s.setpoints} setpoint{'s' if s.setpoints != 1 else ''}"
+                       for s in scales)
+    return (f"the model is the gyroscope's at ±{own_range:g} °/s, where its high rates were measured; readings at "
+            f"rest and at low rates were taken at a finer range, each range's sensitivity relative to it constant "
+            f"over temperature: {others}")
+
+
+def _range_scale_figures(records: GyroRecords, scales: list[RangeScale]) -> dict[str, Any]:
+    """Each other range's fitted scale, its 1σ and, in a dry run, its error against the simulation's truth."""
+    figures: dict[str, Any] = {}
+    for scale in scales:
+        entry: dict[str, Any] = {"scale": scale.scale, "sigma": scale.sigma, "setpoints": scale.setpoints,
+                                 "chi2_reduced": scale.chi2_reduced}
+        true = (records.truth_range_scale or {}).get(scale.range)
+        if true is not None:
+            entry["truth_error"] = scale.scale - (1.0 + true)
+        figures[f"{scale.range:g}"] = entry
+    return figures
 
 
 def _figures(records: GyroRecords, thermal: ThermalModel, out_of_range: OutOfRange,
@@ -366,8 +441,8 @@ def quantisation_sigma(records: GyroRecords) -> np.ndarray:
     codes, amplitude (LSB/π)·exp(−2π²σ²/LSB²) (the first term of its Fourier series for Gaussian noise σ; Widrow
     and Kollár, "Quantization Noise", 2008, ch. 7), its RMS over the place amplitude/√2. An ICM-42688-P's
     gyroscope at ±2000 °/s (noise 0.3 code) leaves about 0.0026 °/s; at ±250 °/s (2.3 codes), nothing."""
-    lsb = records.info.lsb
-    if records.samples_per_record < 2 or lsb <= 0:
+    lsb = records.lsb_dps()
+    if records.samples_per_record < 2 or records.info.lsb <= 0:
         return np.zeros_like(records.stderr_dps)
     sigma = records.stderr_dps * np.sqrt(records.samples_per_record)  # each sample's noise
     return lsb / np.pi * np.exp(-2.0 * np.pi**2 * (sigma / lsb) ** 2) / np.sqrt(2.0)

@@ -106,3 +106,17 @@ def distort_jacobian(true_dps: np.ndarray, force_g: np.ndarray, params: np.ndarr
     for i in rows:
         jacobian[..., i, GSENS.start + 3 * i: GSENS.start + 3 * i + 3] = force_g
     return jacobian
+
+
+def read_at_scale(params: np.ndarray, factor: np.ndarray) -> np.ndarray:
+    """The parameters of a gyroscope that reads `factor` (..., 3) × what `params` says, per axis: its bias, K's
+    rows and G's rows scaled, the nonlinearity (relative to a rate of the scaled reading) divided by factor²."""
+    params = np.array(params, dtype=float)
+    factor = np.asarray(factor, dtype=float)
+    params[..., BIAS] *= factor
+    params[..., SCALE] *= factor
+    for column, (i, _) in enumerate(CROSS_TERMS):
+        params[..., CROSS.start + column] *= factor[..., i]
+    params[..., NONLINEARITY] /= factor**2
+    params[..., GSENS] *= np.repeat(factor, 3, axis=-1)
+    return params

@@ -26,20 +26,19 @@ def noise_allan(campaign: Campaign, serial: str, channel: str, odr_hz: float,
     """The Allan figures of one DUT's channel from the campaign's noise records (None: it has none), in the
     units its channel model quotes them (`quoted_as`): those of the record nearest 25 °C, and each setpoint's in
     `by_setpoint`."""
-    info = campaign.channel_info(serial, channel)
     plan = campaign.header.plan
     keys = campaign.pose_column("step_key")
     noise = np.isin(keys, list(plan.keys_of(NOISE_KIND)))
     if not noise.any():
         return None
     setpoints = campaign.pose_column("setpoint_c")
-    codes = campaign.channel_column(serial, channel, "raw_codes")
+    values = campaign.channel_values(serial, channel)
     starts, ends = campaign.pose_column("t_start_s"), campaign.pose_column("t_end_s")
     by_setpoint = []
     for setpoint in dict.fromkeys(setpoints[noise].tolist()):
         rows = np.flatnonzero(noise & (setpoints == setpoint))
         rows = rows[np.argsort(starts[rows])]
-        stream = codes[rows].reshape(-1, codes.shape[-1]) * info.lsb
+        stream = values[rows].reshape(-1, values.shape[-1])
         span_s = float(ends[rows[-1]] - starts[rows[0]])
         gaps_s = float(np.sum(np.maximum(starts[rows[1:]] - ends[rows[:-1]], 0.0)))
         try:

@@ -173,9 +173,9 @@ def _noise_curves(campaign: Campaign, fitted: dict[str, dict[str, FittedChannel]
             model = model_for_quantity(info.quantity)
             if model is None or model.noise is None or odr_hz <= 0:
                 continue
-            codes = campaign.channel_column(serial, info.name, "raw_codes")[rows]
+            values = campaign.channel_values(serial, info.name)[rows]
             try:
-                curves = allan_deviation(codes.reshape(-1, codes.shape[-1]) * info.lsb, odr_hz)
+                curves = allan_deviation(values.reshape(-1, values.shape[-1]), odr_hz)
             except ValueError:
                 continue
             channel = fitted.get(serial, {}).get(info.name)

@@ -8,6 +8,7 @@ from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.core.formatting import format_duration
 from accelcal_rig.engine.estimate import DurationEstimate
 from accelcal_rig.engine.preparation import PreparedCampaign
+from accelcal_rig.engine.step_ranges import FINE_RANGE_SHARE
 from accelcal_rig.parts.part import odr_hz_of
 from accelcal_rig.parts.registry import part
 from accelcal_rig.plan.compile import setpoint_label
@@ -104,7 +105,10 @@ def _storage_line(prepared: PreparedCampaign) -> str:
 def _poses_line(prepared: PreparedCampaign) -> str:
     procedure, plan = prepared.procedure.model, prepared.plan
     acquisition, cooldown = procedure.acquisition, procedure.cooldown
-    ranges = ", ".join(f"{channel} ±{value:g}" for channel, value in acquisition.ranges.items())
+    fine = acquisition.fine_ranges
+    ranges = ", ".join(f"{channel} ±{value:g}" + (f" (±{fine[channel]:g} at rest and up to {FINE_RANGE_SHARE * fine[channel]:g})"
+                                                   if channel in fine else "")
+                       for channel, value in acquisition.ranges.items())
     faster = {p.label: odr_hz_of(p, acquisition.odr_hz) for p in (part(s.part) for s in prepared.rig.model.fixture.sensors)
               if odr_hz_of(p, acquisition.odr_hz) != acquisition.odr_hz}
     rates = "".join(f" ({label} at {rate:g} Hz, its next rate above)" for label, rate in faster.items())

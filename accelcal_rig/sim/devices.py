@@ -205,7 +205,9 @@ class SimulationTruth:
                 "gyro_noise_dps_per_sample": self._lab.gyro_noise_dps(index, odr_hz),
                 "gyro_bias_instability_dph": 3600.0 * float(self._lab.bias_wander[index].sigma > 0)
                 * self._lab.gyro_bias_instability_dps,
-                "earth_rate_world_dps": np.asarray(self._lab.earth_rate_world_dps, dtype=float)}
+                "earth_rate_world_dps": np.asarray(self._lab.earth_rate_world_dps, dtype=float),
+                # Each range's sensitivity relative to the widest's: (ranges, δ per axis).
+                "gyro_range_scale": np.array([[r, *d] for r, d in sorted(dut.gyro_range_scale.items())])}
 
     def block_truth(self, serial: str, block: SampleBlock) -> dict[str, np.ndarray]:
         return self._lab.truth_between(self._index[serial], block.t_start_s, block.t_end_s)

@@ -29,6 +29,7 @@ from accelcal_rig.sim.mount_faults import MountFaults
 from accelcal_rig.sim.truth import (
     DutTruth,
     fixture_parameters_at,
+    gyro_range_scale,
     gyro_truth_for_serial,
     mag_truth_for_serial,
     truth_for_serial,
@@ -48,6 +49,9 @@ class SimulatedDut:
         self.part = dut_part
         #: A gyroscope's hidden truth, where the part has one (its own seed: the acceleration truth is unchanged).
         self.gyro_truth: DutTruth | None = gyro_truth_for_serial(serial) if "gyro" in dut_part.channel_names else None
+        #: Its gyroscope's sensitivity at each range relative to the widest (sim/truth.py).
+        self.gyro_range_scale = (gyro_range_scale(serial, tuple(dut_part.channel("gyro").ranges))
+                                 if self.gyro_truth is not None else {})
         #: A magnetometer's hidden truth (Eq. 1: hard iron, soft iron), where the part has one.
         self.mag_truth: DutTruth | None = (mag_truth_for_serial(serial) if any(
             c.quantity == MAGNETIC_FIELD for c in dut_part.channels) else None)
@@ -264,6 +268,7 @@ class VirtualLab:
             raise ValueError(f"{dut.serial}: the {dut.part.label} has no gyroscope")
         parameters = dut.gyro_truth.parameters_at(float(instant.temperature_c[index]))
         reading = distort_rate(self.true_rate_dps(index), instant.gravity_g[index], parameters)
+        reading = reading * (1.0 + dut.gyro_range_scale.get(float(range_dps), np.zeros(3)))
         noise = self.gyro_rngs[index].normal(0.0, self.gyro_noise_dps(index, odr_hz), (n_samples, 3))
         wander = self.bias_wander[index].at(t_start_s + np.arange(n_samples) / odr_hz)
         return dut.part.channel("gyro").quantise(reading + noise + wander, range_dps)

@@ -87,6 +87,21 @@ def gyro_truth_for_serial(serial: str) -> DutTruth:
     return _cubic_truth(serial, f"gyro:{serial}", _GYRO_CENTRE, _GYRO_HALF_WIDTH, _GYRO_DRIFT_LOW, _GYRO_DRIFT_HIGH)
 
 
+#: The spread of a gyroscope's sensitivity from one of its ranges to another (relative, per axis, 1σ): the data
+#: sheet states ±0.5 % for each range (ICM-42688-P, "sensitivity scale factor tolerance"); one analog chain
+#: behind every range keeps their differences smaller, an assumption of 0.1 %.
+GYRO_RANGE_SCALE_SIGMA = 1e-3
+
+
+def gyro_range_scale(serial: str, ranges: tuple[float, ...]) -> dict[float, np.ndarray]:
+    """Each range's sensitivity relative to the widest one's (whose K the truth's parameters are), per axis: the
+    gyroscope of `serial` reads (1 + δ) × what its truth says at a range with δ ≠ 0. Deterministic per serial."""
+    widest = max(ranges)
+    rng = np.random.default_rng(int.from_bytes(hashlib.sha256(f"gyro-ranges:{serial}".encode()).digest()[:8], "big"))
+    draws = rng.normal(0.0, GYRO_RANGE_SCALE_SIGMA, (len(ranges), 3))
+    return {float(r): (np.zeros(3) if r == widest else d) for r, d in zip(sorted(ranges), draws)}
+
+
 # A magnetometer's hidden truth: Eq. 1's 12 parameters (its hard-iron offset is the bias, its soft-iron matrix
 # M·C·S), the same smooth cubics. Magnitudes of an LIS3MDL on a fixture: zero-gauss level and hard iron within
 # ±0.3 gauss at 25 °C drifting 2–10 mgauss over −40…60 °C (the data sheet states no temperature coefficient: an

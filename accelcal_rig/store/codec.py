@@ -98,6 +98,8 @@ def encode_pose(pose: PoseRecord) -> bytes:
         arrays[f"{name}/raw_codes"] = np.stack([np.asarray(c.raw_codes, dtype="i4") for c in channels])
         for field in ("mean", "stderr", "reference"):
             arrays[f"{name}/{field}"] = np.stack([np.asarray(getattr(c, field), dtype="f8") for c in channels])
+        if any(c.range is not None for c in channels):  # a step at a range other than the campaign's (NaN: its own)
+            arrays[f"{name}/range"] = np.array([np.nan if c.range is None else c.range for c in channels], dtype="f8")
     if all(d.truth is not None for d in duts) and duts:
         arrays["truth_parameters"] = np.stack([np.asarray(d.truth["parameters"], dtype="f8") for d in duts])  # type: ignore[index]
         arrays["truth_gravity_g"] = np.stack([np.asarray(d.truth["gravity_g"], dtype="f8") for d in duts])  # type: ignore[index]
@@ -218,8 +220,12 @@ def _pose_channels(meta: dict, arrays: dict[str, np.ndarray], serials: list[str]
             for field, shape in expected.items():
                 if fields[field].shape != shape:
                     raise ValueError(f"{names[name][field]} has shape {fields[field].shape}, expected {shape}")
+            ranges = arrays.get(f"{name}/range")
+            if ranges is not None and ranges.shape != (len(owners),):
+                raise ValueError(f"{name}/range has shape {ranges.shape}, expected {(len(owners),)}")
+            range_ = None if ranges is None or not np.isfinite(ranges[i]) else float(ranges[i])
             channels[serial][name] = ChannelPoseRecord(fields["raw_codes"][i], fields["mean"][i],
-                                                       fields["stderr"][i], fields["reference"][i])
+                                                       fields["stderr"][i], fields["reference"][i], range_)
     for serial in serials:
         if set(channels[serial]) != {c.name for c in header.dut_channels(serial)}:
             raise ValueError(f"sensor {serial}: channels {sorted(channels[serial])}, the campaign says "

@@ -136,6 +136,24 @@ class Campaign:
             self._columns[key] = _stack(values, tail, "i4" if name == "raw_codes" else "f8")
         return self._columns[key]
 
+    def channel_ranges(self, serial: str, channel: str) -> np.ndarray:
+        """(N,) the ± full scale each stored record of the channel was taken at: the channel's own range where the
+        record states none (every record of a campaign at one range)."""
+        key = f"duts/{serial}/{channel}/range"
+        if key not in self._columns:
+            index = self.serials.index(serial)
+            default = self.channel_info(serial, channel).range
+            values = [p.duts[index].channels[channel].range for p in self.poses]
+            self._columns[key] = np.array([default if v is None else v for v in values], dtype="f8")
+        return self._columns[key]
+
+    def channel_values(self, serial: str, channel: str) -> np.ndarray:
+        """(N, n, axes) each record's samples in the channel's unit: its codes times its own code size (the
+        channel's, scaled by the record's range: a part's codes are one width at every range)."""
+        info = self.channel_info(serial, channel)
+        lsb = info.lsb * self.channel_ranges(serial, channel) / info.range
+        return self.channel_column(serial, channel, "raw_codes") * lsb[:, None, None]
+
     def channel_info(self, serial: str, channel: str) -> ChannelInfo:
         for info in self.header.dut_channels(serial):
             if info.name == channel:
@@ -235,6 +253,9 @@ def measurements_sha256(campaign: Campaign) -> str:
             if index == 0:
                 digest.update(np.ascontiguousarray(campaign.dut_column(serial, "temperature_c")).tobytes())
             digest.update(np.ascontiguousarray(campaign.channel_column(serial, info.name, "reference")).tobytes())
+            ranges = campaign.channel_ranges(serial, info.name)
+            if np.any(ranges != info.range):  # the codes' meaning; a campaign at one range keeps its digest
+                digest.update(np.ascontiguousarray(ranges).tobytes())
     return digest.hexdigest()
 
 

@@ -124,6 +124,9 @@ def _image(campaign: Campaign, journal_bytes: int) -> bytes:
                 for name in CHANNEL_FIELDS:
                     _dataset(channel_group, name, campaign.channel_column(serial, channel.name, name),
                              "LSB" if name == "raw_codes" else channel.unit)
+                ranges = campaign.channel_ranges(serial, channel.name)
+                if np.any(ranges != channel.range):  # some records at a finer range: each record's range
+                    _dataset(channel_group, "range", ranges, channel.unit)
         instruments = file.create_group("instruments")
         for name, info in campaign.instruments.items():
             instruments.create_group(name).attrs.update(info)
@@ -242,6 +245,11 @@ def read_campaign_file(file: h5py.File) -> Campaign:
              "chamber_temperature_c": ((2,), "f")}
     truth_tails = {"parameters": ((12,), "f"), "gravity_g": ((3,), "f"), "temperature_c": ((), "f")}
     dut_columns = {s: _dut_columns(header, s, version, n) for s in header.serials}
+    for serial in header.serials:  # a channel some of whose records are at a range of their own
+        for info in header.dut_channels(serial) if version >= 3 else ():
+            path = f"duts/{serial}/{info.name}/range"
+            if path in file:
+                dut_columns[serial][(info.name, "range")] = (path, (), "f")
     lengths = {f"poses/{name}": reader.node(f"poses/{name}", h5py.Dataset).shape for name in tails}
     for serial in header.serials:
         lengths.update({path: reader.node(path, h5py.Dataset).shape for path, _, _ in dut_columns[serial].values()})
@@ -265,7 +273,8 @@ def read_campaign_file(file: h5py.File) -> Campaign:
     for i, key in enumerate(keys):
         pose_duts = [DutPoseRecord(
             serial=s,
-            channels={c.name: ChannelPoseRecord(*(duts[s][(c.name, name)][i] for name in CHANNEL_FIELDS))
+            channels={c.name: ChannelPoseRecord(**{name: duts[s][(c.name, name)][i] for name in CHANNEL_FIELDS},
+                                                range=_record_range(duts[s].get((c.name, "range")), i, c.range))
                       for c in header.dut_channels(s)},
             temperature_c=(float(duts[s][("", "temperature_c")][i, 0]), float(duts[s][("", "temperature_c")][i, 1])),
             temperature_in_band=bool(duts[s][("", "temperature_in_band")][i]),
@@ -298,6 +307,13 @@ def read_campaign_file(file: h5py.File) -> Campaign:
     campaign.runs = [RunStart(k, 0, "", "") for k in range(1, runs)] + [
         RunStart(runs, int(attrs.get("writer_pid", 0)), _text(attrs.get("writer_host", "")), "")]
     return campaign
+
+
+def _record_range(ranges: np.ndarray | None, row: int, channel_range: float) -> float | None:
+    """A record's range as the pose record holds it: None where it is the channel's own."""
+    if ranges is None or float(ranges[row]) == channel_range:
+        return None
+    return float(ranges[row])
 
 
 #: Where formats 1 and 2 kept the acceleration channel's fields: beside the DUT's own.

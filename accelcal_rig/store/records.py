@@ -71,6 +71,8 @@ class ChannelPoseRecord:
     stderr: np.ndarray               # (axes,) standard error of the mean
     reference: np.ndarray            # (axes,) what the channel should read in the DUT frame: gravity from the
                                      # commanded angles and the mount; the table's rate (zero at rest)
+    range: float | None = None       # ± full scale of this record when not the campaign's (a gyroscope's finer
+                                     # range at rest: engine/step_ranges.py); None: the channel's (ChannelInfo)
 
 
 @dataclass(frozen=True)

@@ -272,4 +272,7 @@ def test_json_csv_and_the_c_header_carry_the_gyro_beside_the_accelerometer(imu_c
         assert "bias_x_dps" in exported.text and "bias_x_g" in exported.text, fmt
     rows = [line.split(",") for line in export_format(calibration, "csv", options).text.splitlines()[1:]]
     assert {(row[1], row[2], row[3]) for row in rows} == {("accel", "sfem-eq1", "g"), ("gyro", "gyro-rate-table", "dps")}
-    assert len(rows) == 4 * (12 + 27)
+    assert len(rows) == 4 * (12 + 27 + 3)  # the gyroscope's scale at its finer range: a row per axis
+    scales = [row for row in rows if row[5].startswith("range_scale_")]
+    assert {row[4] for row in scales} == {"250.0"} and {row[4] for row in rows if row[1] == "gyro"} == {"250.0", "2000.0"}
+    assert all(abs(float(row[12]) - 1.0) < 0.01 for row in scales)

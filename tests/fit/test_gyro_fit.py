@@ -42,8 +42,9 @@ PROCEDURE = {
     "name": "imu-small", "rig": str(RIG), "setpoints_c": [0, 20, 40],
     "soak": {"criterion": "settling", "min_dwell_min": 10, "window_min": 10, "poll_s": 60},
     "schedule": {"kind": "paper-24"},
-    "acquisition": {"samples_per_pose": 100, "range_g": 2, "range_dps": 2000, "odr_hz": 100, "settle_s": 1},
-    "rates": {"rates_dps": [10, 100, 1000], "settle_s": 1, "verify_rates_dps": [30, 500]},
+    "acquisition": {"samples_per_pose": 100, "range_g": 2, "range_dps": 2000, "fine_ranges": {"gyro": 250},
+                    "odr_hz": 100, "settle_s": 1},
+    "rates": {"rates_dps": [10, 100, 500, 1000], "settle_s": 1, "verify_rates_dps": [30, 700]},
     "noise": {"duration_s": 20},
     "fit": {"mode": "reference", "polynomial_degree": 1},
     "verify": {"schedule": {"kind": "sphere", "count": 6}, "at_setpoints": False, "setpoints_c": [10, 30]},
@@ -81,7 +82,7 @@ def test_the_plan_turns_each_fixture_axis_both_ways_at_every_rate(tmp_path: Path
     stage = plan.stages[0]
     turning = [s for s in stage.body if isinstance(s, RateStep) and not isinstance(s, VerifyRate)]
     assert sorted({(s.about, s.rate_dps) for s in turning}) == sorted(
-        (axis, sign * rate) for axis in "xyz" for rate in (10, 100, 1000) for sign in (-1, 1))
+        (axis, sign * rate) for axis in "xyz" for rate in (10, 100, 500, 1000) for sign in (-1, 1))
     assert [s for s in stage.body if isinstance(s, VerifyRate)] == []          # verified at 10 and 30 °C only
     assert sum(isinstance(s, StopRotation) for s in stage.body) == 3
     for step in turning:   # the pose puts "up" along the fixture axis the vertical rate axis turns about
@@ -89,7 +90,7 @@ def test_the_plan_turns_each_fixture_axis_both_ways_at_every_rate(tmp_path: Path
         assert step.pose.gravity_fixture[axis] == pytest.approx(1.0)
         assert step.rate_fixture_dps[axis] == step.rate_dps
     checks = [s for stage in plan.stages if stage.setpoint_c == 10 for s in stage.body if isinstance(s, VerifyRate)]
-    assert sorted({abs(s.rate_dps) for s in checks}) == [30, 500] and len(checks) == 12
+    assert sorted({abs(s.rate_dps) for s in checks}) == [30, 700] and len(checks) == 12
 
 
 def test_the_accelerometer_fit_sees_only_the_poses_taken_at_rest(campaign_path: Path) -> None:
@@ -116,7 +117,13 @@ def test_every_gyroscope_reference_holds_the_table_and_the_earth(campaign_path: 
     earth = np.linalg.norm(records.reference_dps[at_rest], axis=1)
     assert earth == pytest.approx(np.degrees(7.292115e-5), rel=1e-6)   # latitude and heading given: all of it
     turning = records.rows("rate")
-    assert np.sort(np.unique(np.round(np.abs(records.reference_dps[turning]).max(axis=1)))).tolist() == [10, 100, 1000]
+    assert np.sort(np.unique(np.round(np.abs(records.reference_dps[turning]).max(axis=1)))).tolist() == [10, 100, 500,
+                                                                                                       1000]
+    # At rest, in the noise records and at rates within 80 % of ±250 °/s the gyroscope was at its finer range.
+    assert records.range_dps is not None
+    fine = records.range_dps == 250.0
+    slow = np.linalg.norm(records.reference_dps, axis=1) <= 200.0
+    assert np.array_equal(fine, slow) and fine.any() and (~fine).any()
 
 
 def test_the_fit_recovers_the_hidden_gyroscope_within_its_uncertainty(fitted: tuple[Path, dict]) -> None:
@@ -141,10 +148,15 @@ def test_rates_the_fit_never_saw_are_compensated(fitted: tuple[Path, dict], camp
         assert verification["rmse_dps"] < verification["rmse_before_dps"] / 50
         # Compensated with the calibration file, as firmware would: the same figure.
         records = gyro_records(campaign, serial)
-        rows = records.rows("verify-rate")
-        rate = apply(calibration.channel(serial, "gyro"), records.mean_dps[rows], records.temperature_c[rows],
-                     {"acceleration": records.force_g[rows]})
-        rms = float(np.sqrt(np.mean((rate - records.reference_dps[rows]) ** 2)))
+        assert records.range_dps is not None
+        errors = []
+        for range_dps in (250.0, 2000.0):  # 30 °/s at the finer range, 700 °/s at ±2000: each at its own range
+            rows = records.rows("verify-rate") & (records.range_dps == range_dps)
+            assert rows.any()
+            rate = apply(calibration.channel(serial, "gyro"), records.mean_dps[rows], records.temperature_c[rows],
+                         {"acceleration": records.force_g[rows]}, range_dps)
+            errors.append(rate - records.reference_dps[rows])
+        rms = float(np.sqrt(np.mean(np.concatenate(errors) ** 2)))
         assert rms == pytest.approx(verification["rmse_dps"], rel=1e-6)
         assert calibration.duts[serial].not_calibrated == {}
 
@@ -181,6 +193,12 @@ def test_the_noise_record_gives_each_axis_its_random_walk(fitted: tuple[Path, di
     ({"rates": {"rates_dps": [1400, 1600]}, "acquisition": {**PROCEDURE["acquisition"], "range_dps": 2000}},
      "rates", "beyond turntable axis outer's max_rate_dps 1500"),
     ({"rates": {"rates_dps": [10], "verify_rates_dps": [10]}}, "rates", "is a calibration rate"),
+    ({"acquisition": {**PROCEDURE["acquisition"], "fine_ranges": {"gyro": 300}}}, "fine_ranges.gyro",
+     "±300 dps is not a range of the ICM-42688-P"),
+    ({"acquisition": {**PROCEDURE["acquisition"], "range_dps": 250, "fine_ranges": {"gyro": 500}}, "rates":
+      {"rates_dps": [10], "settle_s": 1}}, "fine_ranges.gyro", "not finer than the channel's range"),
+    ({"acquisition": {**PROCEDURE["acquisition"], "fine_ranges": {"accel": 4}}}, "fine_ranges.accel",
+     "no accel channel that measures angular rate"),
 ])
 def test_a_rate_the_part_or_the_table_cannot_take_is_one_line(tmp_path: Path, changes: dict, key: str,
                                                               message: str) -> None:

@@ -61,3 +61,34 @@ def test_rig_repair_rewrites_a_format_2_campaign_as_format_3_value_for_value(for
             for name, values in old.items():
                 np.testing.assert_array_equal(accel[name][:], values)
     assert not load_campaign(format2).integrity_problems()
+
+
+def test_a_record_at_a_finer_range_keeps_it_in_the_journal_and_the_hdf5_file(imu_dry_run, tmp_path: Path) -> None:
+    """The small IMU campaign takes its gyroscope's records at rest and at low rates at ±250 °/s: the journal
+    and the HDF5 file both hold each record's range (the file only where some record differs), read the same,
+    and the measurements' digest covers them; a campaign at one range keeps its old digest (the quick dry run's
+    files carry none)."""
+    from tests.report.imu_campaign import copied
+
+    campaign_path, _ = copied(imu_dry_run, tmp_path)
+    from_journal, from_file = load_campaign(campaign_path), read_hdf5_campaign(campaign_path)
+    serial = from_journal.serials[0]
+    ranges = from_journal.channel_ranges(serial, "gyro")
+    assert set(ranges.tolist()) == {250.0, 2000.0}
+    assert np.array_equal(ranges, from_file.channel_ranges(serial, "gyro"))
+    assert set(from_journal.channel_ranges(serial, "accel").tolist()) == {2.0}
+    with h5py.File(campaign_path) as file:
+        assert f"duts/{serial}/gyro/range" in file and f"duts/{serial}/accel/range" not in file
+    assert measurements_sha256(from_journal) == measurements_sha256(from_file)
+    # The samples in °/s follow each record's own code size: 8 × finer at ±250 than at ±2000.
+    values = from_journal.channel_values(serial, "gyro")
+    codes = from_journal.channel_column(serial, "gyro", "raw_codes")
+    fine = ranges == 250.0
+    lsb = from_journal.channel_info(serial, "gyro").lsb
+    assert np.allclose(values[fine], codes[fine] * lsb / 8) and np.allclose(values[~fine], codes[~fine] * lsb)
+    # Another range for the same codes is another measurement.
+    changed = from_journal.poses[0].duts[0].channels["gyro"]
+    from dataclasses import replace
+    from_journal.poses[0].duts[0].channels["gyro"] = replace(changed, range=None if changed.range else 250.0)
+    from_journal._columns.clear()
+    assert measurements_sha256(from_journal) != measurements_sha256(from_file)
