@@ -176,10 +176,15 @@ class Walked:
 
 
 def snapshot(*folders: Path) -> dict[str, str]:
-    """Every file and folder under these, with its content's hash: what a request must leave as it was."""
+    """Every file and folder under these, with its content's hash: what a request must leave as it was. An SQLite
+    database's empty write-ahead log and its index are left out: SQLite leaves them behind when two connections
+    close at once (neither is the last to go), and an empty log holds nothing written."""
     found = {}
     for folder in folders:
         for path in sorted(folder.rglob("*")):
+            wal = path.with_name(path.name.removesuffix("-shm") + "-wal") if path.name.endswith("-shm") else path
+            if wal.name.endswith(".sqlite-wal") and (not wal.exists() or wal.stat().st_size == 0):
+                continue
             found[str(path)] = hashlib.sha256(path.read_bytes()).hexdigest() if path.is_file() else "folder"
     return found
 
