@@ -3,7 +3,8 @@ rest and at the largest calibrated rate about each axis, over the calibrated ran
 the verification records' errors against the simulation truth fall inside the expanded uncertainty.
 
 Sources: the fit (each setpoint's parameter covariance, carried through the thermal polynomials); the
-thermal model (each parameter's scatter about its polynomial beyond its setpoints' 1σ); the temperature (a
+thermal model (each parameter's scatter about its polynomial beyond its setpoints' 1σ; a joint fit's, its
+records' scatter about it beyond their noise); the temperature (a
 reading's temperature uncertainty times the parameters' slope); the table's rate accuracy (± uniform, a
 common relative error of every rate); its position accuracy (± uniform per axis: the turning axis tilted
 anew at each setpoint, a cross-axis error the polynomials average over the setpoints); the Earth's rate
@@ -104,7 +105,12 @@ def sources_dps(true_dps: np.ndarray, force_g: np.ndarray, temperature_c: np.nda
     jacobian = rate_jacobian(true_dps, force_g, params)
     weights = polynomial_weights(thermal, setpoint_temperatures_c, sigmas, temperature_c)                # (m, P, K)
     fit_cov = np.einsum("mpk,kpq,mqk->mpq", weights, covariances, weights)
-    thermal_var = thermal_model_variance(thermal, sigmas, between_setpoints_sigma(systematic))
+    misfit = systematic.get("model_misfit_dps")
+    # A joint fit's lack of fit is its records' own excess scatter (gyro_fit.joint_misfit_dps), not its per-band
+    # estimates' scatter about the polynomials.
+    thermal_var = (thermal_model_variance(thermal, sigmas, between_setpoints_sigma(systematic)) if misfit is None
+                   else np.zeros(gyro_model.N_PARAMETERS))
+    misfit_dps = np.zeros(3) if misfit is None else np.asarray(misfit, dtype=float)
     slope = _slope_per_c(thermal, temperature_c)
     magnitude = np.abs(true_dps)
     # Each setpoint's moves tilt the turning axis anew: its cross-axis estimates carry their own pointing
@@ -114,7 +120,7 @@ def sources_dps(true_dps: np.ndarray, force_g: np.ndarray, temperature_c: np.nda
     pointing_var = np.einsum("mpk,p->mp", weights**2, pointing)
     return {
         "fit": np.sqrt(np.einsum("mip,mpq,miq->mi", jacobian, fit_cov, jacobian)),
-        "thermal model": np.sqrt(np.einsum("mip,p->mi", jacobian**2, thermal_var)),
+        "thermal model": np.sqrt(np.einsum("mip,p->mi", jacobian**2, thermal_var) + misfit_dps**2),
         "temperature": np.abs(np.einsum("mip,mp->mi", jacobian, slope)) * temperature_u_c,
         "table rate": magnitude * systematic["scale"],
         "table pointing": np.sqrt(np.einsum("mip,mp->mi", jacobian**2, pointing_var)),

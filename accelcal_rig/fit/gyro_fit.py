@@ -241,12 +241,14 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
     temperatures = np.array([records.temperature_c[g].mean() for g in groups])
     estimates, sigmas = np.array([f.parameters for f in fits]), np.array([f.sigma for f in fits])
     thermal = fit_thermal(temperatures, estimates, sigmas, np.ones(gyro_model.N_PARAMETERS, dtype=bool), degree)
+    joint_rows: np.ndarray | None = None
     if joint:
         rows = np.concatenate(groups)
         refined = fit_gyro_joint(thermal, records.temperature_c[rows], records.mean_dps[rows],
                                  records.stderr_dps[rows], records.reference_dps[rows], records.force_g[rows],
                                  STDERR_FLOOR_DPS)
         thermal = replace(refined, residuals=estimates - refined.parameters_at(temperatures, "extrapolate"))
+        joint_rows = rows
     # A setpoint whose records do not determine the model (a campaign stopped in its rate steps) is left out,
     # said so: the others still calibrate the gyroscope over their range.
     thermal.warnings.extend(f"gyroscope setpoint left out: {why}" for why in skipped)
@@ -257,7 +259,8 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
     metrics["temperature_range_c"] = [float(temperatures.min()), float(temperatures.max())]
     metrics["earth_rate"] = earth_rate_statement(site)
     wander = _bias_wander_dps(allan)
-    systematic: dict[str, Any] = {**_systematic_sigma(site), "bias_instability_dps": wander}
+    misfit = None if joint_rows is None else joint_misfit_dps(records, thermal, joint_rows, wander)
+    systematic: dict[str, Any] = {**_systematic_sigma(site), "bias_instability_dps": wander, "model_misfit_dps": misfit}
     metrics["table_systematics_1sigma"] = {"scale_relative": systematic["scale"], "cross_rad": systematic["cross"],
                                            "earth_dps": systematic["earth_dps"]}
     metrics["bias_instability_1sigma_dps"] = (wander.tolist() if allan is not None
@@ -454,6 +457,24 @@ def _rms(values: np.ndarray) -> float | None:
 
 def _max(values: np.ndarray) -> float | None:
     return float(np.max(np.abs(values))) if values.size else None
+
+
+def joint_misfit_dps(records: GyroRecords, thermal: ThermalModel, rows: np.ndarray,
+                     wander_dps: np.ndarray) -> np.ndarray:
+    """(3,) a joint thermal fit's lack of fit, per axis: what its calibration records scatter about it beyond
+    their noise, quantisation and the bias's wander (`wander_dps`, a source of its own), where that scatter is
+    evidently more (χ² beyond its 99 % quantile); zero else. The ramp method's per-band estimates are no
+    measure of it: a band's fit takes its records, which a lagging fixture spreads over several degrees, at
+    one temperature, and scatters by that."""
+    predicted = gyro_model.distort_rate(records.reference_dps[rows], records.force_g[rows],
+                                        thermal.parameters_at(records.temperature_c[rows], "extrapolate"))
+    residual = predicted - records.mean_dps[rows]
+    noise2 = (np.maximum(records.stderr_dps[rows], STDERR_FLOOR_DPS) ** 2 + quantisation_sigma(records)[rows] ** 2
+              + np.asarray(wander_dps, dtype=float) ** 2)
+    dof = max(len(rows) - gyro_model.N_PARAMETERS * (thermal.degree + 1) // 3, 1)
+    evident = np.sum(residual**2 / noise2, axis=0) > chi2.ppf(0.99, dof)
+    excess = np.maximum(np.sum(residual**2, axis=0) / dof - np.mean(noise2, axis=0), 0.0)
+    return np.where(evident, np.sqrt(excess), 0.0)
 
 
 def _systematic_sigma(site: dict[str, Any]) -> dict[str, float]:
