@@ -387,7 +387,7 @@ def test_rig_export_writes_each_format(fitted_paper_campaign: tuple[Path, Path],
     assert (tmp_path / "cal.csv").read_text().count("\n") == 1 + 4 * 12
     assert "accelcal_apply(" in (tmp_path / "cal.h").read_text()
     assert main(["export", str(calibration), "--format", "csv"]) == 0  # standard output
-    assert capsys.readouterr().out.startswith("serial,channel,model,unit,parameter,")
+    assert capsys.readouterr().out.startswith("serial,channel,model,unit,range,parameter,")
 
 
 def test_rig_export_of_a_broken_calibration_is_one_line(tmp_path: Path, capsys) -> None:

@@ -79,7 +79,7 @@ def test_a_bidirectional_ramp_turns_at_the_last_setpoint_and_measures_half_way_b
 
 def test_the_imu_fast_method_turns_rate_steps_in_every_band_and_records_noise_only_where_soaked() -> None:
     """procedures/imu-fast.yaml: in each band each way, the ramp's setpoint written before every pose and every
-    rate step (24: four rates both ways about three axes); the still noise record and the verification rates
+    rate step (30: five rates both ways about three axes); the still noise record and the verification rates
     only where the DUTs were soaked (the start and the turn); `rig plan` times every step."""
     prepared = prepare(REPO / "procedures" / "imu-fast.yaml")
     plan = prepared.plan
@@ -89,7 +89,7 @@ def test_the_imu_fast_method_turns_rate_steps_in_every_band_and_records_noise_on
         steps = body[1::2]
         assert all(isinstance(step, AdvanceRamp) for step in body[0::2])
         assert [type(s) for s in steps[:12]] == [MeasurePose] * 12
-        assert [type(s) for s in steps[12:]].count(RateStep) == 24   # the table stopped between the axes
+        assert [type(s) for s in steps[12:]].count(RateStep) == 30   # the table stopped between the axes
     keys = [s.key for s in plan.records]
     assert sorted({k.split("/")[0] for k in keys if "/noise" in k}) == ["T-40", "T60"]
     assert sorted({k.split("/")[0] for k in keys if "/verify" in k}) == ["T-40", "T60"]
