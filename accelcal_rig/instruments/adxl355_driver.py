@@ -172,7 +172,7 @@ class Adxl355(BridgeCapturing):
             codes, carried = self._burst(carried)
             pieces.append({"accel": codes})
             have += len(codes)
-        status, temperature_after = self._status_and_temperature()
+        status, temperature_after = self._status_and_temperature(bare=True)
         if status & adxl355.STATUS_FIFO_OVR:
             return None
         return self._block(pieces, n_samples, t_start, (temperature_before, temperature_after))
@@ -182,10 +182,12 @@ class Adxl355(BridgeCapturing):
         raw = self._fifo_bus.read(adxl355.REG_FIFO_DATA, 3 * adxl355.FIFO_CAPACITY_ENTRIES)
         return adxl355.decode_fifo(raw, carried)
 
-    def _status_and_temperature(self) -> tuple[int, float]:
+    def _status_and_temperature(self, bare: bool = False) -> tuple[int, float]:
         """STATUS, FIFO_ENTRIES, TEMP2 and TEMP1 are neighbours: one burst, then the temperature read again
-        until two reads agree (the burst's may have torn)."""
-        status, _, high, low = self._bus.read(adxl355.REG_STATUS, 4)
+        until two reads agree (the burst's may have torn). `bare`: the burst on the bare transport, never retried
+        alone — STATUS's FIFO_OVR clears as it is read, so a reply lost after that read would hide the loss from
+        its retry (a lost reply fails the block, which is taken again whole)."""
+        status, _, high, low = (self._fifo_bus if bare else self._bus).read(adxl355.REG_STATUS, 4)
         return self._agreed_temperature_c((status, adxl355.raw_temperature(high, low)))
 
     def _status(self) -> int:

@@ -330,3 +330,48 @@ def test_a_capture_started_together_is_timed_from_its_request_not_from_when_its_
         for driver, server in zip(drivers, servers):
             driver.close()
             server.stop()
+
+
+def test_a_lost_reply_to_the_status_that_ends_a_drained_block_is_never_retried_alone() -> None:
+    """A version 1 bridge (the host drains the FIFO): STATUS's FIFO_OVR clears as it is read, so the read that
+    ends a block is not retried by itself when its reply is lost — the retry would read a cleared flag and pass a
+    block that lost samples. The loss reaches the caller, who takes the block again whole."""
+    from accelcal_rig.instruments import adxl355
+
+    clock = VirtualClock()
+    lab = VirtualLab(load_rig(SIM_RIG).model, clock, 3)
+    server = SimulatedBridgeServer(lab, 1, 1).start()
+    bus = SerialBridge.open(server.path)
+    driver = Adxl355(bus, "ADX355-A002", clock)
+    retries: list[int] = []
+
+    def retried(operation, reconnect=None):
+        for attempt in range(3):
+            try:
+                return operation()
+            except TransientInstrumentError:
+                retries.append(attempt)
+        return operation()
+
+    real_read, status_reads = bus.read, []
+
+    def lossy_read(register: int, count: int) -> bytes:
+        reply = real_read(register, count)
+        if register == adxl355.REG_STATUS and count == 4:
+            status_reads.append(reply[0])
+            if len(status_reads) == 3:  # the block's closing STATUS: read (and cleared) on the part, then lost
+                raise TransientInstrumentError("reply lost on the line")
+        return reply
+
+    try:
+        driver.retry_exchanges(retried)
+        bring_up(driver)
+        bus.read = lossy_read  # type: ignore[method-assign]
+        with pytest.raises(TransientInstrumentError, match="reply lost"):
+            driver.acquire(30)
+        assert len(status_reads) == 3 and retries == []   # not retried alone
+        bus.read = real_read  # type: ignore[method-assign]
+        assert len(driver.acquire(30).codes["accel"]) == 30  # taken again whole
+    finally:
+        driver.close()
+        server.stop()
