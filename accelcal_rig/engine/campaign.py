@@ -33,7 +33,7 @@ from accelcal_rig.engine.rate_steps import bring_rate_axes_to_rest
 from accelcal_rig.engine.resume import ResumePoint
 from accelcal_rig.engine.run_context import RunContext
 from accelcal_rig.engine.safe_state import apply_safe_state, safe_setpoint_c
-from accelcal_rig.engine.states import ACTIVE_STATES, State, StateMachine
+from accelcal_rig.engine.states import ACTIVE_STATES, TRANSITION_KIND, State, StateMachine, transition_text
 from accelcal_rig.engine.step_table import handler_for
 from accelcal_rig.engine.thermal_steps import SetpointSkipped
 from accelcal_rig.errors import CampaignAborted, InstrumentError, RigError, TransientInstrumentError
@@ -246,9 +246,8 @@ class CampaignRunner:
                                n_duts, self.clock.now(), fit, fit_failed)
 
     def _record_transition(self, previous: State, target: State, reason: str) -> None:
-        suffix = f" ({reason})" if reason else ""
         if self.events is not None:
-            self.events.debug("transition", f"{previous} → {target}{suffix}")
+            self.events.debug(TRANSITION_KIND, transition_text(previous, target, reason))
         if self.report.phase_of(target) != self.report.phase_of(previous):
             self.report.publish(self.machine.state)  # within a pose the snapshot after storing it says all
 

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from enum import StrEnum
+
+from accelcal_rig.store.records import StoredEvent
 
 
 class State(StrEnum):
@@ -46,6 +48,21 @@ TRANSITIONS: dict[State, frozenset[State]] = {
 # A fault or a signal may strike in any active state; it always leads through ABORTING to SAFE.
 for _state in ACTIVE_STATES:
     TRANSITIONS[_state] = TRANSITIONS[_state] | {State.ABORTING}
+
+
+#: The event kind the engine logs each move under, its message `transition_text`'s.
+TRANSITION_KIND = "transition"
+
+
+def transition_text(previous: State, target: State, reason: str = "") -> str:
+    """How a move reads in the campaign's event log: "safe → fit", with its reason in brackets."""
+    return f"{previous} → {target}" + (f" ({reason})" if reason else "")
+
+
+def entered_at(events: Iterable[StoredEvent], state: State) -> list[str]:
+    """The wall-clock times the log says the engine entered `state`, oldest first."""
+    return [e.wall_time for e in events
+            if e.kind == TRANSITION_KIND and e.message.split(" (")[0].endswith(f"→ {state}")]
 
 
 class IllegalTransition(RuntimeError):

@@ -36,7 +36,7 @@ def to_csv(calibration: CalibrationFile) -> str:
             writer.writerow([serial, channel, sensor.model, sensor.unit, repr(sensor.range), name, *domain,
                              repr(sensor.lsb), *(repr(float(c)) for c in coefficients)])
         for other in sensor.range_scales:
-            lsb = sensor.lsb * other.range / sensor.range
+            lsb = sensor.lsb * other.range / sensor.range  # the part's codes are one width at every range
             for axis, scale in zip("xyz", other.scale):
                 writer.writerow([serial, channel, sensor.model, sensor.unit, repr(other.range), f"range_scale_{axis}",
                                  *domain, repr(lsb), repr(float(scale)), *(["0.0"] * degree)])

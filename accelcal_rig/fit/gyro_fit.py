@@ -73,7 +73,7 @@ class GyroRecords:
     def lsb_dps(self) -> np.ndarray:
         """(N, 1) each record's code size: the channel's, scaled by the record's range (codes of one width)."""
         ranges = np.full(len(self.kind), self.info.range) if self.range_dps is None else self.range_dps
-        return (self.info.lsb * ranges / self.info.range)[:, None]
+        return np.asarray(self.info.lsb_at(ranges))[:, None]
 
     def rows(self, *kinds: str) -> np.ndarray:
         return np.isin(self.kind, kinds)

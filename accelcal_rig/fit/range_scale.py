@@ -49,6 +49,7 @@ def fit_range_scales(mean_dps: np.ndarray, stderr_dps: np.ndarray, reference_dps
     if not others:
         return []
     per_range: dict[float, list[tuple[np.ndarray, np.ndarray]]] = {r: [] for r in others}
+    failed: list[str] = []
     for setpoint in dict.fromkeys(setpoint_c.tolist()):
         rows = setpoint_c == setpoint
         turning = np.linalg.norm(reference_dps, axis=1) > 1.0
@@ -58,15 +59,18 @@ def fit_range_scales(mean_dps: np.ndarray, stderr_dps: np.ndarray, reference_dps
         try:
             estimates = _fit_setpoint(mean_dps[rows], stderr_dps[rows], reference_dps[rows], force_g[rows],
                                       range_dps[rows], present, stderr_floor_dps)
-        except (np.linalg.LinAlgError, ValueError):
+        except (np.linalg.LinAlgError, ValueError) as exc:
+            failed.append(f"{setpoint:g} °C: {exc}")
             continue
         for r, estimate in estimates.items():
             per_range[r].append(estimate)
     scales = []
     for r in others:
         if not per_range[r]:
+            why = f" (fits that failed: {'; '.join(failed)})" if failed else ""
             raise RangeScaleError(f"records at ±{r:g} °/s but no setpoint whose rate steps turn at both it and the "
-                                  f"channel's ±{own_range:g} °/s: its sensitivity cannot be tied to the channel's")
+                                  f"channel's ±{own_range:g} °/s and determine the model: its sensitivity cannot be "
+                                  f"tied to the channel's{why}")
         values = np.array([v for v, _ in per_range[r]])
         sigmas = np.array([s for _, s in per_range[r]])
         weights = 1.0 / sigmas**2
@@ -89,7 +93,7 @@ def _fit_setpoint(mean_dps: np.ndarray, stderr_dps: np.ndarray, reference_dps: n
     n_model = gyro_model.N_PARAMETERS
     at = [range_dps == r for r in others]
     if 3 * len(mean_dps) <= n_model + 3 * len(others):
-        raise ValueError("too few records")
+        raise ValueError(f"{len(mean_dps)} records for {n_model + 3 * len(others)} parameters")
 
     def factors(epsilon: np.ndarray) -> np.ndarray:
         scale = np.ones_like(mean_dps)

@@ -308,9 +308,12 @@ def _still_fit(means: np.ndarray, stderr: np.ndarray, force_g: np.ndarray) -> _S
     design = np.column_stack([np.ones(n), force_g])
     dof = 3 * (n - 4)
     spread = np.linalg.svd(force_g - force_g.mean(axis=0), compute_uv=False) if n > 1 else np.zeros(0)
+    chi2_bias_reduced = _dof_or_none(chi2_bias, 3 * n - 3)
+    # The bias alone: its 1σ widened by √χ²_red where the intervals scatter more than their white noise says, as
+    # the fit with the moves widens its own.
+    bias_sigma = bias_sigma * math.sqrt(max(chi2_bias_reduced or 1.0, 1.0))
     if dof <= 0 or len(spread) < 3 or spread.min() < MIN_FORCE_SPREAD_G:
-        return _Still(bias, bias_sigma, np.zeros((3, 3)), np.full((3, 3), np.nan), False, None,
-                      _dof_or_none(chi2_bias, 3 * n - 3),
+        return _Still(bias, bias_sigma, np.zeros((3, 3)), np.full((3, 3), np.nan), False, None, chi2_bias_reduced,
                       f"g-sensitivity not determinable from the {n} static intervals (their forces do not span "
                       "space beside the bias, or too few): not fitted, held at zero")
     coefficients, sigmas, chi2 = np.zeros((3, 4)), np.zeros((3, 4)), 0.0
@@ -323,8 +326,7 @@ def _still_fit(means: np.ndarray, stderr: np.ndarray, force_g: np.ndarray) -> _S
     statistic = ((chi2_bias - chi2) / 9.0) / (chi2 / dof) if chi2 > 0 else math.inf
     p_value = float(f_distribution.sf(statistic, 9, dof))
     if p_value >= GSENS_ALPHA:
-        return _Still(bias, bias_sigma, np.zeros((3, 3)), np.full((3, 3), np.nan), False, p_value,
-                      _dof_or_none(chi2_bias, 3 * n - 3),
+        return _Still(bias, bias_sigma, np.zeros((3, 3)), np.full((3, 3), np.nan), False, p_value, chi2_bias_reduced,
                       f"g-sensitivity not fitted: the still intervals' means do not depend on the force (F-test "
                       f"p = {p_value:.2g} ≥ {GSENS_ALPHA:g}); held at zero")
     scale = math.sqrt(max(chi2 / dof, 1.0))  # scatter beyond the white noise widens the 1σ, as the fit's does

@@ -11,6 +11,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from accelcal_rig.engine.states import State, entered_at
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import (
     FORMAT_VERSION,
@@ -100,8 +101,7 @@ def _entry(calibration: CalibrationFile, channel: str, sensor: ChannelCalibratio
 def measured_at(campaign: Campaign) -> str:
     """When the campaign's measurements ended: where the run went on to fit them (the journal's transition into
     the fit stage), that moment, since the campaign is only marked finished after its fit; else its end."""
-    into_fit = [e.wall_time for e in campaign.events
-                if e.kind == "transition" and e.message.split(" (")[0].endswith("→ fit")]
+    into_fit = entered_at(campaign.events, State.FIT)
     return (into_fit[-1] if into_fit else "") or campaign.finished or campaign.header.created
 
 

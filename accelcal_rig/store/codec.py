@@ -223,7 +223,9 @@ def _pose_channels(meta: dict, arrays: dict[str, np.ndarray], serials: list[str]
             ranges = arrays.get(f"{name}/range")
             if ranges is not None and ranges.shape != (len(owners),):
                 raise ValueError(f"{name}/range has shape {ranges.shape}, expected {(len(owners),)}")
-            range_ = None if ranges is None or not np.isfinite(ranges[i]) else float(ranges[i])
+            range_ = None if ranges is None or np.isnan(ranges[i]) else float(ranges[i])
+            if range_ is not None and not 0.0 < range_ < np.inf:
+                raise ValueError(f"{name}/range of sensor {serial} is {range_}, not a ± full scale")
             channels[serial][name] = ChannelPoseRecord(fields["raw_codes"][i], fields["mean"][i],
                                                        fields["stderr"][i], fields["reference"][i], range_)
     for serial in serials:

@@ -150,8 +150,7 @@ class Campaign:
     def channel_values(self, serial: str, channel: str) -> np.ndarray:
         """(N, n, axes) each record's samples in the channel's unit: its codes times its own code size (the
         channel's, scaled by the record's range: a part's codes are one width at every range)."""
-        info = self.channel_info(serial, channel)
-        lsb = info.lsb * self.channel_ranges(serial, channel) / info.range
+        lsb = self.channel_info(serial, channel).lsb_at(self.channel_ranges(serial, channel))
         return self.channel_column(serial, channel, "raw_codes") * lsb[:, None, None]
 
     def channel_info(self, serial: str, channel: str) -> ChannelInfo:

@@ -274,7 +274,8 @@ def read_campaign_file(file: h5py.File) -> Campaign:
         pose_duts = [DutPoseRecord(
             serial=s,
             channels={c.name: ChannelPoseRecord(**{name: duts[s][(c.name, name)][i] for name in CHANNEL_FIELDS},
-                                                range=_record_range(duts[s].get((c.name, "range")), i, c.range))
+                                                range=_record_range(duts[s].get((c.name, "range")), i, c.range,
+                                                                    f"duts/{s}/{c.name}/range"))
                       for c in header.dut_channels(s)},
             temperature_c=(float(duts[s][("", "temperature_c")][i, 0]), float(duts[s][("", "temperature_c")][i, 1])),
             temperature_in_band=bool(duts[s][("", "temperature_in_band")][i]),
@@ -309,10 +310,13 @@ def read_campaign_file(file: h5py.File) -> Campaign:
     return campaign
 
 
-def _record_range(ranges: np.ndarray | None, row: int, channel_range: float) -> float | None:
-    """A record's range as the pose record holds it: None where it is the channel's own."""
+def _record_range(ranges: np.ndarray | None, row: int, channel_range: float, path: str) -> float | None:
+    """A record's range as the pose record holds it: None where it is the channel's own; one that is no ± full
+    scale (not positive, not finite) is damage."""
     if ranges is None or float(ranges[row]) == channel_range:
         return None
+    if not 0.0 < float(ranges[row]) < np.inf:
+        raise DamagedFile(f"{path} row {row + 1}: {float(ranges[row])}, not a ± full scale")
     return float(ranges[row])
 
 

@@ -41,6 +41,11 @@ class ChannelInfo:
     range: float                     # ± full scale in `unit`
     lsb: float                       # `unit` per code
 
+    def lsb_at(self, range_: Any) -> Any:
+        """The code size at another range of the part (scalar or array): the part's codes are one width at every
+        range, so it scales with the range."""
+        return self.lsb * range_ / self.range
+
     def attrs(self) -> dict[str, Any]:
         return {"quantity": self.quantity, "unit": self.unit, "axes": list(self.axes), "range": self.range,
                 "lsb": self.lsb}

@@ -92,3 +92,21 @@ def test_a_record_at_a_finer_range_keeps_it_in_the_journal_and_the_hdf5_file(imu
     from_journal.poses[0].duts[0].channels["gyro"] = replace(changed, range=None if changed.range else 250.0)
     from_journal._columns.clear()
     assert measurements_sha256(from_journal) != measurements_sha256(from_file)
+
+
+def test_a_record_range_that_is_no_range_is_one_line_naming_the_dataset(imu_dry_run, tmp_path: Path) -> None:
+    """A damaged or tampered `range` dataset (a negative or infinite ± full scale) is damage said in one line
+    naming the file and the dataset, never codes scaled by it."""
+    from accelcal_rig.errors import ConfigError
+    from tests.report.imu_campaign import copied
+
+    campaign_path, _ = copied(imu_dry_run, tmp_path)
+    serial = load_campaign(campaign_path).serials[0]
+    for bad in (-250.0, np.inf):
+        with h5py.File(campaign_path, "r+") as file:
+            file[f"duts/{serial}/gyro/range"][0] = bad
+        with pytest.raises(ConfigError) as refused:
+            read_hdf5_campaign(campaign_path)
+        message = str(refused.value)
+        assert "\n" not in message and str(campaign_path) in message
+        assert f"duts/{serial}/gyro/range row 1: {bad}, not a ± full scale" in message
