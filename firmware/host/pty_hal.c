@@ -44,9 +44,10 @@ static struct {
     uint64_t wall_us;
     uint64_t cpu_us;
     uint64_t waited_us;
-} board = {false, -1, 0, 0, 0, 0};
-/* Set by SIGCONT: the process was stopped (a stalled board) since the last mark. */
-static volatile sig_atomic_t continued;
+    sig_atomic_t continuations; /* SIGCONTs counted at the last mark */
+} board = {false, -1, 0, 0, 0, 0, 0};
+/* SIGCONTs so far (a stalled board each), counted by the handler. */
+static volatile sig_atomic_t continuations;
 
 static bool make_raw(int fd)
 {
@@ -186,12 +187,28 @@ static bool read_waited_us(uint64_t *waited)
     return true;
 }
 
+/* The wall clock, and the SIGCONTs counted when it was read: every one of them came before the reading, every
+ * later one after it. (A SIGCONT between the reading and the look at the count would otherwise be taken for a
+ * stop inside an interval that ended before it, and the stop's time counted in none.) */
+static uint64_t wall_after_continuations(sig_atomic_t *seen)
+{
+    for (;;) {
+        const sig_atomic_t before = continuations;
+        const uint64_t wall = clock_us(CLOCK_MONOTONIC);
+        if (continuations == before) {
+            *seen = before;
+            return wall;
+        }
+    }
+}
+
 /* Moves the board clock on to now. The time since the last mark counts as the CPU time used in it, plus
  * (for a sleep asked to last at most `sleep_limit_us`; none: -1) the time asleep up to that limit, plus
  * all the time neither running nor waiting for a CPU if the process was stopped meanwhile. */
 static void mark_board_clock(int64_t sleep_limit_us)
 {
-    const uint64_t wall = clock_us(CLOCK_MONOTONIC);
+    sig_atomic_t seen;
+    const uint64_t wall = wall_after_continuations(&seen);
     const uint64_t cpu = clock_us(CLOCK_THREAD_CPUTIME_ID);
     uint64_t waited = board.waited_us;
     (void)read_waited_us(&waited); /* on a failed read, no waiting is seen */
@@ -200,8 +217,7 @@ static void mark_board_clock(int64_t sleep_limit_us)
     const uint64_t not_idle = cpu_used + (waited - board.waited_us);
     const uint64_t idle = wall - board.wall_us > not_idle ? wall - board.wall_us - not_idle : 0u;
     uint64_t counted = cpu_used;
-    if (continued) {
-        continued = 0;
+    if (seen != board.continuations) {
         counted += idle;
     } else if (sleep_limit_us > 0) {
         counted += idle < (uint64_t)sleep_limit_us ? idle : (uint64_t)sleep_limit_us;
@@ -210,12 +226,13 @@ static void mark_board_clock(int64_t sleep_limit_us)
     board.wall_us = wall;
     board.cpu_us = cpu;
     board.waited_us = waited;
+    board.continuations = seen;
 }
 
 static void on_continue(int signal_number)
 {
     (void)signal_number;
-    continued = 1;
+    ++continuations;
 }
 
 bool pty_hal_use_board_clock(void)
