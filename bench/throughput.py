@@ -5,15 +5,20 @@
 Each method's shipped procedure is run as a dry run on `configs/sim-honest.yaml` (the chamber's overshoot
 and cooling rate falling towards its floor, slot-to-slot air differences, a fixture lagging more with
 more DUTs) with `--duts` DUTs, its sensors given the effects Eq. 1 does not hold (`SENSOR_EFFECTS`:
-hysteresis relaxing over hours, bias and scale by the rate of temperature change) and 7 verification
-poses the fit never sees, at rest (`verify.on_ramp: false`: a ramp's where it soaks, its ends). Methods:
+hysteresis relaxing over hours, bias and scale by the rate of temperature change) and 48 verification
+poses the fit never sees, at rest (`verify.on_ramp: false`: a ramp's where it soaks, its ends): enough |g|
+errors (96 for a ramp) that a DUT's RMSE ratio scatters by about 1/√(2·96) = 7 %, not the 19 % of 7 poses
+(14 errors), so a per-DUT limit of 1.2 × judges the calibration, not the draw. Methods:
 the paper's soak at every setpoint, today's ramp (one way), the bidirectional ramp. Figures of the worst DUT of each run, the median over the seeds:
 
 - `rig_hours`: the campaign's clock time, first ramp to last pose; `rig_hours_per_dut`;
 - `lower_bound_hours`: the least time the rig's physics allows to take the fixture once through the
   range (see `lower_bound_s`);
-- `verification_rmse_mg` |g| RMSE on the verification poses against `expected_fit_rmse_mg` (what the
-  noise alone would leave) and `noise_floor_mg`;
+- `verification_rmse_mg` |g| RMSE on the verification poses against `expected_verification_rmse_mg` (what
+  the noise alone would leave on them: each check's own and the calibration's carried to it) and
+  `noise_floor_mg`; `verification_over_expected`: the largest of the DUTs' own ratios,
+  `verification_over_expected_median` their median; `verification_over_expected_any_seed`: the largest
+  DUT ratio of any seed (every other figure is the median over the seeds);
 - `residual_drift_mg`: the largest spread of a verification bias over temperature (worst axis and DUT);
 - `hysteresis_mg`: warming minus cooling as the bidirectional fit finds it (largest axis); null for a
   method that approaches each temperature from one side only (it cannot see it);
@@ -61,7 +66,7 @@ SENSOR_EFFECTS = {"hysteresis_mg": 0.2, "hysteresis_span_c": 10.0, "hysteresis_t
                   "rate_bias_mg_per_c_per_min": 0.1, "rate_scale_ppm_per_c_per_min": 5.0}
 #: Verification poses of every method (none of them a calibration pose of any schedule here), at rest: at
 #: every setpoint of the soak method, where the ramps soak (their ends) for theirs.
-VERIFY = {"schedule": {"kind": "sphere", "count": 7}, "at_setpoints": True, "on_ramp": False}
+VERIFY = {"schedule": {"kind": "sphere", "count": 48}, "at_setpoints": True, "on_ramp": False}
 #: The lower bound's DUTs come within this of each end of the range.
 END_WITHIN_C = 0.5
 
@@ -146,7 +151,10 @@ def figures(method: str, duts: int, seed: int) -> dict[str, Any]:
         # uses it (the middle of both branches), is off by up to ±h at a soaked end (docs/calibration.md).
         "verification_as_applied_rmse_mg": max(m.get("verification_as_applied", m["verification"])["rmse_mg"]
                                                for m in metrics),
-        "expected_fit_rmse_mg": max(m["expected_fit_rmse_mg"] for m in metrics),
+        "expected_verification_rmse_mg": max(v["expected_rmse_mg"] for v in verification),
+        "verification_over_expected": max(v["rmse_mg"] / v["expected_rmse_mg"] for v in verification),
+        "verification_over_expected_median": statistics.median(v["rmse_mg"] / v["expected_rmse_mg"]
+                                                               for v in verification),
         "noise_floor_mg": max(v["noise_floor_mg"] for v in verification),
         "residual_drift_mg": max(max(v["drift_mg"]) for v in verification),
         "hysteresis_mg": max(hysteresis) if hysteresis else None,
@@ -168,7 +176,7 @@ def median_record(rows: list[dict[str, Any]]) -> dict[str, Any]:
         elif key not in ("method", "n_duts", "seed", "state"):
             record[key] = statistics.median(values) if values else None
     record["rig_time_over_lower_bound"] = record["rig_hours"] / record["lower_bound_hours"]
-    record["verification_over_expected"] = record["verification_rmse_mg"] / record["expected_fit_rmse_mg"]
+    record["verification_over_expected_any_seed"] = max(r["verification_over_expected"] for r in rows)
     return record
 
 
@@ -194,8 +202,9 @@ def main() -> None:
         hysteresis = "not visible" if r["hysteresis_mg"] is None else f"{r['hysteresis_mg']:.3f} mg"
         print(f"  {r['method']:>18}: rig {r['rig_hours']:.2f} h ({r['rig_hours_per_dut']:.3f} h/DUT; lower bound "
               f"{r['lower_bound_hours']:.2f} h, ×{r['rig_time_over_lower_bound']:.2f}); verification RMSE "
-              f"{r['verification_rmse_mg']:.4f} mg (expected {r['expected_fit_rmse_mg']:.4f}, "
-              f"×{r['verification_over_expected']:.2f}; floor {r['noise_floor_mg']:.4f}; as applied "
+              f"{r['verification_rmse_mg']:.4f} mg (expected {r['expected_verification_rmse_mg']:.4f}; a DUT's ratio "
+              f"×{r['verification_over_expected_median']:.2f} median, ×{r['verification_over_expected']:.2f} worst; "
+              f"floor {r['noise_floor_mg']:.4f}; as applied "
               f"{r['verification_as_applied_rmse_mg']:.4f}); residual drift "
               f"{r['residual_drift_mg']:.4f} mg; hysteresis {hysteresis}; at rest: RMSE {r['at_rest_rmse_mg']:.4f} mg, "
               f"drift {r['at_rest_drift_mg']:.4f} mg over {r['calibrated_range_c'][0]:.1f}…{r['calibrated_range_c'][1]:.1f} °C; "

@@ -18,6 +18,13 @@ RATE_HALF_WINDOW_S = 150.0
 #: The spans of travel over which a hysteresis may swing from one branch to the other that the joint fit tries
 #: beside the sign of the last change (a swing at once): it keeps the one its poses fit best.
 HYSTERESIS_SPANS_C = (2.5, 5.0, 10.0, 20.0, 40.0)
+#: The time constants, h, over which a hysteresis may relax towards the middle at rest (a package's stress
+#: creeping), tried with each span; None: it holds its state. A ramp's checks are where it soaks, the ends, where
+#: a relaxed state and a held one differ most.
+HYSTERESIS_RELAXATIONS_H = (None, 1.0, 2.0, 4.0, 8.0)
+#: Every (span, relaxation) pair the joint fit tries beside the sign of the last change, in the order
+#: `hysteresis_states` gives them.
+HYSTERESIS_CANDIDATES = tuple((span, relax) for span in HYSTERESIS_SPANS_C for relax in HYSTERESIS_RELAXATIONS_H)
 #: The readings are averaged this far either side before the swing is followed (their noise and 0.11 °C steps
 #: would otherwise walk it at rest).
 STATE_HALF_WINDOW_S = 60.0
@@ -67,24 +74,28 @@ def approach_directions(t_s: np.ndarray, temperature_c: np.ndarray, history_t_s:
 
 
 def hysteresis_states(t_s: np.ndarray, temperature_c: np.ndarray, history_t_s: np.ndarray, history_c: np.ndarray,
-                      spans_c: tuple[float, ...] = HYSTERESIS_SPANS_C) -> np.ndarray:
-    """(S, N) each pose's hysteresis state in −1…+1 for each span of `spans_c`: a stop operator on the DUT's own
-    temperature history (its readings, averaged within STATE_HALF_WINDOW_S either side), moving by 2 × the
-    temperature's change / span and held at ±1 (+1 after warming through the whole span, −1 after cooling).
+                      candidates: tuple[tuple[float, float | None], ...] = HYSTERESIS_CANDIDATES) -> np.ndarray:
+    """(S, N) each pose's hysteresis state in −1…+1 for each (span, relaxation) of `candidates`: a stop operator
+    on the DUT's own temperature history (its readings, averaged within STATE_HALF_WINDOW_S either side), moving
+    by 2 × the temperature's change / span and held at ±1 (+1 after warming through the whole span, −1 after
+    cooling), relaxing towards 0 with its time constant (hours; None: not at all) as time passes.
     A sign of the last change (`approach_directions`) is the limit of a span of zero; a real sensor's package
-    and die attach change state over some travel, so after a turn it passes through the middle."""
+    and die attach change state over some travel, so after a turn it passes through the middle, and their
+    stress creeps back at rest."""
     times, readings = _history(t_s, temperature_c, history_t_s, history_c)
     start = np.searchsorted(times, times - STATE_HALF_WINDOW_S, side="left")
     stop = np.searchsorted(times, times + STATE_HALF_WINDOW_S, side="right")
     sums = np.concatenate([[0.0], np.cumsum(readings)])
     smooth = (sums[stop] - sums[start]) / (stop - start)
     change = np.diff(smooth, prepend=smooth[:1])
-    states = np.empty((len(spans_c), len(times)))
+    elapsed_s = np.diff(times, prepend=times[:1])
+    states = np.empty((len(candidates), len(times)))
     moved = np.flatnonzero(np.abs(smooth - smooth[0]) > MOVED_C) if len(smooth) else np.zeros(0, int)
     first = float(np.sign(smooth[moved[0]] - smooth[0])) if len(moved) else 1.0
-    for k, span in enumerate(spans_c):
+    for k, (span, relax_h) in enumerate(candidates):
+        kept = np.ones_like(elapsed_s) if relax_h is None else np.exp(-elapsed_s / (3600.0 * relax_h))
         state = first  # before it first moved: as it then did
-        for i, step in enumerate(change):
-            state = min(1.0, max(-1.0, state + 2.0 * step / span))
+        for i, (step, keep) in enumerate(zip(change.tolist(), kept.tolist())):
+            state = min(1.0, max(-1.0, state * keep + 2.0 * step / span))
             states[k, i] = state
-    return np.array([np.interp(t_s, times, row) for row in states]).reshape(len(spans_c), len(t_s))
+    return np.array([np.interp(t_s, times, row) for row in states]).reshape(len(candidates), len(t_s))

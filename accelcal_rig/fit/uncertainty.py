@@ -182,13 +182,7 @@ def output_uncertainty(raw_g: np.ndarray, temperature_c: np.ndarray, model: Ther
     params = model.parameters_at(temperature_c, out_of_range)            # (n, 12)
     output = correct(raw_g, params)
     by_parameter = correct_jacobian(raw_g, params)                    # (n, 3, 12)
-    x = model.scaled(temperature_c)
-    if out_of_range == "clamp":
-        x = np.clip(x, -1.0, 1.0)
-    powers = np.vander(x, covariance.n_powers, increasing=True)       # (n, m)
-    by_coefficient = np.einsum("nap,nm->napm", by_parameter[:, :, covariance.free], powers).reshape(
-        len(raw_g), 3, -1)
-
+    by_coefficient = _by_coefficient(by_parameter, temperature_c, model, covariance, out_of_range)
     rows = by_coefficient.reshape(3 * len(raw_g), by_coefficient.shape[-1])  # (n·3, P)
 
     def through(cov: np.ndarray) -> np.ndarray:
@@ -198,9 +192,7 @@ def output_uncertainty(raw_g: np.ndarray, temperature_c: np.ndarray, model: Ther
 
     gain = error_matrix(params)                                        # ∂output/∂raw
     reading = np.sqrt(np.einsum("nab,nb,nab->na", gain, np.asarray(reading_stderr_g, dtype=float) ** 2, gain))
-    warmer = correct(raw_g, model.parameters_at(temperature_c + _STEP_C, out_of_range))
-    cooler = correct(raw_g, model.parameters_at(temperature_c - _STEP_C, out_of_range))
-    by_temperature = (warmer - cooler) / (2 * _STEP_C)
+    by_temperature = _by_temperature(raw_g, temperature_c, model, out_of_range)
     model_u = np.sqrt(np.einsum("nap,np,nap->na", by_parameter, covariance.model_variance_at(temperature_c),
                                 by_parameter))
     sources = {
@@ -215,6 +207,43 @@ def output_uncertainty(raw_g: np.ndarray, temperature_c: np.ndarray, model: Ther
     sources["temperature"] = np.abs(by_temperature) * np.asarray(temperature_u_c, dtype=float)[:, None]
     sources[size_source] = np.abs(output) * gravity_relative_u
     return sources
+
+
+def _by_coefficient(by_parameter: np.ndarray, temperature_c: np.ndarray, model: ThermalModel,
+                    covariance: CoefficientCovariance, out_of_range: OutOfRange) -> np.ndarray:
+    """The compensated output's derivatives (n, 3, P) by the thermal model's free coefficients."""
+    x = model.scaled(temperature_c)
+    if out_of_range == "clamp":
+        x = np.clip(x, -1.0, 1.0)
+    powers = np.vander(x, covariance.n_powers, increasing=True)       # (n, m)
+    return np.einsum("nap,nm->napm", by_parameter[:, :, covariance.free], powers).reshape(len(by_parameter), 3, -1)
+
+
+def _by_temperature(raw_g: np.ndarray, temperature_c: np.ndarray, model: ThermalModel,
+                    out_of_range: OutOfRange) -> np.ndarray:
+    """The compensated output's derivative (n, 3) by the temperature it is compensated at, per °C."""
+    warmer = correct(raw_g, model.parameters_at(temperature_c + _STEP_C, out_of_range))
+    cooler = correct(raw_g, model.parameters_at(temperature_c - _STEP_C, out_of_range))
+    return (warmer - cooler) / (2 * _STEP_C)
+
+
+def magnitude_noise_u(raw_g: np.ndarray, temperature_c: np.ndarray, model: ThermalModel,
+                      covariance: CoefficientCovariance, temperature_u_c: np.ndarray,
+                      out_of_range: OutOfRange) -> np.ndarray:
+    """Each compensated reading's magnitude standard uncertainty (n,) from the noise of the calibration poses
+    (through the coefficients, their correlations kept) and of the temperature it is compensated at: what noise
+    adds to a check's Eq. 9 error beyond its own reading's. Random from calibration to calibration, unlike the
+    pointing and the model's lack of fit."""
+    raw_g = np.asarray(raw_g, dtype=float)
+    temperature_c = np.asarray(temperature_c, dtype=float)
+    params = model.parameters_at(temperature_c, out_of_range)
+    output = correct(raw_g, params)
+    direction = output / np.linalg.norm(output, axis=1, keepdims=True)
+    by_coefficient = _by_coefficient(correct_jacobian(raw_g, params), temperature_c, model, covariance, out_of_range)
+    along = np.einsum("na,nap->np", direction, by_coefficient)        # d|output| by each coefficient
+    fit_var = np.maximum(np.einsum("np,pq,nq->n", along, covariance.noise, along), 0.0)
+    slope = np.einsum("na,na->n", direction, _by_temperature(raw_g, temperature_c, model, out_of_range))
+    return np.sqrt(fit_var + (slope * np.asarray(temperature_u_c, dtype=float)) ** 2)
 
 
 def combined(sources: dict[str, np.ndarray]) -> np.ndarray:

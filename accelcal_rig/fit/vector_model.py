@@ -16,9 +16,10 @@ from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from scipy.stats import chi2
 
 from accelcal_rig.fit.approach import (
-    HYSTERESIS_SPANS_C,
+    HYSTERESIS_CANDIDATES,
     approach_directions,
     hysteresis_states,
     temperature_rates_c_per_min,
@@ -61,7 +62,13 @@ from accelcal_rig.fit.parameter_uncertainty import (
 )
 from accelcal_rig.fit.sfem import correct, norm_only_gauge
 from accelcal_rig.fit.thermal import ThermalModel, fit_thermal
-from accelcal_rig.fit.uncertainty import CoefficientCovariance, combined, consistency, output_uncertainty
+from accelcal_rig.fit.uncertainty import (
+    CoefficientCovariance,
+    combined,
+    consistency,
+    magnitude_noise_u,
+    output_uncertainty,
+)
 from accelcal_rig.fit.verification import AngleFigure, ReferenceUncertainty, pose_figures
 from accelcal_rig.store.read import VectorPoses, read_vector_poses
 
@@ -449,20 +456,28 @@ def _fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity) 
     approach = _both_ways(poses) if options.hysteresis == "on" and options.temperature_model == "joint" else None
     rate = poses.rate_c_per_min if approach is not None else None
     hysteresis, rate_term = np.zeros(3), np.zeros(3)
-    span_c: float | None = None
+    chosen: int | None = None  # which of HYSTERESIS_CANDIDATES; None: the sign of the last change
     if options.temperature_model == "joint":
-        # The hysteresis state: the sign of the last change, or a swing over each span of HYSTERESIS_SPANS_C;
-        # the one the calibration poses fit best (least χ², the same parameters for each) is kept.
-        candidates: list[tuple[float, np.ndarray | None]] = [(0.0, approach)]
+        # The hysteresis state: the sign of the last change, or a swing over a span relaxing at rest (each of
+        # HYSTERESIS_CANDIDATES); the one the calibration poses fit best (least χ², the same parameters) is kept.
+        candidates: list[tuple[int | None, np.ndarray | None]] = [(None, approach)]
         if approach is not None and poses.hysteresis_states is not None:
-            candidates += list(zip(HYSTERESIS_SPANS_C, poses.hysteresis_states))
+            candidates += list(enumerate(poses.hysteresis_states))
+        # A state the campaign's travel does not swing through at least half-way (a span wider than it, or one
+        # relaxing faster than it travels) is no hysteresis these poses can measure: h times a small swing is a
+        # trend the polynomials and a large ±h can mimic. A relaxation is one more thing the poses must
+        # determine: kept only where it fits better than the best state that holds by more than χ²(1) at 99 %.
         start, best = thermal, np.inf
-        for span, state in candidates:
+        results = []
+        for index, state in candidates:
+            if index is not None and state is not None and np.ptp(state) < MIN_STATE_SWING:
+                continue
             found = fit_joint(start, free, pose_temperatures, poses.mean, poses.stderr, reference, options.mode,
                                accuracy_rad, poses.magnitude, state, rate)
-            if found[3] < best:
-                (thermal, hysteresis, rate_term, best), approach, span_c = found, state, span
-        span_c = span_c if approach is not None else None
+            relaxing = index is not None and HYSTERESIS_CANDIDATES[index][1] is not None
+            results.append((found[3] + (RELAXATION_CHI2 if relaxing else 0.0), found, state, index))
+        _, (thermal, hysteresis, rate_term, best), approach, chosen = min(results, key=lambda r: r[0])
+    span_c, relax_h = HYSTERESIS_CANDIDATES[chosen] if chosen is not None else (0.0, None)
     # In-sample: the fit as fitted (its hysteresis and rate terms removed); the calibration delivered, and
     # so the verification, knows neither: it is the sensor at rest, the mean of both directions.
     unhysteretic = poses.mean
@@ -475,6 +490,7 @@ def _fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity) 
         metrics[f"hysteresis_{m}"] = (2e3 * hysteresis).tolist()
         metrics[f"rate_bias_{m}_per_c_per_min"] = (1e3 * rate_term).tolist()
         metrics["hysteresis_span_c"] = span_c
+        metrics["hysteresis_relaxation_h"] = relax_h
     elif options.hysteresis == "on":
         thermal.warnings.append("fit.hysteresis not fitted: " + (
             "the temperature model is not joint" if options.temperature_model != "joint" else
@@ -503,9 +519,8 @@ def _fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity) 
             # pose: the fitted model judged on poses it never saw. The calibration alone (as `apply` uses it,
             # the middle of both branches) beside it: on one branch it is off by up to ±h, the budget's
             # hysteresis.
-            swinging = checks.hysteresis_states is not None and span_c in HYSTERESIS_SPANS_C
-            state = checks.hysteresis_states[HYSTERESIS_SPANS_C.index(span_c)] \
-                if swinging and checks.hysteresis_states is not None and span_c is not None else checks.approach
+            state = checks.hysteresis_states[chosen] \
+                if chosen is not None and checks.hysteresis_states is not None else checks.approach
             assert state is not None  # a hysteresis fit has each pose's approach
             shift = state[:, None] * hysteresis + checks.rate_c_per_min[:, None] * rate_term
             metrics["verification_as_applied"], _ = _verification(checks, thermal, options, covariance, scatter_c,
@@ -532,6 +547,12 @@ def _fit_vector(stored: VectorPoses, options: FitOptions, spec: VectorQuantity) 
     )
     return ChannelFit(poses.serial, calibration, plain(metrics), thermal, parameter_u,
                       VectorFitDetail(setpoints, temperatures, fits, compensated, metrics))
+
+
+#: What a relaxing hysteresis state must gain in χ² over the best held one to be kept: χ²(1) at 99 %.
+RELAXATION_CHI2 = float(chi2.ppf(0.99, 1))
+#: The least swing (of −1…+1) a candidate hysteresis state must make over the calibration poses to be tried.
+MIN_STATE_SWING = 1.0
 
 
 def _file_metrics(metrics: dict[str, Any], milli: str) -> dict[str, Any]:
@@ -578,6 +599,13 @@ def _verification(checks: VectorPoses, thermal: ThermalModel, options: FitOption
     figures = pose_figures(compensated, checks.reference, checks.stderr, checks.setpoint_c, temperatures,
                            options.mode == "norm-only", checks.magnitude, references, spec.milli, spec.angle)
     temperature_u_c = smoothed_temperature_u_c(checks.t_s, groups, scatter_c)
+    # What the checks' Eq. 9 RMSE would be if the model were right: each check's own noise, and the noise of the
+    # calibration carried to it (largest at the range's ends, where a ramp's checks are): the yardstick of an
+    # out-of-sample RMSE, which the in-sample expected_fit_rmse (a fit takes up some of its poses' noise) is not.
+    direction = compensated / np.linalg.norm(compensated, axis=1, keepdims=True)
+    own = np.sum((direction * checks.stderr) ** 2, axis=1)
+    carried = magnitude_noise_u(reading, temperatures, thermal, covariance, temperature_u_c, options.out_of_range)
+    figures[f"expected_rmse_{spec.milli}"] = float(np.sqrt(np.mean(own + carried**2)) * 1e3)
     if shift is not None:  # each check's own state taken off: what is left of the hysteresis is not a source
         covariance = replace(covariance, hysteresis=None)
     if options.mode == "reference":

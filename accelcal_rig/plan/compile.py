@@ -181,7 +181,12 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
             entry = restart = _ramp_and_soak(setpoint)
         at_rest = any(isinstance(step, Soak) for step in entry)
         verified = verify is not None and verify.at_setpoints and (at_rest or verify.on_ramp)
-        if verified:
+        if verified and procedure.method == "ramp" and at_rest:
+            # A ramp soaks only at its ends, and its DUTs still creep towards the air there: the checks first, so
+            # the calibration poses after them reach further and the calibrated range holds every check (one
+            # past it is compensated at the range's end, off by the slope times the overshoot: issue 39).
+            measure[:0] = _verification(setpoint, checks)
+        elif verified:
             measure.extend(_verification(setpoint, checks))
         gyroscope = _gyroscope(procedure, rig, setpoint, spun, poses, calibrate=True, verify=verified, noise=at_rest)
         if procedure.method == "ramp":  # the ramp's setpoint written before each step taken on it

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from accelcal_rig.fit.approach import approach_directions
 from accelcal_rig.fit.joint import fit_joint
@@ -116,6 +117,21 @@ def test_hysteresis_state_swings_over_its_span():
     t = np.arange(0.0, 9000.0, 30.0)
     temperature = np.interp(t, [0, 1800, 3600, 6000, 9000], [20, 60, 60, 20, 20])  # warm, rest, cool, rest
     poses_t = np.array([3000.0, 3600.0 + 5 / 40 * 2400 + 60, 5900.0, 8000.0])
-    states = hysteresis_states(poses_t, np.interp(poses_t, t, temperature), t, temperature, (10.0,))[0]
+    states = hysteresis_states(poses_t, np.interp(poses_t, t, temperature), t, temperature, ((10.0, None),))[0]
     assert states[0] == 1.0 and states[2] == -1.0 and states[3] == -1.0
     assert abs(states[1]) < 0.2  # 5 °C of cooling after the turn (the readings averaged ±60 s)
+
+
+def test_hysteresis_state_relaxes_at_rest_with_its_time_constant():
+    """A relaxing candidate: after warming through the span it falls towards the middle at rest, to e⁻¹ of
+    where it was after one time constant; a held one stays at +1."""
+    from accelcal_rig.fit.approach import hysteresis_states
+
+    t = np.arange(0.0, 12000.0, 30.0)
+    temperature = np.interp(t, [0, 1800, 12000], [20, 60, 60])  # warm, then rest for 2.8 h
+    rested_s = 3600.0
+    poses_t = np.array([1800.0 + 120.0, 1800.0 + 120.0 + rested_s])  # the average of ±60 s has settled by then
+    held, relaxing = hysteresis_states(poses_t, np.interp(poses_t, t, temperature), t, temperature,
+                                       ((10.0, None), (10.0, 1.0)))
+    np.testing.assert_allclose(held, [1.0, 1.0])
+    assert relaxing[1] / relaxing[0] == pytest.approx(np.exp(-1.0), rel=1e-6)

@@ -73,6 +73,9 @@ def test_a_bidirectional_ramp_turns_at_the_last_setpoint_and_measures_half_way_b
     assert len(set(keys)) == len(keys) and "T-35/pose01" in keys
     verified = sorted({k.split("/")[0] for k in keys if "/verify" in k})
     assert verified == ["T-40", "T60"]  # verify.on_ramp: false: at rest only, where the DUTs were soaked
+    for soaked in ("T60", "T-40"):  # the checks before the calibration poses: the DUTs still creep towards the
+        order = [k.split("/")[1][:4] for k in keys if k.startswith(f"{soaked}/") and "/soak" not in k]  # air there
+        assert order == sorted(order, key=lambda kind: kind != "veri") and "pose" in order, order
     estimate = estimate_duration(prepared.procedure.model, prepared.rig.model, plan)
     assert [r.soak_outcome for r in estimate.setpoints].count("stable") == 2  # the start and the turn only
 
