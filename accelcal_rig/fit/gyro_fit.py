@@ -112,10 +112,17 @@ def _described_range_scale(campaign: Campaign, serial: str) -> dict[float, np.nd
 
 def _truth_at_own_range(campaign: Campaign, serial: str, channel: str, own_range: float) -> np.ndarray | None:
     """The truth's parameters as the gyroscope reads at the channel's own range (the simulation describes them
-    at its widest)."""
+    at its widest), each record's with the bias's wander over it where the campaign kept it: the part as it read
+    then, so a check against the truth counts the wander a reading has, as the stated uncertainty does."""
     truth = described_truth(campaign, serial, channel)
     delta = _described_range_scale(campaign, serial).get(float(own_range))
-    return truth if truth is None or delta is None else gyro_model.read_at_scale(truth, 1.0 + delta)
+    if truth is not None and delta is not None:
+        truth = gyro_model.read_at_scale(truth, 1.0 + delta)
+    wander = campaign.truth_column(serial, "gyro_wander_dps")
+    if truth is not None and wander is not None and np.isfinite(wander).all():
+        truth = np.array(truth, dtype=float)
+        truth[:, gyro_model.BIAS] += wander
+    return truth
 
 
 def _truth_range_scale(campaign: Campaign, serial: str, own_range: float) -> dict[float, np.ndarray] | None:
@@ -258,11 +265,8 @@ def fit_gyro(records: GyroRecords, degree: int, out_of_range: OutOfRange, site: 
     metrics["chi2_reduced"] = [f.chi2_reduced for f in fits]
     metrics["temperature_range_c"] = [float(temperatures.min()), float(temperatures.max())]
     metrics["earth_rate"] = earth_rate_statement(site)
-    wander = _bias_wander_dps(allan)
-    misfit = None
-    if joint_rows is not None:
-        wander = np.maximum(wander, wander_seen_dps(records, thermal, joint_rows, site))
-        misfit = joint_misfit_dps(records, thermal, joint_rows, wander, site)
+    wander = np.maximum(_bias_wander_dps(allan), wander_seen_dps(records, thermal, np.concatenate(groups), site))
+    misfit = None if joint_rows is None else joint_misfit_dps(records, thermal, joint_rows, wander, site)
     systematic: dict[str, Any] = {**_systematic_sigma(site), "bias_instability_dps": wander, "model_misfit_dps": misfit}
     metrics["table_systematics_1sigma"] = {"scale_relative": systematic["scale"], "cross_rad": systematic["cross"],
                                            "earth_dps": systematic["earth_dps"]}
@@ -473,8 +477,8 @@ SLOW_RATE_DPS = 60.0
 
 def wander_seen_dps(records: GyroRecords, thermal: ThermalModel, rows: np.ndarray,
                     site: dict[str, Any]) -> np.ndarray:
-    """(3,) how far the bias wanders about a joint fit, per axis, as its calibration records at rest and at
-    slow rates show it: their excess scatter beyond noise and quantisation. A flicker-like wander departs from
+    """(3,) how far the bias wanders about the calibration, per axis, as its calibration records at rest and at
+    slow rates show it: their excess scatter about the thermal model beyond noise and quantisation. A flicker-like wander departs from
     its mean over hours by more than the Allan floor (a minimum over the noise record's few minutes) says; the
     records, spread over the campaign, see the departure a check or a use will."""
     slow = rows[np.abs(records.reference_dps[rows]).max(axis=1) <= SLOW_RATE_DPS]

@@ -71,6 +71,8 @@ class SimulatedDut:
         self.rate_scale_factors = np.array([(1.0 if b & 1 else -1.0) * (0.5 + (b >> 1) / 127.0) for b in signs[9:12]])
         #: (t_start, t_end, n, parameters, gravity, temperature) of recently generated sample chunks.
         self.truth_log: deque[tuple] = deque(maxlen=4096)
+        #: (t_start, t_end, n, mean wander °/s per axis) of recently generated gyroscope chunks.
+        self.gyro_wander_log: deque[tuple] = deque(maxlen=4096)
 
     def put_out_of_spec(self, channel: str, bias: float, scale_pct: float) -> None:
         """Make this part's `channel` beyond its data sheet (`simulation.faults.sensor_out_of_spec`): `bias` (in the
@@ -271,6 +273,7 @@ class VirtualLab:
         reading = reading * (1.0 + dut.gyro_range_scale.get(float(range_dps), np.zeros(3)))
         noise = self.gyro_rngs[index].normal(0.0, self.gyro_noise_dps(index, odr_hz), (n_samples, 3))
         wander = self.bias_wander[index].at(t_start_s + np.arange(n_samples) / odr_hz)
+        dut.gyro_wander_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, wander.mean(axis=0)))
         return dut.part.channel("gyro").quantise(reading + noise + wander, range_dps)
 
     def mag_noise_gauss(self, index: int, odr_hz: float) -> float:
@@ -314,23 +317,21 @@ class VirtualLab:
         return self._instant_cache
 
     def truth_between(self, index: int, t_start_s: float, t_end_s: float) -> dict[str, np.ndarray]:
-        """The truth behind the samples of [t_start_s, t_end_s], averaged over the chunks that made them."""
-        chunks = []
-        for chunk in reversed(self.duts[index].truth_log):  # in time order: only the newest are looked at
-            if chunk[1] <= t_start_s:
-                break
-            if chunk[0] <= t_end_s:
-                chunks.append(chunk)
-        chunks.reverse()
+        """The truth behind the samples of [t_start_s, t_end_s], averaged over the chunks that made them; for a
+        DUT with a gyroscope, also its bias's wander over them (`gyro_wander_dps`: what the part read beyond
+        its model then, which a check of its calibration against the truth must count as a reading does)."""
+        dut = self.duts[index]
+        chunks = _chunks_between(dut.truth_log, t_start_s, t_end_s)
         if not chunks:
-            raise ValueError(f"no samples of {self.duts[index].serial} between {t_start_s:g} and {t_end_s:g} s")
-        if len(chunks) == 1:  # a block fetched at once (every capture): nothing to average
-            _, _, _, parameters, gravity, temperature = chunks[0]
-            return {"parameters": np.array(parameters), "gravity_g": np.array(gravity),
-                    "temperature_c": np.asarray(temperature, dtype=float)}
+            raise ValueError(f"no samples of {dut.serial} between {t_start_s:g} and {t_end_s:g} s")
         weights = np.array([c[2] for c in chunks], dtype=float)
         mean = lambda k: np.average(np.array([c[k] for c in chunks]), axis=0, weights=weights)  # noqa: E731
-        return {"parameters": mean(3), "gravity_g": mean(4), "temperature_c": np.asarray(mean(5), dtype=float)}
+        truth = {"parameters": mean(3), "gravity_g": mean(4), "temperature_c": np.asarray(mean(5), dtype=float)}
+        gyro = _chunks_between(dut.gyro_wander_log, t_start_s, t_end_s)
+        if gyro:
+            truth["gyro_wander_dps"] = np.average(np.array([c[3] for c in gyro]), axis=0,
+                                                  weights=np.array([c[2] for c in gyro], dtype=float))
+        return truth
 
     def gravity_in_dut(self, index: int) -> np.ndarray:
         """True specific force at rest (the site's gravity, up) in DUT `index`'s frame at the table's actual
@@ -349,3 +350,16 @@ class VirtualLab:
 def _accelerometer_noise(dut_part: Part) -> float:
     """A part's accelerometer's noise density, µg/√Hz (0 for a part without one)."""
     return next((c.noise_density_micro_per_rthz for c in dut_part.channels if c.quantity == ACCELERATION), 0.0)
+
+
+def _chunks_between(log: deque[tuple], t_start_s: float, t_end_s: float) -> list[tuple]:
+    """The chunks of a log (t_start, t_end, …) that overlap [t_start_s, t_end_s], in time order: only the newest
+    are looked at."""
+    chunks = []
+    for chunk in reversed(log):
+        if chunk[1] <= t_start_s:
+            break
+        if chunk[0] <= t_end_s:
+            chunks.append(chunk)
+    chunks.reverse()
+    return chunks

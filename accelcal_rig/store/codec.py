@@ -104,6 +104,9 @@ def encode_pose(pose: PoseRecord) -> bytes:
         arrays["truth_parameters"] = np.stack([np.asarray(d.truth["parameters"], dtype="f8") for d in duts])  # type: ignore[index]
         arrays["truth_gravity_g"] = np.stack([np.asarray(d.truth["gravity_g"], dtype="f8") for d in duts])  # type: ignore[index]
         arrays["truth_temperature_c"] = np.array([float(d.truth["temperature_c"]) for d in duts], dtype="f8")  # type: ignore[index]
+        if any("gyro_wander_dps" in d.truth for d in duts):  # type: ignore[operator]
+            arrays["truth_gyro_wander_dps"] = np.stack([np.asarray(d.truth.get("gyro_wander_dps", np.full(3, np.nan)),  # type: ignore[union-attr]
+                                                                   dtype="f8") for d in duts])
     meta = {"step_key": pose.step_key, "pose_number": int(pose.pose_number), "serials": [d.serial for d in duts],
             "channels": having}
     return encode_record("pose", meta, arrays)
@@ -172,6 +175,8 @@ def _pose(record: Record, header: CampaignHeader) -> PoseRecord:
     n_duts, n_axes, n = len(serials), len(header.plan.axis_names), int(header.attrs.get("samples_per_pose", 0))
     shapes = {"commanded_angles_deg": (n_axes,), "measured_angles_deg": (n_axes,), "gravity_fixture": (3,),
               "scalars": (5,), "temperature_c": (n_duts, 2), "temperature_in_band": (n_duts,)}
+    if "truth_gyro_wander_dps" in arrays:
+        shapes["truth_gyro_wander_dps"] = (n_duts, 3)
     for name, shape in shapes.items():
         if arrays[name].shape != shape:
             raise ValueError(f"{name} has shape {arrays[name].shape}, expected {shape}")
@@ -183,8 +188,7 @@ def _pose(record: Record, header: CampaignHeader) -> PoseRecord:
             serial=serial, channels=channels[serial],
             temperature_c=(float(arrays["temperature_c"][i, 0]), float(arrays["temperature_c"][i, 1])),
             temperature_in_band=bool(arrays["temperature_in_band"][i]),
-            truth={"parameters": arrays["truth_parameters"][i], "gravity_g": arrays["truth_gravity_g"][i],
-                   "temperature_c": np.asarray(arrays["truth_temperature_c"][i])} if truth else None)
+            truth=_pose_truth(arrays, i) if truth else None)
         for i, serial in enumerate(serials)
     ]
     if not isinstance(meta["pose_number"], int) or not 0 <= meta["pose_number"] < 2**31:
@@ -195,6 +199,17 @@ def _pose(record: Record, header: CampaignHeader) -> PoseRecord:
 
 #: A pose record's acceleration arrays before parts declared channels (stacked over every DUT).
 _ACCELERATION_ARRAYS = {"raw_codes": "raw_codes", "mean": "mean_g", "stderr": "stderr_g", "reference": "gravity_reference_g"}
+
+
+def _pose_truth(arrays: dict[str, np.ndarray], i: int) -> dict[str, np.ndarray]:
+    """DUT `i`'s simulation truth of a pose record; its gyroscope's wander where the record has it (a DUT with
+    none: NaN)."""
+    truth = {"parameters": arrays["truth_parameters"][i], "gravity_g": arrays["truth_gravity_g"][i],
+             "temperature_c": np.asarray(arrays["truth_temperature_c"][i])}
+    wander = arrays.get("truth_gyro_wander_dps")
+    if wander is not None and np.all(np.isfinite(wander[i])):
+        truth["gyro_wander_dps"] = wander[i]
+    return truth
 
 
 def _pose_channels(meta: dict, arrays: dict[str, np.ndarray], serials: list[str], header: CampaignHeader,

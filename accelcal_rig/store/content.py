@@ -172,8 +172,9 @@ class Campaign:
         if key not in self._columns:
             index = self.serials.index(serial)
             truths = [p.duts[index].truth for p in self.poses]
-            values = [truth[name] if truth is not None else np.nan for truth in truths]
-            self._columns[key] = _stack(values, {"parameters": (12,), "gravity_g": (3,)}.get(name, ()), "f8")
+            tail = {"parameters": (12,), "gravity_g": (3,), "gyro_wander_dps": (3,)}.get(name, ())
+            values = [truth[name] if truth is not None and name in truth else np.full(tail, np.nan) for truth in truths]
+            self._columns[key] = _stack(values, tail, "f8")
         return self._columns[key]
 
     @property

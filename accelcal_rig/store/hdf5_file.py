@@ -41,7 +41,7 @@ TEXT = h5py.string_dtype("utf-8")
 #: Text columns are fixed-length UTF-8 (bytes per row; h5py returns bytes, `.decode()` them), longer text
 #: cut at a character boundary.
 #: A DUT's truth per pose in `simulation_truth/<serial>/` (the rest there describes its model).
-_TRUTH_COLUMNS = ("parameters", "gravity_g", "temperature_c")
+_TRUTH_COLUMNS = ("parameters", "gravity_g", "temperature_c", "gyro_wander_dps")
 TEXT_BYTES = {"step_key": 64, "wall_time": 32, "level": 8, "kind": 16, "message": 1024}
 _UNITS = {"setpoint_c": "degC", "commanded_angles_deg": "deg", "measured_angles_deg": "deg", "gravity_fixture": "g",
           "t_start_s": "s", "t_end_s": "s", "chamber_temperature_c": "degC", "raw_codes": "LSB", "mean_g": "g",
@@ -155,6 +155,9 @@ def _image(campaign: Campaign, journal_bytes: int) -> bytes:
                 group.attrs.update({k: v for k, v in description.items() if not isinstance(v, np.ndarray)})
                 for name in ("parameters", "gravity_g", "temperature_c"):
                     _dataset(group, name, campaign.truth_column(serial, name))
+                wander = campaign.truth_column(serial, "gyro_wander_dps")  # a gyroscope's, where it has one
+                if wander is not None and np.isfinite(wander).any():
+                    _dataset(group, "gyro_wander_dps", wander)
         file.flush()
         return bytes(file.id.get_file_image())
 
@@ -244,6 +247,9 @@ def read_campaign_file(file: h5py.File) -> Campaign:
              "gravity_fixture": ((3,), "f"), "t_start_s": ((), "f"), "t_end_s": ((), "f"),
              "chamber_temperature_c": ((2,), "f")}
     truth_tails = {"parameters": ((12,), "f"), "gravity_g": ((3,), "f"), "temperature_c": ((), "f")}
+    optional_truth = {"gyro_wander_dps": ((3,), "f")}  # a gyroscope's; files before issue 39 have none
+    tails_of = {s: {**truth_tails, **{name: tail for name, tail in optional_truth.items()
+                                      if f"simulation_truth/{s}/{name}" in file}} for s in header.truth}
     dut_columns = {s: _dut_columns(header, s, version, n) for s in header.serials}
     for serial in header.serials:  # a channel some of whose records are at a range of their own
         for info in header.dut_channels(serial) if version >= 3 else ():
@@ -255,7 +261,8 @@ def read_campaign_file(file: h5py.File) -> Campaign:
         lengths.update({path: reader.node(path, h5py.Dataset).shape for path, _, _ in dut_columns[serial].values()})
         if serial in header.truth:
             lengths.update({f"simulation_truth/{serial}/{name}": reader.node(f"simulation_truth/{serial}/{name}",
-                                                                             h5py.Dataset).shape for name in truth_tails})
+                                                                             h5py.Dataset).shape
+                            for name in tails_of[serial]})
     rows = {path: (shape[0] if shape else 0) for path, shape in lengths.items()}
     whole, longest = min(rows.values()), max(rows.values())
     campaign = Campaign(header)
@@ -268,7 +275,7 @@ def read_campaign_file(file: h5py.File) -> Campaign:
     duts = {s: {key: reader.array(path, tail, kinds, whole) for key, (path, tail, kinds) in dut_columns[s].items()}
             for s in header.serials}
     truth = {s: {name: reader.array(f"simulation_truth/{s}/{name}", tail, kinds, whole)
-                 for name, (tail, kinds) in truth_tails.items()} for s in header.serials if s in header.truth}
+                 for name, (tail, kinds) in tails_of[s].items()} for s in header.serials if s in header.truth}
     keys = [_text(k) for k in columns["step_key"]]
     for i, key in enumerate(keys):
         pose_duts = [DutPoseRecord(
@@ -279,7 +286,8 @@ def read_campaign_file(file: h5py.File) -> Campaign:
                       for c in header.dut_channels(s)},
             temperature_c=(float(duts[s][("", "temperature_c")][i, 0]), float(duts[s][("", "temperature_c")][i, 1])),
             temperature_in_band=bool(duts[s][("", "temperature_in_band")][i]),
-            truth={name: truth[s][name][i] for name in truth_tails} if s in truth else None) for s in header.serials]
+            truth={name: truth[s][name][i] for name in tails_of[s] if np.all(np.isfinite(truth[s][name][i]))
+                   or name in truth_tails} if s in truth else None) for s in header.serials]
         campaign.add_pose(PoseRecord(
             key, float(columns["setpoint_c"][i]), int(columns["pose_number"][i]), columns["commanded_angles_deg"][i],
             columns["measured_angles_deg"][i], columns["gravity_fixture"][i], float(columns["t_start_s"][i]),

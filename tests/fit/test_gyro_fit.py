@@ -356,3 +356,33 @@ def test_the_joint_thermal_fit_follows_a_drift_the_per_band_fit_blurs() -> None:
 
     assert worst_bias_error(joint) < 2e-3                                # the truth's cubic, to its noise
     assert worst_bias_error(joint) < 0.5 * worst_bias_error(start)       # the per-band fit blurs the drift
+
+
+def test_the_truth_keeps_each_records_bias_wander(campaign_path: Path) -> None:
+    """A dry run keeps the wander each gyroscope record had (`simulation_truth/<serial>/gyro_wander_dps`): with it
+    the truth explains the readings at rest and at slow rates to their noise (what a truth check of the
+    calibration, whose U holds a reading's wander, must compare with); without it the wander is left over."""
+    from accelcal_rig.fit import gyro_model
+    from accelcal_rig.store.read import described_truth
+
+    campaign = load_campaign(campaign_path)
+    for serial in campaign.serials:
+        records = gyro_records(campaign, serial)
+        wander = campaign.truth_column(serial, "gyro_wander_dps")
+        assert wander is not None and wander.shape == records.mean_dps.shape and np.isfinite(wander).all()
+        scale = {float(r[0]): np.asarray(r[1:]) for r in campaign.header.truth[serial]["gyro_range_scale"]}[250.0]
+        slow = (records.range_dps == 250.0) & (np.abs(records.reference_dps).max(axis=1) <= 60.0)
+        truth = gyro_model.read_at_scale(described_truth(campaign, serial, "gyro"), 1.0 + scale)[slow]
+        wandering = truth.copy()
+        wandering[:, gyro_model.BIAS] += wander[slow]
+
+        z_with, z_without = (_z_rms(records, slow, parameters) for parameters in (wandering, truth))
+        assert z_with < 1.3 and z_without > 1.3 * z_with, (serial, z_with, z_without)
+
+
+def _z_rms(records: GyroRecords, rows: np.ndarray, parameters: np.ndarray) -> float:
+    """The RMS of the records' readings minus what `parameters` predict, each over its standard error."""
+    from accelcal_rig.fit import gyro_model
+
+    predicted = gyro_model.distort_rate(records.reference_dps[rows], records.force_g[rows], parameters)
+    return float(np.sqrt(np.mean(((records.mean_dps[rows] - predicted) / records.stderr_dps[rows]) ** 2)))
