@@ -69,7 +69,29 @@ class Dashboard:
             handle_exit(signum, frame)
 
         server.handle_exit = stopping  # type: ignore[method-assign,assignment]
-        server.run(sockets=[self.listening])
+        with _ctrl_c_as_sigterm():
+            server.run(sockets=[self.listening])
+
+
+@contextmanager
+def _ctrl_c_as_sigterm() -> Iterator[None]:
+    """Ctrl-C ends the server by the path SIGTERM takes (a handler raising KeyboardInterrupt, which uvicorn
+    captures while it serves and raises again once it has stopped), not by asyncio's own: with Python's default
+    SIGINT handler in place, asyncio.run puts in one that cancels the main task instead, and a Ctrl-C sent as the
+    server started sometimes left `rig serve` running (tests/test_cli_serve.py, in CI; SIGTERM never did)."""
+    if threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        yield
+        return
+
+    def interrupt(signum: int, frame: Any) -> None:
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 @contextmanager
