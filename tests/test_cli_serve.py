@@ -11,6 +11,8 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -36,6 +38,18 @@ def first_line(process: subprocess.Popen, deadline_s: float) -> str:
     return received.split(b"\n", 1)[0].decode()
 
 
+@contextmanager
+def sigint_not_ignored() -> Iterator[None]:
+    """The dashboard started as from a shell, whatever this test process was left with: a child inherits an
+    ignored SIGINT, and `rig serve` started so does not hear a Ctrl-C sent as it starts (an earlier test in the
+    same pytest-xdist worker left it ignored: this case hung in three CI runs in a row, the SIGTERM ones never)."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 @pytest.mark.parametrize(("how", "stop", "token"), [
     ([RIG], signal.SIGTERM, None),
     ([RIG], signal.SIGINT, "s3cret-token"),
@@ -44,7 +58,8 @@ def first_line(process: subprocess.Popen, deadline_s: float) -> str:
 def test_rig_serve_says_what_it_stopped_and_exits_0(tmp_path: Path, how: list[str], stop: signal.Signals,
                                                    token: str | None) -> None:
     argv = [*how, "serve", "--campaigns", str(tmp_path), "--port", "0", *(["--token", token] if token else [])]
-    process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    with sigint_not_ignored():
+        process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
         announced = re.fullmatch(r"dashboard on (http://127\.0\.0\.1:\d+)/(\?token=.*)?", first_line(process, DEADLINE_S))
         assert announced, "the first line names where it listens"
@@ -62,8 +77,9 @@ def test_ctrl_c_once_it_answers_says_the_server_stopped_and_a_second_changes_not
     dashboard stopped, exit 0, no traceback (uvicorn's wait for a lifespan cancelled) and no campaign named."""
     import http.client
 
-    process = subprocess.Popen([RIG, "serve", "--campaigns", str(tmp_path), "--port", "0"], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE)
+    with sigint_not_ignored():
+        process = subprocess.Popen([RIG, "serve", "--campaigns", str(tmp_path), "--port", "0"], stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE)
     try:
         address = re.fullmatch(r"dashboard on http://(127\.0\.0\.1):(\d+)/", first_line(process, DEADLINE_S))
         assert address, "the first line names where it listens"
