@@ -76,9 +76,10 @@ class Dashboard:
 @contextmanager
 def _ctrl_c_as_sigterm() -> Iterator[None]:
     """Ctrl-C ends the server by the path SIGTERM takes (a handler raising KeyboardInterrupt, which uvicorn
-    captures while it serves and raises again once it has stopped), not by asyncio's own: with Python's default
-    SIGINT handler in place, asyncio.run puts in one that cancels the main task instead, and a Ctrl-C sent as the
-    server started sometimes left `rig serve` running (tests/test_cli_serve.py, in CI; SIGTERM never did)."""
+    captures while it serves and raises again once it has stopped), not by asyncio's own (with Python's default
+    SIGINT handler in place, asyncio.run puts in one that cancels the main task instead): one path for both
+    signals. A `rig serve` started with SIGINT ignored (a background job) keeps ignoring it until uvicorn
+    listens for it."""
     if threading.current_thread() is not threading.main_thread() or \
             signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
         yield
