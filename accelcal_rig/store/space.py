@@ -40,7 +40,7 @@ def pose_record_bytes(n_duts: int, samples_per_pose: int, n_axes: int, with_trut
     by default every DUT an accelerometer)."""
     truth = {"parameters": np.zeros(12), "gravity_g": np.zeros(3), "temperature_c": np.asarray(0.0)}
     channels = dut_channels if dut_channels is not None else [ACCELEROMETER] * n_duts
-    if any(name == "gyro" for dut in channels for name, _ in dut):  # a dry run's gyroscope wander beside it
+    if any(len(dut) > 1 for dut in channels):  # a dry run may keep a gyroscope's wander beside it: bound it
         truth["gyro_wander_dps"] = np.zeros(3)
     duts = [DutPoseRecord(f"DUT-{k:04d}", {name: ChannelPoseRecord(np.zeros((samples_per_pose, axes), dtype="i4"),
                                                                    np.zeros(axes), np.zeros(axes), np.zeros(axes))
