@@ -15,15 +15,15 @@ RateDps = Annotated[Real, Field(gt=0, le=10_000)]
 
 class RateSteps(StrictModel):
     """Constant rates about each fixture axis in turn, each in both directions: the fixture axis is brought to
-    the turning table axis (a multi-axis table turns it there; it must be the outermost axis with a rate mode,
-    vertical), then the table turns at each rate, holds it for `settle_s` and the samples are taken."""
+    a table axis with a rate mode that can turn the fixture about it (plan/gyro_steps.py says which), then the
+    table turns at each rate, holds it for `settle_s` and the samples are taken."""
 
     rates_dps: list[RateDps] = Field(min_length=1, max_length=32, description="magnitudes, each turned both ways "
                                      "about each axis of `about`; at most the part's range and the table's limit")
     about: list[FixtureAxis] = Field(["x", "y", "z"], min_length=1, max_length=3,
-                                     description="the fixture axes brought to the table's rate axis")
-    axis: str | None = Field(None, max_length=32, description="the table axis that turns (default: the outermost "
-                                                              "with a rate mode)")
+                                     description="the fixture axes turned in turn, each brought to a rate axis")
+    axis: str | None = Field(None, max_length=32, description="the one table axis that turns every fixture axis "
+                                                              "(default: each by the outermost rate axis that can)")
     acceleration_dps2: Real | None = Field(None, gt=0, le=100_000, description="how fast each rate is reached "
                                            "(default: the axis's max_acceleration_dps2)")
     settle_s: Real = Field(1.0, ge=0, le=600, description="hold each rate this long before the samples")

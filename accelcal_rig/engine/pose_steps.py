@@ -4,6 +4,7 @@ reference, engine/references.py), and its temperatures against the band its soak
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import partial
 
 import numpy as np
@@ -52,6 +53,7 @@ def acquire_and_store(step: Measurement, run: RunContext, commanded: np.ndarray)
     acquisition = run.procedure.acquisition
     run.machine.go(State.ACQUIRE, step.key)
     measured = run.turntable.read_angles_deg()
+    read_at_s = run.clock.now()
     # A turning axis: where it stands is a reading of the moment only.
     run.table.angles_deg = None if any(step.rate_fixture_dps) else measured
     chamber_before = run.chamber.read_temperature_c()  # the alarm is checked once per pose, after it
@@ -72,7 +74,8 @@ def acquire_and_store(step: Measurement, run: RunContext, commanded: np.ndarray)
         commanded_angles_deg=commanded, measured_angles_deg=measured, gravity_fixture=gravity_fixture,
         t_start_s=min(b.t_start_s for b in blocks), t_end_s=max(b.t_end_s for b in blocks),
         chamber_temperature_c=(chamber_before, chamber_after),
-        duts=[_dut_record(run, i, block, at, ranges) for i, block in enumerate(blocks)],
+        duts=[_dut_record(run, i, block, replace(at, lead_s=block.t_start_s - read_at_s), ranges)
+              for i, block in enumerate(blocks)],
     )
     run.writer.append_pose(record)
     run.report.pose_stored(chamber_after, tuple(float(np.mean(b.temperature_c)) for b in blocks))

@@ -59,15 +59,16 @@ class RateStepHandler:
                 run.table.angles_deg, run.table.setpoint_c = None, step.setpoint_c
             move_to(run, commanded)
         run.machine.go(State.SETTLE, step.key)
-        table.rotate_at(step.rate_axis, step.rate_dps, acceleration)
-        change_s = abs(step.rate_dps - run.table.rate_dps) / acceleration
-        run.table.rate_dps, run.table.turning_in, run.table.angles_deg = step.rate_dps, step.pose.angles_deg, None
+        rate = step.table_rate_dps
+        table.rotate_at(step.rate_axis, rate, acceleration)
+        change_s = abs(rate - run.table.rate_dps) / acceleration
+        run.table.rate_dps, run.table.turning_in, run.table.angles_deg = rate, step.pose.angles_deg, None
         run.clock.sleep(change_s + procedure_rates.settle_s)
-        tolerance = rate_tolerance_dps(run, step.rate_dps)
-        wait_until(run.clock, lambda: abs(table.read_rate_deg_s(step.rate_axis) - step.rate_dps) <= tolerance,
+        tolerance = rate_tolerance_dps(run, rate)
+        wait_until(run.clock, lambda: abs(table.read_rate_deg_s(step.rate_axis) - rate) <= tolerance,
                    timeout_s=0.5 * change_s + MOVE_MARGIN_S, poll_s=MOVE_POLL_S,
                    what=f"turntable ({run.turntable.endpoint}) axis {run.rig.turntable.axes[step.rate_axis].name} "
-                        f"turning at {step.rate_dps:g} °/s (±{tolerance:.3g})")
+                        f"turning at {rate:g} °/s (±{tolerance:.3g})")
         acquire_and_store(step, run, commanded)
 
     def estimate(self, step: RateStep, played: PlayedRig) -> None:
@@ -80,8 +81,8 @@ class RateStepHandler:
         if played.turning_in != step.pose.angles_deg:
             travel_s = abs(played.rate_dps) / acceleration + played.travel_to(step.pose.angles_deg)
             played.rate_dps = 0.0
-        change_s = abs(step.rate_dps - played.rate_dps) / acceleration
-        played.rate_dps, played.turning_in = step.rate_dps, step.pose.angles_deg
+        change_s = abs(step.table_rate_dps - played.rate_dps) / acceleration
+        played.rate_dps, played.turning_in = step.table_rate_dps, step.pose.angles_deg
         played.wait("poses", travel_s + change_s + procedure_rates.settle_s + MOVE_POLL_S / 2
                     + played.block_s)
 

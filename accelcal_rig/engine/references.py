@@ -24,45 +24,61 @@ if TYPE_CHECKING:
 @dataclass(frozen=True)
 class PoseInstant:
     """Where the table was while a record's samples were taken: the step (its pose, its rate), the angles
-    read as the samples began, and how long they took."""
+    read before the samples, how long they took, and how long after the read the first was taken (on a
+    turning table the read angle is the turn's phase only then)."""
 
     step: Measurement
     measured_angles_deg: np.ndarray
     duration_s: float
+    lead_s: float = 0.0
 
 
 def _gravity_reference(run: RunContext, serial: str, channel: Channel, at: PoseInstant) -> np.ndarray:
-    """The site's gravity (in standard g) in the DUT's frame: the commanded pose, the nominal mount. A rate
-    step's turn about the vertical changes it not; the centripetal acceleration of a DUT off the rate axis is
-    not in it (its radius is not known): no accelerometer fit uses a rate step."""
-    return run.rig.gravity_g * (run.fixture_to_dut[serial] @ np.array(at.step.pose.gravity_fixture))
+    """The site's gravity (in standard g) in the DUT's frame: the commanded pose, the nominal mount; through a
+    rate step, averaged over the samples as the turn carries it (a turn about the vertical changes it not, one
+    about any other axis turns it in the fixture frame). The centripetal acceleration of a DUT off the rate
+    axis is not in it (its radius is not known): no accelerometer fit uses a rate step."""
+    up = np.array(at.step.pose.gravity_fixture)
+    if isinstance(at.step, RateStep):
+        up = run.kinematics.gravity_in_fixture(_turning_angles(at, np.array(at.step.pose.angles_deg))).mean(axis=0)
+    return run.rig.gravity_g * (run.fixture_to_dut[serial] @ up)
 
 
 def _rate_reference(run: RunContext, serial: str, channel: Channel, at: PoseInstant) -> np.ndarray:
     """The true angular rate in the DUT's frame, °/s: the table's (zero through a pose, the commanded rate
-    about the fixture axis through a rate step) and the Earth's as far as the rig config places it."""
+    about the fixture axis through a rate step, whichever table axis turns it) and the Earth's as far as the
+    rig config places it."""
     table = np.array(at.step.rate_fixture_dps)
     return run.fixture_to_dut[serial] @ (table + _earth_rate_fixture_dps(run, at))
 
 
-#: Points over a record's samples at which a turning table's Earth rate is averaged.
+#: Points over a record's samples at which what a turning table carries is averaged: at least this many, and
+#: one every _DEGREES_PER_POINT of the turn.
 _EARTH_POINTS = 64
+_DEGREES_PER_POINT = 5.0
+
+
+def _turning_angles(at: PoseInstant, angles_deg: np.ndarray) -> np.ndarray:
+    """(points, axes): `angles_deg` at the midpoints of a record's samples, a rate step's axis advanced at its
+    rate from the angle read before them (the same angles at every point for a record at rest)."""
+    points = _EARTH_POINTS
+    if isinstance(at.step, RateStep):
+        points = max(points, int(np.ceil(abs(at.step.table_rate_dps) * at.duration_s / _DEGREES_PER_POINT)))
+    angles = np.broadcast_to(np.asarray(angles_deg, dtype=float), (points, len(angles_deg))).copy()
+    if isinstance(at.step, RateStep):
+        times = at.lead_s + (np.arange(points) + 0.5) / points * at.duration_s
+        angles[:, at.step.rate_axis] = at.measured_angles_deg[at.step.rate_axis] + at.step.table_rate_dps * times
+    return angles
 
 
 def _earth_rate_fixture_dps(run: RunContext, at: PoseInstant) -> np.ndarray:
     """The Earth's rate in the fixture frame over the record's samples: nothing where the rig config states no
-    latitude; its vertical component always, along "up" whatever turns about the vertical; its horizontal one
-    (with a heading) turns with a rate step's axis, averaged over the samples from the angles read as they
-    began."""
+    latitude; else through the angles read as they began, a rate step's axis advanced at its rate, averaged
+    over the samples (what turns about the Earth's rate keeps its component along the turn)."""
     if run.rig.latitude_deg is None:
         return np.zeros(3)
     world = earth_rate_world_dps(run.rig.latitude_deg, run.rig.heading_deg)
-    angles = np.broadcast_to(np.asarray(at.measured_angles_deg, dtype=float),
-                             (_EARTH_POINTS, len(at.measured_angles_deg))).copy()
-    if isinstance(at.step, RateStep):
-        times = (np.arange(_EARTH_POINTS) + 0.5) / _EARTH_POINTS * at.duration_s
-        angles[:, at.step.rate_axis] += at.step.rate_dps * times
-    return run.kinematics.world_in_fixture(angles, world).mean(axis=0)
+    return run.kinematics.world_in_fixture(_turning_angles(at, at.measured_angles_deg), world).mean(axis=0)
 
 
 def _field_reference(run: RunContext, serial: str, channel: Channel, at: PoseInstant) -> np.ndarray:

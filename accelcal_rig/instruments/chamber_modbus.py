@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, Self
 
+import numpy as np
 from pymodbus.client import ModbusSerialClient, ModbusTcpClient
 from pymodbus.client.base import ModbusBaseSyncClient
 from pymodbus.exceptions import ModbusException
@@ -136,8 +137,7 @@ class ModbusChamber:
 
     def _plausible(self, value: float, what: str) -> float:
         """Swapped float words give NaN, huge values or, for round temperatures (zero low word), denormals."""
-        tiny = value != 0.0 and abs(value) < 1e-6
-        if tiny or not plausible_c(value):
+        if denormal_float32(value) or not plausible_c(value):
             raise self._error(f"{what} reads {value:g} °C: wrong register map or word order")
         return value
 
@@ -243,3 +243,10 @@ MODBUS_TCP = ChamberDriver("modbus-tcp", _open_tcp, simulator="accelcal_rig.sim.
 #: Simulated on Modbus TCP: the same register map and requests, another framing.
 MODBUS_RTU = ChamberDriver("modbus-rtu", _open_rtu, simulator="accelcal_rig.sim.chamber_server:serve_modbus",
                            protocol="accelcal_rig.protocols.chamber_registers", simulated_by="modbus-tcp")
+
+
+def denormal_float32(value: float) -> bool:
+    """A float32 below the smallest normal one (1.18e-38) but not zero: what a round temperature's words read in
+    the wrong order give (its zero word becomes the exponent's). A chamber near 0 °C reads a small normal float
+    (7.5e-7 °C is one), never a denormal."""
+    return value != 0.0 and abs(value) < float(np.finfo(np.float32).tiny)

@@ -18,7 +18,7 @@ from accelcal_rig.config.rig import RigConfig
 from accelcal_rig.config.schedule import Schedule
 from accelcal_rig.plan import schedules
 from accelcal_rig.plan.frost import with_frost_steps
-from accelcal_rig.plan.gyro_steps import noise_blocks, rate_poses, rate_steps
+from accelcal_rig.plan.gyro_steps import Spin, noise_blocks, rate_steps, spins
 from accelcal_rig.plan.kinematics import TurntableKinematics
 from accelcal_rig.plan.steps import (
     AdvanceRamp,
@@ -164,7 +164,7 @@ def compile_plan(procedure: Procedure, rig: RigConfig) -> Plan:
     if checks:
         _check_verification_is_new(poses, checks)
     width = max(2, len(str(len(poses))))
-    spun = rate_poses(procedure.rates, rig, (checks or poses)[-1].angles_deg) if procedure.rates is not None else {}
+    spun = spins(procedure.rates, rig, (checks or poses)[-1].angles_deg) if procedure.rates is not None else {}
     setpoints = tuple(procedure.setpoints_c)
     bidirectional = procedure.method == "ramp" and procedure.ramp is not None and procedure.ramp.bidirectional
     if bidirectional:  # and back, half-way between the setpoints
@@ -214,7 +214,7 @@ def _checked_after_poses(body: tuple[Step, ...], setpoint_c: float) -> tuple[Ste
     return (*body[:last + 1], CheckSetpoint(setpoint_c), *body[last + 1:])
 
 
-def _gyroscope(procedure: Procedure, rig: RigConfig, setpoint_c: float, spun: dict[str, Pose],
+def _gyroscope(procedure: Procedure, rig: RigConfig, setpoint_c: float, spun: dict[str, Spin],
                poses: tuple[Pose, ...], calibrate: bool, verify: bool, noise: bool = True) -> list[Step]:
     """A gyroscope's steps after the poses: the rate steps (calibration, verification or both), then, at a
     calibration setpoint where the DUTs are soaked (`noise`: not a band taken on a ramp, whose moving

@@ -115,6 +115,42 @@ class TurntableKinematics:
                                   + (self._geometry_limit(target) or "turntable's axis limits"))
         return self.wrap(np.rad2deg(best))
 
+    def turn_in_fixture(self, index: int, angles_deg: np.ndarray) -> np.ndarray:
+        """The direction, in the fixture frame, the fixture turns about when axis `index` turns at these angles:
+        its own direction brought through the axes inside it, (R_(k+1) ⋯ R_n)ᵀ d_k."""
+        inner = self.chain_matrices_from(index + 1, angles_deg)
+        return np.einsum("...ji,j->...i", inner, self._directions[index])
+
+    def chain_matrices_from(self, first: int, angles_deg: np.ndarray) -> np.ndarray:
+        """The chain of the axes from `first` inwards (identity where there are none), shape (..., 3, 3)."""
+        angles = np.asarray(angles_deg, dtype=float)
+        if first >= len(self.axes):
+            return np.broadcast_to(np.eye(3), angles.shape[:-1] + (3, 3)).copy()
+        return TurntableKinematics(self.axes[first:]).chain_matrices(angles[..., first:])
+
+    def solve_turn(self, index: int, turn_fixture: np.ndarray, near_deg: np.ndarray) -> np.ndarray:
+        """Angles at which turning axis `index` turns the fixture about `turn_fixture` (a unit direction in the
+        fixture frame), the axes outside it left where `near_deg` holds them: the axes inside it solved as a
+        table of their own whose "up" is axis `index`'s direction. The innermost axis turns the fixture about
+        its own direction whatever the angles: reached only where that is `turn_fixture`."""
+        near = np.asarray(near_deg, dtype=float)
+        target = np.asarray(turn_fixture, dtype=float) / np.linalg.norm(turn_fixture)
+        direction = self._directions[index]
+        if index == len(self.axes) - 1:
+            if np.linalg.norm(direction - target) > _IK_TOLERANCE_RAD:
+                raise UnreachablePose(f"axis {self.axes[index].name} turns the fixture about "
+                                      f"{np.round(direction, 4).tolist()} only")
+            return self.wrap(near.copy())
+        # Q takes the axis's direction to +z: the axes inside it, seen turned by Q, then bring "up" where Q
+        # takes the target.
+        to_z = _rotation_to_z(direction)
+        inside = [axis.model_copy(update={"axis": tuple(float(v) for v in to_z @ np.array(axis.axis))})
+                  for axis in self.axes[index + 1:]]
+        solved = TurntableKinematics(inside).solve(to_z @ target, near[index + 1:])
+        angles = near.copy()
+        angles[index + 1:] = solved
+        return self.wrap(angles)
+
     def _geometry_limit(self, target: np.ndarray) -> str | None:
         """Why no angles at all reach `target`, where the table's geometry (not its limits) is the reason: a table
         whose only axes are a vertical one and one more turns gravity in the fixture frame only about that second
@@ -147,3 +183,13 @@ class TurntableKinematics:
         grid = np.deg2rad([-120.0, 0.0, 120.0])
         starts.extend(np.stack(np.meshgrid(*([grid] * n), indexing="ij"), axis=-1).reshape(-1, n))
         return [np.clip(s, lower + 1e-9, upper - 1e-9) for s in starts]
+
+
+def _rotation_to_z(direction: np.ndarray) -> np.ndarray:
+    """A rotation matrix taking the unit `direction` to +z (the identity for +z itself)."""
+    z = np.array([0.0, 0.0, 1.0])
+    axis = np.cross(direction, z)
+    sine, cosine = float(np.linalg.norm(axis)), float(direction @ z)
+    if sine < 1e-12:
+        return np.eye(3) if cosine > 0 else np.diag([1.0, -1.0, -1.0])
+    return Rotation.from_rotvec(axis / sine * np.arctan2(sine, cosine)).as_matrix()

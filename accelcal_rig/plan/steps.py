@@ -124,14 +124,21 @@ FIXTURE_AXES = "xyz"
 
 @dataclass(frozen=True)
 class RateStep(Measurement):
-    """Turn the table's rate axis at `rate_dps` (signed, right-handed about the fixture's `about` axis, which
-    the pose has brought to the rate axis), hold it, acquire, store. The table keeps turning after it: the
-    next rate step about the same axis starts from this rate, a StopRotation ends the run of them."""
+    """Turn the table's `rate_axis` so the fixture turns at `rate_dps` (signed, right-handed about its `about`
+    axis, which the pose has brought to the rate axis or the rate axis lies along; `table_sign` −1 where the
+    table axis points against it), hold it, acquire, store. The table keeps turning after it: the next rate
+    step about the same axis starts from this rate, a StopRotation ends the run of them."""
 
     about: str
     rate_dps: float
     rate_axis: int
+    table_sign: float = 1.0
     stored_kind: ClassVar[str] = "rate"
+
+    @property
+    def table_rate_dps(self) -> float:
+        """The rate the table axis is commanded and reads back, about its own direction."""
+        return self.table_sign * self.rate_dps
 
     @property
     def rate_fixture_dps(self) -> tuple[float, float, float]:

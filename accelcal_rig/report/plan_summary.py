@@ -134,13 +134,17 @@ def _gyroscope_lines(prepared: PreparedCampaign) -> list[str]:
     rates = procedure.rates
     if rates is not None:
         turning = [s for s in plan.pose_steps if isinstance(s, RateStep)]
-        axis = rig.turntable.axes[turning[0].rate_axis] if turning else None
+        by_axis: dict[int, list[str]] = {}
+        for step in turning:
+            if step.about not in by_axis.setdefault(step.rate_axis, []):
+                by_axis[step.rate_axis].append(step.about)
         listed = ", ".join(f"±{r:g}" for r in rates.rates_dps)
         checked = (f"; verification ±{', ±'.join(f'{r:g}' for r in rates.verify_rates_dps)} °/s, never fitted"
                    if rates.verify_rates_dps else "")
-        acceleration = rates.acceleration_dps2 or (axis.max_acceleration_dps2 if axis else None)
-        lines.append(f"rates      {listed} °/s about fixture {', '.join(rates.about)} on table axis "
-                     f"{axis.name if axis else '?'} (reached at {acceleration:g} °/s², held {rates.settle_s:g} s): "
+        where = "; ".join(f"{', '.join(abouts)} on table axis {rig.turntable.axes[index].name} (reached at "
+                          f"{rates.acceleration_dps2 or rig.turntable.axes[index].max_acceleration_dps2:g} °/s²)"
+                          for index, abouts in by_axis.items()) or "no table axis"
+        lines.append(f"rates      {listed} °/s about fixture {where}, held {rates.settle_s:g} s: "
                      f"{rates.steps_per_setpoint} per calibration setpoint, {len(turning)} in all{checked}")
     if procedure.noise is not None:
         blocks = procedure.noise_blocks()

@@ -108,6 +108,15 @@ class _Instant:
     reading_g: np.ndarray      # (n, 3) what each reads for it by Eq. 1, before noise and unmodelled effects
 
 
+@dataclass(frozen=True)
+class _Path:
+    """The fixture at each sample of a block taken while the table moves, in the fixture frame."""
+
+    angles_deg: np.ndarray        # (n, axes)
+    up_fixture: np.ndarray        # (n, 3) unit specific force
+    rate_fixture_dps: np.ndarray  # (n, 3) the table's rate and the Earth's
+
+
 class VirtualLab:
     def __init__(self, rig: RigConfig, clock: Clock, seed: int, effects: SimulatedEffects = SimulatedEffects()) -> None:
         sim = rig.simulation
@@ -178,6 +187,7 @@ class VirtualLab:
             else np.zeros((0, 12, 4))
         self._fixture_to_duts = np.stack([d.fixture_to_dut for d in self.duts]) if self.duts else np.zeros((0, 3, 3))
         self._instant_cache: _Instant | None = None
+        self._path_cache: tuple[tuple[float, int, float], _Path | None] | None = None
         #: A DUT mounted otherwise than configured, a loose one, a dead axis (`simulation.faults`).
         self.mount_faults = MountFaults(sim.faults, serials, seed)
         #: The simulated site's true gravity in standard g: the rig config's value, off by a draw of its stated
@@ -235,16 +245,45 @@ class VirtualLab:
 
     def dut_samples(self, index: int, t_start_s: float, n_samples: int, odr_hz: float, range_g: float) -> np.ndarray:
         """`n_samples` codes (n, 3) of DUT `index` from `t_start_s` on, at the DUT's state now (temperature
-        and orientation change negligibly within a FIFO's worth); the truth behind them is recorded."""
+        changes negligibly within a FIFO's worth; where the table turns through the samples, gravity as each
+        sample felt it); the truth behind them is recorded."""
         dut, instant = self.duts[index], self._instant()
         # Copies: the log keeps its rows for hours, not each instant's whole fixture behind them.
-        temperature, params, gravity = float(instant.temperature_c[index]), instant.parameters[index].copy(), \
-            instant.gravity_g[index].copy()
+        temperature, params = float(instant.temperature_c[index]), instant.parameters[index].copy()
+        gravity, reading = instant.gravity_g[index].copy(), instant.reading_g[index]
+        path = self._path(t_start_s, n_samples, odr_hz)
+        if path is not None:  # a turn changes gravity through the samples: each sample its own
+            gravity = self._gravity_along(index, path)
+            reading = distort(gravity, params)
         noise = self.dut_rngs[index].normal(0.0, self.noise_g(index, odr_hz), (n_samples, 3))
-        reading_g = self.mount_faults.reading_g(index, instant.reading_g[index], params[0:3])
+        reading_g = self.mount_faults.reading_g(index, reading, params[0:3])
         raw_g = reading_g + self.unmodelled_g(index, gravity) + noise
-        dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, params, gravity, temperature))
+        dut.truth_log.append((t_start_s, t_start_s + n_samples / odr_hz, n_samples, params,
+                              gravity if gravity.ndim == 1 else gravity.mean(axis=0), temperature))
         return dut.part.channel("accel").quantise(raw_g, range_g)
+
+    def _path(self, t_start_s: float, n_samples: int, odr_hz: float) -> _Path | None:
+        """What the fixture felt at each sample of a block where any table axis moves through it (one path
+        for every DUT sampled at these instants); None where the table holds still."""
+        key = (t_start_s, n_samples, odr_hz)
+        if self._path_cache is None or self._path_cache[0] != key:
+            angles, rates = self.motion.path_deg(t_start_s + np.arange(n_samples) / odr_hz)
+            path = None
+            if np.any(rates) or np.any(angles != angles[0]):
+                path = _Path(angles, self.kinematics.gravity_in_fixture(angles),
+                             self.kinematics.angular_velocity_in_fixture(angles, rates)
+                             + self.kinematics.world_in_fixture(angles, self.earth_rate_world_dps))
+            self._path_cache = (key, path)
+        return self._path_cache[1]
+
+    def _gravity_along(self, index: int, path: _Path) -> np.ndarray:
+        """The true specific force (n, 3) in DUT `index`'s frame at each sample of `path` (a mount fault's turn
+        taken where the table stands now)."""
+        gravity = self.site_gravity_g * path.up_fixture @ self.duts[index].fixture_to_dut.T
+        if self.mount_faults.any_turned:
+            turn = self.mount_faults.turns(self.motion.position_deg(self.clock.now()))[index]
+            gravity = gravity @ turn.T
+        return gravity
 
     def gyro_noise_dps(self, index: int, odr_hz: float) -> float:
         """DUT `index`'s gyroscope's per-sample white noise: its part's density × √(ENBW of an ODR/4 low-pass)."""
@@ -269,7 +308,12 @@ class VirtualLab:
         if dut.gyro_truth is None:
             raise ValueError(f"{dut.serial}: the {dut.part.label} has no gyroscope")
         parameters = dut.gyro_truth.parameters_at(float(instant.temperature_c[index]))
-        reading = distort_rate(self.true_rate_dps(index), instant.gravity_g[index], parameters)
+        path = self._path(t_start_s, n_samples, odr_hz)
+        if path is None:
+            reading = distort_rate(self.true_rate_dps(index), instant.gravity_g[index], parameters)
+        else:  # the table turns through the samples: each sample's rate (the Earth's turned too) and gravity
+            reading = distort_rate(path.rate_fixture_dps @ dut.fixture_to_dut.T, self._gravity_along(index, path),
+                                   parameters)
         reading = reading * (1.0 + dut.gyro_range_scale.get(float(range_dps), np.zeros(3)))
         noise = self.gyro_rngs[index].normal(0.0, self.gyro_noise_dps(index, odr_hz), (n_samples, 3))
         wander = self.bias_wander[index].at(t_start_s + np.arange(n_samples) / odr_hz)

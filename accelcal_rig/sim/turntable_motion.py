@@ -59,6 +59,27 @@ class TurntableMotion:
             rates[axis] = self._rate_state(int(axis), t_s)[1]
         return rates
 
+    def path_deg(self, times_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Every axis's angle and rate at each of `times_s` (shapes (n, axes)), as `position_deg` and
+        `rate_deg_s` give them one time at a time: what the samples of a record taken while the table turns
+        felt, sample by sample."""
+        times = np.asarray(times_s, dtype=float)[:, None]
+        elapsed = np.maximum(times - self._t0, 0.0)
+        delta = self._target - self._start
+        travelled = self.speeds_deg_s * elapsed
+        angles = self._start + np.sign(delta) * np.minimum(np.abs(delta), travelled)
+        rates = np.where(np.abs(delta) > travelled, np.sign(delta) * self.speeds_deg_s, 0.0)
+        for axis in np.flatnonzero(self._rating):
+            dt = np.maximum(times[:, 0] - self._r_t0[axis], 0.0)
+            start, end, acc = self._r_from[axis], self._r_to[axis], self._r_acc[axis]
+            ramp_s = abs(end - start) / acc
+            sign = np.sign(end - start)
+            ramping = dt <= ramp_s
+            angles[:, axis] = np.where(ramping, self._r_angle0[axis] + start * dt + 0.5 * sign * acc * dt * dt,
+                                       self._r_angle0[axis] + 0.5 * (start + end) * ramp_s + end * (dt - ramp_s))
+            rates[:, axis] = np.where(ramping, start + sign * acc * dt, end)
+        return angles, rates
+
     def read_rate_deg_s(self, t_s: float, axis: int) -> float:
         """The rate a controller reads back for one axis: in rate mode with the table's wobble (its own
         stream, drawn only for an axis in rate mode), else as `rate_deg_s`."""

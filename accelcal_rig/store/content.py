@@ -259,9 +259,14 @@ def measurements_sha256(campaign: Campaign) -> str:
     return digest.hexdigest()
 
 
+#: Records taken while the table turns: gravity in the fixture frame may turn through them.
+TURNING_KINDS = frozenset({"rate", "verify-rate"})
+
+
 def _implausible_rows(campaign: Campaign, serial: str) -> list[int]:
-    """Rows no real measurement produces: a reference gravity not as long as the site's, a block of codes
-    all zero in any channel, or a non-finite mean or temperature."""
+    """Rows no real measurement produces: a reference gravity not as long as the site's (through a rate step,
+    gravity averaged over a turn: longer than the site's), a block of codes all zero in any channel, or a
+    non-finite mean or temperature."""
     if not campaign.poses:
         return []
     temperature = campaign.dut_column(serial, "temperature_c")
@@ -273,8 +278,11 @@ def _implausible_rows(campaign: Campaign, serial: str) -> list[int]:
         bad |= ~np.any(codes != 0, axis=(1, 2)) | ~np.all(np.isfinite(mean), axis=1)
         if info.quantity == "acceleration":  # gravity in standard g: the site's gravity's length
             reference = campaign.channel_column(serial, info.name, "reference")
+            kinds = dict(zip(campaign.header.plan.step_key, campaign.header.plan.kind))
+            turning = np.array([kinds.get(p.step_key) in TURNING_KINDS for p in campaign.poses])
             with np.errstate(invalid="ignore"):
-                bad |= np.abs(np.linalg.norm(reference, axis=1) - site) > 1e-6
+                off = np.linalg.norm(reference, axis=1) - site
+                bad |= np.where(turning, off > 1e-6, np.abs(off) > 1e-6)
     return np.flatnonzero(bad).tolist()
 
 

@@ -12,7 +12,7 @@ from accelcal_rig.config.load import load_rig
 from accelcal_rig.config.rig import ChamberConfig
 from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.errors import InstrumentError
-from accelcal_rig.instruments.chamber_modbus import ModbusChamber
+from accelcal_rig.instruments.chamber_modbus import ModbusChamber, denormal_float32
 from accelcal_rig.instruments.limits import LimitedChamber
 from accelcal_rig.protocols.chamber_registers import register_map
 from accelcal_rig.sim.chamber_server import SimulatedChamberServer
@@ -135,3 +135,12 @@ def test_the_simulated_f4_serves_its_limits_and_clamps_beyond_them(served) -> No
     raw.write_setpoint_c(190.0)  # what a controller does with a set point beyond its limits: clamps it
     assert raw.read_setpoint_c() == 180.0
     raw.close()
+
+
+def test_a_chamber_near_zero_is_not_taken_for_swapped_words() -> None:
+    """Swapped words of a round temperature give a float32 denormal; a chamber at 0 °C reads small normal floats
+    (a seeded dry run read 7.5e-7 °C once and was aborted as a wrong word order before this)."""
+    high, low = struct.unpack(">HH", struct.pack(">f", 23.5))          # 0x41BC, 0x0000
+    swapped = struct.unpack(">f", struct.pack(">HH", low, high))[0]   # its words the other way round
+    assert denormal_float32(swapped)
+    assert not any(denormal_float32(v) for v in (0.0, 7.54998e-07, -1e-30, 1.2e-38))

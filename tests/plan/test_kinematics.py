@@ -83,3 +83,21 @@ def test_a_two_axis_table_says_what_its_geometry_reaches() -> None:
                                               r"\[1.0, 0.0, 0.0\]\) bring only fixture directions 90° from the middle "
                                               r"axis to gravity; this one is 45.0° off that circle"):
         kinematics.solve(np.array([1.0, 1.0, 0.0]) / np.sqrt(2), np.zeros(2))
+
+
+def test_an_axis_turns_the_fixture_about_a_direction_its_inner_axes_choose() -> None:
+    """A horizontal outer axis turns the fixture about any direction square to the inner axis (the inner axis
+    chooses which); the innermost turns it about its own direction only, whatever the angles."""
+    axes = (TurntableAxis(name="roll", axis=(1, 0, 0), min_deg=-180, max_deg=180, continuous=True),
+            TurntableAxis(name="spin", axis=(0, 0, 1), min_deg=-180, max_deg=180, continuous=True))
+    kinematics = TurntableKinematics(axes)
+    for target in ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-0.6, 0.8, 0.0]):
+        angles = kinematics.solve_turn(0, np.array(target), np.array([40.0, 10.0]))
+        assert angles[0] == pytest.approx(40.0)                   # the turning axis is left where it was
+        np.testing.assert_allclose(kinematics.angular_velocity_in_fixture(angles, np.array([1.0, 0.0])), target,
+                                   atol=1e-8)
+    np.testing.assert_allclose(kinematics.solve_turn(1, np.array([0.0, 0.0, 1.0]), np.array([40.0, 10.0])),
+                               [40.0, 10.0])
+    for unreachable in ((0, [0.0, 0.0, 1.0]), (1, [1.0, 0.0, 0.0])):
+        with pytest.raises(UnreachablePose):
+            kinematics.solve_turn(unreachable[0], np.array(unreachable[1]), np.zeros(2))
