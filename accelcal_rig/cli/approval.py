@@ -70,11 +70,21 @@ def _authenticated(approvals: Any, name: str, from_stdin: bool) -> Any:
         raise ConfigError(f"registry {approvals.registry.url}: no user {name} (rig registry user add)")
     if not user.may_approve:
         raise ConfigError(f"user {name} may not approve (role {user.role}{', disabled' if user.disabled else ''})")
+    from accelcal_rig.registry.approvals import COMMAND_LINE, utc_now_naive
+    from accelcal_rig.registry.sign_ins import SignIns
+
+    sign_ins = SignIns(approvals.registry)
+    locked_s = sign_ins.locked_for_s(name, utc_now_naive())
+    if locked_s > 0:
+        raise ConfigError(f"user {name}: locked out after too many failed logins, for {locked_s / 60:.0f} more min "
+                          f"(rig registry user enable {name} unlocks it)")
     password = _password(from_stdin, f"password of {name}: ")
     found = approvals.authenticate(name, password)
     if found is None:
+        sign_ins.failed(name, COMMAND_LINE, utc_now_naive())
         raise ConfigError(f"user {name}: wrong password (or no password here: a reverse proxy's user approves "
                           "on the dashboard)")
+    sign_ins.signed_in(name, COMMAND_LINE, utc_now_naive())
     return found
 
 
@@ -129,15 +139,22 @@ def user_command(args: argparse.Namespace) -> int:
         if not args.full_name:
             raise ConfigError("rig registry user add: --full-name is needed (as certificates name the person)")
         password = None if args.no_password else _new_password(args.password_stdin, args.name)
-        approvals.add_user(args.name, args.full_name, args.role, password)
-        print(f"user {args.name} ({args.full_name}) added as {args.role}"
+        approvals.add_user(args.name, args.full_name, args.role or "viewer", password)
+        print(f"user {args.name} ({args.full_name}) added as {args.role or 'viewer'}"
               + (", no password here: the reverse proxy authenticates them" if password is None else ""))
     elif args.user_action == "password":
         approvals.set_password(args.name, _new_password(args.password_stdin, args.name))
-        print(f"user {args.name}: password changed")
+        print(f"user {args.name}: password changed; every session of theirs has ended")
+    elif args.user_action == "role":
+        if args.role is None:
+            raise ConfigError(f"rig registry user role {args.name}: --role approver or viewer")
+        approvals.set_role(args.name, args.role)
+        print(f"user {args.name}: now {args.role}; every session of theirs has ended")
     else:
         approvals.set_disabled(args.name, args.user_action == "disable")
-        print(f"user {args.name} {args.user_action}d")
+        print(f"user {args.name} {args.user_action}d" + ("; every session of theirs has ended"
+                                                         if args.user_action == "disable" else
+                                                         " (and unlocked, if too many failed logins had locked it)"))
     return 0
 
 
@@ -166,6 +183,8 @@ def audit_command(args: argparse.Namespace) -> int:
     from accelcal_rig.cli.registry_access import open_registry
     from accelcal_rig.registry.approvals import Approvals
 
+    if args.sign_ins:
+        return _sign_ins(open_registry(args), args.serial, args.json)
     trail = Approvals(open_registry(args)).trail(serial=args.serial)
     if args.json:
         print(json.dumps([{**row, "at": row["at"].isoformat() + "Z"} for row in trail], indent=1))
@@ -177,6 +196,21 @@ def audit_command(args: argparse.Namespace) -> int:
         reason = f": {row['reason']}" if row["reason"] else ""
         print(f"{row['at']:%Y-%m-%d %H:%M:%S}Z  {row['serial']:<16} calibration {row['calibration_id']:>5}  "
               f"{row['action']}{revision} by {row['full_name']} ({row['authority']}){reason}")
+    return 0
+
+
+def _sign_ins(registry: Any, name: str | None, as_json: bool) -> int:
+    from accelcal_rig.registry.sign_ins import SignIns
+
+    record = SignIns(registry).record(name)
+    if as_json:
+        print(json.dumps([{**row, "at": row["at"].isoformat() + "Z"} for row in record], indent=1))
+        return 0
+    if not record:
+        print("no sign-ins recorded" + (f" for {name}" if name else ""))
+    for row in record:
+        detail = f": {row['detail']}" if row["detail"] else ""
+        print(f"{row['at']:%Y-%m-%d %H:%M:%S}Z  {row['user_name']:<20} {row['event']:<15} from {row['client']}{detail}")
     return 0
 
 

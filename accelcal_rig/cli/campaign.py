@@ -88,7 +88,7 @@ def calibration_path(given: Path | None, output: Path) -> Path:
     return calibration
 
 
-def follow_up_of(args: argparse.Namespace, output: Path, continuing: bool) -> FollowUp:
+def follow_up_of(args: argparse.Namespace, output: Path, continuing: bool, registry: str | None = None) -> FollowUp:
     """Where this command writes the campaign's follow-up: a new campaign's from its flags (recorded in it), a
     continued one's as its `rig run` recorded, each part a flag names now instead."""
     from accelcal_rig.cli import follow_up
@@ -100,7 +100,7 @@ def follow_up_of(args: argparse.Namespace, output: Path, continuing: bool) -> Fo
         found = follow_up.of_campaign(load_campaign(output).attrs, output, args)
         calibration_path(found.calibration, output)
         return found
-    return follow_up.of_run(args, output, calibration_path(args.calibration, output))
+    return follow_up.of_run(args, output, calibration_path(args.calibration, output), registry)
 
 
 class _StopOnFirstSignal:
@@ -295,7 +295,8 @@ def live_publishing(prepared: PreparedCampaign, output: Path, follow_up: FollowU
     if not enabled:
         yield None
         return
-    url = recording_url(follow_up.registry, configured(prepared.rig.model.registry, prepared.rig.path), dry_run)
+    url = recording_url(follow_up.registry or follow_up.recorded_registry,
+                        configured(prepared.rig.model.registry, prepared.rig.path), dry_run)
     identity = Identity(prepared.rig.model.name, output.resolve(), prepared.procedure.model.name, dry_run)
     publisher = LivePublisher(url, identity, fresh)
     handler = publisher.handler()

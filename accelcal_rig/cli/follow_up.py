@@ -32,6 +32,10 @@ class FollowUp:
     operator: str = ""
     #: `--registry` as given (None: the rig config's `registry:`, else the lab's); never one with a password.
     registry: str | None = None
+    #: The registry the run recorded in, however it was named (`--registry`, the rig config, an environment
+    #: variable, the default file): what a resume records in, from whatever shell, unless told otherwise now;
+    #: never one with a password (a resume is then told it again). None: a campaign from before it was kept.
+    recorded_registry: str | None = None
 
     def to_json(self) -> str:
         return json.dumps({**asdict(self), "calibration": str(self.calibration.resolve()),
@@ -48,10 +52,10 @@ class PartState:
         return asdict(self)
 
 
-def of_run(args: argparse.Namespace, output: Path, calibration: Path) -> FollowUp:
-    """`rig run`'s follow-up: its flags, else beside the campaign."""
+def of_run(args: argparse.Namespace, output: Path, calibration: Path, registry: str | None = None) -> FollowUp:
+    """`rig run`'s follow-up: its flags, else beside the campaign; `registry`: the one its rows go to."""
     return FollowUp(calibration, args.certificates or output.with_suffix(".certificates"), not args.no_pdf,
-                    args.operator, _recordable(args.registry))
+                    args.operator, _recordable(args.registry), _recordable(registry))
 
 
 def of_campaign(attrs: dict[str, Any], output: Path, args: argparse.Namespace | None = None) -> FollowUp:
@@ -68,7 +72,7 @@ def of_campaign(attrs: dict[str, Any], output: Path, args: argparse.Namespace | 
     certificates = given("certificates") or stored.get("certificates") or output.with_suffix(".certificates")
     pdf = not given("no_pdf") and bool(stored.get("pdf", True))
     return FollowUp(Path(calibration), Path(certificates), pdf, given("operator") or str(stored.get("operator", "")),
-                    given("registry") or stored.get("registry"))
+                    given("registry") or stored.get("registry"), stored.get("recorded_registry"))
 
 
 def _recordable(registry: str | None) -> str | None:
@@ -83,10 +87,11 @@ def _recordable(registry: str | None) -> str | None:
 
 
 def registry_of(campaign: Path, follow_up: FollowUp, simulated: bool) -> str:
-    """The registry a campaign's calibrations are recorded in (the dry runs' own for a dry run)."""
+    """The registry a campaign's calibrations are recorded in (the dry runs' own for a dry run): `--registry`,
+    else the one its run recorded in, else as the rig config and the environment say now."""
     from accelcal_rig.registry.location import campaign_rig_registry, recording_url
 
-    return recording_url(follow_up.registry, campaign_rig_registry(campaign), simulated)
+    return recording_url(follow_up.registry or follow_up.recorded_registry, campaign_rig_registry(campaign), simulated)
 
 
 def state(campaign_path: Path, follow_up: FollowUp, fit_due: bool = True) -> list[PartState]:

@@ -9,6 +9,10 @@ EXIT_INTERNAL = 70
 EXIT_REJECTED = 3
 #: `rig check`: an instrument failed its check (as an instrument's error is).
 EXIT_CHECK_FAILED = 2
+#: `rig run`/`rig resume`: the campaign, its fit and certificates are done, but its registry rows could not be
+#: recorded (the registry down, full, refusing): `rig resume FILE` records them. Above EXIT_REJECTED: with
+#: both, the DUTs' verdicts are in the summary it printed.
+EXIT_NOT_RECORDED = 4
 
 
 def one_line(error: BaseException) -> str:

@@ -46,11 +46,20 @@ def _read(args: argparse.Namespace) -> tuple[Recording, str]:
             raise ConfigError(f"{args.recording}: --gyro-columns: a campaign file's raw samples hold no turns between "
                               "its poses (the turntable moves between them unrecorded): CSV recordings only")
         recording = read_campaign_recording(args.recording, args.serial, args.setpoint)
-        return recording, recording.serial or args.recording.stem
+        return recording, _serial(recording.serial, args)
     layout = CsvLayout.parse_columns(args.columns, gyro=args.gyro_columns, time_unit=args.time_unit,
                                      rate_hz=args.rate_hz, units=args.units, counts_per_g=args.counts_per_g,
                                      zero_code=args.zero_code, gyro_units=args.gyro_units,
                                      counts_per_dps=args.counts_per_dps)
     recording = read_csv_recording(args.recording, layout)
     check_time_base(recording.source, layout.time, layout.time_unit, recording.t_s, args.part)
-    return recording, args.serial or args.recording.stem
+    return recording, _serial(args.serial, args)
+
+
+def _serial(given: str | None, args: argparse.Namespace) -> str:
+    """The serial the calibration names: given (--serial, a campaign's DUT), else the recording file's name."""
+    from accelcal_rig.core.identifiers import checked_serial
+
+    if given:
+        return checked_serial(given, "--serial")
+    return checked_serial(args.recording.stem, f"{args.recording}: its file name (give --serial)")

@@ -33,15 +33,17 @@ def from_config(args: argparse.Namespace) -> str | None:
     return configured(rig.model.registry, rig.path)
 
 
-def register(flag: str | None, configured: str | None, entries: list[dict[str, Any]]) -> str:
-    """Record entries in the registry they belong to: the one `--registry` (`flag`) names, else a dry run's in
-    the dry runs' own and a real one's in the rig config's (`configured`) or the lab's; one line saying what
-    happened (for `rig run`/`rig fit`/`rig fit-recording`)."""
+def register(flag: str | None, configured: str | None, entries: list[dict[str, Any]],
+             recorded: str | None = None) -> str:
+    """Record entries in the registry they belong to: the one `--registry` (`flag`) names, else the one the
+    campaign's run recorded in (`recorded`), else a dry run's in the dry runs' own and a real one's in the rig
+    config's (`configured`) or the lab's; one line saying what happened (for `rig run`/`rig fit`/
+    `rig fit-recording`)."""
     from accelcal_rig.registry.database import Registry
     from accelcal_rig.registry.location import described, recording_url
 
     simulated = any(entry["simulated"] for entry in entries)
-    url = recording_url(flag, configured, simulated)
+    url = recording_url(flag or recorded, configured, simulated)
     added, already = Registry.open(url, upgrade=True).add(entries)
     tail = f", {already} registered already" if already else ""
     apart = " (a dry run: kept apart from the lab's registry)" if simulated and flag is None else ""

@@ -11,7 +11,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from accelcal_rig.cli.outcome import EXIT_INTERRUPTED, EXIT_REJECTED, one_line
+from accelcal_rig.cli.outcome import EXIT_INTERRUPTED, EXIT_NOT_RECORDED, EXIT_REJECTED, one_line
 from accelcal_rig.core.signals import TerminationRequested
 from accelcal_rig.errors import RigError
 
@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     from accelcal_rig.cli.follow_up import FollowUp
     from accelcal_rig.engine.preparation import PreparedCampaign
     from accelcal_rig.engine.session import NothingToResume, RunResult
+    from accelcal_rig.registry.publisher import LivePublisher
 
 
 def execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace, *, dry_run: bool, seed: int,
@@ -28,9 +29,12 @@ def execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace, 
     from accelcal_rig.assembly import run_campaign
     from accelcal_rig.cli.campaign import campaign_session, follow_up_of, live_publishing, stop_on_first_signal
     from accelcal_rig.engine.session import NothingToResume
+    from accelcal_rig.registry.location import configured, recording_url
     from accelcal_rig.report.live import listeners
 
-    follow_up = follow_up_of(args, output, resume and not overwrite)
+    # The registry this run records in, however it is named: kept in the campaign for its resume.
+    recorded = recording_url(args.registry, configured(prepared.rig.model.registry, prepared.rig.path), dry_run)
+    follow_up = follow_up_of(args, output, resume and not overwrite, recorded)
     prepared = replace(prepared, follow_up=follow_up.to_json())
     with live_publishing(prepared, output, follow_up, dry_run=dry_run, fresh=not resume,
                          enabled=not args.no_publish) as publisher:
@@ -43,7 +47,10 @@ def execute(prepared: PreparedCampaign, output: Path, args: argparse.Namespace, 
                                           calibration=follow_up.calibration, resume=resume, progress=watched)
             except NothingToResume as done:
                 print(done)
-                return _complete_campaign_verdicts(done, output, follow_up, args)
+                code = _complete_campaign_verdicts(done, output, follow_up, args)
+                if publisher is not None:  # its card ends as the campaign did, whatever its last run published
+                    publish_final_state(publisher, output, follow_up)
+                return code
         code = _after_campaign(prepared, result, output, follow_up, args, dry_run)
         if publisher is not None:  # the run's own account: its file need not be read again
             summary = result.summary
@@ -123,28 +130,45 @@ def _finish_follow_up(output: Path, follow_up: FollowUp) -> int:
         code = _certify_after_run(output, follow_up)
     if parts["registry"].state == follow.DONE:
         print(f"registry   {parts['registry'].detail} already")
-    else:
-        record(follow_up.registry, campaign_rig_registry(output), output,
-                lambda: campaign_entries(output, follow_up.calibration),
-                later=f"rig resume {output}, or rig registry add {output}")
+    elif not record(follow_up.registry, campaign_rig_registry(output), output,
+                    lambda: campaign_entries(output, follow_up.calibration),
+                    later=f"rig resume {output} will record them, or rig registry add {output}",
+                    recorded=follow_up.recorded_registry):
+        code = max(code, EXIT_NOT_RECORDED)
     return code
 
 
 def record(flag: str | None, configured: str | None, source: Path, entries: Callable[[], list],
-            json_output: bool = False, later: str | None = None) -> None:
+            json_output: bool = False, later: str | None = None, recorded: str | None = None) -> bool:
     """Record a finished fit in the registry (a dry run's in the dry runs' own); a registry that cannot take it
     is a warning naming how to record it later, never a loss: the calibration file is written already. Beside
-    a JSON report the line goes to stderr, so stdout stays one JSON object."""
+    a JSON report the line goes to stderr, so stdout stays one JSON object. Whether it was recorded."""
     from alembic.util.exc import CommandError
     from sqlalchemy.exc import SQLAlchemyError
 
     from accelcal_rig.cli.registry_access import register
 
     try:
-        print(register(flag, configured, entries()), file=sys.stderr if json_output else sys.stdout)
+        print(register(flag, configured, entries(), recorded), file=sys.stderr if json_output else sys.stdout)
+        return True
     except (RigError, SQLAlchemyError, OSError, CommandError) as exc:
         print(f"rig: warning: not recorded in the registry: {one_line(exc)} (record it later: "
               f"{later or f'rig registry add {source}'})", file=sys.stderr)
+        return False
+
+
+def publish_final_state(publisher: LivePublisher, output: Path, follow_up: FollowUp) -> None:
+    """A complete campaign's final state, as its file and calibration say it, on its live card: a run killed
+    after its last pose, or whose last update never reached the registry, shows done once resumed."""
+    from accelcal_rig.fit.campaign_file import calibration_verdicts
+    from accelcal_rig.store.read import load_campaign
+
+    campaign = load_campaign(output)
+    judged = (calibration_verdicts(output, follow_up.calibration)["verdicts"] or {}
+              if follow_up.calibration.is_file() else {})
+    publisher.finish_stored(campaign.state, len(campaign.poses), campaign.poses_planned,
+                            {serial: {"verdict": str(v["verdict"]), "reasons": list(v["reasons"])}
+                             for serial, v in judged.items()})
 
 
 def rejected_exit(rejected: list[str], fail_on_reject: bool) -> int:

@@ -10,7 +10,9 @@ from pydantic import Field, field_validator, model_validator
 from accelcal_rig.config.bounds import Real, StrictModel, Whole
 
 FixtureAxis = Literal["x", "y", "z"]
-RateDps = Annotated[Real, Field(gt=0, le=10_000)]
+#: A rate step's rate: at least 0.1 °/s, ten times the floor below which a rate read back is taken as rest
+#: (engine/rate_steps.py's RATE_FLOOR_DPS, 0.01 °/s): a slower one could not be told from a table at rest.
+RateDps = Annotated[Real, Field(ge=0.1, le=10_000)]
 
 
 class RateSteps(StrictModel):

@@ -20,6 +20,7 @@ from accelcal_rig.config.bounds import (
     whole_number,
 )
 from accelcal_rig.config.lab import ONE_LINE, InstrumentIdentity, IsoDate, LabConfig, References
+from accelcal_rig.core.identifiers import SERIAL_PATTERN
 from accelcal_rig.core.thermal import dut_time_constant_s
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2, site_gravity_g
 from accelcal_rig.parts.registry import DEFAULT_PART, part
@@ -196,7 +197,7 @@ class TurntableConfig(InstrumentIdentity):
 class SensorConfig(StrictModel):
     """One DUT on the fixture. `mount_euler_deg`: rotation of the DUT frame in the fixture frame (xyz)."""
 
-    serial: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.-]+$")
+    serial: str = Field(min_length=1, max_length=64, pattern=SERIAL_PATTERN)
     name: str = Field("", max_length=64)
     part: str = Field(DEFAULT_PART, max_length=64, description="the sensor part (accelcal_rig.parts), e.g. adxl357")
     driver: str = Field("serial-bridge", max_length=64, description="a sensor driver (accelcal_rig.plugins)")

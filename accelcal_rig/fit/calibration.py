@@ -23,6 +23,7 @@ from pydantic import Field, field_validator, model_validator
 from accelcal_rig.config.bounds import StrictModel, TemperatureC
 from accelcal_rig.config.load import load_validated
 from accelcal_rig.config.yaml_lines import CALIBRATION_LIMITS
+from accelcal_rig.core.identifiers import is_serial
 from accelcal_rig.durable import clear_dead_temporaries, write_text_atomically
 
 FORMAT_NAME = "accelcal-rig calibration"
@@ -219,6 +220,15 @@ class CalibrationFile(StrictModel):
     dropped: dict[str, Annotated[str, Field(max_length=1000)]] = Field(
         {}, max_length=1024, description="the campaign's DUTs left out of the fit, each with why (the early check "
                                          "dropped it: procedure early_check.action drop); written only when any")
+
+    @field_validator("duts", "dropped")
+    @classmethod
+    def _serials(cls, value: dict[str, Any]) -> dict[str, Any]:
+        bad = [serial for serial in value if not is_serial(serial)]
+        if bad:
+            raise ValueError(f"serial {bad[0][:80]!r} is not an identifier (letters, digits, _ . -, beginning with a "
+                             "letter or a digit)")
+        return value
 
     @model_validator(mode="before")
     @classmethod

@@ -22,6 +22,7 @@ from accelcal_rig.errors import ConfigError
 from accelcal_rig.registry.database import Registry, reads
 from accelcal_rig.registry.location import described
 from accelcal_rig.registry.schema import approvals, calibrations, certificate_revisions, users
+from accelcal_rig.registry.sign_ins import record_in
 
 Action = Literal["approve", "reject", "reissue"]
 Role = Literal["approver", "viewer"]
@@ -29,6 +30,8 @@ ROLES: tuple[Role, ...] = ("approver", "viewer")
 #: A password shorter than this is refused (NIST SP 800-63B's minimum for a memorised secret).
 MIN_PASSWORD = 8
 _HASHER = PasswordHasher()
+#: Who changed a user, in the sign-in record, when the command line did.
+COMMAND_LINE = "command line"
 #: Verified against when a name is unknown, so a wrong name costs as long as a wrong password.
 _DUMMY_HASH = _HASHER.hash("accelcal-rig: no such user")
 
@@ -39,6 +42,8 @@ class User:
     full_name: str
     role: str
     disabled: bool
+    #: Raised whenever every session of the user must end (registry/sign_ins.py).
+    generation: int = 0
 
     @property
     def may_approve(self) -> bool:
@@ -79,11 +84,40 @@ class Approvals:
         except sa.exc.IntegrityError:
             raise ConfigError(f"registry {described(self.registry.url)}: user {name} exists already") from None
 
-    def set_password(self, name: str, password: str) -> None:
-        self._update(name, password_hash=_HASHER.hash(_checked(password)))
+    def set_password(self, name: str, password: str, client: str = COMMAND_LINE) -> None:
+        """A new password: every session of the user ends."""
+        self._change(name, {"password_hash": _HASHER.hash(_checked(password))}, client, "password changed")
 
-    def set_disabled(self, name: str, disabled: bool) -> None:
-        self._update(name, disabled=disabled)
+    def set_disabled(self, name: str, disabled: bool, client: str = COMMAND_LINE) -> None:
+        """Disabled: every session of the user ends. Enabled: a lockout (too many failed logins) ends too."""
+        if disabled:
+            self._change(name, {"disabled": True}, client, "disabled")
+            return
+        with self.registry.writing() as connection:
+            row = connection.execute(sa.select(users.c.locked_until).where(users.c.name == name)).first()
+            if row is None:
+                raise ConfigError(f"registry {described(self.registry.url)}: no user {name}")
+            connection.execute(sa.update(users).where(users.c.name == name)
+                               .values(disabled=False, failed_logins=0, locked_until=None))
+            if row.locked_until is not None:
+                record_in(connection, utc_now_naive(), name, client, "unlocked",
+                          f"enabled (it was locked until {row.locked_until:%Y-%m-%d %H:%M:%S}Z)")
+
+    def set_role(self, name: str, role: str, client: str = COMMAND_LINE) -> None:
+        """Another role: every session of the user ends (a session holds the rights of its login)."""
+        if role not in ROLES:
+            raise ConfigError(f"role {role}: not one of {', '.join(ROLES)}")
+        self._change(name, {"role": role}, client, f"role changed to {role}")
+
+    def _change(self, name: str, values: dict[str, Any], client: str, why: str) -> None:
+        """A change to a user that ends every session of theirs, recorded with it, in one transaction."""
+        now = utc_now_naive()
+        with self.registry.writing() as connection:
+            changed = connection.execute(sa.update(users).where(users.c.name == name).values(
+                **values, session_generation=users.c.session_generation + 1)).rowcount
+            if changed == 0:
+                raise ConfigError(f"registry {described(self.registry.url)}: no user {name}")
+            record_in(connection, now, name, client, "sessions ended", why)
 
     def _update(self, name: str, **values: Any) -> None:
         with self.registry.engine.begin() as connection:
@@ -94,13 +128,13 @@ class Approvals:
     def users(self) -> list[User]:
         with self.registry.engine.connect() as connection:
             rows = connection.execute(sa.select(users).order_by(users.c.name)).all()
-        return [User(r.name, r.full_name, r.role, r.disabled) for r in rows]
+        return [_user(r) for r in rows]
 
     @reads
     def user(self, name: str) -> User | None:
         with self.registry.engine.connect() as connection:
             row = connection.execute(sa.select(users).where(users.c.name == name)).first()
-        return None if row is None else User(row.name, row.full_name, row.role, row.disabled)
+        return None if row is None else _user(row)
 
     @reads
     def authenticate(self, name: str, password: str) -> User | None:
@@ -116,7 +150,7 @@ class Approvals:
             return None
         if _HASHER.check_needs_rehash(stored):
             self._update(name, password_hash=_HASHER.hash(password))
-        return User(row.name, row.full_name, row.role, row.disabled)
+        return _user(row)
 
     # ------------------------------------------------------------------ decisions
     @reads
@@ -271,6 +305,10 @@ class IssuedCertificate:
     number: str
     html: str
     pdf: bytes | None
+
+
+def _user(row: Any) -> User:
+    return User(row.name, row.full_name, row.role, row.disabled, int(row.session_generation))
 
 
 def _events(connection: Any, lead: int) -> list[Any]:

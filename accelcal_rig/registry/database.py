@@ -11,6 +11,7 @@ import sqlite3
 import time
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 from typing import Any, TypeVar
@@ -44,6 +45,17 @@ _SQLITE_BUSY_S = 60.0
 CONNECT_TIMEOUT_S = 10
 #: The verdict of a calibration no acceptance limits judged: stored as none (NULL), counted in no yield.
 NOT_JUDGED = "NOT JUDGED"
+
+
+@dataclass(frozen=True)
+class RegistryTimeouts:
+    """How long a registry is waited for: a connection (PostgreSQL's connect_timeout, unless the URL gives one;
+    TCP's user timeout the same), a statement (PostgreSQL's statement_timeout; None: no limit), SQLite's lock.
+    The commands' defaults wait long (a busy lab's registry); the dashboard waits little (web/registry_gate.py)."""
+
+    connect_s: float = CONNECT_TIMEOUT_S
+    statement_s: float | None = None
+    sqlite_busy_s: float = _SQLITE_BUSY_S
 
 
 def migration_config() -> Config:
@@ -82,8 +94,23 @@ class Registry:
         self.engine = engine
         self.url = url
 
+    @contextmanager
+    def writing(self) -> Iterator[Connection]:
+        """A transaction that reads then writes: on SQLite begun IMMEDIATE, so that it waits its turn for the
+        write lock (busy timeout) instead of failing at once when its read would have to become a write while
+        another writer holds the lock; on PostgreSQL an ordinary one."""
+        with self.engine.connect() as connection:
+            if self.engine.dialect.name == "sqlite":
+                connection.info["begin"] = "BEGIN IMMEDIATE"  # see _engine's begin hook
+            try:
+                with connection.begin():
+                    yield connection
+            finally:
+                connection.info.pop("begin", None)
+
     @classmethod
-    def open(cls, url: str, upgrade: bool = True, create: bool = True, read_only: bool = False) -> Registry:
+    def open(cls, url: str, upgrade: bool = True, create: bool = True, read_only: bool = False,
+             timeouts: RegistryTimeouts | None = None) -> Registry:
         """Connect, in one line when it cannot be. A new, empty database is created at the current schema when
         `create` (the commands that record; a reader is refused instead: it never creates a registry); an
         older one is migrated when `upgrade`, else refused (readers do not change a schema); one newer than
@@ -91,7 +118,7 @@ class Registry:
         a reader's connection, which can read a registry on a read-only mount and writes nothing."""
         if not create and url.startswith("sqlite:///") and not Path(url.removeprefix("sqlite:///")).is_file():
             raise ConfigError(f"registry {described(url)}: does not exist (nothing recorded in it yet)")
-        engine = _engine(url, create=create, read_only=read_only)
+        engine = _engine(url, create=create, read_only=read_only, timeouts=timeouts or RegistryTimeouts())
         registry = cls(engine, url)
         for attempt in range(_OPEN_ATTEMPTS):
             try:
@@ -348,21 +375,50 @@ def _with_figures(connection: Connection, rows: list[dict[str, Any]]) -> list[di
     return [{**row, "figures": found[int(row["id"])]} for row in rows]
 
 
-def _engine(url: str, create: bool = True, read_only: bool = False) -> Engine:
+def _engine(url: str, create: bool = True, read_only: bool = False, timeouts: RegistryTimeouts | None = None) -> Engine:
+    timeouts = timeouts or RegistryTimeouts()
     if url.startswith("sqlite:///"):
-        return _sqlite_engine(Path(url.removeprefix("sqlite:///")), create, read_only)
+        return _sqlite_engine(Path(url.removeprefix("sqlite:///")), create, read_only, timeouts.sqlite_busy_s)
     query = url.partition("?")[2]
     # libpq's own connect_timeout, when the URL gives one; else ours: a server that accepts and never
-    # answers is one line within seconds, not a wait of minutes.
-    connect_args = {} if "connect_timeout=" in query else {"connect_timeout": CONNECT_TIMEOUT_S}
+    # answers is one line within seconds, not a wait of minutes. A server that stops answering a connection
+    # already made: TCP's user timeout (unacknowledged data) and keepalives (a silent peer).
+    connect_args: dict[str, Any] = {} if "connect_timeout=" in query else {
+        "connect_timeout": max(2, round(timeouts.connect_s)), "tcp_user_timeout": round(timeouts.connect_s * 1000),
+        "keepalives": 1, "keepalives_idle": 5, "keepalives_interval": 2, "keepalives_count": 2}
+    if timeouts.statement_s is not None and "options=" not in query:
+        connect_args["options"] = f"-c statement_timeout={round(timeouts.statement_s * 1000)}"
     try:
-        return sa.create_engine(url, pool_pre_ping=True, connect_args=connect_args)
+        return sa.create_engine(url, pool_pre_ping=True, connect_args=connect_args,
+                                pool_timeout=max(1.0, timeouts.connect_s))
     except (sa.exc.ArgumentError, ModuleNotFoundError) as exc:
         raise ConfigError(f"registry {described(url)}: {exc} (PostgreSQL needs: pip install "
                           "'accelcal-rig[postgresql]')") from None
 
 
-def _sqlite_engine(path: Path, create: bool, read_only: bool) -> Engine:
+def _read_only_connection(path: Path, busy_s: float) -> sqlite3.Connection:
+    """A reader's connection: read-only; immutable where SQLite cannot make its side files — a folder it cannot
+    write (a read-only mount), or a full disk (its shared-memory file cannot be made: "disk I/O error" at the
+    first read) when no write-ahead log holds anything the file does not (immutable reads would miss it)."""
+    def connect(immutable: bool) -> sqlite3.Connection:
+        address = f"file:{quote(str(path))}?mode=ro" + ("&immutable=1" if immutable else "")
+        return sqlite3.connect(address, uri=True, timeout=busy_s, check_same_thread=False)
+
+    if not os.access(path.parent, os.W_OK):
+        return connect(True)
+    connection = connect(False)
+    try:
+        connection.execute("SELECT count(*) FROM sqlite_master").fetchone()
+        return connection
+    except sqlite3.OperationalError as exc:
+        connection.close()
+        wal = path.with_name(path.name + "-wal")
+        if "disk I/O error" not in str(exc) or (wal.exists() and wal.stat().st_size > 0):
+            raise
+        return connect(True)
+
+
+def _sqlite_engine(path: Path, create: bool, read_only: bool, busy_s: float = _SQLITE_BUSY_S) -> Engine:
     """An SQLite registry: in WAL mode for the commands that write (readers never block the writer, nor it
     them); a reader's connection read-only, and on a mount where not even SQLite's side files can be made,
     opened as immutable (nothing can write there either)."""
@@ -372,12 +428,10 @@ def _sqlite_engine(path: Path, create: bool, read_only: bool) -> Engine:
         except OSError as exc:
             raise ConfigError(f"registry sqlite:///{path}: cannot create its folder: {exc}") from None
     if read_only:
-        immutable = not os.access(path.parent, os.W_OK)
-        address = f"file:{quote(str(path))}?mode=ro" + ("&immutable=1" if immutable else "")
-        engine = sa.create_engine("sqlite://", poolclass=sa.pool.NullPool, creator=lambda: sqlite3.connect(
-            address, uri=True, timeout=_SQLITE_BUSY_S, check_same_thread=False))
+        engine = sa.create_engine("sqlite://", poolclass=sa.pool.NullPool,
+                                  creator=lambda: _read_only_connection(path, busy_s))
     else:
-        engine = sa.create_engine(f"sqlite:///{path}", connect_args={"timeout": _SQLITE_BUSY_S},
+        engine = sa.create_engine(f"sqlite:///{path}", connect_args={"timeout": busy_s},
                                   poolclass=sa.pool.NullPool)
 
     @sa.event.listens_for(engine, "connect")
@@ -386,7 +440,7 @@ def _sqlite_engine(path: Path, create: bool, read_only: bool) -> Engine:
         cursor = dbapi_connection.cursor()
         if not read_only and _ours_or_empty(cursor):
             cursor.execute("PRAGMA journal_mode=WAL")  # readers never block the writer, nor it them
-        cursor.execute(f"PRAGMA busy_timeout={int(_SQLITE_BUSY_S * 1000)}")
+        cursor.execute(f"PRAGMA busy_timeout={int(busy_s * 1000)}")
         cursor.execute("PRAGMA foreign_keys=ON")  # a decision names a calibration that exists
         cursor.close()
 

@@ -11,6 +11,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from accelcal_rig.core.identifiers import checked_serial
 from accelcal_rig.engine.states import State, entered_at
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.fit.calibration import (
@@ -81,7 +82,8 @@ def _entry(calibration: CalibrationFile, channel: str, sensor: ChannelCalibratio
                        "source": calibration.source},
               "sensor": json.loads(sensor.model_dump_json())}
     return {
-        "serial": sensor.serial, "channel": channel, "part": part, "source_kind": source["kind"],
+        "serial": checked_serial(sensor.serial, f"{source['path']}: its calibration"), "channel": channel, "part": part,
+        "source_kind": source["kind"],
         "source_path": source["path"],
         "source_sha256": source["sha256"],
         "fit_sha256": hashlib.sha256(json.dumps(stored["sensor"], sort_keys=True).encode()).hexdigest(),

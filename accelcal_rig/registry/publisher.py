@@ -130,6 +130,14 @@ class LivePublisher:
             self._changed = True
             self._lock.notify()
 
+    def finish_stored(self, state: str, poses_done: int, poses_total: int, verdicts: dict[str, Any]) -> None:
+        """The last word of a campaign found complete in its file (a resume with nothing left to run): published
+        though this run gave no progress, so that a card its last run left "running" ends as the file says."""
+        with self._lock:
+            self._started = True
+            self._row.update(poses_total=poses_total)
+        self.finish(state, poses_done, verdicts)
+
     def close(self, timeout_s: float = 10.0) -> str | None:
         """Publish what is left, within `timeout_s`; what could not be, in one line (None: all of it was)."""
         with self._lock:

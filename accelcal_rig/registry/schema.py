@@ -72,6 +72,11 @@ users = sa.Table(
     sa.Column("password_hash", sa.String(256), nullable=True),        # argon2id; none: a reverse proxy's user
     sa.Column("disabled", sa.Boolean, nullable=False, server_default=sa.false()),
     sa.Column("created_at", sa.DateTime, nullable=False),
+    # Added by migration 0009 (registry/sign_ins.py): raised to end every session of the user; consecutive
+    # failed logins; locked out until (UTC).
+    sa.Column("session_generation", sa.Integer, nullable=False, server_default="0"),
+    sa.Column("failed_logins", sa.Integer, nullable=False, server_default="0"),
+    sa.Column("locked_until", sa.DateTime, nullable=True),
 )
 
 approvals = sa.Table(
@@ -152,6 +157,18 @@ live_temperatures = sa.Table(
     sa.Column("clock_s", sa.Float, nullable=False),
     sa.Column("chamber_c", sa.Float, nullable=True),
     sa.Column("dut_c", sa.Float, nullable=True),                   # the DUTs' mean
+)
+
+
+# Added by migration 0009: the record of sign-ins (registry/sign_ins.py), oldest first.
+sign_ins = sa.Table(
+    "sign_ins", metadata,
+    sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+    sa.Column("at", sa.DateTime, nullable=False),                   # UTC
+    sa.Column("user_name", sa.String(64), nullable=False, index=True),  # as given (a failed login's may be no user)
+    sa.Column("client", sa.String(64), nullable=False),             # the dashboard's client address, or "command line"
+    sa.Column("event", sa.String(32), nullable=False),              # login | login failed | locked | unlocked | logout | sessions ended
+    sa.Column("detail", sa.Text, nullable=False, server_default=""),
 )
 
 

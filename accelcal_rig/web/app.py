@@ -8,13 +8,15 @@ from __future__ import annotations
 
 import hmac
 import secrets
-import threading
+import time
+from collections.abc import Awaitable, Callable
 from pathlib import Path
 from typing import Any
 from urllib.parse import quote
 
 from jinja2 import Environment, PackageLoader, select_autoescape
 from starlette.applications import Starlette
+from starlette.concurrency import run_in_threadpool
 from starlette.exceptions import HTTPException
 from starlette.middleware import Middleware
 from starlette.middleware.base import BaseHTTPMiddleware, RequestResponseEndpoint
@@ -25,21 +27,24 @@ from starlette.responses import FileResponse, HTMLResponse, JSONResponse, PlainT
 from starlette.routing import Mount, Route
 from starlette.staticfiles import StaticFiles
 
-from accelcal_rig.errors import ConfigError
+from accelcal_rig.errors import RigError
 from accelcal_rig.registry.analysis import by_channel, lot_statistics, trend
 from accelcal_rig.registry.database import Registry
-from accelcal_rig.registry.location import described
 from accelcal_rig.web.approval import BEARER_SCOPE_KEY, ApprovalSettings, approval_routes
 from accelcal_rig.web.campaigns import CampaignFolders
 from accelcal_rig.web.errors import CheckedInput, ErrorPages, Unforeseen, exception_handlers
 from accelcal_rig.web.interruptions import resume_markers
 from accelcal_rig.web.lab import LabRigs
+from accelcal_rig.web.registry_gate import TURN_WAIT_S, RegistryGate
+from accelcal_rig.web.sign_in import SignInPolicy
 from accelcal_rig.web.svg import line_plot
 
 _STATIC = Path(__file__).parent / "static"
 #: The registry page's filter (`?made=`): every calibration, only real ones, only dry runs.
 _MADE: dict[str, bool | None] = {"": None, "real": False, "dry-run": True}
 _TOKEN_COOKIE = "accelcal_token"
+#: How long the front page waits for the registry's rigs before it shows the campaigns without them.
+FRONT_WAIT_S = 0.5
 #: A page the dashboard serves but did not make (a certificate, a report: files anyone who can write the
 #: campaign's folder or the registry could have changed) runs in a sandbox of its own origin: no script of
 #: it can read the dashboard's pages, its session or its form token.
@@ -76,26 +81,39 @@ LOOPBACK_HOSTS = ["127.0.0.1", "localhost", "::1", "[::1]"]
 
 
 def create_app(campaign_folders: list[Path], registry_url: str | None, token: str | None = None,
-               tls: bool = False, hosts: list[str] | None = None, user_header: str | None = None) -> Starlette:
+               tls: bool = False, hosts: list[str] | None = None, user_header: str | None = None,
+               sign_in: SignInPolicy | None = None, clock: Callable[[], float] = time.monotonic) -> Starlette:
     """`hosts`: the Host names answered without a token (default LOOPBACK_HOSTS); with a token, any.
     `user_header`: the reverse proxy's header naming the authenticated user (web/approval.py); it needs a
-    token, which the proxy sends as `Authorization: Bearer`."""
+    token, which the proxy sends as `Authorization: Bearer`. `sign_in`: how long sessions live and how logins
+    are limited (web/sign_in.py; its defaults). `clock`: what a failed registry's probes are timed by."""
     if user_header and not token:
         raise ValueError("a user header needs a token: the proxy sends it, so only the proxy names a user")
     campaigns = CampaignFolders(campaign_folders)
-    registry = _LazyRegistry(registry_url)
+    registry = RegistryGate(registry_url, clock)
     templates = Environment(loader=PackageLoader("accelcal_rig.web", "templates"),
                             autoescape=select_autoescape(["html"]))
 
     def page(name: str, status: int = 200, **values: Any) -> HTMLResponse:
         return HTMLResponse(templates.get_template(name).render(registry=registry.label, **values), status_code=status)
 
-    def front(request: Request) -> Response:
-        return page("front.html", campaigns=campaigns.summaries(), folders=campaigns.folders,
-                    show_rigs=registry.url is not None, **lab.overview())
+    async def front(request: Request) -> Response:
+        """The campaigns at once; the rigs as far as the registry answers within FRONT_WAIT_S (else the page says
+        so, and its polling shows them when it does)."""
+        rigs = await rigs_now(FRONT_WAIT_S) if registry.url is not None else {"lab": None, "rigs_error": None}
+        summaries = await run_in_threadpool(campaigns.summaries)
+        return page("front.html", campaigns=summaries, folders=campaigns.folders, show_rigs=registry.url is not None,
+                    **rigs)
 
-    def rigs_fragment(request: Request) -> Response:
-        return HTMLResponse(templates.get_template("_rigs.html").render(registry=registry.label, **lab.overview()))
+    async def rigs_now(wait_s: float) -> dict[str, Any]:
+        try:
+            return await registry.call(lab.overview, turn_wait_s=wait_s)
+        except RigError as exc:
+            return {"lab": None, "rigs_error": str(exc).splitlines()[0]}
+
+    async def rigs_fragment(request: Request) -> Response:
+        rigs = await rigs_now(TURN_WAIT_S)
+        return HTMLResponse(templates.get_template("_rigs.html").render(registry=registry.label, **rigs))
 
     def rigs_json(request: Request) -> Response:
         found = lab.overview()
@@ -189,7 +207,13 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
         return JSONResponse({"channels": {channel: _jsonable(trend(of, channel))
                                           for channel, of in by_channel(rows).items()}} if rows else {"channels": {}})
 
-    lab = LabRigs(registry.get)
+    def gated(handler: Callable[[Request], Response]) -> Callable[[Request], Awaitable[Response]]:
+        """A page that reads the registry: run as the registry's turns allow (web/registry_gate.py)."""
+        async def endpoint(request: Request) -> Response:
+            return await registry.call(handler, request)
+        return endpoint
+
+    lab = LabRigs(registry.get, registry.failed)
     pages = ErrorPages(templates, registry.label)
     # Outermost the unforeseen error's page; then who may ask (their refusals say nothing of the dashboard,
     # not even which registry: plain text); then the address checked before any route reads it.
@@ -202,47 +226,19 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
     middleware.append(Middleware(SessionMiddleware, secret_key=secrets.token_urlsafe(32), session_cookie="accelcal_session",
                                  same_site="strict", https_only=tls, max_age=8 * 3600))
     app = Starlette(routes=[
-        *approval_routes(registry, page, ApprovalSettings(user_header)),
+        *approval_routes(registry, page, ApprovalSettings(user_header, sign_in)),
         Route("/", front), Route("/api/campaigns", campaigns_json),
-        Route("/fragments/rigs", rigs_fragment), Route("/api/rigs", rigs_json), Route("/api/live/stream", lab.stream),
-        Route("/live/{key}", live_page), Route("/api/live/{key}", live_json),
+        Route("/fragments/rigs", rigs_fragment), Route("/api/rigs", gated(rigs_json)), Route("/api/live/stream", lab.stream),
+        Route("/live/{key}", gated(live_page)), Route("/api/live/{key}", gated(live_json)),
         Route("/campaigns/{name}", campaign), Route("/api/campaigns/{name}", campaign_json),
         Route("/campaigns/{name}/{kind}/{file:path}", campaign_file),
-        Route("/registry", registry_search), Route("/registry/serials/{serial:path}", serial_page),
-        Route("/registry/parts/{part}", part_page), Route("/api/registry/serials/{serial:path}", serial_json),
+        Route("/registry", gated(registry_search)), Route("/registry/serials/{serial:path}", gated(serial_page)),
+        Route("/registry/parts/{part}", gated(part_page)),
+        Route("/api/registry/serials/{serial:path}", gated(serial_json)),
         Mount("/static", StaticFiles(directory=_STATIC), name="static"),
-    ], middleware=middleware, exception_handlers=exception_handlers(pages, registry.forget))
+    ], middleware=middleware, exception_handlers=exception_handlers(pages, registry.failed, registry.forget))
     app.state.stop_streams = lab.stop_streams  # rig serve ends the event streams as it stops
     return app
-
-
-class _LazyRegistry:
-    """The registry, opened at its first use (a dashboard of campaigns works without one), never created
-    (a GET, even a page elsewhere's, must not make a file) and never kept after a failure: a registry that
-    could not be read is opened again at the next request, so one repaired (or created) is seen at once."""
-
-    def __init__(self, url: str | None) -> None:
-        self.url = url
-        self._registry: Registry | None = None
-        self._lock = threading.Lock()  # requests are answered on several threads
-        self.label = described(url) if url else "none"
-
-    def get(self) -> Registry:
-        with self._lock:
-            if self._registry is None:
-                if self.url is None:
-                    raise ConfigError("no registry: serve one with rig serve --registry URL")
-                # A view changes no schema and creates nothing: a missing or older registry is one line.
-                self._registry = Registry.open(self.url, upgrade=False, create=False)
-            return self._registry
-
-    def forget(self) -> None:
-        """After a failure: the next request opens the registry again (its schema checked again). Without the
-        lock: called on the event loop, it must not wait for an open under way (a race at worst disposes a
-        registry just opened, which reconnects at its next use)."""
-        opened, self._registry = self._registry, None
-        if opened is not None:
-            opened.engine.dispose()
 
 
 def _certificates(campaign: Path) -> list[str]:

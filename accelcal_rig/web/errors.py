@@ -3,8 +3,9 @@ the status and one line saying what was wrong — never a traceback, an exceptio
 
 400 bad input (refused before any route sees it: a NUL or control character, an address that is not UTF-8,
 an over-long segment or query), 403/409/413 a refused form, 404 nothing there, 405 a method an address does
-not take, 503 the registry cannot be read (the registry layer's one line, which names it without a
-password), 500 anything unforeseen (one line on the server's log; the page says only that it happened)."""
+not take, 429 too many failed logins (with Retry-After), 503 the registry cannot be read, is down or busy
+(the registry layer's one line, which names it without a password), 500 anything unforeseen (one line on the
+server's log; the page says only that it happened)."""
 
 from __future__ import annotations
 
@@ -34,7 +35,7 @@ MAX_QUERY_BYTES = 4096
 #: The longest line an error page shows (a message quoting a long value is cut there).
 MAX_MESSAGE = 300
 _TITLES = {400: "Bad request", 403: "Refused", 404: "Not found", 405: "Not allowed here", 409: "Refused",
-           413: "Too large", 500: "Internal error", 503: "Registry unavailable"}
+           413: "Too large", 429: "Too many attempts", 500: "Internal error", 503: "Registry unavailable"}
 #: Messages for Starlette's own errors (its detail is only the status's phrase).
 _DEFAULTS = {404: "there is no page at this address", 405: "this address does not take that method"}
 #: A driver's exception named in a message, "(sqlite3.DatabaseError) " as SQLAlchemy writes it: not for a page.
@@ -62,10 +63,12 @@ class ErrorPages:
         return HTMLResponse(html, status_code=status, headers=headers)
 
 
-def exception_handlers(pages: ErrorPages, on_failure: Callable[[], None]) -> dict[Any, Callable[..., Any]]:
+def exception_handlers(pages: ErrorPages, on_failure: Callable[[BaseException], None],
+                       on_unforeseen: Callable[[], None]) -> dict[Any, Callable[..., Any]]:
     """Starlette's handlers: HTTPException (the routes' own and Starlette's 404/405) by its status, a
     registry that cannot be read 503, and (ServerErrorMiddleware's, a last resort behind `Unforeseen`) 500.
-    `on_failure`: forget the opened registry, so the next request opens it again."""
+    `on_failure`: the registry failed (web/registry_gate.py: taken as down until a probe finds it back);
+    `on_unforeseen`: something else did (the registry opened afresh at the next request, in case it was it)."""
 
     async def http_error(request: Request, exc: Exception) -> Response:
         assert isinstance(exc, HTTPException)
@@ -74,11 +77,11 @@ def exception_handlers(pages: ErrorPages, on_failure: Callable[[], None]) -> dic
         return pages.response(request.url.path, exc.status_code, message, exc.headers)
 
     async def registry_error(request: Request, exc: Exception) -> Response:
-        on_failure()
+        on_failure(exc)
         return pages.response(request.url.path, 503, registry_reason(exc, pages.registry_label))
 
     async def unforeseen(request: Request, exc: Exception) -> Response:
-        on_failure()
+        on_unforeseen()
         log_unforeseen(request.method, request.url.path, exc)
         return pages.response(request.url.path, 500, UNFORESEEN)
 

@@ -39,8 +39,10 @@ _KEY = re.compile(r"^[0-9a-f]{32}$")
 
 
 class LabRigs:
-    def __init__(self, registry: Callable[[], Registry]) -> None:
+    def __init__(self, registry: Callable[[], Registry],
+                 on_failure: Callable[[BaseException], None] = lambda exc: None) -> None:
         self._registry = registry
+        self._on_failure = on_failure  # a registry that failed here is taken as down (web/registry_gate.py)
         self.changes = LiveChanges(self.board)
         self.stopping = threading.Event()  # the server is stopping: every stream ends
 
@@ -57,6 +59,7 @@ class LabRigs:
         try:
             return {"lab": overview(self.board()), "rigs_error": None}
         except RigError as exc:
+            self._on_failure(exc)
             return {"lab": None, "rigs_error": str(exc).splitlines()[0]}
 
     def campaign(self, key: str) -> dict[str, Any]:

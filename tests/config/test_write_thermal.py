@@ -43,3 +43,30 @@ def test_a_write_that_would_break_the_config_is_refused_and_the_file_left_as_it_
     with pytest.raises(ConfigError, match="its thermal: is not a block of its own lines"):
         write_thermal(config, MEASURED, "x")
     assert config.read_text().endswith("thermal: {heating_rate_c_per_min: 2}\n")
+
+
+def test_a_linked_config_is_written_where_the_link_points_and_stays_a_link(tmp_path: Path) -> None:
+    real = tmp_path / "configs" / "lab.yaml"
+    real.parent.mkdir()
+    real.write_text(UNMEASURED)
+    link = tmp_path / "rig.yaml"
+    link.symlink_to(real)
+    write_thermal(link, MEASURED, "rig characterise a.h5")
+    assert link.is_symlink() and load_rig(real).model.thermal.heating_rate_c_per_min == 2.75
+
+
+def test_line_endings_and_the_sections_own_comments_are_kept(tmp_path: Path) -> None:
+    config = tmp_path / "lab.yaml"
+    section = ("thermal:  # the chamber's, not the data sheet's\n"
+               "  # measured after the door seal was replaced\n"
+               "  heating_rate_c_per_min: 9   # from a 60 °C step\n"
+               "  room_c: 21\n")
+    original = (UNMEASURED + section + "\n# the end\n").replace("\n", "\r\n")
+    config.write_bytes(original.encode())
+    write_thermal(config, MEASURED, "rig characterise a.h5")
+    written = config.read_bytes().decode()
+    assert "\n" not in written.replace("\r\n", "")                          # every line still CRLF
+    assert written.startswith(UNMEASURED.replace("\n", "\r\n")) and written.endswith("\r\n\r\n# the end\r\n")
+    assert ("thermal:  # the chamber's, not the data sheet's\r\n  # measured after the door seal was replaced\r\n"
+            "  heating_rate_c_per_min: 2.75   # from a 60 °C step\r\n") in written
+    assert load_rig(config).model.thermal.room_c == 22.5

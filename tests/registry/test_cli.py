@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from accelcal_rig.cli import main
+from accelcal_rig.cli.outcome import EXIT_NOT_RECORDED
 from accelcal_rig.registry.database import Registry
 from accelcal_rig.registry.location import normalised
 from tests.conftest import REPO
@@ -183,10 +184,13 @@ def test_a_registry_that_cannot_take_the_record_loses_nothing(tmp_path: Path, ca
     blocked.write_text("")
     campaign = tmp_path / "quick.h5"
     assert rig("run", REPO / "procedures" / "quick-6pos.yaml", "--dry-run", "-o", campaign, "-q", "--no-pdf",
-               "--registry", blocked / "lab.sqlite") == 0  # the campaign and its calibration are what matter
+               "--registry", blocked / "lab.sqlite") == EXIT_NOT_RECORDED  # the campaign and its calibration stand
     err = capsys.readouterr().err
-    assert "rig: warning: not recorded in the registry:" in err and f"rig registry add {campaign}" in err
+    assert "rig: warning: not recorded in the registry:" in err and f"rig resume {campaign} will record them" in err
     assert campaign.with_suffix(".calibration.yaml").is_file()
+    blocked.unlink()                                   # the registry can take them now: resume records them
+    assert rig("resume", campaign, "--registry", blocked / "lab.sqlite", "-q", "--no-pdf") == 0
+    assert "4 calibrations recorded" in capsys.readouterr().out
 
 
 def test_a_trend_of_fits_without_stated_uncertainty_is_printed_not_a_crash(tmp_path: Path, capsys) -> None:
@@ -254,3 +258,46 @@ def shifted(entry: dict, by: float) -> dict:
     """A registry entry whose bias figure is `by` more on every axis (a later calibration of the same sensor)."""
     figures = [f | {"value": [v + by for v in f["value"]]} if f["name"] == "bias" else f for f in entry["figures"]]
     return entry | {"figures": figures}
+
+
+def test_a_registry_named_by_the_environment_is_the_one_a_resume_records_in(tmp_path: Path, capsys,
+                                                                            monkeypatch) -> None:
+    """The dry runs' registry named only by $ACCELCAL_DRY_RUN_REGISTRY, and unable to take the rows at the end of
+    the run: a resume from another shell (another environment) records them there, not in its own default."""
+    blocked = tmp_path / "blocked"
+    blocked.write_text("")
+    named = blocked / "named.sqlite"
+    monkeypatch.setenv("ACCELCAL_DRY_RUN_REGISTRY", str(named))
+    campaign = tmp_path / "quick.h5"
+    assert rig("run", REPO / "procedures" / "quick-6pos.yaml", "--dry-run", "-o", campaign, "-q", "--no-pdf",
+               "--no-publish") == EXIT_NOT_RECORDED
+    blocked.unlink()
+    elsewhere = tmp_path / "elsewhere.sqlite"
+    monkeypatch.setenv("ACCELCAL_DRY_RUN_REGISTRY", str(elsewhere))          # another shell's
+    capsys.readouterr()
+    assert rig("resume", campaign, "-q", "--no-pdf", "--no-publish") == 0
+    assert f"4 calibrations recorded in sqlite:///{named}" in capsys.readouterr().out
+    assert len(Registry.open(normalised(str(named))).calibrations()) == 4 and not elsewhere.exists()
+
+
+def test_a_resume_of_a_complete_campaign_ends_its_card_as_its_file_says(tmp_path: Path, capsys) -> None:
+    """A run killed after its last pose (or whose last update never reached the registry) left its card
+    "running"; resuming the complete campaign publishes how it ended."""
+    import sqlalchemy as sa
+
+    from accelcal_rig.registry.live import LiveBoard
+    from accelcal_rig.registry.schema import live_campaigns
+
+    registry = normalised(str(tmp_path / "lab.sqlite"))
+    campaign = tmp_path / "quick.h5"
+    assert rig("run", REPO / "procedures" / "quick-6pos.yaml", "--dry-run", "-o", campaign, "-q", "--no-pdf",
+               "--registry", registry) == 0
+    board = LiveBoard(Registry.open(registry))
+    (card,) = board.campaigns()
+    assert card["state"] == "done" and card["poses_done"] == card["poses_total"] > 0
+    with board.engine.begin() as connection:                 # what a kill before the last update leaves
+        connection.execute(sa.update(live_campaigns).values(state="running", phase="poses", poses_done=0))
+    assert rig("resume", campaign, "-q", "--no-pdf", "--registry", registry) == 0
+    (card,) = LiveBoard(Registry.open(registry)).campaigns()
+    assert card["state"] == "done" and card["poses_done"] == card["poses_total"]
+    assert set(card["verdicts"]) == {"ADX355-A001", "ADX355-A002", "ADX355-A003", "ADX355-A004"}   # quick-6pos judges none

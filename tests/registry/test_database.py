@@ -253,3 +253,30 @@ def test_a_server_that_accepts_and_never_answers_is_one_line_within_the_connect_
         listener.close()
         for connection in held:
             connection.close()
+
+
+def test_a_registry_on_a_full_disk_is_still_read(tmp_path: Path, quick_campaign) -> None:
+    """A full disk (root: a small tmpfs filled up) where SQLite cannot make its shared-memory file to read: read
+    as immutable (its write-ahead log is empty: nothing to miss), by the command line and the dashboard alike."""
+    from accelcal_rig.web.registry_gate import RegistryGate
+
+    mount = tmp_path / "mnt"
+    mount.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", str(mount)], capture_output=True).returncode:
+        pytest.skip("needs to mount a tmpfs (root)")
+    try:
+        url = f"sqlite:///{mount / 'registry.sqlite'}"
+        campaign, calibration = quick_campaign
+        Registry.open(url).add(campaign_entries(campaign, calibration))
+        with open(mount / "filler", "wb") as filler:          # the disk full
+            try:
+                while True:
+                    filler.write(b"\0" * 65536)
+                    filler.flush()
+            except OSError:
+                pass
+        assert Registry.open(url, upgrade=False, create=False, read_only=True).count() == 4
+        gate = RegistryGate(url)
+        assert gate.get().count() == 4 and gate.read_only       # the dashboard shows it; logins are refused
+    finally:
+        subprocess.run(["umount", str(mount)], capture_output=True)

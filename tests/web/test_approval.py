@@ -76,7 +76,10 @@ def test_an_approver_logs_in_and_approves_and_nothing_else_can(lab) -> None:
     assert client.post(decide, data={"csrf": token, "action": "delete"}, headers=ORIGIN).status_code == 400
     assert Approvals(Registry.open(registry)).trail(calibration_id=row_id) == []
 
-    approved = client.post(decide, data={"csrf": token, "action": "approve"}, headers=ORIGIN)
+    unsigned = client.post(decide, data={"csrf": token, "action": "approve", "password": "guess"}, headers=ORIGIN)
+    assert unsigned.status_code == 403 and "the password is wrong: nothing was decided" in unsigned.text
+    assert Approvals(Registry.open(registry)).trail(calibration_id=row_id) == []
+    approved = client.post(decide, data={"csrf": token, "action": "approve", "password": PASSWORD}, headers=ORIGIN)
     assert approved.status_code == 200 and "approved — by Jane Doe" in approved.text
     assert "certificate revision 1" in approved.text
     pdf = client.get(f"/registry/calibrations/{row_id}/certificates/1.pdf")
@@ -152,6 +155,7 @@ def test_an_approval_certifies_only_the_fit_it_approves(lab, tmp_path: Path) -> 
     assert login.status_code == 200
     page = client.get(f"/registry/calibrations/{row_id}")
     refused = client.post(f"/registry/calibrations/{row_id}/decision", data={"csrf": csrf(page.text),
-                                                                             "action": "approve"}, headers=ORIGIN)
+                                                                             "action": "approve", "password": PASSWORD},
+                          headers=ORIGIN)
     assert refused.status_code == 409 and "is not the fit of calibration" in refused.text
     assert book.trail(calibration_id=row_id) == [] and book.certificates(row_id) == []

@@ -27,6 +27,7 @@ from accelcal_rig.registry.database import Registry
 from accelcal_rig.registry.live import campaign_key
 from accelcal_rig.registry.location import normalised
 from accelcal_rig.web.app import create_app
+from accelcal_rig.web.registry_gate import PROBE_S
 
 ORIGIN = {"origin": "http://127.0.0.1"}
 #: Substituted, as written here (already percent-encoded), for one path parameter at a time.
@@ -176,17 +177,45 @@ class Walked:
 
 
 def snapshot(*folders: Path) -> dict[str, str]:
-    """Every file and folder under these, with its content's hash: what a request must leave as it was. An SQLite
-    database's empty write-ahead log and its index are left out: SQLite leaves them behind when two connections
-    close at once (neither is the last to go), and an empty log holds nothing written."""
+    """Every file and folder under these, with its content's hash: what a request must leave as it was. A
+    registry is compared by what it holds, the record of sign-ins left out (a failed login is recorded there,
+    and counted against its user: registry/sign_ins.py); its write-ahead log and index go with it."""
     found = {}
     for folder in folders:
         for path in sorted(folder.rglob("*")):
-            wal = path.with_name(path.name.removesuffix("-shm") + "-wal") if path.name.endswith("-shm") else path
-            if wal.name.endswith(".sqlite-wal") and (not wal.exists() or wal.stat().st_size == 0):
+            if path.name.endswith((".sqlite-wal", ".sqlite-shm")):
+                continue
+            if path.suffix == ".sqlite" and _is_sqlite(path):
+                found[str(path)] = _registry_content(path)
                 continue
             found[str(path)] = hashlib.sha256(path.read_bytes()).hexdigest() if path.is_file() else "folder"
     return found
+
+
+def _is_sqlite(path: Path) -> bool:
+    return path.is_file() and path.read_bytes()[:16] == b"SQLite format 3\x00"
+
+
+def _registry_content(path: Path) -> str:
+    """A hash of every table's rows but the sign-in record's and a user's sign-in counters (read-only)."""
+    import sqlite3
+
+    digest = hashlib.sha256()
+    connection = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+    try:
+        tables = [r[0] for r in connection.execute("SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name")]
+        for table in tables:
+            if table == "sign_ins":
+                continue
+            columns = [r[1] for r in connection.execute(f"PRAGMA table_info({table})")
+                       if not (table == "users" and r[1] in ("failed_logins", "locked_until"))]
+            rows = connection.execute(f"SELECT {', '.join(columns)} FROM {table} ORDER BY 1").fetchall()
+            digest.update(repr((table, columns, rows)).encode())
+    except sqlite3.DatabaseError as exc:  # a damaged registry the walk must leave as damaged as it was
+        digest.update(repr(exc).encode() + path.read_bytes())
+    finally:
+        connection.close()
+    return digest.hexdigest()
 
 
 def problems(url: str, response: Response, new_log: list[logging.LogRecord], allowed: set[int]) -> list[str]:
@@ -292,9 +321,10 @@ def test_every_route_is_walked(lab: Lab) -> None:
 def test_a_get_never_creates_a_registry_and_a_later_one_is_seen(lab: Lab, tmp_path: Path) -> None:
     """A registry that does not exist (a cross-site GET once created it): a 503 page saying nothing is
     recorded yet, no file, no folder; once something is recorded, the next request shows it (a failure is
-    not kept)."""
+    kept beyond the next probe)."""
     url = normalised(str(tmp_path / "lab" / "registry.sqlite"))
-    client = TestClient(create_app([lab.folder], url), base_url="http://127.0.0.1")
+    clock = [0.0]
+    client = TestClient(create_app([lab.folder], url, clock=lambda: clock[0]), base_url="http://127.0.0.1")
     for path in ("/registry", "/registry/serials/ADX355-A001", f"/registry/calibrations/{lab.row_id}", "/login"):
         page = client.get(path)
         assert page.status_code in (200, 503) and not (tmp_path / "lab").exists()
@@ -304,13 +334,17 @@ def test_a_get_never_creates_a_registry_and_a_later_one_is_seen(lab: Lab, tmp_pa
     assert api.status_code == 503 and "nothing recorded" in api.json()["error"]
     (tmp_path / "lab").mkdir()
     shutil.copy(lab.good, tmp_path / "lab" / "registry.sqlite")
+    assert client.get("/registry").status_code == 503          # known down: answered at once until the probe
+    clock[0] += PROBE_S
     assert client.get("/registry").status_code == 200
 
 
 def test_a_registry_damaged_while_served_is_503_and_seen_again_once_repaired(lab: Lab, tmp_path: Path) -> None:
     path = tmp_path / "registry.sqlite"
     shutil.copy(lab.good, path)
-    client = TestClient(create_app([lab.folder], normalised(str(path))), base_url="http://127.0.0.1")
+    clock = [0.0]
+    client = TestClient(create_app([lab.folder], normalised(str(path)), clock=lambda: clock[0]),
+                        base_url="http://127.0.0.1")
     assert client.get("/registry/serials/ADX355-A001").status_code == 200      # opened, kept
     shutil.copy(path, tmp_path / "kept.sqlite")
     connection = sqlite3.connect(path)
@@ -321,6 +355,7 @@ def test_a_registry_damaged_while_served_is_503_and_seen_again_once_repaired(lab
     assert broken.status_code == 503 and STYLED in broken.text and "calibrations" in broken.text
     assert not LEAKS.search(broken.text)
     shutil.copy(tmp_path / "kept.sqlite", path)
+    clock[0] += PROBE_S                                                          # the next probe finds it back
     assert client.get("/registry/serials/ADX355-A001").status_code == 200
 
 

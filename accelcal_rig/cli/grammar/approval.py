@@ -37,25 +37,31 @@ def add_approve_command(commands: Commands) -> None:
 
 def add_approval_actions(actions: Commands) -> None:
     """`rig registry user | audit | certificate`."""
-    user = command(actions, "user", "the lab's users who approve calibrations: add, list, password, disable, enable",
+    user = command(actions, "user", "the lab's users who approve calibrations: add, list, password, role, disable, "
+                   "enable",
                    "Users and their roles (approver, viewer) live in the registry; passwords are stored as argon2id "
                    "hashes. A user without a password is one the lab's reverse proxy authenticates (rig serve "
-                   "--user-header).", "rig registry user add jdoe --full-name 'J. Doe' --role approver")
+                   "--user-header). A new password, another role or disabling a user ends every session of theirs "
+                   "on every dashboard; enable also lifts a lockout after too many failed logins.",
+                   "rig registry user add jdoe --full-name 'J. Doe' --role approver")
     registry_option(user)
-    user.add_argument("user_action", choices=["add", "list", "password", "disable", "enable"])
+    user.add_argument("user_action", choices=["add", "list", "password", "role", "disable", "enable"])
     user.add_argument("name", nargs="?", help="the user's name (all but list)")
     user.add_argument("--full-name", help="add: as certificates name the person")
-    user.add_argument("--role", choices=["approver", "viewer"], default="viewer", help="add: what the user may do")
+    user.add_argument("--role", choices=["approver", "viewer"], help="add (default viewer), role: what the user may do")
     user.add_argument("--by", metavar="APPROVER", help="the approver making the change (needed once the lab has one; "
                                                       "their password is asked for)")
     user.add_argument("--password-stdin", action="store_true",
                       help="read passwords from standard input, one per line: --by's first, then the new one")
     user.add_argument("--no-password", action="store_true",
                       help="add: no password here (the reverse proxy authenticates this user)")
-    audit = command(actions, "audit", "every approval, rejection and reissue, with who, how and when",
-                    "The registry's append-only record of decisions, oldest first.", "rig registry audit ADX355-A001")
+    audit = command(actions, "audit", "every approval, rejection and reissue, with who, how and when; or every sign-in",
+                    "The registry's append-only record of decisions, oldest first; with --sign-ins the record of "
+                    "logins, failed logins, lockouts, unlocks, logouts and sessions ended.",
+                    "rig registry audit ADX355-A001")
     registry_option(audit)
-    audit.add_argument("serial", nargs="?", help="only this DUT")
+    audit.add_argument("serial", nargs="?", help="only this DUT (with --sign-ins: only this user)")
+    audit.add_argument("--sign-ins", action="store_true", help="the sign-in record instead of the decisions")
     audit.add_argument("--json", action="store_true", help="one JSON list")
     certificate = command(actions, "certificate", "a certificate revision the registry keeps, as issued",
                           "Every revision an approval or a reissue issued stays in the registry: list them, or "
