@@ -193,6 +193,7 @@ def test_the_noise_record_gives_each_axis_its_random_walk(fitted: tuple[Path, di
     ({"rates": {"rates_dps": [1400, 1600]}, "acquisition": {**PROCEDURE["acquisition"], "range_dps": 2000}},
      "rates", "beyond turntable axis outer's max_rate_dps 1500"),
     ({"rates": {"rates_dps": [10], "verify_rates_dps": [10]}}, "rates", "is a calibration rate"),
+    ({"rates": {"rates_dps": [1e-300]}}, "rates.rates_dps[0]", "greater than or equal to 0.1"),   # reads as rest
     ({"acquisition": {**PROCEDURE["acquisition"], "fine_ranges": {"gyro": 300}}}, "fine_ranges.gyro",
      "±300 dps is not a range of the ICM-42688-P"),
     ({"acquisition": {**PROCEDURE["acquisition"], "range_dps": 250, "fine_ranges": {"gyro": 500}}, "rates":
