@@ -35,7 +35,7 @@ from accelcal_rig.web.campaigns import CampaignFolders
 from accelcal_rig.web.errors import CheckedInput, ErrorPages, Unforeseen, exception_handlers
 from accelcal_rig.web.interruptions import resume_markers
 from accelcal_rig.web.lab import LabRigs
-from accelcal_rig.web.registry_gate import TURN_WAIT_S, RegistryGate
+from accelcal_rig.web.registry_gate import RegistryGate
 from accelcal_rig.web.sign_in import SignInPolicy
 from accelcal_rig.web.svg import line_plot
 
@@ -43,8 +43,10 @@ _STATIC = Path(__file__).parent / "static"
 #: The registry page's filter (`?made=`): every calibration, only real ones, only dry runs.
 _MADE: dict[str, bool | None] = {"": None, "real": False, "dry-run": True}
 _TOKEN_COOKIE = "accelcal_token"
-#: How long the front page waits for the registry's rigs before it shows the campaigns without them.
+#: How long the front page waits for the registry's rigs before it shows the campaigns without them, and how
+#: long its rigs fragment (each open page's poll) waits before it says the registry is slow.
 FRONT_WAIT_S = 0.5
+FRAGMENT_WAIT_S = 2.0
 #: A page the dashboard serves but did not make (a certificate, a report: files anyone who can write the
 #: campaign's folder or the registry could have changed) runs in a sandbox of its own origin: no script of
 #: it can read the dashboard's pages, its session or its form token.
@@ -106,13 +108,15 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
                     **rigs)
 
     async def rigs_now(wait_s: float) -> dict[str, Any]:
+        """The rigs as far as the registry gives them within `wait_s` in all (a slow answer is not a registry
+        down: the next poll tries again)."""
         try:
-            return await registry.call(lab.overview, turn_wait_s=wait_s)
+            return await registry.call(lab.overview, turn_wait_s=wait_s, answer_wait_s=wait_s, down_if_late=False)
         except RigError as exc:
             return {"lab": None, "rigs_error": str(exc).splitlines()[0]}
 
     async def rigs_fragment(request: Request) -> Response:
-        rigs = await rigs_now(TURN_WAIT_S)
+        rigs = await rigs_now(FRAGMENT_WAIT_S)
         return HTMLResponse(templates.get_template("_rigs.html").render(registry=registry.label, **rigs))
 
     def rigs_json(request: Request) -> Response:

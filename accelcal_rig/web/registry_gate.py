@@ -1,7 +1,8 @@
 """The dashboard's registry, held so that no request waits long on it: opened at its first use (a dashboard of
 campaigns works without one) and never created; every call bounded — the connection (PostgreSQL's
 connect_timeout, TCP's user timeout, a statement timeout; SQLite's busy timeout), how long a request waits for
-a turn (REGISTRY_AT_ONCE calls at a time) and how long it waits for the answer; a registry that failed is known
+a turn (REGISTRY_AT_ONCE calls at a time, a call keeping its turn until it ends) and how long it waits for the
+answer; a registry that failed is known
 to be down and answered at once (503) until a probe — one request at a time, every PROBE_S — opens it again.
 
 Why: with a PostgreSQL registry that accepted connections and never answered, every registry request queued
@@ -19,6 +20,7 @@ from pathlib import Path
 from typing import TypeVar
 
 import anyio
+import anyio.from_thread
 import anyio.to_thread
 
 from accelcal_rig.errors import RigError
@@ -33,9 +35,6 @@ DASHBOARD_TIMEOUTS = RegistryTimeouts(connect_s=3.0, statement_s=5.0, sqlite_bus
 REGISTRY_AT_ONCE = 4
 TURN_WAIT_S = 1.0
 ANSWER_WAIT_S = 8.0
-#: Calls given up on (their threads still waiting for a registry that does not answer) beyond which no new
-#: call is started until a probe finds the registry back.
-MAX_ABANDONED = 8
 #: After a failure, how long the registry is taken as down before a request probes it again.
 PROBE_S = 2.0
 
@@ -73,7 +72,6 @@ class RegistryGate:
         self._down_until = float("-inf")
         self._down_reason = ""
         self._probing = False
-        self._abandoned = 0
         self._turns = anyio.Semaphore(REGISTRY_AT_ONCE)
         #: Opened read-only: the registry is on a read-only mount or not writable by this user (the pages read
         #: it; logins and decisions, which write, are refused saying so).
@@ -148,35 +146,49 @@ class RegistryGate:
         if opened is not None:
             opened.engine.dispose()
 
-    async def call(self, work: Callable[..., T], *args: object, turn_wait_s: float = TURN_WAIT_S) -> T:
+    async def call(self, work: Callable[..., T], *args: object, turn_wait_s: float = TURN_WAIT_S,
+                   answer_wait_s: float = ANSWER_WAIT_S, down_if_late: bool = True) -> T:
         """`work(*args)` in a worker thread once a turn is free: RegistryDown (503) when none frees within
-        `turn_wait_s`, when the answer takes beyond ANSWER_WAIT_S (the call is given up on, its thread left to
-        finish), or while too many given-up calls still wait."""
-        if self._abandoned >= MAX_ABANDONED:
-            raise RegistryDown(f"registry {self.label}: not answering ({self._abandoned} calls still waiting on it)")
+        `turn_wait_s`, or when the answer takes beyond `answer_wait_s` (the request stops waiting; the call
+        keeps its turn until it ends, so no more than REGISTRY_AT_ONCE threads ever wait on the registry; with
+        `down_if_late` the registry is then taken as down)."""
         with anyio.move_on_after(turn_wait_s) as waited:
             await self._turns.acquire()
         if waited.cancelled_caught:
-            raise RegistryDown(f"registry {self.label}: busy ({REGISTRY_AT_ONCE} calls waiting on it): try again "
+            raise RegistryDown(f"registry {self.label}: busy ({REGISTRY_AT_ONCE} calls under way on it): try again "
                                "in a moment")
-        finished = abandoned = False
+        claim = threading.Lock()
+        state = {"started": False, "released": False}
+
+        def release(in_worker: bool) -> None:
+            with claim:
+                if state["released"]:
+                    return
+                state["released"] = True
+            if in_worker:
+                anyio.from_thread.run_sync(self._turns.release)
+            else:
+                self._turns.release()
 
         def run() -> T:
-            nonlocal finished
+            with claim:
+                state["started"] = True
             try:
                 return work(*args)
             finally:
-                with self._lock:
-                    finished = True
-                    self._abandoned -= abandoned
+                try:
+                    release(in_worker=True)
+                except RuntimeError:  # the server's event loop is gone: nothing waits for a turn any more
+                    pass
 
         try:
-            with anyio.move_on_after(ANSWER_WAIT_S):
+            with anyio.move_on_after(answer_wait_s):
                 return await anyio.to_thread.run_sync(run, abandon_on_cancel=True)
         finally:
-            self._turns.release()
-        with self._lock:  # no answer in time: the call is given up on, its thread left to finish
-            abandoned = not finished
-            self._abandoned += abandoned
-        self.failed(TimeoutError(f"no answer within {ANSWER_WAIT_S:g} s"))
-        raise RegistryDown(f"registry {self.label}: no answer within {ANSWER_WAIT_S:g} s")
+            with claim:
+                never_ran = not state["started"]
+            if never_ran:
+                release(in_worker=False)
+        if down_if_late:
+            self.failed(TimeoutError(f"no answer within {answer_wait_s:g} s"))
+        raise RegistryDown(f"registry {self.label}: no answer within {answer_wait_s:g} s")

@@ -10,15 +10,16 @@ user's is, so the answers say nothing of which names exist.
 
 from __future__ import annotations
 
+import asyncio
+import os
+import threading
 import time
 from collections import OrderedDict, deque
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from datetime import datetime
 from typing import Any, TypeVar
-
-import anyio
-import anyio.to_thread
 
 from accelcal_rig.registry.approvals import utc_now_naive
 from accelcal_rig.registry.sign_ins import ACCOUNT_FAILURES, LOCKOUT_S
@@ -28,6 +29,8 @@ T = TypeVar("T")
 #: a login is answered "busy" at once.
 HASHING_AT_ONCE = 2
 HASHING_WAITING = 32
+#: The password checks' niceness (0 normal, 19 lowest): below the threads that answer pages.
+HASHING_NICENESS = 10
 #: Failed logins from one client within CLIENT_WINDOW_S before its logins are refused until the oldest expires.
 CLIENT_FAILURES = 10
 CLIENT_WINDOW_S = 10 * 60
@@ -44,15 +47,31 @@ class Busy(Exception):
 
 
 class Hashing:
-    """Password checks in worker threads, HASHING_AT_ONCE at a time; the event loop never runs one."""
+    """Password checks on threads of their own, HASHING_AT_ONCE at a time, at a lower CPU priority (nice
+    HASHING_NICENESS, which the check's own lane threads inherit): the event loop never runs one, and a flood of
+    them leaves the cores to the pages. (argon2id's default check is ~0.2 s of both cores of a small server.)"""
 
     def __init__(self) -> None:
-        self._limiter = anyio.CapacityLimiter(HASHING_AT_ONCE)
+        self._pool = ThreadPoolExecutor(HASHING_AT_ONCE, thread_name_prefix="password-check",
+                                        initializer=_lower_priority)
+        self._pending = 0
 
-    async def run(self, check: Callable[..., T], *args: Any) -> T:
-        if self._limiter.statistics().tasks_waiting >= HASHING_WAITING:
+    async def run(self, check: Callable[[], T]) -> T:
+        if self._pending >= HASHING_AT_ONCE + HASHING_WAITING:
             raise Busy()
-        return await anyio.to_thread.run_sync(check, *args, limiter=self._limiter)
+        self._pending += 1
+        try:
+            return await asyncio.wrap_future(self._pool.submit(check))
+        finally:
+            self._pending -= 1
+
+
+def _lower_priority() -> None:
+    """This thread (and the threads it starts) at niceness HASHING_NICENESS, where the system allows it."""
+    try:
+        os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), HASHING_NICENESS)
+    except (AttributeError, OSError):  # not Linux, or not allowed: the checks still run off the event loop
+        pass
 
 
 class FailureWindows:
