@@ -217,7 +217,7 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
             return await registry.call(handler, request)
         return endpoint
 
-    lab = LabRigs(registry.get, registry.failed)
+    lab = LabRigs(registry.get, registry.failed, campaigns.ended)
     pages = ErrorPages(templates, registry.label)
     # Outermost the unforeseen error's page; then who may ask (their refusals say nothing of the dashboard,
     # not even which registry: plain text); then the address checked before any route reads it.

@@ -162,6 +162,10 @@ def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: 
             raise HTTPException(503, "busy checking other logins: try again in a few seconds",
                                 headers={"Retry-After": "5"}) from None
         if user is not None:
+            # Checks run two at a time: a right password checked while wrong ones locked the account is refused.
+            locked_s = await registry.call(lambda: SignIns(registry.get()).locked_for_s(name, settings.utc_now()))
+            if locked_s > 0:
+                raise _too_many("this account is locked after too many failed logins", locked_s)
             limits.unknown_names.forget(name)
             return user
         limits.clients.failed(client)

@@ -3,6 +3,7 @@ lock), each read again only when its files change: the campaign's, its progress 
 
 from __future__ import annotations
 
+import socket
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -66,6 +67,23 @@ class CampaignFolders:
 
     def interruptions(self, name: str) -> list[Interruption]:
         return self._read(self.path(name), name).stops
+
+    def ended(self, host: str, campaign: str) -> dict[str, Any] | None:
+        """The summary of a campaign run on this computer, in a watched folder, whose file says it ended (done
+        or aborted), else None: what a rig card the registry last heard running is checked against. A path
+        the registry names is read only when it is one of the watched campaigns (the registry says where to
+        look, never what to open)."""
+        if host != socket.gethostname():
+            return None
+        try:
+            wanted = Path(campaign).resolve()
+        except (OSError, ValueError):
+            return None
+        for name, path in self.paths().items():
+            if path.resolve() == wanted:
+                summary = self._read(path, name).summary
+                return summary if summary.get("state") in ("done", "aborted") else None
+        return None
 
     def path(self, name: str) -> Path:
         paths = self.paths()

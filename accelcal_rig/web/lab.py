@@ -23,7 +23,7 @@ from accelcal_rig.registry.live import LiveBoard
 from accelcal_rig.report.warning_groups import warning_groups
 from accelcal_rig.store.records import StoredEvent
 from accelcal_rig.web.live_watch import LiveChanges
-from accelcal_rig.web.rigs import campaign_view, overview, rig_cards
+from accelcal_rig.web.rigs import EndedInFile, as_file_says, campaign_view, overview, rig_cards
 from accelcal_rig.web.svg import line_plot
 
 #: Longest wait between two events of the stream (a page re-reads the overview at each).
@@ -40,9 +40,12 @@ _KEY = re.compile(r"^[0-9a-f]{32}$")
 
 class LabRigs:
     def __init__(self, registry: Callable[[], Registry],
-                 on_failure: Callable[[BaseException], None] = lambda exc: None) -> None:
+                 on_failure: Callable[[BaseException], None] = lambda exc: None,
+                 ended: EndedInFile | None = None) -> None:
         self._registry = registry
         self._on_failure = on_failure  # a registry that failed here is taken as down (web/registry_gate.py)
+        #: What the watched campaign files say of a campaign the registry last heard running (web/rigs.py).
+        self._ended: EndedInFile = ended or (lambda host, campaign: None)
         self.changes = LiveChanges(self.board)
         self.stopping = threading.Event()  # the server is stopping: every stream ends
 
@@ -57,7 +60,7 @@ class LabRigs:
         """{lab: the cards and recent campaigns, rigs_error: why there are none to show (no registry yet, one
         that cannot be read), else None}."""
         try:
-            return {"lab": overview(self.board()), "rigs_error": None}
+            return {"lab": overview(self.board(), self._ended), "rigs_error": None}
         except RigError as exc:
             self._on_failure(exc)
             return {"lab": None, "rigs_error": str(exc).splitlines()[0]}
@@ -69,7 +72,7 @@ class LabRigs:
         if row is None:
             raise HTTPException(404, f"no campaign {key} published to the registry")
         now = board.now()
-        view = campaign_view(row, now)
+        view = as_file_says(campaign_view(row, now), self._ended)
         events = board.events(key)
         stored = [StoredEvent(e.clock_s, f"{e.at:%Y-%m-%dT%H:%M:%S}Z", e.level, e.kind, e.message) for e in events]
         groups = [{**g.as_dict(), "first": format_duration(g.first_s), "last": format_duration(g.last_s)}
@@ -79,7 +82,7 @@ class LabRigs:
                          "campaign time (h)", "temperature (°C)")
         shown = [{"clock": format_duration(e.clock_s), "at": f"{e.at:%Y-%m-%d %H:%M:%S}", "level": e.level,
                   "kind": e.kind, "message": e.message} for e in events[-EVENTS_SHOWN:]]
-        card = rig_cards([row], now)[0]
+        card = rig_cards([row], now, self._ended)[0]
         return {"c": view, "headline": card.headline, "groups": groups, "plot": plot, "events": shown[::-1]}
 
     async def stream(self, request: Request) -> StreamingResponse:

@@ -1,6 +1,8 @@
 """Every rig of a lab at a glance, from what their campaigns publish to the shared registry
 (registry/live.py): one card per rig — running with its progress and time left, not heard from, aborted
-with why, done with each DUT's verdict, idle — and the recent campaigns of all of them."""
+with why, done with each DUT's verdict, idle — and the recent campaigns of all of them. A campaign the
+registry last heard running whose file, in a folder the dashboard watches, says it ended is shown as its file
+says (its last update never reached the registry: a kill after the last pose, the registry down at the end)."""
 
 from __future__ import annotations
 
@@ -17,6 +19,13 @@ from accelcal_rig.registry.live import LiveBoard
 IDLE_AFTER = timedelta(hours=12)
 #: Campaigns listed under the cards.
 RECENT = 50
+#: What a watched campaign file says of a campaign (host, path): its summary (web/campaigns.py) when it ended,
+#: else None.
+EndedInFile = Callable[[str, str], "dict[str, Any] | None"]
+
+
+def _not_watched(host: str, campaign: str) -> dict[str, Any] | None:
+    return None
 
 
 @dataclass(frozen=True)
@@ -49,8 +58,26 @@ def campaign_view(row: dict[str, Any], now: datetime) -> dict[str, Any]:
     return view
 
 
-def rig_cards(rows: list[dict[str, Any]], now: datetime) -> list[RigCard]:
-    """One card per rig (by its name and computer), in name order: the campaign it runs now, else its latest."""
+def as_file_says(view: dict[str, Any], ended: EndedInFile) -> dict[str, Any]:
+    """A campaign not heard from (`silent`) as its campaign file says, when that says it ended."""
+    if view["status"] != "silent":
+        return view
+    found = ended(str(view["host"]), str(view["campaign"]))
+    if found is None:
+        return view
+    verdicts = found.get("verdicts") or {}
+    total = int(found.get("poses_total") or view["poses_total"]) or 1
+    return {**view, "status": found["state"], "state": found["state"], "stale": False,
+            "poses_done": found.get("poses_done", view["poses_done"]), "poses_total": total,
+            "percent": round(100.0 * int(found.get("poses_done") or 0) / total, 1), "remaining_s": None,
+            "left": None, "abort_reason": found.get("abort_reason") or view.get("abort_reason"),
+            "verdicts": verdicts, "verdict_counts": _verdict_counts(verdicts),
+            "from_file": f"from its campaign file {found.get('file', '')}: its end never reached the registry"}
+
+
+def rig_cards(rows: list[dict[str, Any]], now: datetime, ended: EndedInFile = _not_watched) -> list[RigCard]:
+    """One card per rig (by its name and computer), in name order: the campaign it runs now, else its latest
+    (a silent one as its watched campaign file says, when that says it ended)."""
     by_rig: dict[tuple[str, str], list[dict[str, Any]]] = {}
     for row in rows:
         by_rig.setdefault((row["rig"], row["host"]), []).append(row)
@@ -58,7 +85,7 @@ def rig_cards(rows: list[dict[str, Any]], now: datetime) -> list[RigCard]:
     for (rig, host), mine in sorted(by_rig.items()):
         running = [r for r in mine if r["state"] == "running"]
         shown = max(running or mine, key=lambda r: (r["updated_at"], r["started_at"]))
-        view = campaign_view(shown, now)
+        view = as_file_says(campaign_view(shown, now), ended)
         status = view["status"]
         if status not in ("running", "silent") and now - shown["updated_at"] > IDLE_AFTER:
             status = "idle"
@@ -66,12 +93,13 @@ def rig_cards(rows: list[dict[str, Any]], now: datetime) -> list[RigCard]:
     return cards
 
 
-def overview(board: LiveBoard) -> dict[str, Any]:
+def overview(board: LiveBoard, ended: EndedInFile = _not_watched) -> dict[str, Any]:
     """The cards and the recent campaigns, as the front page and /api/rigs give them."""
     rows = board.campaigns(limit=None)
     now = board.now()
-    return {"now": f"{now:%Y-%m-%d %H:%M:%S} UTC", "rigs": [card.as_dict() for card in rig_cards(rows, now)],
-            "campaigns": [campaign_view(row, now) for row in rows[:RECENT]]}
+    return {"now": f"{now:%Y-%m-%d %H:%M:%S} UTC",
+            "rigs": [card.as_dict() for card in rig_cards(rows, now, ended)],
+            "campaigns": [as_file_says(campaign_view(row, now), ended) for row in rows[:RECENT]]}
 
 
 def _headline(status: str, view: dict[str, Any]) -> str:
@@ -84,7 +112,8 @@ def _headline(status: str, view: dict[str, Any]) -> str:
         "stopped": lambda: f"stopped · {view['poses_done']}/{view['poses_total']} poses",
         "idle": lambda: f"idle · last campaign {view['state']} {view['heard']}",
     }
-    return words.get(status, lambda: status)()
+    said = words.get(status, lambda: status)()
+    return f"{said} (its campaign file says so)" if view.get("from_file") else said
 
 
 def _verdict_counts(verdicts: dict[str, Any]) -> dict[str, int]:

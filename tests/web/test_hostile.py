@@ -3,7 +3,10 @@ approval, the static mount), asked with each hostile path value and query string
 takes it — POST, against a good registry, none, one that does not exist, a file that is not a database, one
 of a newer schema, one that lost a table and one holding a date that is not a date, answers a status and
 the dashboard's styled error page (`{"error": ...}` under /api/): no traceback, no exception's name, nothing
-reflected unescaped, nothing created on disk, no exception reaching the server, one log line per 500."""
+reflected unescaped, nothing created on disk, no exception reaching the server, one log line per 500. And the
+attacks of issue 40: the same walk against a registry that never answers (an outage), a session replayed
+after its user's logout, new password, new role or disabling (revocation), and a flood of wrong logins while
+every page is asked."""
 
 from __future__ import annotations
 
@@ -61,6 +64,8 @@ STYLED = 'id="error-page"'
 REGISTRY_KINDS = ["good", "none", "missing", "not-a-database", "newer-schema", "lost-a-table", "date-not-a-date"]
 #: The good registry again, served with a token (sent as a header): no page may show it.
 TOKEN = "t0ken-s3cret"
+#: The approver's password in the lab's registry.
+PASSWORD = "approver's secret"
 
 
 @dataclass
@@ -82,7 +87,7 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Lab:
     assert main(["run", str(REPO / "procedures" / "quick-6pos.yaml"), "--dry-run", "-o", str(folder / "quick.h5"),
                  "-q", "--no-pdf", "--registry", normalised(str(good))]) == 0
     book = Approvals(Registry.open(normalised(str(good))))
-    book.add_user("jdoe", "Jane Doe", "approver", "approver's secret")
+    book.add_user("jdoe", "Jane Doe", "approver", PASSWORD)
     row_id = min(r["id"] for r in book.registry.calibrations(serial="ADX355-A001"))
     approver = book.user("jdoe")
     assert approver is not None
@@ -402,3 +407,131 @@ def test_the_forms_refusals_are_styled_and_unchanged(lab: Lab, tmp_path: Path) -
     assert stale.status_code == 403 and "missing or stale" in stale.text
     assert client.post("/login", content=b"csrf=" + b"x" * 20_000, headers=ORIGIN).status_code == 413
     assert client.get("/logout").status_code == 405 and STYLED in client.get("/logout").text
+
+
+def _signed_in_client(app: Starlette, address: str) -> TestClient:
+    client = TestClient(app, base_url="http://127.0.0.1", client=(address, 50000))
+    answer = client.post("/login", data={"csrf": session_token(client), "name": "jdoe", "password": PASSWORD},
+                         headers=ORIGIN, follow_redirects=False)
+    assert answer.status_code == 303 and "Signed in as Jane Doe" in client.get("/login").text
+    return client
+
+
+@pytest.mark.parametrize("revoke", ["logout elsewhere", "password changed", "role changed", "disabled"])
+def test_a_revoked_session_decides_nothing_on_any_route(revoke: str, lab: Lab, tmp_path: Path) -> None:
+    """Revocation: a session its user's logout (from another browser), a new password, another role or disabling
+    ended, replayed with its cookie and its form token on every route that changes something and every page:
+    no page shows it signed in, no decision is taken, the registry holds what it held."""
+    path = tmp_path / "registry.sqlite"
+    shutil.copy(lab.good, path)
+    app = create_app([lab.folder], normalised(str(path)))
+    stolen, other = _signed_in_client(app, "10.1.0.1"), _signed_in_client(app, "10.1.0.2")
+    form_token = session_token(stolen)
+    book = Approvals(Registry.open(normalised(str(path))))
+    if revoke == "logout elsewhere":
+        assert other.post("/logout", data={"csrf": session_token(other)}, headers=ORIGIN).status_code == 200
+    else:
+        {"password changed": lambda: book.set_password("jdoe", "a new secret!"),
+         "role changed": lambda: book.set_role("jdoe", "viewer"),
+         "disabled": lambda: book.set_disabled("jdoe", True)}[revoke]()
+    before = snapshot(tmp_path)
+    for template, methods in endpoints(app):
+        url = address(template, valid_values(template, lab))
+        page = stolen.get(url)
+        assert "Signed in as" not in page.text and "Jane Doe</strong>" not in page.text, url
+        if "POST" in methods and template != "/login":
+            for action in ("approve", "reject", "reissue"):
+                answer = stolen.post(url, data={"csrf": form_token, "action": action, "password": PASSWORD,
+                                                "reason": "replayed"}, headers=ORIGIN, follow_redirects=False)
+                assert answer.status_code in (200, 303, 403), (url, answer.status_code)
+    assert snapshot(tmp_path) == before                       # nothing decided, nothing issued
+    assert [t for t in book.trail(calibration_id=lab.row_id) if t["reason"] == "replayed"] == []
+
+
+def test_a_login_flood_holds_up_no_page_and_ends_in_a_lockout_the_record_keeps(lab: Lab, tmp_path: Path) -> None:
+    """A flood: forty wrong logins at once — the approver's name from many clients, names no user has, one
+    client again and again — while every page is asked with its valid values. Each page answers as it does
+    without the flood (within a deadline a queue behind the hashes would miss); each login a styled 401, 429
+    with Retry-After, or a 503 busy; the approver's account is locked with every failure recorded, and then
+    even the right password waits for the lockout."""
+    import anyio
+    import httpx
+
+    from accelcal_rig.registry.sign_ins import ACCOUNT_FAILURES, SignIns
+
+    path = tmp_path / "registry.sqlite"
+    shutil.copy(lab.good, path)
+    url = normalised(str(path))
+    app = create_app([lab.folder], url)
+    pages = [address(t, valid_values(t, lab)) for t, methods in endpoints(app) if "GET" in methods]
+    calm = TestClient(app, base_url="http://127.0.0.1")
+    expected = {page: calm.get(page).status_code for page in pages}
+    answers: list[httpx.Response] = []
+    served: dict[str, int] = {}
+
+    async def flood() -> None:
+        async def client(address_: str) -> httpx.AsyncClient:
+            return httpx.AsyncClient(transport=httpx.ASGITransport(app=app, client=(address_, 50000)),
+                                     base_url="http://127.0.0.1")
+
+        async def wrong_login(address_: str, name: str) -> None:
+            async with await client(address_) as browser:
+                found = re.search(r'name="csrf" value="([^"]+)"', (await browser.get("/login")).text)
+                assert found is not None
+                answers.append(await browser.post("/login", headers=ORIGIN, data={
+                    "csrf": found.group(1), "name": name, "password": "guess"}))
+
+        async def page(url_: str) -> None:
+            async with await client("10.2.9.9") as browser:
+                served[url_] = (await browser.get(url_)).status_code
+
+        with anyio.fail_after(120):                # a deadline: the flood's hashes alone would take seconds
+            async with anyio.create_task_group() as group:
+                for k in range(40):
+                    address_, name = [(f"10.2.0.{k}", "jdoe"), (f"10.2.1.{k}", f"nobody{k % 3}"),
+                                      ("10.2.2.1", f"guess{k}")][k % 3]
+                    group.start_soon(wrong_login, address_, name)
+                for url_ in pages:
+                    group.start_soon(page, url_)
+
+    anyio.run(flood)
+    assert served == expected
+    assert len(answers) == 40 and {a.status_code for a in answers} <= {401, 429, 503}
+    assert any(a.status_code == 429 for a in answers)
+    for answer in answers:
+        assert not shown(answer)
+        if answer.status_code == 401:                          # the login form again, saying why
+            assert 'action="/login"' in answer.text and "unknown user or wrong password" in answer.text
+        else:
+            assert STYLED in answer.text and int(answer.headers["retry-after"]) > 0
+    record = SignIns(Registry.open(url)).record("jdoe")
+    events = [e["event"] for e in record]               # (checks already under way when it locked are recorded too)
+    assert events.count("login failed") >= ACCOUNT_FAILURES and "locked" in events
+    right = TestClient(app, base_url="http://127.0.0.1", client=("10.2.3.1", 50000))
+    locked = right.post("/login", data={"csrf": session_token(right), "name": "jdoe", "password": PASSWORD},
+                        headers=ORIGIN)
+    assert locked.status_code == 429 and "locked after too many failed logins" in locked.text
+
+
+def test_a_silent_registry_answers_every_route_with_a_status_and_a_styled_page(
+        lab: Lab, tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """An outage: a PostgreSQL registry that accepts connections and never answers. The whole walk — every route,
+    every hostile value — is answered (503 where the registry is needed, styled, nothing reflected), and once
+    the first request found it silent no other one waits on it: it is known down until a probe (the probes'
+    clock stands still here), so the walk opens no second connection."""
+    pytest.importorskip("psycopg")
+    from tests.web.test_registry_outage import SilentServer
+
+    server = SilentServer()
+    try:
+        url = f"postgresql://lab@127.0.0.1:{server.port}/registry"
+        app = create_app([lab.folder], url, clock=lambda: 0.0)
+        before = snapshot(lab.folder, tmp_path)
+        with caplog.at_level(logging.ERROR, logger="accelcal_rig.web"):
+            done = walk(app, lab, {503}, caplog, {})
+        assert done.failures == [], f"{len(done.failures)} failures, e.g.\n" + "\n".join(done.failures[:15])
+        assert done.requests == len(requests_of(app, lab)) and done.statuses.get(503, 0) >= 50
+        assert len(server.accepted) == 1                       # tried once; known down for the rest of the walk
+        assert snapshot(lab.folder, tmp_path) == before
+    finally:
+        server.close()

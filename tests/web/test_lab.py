@@ -99,3 +99,35 @@ def test_the_event_stream_says_when_something_changed(published: tuple[str, Live
         assert response.headers["content-type"].startswith("text/event-stream")
         text = "".join(response.iter_text())
     assert text.startswith("retry: ") and "event: change" in text and "event: tick" in text
+
+
+def test_a_card_whose_campaign_file_says_done_shows_done(tmp_path: Path) -> None:
+    """A run whose last update never reached the registry (a kill after the last pose, the registry down at the
+    end) left its card "running" and then silent: a dashboard that watches the campaign's folder shows it as its
+    file says; one that does not, or a campaign of another computer, still says it was not heard from."""
+    from accelcal_rig.cli import main
+    from tests.conftest import REPO
+
+    folder, elsewhere = tmp_path / "campaigns", tmp_path / "elsewhere"
+    folder.mkdir(), elsewhere.mkdir()
+    url = normalised(str(tmp_path / "registry.sqlite"))
+    assert main(["run", str(REPO / "procedures" / "quick-6pos.yaml"), "--dry-run", "-o", str(folder / "quick.h5"),
+                 "-q", "--no-pdf", "--registry", url]) == 0
+    board = LiveBoard(Registry.open(url))
+    with board.engine.begin() as connection:  # the end never published: running, last heard 10 min ago
+        connection.execute(sa.update(live_campaigns).values(state="running", poses_done=3, verdicts={},
+                                                            updated_at=board.now() - timedelta(minutes=10)))
+    [card] = TestClient(create_app([folder], url), base_url="http://127.0.0.1").get("/api/rigs").json()["rigs"]
+    assert card["status"] == "done", card
+    assert card["headline"] == "done · 4 NOT JUDGED (its campaign file says so)"   # the file's (no limits)
+    assert card["campaign"]["poses_done"] == card["campaign"]["poses_total"] > 3
+    assert "its end never reached the registry" in card["campaign"]["from_file"]
+    page = TestClient(create_app([folder], url), base_url="http://127.0.0.1").get("/").text
+    assert "its campaign file says so" in page and "not heard from since" not in page
+
+    [unwatched] = TestClient(create_app([elsewhere], url), base_url="http://127.0.0.1").get("/api/rigs").json()["rigs"]
+    assert unwatched["status"] == "silent"
+    with board.engine.begin() as connection:
+        connection.execute(sa.update(live_campaigns).values(host="another-computer"))
+    [other] = TestClient(create_app([folder], url), base_url="http://127.0.0.1").get("/api/rigs").json()["rigs"]
+    assert other["status"] == "silent"
