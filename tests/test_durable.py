@@ -42,7 +42,7 @@ def test_run_fit_and_certificate_clear_what_killed_writers_left(write, capsys) -
     certificates.mkdir()
     dead = ended_pid()
     left = [calibration.with_name(f"{calibration.name}.tmp-{dead}"),
-            certificates / f"ADX355-A001.html.tmp-{dead}", certificates / f"ADX355-A001.pdf.tmp-{dead}",
+            certificates / f"ADX355-A001.DRAFT.html.tmp-{dead}", certificates / f"ADX355-A001.DRAFT.pdf.tmp-{dead}",
             progress_path(output).with_name(f"{progress_path(output).name}.tmp-{dead}")]
     for path in left:
         path.write_text("half-built")
@@ -54,7 +54,7 @@ def test_run_fit_and_certificate_clear_what_killed_writers_left(write, capsys) -
     again.write_text("half-built")
     assert main(["fit", str(output), "-o", str(calibration)]) == 0
     assert not again.exists()
-    page = certificates / f"ADX355-A002.html.tmp-{ended_pid()}"
+    page = certificates / f"ADX355-A002.DRAFT.html.tmp-{ended_pid()}"
     page.write_text("half-built")
     assert main(["certificate", str(output), "-o", str(certificates), "--no-pdf"]) == 0
     assert not page.exists()

@@ -55,7 +55,7 @@ def test_a_run_records_where_its_follow_up_goes_and_status_finds_it_all_done(fin
 def test_status_names_what_is_missing_and_resume_finishes_it_once(finished, capsys) -> None:
     output, certificates, registry = finished
     serials = sorted(rows_per_serial(registry))
-    (certificates / f"{serials[1]}.html").unlink()
+    (certificates / f"{serials[1]}.DRAFT.html").unlink()
     with sqlite3.connect(registry) as connection:
         connection.execute("DELETE FROM calibrations WHERE serial = ?", (serials[2],))
     status = status_of(output, capsys)
@@ -69,7 +69,7 @@ def test_status_names_what_is_missing_and_resume_finishes_it_once(finished, caps
     assert main(["resume", str(output), "-q"]) == 0  # told nothing: the run's recorded folder and registry
     out = capsys.readouterr().out
     assert "1 calibration recorded" in out and f"{len(serials) - 1} registered already" in out
-    assert (certificates / f"{serials[1]}.html").is_file()
+    assert (certificates / f"{serials[1]}.DRAFT.html").is_file()
     assert rows_per_serial(registry) == {serial: 1 for serial in serials}
     assert {p["state"] for p in status_of(output, capsys)["follow_up"]} == {"done"}
     assert main(["resume", str(output), "-q"]) == 0  # again: nothing to do, nothing recorded twice
@@ -89,8 +89,8 @@ def test_a_calibration_fitted_to_other_measurements_is_stale_and_fitted_again(fi
 
 def test_a_certificate_from_another_calibration_is_stale(finished, capsys) -> None:
     output, certificates, _ = finished
-    page = sorted(certificates.glob("*.html"))[0]
-    page.write_text(page.read_text().replace(page.stem + "-", page.stem + "-0"))  # another number
+    page = sorted(certificates.glob("*.DRAFT.html"))[0]
+    page.write_text(page.read_text().replace("DRAFT-", "DRAFT-0"))  # another draft's identifier
     parts = {p["part"]: p for p in status_of(output, capsys)["follow_up"]}
     assert parts["certificates"]["state"] == "stale"
 

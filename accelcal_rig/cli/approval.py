@@ -8,7 +8,6 @@ import argparse
 import getpass
 import json
 import sys
-from pathlib import Path
 from typing import Any
 
 from accelcal_rig.errors import ConfigError
@@ -17,7 +16,7 @@ from accelcal_rig.errors import ConfigError
 def approve_command(args: argparse.Namespace) -> int:
     from accelcal_rig.cli.registry_access import campaign_entries, open_registry
     from accelcal_rig.registry.approvals import Approvals, IssuedCertificate
-    from accelcal_rig.report.certificate import render_certificate
+    from accelcal_rig.report.certificate import certificates_folder, render_certificate, write_issued
 
     campaign = args.campaign
     calibration = args.calibration or campaign.with_suffix(".calibration.yaml")
@@ -40,9 +39,8 @@ def approve_command(args: argparse.Namespace) -> int:
         if args.action == "approve" and decision.state == "approved":
             # A kill after the registry recorded it, before the files were written: they come from the registry.
             kept = approvals.certificate(lead, decision.revision) if decision.revision else None
-            restored = _write_beside(campaign, serial, IssuedCertificate(
-                int(kept["revision"]), kept["number"], kept["html"], None if kept["pdf"] is None else bytes(kept["pdf"])),
-                only_missing=True) if kept else []
+            restored = write_issued(certificates_folder(campaign), serial, int(kept["revision"]), kept["html"],
+                                    None if kept["pdf"] is None else bytes(kept["pdf"]), only_missing=True) if kept else []
             print(f"{serial}: approved already (revision {decision.revision}, by {decision.by}); a new revision needs "
                   "--reissue --reason" + (f"; its certificate written again → {', '.join(map(str, restored))}"
                                           if restored else ""))
@@ -55,7 +53,7 @@ def approve_command(args: argparse.Namespace) -> int:
             issued = IssuedCertificate(revision, rendered.number, rendered.html, rendered.pdf)
         revision_issued = approvals.record(lead, args.action, user, authority, args.reason, issued)
         if issued is not None:
-            written = _write_beside(campaign, serial, issued)
+            written = write_issued(certificates_folder(campaign), serial, issued.revision, issued.html, issued.pdf)
             print(f"{serial}: {args.action}d by {user.full_name}; certificate {issued.number} revision "
                   f"{revision_issued} → {', '.join(str(p) for p in written)}")
         else:
@@ -101,26 +99,6 @@ def _os_user() -> str:
         return getpass.getuser()
     except (KeyError, OSError):
         return "unknown"
-
-
-def _write_beside(campaign: Path, serial: str, issued: Any, only_missing: bool = False) -> list[Path]:
-    """The revision beside the campaign: CAMPAIGN.certificates/SERIAL.rN.html (and .pdf); earlier revisions
-    stay. `only_missing`: write only what is not there (what was written, either way)."""
-    import re
-
-    from accelcal_rig.durable import write_atomically, write_text_atomically
-
-    folder = campaign.with_suffix(".certificates")
-    folder.mkdir(parents=True, exist_ok=True)
-    stem = f"{re.sub(r'[^A-Za-z0-9_.-]', '_', serial)}.r{issued.revision}"
-    written = []
-    if not (only_missing and (folder / f"{stem}.html").is_file()):
-        written.append(folder / f"{stem}.html")
-        write_text_atomically(written[-1], issued.html, "the certificate")
-    if issued.pdf is not None and not (only_missing and (folder / f"{stem}.pdf").is_file()):
-        written.append(folder / f"{stem}.pdf")
-        write_atomically(written[-1], issued.pdf, "the certificate")
-    return written
 
 
 def user_command(args: argparse.Namespace) -> int:

@@ -120,10 +120,10 @@ def state(campaign_path: Path, follow_up: FollowUp, fit_due: bool = True) -> lis
 
 
 def _certificates(follow_up: FollowUp, calibration: Any) -> PartState:
-    from accelcal_rig.report.certificate import certificate_current, certificate_names
+    from accelcal_rig.report.certificate import certificate_current, draft_names
 
     folder = follow_up.certificates
-    names = certificate_names(list(calibration.duts))
+    names = draft_names(list(calibration.duts))
     pdf = follow_up.pdf and _pdf_available()
     missing = [serial for serial, name in names.items()
                if not certificate_current(folder / f"{name}.html", folder / f"{name}.pdf" if pdf else None,

@@ -25,7 +25,8 @@ from accelcal_rig.fit.channel_model import Section
 from accelcal_rig.fit.channel_models import model_of
 from accelcal_rig.report import certificate_decision, certificate_lab
 from accelcal_rig.store.content import Campaign, measurements_sha256
-from accelcal_rig.store.read import dut_description, usable_campaign
+from accelcal_rig.store.follow_up_record import recorded_follow_up
+from accelcal_rig.store.read import dut_description, load_campaign, usable_campaign
 from accelcal_rig.store.records import utc_now
 
 #: On every page of a dry run's certificate.
@@ -33,6 +34,19 @@ DRY_RUN_PAGES = """
 @page { @top-center { content: "SIMULATED — no physical sensor was calibrated"; font-family: "DejaVu Sans",
                       sans-serif; font-size: 9pt; font-weight: bold; color: #a00000; } }
 """
+#: On every page of a draft: a mark above (beside a dry run's), its own footer, and a watermark across the page
+#: (an element fixed in place is drawn on every page of the PDF; on screen, across the window).
+DRAFT_PAGES = """
+@page { @top-left { content: "DRAFT — NOT ISSUED"; font-family: "DejaVu Sans", sans-serif; font-size: 9pt;
+                    font-weight: bold; color: #a00000; }
+        @bottom-center { content: "Draft " string(number) " — not a certificate until approved — page "
+                         counter(page) " of " counter(pages); font-family: "DejaVu Sans", sans-serif;
+                         font-size: 8pt; color: #a00000; } }
+.watermark { position: fixed; top: 38%; left: 0; width: 100%; text-align: center; font-size: 96pt;
+             font-weight: bold; color: rgba(160, 0, 0, 0.13); transform: rotate(-35deg); z-index: -1; }
+"""
+#: What a draft's file name ends in (before .html or .pdf); an issued revision's ends in `.rN`.
+DRAFT_SUFFIX = ".DRAFT"
 
 STYLE = """
 @page { size: A4; margin: 16mm 15mm 18mm 15mm;
@@ -72,7 +86,7 @@ def write_certificates(campaign_path: Path, calibration_path: Path, folder: Path
     warnings = [] if render is not None or not pdf else [
         "PDFs need WeasyPrint: pip install 'accelcal-rig[certificate]' (HTML certificates written)"]
     written: list[Written] = []
-    for serial, name in certificate_names(list(calibration.duts)).items():
+    for serial, name in draft_names(list(calibration.duts)).items():
         page = certificate_html(campaign, campaign_path, calibration, calibration_path, serial, operator)
         pdf_path = None
         clear_dead_temporaries(folder / f"{name}.pdf", folder / f"{name}.html")  # what a killed writer left
@@ -97,20 +111,47 @@ def certificate_names(serials: Sequence[str]) -> dict[str, str]:
     return names
 
 
+def draft_names(serials: Sequence[str]) -> dict[str, str]:
+    """Each serial's draft file name (without .html or .pdf): never the name an issued revision has."""
+    return {serial: name + DRAFT_SUFFIX for serial, name in certificate_names(serials).items()}
+
+
+def issued_name(serial: str, revision: int) -> str:
+    """An issued revision's file name (without .html or .pdf)."""
+    return f"{certificate_names([serial])[serial]}.r{revision}"
+
+
 def certificate_current(page: Path, pdf: Path | None, calibration: CalibrationFile, serial: str) -> bool:
     """Whether the draft certificate in `page` (and `pdf`, when one is due) was written from `calibration`:
-    the page names its certificate number, and the PDF, written just before it, is there."""
+    the page names its draft's identifier, and the PDF, written just before it, is there."""
     try:
         text = page.read_text(encoding="utf-8", errors="replace")
     except OSError:
         return False
-    number = certificate_number_of(serial, calibration)
-    return number in text and (pdf is None or pdf.is_file())
+    return draft_identifier(serial, calibration) in text and (pdf is None or pdf.is_file())
 
 
-def certificate_number_of(serial: str, calibration: CalibrationFile) -> str:
-    """The draft certificate number of a DUT of a calibration (revision 1's base)."""
-    return certificate_lab.certificate_number(serial, calibration).base
+def draft_identifier(serial: str, calibration: CalibrationFile) -> str:
+    """What a DUT's draft is called in place of a number: not the number its approval will issue (a draft
+    cannot be cited as the certificate), yet as unique to the measurements and the fit."""
+    return certificate_lab.draft_identifier(serial, calibration)
+
+
+def write_issued(folder: Path, serial: str, revision: int, page: str, pdf: bytes | None,
+                 only_missing: bool = False) -> list[Path]:
+    """An issued revision as files in `folder` (where the run's certificates are): SERIAL.rN.pdf (written first)
+    and .html; earlier revisions and the draft stay. `only_missing`: write only what is not there (what was
+    written, either way)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    stem = issued_name(serial, revision)
+    written = []
+    if pdf is not None and not (only_missing and (folder / f"{stem}.pdf").is_file()):
+        written.append(folder / f"{stem}.pdf")
+        write_atomically(written[-1], pdf, "the certificate")
+    if not (only_missing and (folder / f"{stem}.html").is_file()):
+        written.append(folder / f"{stem}.html")
+        write_text_atomically(written[-1], page, "the certificate")
+    return written
 
 
 @dataclass(frozen=True)
@@ -131,8 +172,10 @@ class Rendered:
 
 def render_certificate(campaign_path: Path, calibration_path: Path, serial: str, revision: int, approver: str,
                        pdf: bool = True, reason: str = "", operator: str = "") -> Rendered:
-    """One DUT's certificate issued as `revision`, approved by `approver` today: what an approval keeps."""
+    """One DUT's certificate issued as `revision`, approved by `approver` today: what an approval keeps.
+    `operator`: who performed it, else who its run recorded."""
     campaign, calibration = _certifiable(campaign_path, calibration_path)
+    operator = operator or recorded_operator(campaign)
     if serial not in calibration.duts:
         raise ConfigError(f"{calibration_path}: no sensor {serial}")
     approval = Approval(approver, utc_now()[:10], reason)
@@ -141,6 +184,27 @@ def render_certificate(campaign_path: Path, calibration_path: Path, serial: str,
     render = _pdf_renderer() if pdf else None
     number = certificate_lab.certificate_number(serial, calibration, revision).base
     return Rendered(number, page, None if render is None else _rendered_pdf(render, page, calibration_path))
+
+
+def draft_html(campaign_path: Path, calibration_path: Path, serial: str) -> str:
+    """One DUT's draft as the campaign and its calibration make it now (what the approver reads before
+    deciding): refused in one line as a certificate would be."""
+    campaign, calibration = _certifiable(campaign_path, calibration_path)
+    if serial not in calibration.duts:
+        raise ConfigError(f"{calibration_path}: no sensor {serial}")
+    return certificate_html(campaign, campaign_path, calibration, calibration_path, serial,
+                            recorded_operator(campaign))
+
+
+def recorded_operator(campaign: Campaign) -> str:
+    """Who performed the campaign, as its `rig run --operator` recorded it ("" when none was given)."""
+    return str(recorded_follow_up(campaign.attrs).get("operator") or "")
+
+
+def certificates_folder(campaign_path: Path) -> Path:
+    """Where the run's certificates are (its `--certificates`, recorded in the campaign), else beside it."""
+    recorded = recorded_follow_up(load_campaign(campaign_path).attrs).get("certificates")
+    return Path(recorded) if recorded else campaign_path.with_suffix(".certificates")
 
 
 def _certifiable(campaign_path: Path, calibration_path: Path) -> tuple[Campaign, CalibrationFile]:
@@ -203,9 +267,12 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
     attrs = campaign.attrs
     channels = dict(calibration.duts[serial].channels)
     models = {name: model_of(channel) for name, channel in channels.items()}
-    number = certificate_lab.certificate_number(serial, calibration, revision)
-    banners = [] if approval is not None else [
-        "DRAFT: not issued until a person approves it (rig approve, or the dashboard)."]
+    draft = approval is None
+    number: certificate_lab.CertificateNumber | str = (
+        certificate_lab.draft_identifier(serial, calibration) if draft
+        else certificate_lab.certificate_number(serial, calibration, revision))
+    banners = [] if not draft else [
+        "DRAFT: not issued. An approval (rig approve, or the dashboard) issues it, with its number."]
     if attrs.get("dry_run"):
         banners.append("SIMULATED: a dry run against simulated instruments. No physical sensor was calibrated.")
     if calibration.source.get("partial"):
@@ -216,17 +283,20 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
                 for channel, why in uncalibrated.items()]
     several = len(channels) > 1
     style = (STYLE + certificate_decision.STYLE + (DRY_RUN_PAGES if attrs.get("dry_run") else "")
-             + (SEVERAL_STYLE if several else ""))
+             + (DRAFT_PAGES if draft else "") + (SEVERAL_STYLE if several else ""))
     sensors = [model.sensor for model in models.values()]
     named = ", ".join(sensors[:-1]) + " and " + sensors[-1] if several else sensors[0]
     item = f"MEMS IMU: {named}" if several else f"MEMS {named}{' channel' if uncalibrated else ''}"
-    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Calibration certificate {_e(number)}"
+    title = f"DRAFT (not issued) {number}" if draft else f"Calibration certificate {number}"
+    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{_e(title)}"
              f"</title><style>{style}</style><style>{certificate_lab.LAB_STYLE}</style></head><body>",
+             *(["<div class='watermark' aria-hidden='true'>DRAFT</div>"] if draft else []),
              certificate_lab.header_html(campaign),
-             f"<h1>Calibration certificate: {_e(item)}</h1>",
-             f"<p>Certificate <b class='number'>{_e(number)}</b> — "
-             f"{'issued ' + _e(approval.date) if approval else 'draft of ' + _e(utc_now()[:10])} by accelcal-rig "
-             f"{_e(__version__)}</p>",
+             f"<h1>{'DRAFT of a calibration certificate' if draft else 'Calibration certificate'}: {_e(item)}</h1>",
+             (f"<p>Certificate <b class='number'>{_e(number)}</b> — issued {_e(approval.date)} by accelcal-rig "
+              f"{_e(__version__)}</p>" if approval is not None else
+              f"<p>Draft <b class='number'>{_e(number)}</b> of {_e(utc_now()[:10])} by accelcal-rig {_e(__version__)}: "
+              "no certificate number until approved</p>"),
              *(f"<div class='banner'>{_e(b)}</div>" for b in banners)]
     configured = "; ".join(f"{name} ±{c.range:g} {c.unit}, {_per_code(c.lsb, c.unit)} per code" for name, c in channels.items())
     parts += ["<div class='front'>", "<h2>Item calibrated</h2>", _rows([
@@ -259,7 +329,7 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
               "<table class='signatures'><tr><th class='text'></th><th class='text'>name</th><th class='text'>date"
               "</th><th class='text'>signature</th></tr>"
               f"<tr><td>performed by</td><td>{_e(operator)}</td><td></td><td></td></tr>"
-              f"<tr><td>approved by</td><td>{_e(approval.approver if approval else '')}</td>"
+              f"<tr><td>approved by</td><td>{_e(approval.approver if approval else 'not approved: a draft')}</td>"
               f"<td>{_e(approval.date if approval else '')}</td><td></td></tr></table>",
               *([f"<p>Revision {revision} replaces revision {revision - 1}: {_e(approval.reason)}</p>"]
                 if approval is not None and revision > 1 and approval.reason else []),

@@ -69,6 +69,14 @@ def certificate_number(serial: str, calibration: CalibrationFile, revision: int 
     return CertificateNumber(f"{serial}-{digest[:12].upper()}", revision)
 
 
+def draft_identifier(serial: str, calibration: CalibrationFile) -> str:
+    """A draft's name in place of a number: from the same measurements and fit as the number its approval will
+    issue, but another digest, so a draft is never cited by the issued certificate's number."""
+    measured = str(calibration.source.get("measurements_sha256", ""))
+    digest = hashlib.sha256(f"draft\n{serial}\n{measured}\n{calibration.created}".encode()).hexdigest()
+    return f"DRAFT-{digest[:10].upper()}"
+
+
 def header_html(campaign: Campaign) -> str:
     """The laboratory's name and address, at the top of the first page."""
     attrs = campaign.attrs
@@ -254,5 +262,8 @@ def traceability_html(campaign: Campaign) -> str:
     return head + "".join(rows) + "</table>"
 
 
-def end_html(number: CertificateNumber) -> str:
+def end_html(number: CertificateNumber | str) -> str:
+    """The end mark: of the certificate and its revision, or of a draft (a string: its identifier)."""
+    if isinstance(number, str):
+        return f"<p class='end'>End of draft {_e(number)}: not issued, not a calibration certificate</p>"
     return f"<p class='end'>End of certificate {_e(number)}</p>"

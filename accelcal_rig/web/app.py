@@ -7,6 +7,7 @@ served is one styled page with its status (web/errors.py), never a traceback."""
 from __future__ import annotations
 
 import hmac
+import re
 import secrets
 import time
 from collections.abc import Awaitable, Callable
@@ -30,6 +31,7 @@ from starlette.staticfiles import StaticFiles
 from accelcal_rig.errors import RigError
 from accelcal_rig.registry.analysis import by_channel, lot_statistics, trend
 from accelcal_rig.registry.database import Registry
+from accelcal_rig.report.certificate import DRAFT_SUFFIX
 from accelcal_rig.web.approval import BEARER_SCOPE_KEY, ApprovalSettings, approval_routes
 from accelcal_rig.web.campaigns import CampaignFolders
 from accelcal_rig.web.errors import CheckedInput, ErrorPages, Unforeseen, exception_handlers
@@ -245,9 +247,20 @@ def create_app(campaign_folders: list[Path], registry_url: str | None, token: st
     return app
 
 
-def _certificates(campaign: Path) -> list[str]:
+def _certificates(campaign: Path) -> list[dict[str, str]]:
+    """The certificate files beside the campaign, each with what it is: a draft (not issued) or an issued
+    revision (report/certificate.py names them so)."""
     folder = campaign.with_suffix(".certificates")
-    return sorted(p.name for p in folder.glob("*") if p.suffix in (".html", ".pdf")) if folder.is_dir() else []
+    if not folder.is_dir():
+        return []
+    found = []
+    for name in sorted(p.name for p in folder.glob("*") if p.suffix in (".html", ".pdf")):
+        stem = name.rsplit(".", 1)[0]
+        revision = re.fullmatch(r".*\.r(\d+)", stem)
+        label = ("DRAFT, not issued" if stem.endswith(DRAFT_SUFFIX) else
+                 f"issued, revision {revision.group(1)}" if revision else "not a certificate this dashboard wrote")
+        found.append({"name": name, "label": label, "draft": "yes" if stem.endswith(DRAFT_SUFFIX) else ""})
+    return found
 
 
 def _inside(base: Path, relative: str) -> Path | None:

@@ -247,6 +247,27 @@ def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: 
             raise HTTPException(404, "issued as HTML only")
         return Response(bytes(row["pdf"]), media_type="application/pdf")
 
+    def draft(request: Request) -> Response:
+        """The draft certificate of a calibration whose campaign is on this computer, as the files make it now
+        (HTML, sandboxed as every page the dashboard did not write itself): what the approver reads first."""
+        row_id = int(request.path_params["id"])
+        if row_id > MAX_ID:
+            raise HTTPException(404, "no such calibration in the registry")
+        try:
+            row = registry.get().calibration(row_id)
+        except RigError as exc:
+            raise _not_there(exc, f"no calibration {row_id} in the registry") from None
+        found = _campaign_of(row)
+        if found is None:
+            raise HTTPException(404, f"the campaign file of calibration {row_id} is not on this computer")
+        try:
+            from accelcal_rig.report.certificate import draft_html
+
+            page = draft_html(found[0], found[1], str(row["serial"]))
+        except (RigError, OSError) as exc:
+            raise HTTPException(409, f"no draft: {str(exc).splitlines()[0]}") from None
+        return HTMLResponse(page, headers={"Content-Security-Policy": "sandbox"})
+
     def gated(handler: Callable[[Request], Response]) -> Callable[[Request], Awaitable[Response]]:
         async def endpoint(request: Request) -> Response:
             return await registry.call(handler, request)  # type: ignore[no-any-return]
@@ -256,6 +277,7 @@ def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: 
             Route("/logout", logout, methods=["POST"]),
             Route("/registry/calibrations/{id:int}", gated(calibration_page), methods=["GET"]),
             Route("/registry/calibrations/{id:int}/decision", decide, methods=["POST"]),
+            Route("/registry/calibrations/{id:int}/draft", gated(draft), methods=["GET"]),
             Route("/registry/calibrations/{id:int}/certificates/{revision:int}.{kind}", gated(certificate_file))]
 
 
@@ -309,11 +331,11 @@ def _campaign_of(row: dict[str, Any]) -> tuple[Path, Path] | None:
 def _decide(reg: Any, row_id: int, action: str, user: User, authority: str, reason: str) -> str:
     """Record the decision; an approval or a reissue renders the certificate revision from the campaign."""
     from accelcal_rig.registry.entries import campaign_entries
-    from accelcal_rig.report.certificate import render_certificate
+    from accelcal_rig.report.certificate import certificates_folder, render_certificate, write_issued
 
     book = Approvals(reg)
     row = reg.calibration(row_id)
-    issued = None
+    issued, found = None, None
     if action != "reject":
         found = _campaign_of(row)
         if found is None:
@@ -331,5 +353,11 @@ def _decide(reg: Any, row_id: int, action: str, user: User, authority: str, reas
         rendered = render_certificate(found[0], found[1], row["serial"], revision, user.full_name, reason=reason)
         issued = IssuedCertificate(revision, rendered.number, rendered.html, rendered.pdf)
     revision_issued = book.record(row_id, action, user, authority, reason, issued)  # type: ignore[arg-type]
-    return (f"{action}d by {user.full_name}" + (f": certificate revision {revision_issued} issued"
-                                                 if revision_issued else ""))
+    if issued is None or found is None:
+        return f"{action}d by {user.full_name}"
+    said = f"{action}d by {user.full_name}: certificate {issued.number} revision {revision_issued} issued"
+    try:  # where the run's certificates are, as rig approve writes it; the registry keeps it either way
+        written = write_issued(certificates_folder(found[0]), row["serial"], issued.revision, issued.html, issued.pdf)
+    except OSError as exc:
+        return f"{said} (kept in the registry; not written beside the campaign: {exc.strerror or exc})"
+    return f"{said} → {', '.join(p.name for p in written)}"

@@ -15,7 +15,7 @@ import yaml
 
 from accelcal_rig.cli import main
 from accelcal_rig.fit.calibration import load_calibration
-from accelcal_rig.report.certificate_lab import CertificateNumber, certificate_number
+from accelcal_rig.report.certificate_lab import CertificateNumber, certificate_number, draft_identifier
 from tests.conftest import SIM_RIG
 
 PROCEDURE = """\
@@ -81,14 +81,17 @@ def _pages(pdf: Path) -> list[str]:
 def test_the_pdf_states_every_required_item(certified: tuple[Path, Path, list[str]], serial: str, customer: str,
                                             received: str, condition: str) -> None:
     campaign, calibration, _ = certified
-    pdf = campaign.with_suffix(".certificates") / f"{serial}.pdf"
+    pdf = campaign.with_suffix(".certificates") / f"{serial}.DRAFT.pdf"
     pages = _pages(pdf)
     text = " ".join(pages)
     number = certificate_number(serial, load_calibration(calibration))
     assert re.fullmatch(rf"{serial}-[0-9A-F]{{12}} revision 1", str(number))
-    for page in pages:  # the number and its revision on every page, the end on the last only
-        assert str(number) in page
-    assert "End of certificate" not in " ".join(pages[:-1]) and f"End of certificate {number}" in pages[-1]
+    draft = draft_identifier(serial, load_calibration(calibration))
+    assert re.fullmatch(r"DRAFT-[0-9A-F]{10}", draft)
+    for page in pages:  # a draft's identifier, never the number its approval will issue, and its mark on every page
+        assert draft in page and "DRAFT — NOT ISSUED" in page and "not a certificate until approved" in page
+        assert number.base not in page
+    assert "End of draft" not in " ".join(pages[:-1]) and f"End of draft {draft}" in pages[-1]
     for expected in (
             "Test Metrology Laboratory", "12 Test Road", "12345 Testtown", "room B.104, thermal lab",   # §7.8.2.1 b, c
             f"customer {customer}", f"date of receipt {received}", f"condition on receipt {condition}",  # e, f, §7.8.2.1 i
@@ -126,7 +129,7 @@ def test_a_rig_config_without_a_lab_says_so(write, workdir: Path) -> None:
     assert "lab:" not in rig.read_text()
     assert main(["run", str(write("tiny.yaml", TINY_PROCEDURE)), "--dry-run", "-o", str(workdir / "c.h5"), "-q",
                  "--no-pdf"]) == 0
-    page = (workdir / "c.certificates" / "ADX355-A001.html").read_text(encoding="utf-8")
+    page = (workdir / "c.certificates" / "ADX355-A001.DRAFT.html").read_text(encoding="utf-8")
     for expected in ("Laboratory not stated in the rig config", "laboratory not stated in the rig config",
                      "tiny (version not stated in the procedure)", "not stated (the fixture&#x27;s sensor entry, or rig "
                      "run --customer)", "no reference is stated in the rig config"):

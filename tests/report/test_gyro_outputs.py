@@ -70,7 +70,7 @@ def test_an_imu_certificate_fits_on_three_pages_and_ends_on_its_last(imu: tuple[
     for w in written:
         assert w.pdf is not None and w.pdf.read_bytes().startswith(b"%PDF")
         pages = PdfReader(w.pdf).pages           # two sensors and ISO/IEC 17025's contents: at most three
-        assert 1 <= len(pages) <= 3 and "End of certificate" in pages[-1].extract_text()
+        assert 1 <= len(pages) <= 3 and "End of draft" in pages[-1].extract_text()
         assert all("End of certificate" not in page.extract_text() for page in pages[:-1])
 
 

@@ -45,8 +45,8 @@ def test_a_campaign_page_has_its_plot_warnings_and_certificates(lab) -> None:
     client = TestClient(base_url="http://127.0.0.1", app=create_app([folder], registry))
     page = client.get("/campaigns/quick.h5")
     assert page.status_code == 200 and "<svg" in page.text and "chamber air" in page.text
-    assert "ADX355-A001.html" in page.text
-    certificate = client.get("/campaigns/quick.h5/certificates/ADX355-A001.html")
+    assert "ADX355-A001.DRAFT.html" in page.text and "DRAFT, not issued" in page.text
+    certificate = client.get("/campaigns/quick.h5/certificates/ADX355-A001.DRAFT.html")
     assert certificate.status_code == 200 and "ADX355-A001" in certificate.text
     assert certificate.headers["content-security-policy"] == "sandbox"  # its scripts cannot reach the dashboard
     assert client.get("/campaigns/quick.h5/certificates/..%2Fquick.h5.journal").status_code == 404  # exists, outside

@@ -66,7 +66,11 @@ def test_an_approver_logs_in_and_approves_and_nothing_else_can(lab) -> None:
     assert "httponly" in cookie and "samesite=strict" in cookie
 
     page = client.get(f"/registry/calibrations/{row_id}")
-    assert "approve as Jane Doe" in page.text
+    assert "approve as Jane Doe" in page.text and "Read the draft certificate" in page.text
+    draft = client.get(f"/registry/calibrations/{row_id}/draft")    # read before deciding
+    assert draft.status_code == 200 and draft.headers["content-security-policy"] == "sandbox"
+    assert "DRAFT of a calibration certificate" in draft.text and "ADX355-A001" in draft.text
+    assert client.get(f"/registry/calibrations/{row_id + 999}/draft").status_code == 404
     token = csrf(page.text)
     # A page on another site, or one that hides where it comes from, cannot decide in her name; nor a form
     # without the session's token.
@@ -81,7 +85,10 @@ def test_an_approver_logs_in_and_approves_and_nothing_else_can(lab) -> None:
     assert Approvals(Registry.open(registry)).trail(calibration_id=row_id) == []
     approved = client.post(decide, data={"csrf": token, "action": "approve", "password": PASSWORD}, headers=ORIGIN)
     assert approved.status_code == 200 and "approved — by Jane Doe" in approved.text
-    assert "certificate revision 1" in approved.text
+    assert "certificate revision 1" in approved.text and "ADX355-A001.r1.pdf" in approved.text
+    beside = folder / "quick.certificates"                # the issued files where the run's certificates are
+    assert (beside / "ADX355-A001.r1.html").is_file() and (beside / "ADX355-A001.DRAFT.html").is_file()
+    assert "DRAFT" not in (beside / "ADX355-A001.r1.html").read_text()
     pdf = client.get(f"/registry/calibrations/{row_id}/certificates/1.pdf")
     assert pdf.status_code == 200 and pdf.content.startswith(b"%PDF")
     issued = client.get(f"/registry/calibrations/{row_id}/certificates/1.html")

@@ -93,7 +93,7 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Lab:
     assert approver is not None
     book.record(row_id, "approve", approver, "test", certificate=IssuedCertificate(1, "N-1", "<p>1</p>", None))
     book.registry.engine.dispose()
-    values = {"name": "quick.h5", "kind": "certificates", "file": "ADX355-A001.html", "serial": "ADX355-A001",
+    values = {"name": "quick.h5", "kind": "certificates", "file": "ADX355-A001.DRAFT.html", "serial": "ADX355-A001",
               "part": "adxl355", "id": str(row_id), "revision": "1", "path": "dashboard.css",
               "key": campaign_key(socket.gethostname(), str((folder / "quick.h5").resolve()))}  # the run published it
     return Lab(folder, good, row_id, values)
