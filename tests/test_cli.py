@@ -207,7 +207,9 @@ def test_rig_fit_on_a_file_without_poses_is_one_line(write, workdir: Path, capsy
     with pytest.raises(CampaignAborted):
         run_campaign(prepare(write("tiny.yaml", TINY_PROCEDURE)), campaign, dry_run=True, seed=0, overwrite=False,
                      build_instruments=no_sensors_answer)
-    err = one_line_error(capsys, ["fit", str(campaign), "-o", str(workdir / "cal.yaml")], 1)
+    err = one_line_error(capsys, ["fit", str(campaign), "-o", str(workdir / "cal.yaml")], 2)
+    assert "the campaign is aborted (" in err and ", 0 of 6 poses stored, next " in err
+    err = one_line_error(capsys, ["fit", str(campaign), "-o", str(workdir / "cal.yaml"), "--partial"], 1)
     assert "no poses stored, nothing to fit" in err
 
 

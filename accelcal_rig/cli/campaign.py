@@ -5,6 +5,7 @@ logging a run has on the console and in its log file, the lock and the free-spac
 from __future__ import annotations
 
 import argparse
+import datetime as dt
 import logging
 import signal
 import sys
@@ -43,6 +44,7 @@ def prepare_run(args: argparse.Namespace) -> tuple[PreparedCampaign, bool]:
 
         profile = str(load_campaign(args.output).attrs.get("chamber_profile", "")) or None
     prepared = replace(prepare(args.procedure, args.config, args.faults, profile), receipt=_receipt(args))
+    _received_before(prepared, args.today())
     if exists and not (args.overwrite or args.resume):
         raise ConfigError(f"{args.output}: campaign file exists; continue it with --resume, or choose another -o "
                           "or pass --overwrite")
@@ -64,6 +66,17 @@ def _receipt(args: argparse.Namespace) -> Receipt:
         if len(text) > longest or any(ord(c) < 32 or ord(c) == 127 for c in text):
             raise ConfigError(f"{option}: not one line of at most {longest} characters")
     return Receipt(args.customer, received, args.condition, args.lot)
+
+
+def _received_before(prepared: PreparedCampaign, today: dt.date) -> None:
+    """An item is received before it is calibrated: a date of receipt after today's is refused, naming its key."""
+    for index, sensor in enumerate(prepared.rig.model.fixture.sensors):
+        received, key = ((sensor.received_date, f"fixture.sensors[{index}].received_date ({sensor.serial})")
+                         if sensor.received_date is not None else (prepared.receipt.received_date, "--received"))
+        if received is not None and received > today:
+            where = f"{prepared.rig.path}: " if key.startswith("fixture") else ""
+            raise ConfigError(f"{where}{key}: {received.isoformat()} is after the calibration ({today.isoformat()}): "
+                              "an item is received before it is calibrated")
 
 
 def prepare_resume(args: argparse.Namespace) -> tuple[PreparedCampaign, bool, int]:

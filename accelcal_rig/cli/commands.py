@@ -166,13 +166,15 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     from accelcal_rig.cli.registry_access import campaign_entries, stored_rig_registry
     from accelcal_rig.fit.campaign_file import fit_campaign_file
 
-    outcome = fit_campaign_file(args.campaign, args.output, mode=args.mode, degree=args.degree, free=args.parameters,
-                                out_of_range=args.out_of_range, temperature_model=args.temperature_model)
+    outcome = fit_campaign_file(args.campaign, args.output, partial=args.partial, mode=args.mode, degree=args.degree,
+                                free=args.parameters, out_of_range=args.out_of_range,
+                                temperature_model=args.temperature_model)
     for warning in outcome.warnings:
         print(f"rig: warning: {warning}", file=sys.stderr)
     print(json.dumps(outcome.report) if args.json else "\n".join(fit_lines(outcome.report, args.output)))
-    record(args.registry, stored_rig_registry(args.campaign), args.campaign,
-            lambda: campaign_entries(args.campaign, args.output), args.json)
+    if outcome.ended:  # a partial fit is never a serial's calibration, nor masks one: not recorded
+        record(args.registry, stored_rig_registry(args.campaign), args.campaign,
+               lambda: campaign_entries(args.campaign, args.output), args.json)
     rejected = [serial for serial, r in outcome.report.items() if r["verdict"] == "FAIL"]
     return rejected_exit(rejected, args.fail_on_reject)
 

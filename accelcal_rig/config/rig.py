@@ -248,9 +248,13 @@ class FixtureConfig(StrictModel):
     @field_validator("sensors")
     @classmethod
     def _unique_serials(cls, value: list[SensorConfig]) -> list[SensorConfig]:
-        serials = [s.serial for s in value]
-        if len(set(serials)) != len(serials):
-            raise ValueError("sensor serial numbers must be distinct")
+        seen: dict[str, str] = {}
+        for sensor in value:  # compared as a person reads them: ADX-a1 and ADX-A1 are one item's label
+            other = seen.setdefault(sensor.serial.casefold(), sensor.serial)
+            if other != sensor.serial or sum(s.serial == other for s in value) > 1:
+                raise ValueError(f"sensor serial numbers must be distinct, case aside: {other!r} and "
+                                 f"{sensor.serial!r}" if other != sensor.serial else
+                                 f"sensor serial numbers must be distinct: {other!r} twice")
         return value
 
 
@@ -474,6 +478,15 @@ class RigConfig(StrictModel):
                                    "(the certificates' traceability)")
     references_overdue: Literal["warn", "refuse"] = Field("warn", description="a reference past its due date: rig "
                                                           "plan and rig run warn, or refuse to run")
+
+    @model_validator(mode="after")
+    def _surveyed_gravity_stated(self) -> RigConfig:
+        """A gravity survey named as a reference with the standard value left in its place would trace the
+        certificates to a survey whose result they do not use."""
+        if self.references.site_gravity is not None and "gravity_m_s2" not in self.model_fields_set:
+            raise ValueError("references.site_gravity names a gravity survey but gravity_m_s2 is not stated: "
+                             "state the surveyed value (and gravity_uncertainty_m_s2)")
+        return self
 
     @model_validator(mode="after")
     def _cooling_floor_below_the_chamber(self) -> RigConfig:

@@ -26,16 +26,21 @@ from accelcal_rig.store.read import load_campaign, usable_campaign
 class FitOutcome:
     report: dict[str, Any]    #: per sensor serial, as `rig fit --json` prints it
     warnings: list[str]       #: for the operator, one line each
+    ended: bool = True        #: the campaign had ended (done): else a partial fit, never recorded
 
 
-def fit_campaign_file(path: Path, output: Path, **overrides: Any) -> FitOutcome:
+def fit_campaign_file(path: Path, output: Path, partial: bool = False, **overrides: Any) -> FitOutcome:
     """The campaign at `path` fitted with the options it records (any `overrides` not None instead: mode,
     degree, free, out_of_range, temperature_model), its calibration written to `output`; the campaign is
-    only read."""
+    only read. A campaign that has not ended (not `done`) is refused in one line unless `partial`: nothing is
+    recorded from half a campaign."""
     running = holder(path)
     if running is not None:
         raise ConfigError(f"{path}: a campaign is running on it, {running}: fit it once it is done")
     campaign = usable_campaign(path)
+    if campaign.state != "done" and not partial:
+        raise ConfigError(f"{path}: {unfinished(campaign)}: rig resume {path} finishes it (rig fit --partial fits "
+                          "what is stored, never recorded in the registry)")
     warnings = [f"{path}: {note}" for note in campaign.notes]
     options = recorded_options(campaign.attrs, str(path), **overrides)
     if options is None:
@@ -49,8 +54,18 @@ def fit_campaign_file(path: Path, output: Path, **overrides: Any) -> FitOutcome:
         raise RigError(f"{path}: fit failed: {str(exc).splitlines()[0]}") from None
     warnings += [f"sensor {serial}: not fitted: {why}" for serial, why in fitted.dropped.items()]
     if campaign.state != "done":
-        warnings.append(f"campaign state is {campaign.state}: fitted the poses stored so far")
-    return FitOutcome(report, warnings)
+        warnings.append(f"a partial fit of a campaign that has not ended ({unfinished(campaign)}): its calibration "
+                        "and certificates say PARTIAL; it is not recorded in the registry")
+    return FitOutcome(report, warnings, ended=campaign.state == "done")
+
+
+def unfinished(campaign: Campaign) -> str:
+    """What a campaign that has not ended lacks, in a few words: its state and the poses still to measure."""
+    stored, planned = len(campaign.poses), campaign.poses_planned
+    missing = [key for key in campaign.header.plan.pose_keys if key not in campaign.stored_keys]
+    why = f" ({campaign.abort_reason})" if campaign.state == "aborted" and campaign.abort_reason else ""
+    return (f"the campaign is {campaign.state}{why}, {stored} of {planned} poses stored"
+            + (f", next {missing[0]}" if missing else ""))
 
 
 def calibration_verdicts(campaign_path: Path, calibration_path: Path | None = None,

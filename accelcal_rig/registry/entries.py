@@ -26,8 +26,9 @@ from accelcal_rig.fit.parameter_uncertainty import reference_c
 from accelcal_rig.store.content import Campaign, measurements_sha256
 from accelcal_rig.store.read import load_campaign
 
-#: Campaign states whose fit is final: a running campaign's file is still being written.
-FINISHED_STATES = ("done", "aborted")
+#: Campaign states whose fit is recorded: a running campaign's file is still being written, and an aborted one
+#: stopped before its last pose (a fit of it is partial: never a serial's calibration).
+FINISHED_STATES = ("done",)
 #: The verdicts stored as they are (CONDITIONAL: a limit met or missed inside its guard band under guarded
 #: acceptance); any other (NOT JUDGED: no limits stated) is stored as none, counted in no yield.
 STORED_VERDICTS = ("PASS", "FAIL", "CONDITIONAL")
@@ -50,7 +51,10 @@ def campaign_entries(campaign_path: Path, calibration_path: Path | None = None) 
                           f"(rig fit {campaign_path} -o {calibration_path})")
     campaign = load_campaign(campaign_path)
     if campaign.state not in FINISHED_STATES:
-        raise ConfigError(f"{campaign_path}: campaign is {campaign.state}, not finished: register it when it ends")
+        why = f" ({campaign.abort_reason})" if campaign.state == "aborted" and campaign.abort_reason else ""
+        raise ConfigError(f"{campaign_path}: campaign is {campaign.state}{why}, {len(campaign.poses)} of "
+                          f"{campaign.poses_planned} poses stored: nothing is recorded from half a campaign (rig "
+                          f"resume {campaign_path} finishes it)")
     calibration = load_calibration(calibration_path)
     if calibration.source.get("measurements_sha256") != measurements_sha256(campaign):
         raise ConfigError(f"{calibration_path}: fitted to other measurements than {campaign_path} holds (its "

@@ -127,6 +127,18 @@ def _checks(plan: Any) -> int:
     return sum(1 for s in plan.pose_steps if s.stored_kind == "verify")
 
 
+def _earth_rate(latitude_deg: float | None, heading_deg: float | None) -> str:
+    """What the gyroscope's reference does with the Earth's rate, as the rig config lets it (its certificate
+    states the same)."""
+    if latitude_deg is None:
+        return ("the Earth's rate (up to 0.0042 °/s) is NOT taken out: the rig config states no latitude_deg, so it "
+                "stays in every gyroscope's fitted bias (its certificate says so)")
+    if heading_deg is None:
+        return (f"vertical component at latitude {latitude_deg:g}° taken out; the horizontal one stays in the fitted "
+                "bias (the rig config states no heading_deg)")
+    return f"taken out at latitude {latitude_deg:g}° and table heading {heading_deg:g}°"
+
+
 def _gyroscope_lines(prepared: PreparedCampaign) -> list[str]:
     """The rate steps and the noise record, where the procedure has them."""
     procedure, plan, rig = prepared.procedure.model, prepared.plan, prepared.rig.model
@@ -146,6 +158,7 @@ def _gyroscope_lines(prepared: PreparedCampaign) -> list[str]:
                           for index, abouts in by_axis.items()) or "no table axis"
         lines.append(f"rates      {listed} °/s about fixture {where}, held {rates.settle_s:g} s: "
                      f"{rates.steps_per_setpoint} per calibration setpoint, {len(turning)} in all{checked}")
+        lines.append(f"earth      {_earth_rate(rig.latitude_deg, rig.heading_deg)}")
     if procedure.noise is not None:
         blocks = procedure.noise_blocks()
         block_s = procedure.acquisition.samples_per_pose / procedure.acquisition.odr_hz
@@ -264,6 +277,8 @@ def plan_json(prepared: PreparedCampaign, estimate: DurationEstimate) -> dict[st
         "poses_total": len(plan.pose_steps),
         "acceptance": procedure.acceptance.model_dump(),
         "warnings": plan_warnings(prepared),
+        **({"earth_rate": _earth_rate(prepared.rig.model.latitude_deg, prepared.rig.model.heading_deg)}
+           if procedure.rates is not None else {}),
         "storage": {"journal_bytes": storage.journal_bytes, "file_bytes": storage.file_bytes,
                     "need_bytes": storage.need_bytes, "start_free_bytes": int(START_MARGIN * storage.need_bytes)},
         "estimate": {

@@ -90,3 +90,64 @@ def test_a_bad_received_date_and_a_numeric_version_are_one_line(write, workdir: 
     assert main(["plan", str(numbered)]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and re.match(rf"rig: error: {re.escape(str(numbered))}:2: version: write it as quoted text", err[0])
+
+
+def test_a_receipt_after_the_calibration_is_refused_naming_its_key(write, workdir: Path, capsys) -> None:
+    """An item is received before it is calibrated: `--received` or a fixture entry's `received_date` after the
+    day of the run is one line naming which, and no campaign is made."""
+    procedure = write("tiny.yaml", TINY_PROCEDURE)
+    today = _on(dt.date(2026, 12, 1))
+    assert main(["run", str(procedure), "--dry-run", "-o", str(workdir / "c.h5"), "--received", "2026-12-02"],
+                today=today) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        "rig: error: --received: 2026-12-02 is after the calibration (2026-12-01): an item is received before it is "
+        "calibrated"]
+    rig = workdir / "sim.yaml"
+    rig.write_text(rig.read_text().replace("{serial: ADX355-A002, name: dut2,",
+                                           "{serial: ADX355-A002, name: dut2, received_date: 2027-01-05,"))
+    assert main(["run", str(procedure), "--dry-run", "-o", str(workdir / "c.h5"), "--received", "2026-11-20"],
+                today=today) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "fixture.sensors[1].received_date (ADX355-A002): 2027-01-05 is after" in err[0]
+    assert not (workdir / "c.h5").exists()
+
+
+def test_serials_that_differ_only_by_case_are_one_item(write, workdir: Path, capsys) -> None:
+    rig = workdir / "sim.yaml"
+    rig.write_text(rig.read_text().replace("{serial: ADX355-A002,", "{serial: adx355-a001,"))
+    assert main(["plan", str(write("tiny.yaml", TINY_PROCEDURE))]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "distinct, case aside: 'ADX355-A001' and 'adx355-a001'" in err[0]
+
+
+def test_a_gravity_survey_needs_its_value(write, workdir: Path, capsys) -> None:
+    """A survey named as the site gravity's reference with the standard value left in place (the example rig
+    config once did this) is refused; stating the surveyed value is enough."""
+    rig = workdir / "sim.yaml"
+    survey = ("references:\n  site_gravity: {certificate: GRAV-1, issuer: Survey, due_date: 2999-12-31}\n")
+    rig.write_text(rig.read_text() + survey)
+    procedure = write("tiny.yaml", TINY_PROCEDURE)
+    assert main(["plan", str(procedure)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "site_gravity names a gravity survey but gravity_m_s2 is not stated" in err[0]
+    rig.write_text(rig.read_text() + "gravity_m_s2: 9.8112\n")
+    assert main(["plan", str(procedure)]) == 0
+
+
+def test_plan_says_what_the_gyroscope_reference_does_with_the_earths_rate(tmp_path: Path, capsys) -> None:
+    """A gyroscope campaign on a rig config without latitude_deg: `rig plan` says the Earth's rate stays in the
+    fitted bias (as the calibration and the certificate do), in its lines and in --json."""
+    import json
+
+    from tests.conftest import REPO
+
+    config = tmp_path / "imu.yaml"
+    config.write_text((REPO / "configs" / "sim-imu.yaml").read_text())
+    procedure = REPO / "procedures" / "imu-fast.yaml"
+    assert main(["plan", str(procedure), "--config", str(config)]) == 0
+    assert "earth      taken out at latitude 48.14°" in capsys.readouterr().out
+    lines = config.read_text().splitlines()
+    config.write_text("\n".join(line for line in lines if not line.startswith(("latitude_deg:", "heading_deg:"))))
+    assert main(["plan", str(procedure), "--config", str(config), "--json"]) == 0
+    stated = json.loads(capsys.readouterr().out)["earth_rate"]
+    assert "is NOT taken out: the rig config states no latitude_deg" in stated

@@ -55,8 +55,15 @@ def test_a_partial_campaign_says_so_and_fails(paper_campaign: Path, tmp_path: Pa
     shutil.copy(journal_path(paper_campaign), journal_path(campaign))
     kill_mid_pose(campaign, 300)  # a run killed at its 301st pose
     calibration = tmp_path / "partial.calibration.yaml"
-    assert main(["fit", str(campaign), "-o", str(calibration)]) == 0
-    capsys.readouterr()
+    registry = tmp_path / "registry.sqlite"
+    assert main(["fit", str(campaign), "-o", str(calibration), "--registry", str(registry)]) == 2
+    refused = capsys.readouterr().err.strip().splitlines()
+    assert len(refused) == 1 and "300 of 432 poses stored, next " in refused[0] and "rig resume" in refused[0]
+    assert not calibration.exists() and not registry.exists()                 # nothing written, nothing recorded
+    assert main(["fit", str(campaign), "-o", str(calibration), "--registry", str(registry), "--partial"]) == 0
+    assert "a partial fit" in capsys.readouterr().err and not registry.exists()   # never a serial's calibration
+    assert main(["registry", "add", str(campaign), "--registry", str(registry)]) == 2
+    assert "nothing is recorded from half a campaign" in capsys.readouterr().err
     assert main(["certificate", str(campaign), "-o", str(tmp_path / "certs"), "--no-pdf"]) == 0
     page = next((tmp_path / "certs").glob("*.html")).read_text(encoding="utf-8")
     assert "PARTIAL: partial campaign: 300 of 432 poses stored" in page and "class='verdict FAIL'" in page

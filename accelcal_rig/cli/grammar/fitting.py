@@ -30,6 +30,9 @@ def _add_fit(commands: Commands) -> None:
     fit.add_argument("--out-of-range", choices=["clamp", "extrapolate"], help="default: the procedure's")
     fit.add_argument("--temperature-model", choices=["per-setpoint", "joint"],
                      help="default: the procedure's fit.temperature_model")
+    fit.add_argument("--partial", action="store_true",
+                     help="fit a campaign that has not ended (killed, stopped or aborted before its last pose): "
+                          "the calibration and its certificates say PARTIAL, nothing is recorded in the registry")
     fit.add_argument("--json", action="store_true", help="print the metrics as one JSON object")
     registry_option(fit)
     fail_on_reject(fit)
