@@ -86,9 +86,19 @@ def calibration_verdicts(campaign_path: Path, calibration_path: Path | None = No
     return {
         "calibration": f"{path}" + ("" if current else " (fitted to other measurements than the campaign's now: "
                                                        "fit again)") + (f"; {partial}" if partial else ""),
-        "verdicts": {serial: {"verdict": judged.verdict, "reasons": judged.reasons}
+        "verdicts": {serial: {"verdict": judged.verdict, "reasons": judged.reasons,
+                              "sensors": sensor_verdicts(calibration, serial)}
                      for serial, judged in dut_verdicts(calibration).items()},
     }
+
+
+def sensor_verdicts(calibration: CalibrationFile, serial: str) -> dict[str, str]:
+    """Each calibrated sensor's own verdict of a DUT, by the sensor's name ("accelerometer", "gyroscope"): an
+    IMU's page shows both, not only the DUT's combined one."""
+    from accelcal_rig.fit.channel_models import model_of
+
+    return {model_of(channel).sensor: channel.verdict or NOT_JUDGED
+            for channel in calibration.duts[serial].channels.values()}
 
 
 def dut_verdicts(calibration: CalibrationFile) -> dict[str, Judgement]:

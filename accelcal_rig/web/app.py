@@ -293,7 +293,7 @@ def _channel_view(reg: Registry, serial: str, channel: str, rows: list[dict[str,
                                  for k, axis in enumerate("xyz")},
                          "days since the first calibration", f"bias at the reference temperature ({unit})")
     current = reg.current(serial, simulated=simulated, channel=channel)
-    return {"channel": channel, "current": current, "trend": result, "plot": plot,
+    return {"channel": channel, "current": current, "trend": result, "plot": plot, "calibrations": len(rows),
             "why_not_valid": "" if current is not None else reg.why_not_valid(serial, channel)}
 
 

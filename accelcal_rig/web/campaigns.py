@@ -136,9 +136,25 @@ def _verdicts(path: Path, calibration: Path, campaign: Any) -> dict[str, Any]:
     except (RigError, OSError, ValueError, KeyError, TypeError) as exc:  # the campaign is still shown
         return {"calibration": f"{calibration}: cannot be judged: {(str(exc).splitlines() or [type(exc).__name__])[0]}",
                 "verdicts": {}}
-    return {"calibration": found["calibration"],
-            "verdicts": {serial: {"verdict": judged["verdict"] or NOT_JUDGED, "reasons": list(judged["reasons"])}
-                         for serial, judged in (found["verdicts"] or {}).items()}}
+    verdicts = {serial: {"verdict": judged["verdict"] or NOT_JUDGED, "reasons": list(judged["reasons"]),
+                         "sensors": dict(judged.get("sensors") or {})}
+                for serial, judged in (found["verdicts"] or {}).items()}
+    return {"calibration": found["calibration"], "verdicts": verdicts, "sensor_verdicts": by_sensor(verdicts)}
+
+
+def by_sensor(verdicts: dict[str, Any]) -> str:
+    """A campaign of several sensors per DUT (IMUs) in one line, each sensor's verdicts counted, worst first:
+    "accelerometer 4 PASS · gyroscope 3 PASS, 1 FAIL"; "" when each DUT has one sensor (its verdict says it)."""
+    sensors = list(dict.fromkeys(name for judged in verdicts.values() for name in judged.get("sensors", {})))
+    if len(sensors) < 2:
+        return ""
+    order = ["FAIL", "CONDITIONAL", "PASS", NOT_JUDGED]
+    parts = []
+    for sensor in sensors:
+        said = [judged["sensors"][sensor] for judged in verdicts.values() if sensor in judged.get("sensors", {})]
+        counts = ", ".join(f"{said.count(v)} {v}" for v in order if v in said)
+        parts.append(f"{sensor} {counts}")
+    return " · ".join(parts)
 
 
 def _writer_gone(path: Path, summary: dict[str, Any]) -> bool:

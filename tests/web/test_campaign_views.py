@@ -159,3 +159,22 @@ def test_an_unknown_campaign_is_a_styled_404_on_every_route_that_names_one(resum
             assert answer.json() == {"error": "no campaign nope.h5 in the watched folders"}
         else:
             assert 'id="error-page"' in answer.text and "no campaign nope.h5 in the watched folders" in answer.text
+
+
+def test_an_imu_campaign_shows_both_sensors_verdicts(imu_dry_run: tuple[Path, Path], tmp_path: Path) -> None:
+    """An IMU's page and the list say each sensor's verdict, not only the DUT's combined one."""
+    from tests.report.imu_campaign import copied
+
+    campaign, _ = copied(imu_dry_run, tmp_path)
+    app = client(tmp_path)
+    (row,) = app.get("/api/campaigns").json()
+    sensors = {serial: judged["sensors"] for serial, judged in row["verdicts"].items()}
+    assert sensors and all(set(s) == {"accelerometer", "gyroscope"} for s in sensors.values())
+    assert row["sensor_verdicts"].startswith("accelerometer ") and " · gyroscope " in row["sensor_verdicts"]
+    for sensor in ("accelerometer", "gyroscope"):
+        said = [s[sensor] for s in sensors.values()]
+        counted = ", ".join(f"{said.count(v)} {v}" for v in ("FAIL", "CONDITIONAL", "PASS", "NOT JUDGED") if v in said)
+        assert f"{sensor} {counted}" in row["sensor_verdicts"]
+    assert row["sensor_verdicts"] in app.get("/").text
+    page = app.get(f"/campaigns/{campaign.name}").text
+    assert page.count('<ul class="sensors">') == len(sensors) and "<li>gyroscope <span class=\"verdict" in page

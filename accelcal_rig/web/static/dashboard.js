@@ -18,6 +18,7 @@ function progressFields(c) {
     warnings: String((c.warnings || []).length),
     line: p.now || c.last_event || "",  // the progress line without its pose count: the poses field is the journal's
     finished: c.finished || "—",
+    sensor_verdicts: c.sensor_verdicts || "",  // an IMU campaign's verdicts per sensor
   };
 }
 
