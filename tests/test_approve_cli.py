@@ -102,3 +102,30 @@ def test_an_approver_issues_revisions_and_every_decision_is_audited(fitted, monk
     audit = capsys.readouterr().out.splitlines()
     assert [line.split()[5] for line in audit] == ["approve", "reissue"]
     assert all("by Jane Doe (rig approve, password of registry user jdoe" in line for line in audit)
+
+
+def test_a_dry_runs_printed_next_step_works_as_printed(monkeypatch, capsys, tmp_path) -> None:
+    """The README's dry run, then what it prints: add an approver where its rows are (the dry runs' registry,
+    named however the run found it) and approve. Nothing sends the user to a command that then says there is
+    nothing to do; the issued certificate is marked SIMULATED."""
+    import re
+    import shlex
+
+    monkeypatch.setenv("ACCELCAL_DRY_RUN_REGISTRY", str(tmp_path / "rehearsals.sqlite"))
+    monkeypatch.setenv("ACCELCAL_REGISTRY", str(tmp_path / "lab.sqlite"))
+    campaign = tmp_path / "c.h5"
+    assert main(["run", str(REPO / "procedures" / "quick-6pos.yaml"), "--dry-run", "-o", str(campaign), "-q",
+                 "--no-pdf", "--no-publish"]) == 0
+    said = capsys.readouterr().out
+    found = re.search(r"certificates are drafts until approved: (rig approve .+ --as USER), USER an approver in "
+                      r"registry (\S+) \(once: (rig registry user add .+)\)$", said, re.MULTILINE)
+    assert found is not None, said
+    add = shlex.split(found.group(3).replace("USER", "jdoe").replace("NAME", "'Jane Doe'"))
+    assert rig(monkeypatch, *add[1:], "--password-stdin", stdin=PASSWORD + "\n") == 0
+    approve = shlex.split(found.group(1).replace("USER", "jdoe"))
+    assert rig(monkeypatch, *approve[1:], "--serial", SERIAL, "--password-stdin", stdin=PASSWORD + "\n") == 0
+    out = capsys.readouterr().out
+    assert f"{SERIAL}: approved by Jane Doe" in out and "(SIMULATED: a dry run's, in the dry runs' registry)" in out
+    issued = (tmp_path / "c.certificates" / f"{SERIAL}.r1.html").read_text()
+    assert "SIMULATED" in issued and "DRAFT" not in issued
+    assert not (tmp_path / "lab.sqlite").exists()                 # the lab's registry never saw the rehearsal

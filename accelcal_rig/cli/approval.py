@@ -14,17 +14,24 @@ from accelcal_rig.errors import ConfigError
 
 
 def approve_command(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli.registry_access import campaign_entries, open_registry
+    from accelcal_rig.cli.follow_up import campaign_registry_url
+    from accelcal_rig.cli.registry_access import campaign_entries
     from accelcal_rig.registry.approvals import Approvals, IssuedCertificate
+    from accelcal_rig.registry.database import Registry
+    from accelcal_rig.registry.location import described
     from accelcal_rig.report.certificate import certificates_folder, render_certificate, write_issued
 
     campaign = args.campaign
     calibration = args.calibration or campaign.with_suffix(".calibration.yaml")
-    registry = open_registry(args, upgrade=True)
+    if not campaign.is_file():
+        raise ConfigError(f"{campaign}: no such campaign file")
+    url = campaign_registry_url(campaign, args.registry)  # where its run recorded it (a dry run's: the dry runs')
+    registry = Registry.open(url, upgrade=True, create=False)
     approvals = Approvals(registry)
     user = _authenticated(approvals, args.user, args.password_stdin)
     authority = f"rig approve, password of registry user {user.name} (operating-system user {_os_user()})"
     entries = campaign_entries(campaign, calibration)
+    simulated = any(entry["simulated"] for entry in entries)
     serials = list(dict.fromkeys(e["serial"] for e in entries))
     unknown = [s for s in (args.serial or []) if s not in serials]
     if unknown:
@@ -32,8 +39,8 @@ def approve_command(args: argparse.Namespace) -> int:
     ids = registry.ids_of(entries)
     for serial in args.serial or serials:
         if serial not in ids:
-            raise ConfigError(f"{campaign}: DUT {serial}'s calibration is not in the registry {registry.url}: record it "
-                              "first (rig registry add)")
+            raise ConfigError(f"{campaign}: DUT {serial}'s calibration is not in registry {described(url)}, where its "
+                              f"run records it: rig resume {campaign} records it there")
         lead = ids[serial]
         decision = approvals.decision(lead)
         if args.action == "approve" and decision.state == "approved":
@@ -55,7 +62,8 @@ def approve_command(args: argparse.Namespace) -> int:
         if issued is not None:
             written = write_issued(certificates_folder(campaign), serial, issued.revision, issued.html, issued.pdf)
             print(f"{serial}: {args.action}d by {user.full_name}; certificate {issued.number} revision "
-                  f"{revision_issued} → {', '.join(str(p) for p in written)}")
+                  f"{revision_issued} → {', '.join(str(p) for p in written)}"
+                  + (" (SIMULATED: a dry run's, in the dry runs' registry)" if simulated else ""))
         else:
             print(f"{serial}: rejected by {user.full_name}: {args.reason}")
     return 0

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -92,6 +92,18 @@ def registry_of(campaign: Path, follow_up: FollowUp, simulated: bool) -> str:
     from accelcal_rig.registry.location import campaign_rig_registry, recording_url
 
     return recording_url(follow_up.registry or follow_up.recorded_registry, campaign_rig_registry(campaign), simulated)
+
+
+def campaign_registry_url(campaign: Path, flag: str | None) -> str:
+    """The registry a campaign's calibrations were recorded in: `--registry` (`flag`), else the one its run
+    recorded in however it was named, else a dry run's in the dry runs' own and a real one's as the rig config
+    and the environment say now. Where `rig approve` looks, as `rig run` printed it."""
+    from accelcal_rig.store.read import load_campaign
+
+    attrs = load_campaign(campaign).attrs
+    follow_up = of_campaign(attrs, campaign)
+    return registry_of(campaign, replace(follow_up, registry=flag or follow_up.registry),
+                       bool(attrs.get("dry_run", False)))
 
 
 def state(campaign_path: Path, follow_up: FollowUp, fit_due: bool = True) -> list[PartState]:

@@ -198,4 +198,21 @@ def certify(campaign: Path, calibration: Path, folder: Path, operator: str, pdf:
     for w in written:
         print(certificate_line(w))
     if written:  # a draft until a person approves it
-        print(f"certificates are drafts until approved: rig approve {campaign} --as USER")
+        print(next_step(campaign))
+
+
+def next_step(campaign: Path) -> str:
+    """How the drafts are approved, as commands that work as printed (USER and NAME filled in): in the registry
+    the campaign's rows are in — a dry run's in the dry runs' own, where its approver must be too."""
+    import shlex
+
+    from accelcal_rig.cli.follow_up import campaign_registry_url
+    from accelcal_rig.registry.location import described
+
+    try:
+        url = described(campaign_registry_url(campaign, None))
+    except (RigError, OSError):
+        return f"certificates are drafts until approved: rig approve {shlex.quote(str(campaign))} --as USER"
+    return (f"certificates are drafts until approved: rig approve {shlex.quote(str(campaign))} --as USER, USER an "
+            f"approver in registry {url} (once: rig registry user add USER --full-name NAME --role approver "
+            f"--registry {shlex.quote(url)})")
