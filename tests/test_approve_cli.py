@@ -60,7 +60,7 @@ def test_an_approver_issues_revisions_and_every_decision_is_audited(fitted, monk
                "--registry", registry, "--operator", "A. Smith", stdin=PASSWORD + "\n") == 0
     out = capsys.readouterr().out
     assert f"{SERIAL}: approved by Jane Doe; certificate" in out and "revision 1 →" in out
-    pages = [page.extract_text() for page in PdfReader(folder / f"{SERIAL}.r1.pdf").pages]
+    pages = [" ".join(page.extract_text().split()) for page in PdfReader(folder / f"{SERIAL}.r1.pdf").pages]
     text = " ".join(pages)
     assert "Jane Doe" in text and "A. Smith" in text
     for page in pages:                                   # the issued number on every page, no draft mark on any
@@ -83,7 +83,8 @@ def test_an_approver_issues_revisions_and_every_decision_is_audited(fitted, monk
                stdin=PASSWORD + "\n") == 0
     assert "revision 2 →" in capsys.readouterr().out
     second = (folder / f"{SERIAL}.r2.html").read_text()
-    assert "Revision 2 replaces revision 1: customer&#x27;s address corrected" in second
+    assert "Revision 2 replaces revision 1 (issued " in second and "customer&#x27;s address corrected" in second
+    assert "Nothing amended: the same statements, reissued." in second
     assert (folder / f"{SERIAL}.r1.pdf").is_file()                    # the earlier revision stays
 
     assert rig(monkeypatch, "registry", "list", "--serial", SERIAL, "--json", "--registry", registry) == 0

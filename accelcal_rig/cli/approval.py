@@ -16,13 +16,19 @@ from accelcal_rig.errors import ConfigError
 def approve_command(args: argparse.Namespace) -> int:
     from accelcal_rig.cli.follow_up import campaign_registry_url
     from accelcal_rig.cli.registry_access import campaign_entries
-    from accelcal_rig.registry.approvals import Approvals, IssuedCertificate
+    from accelcal_rig.registry.approvals import Approvals
     from accelcal_rig.registry.database import Registry
     from accelcal_rig.registry.location import described
-    from accelcal_rig.report.certificate import certificates_folder, render_certificate, write_issued
+    from accelcal_rig.report.certificate import certificates_folder, write_issued
+    from accelcal_rig.web.issuing import issued_certificate
 
     campaign = args.campaign
     calibration = args.calibration or campaign.with_suffix(".calibration.yaml")
+    amendments = {"customer": args.customer, "contact": args.contact, "received_date": args.received,
+                  "condition": args.condition, "remarks": args.remarks}
+    if args.action != "reissue" and any(value is not None for value in amendments.values()):
+        raise ConfigError("--customer, --contact, --received, --condition, --remarks: only a reissue amends a "
+                          "certificate (rig approve --reissue --reason …)")
     if not campaign.is_file():
         raise ConfigError(f"{campaign}: no such campaign file")
     url = campaign_registry_url(campaign, args.registry)  # where its run recorded it (a dry run's: the dry runs')
@@ -52,13 +58,12 @@ def approve_command(args: argparse.Namespace) -> int:
                   "--reissue --reason" + (f"; its certificate written again → {', '.join(map(str, restored))}"
                                           if restored else ""))
             continue
-        issued = None
+        issued, at = None, None
         if args.action != "reject":
-            revision = approvals.next_revision(lead)
-            rendered = render_certificate(campaign, calibration, serial, revision, user.full_name,
-                                          pdf=not args.no_pdf, reason=args.reason, operator=args.operator)
-            issued = IssuedCertificate(revision, rendered.number, rendered.html, rendered.pdf)
-        revision_issued = approvals.record(lead, args.action, user, authority, args.reason, issued)
+            issued, at = issued_certificate(approvals, lead, serial, args.action, user, authority, args.reason,
+                                            campaign, calibration, amendments, pdf=not args.no_pdf,
+                                            operator=args.operator)
+        revision_issued = approvals.record(lead, args.action, user, authority, args.reason, issued, at)
         if issued is not None:
             written = write_issued(certificates_folder(campaign), serial, issued.revision, issued.html, issued.pdf)
             print(f"{serial}: {args.action}d by {user.full_name}; certificate {issued.number} revision "
@@ -125,7 +130,7 @@ def user_command(args: argparse.Namespace) -> int:
         if not args.full_name:
             raise ConfigError("rig registry user add: --full-name is needed (as certificates name the person)")
         password = None if args.no_password else _new_password(args.password_stdin, args.name)
-        approvals.add_user(args.name, args.full_name, args.role or "viewer", password)
+        approvals.add_user(args.name, args.full_name, args.role or "viewer", password, args.function or "")
         print(f"user {args.name} ({args.full_name}) added as {args.role or 'viewer'}"
               + (", no password here: the reverse proxy authenticates them" if password is None else ""))
     elif args.user_action == "password":
@@ -136,6 +141,11 @@ def user_command(args: argparse.Namespace) -> int:
             raise ConfigError(f"rig registry user role {args.name}: --role approver or viewer")
         approvals.set_role(args.name, args.role)
         print(f"user {args.name}: now {args.role}; every session of theirs has ended")
+    elif args.user_action == "function":
+        if args.function is None:
+            raise ConfigError(f"rig registry user function {args.name}: --function TEXT (e.g. 'Head of laboratory')")
+        approvals.set_function(args.name, args.function)
+        print(f"user {args.name}: certificates they approve from now on name them as {args.function or '(no function)'}")
     else:
         approvals.set_disabled(args.name, args.user_action == "disable")
         print(f"user {args.name} {args.user_action}d" + ("; every session of theirs has ended"

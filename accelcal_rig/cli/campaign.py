@@ -61,11 +61,12 @@ def _receipt(args: argparse.Namespace) -> Receipt:
         received = iso_date(args.received) if args.received else None
     except ValueError as exc:
         raise ConfigError(f"--received: {exc}") from None
-    for option, text, longest in (("--customer", args.customer, 200), ("--condition", args.condition, 500),
-                                  ("--lot", args.lot, 64)):
+    for option, text, longest in (("--customer", args.customer, 200), ("--contact", args.contact, 200),
+                                  ("--condition", args.condition, 500), ("--lot", args.lot, 64)):
         if len(text) > longest or any(ord(c) < 32 or ord(c) == 127 for c in text):
             raise ConfigError(f"{option}: not one line of at most {longest} characters")
-    return Receipt(args.customer, received, args.condition, args.lot)
+    return Receipt(customer=args.customer, received_date=received, condition=args.condition, lot=args.lot,
+                   contact=args.contact)
 
 
 def _received_before(prepared: PreparedCampaign, today: dt.date) -> None:

@@ -104,5 +104,6 @@ class Receipt:
 
     customer: str = ""
     received_date: dt.date | None = None
+    contact: str = ""                 # the customer's contact (`rig run --contact`)
     condition: str = ""
     lot: str = ""                     # the lab's lot (`rig run --lot`), not the part number

@@ -210,6 +210,8 @@ class SensorConfig(StrictModel):
     mount_euler_deg: tuple[AngleDeg, AngleDeg, AngleDeg] = (0.0, 0.0, 0.0)
     customer: str = Field("", max_length=200, pattern=ONE_LINE, description="whose item it is (its certificate states "
                           "it); empty: rig run --customer's, else not stated")
+    contact: str = Field("", max_length=200, pattern=ONE_LINE, description="the customer's contact for this item "
+                         "(a person, an address: its certificate states it); empty: rig run --contact's, else not stated")
     received_date: IsoDate | None = Field(None, description="when the laboratory received the item (YYYY-MM-DD); "
                                           "unset: rig run --received's, else not stated")
     lot: str = Field("", max_length=64, pattern=ONE_LINE, description="the lab's lot this DUT belongs to (its own word "

@@ -49,10 +49,11 @@ def reference_info(rig: RigConfig) -> dict[str, dict[str, str]]:
 
 
 def receipt_info(sensor: SensorConfig, default: Receipt) -> dict[str, str]:
-    """Whose the DUT is, when it was received and in what condition: its fixture entry's, else the campaign's
+    """Whose the DUT is, their contact, when it was received and in what condition: its fixture entry's, else the campaign's
     (`rig run --customer` …); "" for what neither states."""
     received = sensor.received_date or default.received_date
-    return {"customer": sensor.customer or default.customer, "received_date": received.isoformat() if received else "",
+    return {"customer": sensor.customer or default.customer, "contact": sensor.contact or default.contact,
+            "received_date": received.isoformat() if received else "",
             "condition": sensor.condition or default.condition, "lot": sensor.lot or default.lot}
 
 

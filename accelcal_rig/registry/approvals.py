@@ -10,7 +10,8 @@ gyroscope rows are approved together and share one certificate, kept under the D
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass
+import json
+from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from typing import Any, Literal
 
@@ -44,6 +45,8 @@ class User:
     disabled: bool
     #: Raised whenever every session of the user must end (registry/sign_ins.py).
     generation: int = 0
+    #: What a certificate prints under their name as approver ("Head of laboratory"); "" when not stated.
+    function: str = ""
 
     @property
     def may_approve(self) -> bool:
@@ -69,8 +72,9 @@ class Approvals:
         self.registry = registry
 
     # ------------------------------------------------------------------ users
-    def add_user(self, name: str, full_name: str, role: str, password: str | None) -> None:
-        """A new user; `password` None for one a reverse proxy authenticates (no password here)."""
+    def add_user(self, name: str, full_name: str, role: str, password: str | None, function: str = "") -> None:
+        """A new user; `password` None for one a reverse proxy authenticates (no password here); `function`:
+        what certificates print under their name as approver."""
         if role not in ROLES:
             raise ConfigError(f"role {role}: not one of {', '.join(ROLES)}")
         if not name or len(name) > 64 or not name.isprintable() or not full_name or len(full_name) > 128:
@@ -80,7 +84,7 @@ class Approvals:
             with self.registry.engine.begin() as connection:
                 connection.execute(sa.insert(users).values(name=name, full_name=full_name, role=role,
                                                            password_hash=hashed, disabled=False,
-                                                           created_at=utc_now_naive()))
+                                                           created_at=utc_now_naive(), function=_function(function)))
         except sa.exc.IntegrityError:
             raise ConfigError(f"registry {described(self.registry.url)}: user {name} exists already") from None
 
@@ -108,6 +112,10 @@ class Approvals:
         if role not in ROLES:
             raise ConfigError(f"role {role}: not one of {', '.join(ROLES)}")
         self._change(name, {"role": role}, client, f"role changed to {role}")
+
+    def set_function(self, name: str, function: str) -> None:
+        """What certificates print under the user's name as approver from now on (issued ones keep theirs)."""
+        self._update(name, function=_function(function))
 
     def _change(self, name: str, values: dict[str, Any], client: str, why: str) -> None:
         """A change to a user that ends every session of theirs, recorded with it, in one transaction."""
@@ -191,9 +199,10 @@ class Approvals:
         return {i: self.decision(i) for i in calibration_ids}
 
     def record(self, calibration_id: int, action: Action, user: User, authority: str, reason: str = "",
-               certificate: IssuedCertificate | None = None) -> int | None:
+               certificate: IssuedCertificate | None = None, at: datetime | None = None) -> int | None:
         """Record a decision on a DUT's calibration (every channel row of it), and the certificate revision an
-        approval or a reissue issues, in one transaction; the revision number issued, if any."""
+        approval or a reissue issues, in one transaction; the revision number issued, if any. `at`: the time
+        the certificate states (naive UTC; default now)."""
         if not user.may_approve:
             raise ConfigError(f"user {user.name} may not approve (role {user.role}"
                               f"{', disabled' if user.disabled else ''})")
@@ -207,13 +216,14 @@ class Approvals:
             raise ConfigError(f"calibration {lead}: a reason with a NUL character")
         try:
             with self.registry.engine.begin() as connection:
-                return self._record(connection, rows, lead, action, user, authority, reason, certificate)
+                return self._record(connection, rows, lead, action, user, authority, reason, certificate,
+                                    at or utc_now_naive())
         except (sa.exc.IntegrityError, sa.exc.OperationalError) as exc:  # another decision in the same moment
             raise ConfigError(f"calibration {lead}: not recorded, another decision was being recorded at the same "
                               f"time ({str(exc.orig).splitlines()[0]}): look again and retry") from None
 
     def _record(self, connection: Any, rows: list[dict[str, Any]], lead: int, action: Action, user: User,
-                authority: str, reason: str, certificate: IssuedCertificate | None) -> int | None:
+                authority: str, reason: str, certificate: IssuedCertificate | None, now: datetime) -> int | None:
         """The decision checked against the record as this transaction sees it, then recorded."""
         events = _events(connection, lead)
         state = "awaiting approval" if not events else "rejected" if events[0].action == "reject" else "approved"
@@ -221,7 +231,6 @@ class Approvals:
             raise ConfigError(f"calibration {lead}: {state}, so there is no certificate to reissue: approve it")
         if action == "approve" and state == "approved":
             raise ConfigError(f"calibration {lead}: approved already: a new revision is a reissue, with a reason")
-        now = utc_now_naive()
         revision = None
         if certificate is not None and action != "reject":
             issued = connection.execute(sa.select(sa.func.max(certificate_revisions.c.revision))
@@ -233,7 +242,8 @@ class Approvals:
             connection.execute(sa.insert(certificate_revisions).values(
                 calibration_id=lead, revision=revision, number=certificate.number, approver=user.full_name,
                 issued_at=now, reason=reason, html=certificate.html, pdf=certificate.pdf,
-                sha256=hashlib.sha256(certificate.pdf or certificate.html.encode()).hexdigest()))
+                sha256=hashlib.sha256(certificate.pdf or certificate.html.encode()).hexdigest(),
+                amendments=json.dumps(certificate.amendments, sort_keys=True)))
         connection.execute(sa.insert(approvals), [
             {"calibration_id": int(r["id"]), "action": action, "user_name": user.name,
              "full_name": user.full_name, "authority": authority, "reason": reason,
@@ -292,6 +302,21 @@ class Approvals:
         return dict(row._mapping)
 
     @reads
+    def amendments(self, calibration_id: int) -> dict[str, str]:
+        """What the DUT's newest certificate revision states in place of the campaign's facts (what a reissue
+        carries over and amends further); {} before any revision."""
+        lead = self.lead_id(calibration_id)
+        with self.registry.engine.connect() as connection:
+            stored = connection.execute(sa.select(certificate_revisions.c.amendments).where(
+                certificate_revisions.c.calibration_id == lead).order_by(certificate_revisions.c.revision.desc())
+                .limit(1)).scalar()
+        try:
+            found = json.loads(stored or "{}")
+        except ValueError:
+            found = {}
+        return {str(k): str(v) for k, v in found.items()} if isinstance(found, dict) else {}
+
+    @reads
     def approved_ids(self, calibration_ids: list[int]) -> set[int]:
         """Of these rows, those whose DUT's calibration is approved now."""
         return {i for i in calibration_ids if self.decision(i).state == "approved"}
@@ -305,10 +330,18 @@ class IssuedCertificate:
     number: str
     html: str
     pdf: bytes | None
+    #: The item facts this revision states in place of the campaign's (report/certificate.py AMENDABLE).
+    amendments: dict[str, str] = field(default_factory=dict)
 
 
 def _user(row: Any) -> User:
-    return User(row.name, row.full_name, row.role, row.disabled, int(row.session_generation))
+    return User(row.name, row.full_name, row.role, row.disabled, int(row.session_generation), row.function or "")
+
+
+def _function(function: str) -> str:
+    if len(function) > 128 or not function.isprintable():
+        raise ConfigError(f"function {function[:40]!r}: one line of at most 128 characters")
+    return function
 
 
 def _events(connection: Any, lead: int) -> list[Any]:

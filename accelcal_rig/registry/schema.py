@@ -77,6 +77,8 @@ users = sa.Table(
     sa.Column("session_generation", sa.Integer, nullable=False, server_default="0"),
     sa.Column("failed_logins", sa.Integer, nullable=False, server_default="0"),
     sa.Column("locked_until", sa.DateTime, nullable=True),
+    # Added by migration 0010: what certificates print under the approver's name ("Head of laboratory").
+    sa.Column("function", sa.String(128), nullable=False, server_default=""),
 )
 
 approvals = sa.Table(
@@ -104,6 +106,9 @@ certificate_revisions = sa.Table(
     sa.Column("html", sa.Text, nullable=False),
     sa.Column("pdf", sa.LargeBinary, nullable=True),
     sa.Column("sha256", sa.String(64), nullable=False),
+    # Added by migration 0010: the item facts this revision states in place of the campaign's (JSON: customer,
+    # contact, received_date, condition, remarks), carried over by the next revision.
+    sa.Column("amendments", sa.Text, nullable=False, server_default="{}"),
     sa.UniqueConstraint("calibration_id", "revision", name="one_certificate_per_revision"),
 )
 

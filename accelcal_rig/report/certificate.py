@@ -13,7 +13,7 @@ from __future__ import annotations
 import html
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -156,11 +156,21 @@ def write_issued(folder: Path, serial: str, revision: int, page: str, pdf: bytes
 
 @dataclass(frozen=True)
 class Approval:
-    """Who approved the certificate revision being issued, and when (UTC date); a reissue's reason."""
+    """Who approved the certificate revision being issued, and when (UTC date); a reissue's reason; the
+    electronic approval's record (how the approver was known, the time, which record keeps it); a reissue's
+    amendments (what it states in place of the campaign's facts, cumulative), what they changed and which
+    revision it replaces."""
 
     approver: str
     date: str
     reason: str = ""
+    function: str = ""
+    at: str = ""                                   #: "2026-12-07 14:03 UTC"
+    how: str = ""                                  #: the record's authority: "rig approve, password of …"
+    record: str = ""                               #: "the laboratory's registry, calibration 17, …"
+    amendments: dict[str, str] = field(default_factory=dict)
+    changes: tuple[str, ...] = ()
+    replaces: str = ""                             #: "revision 1 (issued 2026-12-07)"
 
 
 @dataclass(frozen=True)
@@ -170,15 +180,14 @@ class Rendered:
     pdf: bytes | None
 
 
-def render_certificate(campaign_path: Path, calibration_path: Path, serial: str, revision: int, approver: str,
-                       pdf: bool = True, reason: str = "", operator: str = "") -> Rendered:
-    """One DUT's certificate issued as `revision`, approved by `approver` today: what an approval keeps.
-    `operator`: who performed it, else who its run recorded."""
+def render_certificate(campaign_path: Path, calibration_path: Path, serial: str, revision: int, approval: Approval,
+                       pdf: bool = True, operator: str = "") -> Rendered:
+    """One DUT's certificate issued as `revision` with its `approval`: what an approval keeps. `operator`: who
+    performed it, else who its run recorded (a reissue carries it over)."""
     campaign, calibration = _certifiable(campaign_path, calibration_path)
     operator = operator or recorded_operator(campaign)
     if serial not in calibration.duts:
         raise ConfigError(f"{calibration_path}: no sensor {serial}")
-    approval = Approval(approver, utc_now()[:10], reason)
     page = certificate_html(campaign, campaign_path, calibration, calibration_path, serial, operator, revision,
                             approval)
     render = _pdf_renderer() if pdf else None
@@ -194,6 +203,40 @@ def draft_html(campaign_path: Path, calibration_path: Path, serial: str) -> str:
         raise ConfigError(f"{calibration_path}: no sensor {serial}")
     return certificate_html(campaign, campaign_path, calibration, calibration_path, serial,
                             recorded_operator(campaign))
+
+
+def amend(campaign_path: Path, serial: str, carried: dict[str, str],
+          given: dict[str, str | None]) -> tuple[dict[str, str], tuple[str, ...]]:
+    """A reissue's amendments: the facts the last revision stated in place of the campaign's (`carried`) with
+    those `given` now (None: not amended); (the amendments the new revision states, what changed, in words).
+    Refused in one line: a date of receipt that is not a date or is after the calibration, a text of more than
+    one line or too long."""
+    from accelcal_rig.config.lab import iso_date
+
+    campaign = load_campaign(campaign_path)
+    before = {**certificate_lab.item_facts(campaign, serial), **carried}
+    amended, changes = dict(carried), []
+    first_day = certificate_lab.calibration_dates(campaign)[0]
+    for key, value in given.items():
+        if value is None:
+            continue
+        option = "--received" if key == "received_date" else f"--{key}"
+        value = value.strip()
+        if len(value) > (2000 if key == "remarks" else 200) or any(ord(c) < 32 or ord(c) == 127 for c in value):
+            raise ConfigError(f"{option}: not one line of at most {2000 if key == 'remarks' else 200} characters")
+        if key == "received_date" and value:
+            try:
+                value = iso_date(value).isoformat()
+            except ValueError as exc:
+                raise ConfigError(f"{option}: {exc}") from None
+            if value > first_day:
+                raise ConfigError(f"{option}: {value} is after the calibration ({first_day}): an item is received "
+                                  "before it is calibrated")
+        if value != before.get(key, ""):
+            amended[key] = value
+            changes.append(f"{certificate_lab.AMENDABLE[key]}: {before.get(key) or 'not stated'} → "
+                           f"{value or 'not stated'}")
+    return amended, tuple(changes)
 
 
 def recorded_operator(campaign: Campaign) -> str:
@@ -271,8 +314,7 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
     number: certificate_lab.CertificateNumber | str = (
         certificate_lab.draft_identifier(serial, calibration) if draft
         else certificate_lab.certificate_number(serial, calibration, revision))
-    banners = [] if not draft else [
-        "DRAFT: not issued. An approval (rig approve, or the dashboard) issues it, with its number."]
+    banners: list[str] = []
     if attrs.get("dry_run"):
         banners.append("SIMULATED: a dry run against simulated instruments. No physical sensor was calibrated.")
     if calibration.source.get("partial"):
@@ -295,8 +337,9 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
              f"<h1>{'DRAFT of a calibration certificate' if draft else 'Calibration certificate'}: {_e(item)}</h1>",
              (f"<p>Certificate <b class='number'>{_e(number)}</b> — issued {_e(approval.date)} by accelcal-rig "
               f"{_e(__version__)}</p>" if approval is not None else
-              f"<p>Draft <b class='number'>{_e(number)}</b> of {_e(utc_now()[:10])} by accelcal-rig {_e(__version__)}: "
-              "no certificate number until approved</p>"),
+              f"<div class='banner'>DRAFT: not issued. <b class='number'>{_e(number)}</b> of {_e(utc_now()[:10])} "
+              f"(accelcal-rig {_e(__version__)}) has no certificate number: an approval (rig approve, or the "
+              "dashboard) issues it, with its number.</div>"),
              *(f"<div class='banner'>{_e(b)}</div>" for b in banners)]
     configured = "; ".join(f"{name} ±{c.range:g} {c.unit}, {_per_code(c.lsb, c.unit)} per code" for name, c in channels.items())
     parts += ["<div class='front'>", "<h2>Item calibrated</h2>", _rows([
@@ -305,7 +348,7 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
         ("configured", f"{configured}; {dut.get('odr_hz', '?')} Hz"),
         ("mount on the fixture", f"{dut.get('name', '')} ({', '.join(f'{a:g}' for a in dut.get('mount_euler_deg', []))}° "
                                  "xyz Euler)"),
-        *certificate_lab.item_rows(campaign, serial),
+        *certificate_lab.item_rows(campaign, serial, approval.amendments if approval else None),
     ])]
     parts += ["<h2>Calibration</h2>", _rows([
         *certificate_lab.calibration_rows(campaign, campaign_path.name, calibration, calibration_path.name,
@@ -325,18 +368,43 @@ def certificate_html(campaign: Campaign, campaign_path: Path, calibration: Calib
     ranges = "; ".join(f"{name} {c.validity_c[0]:.2f} … {c.validity_c[1]:.2f} °C (outside it "
                        f"{'clamped to its edge' if c.out_of_range == 'clamp' else 'extrapolated'})"
                        for name, c in channels.items())
+    remarks = (approval.amendments.get("remarks", "") if approval else "")
+    if remarks:
+        parts += ["<section><h2>Remarks</h2>", f"<p>{_e(remarks)}</p>", "</section>"]
     parts += ["<section><h2>Signatures</h2>",
               "<table class='signatures'><tr><th class='text'></th><th class='text'>name</th><th class='text'>date"
               "</th><th class='text'>signature</th></tr>"
-              f"<tr><td>performed by</td><td>{_e(operator)}</td><td></td><td></td></tr>"
-              f"<tr><td>approved by</td><td>{_e(approval.approver if approval else 'not approved: a draft')}</td>"
-              f"<td>{_e(approval.date if approval else '')}</td><td></td></tr></table>",
-              *([f"<p>Revision {revision} replaces revision {revision - 1}: {_e(approval.reason)}</p>"]
-                if approval is not None and revision > 1 and approval.reason else []),
+              f"<tr><td>performed by</td><td>{_e(operator)}</td><td></td><td></td></tr>",
+              _approved_row(approval), "</table>",
+              *_revision_statement(revision, approval),
               "<p class='note'>The results refer only to the item calibrated, under the conditions stated, within "
               f"the calibrated temperature range: {_e(ranges)}.</p>", certificate_lab.end_html(number),
               "</section></body></html>"]
     return "\n".join(parts)
+
+
+def _approved_row(approval: Approval | None) -> str:
+    """The approver's row: their name and function, the date, and the electronic approval's record in place of
+    a handwritten signature (who, how they were known, when, which record keeps it)."""
+    if approval is None:
+        return "<tr><td>approved by</td><td>not approved: a draft</td><td></td><td></td></tr>"
+    who = approval.approver + (f", {approval.function}" if approval.function else "")
+    signed = "; ".join(part for part in (
+        f"approved electronically at {approval.at}" if approval.at else "",
+        approval.how, f"record: {approval.record}" if approval.record else "") if part)
+    return (f"<tr><td>approved by</td><td>{_e(who)}</td><td>{_e(approval.date)}</td>"
+            f"<td class='electronic'>{_e(signed)}</td></tr>")
+
+
+def _revision_statement(revision: int, approval: Approval | None) -> list[str]:
+    """A reissue names the revision it replaces, why, and what it amended; the rest is carried over."""
+    if approval is None or revision == 1:
+        return []
+    replaced = approval.replaces or f"revision {revision - 1}"
+    amended = ("Amended: " + "; ".join(approval.changes) + ". Everything else as " + replaced.split(" (")[0]
+               + " stated it." if approval.changes else "Nothing amended: the same statements, reissued.")
+    return [f"<p class='revision'>Revision {revision} replaces {_e(replaced)}"
+            + (f": {_e(approval.reason)}" if approval.reason else "") + f". {_e(amended)}</p>"]
 
 
 #: A certificate of several channels states them on at most two pages: its tables a little tighter.

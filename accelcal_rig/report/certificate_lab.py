@@ -93,9 +93,21 @@ def place_of_calibration(campaign: Campaign) -> str:
     return "at the laboratory's address" if campaign.attrs.get("lab_name") else "laboratory not stated in the rig config"
 
 
-def item_rows(campaign: Campaign, serial: str) -> Rows:
-    """Whose the item is, when it was received and in what condition, as the campaign recorded them."""
+#: What a reissue may amend (ISO/IEC 17025 §7.8.8), by its key, as the certificate names it.
+AMENDABLE: dict[str, str] = {"customer": "customer", "contact": "customer's contact", "received_date": "date of receipt",
+                             "condition": "condition on receipt", "remarks": "remarks"}
+
+
+def item_facts(campaign: Campaign, serial: str) -> dict[str, str]:
+    """The amendable facts of a DUT as its campaign recorded them ("" for what it does not state)."""
     dut = dut_description(campaign, serial)
+    return {key: str(dut.get(key, "")) for key in AMENDABLE}
+
+
+def item_rows(campaign: Campaign, serial: str, amendments: dict[str, str] | None = None) -> Rows:
+    """Whose the item is, their contact, when it was received and in what condition: as a reissue amended them
+    (`amendments`), else as the campaign recorded them."""
+    dut = {**dut_description(campaign, serial), **(amendments or {})}
     recorded = "customer" in dut   # campaigns from before these were recorded have none of them
 
     def stated(key: str, what: str) -> str:
@@ -105,6 +117,7 @@ def item_rows(campaign: Campaign, serial: str) -> Rows:
         return f"not stated (the fixture's sensor entry, or {what})" if recorded else "not recorded (an older campaign)"
 
     return [("customer", stated("customer", "rig run --customer")),
+            ("customer's contact", stated("contact", "rig run --contact")),
             ("date of receipt", stated("received_date", "rig run --received")),
             ("condition on receipt", stated("condition", "rig run --condition"))]
 

@@ -19,7 +19,7 @@ import re
 import secrets
 from collections.abc import Awaitable, Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 from urllib.parse import parse_qs, urlsplit
 
 from starlette.concurrency import run_in_threadpool
@@ -29,7 +29,7 @@ from starlette.responses import HTMLResponse, RedirectResponse, Response
 from starlette.routing import Route
 
 from accelcal_rig.errors import RigError
-from accelcal_rig.registry.approvals import Approvals, IssuedCertificate, User
+from accelcal_rig.registry.approvals import Action, Approvals, User
 from accelcal_rig.registry.sign_ins import SignIns
 from accelcal_rig.web.registry_gate import RegistryReadOnly
 from accelcal_rig.web.sign_in import Busy, SignInPolicy
@@ -213,6 +213,10 @@ def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: 
         action = fields.get("action", "")
         if action not in ("approve", "reject", "reissue"):
             raise HTTPException(400, f"action {action[:40]!r}: not one of approve, reject, reissue")
+        # A reissue's amendments: a field left empty is not amended.
+        amendments: dict[str, str | None] = {key: fields.get(field, "").strip() or None for key, field in (
+            ("customer", "customer"), ("contact", "contact"), ("received_date", "received"),
+            ("condition", "condition"), ("remarks", "remarks"))} if action == "reissue" else {}
         # A decision is signed with the password again (a session left open is not a signature); a reverse
         # proxy's user re-authenticates as the proxy asks, which is the proxy's to decide.
         if not via_header and await checked_password(request, user.name, fields.get("password", "")) is None:
@@ -220,9 +224,9 @@ def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: 
         try:
             # Not a bounded registry call: rendering the certificate takes its time (the registry's own
             # timeouts bound its part).
-            message = await run_in_threadpool(lambda: _decide(registry.get(), row_id, action, user,
+            message = await run_in_threadpool(lambda: _decide(registry.get(), row_id, cast(Action, action), user,
                                                               settings.authority(user, via_header),
-                                                              fields.get("reason", "")))
+                                                              fields.get("reason", ""), amendments))
         except RigError as exc:
             raise HTTPException(409, f"refused: {exc}") from None
         except OSError as exc:  # the campaign or its calibration unreadable here: one line, nothing recorded
@@ -328,14 +332,17 @@ def _campaign_of(row: dict[str, Any]) -> tuple[Path, Path] | None:
     return (campaign, calibration) if campaign.is_file() and calibration.is_file() else None
 
 
-def _decide(reg: Any, row_id: int, action: str, user: User, authority: str, reason: str) -> str:
-    """Record the decision; an approval or a reissue renders the certificate revision from the campaign."""
+def _decide(reg: Any, row_id: int, action: Action, user: User, authority: str, reason: str,
+            given: dict[str, str | None]) -> str:
+    """Record the decision; an approval or a reissue renders the certificate revision from the campaign (a
+    reissue with the amendments `given`: None for each not amended)."""
     from accelcal_rig.registry.entries import campaign_entries
-    from accelcal_rig.report.certificate import certificates_folder, render_certificate, write_issued
+    from accelcal_rig.report.certificate import certificates_folder, write_issued
+    from accelcal_rig.web.issuing import issued_certificate
 
     book = Approvals(reg)
     row = reg.calibration(row_id)
-    issued, found = None, None
+    issued, found, at = None, None, None
     if action != "reject":
         found = _campaign_of(row)
         if found is None:
@@ -349,10 +356,9 @@ def _decide(reg: Any, row_id: int, action: str, user: User, authority: str, reas
         if reg.ids_of(campaign_entries(*found)).get(row["serial"]) != lead["id"]:
             raise RigError(f"{found[1].name} beside the campaign is not the fit of calibration {lead['id']} (refitted "
                            "since?): approve the calibration it is, or fit again and record it")
-        revision = book.next_revision(row_id)
-        rendered = render_certificate(found[0], found[1], row["serial"], revision, user.full_name, reason=reason)
-        issued = IssuedCertificate(revision, rendered.number, rendered.html, rendered.pdf)
-    revision_issued = book.record(row_id, action, user, authority, reason, issued)  # type: ignore[arg-type]
+        issued, at = issued_certificate(book, int(lead["id"]), str(row["serial"]), action, user, authority, reason,
+                                        found[0], found[1], given)
+    revision_issued = book.record(row_id, action, user, authority, reason, issued, at)
     if issued is None or found is None:
         return f"{action}d by {user.full_name}"
     said = f"{action}d by {user.full_name}: certificate {issued.number} revision {revision_issued} issued"

@@ -27,6 +27,13 @@ def add_approve_command(commands: Commands) -> None:
                       help="issue a new certificate revision of an approved calibration (needs --reason)")
     approve.set_defaults(action="approve")
     approve.add_argument("--reason", default="", help="why (a rejection's, a reissue's; recorded)")
+    amend = approve.add_argument_group("a reissue's amendments (ISO/IEC 17025 §7.8.8): what the new revision states "
+                                       "in place of the campaign's (everything else is carried over)")
+    amend.add_argument("--customer", help="whose the item is")
+    amend.add_argument("--contact", help="the customer's contact")
+    amend.add_argument("--received", metavar="YYYY-MM-DD", help="the date of receipt")
+    amend.add_argument("--condition", help="the item's condition on receipt")
+    amend.add_argument("--remarks", help="remarks the certificate states")
     approve.add_argument("--calibration", type=Path, help="its calibration (default: FILE.calibration.yaml beside it)")
     approve.add_argument("--password-stdin", action="store_true",
                          help="read the approver's password from standard input (else it is asked for)")
@@ -37,18 +44,20 @@ def add_approve_command(commands: Commands) -> None:
 
 def add_approval_actions(actions: Commands) -> None:
     """`rig registry user | audit | certificate`."""
-    user = command(actions, "user", "the lab's users who approve calibrations: add, list, password, role, disable, "
-                   "enable",
+    user = command(actions, "user", "the lab's users who approve calibrations: add, list, password, role, function, "
+                   "disable, enable",
                    "Users and their roles (approver, viewer) live in the registry; passwords are stored as argon2id "
                    "hashes. A user without a password is one the lab's reverse proxy authenticates (rig serve "
                    "--user-header). A new password, another role or disabling a user ends every session of theirs "
                    "on every dashboard; enable also lifts a lockout after too many failed logins.",
                    "rig registry user add jdoe --full-name 'J. Doe' --role approver")
     registry_option(user)
-    user.add_argument("user_action", choices=["add", "list", "password", "role", "disable", "enable"])
+    user.add_argument("user_action", choices=["add", "list", "password", "role", "function", "disable", "enable"])
     user.add_argument("name", nargs="?", help="the user's name (all but list)")
     user.add_argument("--full-name", help="add: as certificates name the person")
     user.add_argument("--role", choices=["approver", "viewer"], help="add (default viewer), role: what the user may do")
+    user.add_argument("--function", help="add, function: what certificates print under the approver's name "
+                                         "(e.g. 'Head of laboratory')")
     user.add_argument("--by", metavar="APPROVER", help="the approver making the change (needed once the lab has one; "
                                                       "their password is asked for)")
     user.add_argument("--password-stdin", action="store_true",

@@ -42,6 +42,8 @@ def _add_run(commands: Commands) -> None:
     run.add_argument("--customer", metavar="NAME", default="",
                      help="whose DUTs they are, for every DUT whose fixture entry names no customer (recorded in the "
                           "campaign file, stated on the certificates)")
+    run.add_argument("--contact", metavar="TEXT", default="",
+                     help="the customer's contact, for every DUT whose fixture entry has no contact")
     run.add_argument("--received", metavar="YYYY-MM-DD", default="",
                      help="when the DUTs were received, for every DUT whose fixture entry has no received_date")
     run.add_argument("--condition", metavar="TEXT", default="",
