@@ -111,3 +111,26 @@ def test_a_signal_before_rig_serve_handles_it_says_the_server_stopped(monkeypatc
     monkeypatch.setattr(cli, "_cmd_serve", interrupted)
     assert cli.main(["serve", "--campaigns", "."]) == 0
     assert capsys.readouterr().err == "rig serve: stopped\n"
+
+
+def test_a_stop_while_the_dashboard_starts_is_noted_not_raised() -> None:
+    """SIGINT and SIGTERM from the moment `rig serve` begins are noted and handed to the server once it runs —
+    never a KeyboardInterrupt raised wherever the program is (inside an import as the server starts, it left the
+    import lock held: "cannot release un-acquired lock", exit 70). A stop before serving ends it without
+    serving; the handlers found are put back."""
+    from accelcal_rig.cli.serve import stop_requests
+
+    before = {stop: signal.getsignal(stop) for stop in (signal.SIGINT, signal.SIGTERM)}
+    handed: list[int] = []
+
+    class Server:
+        def handle_exit(self, signum: int, frame: object) -> None:
+            handed.append(signum)
+
+    with stop_requests() as stops:
+        signal.raise_signal(signal.SIGINT)               # before there is a server: noted only
+        assert stops.requested and handed == []
+        stops.server = Server()
+        signal.raise_signal(signal.SIGTERM)              # while it serves: handed to the server
+        assert handed == [signal.SIGTERM]
+    assert {stop: signal.getsignal(stop) for stop in before} == before

@@ -201,16 +201,30 @@ def _cmd_completion(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_schema(args: argparse.Namespace) -> int:
+    from accelcal_rig.config.schemas import schema_text
+    from accelcal_rig.durable import write_text_atomically
+
+    text = schema_text(args.kind)
+    if args.output is None:
+        sys.stdout.write(text)
+        return 0
+    write_text_atomically(args.output, text, "the schema")
+    print(f"{args.kind} schema → {args.output}")
+    return 0
+
+
 def _cmd_serve(args: argparse.Namespace) -> int:
-    from accelcal_rig.cli.serve import open_dashboard, stopped_line, stops_ignored
+    from accelcal_rig.cli.serve import open_dashboard, stop_requests, stopped_line, stops_ignored
 
     dashboard = None
     try:
-        dashboard = open_dashboard(args)
-        print(f"dashboard on {dashboard.url}", flush=True)
-        dashboard.serve()
+        with stop_requests() as stops:  # SIGINT or SIGTERM: how a dashboard is meant to end
+            dashboard = open_dashboard(args)
+            print(f"dashboard on {dashboard.url}", flush=True)
+            dashboard.serve(stops)
     except (KeyboardInterrupt, TerminationRequested):
-        pass  # SIGINT or SIGTERM: how a dashboard is meant to end
+        pass  # a stop from elsewhere (a thread that is not the main one cannot take signals)
     with stops_ignored():  # a second Ctrl-C as it says so is the same request
         print(stopped_line(dashboard), file=sys.stderr)
     return 0
@@ -323,7 +337,8 @@ def main(argv: list[str] | None = None, today: Callable[[], dt.date] = dt.date.t
                "fit": _cmd_fit, "check": _cmd_check, "characterise": _cmd_characterise,
                "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export, "certificate": _cmd_certificate,
                "fit-recording": _cmd_fit_recording, "analyze": _cmd_analyze, "registry": _cmd_registry,
-               "serve": _cmd_serve, "completion": _cmd_completion, "approve": _cmd_approve}[args.command]
+               "serve": _cmd_serve, "completion": _cmd_completion, "schema": _cmd_schema,
+               "approve": _cmd_approve}[args.command]
     try:
         return handler(args)
     except CampaignAborted as exc:

@@ -48,9 +48,9 @@ class Dashboard:
 
         return f"{self.address}/" + (f"?token={quote(self.token, safe='')}" if self.token else "")
 
-    def serve(self) -> None:
-        """Serve it until SIGINT or SIGTERM: uvicorn closes its connections, then raises the signal again with
-        the handler it found (the `rig` program's: KeyboardInterrupt), for the caller to end on."""
+    def serve(self, stops: StopRequests) -> None:
+        """Serve it until SIGINT or SIGTERM (`stops`: what asked for a stop before it began, and passes one that
+        comes while it starts to the server): uvicorn closes its connections and returns."""
         import uvicorn
 
         # No lifespan: the app has no start-up or shutdown of its own, and a second Ctrl-C while it stops would
@@ -69,30 +69,44 @@ class Dashboard:
             handle_exit(signum, frame)
 
         server.handle_exit = stopping  # type: ignore[method-assign,assignment]
-        with _ctrl_c_as_sigterm():
-            server.run(sockets=[self.listening])
+        stops.server = server
+        if stops.requested:  # asked to stop before it began: nothing to serve
+            return
+        server.run(sockets=[self.listening])
+
+
+class StopRequests:
+    """SIGINT and SIGTERM from before `rig serve` prints its address until it has stopped: noted, and handed to
+    the server once there is one (uvicorn's own handlers take them while it serves, and hand them back here as
+    it stops) — never an exception raised wherever the program happens to be: a KeyboardInterrupt inside an
+    import, as the server starts, leaves the import lock held ("cannot release un-acquired lock")."""
+
+    def __init__(self) -> None:
+        self.requested = False
+        self.server: Any = None
+
+    def __call__(self, signum: int, frame: Any) -> None:
+        self.requested = True
+        if self.server is not None:
+            self.server.handle_exit(signum, frame)
 
 
 @contextmanager
-def _ctrl_c_as_sigterm() -> Iterator[None]:
-    """Ctrl-C ends the server by the path SIGTERM takes (a handler raising KeyboardInterrupt, which uvicorn
-    captures while it serves and raises again once it has stopped), not by asyncio's own (with Python's default
-    SIGINT handler in place, asyncio.run puts in one that cancels the main task instead): one path for both
-    signals. A `rig serve` started with SIGINT ignored (a background job) keeps ignoring it until uvicorn
-    listens for it."""
-    if threading.current_thread() is not threading.main_thread() or \
-            signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
-        yield
+def stop_requests() -> Iterator[StopRequests]:
+    """SIGINT and SIGTERM as StopRequests while the dashboard starts and serves; the handlers found are put back
+    after. A `rig serve` started with SIGINT ignored (a background job) keeps ignoring it until uvicorn listens
+    for it."""
+    stops = StopRequests()
+    if threading.current_thread() is not threading.main_thread():
+        yield stops
         return
-
-    def interrupt(signum: int, frame: Any) -> None:
-        raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGINT, interrupt)
+    previous = {stop: signal.signal(stop, stops) for stop in (signal.SIGINT, signal.SIGTERM)
+                if not (stop == signal.SIGINT and signal.getsignal(stop) is signal.SIG_IGN)}
     try:
-        yield
+        yield stops
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for stop, handler in previous.items():
+            signal.signal(stop, handler)
 
 
 @contextmanager
