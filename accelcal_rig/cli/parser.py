@@ -16,7 +16,7 @@ from accelcal_rig.cli.grammar.common import Parser
 from accelcal_rig.cli.grammar.documents import add_document_commands
 from accelcal_rig.cli.grammar.fitting import add_fit_commands
 from accelcal_rig.cli.grammar.registry import add_registry_commands
-from accelcal_rig.cli.grammar.service import add_completion_command, add_serve_command
+from accelcal_rig.cli.grammar.service import add_completion_command, add_schema_command, add_serve_command
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -29,6 +29,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_registry_commands(commands)     # registry
     add_approve_command(commands)       # approve
     add_completion_command(commands)
+    add_schema_command(commands)
     add_serve_command(commands)
     add_document_commands(commands)     # report, certificate, export
     return parser

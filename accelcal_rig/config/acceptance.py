@@ -82,6 +82,19 @@ class ChannelLimits(StrictModel):
         return dict(self.__pydantic_extra__ or {})
 
 
+def _before_channels_for_editors(schema: dict[str, Any]) -> None:
+    """The accelerometer's limits at the top of `acceptance`, as `_before_channels` reads them, in the schema
+    editors check files with (config/schemas.py)."""
+    channel = schema.get("additionalProperties", {})
+    for key in _BEFORE_CHANNELS:
+        schema["properties"][key] = ({"type": "object", "description": "the accel channel's parameter limits"}
+                                     if key == "parameters" else
+                                     {"type": "number", "exclusiveMinimum": 0, "maximum": 1e6,
+                                      "description": f"the {_BEFORE_CHANNELS_CHANNEL} channel's limit (written before "
+                                                     f"limits were keyed by channel: {_BEFORE_CHANNELS_CHANNEL}.{key})"})
+    schema["additionalProperties"] = channel
+
+
 class Acceptance(StrictModel):
     """What a DUT's calibration must meet to PASS: each channel's limits under its channel's name
     (`acceptance: {accel: {…}, gyro: {…}}`), and how every figure is decided. A limit left out is not judged;
@@ -89,7 +102,7 @@ class Acceptance(StrictModel):
     Limits written before they were keyed by channel (an accelerometer's at the top of `acceptance`) are the
     `accel` channel's."""
 
-    model_config = _OPEN
+    model_config = ConfigDict(**_OPEN, json_schema_extra=_before_channels_for_editors)
     __pydantic_extra__: dict[Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]{0,31}$")], ChannelLimits] = Field(
         init=False)  # type: ignore[assignment]
 

@@ -6,10 +6,10 @@ from collections.abc import Sequence
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import Field, field_validator, model_validator
+from pydantic import ConfigDict, Field, field_validator, model_validator
 
 from accelcal_rig.config.acceptance import Acceptance, Verification
-from accelcal_rig.config.bounds import Real, StrictModel, TemperatureC, TemperatureSpanC, Whole
+from accelcal_rig.config.bounds import STRICT, Real, StrictModel, TemperatureC, TemperatureSpanC, Whole
 from accelcal_rig.config.rate_steps import NoiseRecord, RateSteps
 from accelcal_rig.config.schedule import MAX_SCHEDULE_POSES, Schedule
 
@@ -75,8 +75,28 @@ _RANGE_G_CHANNEL, _RANGE_G_DEFAULT = "accel", 2
 BEFORE_RANGES = {"range_g": "accel", "range_dps": "gyro"}
 
 
+def _setpoint_range_for_editors(schema: dict[str, Any]) -> None:
+    """`setpoints_c` as a list, or the `{from_c, to_c, step_c}` shorthand `_setpoint_range` reads (for editors)."""
+    listed = dict(schema)
+    schema.clear()
+    schema["anyOf"] = [listed, {"type": "object", "additionalProperties": False,
+                                "required": ["from_c", "to_c", "step_c"],
+                                "properties": {key: {"type": "number"} for key in ("from_c", "to_c", "step_c")},
+                                "description": "an evenly stepped list: from from_c to to_c in steps of step_c"}]
+
+
+def _before_ranges_for_editors(schema: dict[str, Any]) -> None:
+    """The keys `_before_ranges` reads, in the schema editors check files with (config/schemas.py)."""
+    for key, channel in BEFORE_RANGES.items():
+        schema["properties"][key] = {"type": "number", "exclusiveMinimum": 0, "maximum": 1e6,
+                                     "description": f"± full scale of the {channel} channel (written before ranges were "
+                                                    f"keyed by channel: ranges.{channel})"}
+
+
 class Acquisition(StrictModel):
     """How each pose is measured."""
+
+    model_config = ConfigDict(**STRICT, json_schema_extra=_before_ranges_for_editors)
 
     samples_per_pose: Whole = Field(200, ge=2, le=100_000)
     ranges: dict[Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]{0,31}$")], Annotated[Real, Field(gt=0, le=1e6)]] = Field(
@@ -219,7 +239,7 @@ class Procedure(StrictModel):
     description: str = Field("", max_length=10_000)
     rig: str = Field(min_length=1, max_length=4096, pattern=r"^[^\x00]+$",
                      description="rig config path, relative to this file")
-    setpoints_c: list[TemperatureC] = Field(min_length=1, max_length=200)
+    setpoints_c: list[TemperatureC] = Field(min_length=1, max_length=200, json_schema_extra=_setpoint_range_for_editors)
     soak: SoakCriterion = SoakCriterion()
     schedule: Schedule
     acquisition: Acquisition = Acquisition()

@@ -1,4 +1,4 @@
-"""The grammar of the commands that serve the operator's tools: `rig completion` and `rig serve`."""
+"""The grammar of the commands that serve the operator's tools: `rig completion`, `rig schema` and `rig serve`."""
 
 from __future__ import annotations
 
@@ -15,6 +15,18 @@ def add_completion_command(commands: Commands) -> None:
                          "rig completion bash > ~/.local/share/bash-completion/completions/rig",
                          "rig completion bash > ~/.local/share/bash-completion/completions/rig")
     completion.add_argument("shell", choices=["bash"])
+
+
+def add_schema_command(commands: Commands) -> None:
+    """`rig schema`: the JSON Schema of a procedure or a rig config, for an editor."""
+    schema = command(commands, "schema", "print the JSON Schema of a procedure or a rig config, for an editor",
+                     "Print (or write with -o) the JSON Schema the procedure or rig-config models validate against: "
+                     "an editor with the YAML language server completes and checks keys with it when a file's "
+                     "first line names it (# yaml-language-server: $schema=PATH). The package ships both "
+                     "(accelcal_rig/schemas/), and every shipped procedure and rig config names its own.",
+                     "rig schema procedure -o procedure.schema.json")
+    schema.add_argument("kind", choices=["procedure", "rig-config"])
+    schema.add_argument("-o", "--output", type=Path, help="write it here (default: standard output)")
 
 
 def add_serve_command(commands: Commands) -> None:
