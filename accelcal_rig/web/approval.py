@@ -251,23 +251,28 @@ def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: 
             raise HTTPException(404, "issued as HTML only")
         return Response(bytes(row["pdf"]), media_type="application/pdf")
 
-    def draft(request: Request) -> Response:
-        """The draft certificate of a calibration whose campaign is on this computer, as the files make it now
-        (HTML, sandboxed as every page the dashboard did not write itself): what the approver reads first."""
+    def draft_row(request: Request) -> dict[str, Any]:
         row_id = int(request.path_params["id"])
         if row_id > MAX_ID:
             raise HTTPException(404, "no such calibration in the registry")
         try:
-            row = registry.get().calibration(row_id)
+            return registry.get().calibration(row_id)  # type: ignore[no-any-return]
         except RigError as exc:
             raise _not_there(exc, f"no calibration {row_id} in the registry") from None
+
+    async def draft(request: Request) -> Response:
+        """The draft certificate of a calibration whose campaign is on this computer, as the files make it now
+        (HTML, sandboxed as every page the dashboard did not write itself): what the approver reads first. The
+        registry is asked for the row only; the campaign is read outside the registry's turns (a large campaign
+        takes its time, which is not the registry's)."""
+        row = await registry.call(draft_row, request)
         found = _campaign_of(row)
         if found is None:
-            raise HTTPException(404, f"the campaign file of calibration {row_id} is not on this computer")
-        try:
-            from accelcal_rig.report.certificate import draft_html
+            raise HTTPException(404, f"the campaign file of calibration {row['id']} is not on this computer")
+        from accelcal_rig.report.certificate import draft_html
 
-            page = draft_html(found[0], found[1], str(row["serial"]))
+        try:
+            page = await run_in_threadpool(draft_html, found[0], found[1], str(row["serial"]))
         except (RigError, OSError) as exc:
             raise HTTPException(409, f"no draft: {str(exc).splitlines()[0]}") from None
         return HTMLResponse(page, headers={"Content-Security-Policy": "sandbox"})
@@ -281,7 +286,7 @@ def approval_routes(registry: Any, page: Callable[..., HTMLResponse], settings: 
             Route("/logout", logout, methods=["POST"]),
             Route("/registry/calibrations/{id:int}", gated(calibration_page), methods=["GET"]),
             Route("/registry/calibrations/{id:int}/decision", decide, methods=["POST"]),
-            Route("/registry/calibrations/{id:int}/draft", gated(draft), methods=["GET"]),
+            Route("/registry/calibrations/{id:int}/draft", draft, methods=["GET"]),
             Route("/registry/calibrations/{id:int}/certificates/{revision:int}.{kind}", gated(certificate_file))]
 
 
