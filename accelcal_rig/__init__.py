@@ -1,3 +1,5 @@
-"""accelcal-rig: unattended thermal calibration campaigns for MEMS accelerometers."""
+"""accelcal-rig: unattended thermal calibration of MEMS accelerometers, gyroscopes and IMUs."""
 
-__version__ = "0.1.0"
+# The one source of the version: pyproject.toml reads it (tool.setuptools.dynamic), `rig --version` prints it,
+# CHANGELOG.md names it.
+__version__ = "0.9.0"

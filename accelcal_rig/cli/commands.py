@@ -12,6 +12,7 @@ import datetime as dt
 import json
 import logging
 import os
+import shlex
 import signal
 import sys
 from collections.abc import Callable
@@ -201,6 +202,16 @@ def _cmd_completion(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_init(args: argparse.Namespace) -> int:
+    from accelcal_rig.config.starter import write_starter
+
+    written = write_starter(args.folder)
+    folders = sorted({path.parent.name for path in written if path.parent != args.folder})
+    print(f"wrote {len(written)} files into {args.folder}: README.md, {', '.join(f + '/' for f in folders)}")
+    print(f"next: cd {shlex.quote(str(args.folder))} && rig run procedures/paper-24pos-thermal.yaml --dry-run -o paper.h5")
+    return 0
+
+
 def _cmd_schema(args: argparse.Namespace) -> int:
     from accelcal_rig.config.schemas import schema_text
     from accelcal_rig.durable import write_text_atomically
@@ -337,7 +348,7 @@ def main(argv: list[str] | None = None, today: Callable[[], dt.date] = dt.date.t
                "fit": _cmd_fit, "check": _cmd_check, "characterise": _cmd_characterise,
                "sim": _cmd_sim, "report": _cmd_report, "export": _cmd_export, "certificate": _cmd_certificate,
                "fit-recording": _cmd_fit_recording, "analyze": _cmd_analyze, "registry": _cmd_registry,
-               "serve": _cmd_serve, "completion": _cmd_completion, "schema": _cmd_schema,
+               "serve": _cmd_serve, "completion": _cmd_completion, "schema": _cmd_schema, "init": _cmd_init,
                "approve": _cmd_approve}[args.command]
     try:
         return handler(args)

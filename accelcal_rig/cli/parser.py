@@ -16,13 +16,19 @@ from accelcal_rig.cli.grammar.common import Parser
 from accelcal_rig.cli.grammar.documents import add_document_commands
 from accelcal_rig.cli.grammar.fitting import add_fit_commands
 from accelcal_rig.cli.grammar.registry import add_registry_commands
-from accelcal_rig.cli.grammar.service import add_completion_command, add_schema_command, add_serve_command
+from accelcal_rig.cli.grammar.service import (
+    add_completion_command,
+    add_init_command,
+    add_schema_command,
+    add_serve_command,
+)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = Parser(prog="rig", description="Run MEMS accelerometer calibration campaigns.")
+    parser = Parser(prog="rig", description="Run unattended thermal calibration campaigns of MEMS accelerometers, gyroscopes and IMUs.")
     parser.add_argument("--version", action="version", version=f"accelcal-rig {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    add_init_command(commands)
     add_campaign_commands(commands)     # run, plan, resume, status, repair, check, sim
     add_fit_commands(commands)          # fit, fit-recording
     add_analysis_commands(commands)     # analyze

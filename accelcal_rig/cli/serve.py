@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from accelcal_rig.core.extras import install_hint
 from accelcal_rig.errors import ConfigError
 
 #: Longest wait, as the dashboard stops, for its open connections (a page's event stream) to close.
@@ -141,7 +142,7 @@ def open_dashboard(args: argparse.Namespace) -> Dashboard:
 
         from accelcal_rig.web.app import LOOPBACK_HOSTS, create_app
     except ModuleNotFoundError as exc:
-        raise ConfigError(f"rig serve needs {exc.name}: pip install 'accelcal-rig[dashboard]'") from None
+        raise ConfigError(f"rig serve needs {exc.name}: {install_hint('dashboard')}") from None
     token = args.token or os.environ.get("ACCELCAL_DASHBOARD_TOKEN") or None
     _check_access(args.host, token, args.tls_cert, args.tls_key)
     if args.user_header and token is None:

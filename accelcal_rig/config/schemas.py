@@ -1,7 +1,7 @@
 """JSON Schemas of the YAML a user writes — procedures and rig configs — generated from the models that validate
 them, so an editor with the YAML language server completes and checks keys as `rig` will (each shipped file
 names its schema in its first line: `# yaml-language-server: $schema=…`). The schemas ship in the package
-(accelcal_rig/schemas/); `rig schema KIND` prints one, and a test keeps the shipped ones equal to the models."""
+(accelcal_rig/starter/schemas/); `rig schema KIND` prints one, and a test keeps the shipped ones equal to the models."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ KINDS: dict[str, tuple[type[BaseModel], str]] = {
     "rig-config": (RigConfig, "rig-config.schema.json"),
 }
 #: Where the shipped schemas are.
-SHIPPED = Path(__file__).resolve().parent.parent / "schemas"
+SHIPPED = Path(__file__).resolve().parent.parent / "starter" / "schemas"
 
 
 def schema(kind: str) -> dict[str, Any]:

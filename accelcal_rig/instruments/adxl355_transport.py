@@ -29,6 +29,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, Protocol, runtime_checkable
 
+from accelcal_rig.core.extras import install_hint
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
 from accelcal_rig.instruments.line_port import LinePort
 from accelcal_rig.parts import registry as parts
@@ -261,7 +262,7 @@ class SpidevBus:
         try:
             import spidev  # type: ignore[import-not-found]
         except ImportError:
-            raise InstrumentError("spidev is not installed: pip install 'accelcal-rig[spidev]'") from None
+            raise InstrumentError(f"spidev is not installed: {install_hint('spi')}") from None
         device = spidev.SpiDev()
         try:
             device.open(bus, chip_select)

@@ -26,6 +26,7 @@ from alembic.util.exc import CommandError
 from sqlalchemy.dialects import postgresql, sqlite
 from sqlalchemy.engine import Connection, Engine
 
+from accelcal_rig.core.extras import install_hint
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.registry.location import described
 from accelcal_rig.registry.schema import approvals, calibration_figures, calibrations, registry_tables
@@ -392,8 +393,7 @@ def _engine(url: str, create: bool = True, read_only: bool = False, timeouts: Re
         return sa.create_engine(url, pool_pre_ping=True, connect_args=connect_args,
                                 pool_timeout=max(1.0, timeouts.connect_s))
     except (sa.exc.ArgumentError, ModuleNotFoundError) as exc:
-        raise ConfigError(f"registry {described(url)}: {exc} (PostgreSQL needs: pip install "
-                          "'accelcal-rig[postgresql]')") from None
+        raise ConfigError(f"registry {described(url)}: {exc} (PostgreSQL needs: {install_hint('postgresql')})") from None
 
 
 def _read_only_connection(path: Path, busy_s: float) -> sqlite3.Connection:

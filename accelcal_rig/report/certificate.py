@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from accelcal_rig import __version__
+from accelcal_rig.core.extras import install_hint
 from accelcal_rig.durable import clear_dead_temporaries, write_atomically, write_text_atomically
 from accelcal_rig.errors import ConfigError, RigError
 from accelcal_rig.fit.calibration import CalibrationFile, ChannelCalibration, load_calibration
@@ -84,7 +85,7 @@ def write_certificates(campaign_path: Path, calibration_path: Path, folder: Path
     folder.mkdir(parents=True, exist_ok=True)
     render = _pdf_renderer() if pdf else None
     warnings = [] if render is not None or not pdf else [
-        "PDFs need WeasyPrint: pip install 'accelcal-rig[certificate]' (HTML certificates written)"]
+        f"PDFs need WeasyPrint: {install_hint('pdf')} (HTML certificates written)"]
     written: list[Written] = []
     for serial, name in draft_names(list(calibration.duts)).items():
         page = certificate_html(campaign, campaign_path, calibration, calibration_path, serial, operator)

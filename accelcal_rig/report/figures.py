@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from accelcal_rig.core.extras import install_hint
 from accelcal_rig.core.units import STANDARD_GRAVITY_M_S2
 from accelcal_rig.durable import write_atomically
 from accelcal_rig.errors import ConfigError
@@ -37,7 +38,7 @@ def pyplot():  # noqa: ANN201 - matplotlib's module
     try:
         import matplotlib
     except ImportError:
-        raise ConfigError("rig report needs matplotlib: pip install 'accelcal-rig[report]'") from None
+        raise ConfigError(f"rig report needs matplotlib: {install_hint('report')}") from None
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 

@@ -1,5 +1,5 @@
 """The JSON Schemas editors check procedures and rig configs with (config/schemas.py): the shipped ones are the
-models' own (a model change without `rig schema KIND -o accelcal_rig/schemas/…` fails here), every shipped file
+models' own (a model change without `rig schema KIND -o schemas/…` fails here), every shipped file
 names its schema in its first line and validates against it, and a misspelled key or a value out of bounds is
 refused by the schema as by `rig` itself."""
 

@@ -34,7 +34,7 @@ def _add_certificate(commands: Commands) -> None:
                           "Write OUT/<serial>.html and OUT/<serial>.pdf for every DUT of the calibration: the item "
                           "and its identity, the campaign and its instruments, the results, the verification, the "
                           "uncertainty budget, the verdict and fields for signatures. PDFs need WeasyPrint (pip "
-                          "install 'accelcal-rig[certificate]'). `rig run` writes them at its end too.",
+                          "install 'accelcal-rig[pdf]'). `rig run` writes them at its end too.",
                           "rig certificate campaign.h5 -o certs/ --operator 'A. Smith'")
     certificate.add_argument("campaign", type=Path, help="campaign file (HDF5)")
     certificate.add_argument("-o", "--output", type=Path, required=True, help="folder to write (created if needed)")

@@ -1,10 +1,23 @@
-"""The grammar of the commands that serve the operator's tools: `rig completion`, `rig schema` and `rig serve`."""
+"""The grammar of the commands that serve the operator's tools: `rig init`, `rig completion`, `rig schema` and
+`rig serve`."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from accelcal_rig.cli.grammar.common import Commands, command, number, registry_option
+
+
+def add_init_command(commands: Commands) -> None:
+    """`rig init`: a lab folder with the starting set of procedures, rig configs and schemas."""
+    init = command(commands, "init", "write a lab folder: the shipped procedures, rig configs and schemas to edit",
+                   "Write the starting set the package ships into FOLDER (new, or empty: nothing of yours is "
+                   "replaced): procedures/ (the paper's campaign, a quick one, IMU campaigns), configs/ (simulated "
+                   "rigs for --dry-run, and example-lab.yaml, the template of a real rig) and schemas/ (the JSON "
+                   "Schemas each file names in its first line, for an editor), with a README. Then, in FOLDER: "
+                   "rig run procedures/paper-24pos-thermal.yaml --dry-run -o paper.h5",
+                   "rig init lab")
+    init.add_argument("folder", type=Path, help="the folder to write (new, or empty)")
 
 
 def add_completion_command(commands: Commands) -> None:
@@ -23,7 +36,8 @@ def add_schema_command(commands: Commands) -> None:
                      "Print (or write with -o) the JSON Schema the procedure or rig-config models validate against: "
                      "an editor with the YAML language server completes and checks keys with it when a file's "
                      "first line names it (# yaml-language-server: $schema=PATH). The package ships both "
-                     "(accelcal_rig/schemas/), and every shipped procedure and rig config names its own.",
+                     "(rig init writes them into a lab folder's schemas/), and every shipped procedure and rig config names "
+                     "its own.",
                      "rig schema procedure -o procedure.schema.json")
     schema.add_argument("kind", choices=["procedure", "rig-config"])
     schema.add_argument("-o", "--output", type=Path, help="write it here (default: standard output)")
