@@ -1,12 +1,14 @@
 """Run the site's getting-started commands verbatim, as a lab would: the block after the marker in
 docs/getting-started.md, in an empty folder holding only dist/ with the built wheel. Its last line, `rig serve`,
 runs until it is stopped: it is started in the background, its page fetched, then stopped with Ctrl-C (SIGINT),
-which must end it with exit code 0.
+which must end it with exit code 0. Then, with --then SCRIPT, SCRIPT runs with that virtual environment as its
+argument (CI installs the example plug-in into it: examples/ci-check.sh).
 
-Usage: python3 .ci/getting_started.py DIST_FOLDER"""
+Usage: python3 .ci/getting_started.py DIST_FOLDER [--then SCRIPT]"""
 
 from __future__ import annotations
 
+import os
 import re
 import shutil
 import signal
@@ -32,6 +34,7 @@ def block() -> list[str]:
 
 def main() -> int:
     dist = Path(sys.argv[1]).resolve()
+    then = Path(sys.argv[3]).resolve() if len(sys.argv) == 4 and sys.argv[2] == "--then" else None
     lines = block()
     if not lines[-1].startswith("rig serve"):
         sys.exit(f"{PAGE}: the block's last line is not rig serve: {lines[-1]!r}")
@@ -39,7 +42,9 @@ def main() -> int:
     shutil.copytree(dist, folder / "dist")
     log = folder / "serve.out"
     script = "set -euxo pipefail\n" + "\n".join(lines[:-1]) + f"\nexec {lines[-1]} > {log} 2>&1\n"
-    server = subprocess.Popen(["bash", "-c", script], cwd=folder, start_new_session=True)
+    # A fresh machine's home: the registries the commands find by default are the folder's, not this user's.
+    env = {**os.environ, "XDG_DATA_HOME": str(folder / "home-data")}
+    server = subprocess.Popen(["bash", "-c", script], cwd=folder, env=env, start_new_session=True)
     try:
         url = wait_for_address(server, log)
         with urllib.request.urlopen(url, timeout=30) as page:  # noqa: S310 - the local dashboard just started
@@ -54,6 +59,8 @@ def main() -> int:
     finally:
         if server.poll() is None:
             server.kill()
+    if then is not None:
+        subprocess.run(["bash", str(then), str(folder / "venv")], check=True)
     shutil.rmtree(folder, ignore_errors=True)
     return 0
 

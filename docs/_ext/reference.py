@@ -96,7 +96,7 @@ def _object_section(name: str, node: dict[str, Any], level: int) -> list[str]:
     lines += ["| key | type | unit | default | limits | what it is |", "|---|---|---|---|---|---|"]
     for key in sorted(properties):
         spec = properties[key]
-        default = "required" if key in required else (_value(spec["default"]) if "default" in spec else "—")
+        default = "required" if key in required else _default(spec)
         lines.append("| " + " | ".join([f"`{key}`", _type(spec), _unit(key), default, _limits(spec),
                                          _cell(spec.get("description", ""))]) + " |")
     extra = node.get("additionalProperties")
@@ -128,6 +128,16 @@ def _type(spec: dict[str, Any]) -> str:
     if spec.get("format") == "date":
         return "date (YYYY-MM-DD)"
     return str(kind) if kind else "any"
+
+
+def _default(spec: dict[str, Any]) -> str:
+    """The default as a user would write it; a section's own defaults are in its section."""
+    if "default" not in spec:
+        return "—"
+    value = spec["default"]
+    if isinstance(value, dict) and value:
+        return "its keys' defaults"
+    return '""' if value == "" else _value(value)
 
 
 def _limits(spec: dict[str, Any]) -> str:
