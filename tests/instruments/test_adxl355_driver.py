@@ -204,7 +204,8 @@ def test_spidev_missing_is_a_clear_error(monkeypatch) -> None:
         return real_import(name, *args, **kwargs)
 
     monkeypatch.setattr(builtins, "__import__", no_spidev)
-    with pytest.raises(InstrumentError, match=r"spidev is not installed: pip install 'accelcal-rig\[spidev\]'"):
+    with pytest.raises(InstrumentError, match=r"spidev is not installed: pip install 'accelcal-rig\[spi\]' "
+                                              r"\(its packages: pip install 'spidev>=[0-9.]+'\)"):
         SpidevBus.open(0, 0)
 
 

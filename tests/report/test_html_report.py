@@ -93,7 +93,8 @@ def test_without_matplotlib_the_error_says_how_to_install_it(paper_campaign: Pat
     monkeypatch.setitem(sys.modules, "matplotlib", None)  # import fails as if not installed
     assert main(["report", str(paper_campaign), "-o", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
-    assert err.strip() == "rig: error: rig report needs matplotlib: pip install 'accelcal-rig[report]'"
+    assert re.fullmatch(r"rig: error: rig report needs matplotlib: pip install 'accelcal-rig\[report\]' "
+                        r"\(its packages: pip install 'matplotlib>=[0-9.]+'\)", err.strip()), err
     assert not (tmp_path / "out").exists()
 
 
