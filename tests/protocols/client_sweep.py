@@ -693,6 +693,9 @@ DOCUMENTED: tuple[Documented, ...] = (
     Documented("espec-p300", r"PRGM,(PAUSE|CONTINUE|ADVANCE|END.*)", "NA:CONT NOT READY-2",
                "ChamberConnectLibrary especinteract.py ERROR_DESCIPTIONS: 'Chamber is not running a program' (none "
                "runs in the simulated chamber)"),
+    Documented("watlow-f4", r"read holding (319|1925) x1", "exception 2",
+               "ChamberConnectLibrary watlowf4.py process_controller (lines 952-966): loop 2's set point (319) and the "
+               "cascade flag (1925) are probed, an exception meaning a single-loop F4 without cascade, as simulated"),
 )
 
 
