@@ -1,0 +1,338 @@
+"""The requests of public clients that cannot be installed here, as data: per public method (function, or a
+C# method behind a button), the exact requests in the order the client sends them, and what the maker
+documents as the answer to each, cited. tests/protocols/client_sweep.py replays each method on a new
+connection through its recording proxy and reads each reply as the client does (a line; or, the
+AcutronicRobotics client, one recv() whose first 8 bytes it cuts off).
+
+No code of these clients is copied: the request texts are facts read from their sources (repository, commit,
+path, function), and the documented answers are from the makers' command lists and manuals:
+
+- ESPEC North America's WatlowF4T-SCPI-Lib (MIT), f4tscpi/f4t_interface.py and f4t_class.py at commit
+  78be8a50a82d417920464818046ab5d3703b3c1b (on no package index; the fetch tool has no snapshot of it: read
+  from the search index). Its command list is the spreadsheet in the same author's
+  PaulNongL/WatlowF4TscpiLibrary (f4t_scpi_cmds/f4t_scpi_commands.ods, commit
+  78615738ffdee820f04c90841fa2598356024e5d): `F4T list` below. Requests end LF; replies are read to LF with a
+  1.5 s timeout (F4T.__init__), an unanswered query reading as 'FAILED' (read_items).
+- IEAv-EFO/acutrol3000 (no licence stated), python/acutrol3000.py at commit
+  3777621b1cf5a1288e5c2134fa97b6276683518f: module functions over PyVISA GPIB (`GPIB1::1::INSTR`); query()
+  reads a reply, write() none. On IEEE-488 "the interface protocol only receives a response if the command
+  requests data" (TM-8004-C §2, in doc/ of the same repository): settings unanswered.
+- AcutronicRobotics/acutrol (MIT), acutrol.py and ac117.json at commit
+  5e9b652eddc1e4c2c664c1c3df7daf553471fefd (Python 2: `<>`): class AcutrolDevice over TCP (port 9888),
+  each command followed by '\r\n' and answered, as TM-8004-C §2 says of the interfaces other than IEEE-488
+  ("all commands issued to Acutrol will receive a response … an error code and a message length; this is
+  prefixed to data"): the client reads one recv(1024), cuts 8 bytes and compares `OK` (ac117.json) or reads a
+  number.
+- williamsea/Acutrol (no licence stated), Acutrol/Form1.cs at commit
+  0f6be385c44abd2ce9e8fa277a4b47f235c98f26: a Windows Forms client over NI VisaNS GPIB (`GPIB0::1::INSTR`),
+  each message ending ` \n` (a blank, then LF). The same author's Acutrol_VisualStudio2010 is a later copy.
+
+The ACUTROL3000 simulator serves the profile on a serial line (LF): the GPIB clients' requests are sent with LF
+(on GPIB EOI ends a message, "optionally followed by CR and/or LF", TM-8004-C §2.4); the TCP client's with its
+own CR LF.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+_N = r"[-+]?\d+(\.\d+)?([eE][-+]?\d+)?"  # a number as the clients read it (float())
+
+
+@dataclass(frozen=True)
+class Expect:
+    """One request as the client sends it (without its terminator) and the answer its maker documents."""
+
+    request: str
+    answer: str | None  # a regular expression the reply (terminators cut) must match in full; None: no reply
+    source: str  # where the maker documents that answer
+    prefixed: bool = False  # the reply starts with an 8-byte prefix the client cuts off (ACL over TCP)
+
+    def check(self, reply: bytes) -> str:
+        """'' when the reply is the documented one; else what is wrong with it."""
+        text = reply.decode("latin-1")
+        if self.answer is None:
+            return "" if not text else f"answered {text.strip()!r}; documented: no reply ({self.source})"
+        if not text:
+            return f"no reply; documented: {self.answer!r} ({self.source})"
+        if self.prefixed:  # an 8-byte prefix (its layout undocumented), then the answer; a bare line is not it
+            body = text[8:].strip()
+            bare = re.fullmatch(self.answer, text.strip()) is not None or text.startswith("ERR")
+            if len(reply) > 8 and re.fullmatch(self.answer, body) and not bare:
+                return ""
+            return f"answered {text.strip()!r}, no prefix (the client reads {body!r}); documented: an error code " \
+                   f"and a length, then {self.answer!r} ({self.source})"
+        if not re.fullmatch(self.answer, text.strip()):
+            return f"answered {text.strip()!r}; documented: {self.answer!r} ({self.source})"
+        return ""
+
+
+@dataclass(frozen=True)
+class Method:
+    name: str
+    where: str  # path and function (line) in the client's repository
+    call: str  # the call the requests are for (its arguments)
+    requests: tuple[Expect, ...] = ()
+    not_sent: str | None = None  # a public method that sends nothing of its own: why
+
+
+@dataclass(frozen=True)
+class DataClient:
+    name: str
+    profile: str  # the simulator it is replayed against
+    source: str  # repository@commit
+    licence: str
+    transport: str
+    write_terminator: str
+    read_terminator: str
+    reply_wait_s: float  # how long the replay waits for a reply (the client's own timeout, shortened)
+    methods: tuple[Method, ...]
+
+
+# ---------------------------------------------------------------------- ESPEC's F4T SCPI library
+_F4T_LIST = "F4T list (PaulNongL/WatlowF4TscpiLibrary f4t_scpi_cmds/f4t_scpi_commands.ods)"
+_FLOAT = rf"{_N}"
+_IF = "f4tscpi/f4t_interface.py"
+_CLS = "f4tscpi/f4t_class.py"
+
+
+def _f4t_query(request: str, answer: str, row: str) -> Expect:
+    return Expect(request, answer, f"{_F4T_LIST}: {row}")
+
+
+def _f4t_setting(request: str, row: str) -> Expect:
+    return Expect(request, None, f"{_F4T_LIST}: {row} (W: a setting, unanswered)")
+
+
+_IDN = _f4t_query("*IDN?", r"Watlow Electric,[^,]*,\d+,[^,]*", "Identification → Watlow Electric | <string> | "
+                  "<integer> | <string>")
+
+F4T_SCPI = DataClient(
+    "ESPEC WatlowF4T-SCPI-Lib F4T", "watlow-f4t-scpi",
+    "EspecNorthAmerica/WatlowF4T-SCPI-Lib@78be8a50a82d417920464818046ab5d3703b3c1b", "MIT",
+    "request lists replayed over TCP through the proxy (the library connects to port 5025 with "
+    "socket.create_connection)", "\n", "\n", 0.3, (
+        Method("__init__", f"{_CLS} Controller.__init__ (get_id when no id is given)", "F4T(host)", (_IDN,)),
+        Method("get_id", f"{_IF} F4T.get_id", "get_id()", (_IDN,)),
+        Method("get_units", f"{_IF} F4T.get_units (TempUnits(rsp): C or F)", "get_units()",
+               (_f4t_query(":UNIT:TEMPERATURE?", "C|F", "Query Comm. Temperature units → C|F"),)),
+        Method("set_units", f"{_IF} F4T.set_units (get_units; its else branch, ':UNITS:TEMPERATURE' + 'C', is "
+               "unreachable: get_units returns a TempUnits or raises)", "set_units()",
+               (_f4t_query(":UNIT:TEMPERATURE?", "C|F", "Query Comm. Temperature units → C|F"),)),
+        Method("get_profiles", f"{_IF} F4T.get_profiles (profiles 1…39, each selected then its name read, until a "
+               "name is empty; here the first)", "get_profiles()",
+               (_f4t_setting(":PROGRAM:NUMBER 1", "Select a profile (1-40)"),
+                _f4t_query(":PROGRAM:NAME?", r".*", "Read selected profile name → <string value>"))),
+        Method("select_profile", f"{_IF} F4T.select_profile", "select_profile(1)",
+               (_f4t_setting(":PROGRAM:NUMBER 1", "Select a profile (1-40)"),)),
+        Method("prog_mode", f"{_IF} F4T.prog_mode (docstring: start, stop, pause, resume)", "prog_mode('START')",
+               (_f4t_setting(":PROGRAM:SELECTED:STATE START", "start profile"),)),
+        Method("get_pv", f"{_IF} F4T.get_pv (loop 1 temperature, 2 humidity)", "get_pv(1); get_pv(2)",
+               (_f4t_query(":SOURCE:CLOOP1:PVALUE?", _FLOAT, "Read Temperature PV (Control loop) → <floating point>"),
+                _f4t_query(":SOURCE:CLOOP2:PVALUE?", _FLOAT, "Read Temperature PV (Control loop) → <floating point>"))),
+        Method("get_sp", f"{_IF} F4T.get_sp", "get_sp(1); get_sp(2)",
+               (_f4t_query(":SOURCE:CLOOP1:SPOINT?", _FLOAT, "Read SP → <floating point value>"),
+                _f4t_query(":SOURCE:CLOOP2:SPOINT?", _FLOAT, "Read SP → <floating point value>"))),
+        Method("get_cascadeSP", f"{_IF} F4T.get_cascadeSP", "get_cascadeSP()",
+               (_f4t_query(":SOURCE:CASCADE1:SPOINT?", _FLOAT, "Read Set Point (Cascade) → <floating point value>; "
+                           "listed for controllers WITH cascade control only"),)),
+        Method("get_cascadeLoopPV", f"{_IF} F4T.get_cascadeLoopPV (loop true: OUTER, else INNER)",
+               "get_cascadeLoopPV(True); get_cascadeLoopPV(False)",
+               (_f4t_query(":SOURCE:CASCADE1:OUTER:PVALUE?", _FLOAT, "Read Outer Loop PV (Cascade); cascade only"),
+                _f4t_query(":SOURCE:CASCADE1:INNER:PVALUE?", _FLOAT, "Read Inner Loop PV (Cascade); cascade only"))),
+        Method("get_cascadeLoopSP", f"{_IF} F4T.get_cascadeLoopSP", "get_cascadeLoopSP(True); get_cascadeLoopSP(False)",
+               (_f4t_query(":SOURCE:CASCADE1:OUTER:SPOINT?", _FLOAT, "Read Outer Loop Set Point (Cascade); cascade only"),
+                _f4t_query(":SOURCE:CASCADE1:INNER:SPOINT?", _FLOAT, "Read Inner Loop Set Point (Cascade); cascade only"))),
+        Method("write_sp", f"{_IF} F4T.write_sp (no leading colon; the value as str(float))", "write_sp(25.0, 1)",
+               (_f4t_setting("SOURCE:CLOOP1:SPOINT 25.0", "Write SP"),
+                _f4t_query(":SOURCE:CLOOP1:SPOINT?", r"25(\.0+)?", "Read SP (read back: the set point written)"))),
+        Method("get_ts", f"{_IF} F4T.get_ts", "get_ts(1)",
+               (_f4t_query(":OUTPUT1:STATE?", "OFF|ON", "Query event output state → OFF|ON (outputs 1-7)"),)),
+        Method("set_output", f"{_IF} F4T.set_output (reads the state, writes the other)", "set_output(1)",
+               (_f4t_query(":OUTPUT1:STATE?", "OFF|ON", "Query event output state → OFF|ON (outputs 1-7)"),
+                _f4t_setting(":OUTPUT1:STATE ON", "Set event output on"),
+                _f4t_query(":OUTPUT1:STATE?", "ON", "Query event output state (read back)"))),
+        Method("get_tsName", f"{_IF} F4T.get_tsName", "get_tsName(1)",
+               (Expect(":OUTPUT1:NAME?", r".*", "not in the F4T list: the library's own (an output's name, a string)"),)),
+        Method("ramp_mode", f"{_IF} F4T.ramp_mode (docstring: OFF, STARTUP, SETPOINT, BOTH)", "ramp_mode('OFF', 1)",
+               (_f4t_setting(":SOURCE:CLOOP1:RACTION OFF", "Set ramping off"),)),
+        Method("get_ramp", f"{_IF} F4T.get_ramp (rate: RRATE, else RTIME)", "get_ramp('rate', 1); get_ramp('time', 1)",
+               (_f4t_query(":SOURCE:CLOOP1:RRATE?", _FLOAT, "Read ramp rate → <floating point value>"),
+                _f4t_query(":SOURCE:CLOOP1:RTIME?", _FLOAT, "Read ramp time → <floating point value>"))),
+        Method("set_ramp", f"{_IF} F4T.set_ramp", "set_ramp('rate', 2.0, 1); set_ramp('time', 30, 1)",
+               (_f4t_setting(":SOURCE:CLOOP1:RRATE 2.0", "Write ramp rate"),
+                _f4t_setting(":SOURCE:CLOOP1:RTIME 30", "Write ramp time"))),
+        Method("set_rampScale", f"{_IF} F4T.set_rampScale (RampScale: HOURS, MINUTES)", "set_rampScale('MINUTES', 1)",
+               (_f4t_setting(":SOURCE:CLOOP1:RSCALE MINUTES", "Write ramp scale to minutes"),)),
+        Method("send_cmd", f"{_CLS} Controller.send_cmd", "send_cmd(cmd)",
+               not_sent="the transport primitive: sends what its caller gives it"),
+        Method("read_items", f"{_CLS} Controller.read_items", "read_items()", not_sent="reads a reply; sends nothing"),
+        Method("clear_buffer", f"{_CLS} Controller.clear_buffer", "clear_buffer()",
+               not_sent="reads and drops what is pending; sends nothing"),
+        Method("close", f"{_CLS} Controller.close", "close()", not_sent="closes the socket"),
+        Method("source_dev", f"{_CLS} Controller.source_dev (classmethod)", "F4T.source_dev(dev)",
+               not_sent="builds an object on another's connection; sends nothing"),
+    ))
+
+# ---------------------------------------------------------------------- ACUTROL3000 clients
+_ACL = "Acutronic TM-8004-C (ACL Programming Manual, IEAv-EFO/acutrol3000 doc/TM-8004-Command Language.pdf)"
+_GPIB_SETTING = f"{_ACL} §2: over IEEE-488 a command is answered only if it requests data"
+_IEAV = "python/acutrol3000.py"
+
+
+def _q(request: str, answer: str, section: str) -> Expect:
+    return Expect(request, answer, f"{_ACL} {section}")
+
+
+def _s(request: str, section: str) -> Expect:
+    return Expect(request, None, f"{_GPIB_SETTING}; {section}")
+
+
+_CHECK_ERROR = (_q(":interlock? 1", r"\w+", "Table 6 :Interlock? (the client compares 'Fault')"),
+                _q("*stb?", r"\d+", "§3.10 *STB? → <NR1> 0…255 (the client compares 65)"))
+_STOP = (_s(":mode:synt 1", "§4.7.6 Mode:Synthesis"), _s(":dem:osc 1,0,0,0", "§4.3.4 Demand:Oscillator"),
+         _s(":mode:rate 1", "§4.7.5 Mode:Rate"), _s(":dem:rate 1,0", "§4.3.6 Demand:Rate"))
+
+IEAV = DataClient(
+    "IEAv-EFO acutrol3000", "acutrol3000", "IEAv-EFO/acutrol3000@3777621b1cf5a1288e5c2134fa97b6276683518f",
+    "none stated", "request lists replayed over the proxy onto the simulator's serial line (the client: PyVISA "
+    "GPIB, query() reads a reply, write() none)", "\n", "\n", 0.3, (
+        Method("(module)", f"{_IEAV} lines 4-6 (at import)", "import acutrol3000",
+               (_q("*idn?", r".+", "§3 *IDN?"),)),
+        Method("status", f"{_IEAV} status (line 14)", "status()",
+               (_q(":read:pos? 1;rate? 1;acc? 1", rf"{_N};{_N};{_N}", "§4.10.1, 4.10.4, 4.10.5 (Read:Acceleration, "
+                   "Position, Rate; ';' compound, §2.2.2)"),)),
+        Method("read_pos", f"{_IEAV} read_pos", "read_pos()", (_q(":read:pos? 1", _N, "§4.10.4 Read:Position?"),)),
+        Method("read_rate", f"{_IEAV} read_rate (write, then read)", "read_rate()",
+               (_q(":read:rate? 1", _N, "§4.10.5 Read:Rate?"),)),
+        Method("read_acc", f"{_IEAV} read_acc", "read_acc()", (_q(":read:acc? 1", _N, "§4.10.1 Read:Acceleration?"),)),
+        Method("check_error", f"{_IEAV} check_error (lines 39-48)", "check_error()", _CHECK_ERROR),
+        Method("initialize", f"{_IEAV} initialize (lines 52-60; then stop())", "initialize()",
+               (_s(":Interlock:Reset", "§4.5.6 Interlock:Reset"), _s(":mode:off 1", "§4.7.3 Mode:Off"),
+                _s(":int:close 1", "§4.5.1 Interlock:Close"), *_STOP)),
+        Method("terminate", f"{_IEAV} terminate (stop(), then lines 66-68)", "terminate()",
+               (*_STOP, _s(":int:open 1", "§4.5.5 Interlock:Open"))),
+        Method("stop", f"{_IEAV} stop (lines 72-79: send_oscillation(0,0), rate mode, zero rate)", "stop()", _STOP),
+        Method("limits", f"{_IEAV} limits (lines 83-95)", "limits()",
+               (_q(":limit:absolute? 1", r".+", "§4.6.1 Limit:Absolute?"),
+                *(_q(f":limit:{kind}? {mode},1", _N, "§4.6.2 / 4.6.8 Limit:Acceleration? / Limit:Rate?")
+                  for kind in ("acc", "rate") for mode in ("pos", "rate", "synt")))),
+        Method("set_limits", f"{_IEAV} set_limits (lines 99-109, defaults 8300, 1000)", "set_limits()",
+               tuple(_s(f":lim:{kind} {mode},1,{value}", "§4.6.2 / 4.6.8 Limit:Acceleration / Limit:Rate")
+                     for kind, value in (("acc", 8300), ("rate", 1000)) for mode in ("pos", "rate", "synt"))),
+        Method("send_rate", f"{_IEAV} send_rate (lines 113-128; check_error, then ':int:close 1', then time.sleed: "
+               "an AttributeError in the client ends it there)", "send_rate(10)",
+               (*_CHECK_ERROR, _s(":int:close 1", "§4.5.1 Interlock:Close"))),
+        Method("wait_stop", f"{_IEAV} wait_stop (status() until |rate| <= 0.01)", "wait_stop()",
+               (_q(":read:pos? 1;rate? 1;acc? 1", rf"{_N};{_N};{_N}", "§4.10 (as status)"),)),
+        Method("send_position", f"{_IEAV} send_position (lines 143-152: ':mode 1,pos' unless ':mode? 1' reads "
+               "'Position')", "send_position(10)",
+               (*_CHECK_ERROR, _s(":int:close 1", "§4.5.1 Interlock:Close"),
+                _q(":mode? 1", "P|R|S|O|A|Position|Rate", "§4.7 Mode[?] (examples answer P, R; the client compares "
+                   "'Position')"),
+                _s(":mode 1,pos", "§4.7 Mode[?]"), _s(":dem:pos 1,10", "§4.3.5 Demand:Position"))),
+        Method("send_delta_position", f"{_IEAV} send_delta_position (lines 156-172)", "send_delta_position(5)",
+               (*_CHECK_ERROR, _s(":int:close 1", "§4.5.1 Interlock:Close"),
+                _q(":mode? 1", "P|R|S|O|A|Position|Rate", "§4.7 Mode[?]"), _s(":mode 1,pos", "§4.7 Mode[?]"),
+                _s(":dem:delta 1,5", "§4.3.2 Demand:DeltaPosition"))),
+        Method("set_oscillation", f"{_IEAV} set_oscillation (lines 176-182; its comment: 'Command not working')",
+               "set_oscillation()",
+               (_s(":con:osc 1,Enable,2.0,0.1,Pos,Lin", "§4.2.19 Configure:Oscillator"),
+                _q(":con:osc? 1", r".+", "§4.2.19 Configure:Oscillator?"))),
+        Method("send_oscillation", f"{_IEAV} send_oscillation (lines 185-193)", "send_oscillation(10, 1)",
+               (_s(":mode:synt 1", "§4.7.6 Mode:Synthesis"), _s(":dem:osc 1,10,1,0", "§4.3.4 Demand:Oscillator"))),
+    ))
+
+_ACR = "acutrol.py"
+_TCP = f"{_ACL} §2 (all commands answered on interfaces other than IEEE-488, error code and length prefixed) and " \
+       "the client: recv(1024)[8:]"
+
+
+def _ok(request: str) -> Expect:
+    return Expect(request, "OK", f"{_TCP}; ac117.json expects 'OK'", prefixed=True)
+
+
+def _acked(request: str) -> Expect:
+    return Expect(request, r".*", f"{_TCP} (the client reads and drops it)", prefixed=True)
+
+
+ACUTRONIC_ROBOTICS = DataClient(
+    "AcutronicRobotics acutrol", "acutrol3000", "AcutronicRobotics/acutrol@5e9b652eddc1e4c2c664c1c3df7daf553471fefd",
+    "MIT", "request lists replayed over the proxy onto the simulator's serial line, each ending CR LF as the client "
+    "sends it over TCP; its reply read as one recv() whose first 8 bytes it cuts", "\r\n", "\n", 0.3, (
+        Method("__init__", f"{_ACR} AcutrolDevice.__init__ (then startup())", "AcutrolDevice(IP, PORT)",
+               tuple(_ok(c) for c in (":utility:lockout on", ":interlock:open 1", ":interlock:reset 1",
+                                      ":interlock:close 1"))),
+        Method("startup", f"{_ACR} AcutrolDevice.startup (ac117.json 'startup')", "startup()",
+               tuple(_ok(c) for c in (":utility:lockout on", ":interlock:open 1", ":interlock:reset 1",
+                                      ":interlock:close 1"))),
+        Method("shutdown", f"{_ACR} AcutrolDevice.shutdown (ac117.json 'shutdown')", "shutdown()",
+               (_ok(":mode:off 1"), _ok(":interlock:open 1"))),
+        Method("status", f"{_ACR} AcutrolDevice.status (no '?': §4.10 ACT2000 compatibility)", "status()",
+               (Expect(":read:rate 1", _N, f"{_TCP}; §4.10.5 Read:Rate", prefixed=True),
+                Expect(":read:position 1", _N, f"{_TCP}; §4.10.4 Read:Position", prefixed=True))),
+        Method("command_position", f"{_ACR} AcutrolDevice.command_position (not yet in position mode)",
+               "command_position(0.5)",
+               (_acked(":mode:position 1"), _acked(":demand:position 1, 28.648"))),
+        Method("command_rate", f"{_ACR} AcutrolDevice.command_rate (not yet in rate mode)", "command_rate(0.1)",
+               (_acked(":mode:rate 1"), _acked(":demand:rate 1, 05.730"))),
+        Method("send_command", f"{_ACR} AcutrolDevice.send_command", "send_command(command)",
+               not_sent="the transport primitive: sends what its caller gives it"),
+        Method("send_command_list", f"{_ACR} AcutrolDevice.send_command_list", "send_command_list(list)",
+               not_sent="sends its caller's list (startup and shutdown above are its uses)"),
+    ))
+
+_FORM = "Acutrol/Form1.cs"
+
+
+def _w(request: str, section: str) -> Expect:
+    """A williamsea message: the client writes ' \\n' after it (a trailing blank)."""
+    return Expect(request + " ", None, f"{_GPIB_SETTING}; {section}")
+
+
+def _r(request: str, answer: str, section: str) -> Expect:
+    return Expect(request + " ", answer, f"{_ACL} {section}")
+
+
+WILLIAMSEA = DataClient(
+    "williamsea Acutrol (C#)", "acutrol3000", "williamsea/Acutrol@0f6be385c44abd2ce9e8fa277a4b47f235c98f26",
+    "none stated", "request lists replayed over the proxy onto the simulator's serial line (the client: NI VisaNS "
+    "GPIB, each message ' \\n'-terminated as it writes it)", "\n", "\n", 0.3, (
+        Method("SelectMode", f"{_FORM} SelectMode (':M:'+mode+' 1 \\n': P, R, A, S)", "SelectMode(P); SelectMode(R); "
+               "SelectMode(A); SelectMode(S)",
+               (_w(":M:P 1", "§4.7.4 Mode:Position"), _w(":M:R 1", "§4.7.5 Mode:Rate"),
+                _w(":M:A 1", "§4.7.1 Mode:Arate"), _w(":M:S 1", "§4.7.6 Mode:Synthesis"))),
+        Method("ReadParameter", f"{_FORM} ReadParameter (':u:f f ; :R:'+P|R|A+' 1 \\n', then ReadString)",
+               "ReadParameter(P); (R); (A)",
+               tuple(_r(f":u:f f ; :R:{p} 1", _N, "§4.14.1 Utility:Format FLOat; §4.10 Read (no '?': ACT2000)")
+                     for p in ("P", "R", "A"))),
+        Method("ReadOvarParameter", f"{_FORM} ReadOvarParameter (called only from commented-out code)",
+               "ReadOvarParameter(1)", (_r(":u:f f ; :r:o 1", _N, "§4.14.1; Table 5 :Read:Ovariable"),)),
+        Method("CommendParameter", f"{_FORM} CommendParameter (':D:'+P|R|A+' 1, '+text+' \\n')",
+               "CommendParameter(P, 10); (R, 5); (A, 2)",
+               (_w(":D:P 1, 10", "§4.3.5 Demand:Position"), _w(":D:R 1, 5", "§4.3.6 Demand:Rate"),
+                _w(":D:A 1, 2", "§4.3.1 Demand:Acceleration"))),
+        Method("CommendSinusoidal", f"{_FORM} CommendSinusoidal", "CommendSinusoidal(2, 0.5, 0)",
+               (_w(":D:O 1, 2, 0.5, 0", "§4.3.4 Demand:Oscillator"),)),
+        Method("SetAllLimits", f"{_FORM} SetAllLimits (per mode P, R, S; abort A; velocity trip)", "SetAllLimits()",
+               (_w(":L :L P 1 -10; :L :H P 1 10", "§4.6.7 / 4.6.6 Limit:LowPosition / HighPosition"),
+                _w(":L :R P 1 20", "§4.6.8 Limit:Rate"), _w(":L :A P 1 50", "§4.6.2 Limit:Acceleration"),
+                _w(":L :R A 1 20", "§4.6.8 Limit:Rate (abort mode)"), _w(":L :V P 1 30", "§4.6.9 Limit:VelocityTrip"))),
+        Method("SetupWindows", f"{_FORM} SetupWindows / button_default_windows_Click (':C:W n, code  \\n')",
+               "SetupWindows('1', Estimated Position)", (Expect(":C:W 1, 1082  ", None, f"{_GPIB_SETTING}; Table 5 "
+                                                                ":Configure:Window"),)),
+        Method("Interlock_Open", f"{_FORM} Interlock_Open", "Interlock_Open()",
+               (Expect(":I:O 1  ", None, f"{_GPIB_SETTING}; §4.5.5 Interlock:Open"),)),
+        Method("Interlock_Close", f"{_FORM} Interlock_Close", "Interlock_Close()",
+               (Expect(":I:C 1  ", None, f"{_GPIB_SETTING}; §4.5.1 Interlock:Close"),)),
+        Method("button_interlock_reset_Click", f"{_FORM} button_interlock_reset_Click", "(button)",
+               (_w(":I:R", "§4.5.6 Interlock:Reset"),)),
+        Method("button_ECP_Click", f"{_FORM} button_ECP_Click (touch sequence, no leading colon)", "(button)",
+               (_w("u:t 179,179,176,32,152,151,32,50,176,181,181,181", "Table 5 :Utility:Touch (Table 8: behaves "
+                   "differently; legacy touch sequences 'will not function as expected', §1)"),)),
+        Method("button_cut_analog_input_Click", f"{_FORM} button_cut_analog_input_Click", "(button)",
+               (_w(":u:t 180,177,178,50,32,144,32,176,181,179,50,32,144,32,176,181,181,181", "Table 5 :Utility:Touch (Table 8)"),)),
+    ))
+
+DATA_CLIENTS: tuple[DataClient, ...] = (F4T_SCPI, IEAV, ACUTRONIC_ROBOTICS, WILLIAMSEA)
