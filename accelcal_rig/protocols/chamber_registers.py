@@ -5,6 +5,7 @@ Addresses are zero-based Modbus PDU addresses (what goes on the wire), not "4xxx
 
 from __future__ import annotations
 
+import struct
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
@@ -54,12 +55,23 @@ WATLOW_F4 = ChamberRegisterMap(
 )
 
 #: Watlow F4T (Data Map 1): float32, low word first by default; set point 2782, process value 2820;
-#: event 1 "Power" at 16594 (63 on, 62 off); alarm 1 state at 1356 (88, 61 and 12 inactive). It has no
-#: identity or units register in its map, so only the values' plausibility identifies it.
+#: event 1 "Power" at 16594 (63 on, 62 off); alarm 1 state at 1356 (88, 61 and 12 inactive); loop 1's set
+#: point low / high limits at 2774 / 2776 (ESPEC's ChamberConnectLibrary, watlowf4t.py get_loop_range and
+#: set_loop_range). It has no identity or units register in its map, so only the values' plausibility
+#: identifies it.
 WATLOW_F4T = ChamberRegisterMap(
     encoding="float32", word_order="little", process_value=2820, setpoint=2782,
     power_register=16594, power_on=63, power_off=62, alarm_register=1356, alarm_inactive=[88, 61, 12],
+    setpoint_low_register=2774, setpoint_high_register=2776,
 )
+
+def encode_temperature(m: ChamberRegisterMap, temperature_c: float) -> list[int]:
+    """A temperature in the map's encoding: a float's two words in its order, or a scaled signed register."""
+    if m.encoding == "float32":
+        high, low = struct.unpack(">HH", struct.pack(">f", temperature_c))
+        return [low, high] if m.word_order == "little" else [high, low]
+    return [int(round(temperature_c * 10**m.decimals)) & 0xFFFF]
+
 
 PROFILES: dict[str, ChamberRegisterMap] = {"watlow-f4": WATLOW_F4, "watlow-f4t": WATLOW_F4T}
 

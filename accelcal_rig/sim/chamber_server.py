@@ -1,14 +1,17 @@
 """A simulated chamber controller on the wire: a pymodbus TCP server on 127.0.0.1 serving a register map.
 
 Any Modbus master can talk to it. Each request is answered from the virtual lab at the shared clock's
-time; a set-point or power write goes into the lab. Registers outside the map do not exist (Modbus
-exception 2), as on a real controller; a value it cannot take (half a float, a NaN or infinite set point,
-an output value the map does not name) is exception 3, illegal data value, and changes nothing.
+time; a set-point, set-point limit or power write goes into the lab. Beside the driver's map it serves the
+controller's panel (sim/register_panels.py: what the maker's own library reads and writes). Registers outside
+both do not exist (Modbus exception 2), as on a real controller; a value it cannot take (half a float, a NaN or
+infinite set point, limits that cross, an output value the map does not name) is exception 3, illegal data
+value, and changes nothing.
 """
 
 from __future__ import annotations
 
 import asyncio
+import datetime as dt
 import math
 import struct
 import threading
@@ -18,9 +21,10 @@ from pymodbus.server import ModbusTcpServer
 from pymodbus.simulator import DataType, SimData, SimDevice
 
 from accelcal_rig.config.rig import ChamberConfig
-from accelcal_rig.protocols.chamber_registers import ChamberRegisterMap
+from accelcal_rig.protocols.chamber_registers import ChamberRegisterMap, encode_temperature
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
+from accelcal_rig.sim.register_panels import PanelRegister, PanelState, panel_for
 
 _STARTUP_TIMEOUT_S = 10.0
 #: A dropped request is answered this late (wall clock): after any sane client timeout, to a client that
@@ -31,8 +35,10 @@ _DROPPED_REPLY_LATE_S = 5.0
 class SimulatedChamberServer:
     def __init__(self, lab: VirtualLab, registers: ChamberRegisterMap, device_id: int = 1,
                  host: str = "127.0.0.1", port: int = 0, faults: ReplyFaults | None = None,
-                 stall_after_s: float | None = None) -> None:
+                 stall_after_s: float | None = None, panel: tuple[PanelRegister, ...] = ()) -> None:
         self._lab = lab
+        self._panel = {register.address: register for register in panel}
+        self._panel_state = PanelState(clock_start=dt.datetime.now(dt.UTC).replace(microsecond=0, tzinfo=None))
         self._faults = faults
         self._stall_after_s = stall_after_s
         self._map = registers
@@ -96,10 +102,15 @@ class SimulatedChamberServer:
         m = self._map
         width = 2 if m.encoding == "float32" else 1
         addresses = {m.process_value: width, m.setpoint: width}
+        for register in (m.setpoint_low_register, m.setpoint_high_register):
+            if register is not None:
+                addresses[register] = width
         for register in (m.identity_register, m.decimals_register, m.units_register, m.power_register,
-                         m.alarm_register, m.setpoint_low_register, m.setpoint_high_register, m.purge_register):
+                         m.alarm_register, m.purge_register):
             if register is not None:
                 addresses[register] = 1
+        for panel in self._panel.values():
+            addresses.setdefault(panel.address, panel.count)
         return [SimData(address=a, count=n, datatype=DataType.REGISTERS) for a, n in sorted(addresses.items())]
 
     async def _action(self, function_code: int, start_address: int, address: int, count: int,
@@ -144,6 +155,16 @@ class SimulatedChamberServer:
             if self._stall_after_s is None or now < self._stall_after_s:
                 self._lab.thermal.set_setpoint(now, setpoint)  # a stalled chamber takes it but does not follow
             self.last_setpoint_c = setpoint
+        refused = self._write_limits(requested, values, address)
+        if refused is not None:
+            return refused
+        for panel in self._panel.values():
+            if panel.address in requested:
+                words = values[panel.address - address:panel.address - address + panel.count]
+                if panel.write is None:
+                    return ExcCodes.ILLEGAL_ADDRESS
+                if len(words) < panel.count or not panel.write(self._panel_state, self._lab, words):
+                    return ExcCodes.ILLEGAL_VALUE
         if m.power_register is not None and m.power_register in requested:
             value = values[m.power_register - address]
             if value not in (m.power_on, m.power_off):
@@ -154,6 +175,27 @@ class SimulatedChamberServer:
             if value not in (m.purge_on, m.purge_off):
                 return ExcCodes.ILLEGAL_VALUE
             self._lab.moisture.set_purge(now, value == m.purge_on)
+        return None
+
+    def _write_limits(self, requested: range, values: list[int], address: int) -> ExcCodes | None:
+        """The controller's set point limits, written as ESPEC's library's set_loop_range writes them (high, then
+        low): limits that would cross, or are not finite, are refused and kept."""
+        m = self._map
+        width = 2 if m.encoding == "float32" else 1
+        low, high = self._lab.controller_limits_c
+        for register, is_low in ((m.setpoint_low_register, True), (m.setpoint_high_register, False)):
+            if register is None or register not in requested:
+                continue
+            words = values[register - address:register - address + width]
+            if len(words) < width:
+                return ExcCodes.ILLEGAL_VALUE
+            value = self._decode(words)
+            if not math.isfinite(value):
+                return ExcCodes.ILLEGAL_VALUE
+            low, high = (value, high) if is_low else (low, value)
+        if low >= high:
+            return ExcCodes.ILLEGAL_VALUE
+        self._lab.controller_limits_c = (low, high)
         return None
 
     def _values(self, requested: range) -> dict[int, list[int]]:
@@ -178,14 +220,13 @@ class SimulatedChamberServer:
         if m.setpoint_low_register is not None and m.setpoint_high_register is not None:
             low, high = self._lab.controller_limits_c
             values[m.setpoint_low_register], values[m.setpoint_high_register] = self._encode(low), self._encode(high)
+        for panel in self._panel.values():
+            if not set(requested).isdisjoint(range(panel.address, panel.address + panel.count)):
+                values.setdefault(panel.address, panel.read(self._panel_state, self._lab))
         return values
 
     def _encode(self, temperature_c: float) -> list[int]:
-        m = self._map
-        if m.encoding == "float32":
-            high, low = struct.unpack(">HH", struct.pack(">f", temperature_c))
-            return [low, high] if m.word_order == "little" else [high, low]
-        return [int(round(temperature_c * 10**m.decimals)) & 0xFFFF]
+        return encode_temperature(self._map, temperature_c)
 
     def _decode(self, words: list[int]) -> float:
         m = self._map
@@ -197,5 +238,7 @@ class SimulatedChamberServer:
 
 def serve_modbus(lab: VirtualLab, config: ChamberConfig, faults: InstrumentFaults) -> SimulatedChamberServer:
     """The Modbus chamber drivers' simulator: the config's register map on Modbus TCP (RTU too)."""
-    return SimulatedChamberServer(lab, config.register_map(), config.device_id, faults=faults.replies,
-                                  stall_after_s=faults.after_s(faults.settings.chamber_stall_after_min))
+    registers = config.register_map()
+    return SimulatedChamberServer(lab, registers, config.device_id, faults=faults.replies,
+                                  stall_after_s=faults.after_s(faults.settings.chamber_stall_after_min),
+                                  panel=panel_for(config.profile, registers))

@@ -45,10 +45,12 @@ from accelcal_rig.protocols.turntable_line import ACUTROL3000
 from accelcal_rig.sim.chamber_line_server import SimulatedLineChamberServer
 from accelcal_rig.sim.chamber_server import SimulatedChamberServer
 from accelcal_rig.sim.lab import VirtualLab
+from accelcal_rig.sim.register_panels import panel_for
 from accelcal_rig.sim.turntable_server import SimulatedTurntableServer
 from tests.conftest import SIM_RIG
 from tests.protocols.client_requests import DATA_CLIENTS, DataClient, Expect
 from tests.protocols.maker_requests import NOT_SIMULATED as CHAMBER_NOT_SIMULATED
+from tests.protocols.modbus_requests import not_simulated as modbus_not_simulated
 from tests.protocols.turntable_requests import NOT_SIMULATED as TURNTABLE_NOT_SIMULATED
 
 CHILD = Path(__file__).with_name("client_sweep_child.py")
@@ -308,7 +310,7 @@ def simulator(kind: str, profile: str, options: dict[str, object]) -> Iterator[t
     if kind == "line":
         server = SimulatedLineChamberServer(lab, line_protocol(profile), "tcp", **options)  # type: ignore[arg-type]
     elif kind == "modbus":
-        server = SimulatedChamberServer(lab, register_map(profile))
+        server = SimulatedChamberServer(lab, register_map(profile), panel=panel_for(profile, register_map(profile)))
     else:
         server = SimulatedTurntableServer(lab, ACUTROL3000)
     server.start()
@@ -710,6 +712,9 @@ class ClientLimit:
 
 
 CLIENT_LIMITS: tuple[ClientLimit, ...] = (
+    *(ClientLimit(f"ChamberConnectLibrary {name}", r"^sample$", r"NoneType",
+                  "sample()'s default lookup=None is indexed before it is checked (controllerinterface.py:1046-1047): "
+                  "the library's own bug; every request it sent was answered") for name in ("WatlowF4", "WatlowF4T")),
     ClientLimit("PyMeasure Thermotron3800, PyVISA's terminations", r".*", r"VI_ERROR_TMO",
                 "PyVISA's TCPIP SOCKET resource has no read termination unless one is given: the reply came (see "
                 "the wire) and was read only up to the timeout; a Thermotron3800 on a socket needs read_termination"),
@@ -745,6 +750,10 @@ for _request, _client, _where, _why in TURNTABLE_NOT_SIMULATED:
 
 def listed(profile: str, exchange: Exchange) -> str | None:
     """Why the request is not simulated, where it is already listed so; None: not listed."""
+    register = re.match(r"(?:read holding|write) (\d+)", exchange.text)
+    if register is not None:
+        entry = modbus_not_simulated(profile, int(register.group(1)))
+        return f"{entry.why} (modbus_requests.NOT_SIMULATED: {entry.client} {entry.where})" if entry else None
     return LISTED.get(profile, {}).get(_shape(exchange.text))
 
 
