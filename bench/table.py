@@ -258,7 +258,7 @@ BENCHES: tuple[Bench, ...] = (
     Bench("dry_run_paper", "dry_run_paper.py", ("--runs", "3", "--json"), about="2 min", rows=(
         Row("the paper campaign's dry run, whole process: `rig run procedures/paper-24pos-thermal.yaml --dry-run` "
             "(432 poses × 4 ADXL355 through the wire-level simulators, the fit, four certificates with PDFs)",
-            dry_run_paper, "< 20 s (DESIGN §8)", lambda r: r["wall_median_s"] < 20),
+            dry_run_paper, "< 20 s (the design's)", lambda r: r["wall_median_s"] < 20),
         Row("the same campaign alone (fit incl., imports and certificates excl.): through the wires against the "
             "in-process simulated instruments, interleaved",
             lambda r: (f"{r['campaign_alone']['wire_median_s']:.2f} s / {r['campaign_alone']['in_process_median_s']:.2f} s "
@@ -353,7 +353,7 @@ BENCHES: tuple[Bench, ...] = (
     Bench("dashboard", "dashboard.py", ("--json",), about="1 min", rows=(
         Row("the dashboard (`rig serve`, over HTTP on loopback) watching copies of the paper campaign's dry run "
             "(432 poses × 4 DUTs each): the front page, first load (every campaign read from its journal)",
-            lambda r: f"{1e3 * r['first_front_page_s']:,.0f} ms ({r['campaigns']} campaigns)"),
+            lambda r: f"{thousands(1e3 * r['first_front_page_s'])} ms ({r['campaigns']} campaigns)"),
         Row("the same, later loads (each campaign read again only when it changes; medians): the front page / "
             "`/api/campaigns` (what the page polls) / one campaign's page",
             lambda r: (f"**{1e3 * r['front_page_s']:.1f}** / {1e3 * r['campaigns_json_s']:.1f} / "
@@ -524,8 +524,8 @@ def row_value(bench: Bench, row: Row, stored: Output | None) -> str:
             try:
                 verdict = ": met" if row.met(output) else ": **not met**"
             except (KeyError, IndexError, TypeError, StopIteration):
-                verdict = ""
-        value += f" (target {row.target}{verdict})"
+                verdict = ""   # the stored run did not measure what the target is about
+        value += f" — target {row.target}{verdict}"
     if stored.get("exit_code", 0) != 0:
         value += f" (the bench exited {stored['exit_code']})"
     if stored.get("hand_written"):
@@ -540,36 +540,39 @@ def load_results(results: Path) -> dict[str, Output]:
 INTRO = """\
 # Performance and accuracy
 
-<!-- Written by `python bench/table.py write` from bench/results/*.json: edit the script, not this page. -->
+<!-- Written by `python bench/table.py write` from bench/results/*.json: edit the script or re-run a bench,
+not this page. -->
 
-Each row is one figure a bench measures: what it is, the command that measured it, the value (with the target
-or bound it is held to, and whether it met it), and the date and commit of that run (UTC; "+dirty": tracked
-files differed from the commit). The figures come from the simulated rig's dry runs, on the machine of the
-run (the results file in `bench/results/` names its cores, Python and load average): wall-clock figures move
-with the machine's load, so compare figures of the same hour, not of this table's rows against each other.
-A command with fewer seeds, runs or sizes than the bench's default is its quick form.
+Each row is one figure a bench measures: what it is, the command that measured it, its value (with the target
+or bound it is held to, and whether the run met it), and the date (UTC) and commit of that run ("+dirty":
+tracked files differed from the commit). The figures are of the simulated rig's dry runs and the software
+around them, on the machine of the run: its results file in `bench/results/` names the cores, the Python and
+the load average at the start. Wall-clock figures move with the machine's load, so compare figures measured
+in the same hour, not rows of different dates. A command with fewer seeds, runs or sizes than the bench's
+default is its quick form.
 
-Re-measure one figure, or all, and rewrite this page:
+Re-measure a figure, or all of them, and rewrite this page (the benches import the checkout the script is in):
 
-    python bench/table.py run BENCH              # e.g. startup; stores bench/results/BENCH.json
-    python bench/table.py run --quick            # every bench, each in under ~3 minutes (fewer seeds or runs)
-    python bench/table.py run                    # every bench in full (the slowest take an hour)
-    python bench/table.py write                  # this page from bench/results/
-    python bench/table.py list                   # the benches and their commands, full and quick
+    python bench/table.py run BENCH …    # e.g. startup: stores bench/results/startup.json
+    python bench/table.py run --quick    # every bench, each in a form of under ~3 minutes (fewer seeds or runs)
+    python bench/table.py run            # every bench in full (the slowest take an hour)
+    python bench/table.py write          # this page, from bench/results/
+    python bench/table.py list           # the benches, their full and quick commands
 
-Not here: the kill, disk-full, concurrency, signal, fault and fuzz trials (`bench/reliability.py`,
-`bench/follow_up.py`, `bench/fuzz.py`, `bench/registry_first_use.py`), whose figures are in
-[reliability.md](reliability.md#figures) and [registry.md](registry.md); benches with no `--json` mode yet
-(`bench/fit_accuracy.py`, `bench/operator.py`, `bench/ramp_vs_soak.py`, `bench/wire_round_trips.py`). The
-CI row has no bench: its results file (`bench/results/ci.json`) is copied by hand from a recorded CI run and
-says so. The figures of past issues, measured along the way, are in this page's git history
-(`git log -p docs/performance.md`).
+Not in the table: the kill, disk-full, concurrency, signal, fault and fuzz trials (`bench/reliability.py`,
+`bench/follow_up.py`, `bench/fuzz.py`, `bench/registry_first_use.py`; their figures are in
+[reliability.md](reliability.md#figures) and [registry.md](registry.md)), and the benches with no `--json`
+mode yet (`bench/fit_accuracy.py`, `bench/operator.py`, `bench/ramp_vs_soak.py`, `bench/wire_round_trips.py`).
+The CI row has no bench: its results file is copied by hand from a recorded CI run, and its row says so. The
+figures of past issues, and how each was reached, are in this page's history: `git log -p docs/performance.md`.
 """
 
 
 def render(results: Path) -> str:
     """The page: the intro, then one table of every bench's rows, measured or not."""
     stored = load_results(results)
+    for name in sorted(set(stored) - set(BY_NAME)):
+        print(f"{results / name}.json: no bench of that name in BENCHES, left out", file=sys.stderr)
     lines = [INTRO, "| figure | command | value | date | commit |", "|---|---|---|---|---|"]
     for bench in BENCHES:
         found = stored.get(bench.name)
