@@ -71,14 +71,14 @@ class Bench:
 
 
 def thousands(value: float) -> str:
-    """12 345 678: a thin-space-free group of three, as the docs write counts."""
+    """12 345 678: groups of three digits split by a space, as the docs write large counts."""
     return f"{value:,.0f}".replace(",", " ")
 
 
-def span(values: Sequence[float], fmt: str = ".2f", unit: str = "") -> str:
-    """'a … b unit', or one value when all are the same."""
+def span(values: Sequence[float], fmt: str = ".2f") -> str:
+    """'low … high', or the one value when they print the same."""
     low, high = min(values), max(values)
-    return f"{low:{fmt}}{unit}" if f"{low:{fmt}}" == f"{high:{fmt}}" else f"{low:{fmt}} … {high:{fmt}}{unit}"
+    return f"{low:{fmt}}" if f"{low:{fmt}}" == f"{high:{fmt}}" else f"{low:{fmt}} … {high:{fmt}}"
 
 
 def method(output: Output, name: str) -> Output:
