@@ -255,7 +255,7 @@ UNCERTAINTY_HONEST = {"soak": "soak (`paper-24pos-thermal`)", "ramp": "ramp (`pa
 
 #: Every bench the table shows, in the page's order, each with its rows. A bench not here is not run by `run`.
 BENCHES: tuple[Bench, ...] = (
-    Bench("dry_run_paper", "dry_run_paper.py", ("--runs", "3", "--json"), about="2 min", rows=(
+    Bench("dry_run_paper", "dry_run_paper.py", ("--runs", "3", "--json"), about="1 min", rows=(
         Row("the paper campaign's dry run, whole process: `rig run procedures/paper-24pos-thermal.yaml --dry-run` "
             "(432 poses × 4 ADXL355 through the wire-level simulators, the fit, four certificates with PDFs)",
             dry_run_paper, "< 20 s (the design's)", lambda r: r["wall_median_s"] < 20),
@@ -265,24 +265,23 @@ BENCHES: tuple[Bench, ...] = (
                        f"= **{r['campaign_alone']['ratio']:.2f} ×** (medians)"),
             "≤ 2 ×", lambda r: r["campaign_alone"]["ratio"] <= 2),
     )),
-    Bench("dry_run_ab", "dry_run_ab.py", ("--runs", "3", "--json"), quick=("--runs", "1", "--json"), about="4 min", rows=(
+    Bench("dry_run_ab", "dry_run_ab.py", ("--runs", "3", "--json"), quick=("--runs", "1", "--json"), about="1.5 min", rows=(
         Row("the IMU paper dry run (`paper-24pos-imu.yaml`: 432 poses × 4 ICM-42688-P, the FIFO captured by the "
             "bridge) against the ADXL355 paper dry run (the same poses × 4), `--no-pdf --no-publish --seed 11`, "
             "alternated pair by pair", dry_run_ab, "IMU ≤ 2 × ADXL355", lambda r: r["ratio_median"] <= 2),
     )),
-    Bench("imu_paper", "imu_paper.py", ("--json",), about="1 min", rows=(
+    Bench("imu_paper", "imu_paper.py", ("--json",), about="15 s", rows=(
         Row("the paper campaign on four ICM-42688-P (`paper-24pos-imu.yaml`, seed 11): `rig run --dry-run --no-pdf`, "
             "whole process", lambda r: f"{r['wall_s']:.1f} s wall"),
         Row("its accelerometers: each IMU's verification \\|g\\| RMSE over its expected fit RMSE", imu_paper,
             "≤ 1.2 ×", lambda r: r["worst_ratio"] <= 1.2),
     )),
-    Bench("large_fixture", "large_fixture.py", ("--json",), quick=("--sizes", "4,16", "--json"), about="3 min", rows=(
+    Bench("large_fixture", "large_fixture.py", ("--json",), quick=("--sizes", "4,16", "--json"), about="1.5 min", rows=(
         Row("the paper dry run (432 poses, the fit of every DUT, `--no-pdf`) by fixture size, each DUT behind its own "
             "simulated bridge, one `rig run` process each: wall time", large_fixture, "64 DUTs < 30 s",
             large_fixture_64),
     )),
-    Bench("throughput", "throughput.py", ("--seeds", "3", "--json"), about="30 min",
-          quick=("--quick", "--methods", "bidirectional-ramp", "--json"), rows=(
+    Bench("throughput", "throughput.py", ("--seeds", "3", "--json"), about="5 min", quick=("--quick", "--json"), rows=(
         Row(f"the fast method (bidirectional ramp, `fast-bidirectional-ramp.yaml`), {THROUGHPUT_RIG}: rig time",
             fast_rig_time),
         Row("the fast method: each DUT's verification \\|g\\| RMSE over its expected RMSE (what the noise alone "
@@ -297,8 +296,8 @@ BENCHES: tuple[Bench, ...] = (
         Row("the one-way ramp (`paper-24pos-ramp.yaml`, 0.5 °C/min), the same rig and sensors",
             lambda r: throughput_method(r, "ramp")),
     )),
-    Bench("imu_throughput", "imu_throughput.py", ("--seeds", "2", "--methods", "fast,soak", "--json"), about="12 min",
-          quick=("--quick", "--methods", "fast", "--json"), rows=(
+    Bench("imu_throughput", "imu_throughput.py", ("--seeds", "2", "--methods", "fast,soak", "--json"), about="5 min",
+          quick=("--quick", "--methods", "fast,soak", "--json"), rows=(
         Row(f"the fast IMU method (`imu-fast.yaml`, the bidirectional ramp with poses and rate steps in every band), "
             f"{IMU_RIG}: rig time", lambda r: imu_rig_time(r, "fast"), "≤ 6 h",
             lambda r: method(r, "fast")["rig_hours_worst"] <= 6),
@@ -319,7 +318,7 @@ BENCHES: tuple[Bench, ...] = (
             "soak time (longest soak), worst verification \\|g\\| RMSE / residual drift", lambda r: soak_criteria(r, 4)),
         Row("the same with 64 DUTs", lambda r: soak_criteria(r, 64)),
     )),
-    Bench("uncertainty", "uncertainty.py", ("--runs", "10", "--json"), quick=("--runs", "3", "--json"), about="6 min",
+    Bench("uncertainty", "uncertainty.py", ("--runs", "10", "--json"), quick=("--runs", "3", "--json"), about="2 min",
           rows=tuple(
         Row(f"is the stated uncertainty true? Dry runs of the paper campaign (new noise, the same sensors) fitted in "
             f"both modes, {site}: each verification pose's axis errors against the truth inside U (k = 2)",
@@ -327,15 +326,15 @@ BENCHES: tuple[Bench, ...] = (
             lambda r, site=site: within([r[f"{site}, {m}"]["observed_coverage_k2"] for m in ("reference", "norm-only")],
                                         0.93, 0.97))
         for site in ("standard gravity", "site gravity 9.8123 ± 0.0002 m/s²"))),
-    Bench("uncertainty_honest", "uncertainty.py", ("--honest", "--runs", "10", "--json"), about="60 min",
-          quick=("--honest", "--method", "bidirectional-ramp", "--runs", "1", "--json"), rows=tuple(
+    Bench("uncertainty_honest", "uncertainty.py", ("--honest", "--runs", "10", "--json"), about="20 min",
+          quick=("--honest", "--runs", "1", "--json"), rows=tuple(
         Row(f"the same on bench/throughput.py's honest rig (16 DUTs, the sensors' effects), {label}, fitted as the "
             f"procedure says: axis errors against the truth inside U (k = 2)",
             lambda r, name=name: uncertainty_honest(r, name), "93–97 %",
             lambda r, name=name: 0.93 <= r["methods"][name]["coverage_k2"] <= 0.97)
         for name, label in UNCERTAINTY_HONEST.items())),
     Bench("gyro_coverage", "gyro_coverage.py", ("--seeds", "6", "--json"), quick=("--seeds", "1", "--json"),
-          about="20 min", rows=(
+          about="2 min", rows=(
         Row("a gyroscope's calibration over dry runs (tests/fit/test_gyro_fit.py's IMU campaign, −40 … 60 °C in 5 "
             "setpoints, degree 3, 120 s noise records, verified between the setpoints): k = 2 coverage against the truth",
             lambda r: (f"**{r['coverage_k2_mean']:.3f}** over {r['runs'] * r['duts_per_run']} IMUs (per IMU "
@@ -343,14 +342,14 @@ BENCHES: tuple[Bench, ...] = (
             "93–97 %", lambda r: 0.93 <= r["coverage_k2_mean"] <= 0.97),
         Row("the same runs: truth errors in units of their σ, rate errors, noise figures, wall time", gyro_figures),
     )),
-    Bench("dashboard_load", "dashboard_load.py", ("--json",), about="3 min", rows=tuple(
+    Bench("dashboard_load", "dashboard_load.py", ("--json",), about="1.5 min", rows=tuple(
         Row(f"`rig serve` under load (open pages polling the rigs fragment and the campaigns list, event-stream "
             f"clients, a flood of wrong logins), {label}: `/`, a published campaign's live page and a static file "
             f"fetched over and over from 1 s in; the server's memory", lambda r, key=key: dashboard_load(r, key),
             "p99 of `/` ≤ 1 s", lambda r, key=key: dashboard_registry(r, key)["/"]["p99_s"] <= 1.0)
         for key, label in (("sqlite", "SQLite registry"), ("postgresql", "PostgreSQL registry (a private server)"),
                            ("silent postgresql", "a PostgreSQL registry that accepts connections and never answers")))),
-    Bench("dashboard", "dashboard.py", ("--json",), about="1 min", rows=(
+    Bench("dashboard", "dashboard.py", ("--json",), about="15 s", rows=(
         Row("the dashboard (`rig serve`, over HTTP on loopback) watching copies of the paper campaign's dry run "
             "(432 poses × 4 DUTs each): the front page, first load (every campaign read from its journal)",
             lambda r: f"{thousands(1e3 * r['first_front_page_s'])} ms ({r['campaigns']} campaigns)"),
@@ -359,7 +358,7 @@ BENCHES: tuple[Bench, ...] = (
             lambda r: (f"**{1e3 * r['front_page_s']:.1f}** / {1e3 * r['campaigns_json_s']:.1f} / "
                        f"{1e3 * r['campaign_page_s']:.1f} ms")),
     )),
-    Bench("live_status", "live_status.py", ("--runs", "3", "--json"), about="3 min", rows=(
+    Bench("live_status", "live_status.py", ("--runs", "3", "--json"), about="2 min", rows=(
         Row("publishing live status: the paper dry run publishing to an SQLite registry against `--no-publish`, "
             "alternated, medians",
             lambda r: (f"{r['publish']['with_s']:.2f} s against {r['publish']['without_s']:.2f} s: ratio "
@@ -377,7 +376,7 @@ BENCHES: tuple[Bench, ...] = (
         Row("its queries: a serial's history / its valid calibration / its trend; one stored fit; a date-filtered "
             "list (fits left out); a part's lot statistics", registry_queries),
     )),
-    Bench("startup", "startup.py", ("--runs", "20", "--json"), about="10 s", rows=(
+    Bench("startup", "startup.py", ("--runs", "20", "--json"), about="5 s", rows=(
         Row("`rig --help`, whole process: wall time (median over the runs, after a warm-up) and the heavy libraries "
             "it imports",
             lambda r: f"**{r['median_wall_ms']:.0f} ms**; imports {', '.join(r['heavy_imports']) or 'none of them'}",
@@ -391,7 +390,7 @@ BENCHES: tuple[Bench, ...] = (
             lambda r: f"**{thousands(r['captured']['samples_per_s'])}** / {thousands(r['drained']['samples_per_s'])} samples/s",
             "> 4000 /s", lambda r: min(r["captured"]["samples_per_s"], r["drained"]["samples_per_s"]) > 4000),
     )),
-    Bench("firmware_throughput", "firmware_throughput.py", ("--seconds", "10", "--json"), about="30 s", rows=(
+    Bench("firmware_throughput", "firmware_throughput.py", ("--seconds", "10", "--json"), about="15 s", rows=(
         Row("the reference bridge firmware (`firmware/`, built for the host in front of its C model of an ADXL355, on a "
             "pseudo-terminal) through the project's driver: back-to-back captures at 4000 Hz",
             lambda r: (f"**{thousands(r['sustained']['samples_per_s'])} gap-free samples/s** "
