@@ -75,6 +75,11 @@ def thousands(value: float) -> str:
     return f"{value:,.0f}".replace(",", " ")
 
 
+def count(n: int, noun: str) -> str:
+    """'1 seed', '3 seeds'."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
 def span(values: Sequence[float], fmt: str = ".2f") -> str:
     """'low … high', or the one value when they print the same."""
     low, high = min(values), max(values)
@@ -122,18 +127,18 @@ def imu_accuracy(r: Output, name: str) -> str:
     m = method(r, name)
     return (f"accelerometer median {m['accel']['ratio_median_of_medians']:.2f} ×, worst **{m['accel']['ratio_worst']:.2f} ×**; "
             f"gyroscope median {m['gyro']['ratio_median_of_medians']:.2f} ×, worst **{m['gyro']['ratio_worst']:.2f} ×** "
-            f"(worst IMU of {m['seeds']} seed(s))")
+            f"(worst IMU of {count(m['seeds'], 'seed')})")
 
 
 def imu_coverage(r: Output, name: str) -> str:
     m = method(r, name)
     return (f"accelerometer **{span(m['accel']['coverage_k2_range'], '.3f')}**, gyroscope "
-            f"**{span(m['gyro']['coverage_k2_range'], '.3f')}** (over {m['seeds']} seed(s))")
+            f"**{span(m['gyro']['coverage_k2_range'], '.3f')}** (over {count(m['seeds'], 'seed')})")
 
 
 def imu_rig_time(r: Output, name: str) -> str:
     m = method(r, name)
-    return f"**{m['rig_hours_median']:.2f} h** (median of {m['seeds']} seed(s); longest {m['rig_hours_worst']:.2f} h)"
+    return f"**{m['rig_hours_median']:.2f} h** (median of {count(m['seeds'], 'seed')}; longest {m['rig_hours_worst']:.2f} h)"
 
 
 FAST = "bidirectional-ramp"
@@ -142,13 +147,13 @@ FAST = "bidirectional-ramp"
 def fast_rig_time(r: Output) -> str:
     m = method(r, FAST)
     return (f"**{m['rig_hours']:.2f} h** ({m['rig_hours_per_dut']:.3f} h per DUT, {m['rig_time_over_lower_bound']:.2f} × "
-            f"the lower bound of {m['lower_bound_hours']:.2f} h; median of {m['seeds']} seed(s))")
+            f"the lower bound of {m['lower_bound_hours']:.2f} h; median of {count(m['seeds'], 'seed')})")
 
 
 def fast_verification(r: Output) -> str:
     m = method(r, FAST)
     return (f"median DUT {m['verification_over_expected_median']:.2f} ×, worst DUT **{m['verification_over_expected']:.3f} ×** "
-            f"(median over {m['seeds']} seed(s); the worst of any seed {m['verification_over_expected_any_seed']:.2f} ×)")
+            f"(median over {count(m['seeds'], 'seed')}; the worst of any seed {m['verification_over_expected_any_seed']:.2f} ×)")
 
 
 def fast_at_rest(r: Output) -> str:
@@ -165,7 +170,7 @@ def throughput_method(r: Output, name: str) -> str:
     return (f"rig {m['rig_hours']:.2f} h ({m['rig_hours_per_dut']:.3f} h per DUT, {m['rig_time_over_lower_bound']:.2f} × "
             f"the lower bound); worst DUT's verification RMSE {m['verification_over_expected']:.2f} × expected; residual "
             f"drift {m['residual_drift_mg']:.3f} mg; at rest {m['at_rest_rmse_mg']:.4f} mg RMSE, {m['at_rest_drift_mg']:.3f} mg "
-            f"drift; hysteresis {hysteresis} (median of {m['seeds']} seed(s))")
+            f"drift; hysteresis {hysteresis} (median of {count(m['seeds'], 'seed')})")
 
 
 def uncertainty_site(r: Output, site: str) -> str:
@@ -180,7 +185,7 @@ def uncertainty_site(r: Output, site: str) -> str:
 def uncertainty_honest(r: Output, name: str) -> str:
     m = r["methods"][name]
     return (f"**{100 * m['coverage_k2']:.2f} %** of {thousands(m['axis_errors'])} axis errors (error/u RMS {m['z_rms']:.2f}; "
-            f"per DUT and run {100 * m['per_dut_min']:.1f} … {100 * m['per_dut_max']:.1f} %; {m['runs']} run(s) × {m['duts']} DUTs)")
+            f"per DUT and run {100 * m['per_dut_min']:.1f} … {100 * m['per_dut_max']:.1f} %; {count(m['runs'], 'run')} × {m['duts']} DUTs)")
 
 
 def dashboard_registry(r: Output, registry: str) -> Output:
@@ -258,7 +263,7 @@ BENCHES: tuple[Bench, ...] = (
     Bench("dry_run_paper", "dry_run_paper.py", ("--runs", "3", "--json"), about="1 min", rows=(
         Row("the paper campaign's dry run, whole process: `rig run procedures/paper-24pos-thermal.yaml --dry-run` "
             "(432 poses × 4 ADXL355 through the wire-level simulators, the fit, four certificates with PDFs)",
-            dry_run_paper, "< 20 s (the design's)", lambda r: r["wall_median_s"] < 20),
+            dry_run_paper, "< 20 s", lambda r: r["wall_median_s"] < 20),
         Row("the same campaign alone (fit incl., imports and certificates excl.): through the wires against the "
             "in-process simulated instruments, interleaved",
             lambda r: (f"{r['campaign_alone']['wire_median_s']:.2f} s / {r['campaign_alone']['in_process_median_s']:.2f} s "
@@ -338,7 +343,7 @@ BENCHES: tuple[Bench, ...] = (
         Row("a gyroscope's calibration over dry runs (tests/fit/test_gyro_fit.py's IMU campaign, −40 … 60 °C in 5 "
             "setpoints, degree 3, 120 s noise records, verified between the setpoints): k = 2 coverage against the truth",
             lambda r: (f"**{r['coverage_k2_mean']:.3f}** over {r['runs'] * r['duts_per_run']} IMUs (per IMU "
-                       f"{span(r['coverage_k2_range'])}; {r['runs']} run(s))"),
+                       f"{span(r['coverage_k2_range'])}; {count(r['runs'], 'run')})"),
             "93–97 %", lambda r: 0.93 <= r["coverage_k2_mean"] <= 0.97),
         Row("the same runs: truth errors in units of their σ, rate errors, noise figures, wall time", gyro_figures),
     )),
