@@ -286,7 +286,7 @@ BENCHES: tuple[Bench, ...] = (
             "simulated bridge, one `rig run` process each: wall time", large_fixture, "64 DUTs < 30 s",
             large_fixture_64),
     )),
-    Bench("throughput", "throughput.py", ("--seeds", "3", "--json"), about="5 min", quick=("--quick", "--json"), rows=(
+    Bench("throughput", "throughput.py", ("--seeds", "3", "--json"), about="2.5 min", quick=("--quick", "--json"), rows=(
         Row(f"the fast method (bidirectional ramp, `fast-bidirectional-ramp.yaml`), {THROUGHPUT_RIG}: rig time",
             fast_rig_time),
         Row("the fast method: each DUT's verification \\|g\\| RMSE over its expected RMSE (what the noise alone "
@@ -301,7 +301,7 @@ BENCHES: tuple[Bench, ...] = (
         Row("the one-way ramp (`paper-24pos-ramp.yaml`, 0.5 °C/min), the same rig and sensors",
             lambda r: throughput_method(r, "ramp")),
     )),
-    Bench("imu_throughput", "imu_throughput.py", ("--seeds", "2", "--methods", "fast,soak", "--json"), about="5 min",
+    Bench("imu_throughput", "imu_throughput.py", ("--seeds", "2", "--methods", "fast,soak", "--json"), about="3.5 min",
           quick=("--quick", "--methods", "fast,soak", "--json"), rows=(
         Row(f"the fast IMU method (`imu-fast.yaml`, the bidirectional ramp with poses and rate steps in every band), "
             f"{IMU_RIG}: rig time", lambda r: imu_rig_time(r, "fast"), "≤ 6 h",
@@ -331,7 +331,7 @@ BENCHES: tuple[Bench, ...] = (
             lambda r, site=site: within([r[f"{site}, {m}"]["observed_coverage_k2"] for m in ("reference", "norm-only")],
                                         0.93, 0.97))
         for site in ("standard gravity", "site gravity 9.8123 ± 0.0002 m/s²"))),
-    Bench("uncertainty_honest", "uncertainty.py", ("--honest", "--runs", "10", "--json"), about="20 min",
+    Bench("uncertainty_honest", "uncertainty.py", ("--honest", "--runs", "10", "--json"), about="13 min",
           quick=("--honest", "--runs", "1", "--json"), rows=tuple(
         Row(f"the same on bench/throughput.py's honest rig (16 DUTs, the sensors' effects), {label}, fitted as the "
             f"procedure says: axis errors against the truth inside U (k = 2)",
@@ -339,7 +339,7 @@ BENCHES: tuple[Bench, ...] = (
             lambda r, name=name: 0.93 <= r["methods"][name]["coverage_k2"] <= 0.97)
         for name, label in UNCERTAINTY_HONEST.items())),
     Bench("gyro_coverage", "gyro_coverage.py", ("--seeds", "6", "--json"), quick=("--seeds", "1", "--json"),
-          about="2 min", rows=(
+          about="1 min", rows=(
         Row("a gyroscope's calibration over dry runs (tests/fit/test_gyro_fit.py's IMU campaign, −40 … 60 °C in 5 "
             "setpoints, degree 3, 120 s noise records, verified between the setpoints): k = 2 coverage against the truth",
             lambda r: (f"**{r['coverage_k2_mean']:.3f}** over {r['runs'] * r['duts_per_run']} IMUs (per IMU "
@@ -373,7 +373,7 @@ BENCHES: tuple[Bench, ...] = (
         Row("the lab's dashboard on a full registry (each campaign 200 events, 840 temperature points, one running per "
             "rig), through the app: the front page, `/api/rigs`, a published campaign", live_pages),
     )),
-    Bench("registry", "registry.py", ("--json",), quick=("--count", "20000", "--json"), about="2 min", rows=(
+    Bench("registry", "registry.py", ("--json",), quick=("--count", "20000", "--json"), about="35 s", rows=(
         Row("the registry (SQLite, a new file): recording calibrations, each a copy of one real quick-6pos "
             "calibration with its own serial, part lot and date, in batches of 500",
             lambda r: (f"{thousands(r['count'])} in {r['insert_s']:.1f} s, **{thousands(r['insert_per_s'])} /s**; "
