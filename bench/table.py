@@ -317,7 +317,7 @@ BENCHES: tuple[Bench, ...] = (
             lambda r: f"{imu_rig_time(r, 'soak')}; {imu_accuracy(r, 'soak')}; coverage {imu_coverage(r, 'soak')}"),
     )),
     Bench("soak_criteria", "soak_criteria.py", ("--duts", "4,64", "--json"), quick=("--duts", "4", "--json"),
-          about="8 min", rows=(
+          about="2 min", rows=(
         Row("the paper campaign's soaks (seed 0, plain simulated rig) by the band criterion (10 min window, 0.3 °C) and "
             "the settling criterion (20 min window, 0.1 °C still to come), polled every 30 s and 10 s, 4 DUTs: total "
             "soak time (longest soak), worst verification \\|g\\| RMSE / residual drift", lambda r: soak_criteria(r, 4)),
