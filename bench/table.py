@@ -377,7 +377,7 @@ BENCHES: tuple[Bench, ...] = (
         Row("the registry (SQLite, a new file): recording calibrations, each a copy of one real quick-6pos "
             "calibration with its own serial, part lot and date, in batches of 500",
             lambda r: (f"{thousands(r['count'])} in {r['insert_s']:.1f} s, **{thousands(r['insert_per_s'])} /s**; "
-                       f"1 000 already registered skipped in {r['add_again_s']:.2f} s; {r['file_mb']:.0f} MB on disk")),
+                       f"1 000 already registered skipped in {r['add_again_s']:.2f} s; {thousands(r['file_mb'])} MB on disk")),
         Row("its queries: a serial's history / its valid calibration / its trend; one stored fit; a date-filtered "
             "list (fits left out); a part's lot statistics", registry_queries),
     )),
@@ -568,7 +568,8 @@ Not in the table: the kill, disk-full, concurrency, signal, fault and fuzz trial
 [reliability.md](reliability.md#figures) and [registry.md](registry.md)), and the benches with no `--json`
 mode yet (`bench/fit_accuracy.py`, `bench/operator.py`, `bench/ramp_vs_soak.py`, `bench/wire_round_trips.py`).
 The CI row has no bench: its results file is copied by hand from a recorded CI run, and its row says so. The
-figures of past issues, and how each was reached, are in this page's history: `git log -p docs/performance.md`.
+figures of past issues, and how each was reached, are in this page's history: `git log -p docs/performance.md`,
+the last of them in `git show ed0b3a4:docs/performance.md`.
 """
 
 
