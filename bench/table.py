@@ -559,7 +559,7 @@ Re-measure a figure, or all of them, and rewrite this page (the benches import t
 
     python bench/table.py run BENCH …    # e.g. startup: stores bench/results/startup.json
     python bench/table.py run --quick    # every bench, each in a form of under ~3 minutes (fewer seeds or runs)
-    python bench/table.py run            # every bench in full (the slowest take an hour)
+    python bench/table.py run            # every bench in full (about half an hour, 13 min of it uncertainty_honest)
     python bench/table.py write          # this page, from bench/results/
     python bench/table.py list           # the benches, their full and quick commands
 
