@@ -73,3 +73,10 @@ def test_the_output_a_bench_ends_with_is_found_after_its_lines() -> None:
     assert table.last_json('{"a": 1}') == {"a": 1}
     assert table.last_json('rig --help: median 44 ms\n{"median_wall_ms": 44.0}\n') == {"median_wall_ms": 44.0}
     assert table.last_json('3 trials\n{\n "x": {\n  "y": 2\n }\n}\n') == {"x": {"y": 2}}
+
+
+def test_the_page_is_the_table_of_the_stored_results() -> None:
+    """docs/performance.md is written by the script, never by hand: a result stored without the page rewritten,
+    or the page edited, fails here."""
+    table = table_module()
+    assert table.PAGE.read_text(encoding="utf-8") == table.render(table.RESULTS), "run: python bench/table.py write"
