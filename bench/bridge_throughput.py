@@ -2,12 +2,13 @@
 on a pseudo-terminal, at the part's top data rate (4 kHz), timed on the wall clock: with the bridge
 capturing blocks itself (protocol version 2) and with the host draining the FIFO (version 1). Usage:
 
-    python bench/bridge_throughput.py [--seconds 5]
+    python bench/bridge_throughput.py [--seconds 5] [--json]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import time
 from pathlib import Path
 
@@ -44,12 +45,18 @@ def throughput(protocol_version: int, seconds: float) -> tuple[int, float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=5.0)
+    parser.add_argument("--json", action="store_true", help="one JSON object instead of the lines")
     args = parser.parse_args()
-    for version, how in [(2, "bridge captures blocks"), (1, "host drains the FIFO every 30 samples")]:
+    paths = {}
+    for version, key, how in [(2, "captured", "bridge captures blocks"), (1, "drained", "host drains the FIFO every 30 samples")]:
         samples, wall = throughput(version, args.seconds)
-        print(f"bridge path at 4000 Hz, {how}: {samples} gap-free samples in {wall:.2f} s wall = "
-              f"{samples / wall:,.0f} samples/s per sensor (target > 4000)")
-
+        paths[key] = {"protocol_version": version, "samples": samples, "wall_s": round(wall, 3),
+                      "samples_per_s": round(samples / wall)}
+        if not args.json:
+            print(f"bridge path at 4000 Hz, {how}: {samples} gap-free samples in {wall:.2f} s wall = "
+                  f"{samples / wall:,.0f} samples/s per sensor (target > 4000)")
+    if args.json:
+        print(json.dumps({"odr_hz": 4000.0, "seconds": args.seconds, **paths}))
 
 if __name__ == "__main__":
     main()

@@ -5,7 +5,11 @@ user runs it: the real drivers talking to wire-level simulators (Modbus TCP on l
 (2) The campaign alone (run_campaign, imports excluded) through those wires against the in-process
 simulated instruments. Usage:
 
-    python bench/dry_run_paper.py [--runs 3]
+    python bench/dry_run_paper.py [--runs 3] [--json]
+
+`--json`: one JSON object instead of the lines: each process run's wall time, peak RSS, virtual hours
+and file size, their median wall, and the campaign alone through the wire and in-process with the ratio
+of their medians.
 """
 
 from __future__ import annotations
@@ -64,33 +68,46 @@ def main() -> None:
     throwaway_registry()
     import h5py
 
-
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--json", action="store_true", help="one JSON object instead of the lines")
     args = parser.parse_args()
     silence_campaign_log()
-    walls = []
+    median = lambda values: sorted(values)[len(values) // 2]  # noqa: E731
+
+    def say(line: str) -> None:  # the lines, unless the JSON object is asked for
+        if not args.json:
+            print(line)
+
+    runs = []
     with tempfile.TemporaryDirectory() as folder:
         output = Path(folder) / "campaign.h5"
         for seed in range(args.runs):
             wall, peak_mb, report = cli_run(output, seed)
-            walls.append(wall)
             with h5py.File(output, "r") as f:
                 virtual_h = float(f["poses/t_end_s"][-1]) / 3600
                 chamber = f["instruments/chamber"].attrs["driver"]
-            print(f"rig run (process, {chamber} over the wire) {seed}: wall {wall:.2f} s, peak RSS {peak_mb:.0f} MB, "
-                  f"{report['poses_done']}/{report['poses_total']} poses × {len(report['duts'])} DUTs, "
-                  f"virtual {virtual_h:.2f} h, file {output.stat().st_size / 1e6:.2f} MB")
-        print(f"summary: process wall median {sorted(walls)[len(walls) // 2]:.2f} s (min {min(walls):.2f}, "
-              f"max {max(walls):.2f}) over {len(walls)} runs on {os.cpu_count()} cores")
+            runs.append({"seed": seed, "wall_s": round(wall, 2), "peak_rss_mb": round(peak_mb), "virtual_h": round(virtual_h, 2),
+                         "file_mb": round(output.stat().st_size / 1e6, 2), "poses": report["poses_done"],
+                         "duts": len(report["duts"])})
+            say(f"rig run (process, {chamber} over the wire) {seed}: wall {wall:.2f} s, peak RSS {peak_mb:.0f} MB, "
+                f"{report['poses_done']}/{report['poses_total']} poses × {len(report['duts'])} DUTs, "
+                f"virtual {virtual_h:.2f} h, file {output.stat().st_size / 1e6:.2f} MB")
+        walls = [r["wall_s"] for r in runs]
+        say(f"summary: process wall median {median(walls):.2f} s (min {min(walls):.2f}, "
+            f"max {max(walls):.2f}) over {len(walls)} runs on {os.cpu_count()} cores")
         wire, local = [], []
         for seed in range(args.runs):  # interleaved, so a busier spell of the machine hits both alike
             wire.append(campaign_only(output, seed, in_process=False))
             local.append(campaign_only(output, seed, in_process=True))
-        median = lambda values: sorted(values)[len(values) // 2]  # noqa: E731
-        print(f"campaign alone (incl. fit): through the wire median {median(wire):.2f} s, in-process "
-              f"median {median(local):.2f} s, ratio {median(wire) / median(local):.2f}")
-
+        say(f"campaign alone (incl. fit): through the wire median {median(wire):.2f} s, in-process "
+            f"median {median(local):.2f} s, ratio {median(wire) / median(local):.2f}")
+    if args.json:
+        print(json.dumps({"runs": runs, "wall_median_s": median(walls),
+                          "campaign_alone": {"wire_s": [round(w, 2) for w in wire], "in_process_s": [round(s, 2) for s in local],
+                                             "wire_median_s": round(median(wire), 2),
+                                             "in_process_median_s": round(median(local), 2),
+                                             "ratio": round(median(wire) / median(local), 3)}}))
 
 if __name__ == "__main__":
     main()

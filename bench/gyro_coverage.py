@@ -58,7 +58,7 @@ def main() -> None:
                 run_campaign(prepare(procedure), output, dry_run=True, seed=seed, overwrite=False)
             wall_s = time.perf_counter() - start   # the dry run itself (the fit follows, in-process)
             _, report = fit_and_save(load_campaign(output), output, Path(folder) / "cal.yaml", FitOptions(degree=3))
-            gyro = [r["gyro"] for r in report.values()]
+            gyro = [r["channels"]["gyro"] for r in report.values()]  # the report gives figures per channel
             truth = load_campaign(output).header.truth
             arw_truth = [float(t["gyro_noise_dps_per_sample"]) / np.sqrt(SMALL["acquisition"]["odr_hz"]) * 60.0
                          for t in truth.values()]

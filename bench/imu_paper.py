@@ -40,11 +40,12 @@ def main() -> None:
                                            check=True, capture_output=True, text=True).stdout)
         with h5py.File(output, "r") as f:
             gyro = {serial: list(dut["gyro/raw_codes"].shape) for serial, dut in f["duts"].items()}
-    duts = {serial: {"verification_rmse_mg": r["verification"]["rmse_mg"],
-                     "expected_fit_rmse_mg": r["expected_fit_rmse_mg"],
-                     "ratio": r["verification"]["rmse_mg"] / r["expected_fit_rmse_mg"],
-                     "verdict": r["verdict"], "gyro_raw_codes_shape": gyro[serial]}
-            for serial, r in report.items()}
+    accel = {serial: r["channels"]["accel"] for serial, r in report.items()}  # `rig fit --json`: figures per channel
+    duts = {serial: {"verification_rmse_mg": a["verification"]["rmse_mg"],
+                     "expected_fit_rmse_mg": a["expected_fit_rmse_mg"],
+                     "ratio": a["verification"]["rmse_mg"] / a["expected_fit_rmse_mg"],
+                     "verdict": report[serial]["verdict"], "gyro_raw_codes_shape": gyro[serial]}
+            for serial, a in accel.items()}
     figures = {"wall_s": round(wall_s, 1), "seed": args.seed, "duts": duts,
                "worst_ratio": max(d["ratio"] for d in duts.values())}
     if args.json:
