@@ -408,7 +408,7 @@ BENCHES: tuple[Bench, ...] = (
     )),
     Bench("ci", None, (), hand_command="CI=true bash .ci/run", rows=(
         Row("the test suite and CI on a fresh clone (install, lint, import layers, types, the firmware's cross build, "
-            "the tests)",
+            "the documentation site, the wheel and the getting-started commands with it, the example plug-in, the tests)",
             lambda r: (f"{thousands(r['tests'])} tests in {r['pytest_wall_s']:.0f} s on {r['workers']} workers "
                        f"(pytest-xdist); the whole script {r['script_wall_s']:.0f} s ({r['script_wall_s'] / 60:.1f} min)"),
             "~20 min", lambda r: r["script_wall_s"] <= 20 * 60),
