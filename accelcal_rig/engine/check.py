@@ -85,10 +85,23 @@ def describe_chamber(chamber: Chamber, rig: RigConfig) -> str:
 
 
 def describe_turntable(turntable: Turntable, rig: RigConfig) -> str:
-    """Its endpoint, identity, angles, whether in position, and the rates of the axes given a rate mode."""
+    """Its endpoint, identity, angles, whether in position, the rates of the axes given a rate mode, and for an
+    ACL controller whether it acknowledges every command (a controller doing otherwise than the rig config says
+    has failed the identity already, naming the override)."""
     angles = " ".join(f"{a:.3f}" for a in turntable.read_angles_deg())
     return (f"{turntable.endpoint}: {turntable.identify()}, angles {angles}°, "
-            f"{'in position' if _at_rest(turntable) else 'moving'}{_rates(turntable, rig)}")
+            f"{'in position' if _at_rest(turntable) else 'moving'}{_rates(turntable, rig)}{_acknowledgements(rig)}")
+
+
+def _acknowledgements(rig: RigConfig) -> str:
+    if rig.turntable is None or rig.turntable.driver != "serial":
+        return ""
+    protocol = rig.turntable.line_protocol()
+    if protocol.dialect != "acl":
+        return ""
+    if protocol.acknowledgement == "length-prefixed":
+        return ", acknowledges every command (length-prefixed: an error code and a length before each answer)"
+    return ", answers queries only (no acknowledgements, as on GPIB)"
 
 
 def describe_sensor(sensor: Sensor) -> str:

@@ -13,6 +13,7 @@ import serial
 
 from accelcal_rig.core.descriptors import read_within, write_within
 from accelcal_rig.errors import InstrumentError, TransientInstrumentError
+from accelcal_rig.protocols.acl_blocks import PREFIX_BYTES, is_block, looks_like_prefix, prefix
 
 
 class LinePort:
@@ -46,12 +47,43 @@ class LinePort:
             raw = self._read_line()
         except (serial.SerialException, OSError) as exc:
             raise TransientInstrumentError(f"{self.name}: {request!r}: port failed: {exc}", reconnect=True) from None
+        if is_block(raw):
+            self._let_late_reply_pass()
+            raise InstrumentError(f"{self.name}: {request!r}: the controller answers every command with an error "
+                                  "code and a length before the text (TM-8004-C §2), which this profile does not "
+                                  "read: set the rig config's protocol_overrides: {acknowledgement: length-prefixed}")
         if not raw.endswith(self._read_terminator):
             self._let_late_reply_pass()
             raise TransientInstrumentError(f"{self.name}: {request!r}: no reply within the timeout")
         # Lines before the last are late replies to earlier requests that arrived with this one.
         last = raw[: -len(self._read_terminator)].split(self._read_terminator)[-1]
         return last.decode(self._encoding, errors="replace").strip()
+
+    def ask_block(self, request: str) -> tuple[int, str]:
+        """Send one request and read its response block (protocols/acl_blocks.py): the error code and the text
+        (a NUL after it dropped)."""
+        self.send(request)
+        try:
+            raw = self._read_block()
+        except (serial.SerialException, OSError) as exc:
+            raise TransientInstrumentError(f"{self.name}: {request!r}: port failed: {exc}", reconnect=True) from None
+        found = prefix(raw)
+        if found is None:
+            if raw and not looks_like_prefix(raw):
+                self._let_late_reply_pass()
+                raise InstrumentError(f"{self.name}: {request!r}: the controller answered {ascii(bytes(raw[:40]))} "
+                                      "with no error code and length before it: it does not acknowledge every "
+                                      "command (TM-8004-C §2 says GPIB does not); set the rig config's "
+                                      "protocol_overrides: {acknowledgement: none}")
+            self._let_late_reply_pass()
+            raise TransientInstrumentError(f"{self.name}: {request!r}: no reply within the timeout")
+        code, length = found
+        if len(raw) < PREFIX_BYTES + length:
+            self._let_late_reply_pass()
+            raise TransientInstrumentError(f"{self.name}: {request!r}: a response cut short ({len(raw)} of "
+                                           f"{PREFIX_BYTES + length} bytes within the timeout)")
+        text = raw[PREFIX_BYTES:PREFIX_BYTES + length].decode(self._encoding, errors="replace")
+        return code, text.rstrip("\0").strip()
 
     def send(self, request: str) -> None:
         """Send a request: one that has no reply (a SCPI setting), or one whose reply `receive` reads."""
@@ -95,6 +127,25 @@ class LinePort:
                 break
             line += chunk
         return bytes(line)
+
+    def _read_block(self) -> bytes:
+        """A response block: its prefix, then as many bytes as it says; stops short at the port's timeout. A
+        reply that is a line of text instead (no prefix) is returned once its terminator has come."""
+        data = bytearray()
+        deadline = time.monotonic() + (self._port.timeout or 0.0)
+        read = self._read_fd if self._local_device() else self._read_port
+        while True:
+            found = prefix(bytes(data))
+            if found is not None and len(data) >= PREFIX_BYTES + found[1]:
+                break
+            if found is None and len(data) >= PREFIX_BYTES and not looks_like_prefix(bytes(data)) \
+                    and self._read_terminator in data:
+                break
+            chunk = read(deadline)
+            if not chunk or time.monotonic() > deadline:
+                break
+            data += chunk
+        return bytes(data)
 
     def _local_device(self) -> bool:
         """A plain local device (not a spy:// or other URL's port, whose own read and write do more): read

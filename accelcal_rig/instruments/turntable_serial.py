@@ -123,6 +123,12 @@ class SerialTurntable:
 
     def _ask_once(self, command: Command, request: str | None, **fields: object) -> dict[str, str]:
         request = self.protocol.request(command, **fields) if request is None else request
+        if self.protocol.acknowledgement == "length-prefixed":
+            code, text = self._line.ask_block(request)
+            if code != 0:
+                raise InstrumentError(f"turntable ({self.endpoint}): {request!r} refused: error code {code}"
+                                      + (f", {text!r}" if text else ""))
+            return {} if command.reply is None else read_reply(self.protocol, command, request, text, self.endpoint)
         if command.reply is None:
             self._line.send(request)
             return {}

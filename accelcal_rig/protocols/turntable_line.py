@@ -15,6 +15,10 @@ A rate table's profile also says how one axis turns at a constant rate (`rotate`
 brought to rest and held (`hold`); a profile without them (None) has no rate mode, and its driver no
 constant-rate capability.
 
+An ACL controller on TCP (and every interface but GPIB) answers every command with a response block, an error
+code and a length before the text (`acknowledgement: length-prefixed`, protocols/acl_blocks.py); the driver
+then reads a block after every command and takes a code other than 0 as a refusal.
+
 A profile's `dialect` says how its controller reads a request (line_dialects.py): `plain`, the text as
 written; `acl`, Acutronic's command language (acl_messages.py): templates in the manual's notation, sent
 as lower-case long forms, read in any documented spelling and joined into lines by `;`.
@@ -58,6 +62,10 @@ class TurntableProtocol(BaseModel):
     write_terminator: str = Field("\n", min_length=1, max_length=4)
     read_terminator: str = Field("\n", min_length=1, max_length=4)
     error_pattern: str = Field("^ERR", max_length=256)
+    acknowledgement: Literal["none", "length-prefixed"] = Field(
+        "none", description="ACL only: whether the controller answers every command with an error code and a length "
+        "before the text (TM-8004-C §2: every interface but GPIB; protocols/acl_blocks.py), or answers queries "
+        "only, with a line (GPIB, and this profile's serial line)")
     identify: Command
     move: Command
     position: Command
@@ -113,6 +121,8 @@ class TurntableProtocol(BaseModel):
         if self.multi_axis_move and self.move.reply is not None:
             raise ValueError("multi_axis_move: the move must be unanswered (a controller answering each of the "
                              "joined commands would leave replies on the line)")
+        if self.acknowledgement != "none" and self.dialect != "acl":
+            raise ValueError("acknowledgement: length-prefixed acknowledgements are the ACL's (dialect: acl)")
         if self.dialect == "acl" and self.move_separator != ";":
             raise ValueError("move_separator: ACL joins commands in one line with ';'")
         for name, command in self.commands():

@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 
 from accelcal_rig.config.rig import TurntableConfig
-from accelcal_rig.protocols import acl_messages
+from accelcal_rig.protocols import acl_blocks, acl_messages
 from accelcal_rig.protocols.line_dialects import request_pattern
 from accelcal_rig.protocols.line_templates import finite_number
 from accelcal_rig.protocols.turntable_line import Command, TurntableProtocol
@@ -43,8 +43,14 @@ class SimulatedTurntableServer:
                                   for name, command, pattern in self._patterns), key=lambda step: -step[0])
         if protocol.write_terminator != protocol.read_terminator:
             raise ValueError("the simulated turntable needs one terminator for both directions")
-        self._server = PtyLineServer(self._handle, protocol.write_terminator.encode(), "simulated-turntable", faults,
-                                     overlong=_overlong_answer)
+        if protocol.acknowledgement == "length-prefixed":  # every command answered with a block (acl_blocks.py)
+            self._server = PtyLineServer(lambda request: _acknowledged(self._handle(request)),
+                                         protocol.write_terminator.encode(), "simulated-turntable", faults,
+                                         reply_terminator=b"", encoding="latin-1",
+                                         overlong=lambda head: _acknowledged(_overlong_answer(head)))
+        else:
+            self._server = PtyLineServer(self._handle, protocol.write_terminator.encode(), "simulated-turntable",
+                                         faults, overlong=_overlong_answer)
         self.path = self.endpoint = self._server.path
         n_axes = len(lab.motion.speeds_deg_s)
         #: Fault reply of each axis (fault injection sets them); a profile without per-axis faults reads axis 1's.
@@ -230,6 +236,14 @@ def _numbers(fields: dict[str, str]) -> dict[str, float]:
     """The request's numbers, each finite and written as a controller writes one: ValueError (answered `ERR …`)
     for `nan`, `inf`, `1e400` and the like, which would otherwise reach the simulated motion."""
     return {name: finite_number(fields[name]) for name in _NUMBER_FIELDS if name in fields}
+
+
+def _acknowledged(answer: str | None) -> str:
+    """A command's answer as a response block (sent as latin-1, byte for byte): a refusal's code is the
+    simulator's for an unknown command, a setting's text "OK" (as AcutronicRobotics' TCP client reads it)."""
+    refused = answer is not None and answer.startswith("ERR")
+    text = "OK" if answer is None else answer
+    return acl_blocks.block(acl_blocks.UNKNOWN_COMMAND if refused else 0, text).decode("latin-1")
 
 
 def _overlong_answer(head: str) -> str:

@@ -37,6 +37,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from accelcal_rig.protocols.acl_blocks import PREFIX_BYTES, prefix
+
 _N = r"[-+]?\d+(\.\d+)?([eE][-+]?\d+)?"  # a number as the clients read it (float())
 
 
@@ -56,13 +58,15 @@ class Expect:
             return "" if not text else f"answered {text.strip()!r}; documented: no reply ({self.source})"
         if not text:
             return f"no reply; documented: {self.answer!r} ({self.source})"
-        if self.prefixed:  # an 8-byte prefix (its layout undocumented), then the answer; a bare line is not it
-            body = text[8:].strip()
-            bare = re.fullmatch(self.answer, text.strip()) is not None or text.startswith("ERR")
-            if len(reply) > 8 and re.fullmatch(self.answer, body) and not bare:
+        if self.prefixed:  # a response block (protocols/acl_blocks.py): error code 0, then the answer
+            found = prefix(reply)
+            body = reply[PREFIX_BYTES:].decode("latin-1").strip()
+            if found is not None and found[0] == 0 and re.fullmatch(self.answer, body):
                 return ""
-            return f"answered {text.strip()!r}, no prefix (the client reads {body!r}); documented: an error code " \
-                   f"and a length, then {self.answer!r} ({self.source})"
+            if found is not None:
+                return f"answered error code {found[0]}, {body!r}; documented: code 0 and {self.answer!r} ({self.source})"
+            return f"answered {text.strip()!r}, no prefix (the client reads {text[8:].strip()!r}); documented: an " \
+                   f"error code and a length, then {self.answer!r} ({self.source})"
         if not re.fullmatch(self.answer, text.strip()):
             return f"answered {text.strip()!r}; documented: {self.answer!r} ({self.source})"
         return ""
@@ -88,6 +92,7 @@ class DataClient:
     read_terminator: str
     reply_wait_s: float  # how long the replay waits for a reply (the client's own timeout, shortened)
     methods: tuple[Method, ...]
+    profile_overrides: tuple[tuple[str, object], ...] = ()  # the profile as that client's rig configures it
 
 
 # ---------------------------------------------------------------------- ESPEC's F4T SCPI library
@@ -281,7 +286,7 @@ ACUTRONIC_ROBOTICS = DataClient(
                not_sent="the transport primitive: sends what its caller gives it"),
         Method("send_command_list", f"{_ACR} AcutrolDevice.send_command_list", "send_command_list(list)",
                not_sent="sends its caller's list (startup and shutdown above are its uses)"),
-    ))
+    ), profile_overrides=(("acknowledgement", "length-prefixed"),))  # a TCP client: every command acknowledged
 
 _FORM = "Acutrol/Form1.cs"
 

@@ -41,7 +41,7 @@ from accelcal_rig.config.load import load_rig
 from accelcal_rig.core.clock import VirtualClock
 from accelcal_rig.protocols.chamber_lines import LINE_PROFILES, line_protocol
 from accelcal_rig.protocols.chamber_registers import register_map
-from accelcal_rig.protocols.turntable_line import ACUTROL3000
+from accelcal_rig.protocols.turntable_line import ACUTROL3000, turntable_protocol
 from accelcal_rig.sim.chamber_line_server import SimulatedLineChamberServer
 from accelcal_rig.sim.chamber_server import SimulatedChamberServer
 from accelcal_rig.sim.lab import VirtualLab
@@ -312,7 +312,7 @@ def simulator(kind: str, profile: str, options: dict[str, object]) -> Iterator[t
     elif kind == "modbus":
         server = SimulatedChamberServer(lab, register_map(profile), panel=panel_for(profile, register_map(profile)))
     else:
-        server = SimulatedTurntableServer(lab, ACUTROL3000)
+        server = SimulatedTurntableServer(lab, turntable_protocol("acutrol3000", options) if options else ACUTROL3000)
     server.start()
     try:
         yield server.endpoint, "pty" if kind == "turntable" else "tcp"
@@ -605,7 +605,7 @@ def sweep_data_client(client: DataClient) -> ClientSweep:
     record = ClientSweep(client.name, client.profile, client.source, client.transport)
     kind = "turntable" if client.profile == "acutrol3000" else "line"
     error = error_pattern(kind, client.profile)
-    with simulator(kind, client.profile, {}) as (endpoint, transport):
+    with simulator(kind, client.profile, dict(client.profile_overrides)) as (endpoint, transport):
         proxy = RecordingProxy(endpoint, transport)
         try:
             for method in client.methods:
