@@ -42,6 +42,9 @@ class ChamberLineProtocol(BaseModel):
 
     write_terminator: str = Field("\n", min_length=1, max_length=4)
     read_terminator: str = Field("\n", min_length=1, max_length=4)
+    any_line_end: bool = Field(False, description="the controller ends a request at CR, LF or CR LF, whichever "
+                               "comes (for the simulator: a client's other terminator answered, not joined to the "
+                               "next request); the driver sends write_terminator")
     dialect: Dialect = Field("plain", description="how the controller reads a request: plain text, ESPEC (a "
                              "blank after a comma optional), SIMSERV (numbered commands), SCPI (headers)")
     encoding: Literal["ascii", "latin-1"] = Field("ascii", description="latin-1 where fields are separated by a "
@@ -206,8 +209,9 @@ ESPEC_P300 = ChamberLineProtocol(
 
 #: Thermotron 8800 (8200 class): channel 1 is air temperature, 2 humidity; operations answer `0`. No purge
 #: command: its auxiliaries are set eight at a time (`AUXE1,ddd`), which would clobber the others wired there.
+#: Its clients end requests with CR LF, CR or LF and no source says which it takes: each ends a request.
 THERMOTRON_8800 = ChamberLineProtocol(
-    write_terminator="\r", read_terminator="\r\n", default_port=8888,
+    write_terminator="\r", read_terminator="\r\n", default_port=8888, any_line_end=True,
     identify=LineCommand(send="IDEN?", reply=r"(?P<identity>.+)", answer="{identity}"),
     read_temperature=LineCommand(send="PVAR1?", reply=rf"(?P<pv>{_N})", answer="{pv:.2f}"),
     read_setpoint=LineCommand(send="SETP1?", reply=rf"(?P<sp>{_N})", answer="{sp:.2f}"),

@@ -13,6 +13,7 @@ from accelcal_rig.protocols.chamber_lines import ChamberLineProtocol, Operation
 from accelcal_rig.protocols.line_templates import finite_number
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
+from accelcal_rig.sim.line_answers import ANY_LINE_END
 from accelcal_rig.sim.line_extras import Unknown, extras_for
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 from accelcal_rig.sim.tcp_line_server import TcpLineServer
@@ -40,7 +41,7 @@ class SimulatedLineChamberServer:
         self._stall_after_s = stall_after_s
         #: The last set point written over the wire, for tests that check the safe state.
         self.last_setpoint_c: float | None = None
-        requests_end = protocol.write_terminator.encode(protocol.encoding)
+        requests_end = ANY_LINE_END if protocol.any_line_end else protocol.write_terminator.encode(protocol.encoding)
         replies_end = protocol.read_terminator.encode(protocol.encoding)
         server = TcpLineServer if transport == "tcp" else PtyLineServer
         self._server: TcpLineServer | PtyLineServer = server(self._handle, requests_end, "simulated-chamber", faults,

@@ -34,6 +34,7 @@ class Row:
     setpoint_c: float | None = None  # afterwards the controller's set point is this
     powered: bool | None = None  # afterwards the chamber conditions (runs) or not
     purge: bool | None = None  # afterwards the dry-air purge output is on or off
+    ending: str | None = None  # the line end the client sends, where it is not the profile's write_terminator
 
 
 @dataclass(frozen=True)
@@ -138,6 +139,12 @@ THERMOTRON = (
         Row("RUNM", "pymeasure/instruments/thermotron/thermotron3800.py run", "power_on", reply="0", powered=True),
         Row("SETP1,-12.5", "pymeasure/instruments/thermotron/thermotron3800.py setpoint (SETP1,%g)",
             "write_setpoint", reply="0", setpoint_c=-12.5),
+        # Thermotron3800 leaves the terminators to its user: PyVISA's default CR LF, or LF, each ends a request
+        Row("IDEN?", "thermotron3800.py id (PyVISA's write_termination, CR LF)", "identify", ending="\r\n"),
+        Row("PVAR1?", "thermotron3800.py temperature (write_termination='\\n')", "read_temperature", ending="\n"),
+        Row("SETP1,-20", "thermotron3800.py setpoint (write_termination='\\n')", "write_setpoint", reply="0",
+            setpoint_c=-20.0, ending="\n"),
+        Row("SETP1?", "thermotron3800.py setpoint (the profile's CR again)", "read_setpoint"),
     )),
 )
 

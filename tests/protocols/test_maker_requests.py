@@ -39,8 +39,9 @@ class Wire:
         self.protocol, self._client = protocol, client
         self._end = protocol.read_terminator.encode(protocol.encoding)
 
-    def send(self, request: str) -> None:
-        self._client.send((request + self.protocol.write_terminator).encode(self.protocol.encoding))
+    def send(self, request: str, ending: str | None = None) -> None:
+        end = self.protocol.write_terminator if ending is None else ending
+        self._client.send((request + end).encode(self.protocol.encoding))
 
     def reply(self) -> str:
         return self._client.reply(self._end).removesuffix(self._end).decode(self.protocol.encoding)
@@ -74,7 +75,7 @@ def check_values(values: dict[str, str], protocol: ChamberLineProtocol, server: 
 
 def replay(row: Row, wire: Wire, server: SimulatedLineChamberServer, lab: VirtualLab) -> None:
     protocol = wire.protocol
-    wire.send(row.request)
+    wire.send(row.request, row.ending)
     command = protocol.command(row.operation) if row.operation is not None else None
     if row.silent:
         assert command is None or command.reply is None, "a silent row of an answered operation"
