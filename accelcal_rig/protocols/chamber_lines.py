@@ -264,10 +264,11 @@ SIMSERV = ChamberLineProtocol(
 
 #: Watlow F4T over SCPI (TCP port 5025 only): loop 1 is temperature, loop 2 humidity. Headers in the
 #: manual's notation (sent as upper-case long forms). Settings are not answered and the F4T has no error
-#: queue: a set point is confirmed by reading it back.
+#: queue: a set point is confirmed by reading it back. `*IDN?` answers `Watlow Electric,<part>,<serial>,
+#: <software>` (ESPEC's F4T command list); the simulator's part is its identity, its serial 1.
 WATLOW_F4T_SCPI = ChamberLineProtocol(
     dialect="scpi", write_terminator="\n", read_terminator="\n", default_port=5025,
-    identify=LineCommand(send="*IDN?", reply=r"(?P<identity>.+)", answer="{identity}"),
+    identify=LineCommand(send="*IDN?", reply=r"(?P<identity>.+)", answer="Watlow Electric,{identity},1,simulated"),
     read_temperature=LineCommand(send=":SOURce:CLOop1:PVALue?", reply=rf"(?P<pv>{_N})", answer="{pv:.2f}"),
     read_setpoint=LineCommand(send=":SOURce:CLOop1:SPOint?", reply=rf"(?P<sp>{_N})", answer="{sp:.2f}"),
     write_setpoint=LineCommand(send=":SOURce:CLOop1:SPOint {value:.2f}"),

@@ -10,6 +10,7 @@ from accelcal_rig.protocols.chamber_lines import ChamberLineProtocol
 from accelcal_rig.protocols.simserv_commands import FIELDS, SEPARATOR, command_fields
 from accelcal_rig.sim.controller_extras import UNKNOWN, Answer, Extras, Panel
 from accelcal_rig.sim.espec_extras import EspecExtras
+from accelcal_rig.sim.f4t_scpi_extras import F4tScpiExtras
 from accelcal_rig.sim.lab import VirtualLab
 
 
@@ -71,6 +72,6 @@ class SimservExtras(Extras):
 
 
 def extras_for(protocol: ChamberLineProtocol, lab: VirtualLab, panel: Panel) -> Extras:
-    """The extras of the profile's dialect."""
-    kinds: dict[str, type[Extras]] = {"espec": EspecExtras, "simserv": SimservExtras}
+    """The extras of the profile's dialect (SCPI's are the F4T's, the one SCPI chamber profile)."""
+    kinds: dict[str, type[Extras]] = {"espec": EspecExtras, "simserv": SimservExtras, "scpi": F4tScpiExtras}
     return kinds.get(protocol.dialect, Extras)(protocol, lab, panel)

@@ -290,13 +290,32 @@ SIMSERV = (
 
 WATLOW_F4T = (
     Conversation("watlow-f4t-scpi", "EspecNorthAmerica/WatlowF4T-SCPI-Lib", "MIT", (
-        Row("*IDN?", "f4tscpi/f4t_interface.py get_id", "identify"),
+        Row("*IDN?", "f4tscpi/f4t_interface.py get_id (the F4T list: Watlow Electric | <string> | <integer> | "
+            "<string>)", "identify", reply=r"Watlow Electric,[^,]*,\d+,[^,]*"),
         Row(":UNIT:TEMPERATURE?", "f4tscpi/f4t_interface.py get_units", "units", reply="C|F"),
         Row(":SOURCE:CLOOP1:PVALUE?", "f4tscpi/f4t_interface.py get_pv", "read_temperature"),
         Row("SOURCE:CLOOP1:SPOINT 25.0", "f4tscpi/f4t_interface.py write_sp (no leading colon, str(float))",
             "write_setpoint", silent=True, setpoint_c=25.0),
         Row(":SOURCE:CLOOP1:SPOINT?", "f4tscpi/f4t_interface.py get_sp", "read_setpoint"),
         Row(":SOURCE:CLOOP2:PVALUE?", "f4tscpi/f4t_interface.py get_pv (loop 2)", "humidity"),
+        # Beyond the profile (issue 43): the F4T list's headers (PaulNongL/WatlowF4TscpiLibrary
+        # f4t_scpi_cmds/f4t_scpi_commands.ods) the library sends, held and read back
+        Row(":SOURCE:CLOOP2:SPOINT 45.0", "f4tscpi/f4t_interface.py write_sp(45.0, 2) (Write SP)", silent=True),
+        Row(":SOURCE:CLOOP2:SPOINT?", "f4tscpi/f4t_interface.py get_sp(2) (Read SP)", reply=r"45\.00"),
+        Row(":SOURCE:CLOOP1:RACTION OFF", "f4tscpi/f4t_interface.py ramp_mode (Set ramping off)", silent=True),
+        Row(":SOURCE:CLOOP1:RSCALE MINUTES", "f4tscpi/f4t_interface.py set_rampScale (Write ramp scale to minutes)",
+            silent=True),
+        Row(":SOURCE:CLOOP1:RRATE 2.0", "f4tscpi/f4t_interface.py set_ramp('rate') (Write ramp rate)", silent=True),
+        Row(":SOURCE:CLOOP1:RRATE?", "f4tscpi/f4t_interface.py get_ramp('rate') (Read ramp rate)", reply=r"2\.00"),
+        Row(":SOURCE:CLOOP1:RTIME 30", "f4tscpi/f4t_interface.py set_ramp('time') (Write ramp time)", silent=True),
+        Row(":SOURCE:CLOOP1:RTIME?", "f4tscpi/f4t_interface.py get_ramp('time') (Read ramp time)", reply=r"30\.00"),
+        Row(":SOURCE:CLOOP1:ERROR?", "the F4T list: Query input error → ERROR|NONE", reply="NONE"),
+        Row(":OUTPUT3:STATE?", "f4tscpi/f4t_interface.py get_ts(3) (Query event output state)", reply="OFF"),
+        Row(":OUTPUT3:STATE ON", "f4tscpi/f4t_interface.py set_output(3) (Set event output on)", silent=True),
+        Row(":OUTPUT3:STATE?", "f4tscpi/f4t_interface.py set_output (read back)", reply="ON"),
+        Row(":PROGRAM:NUMBER 1", "f4tscpi/f4t_interface.py select_profile (Select a profile, 1-40)", silent=True),
+        Row(":PROGRAM:NAME?", "f4tscpi/f4t_interface.py get_profiles (Read selected profile name; none stored: "
+            "empty, where the library stops)", reply=""),
     )),
     Conversation("watlow-f4t-scpi", "DAsh0244/te107_control", "MIT", (
         Row("SOURCE:CLOOP1:SPOINT 30.0", "src/f4t_control.py set_temperature", "write_setpoint", silent=True,
@@ -306,7 +325,26 @@ WATLOW_F4T = (
     Conversation("watlow-f4t-scpi", "PyPI py-lab-hal 2.5.20241201", "Apache-2.0", (
         Row(":SOURCE:CLOOP1:SPOINT -12.50", "py_lab_hal/instrument/temp_chamber/testequity_107.py Testequity107",
             "write_setpoint", silent=True, setpoint_c=-12.5),
+        Row("OUTPUT1:STATE ON", "py_lab_hal/instrument/temp_chamber/testequity_107.py enable_power(True) (an event "
+            "output wired to nothing simulated: held)", silent=True),
+        Row(":OUTPUT1:STATE?", "the F4T list: Query event output state", reply="ON"),
+        Row(":SOURCE:CLOOP1:RACTION OFF", "py_lab_hal/instrument/temp_chamber/testequity_107.py enable_ramp(False)",
+            silent=True),
+        Row(":SOURCE:CLOOP1:RRATE 1.50", "py_lab_hal/instrument/temp_chamber/testequity_107.py set_ramp_rate",
+            silent=True),
+        Row(":SOURCE:CLOOP1:RRATE?", "the F4T list: Read ramp rate", reply=r"1\.50"),
+        Row(":PROGRAM:NUMBER 2", "py_lab_hal/instrument/temp_chamber/testequity_107.py run_profile", silent=True),
     )),
+    # A TestEquity chamber: output 1 enables the chamber (TestEquity's F4T manual), the profile's power command
+    # by override (docs/instruments.md); reading the output back is reading the chamber's run.
+    Conversation("watlow-f4t-scpi", "PyPI py-lab-hal 2.5.20241201", "Apache-2.0", (
+        Row("OUTPUT1:STATE OFF", "py_lab_hal/instrument/temp_chamber/testequity_107.py enable_power(False)", "power_off",
+            silent=True, powered=False),
+        Row(":OUTPUT1:STATE?", "the F4T list: Query event output state", reply="OFF"),
+        Row("OUTPUT1:STATE ON", "py_lab_hal/instrument/temp_chamber/testequity_107.py enable_power(True)", "power_on",
+            silent=True, powered=True),
+        Row(":OUTPUT1:STATE?", "the F4T list: Query event output state", reply="ON"),
+    ), overrides={"power_on": {"send": ":OUTPut1:STATe ON"}, "power_off": {"send": ":OUTPut1:STATe OFF"}}),
     # SCPI-99 vol. 1 §6-7: the spellings the manuals' notation (:SOURce:CLOop1:SPOint) allows.
     Conversation("watlow-f4t-scpi", "SCPI-99 program header grammar", "standard", (
         Row(":sour:clo1:spo 30", "short forms, lower case", "write_setpoint", silent=True, setpoint_c=30.0),
@@ -361,11 +399,16 @@ NOT_SIMULATED: tuple[tuple[str, str, str, str, str], ...] = (
         (":SOURCE:CASCADE1:SPOINT?", "get_cascadeSP"), (":SOURCE:CASCADE1:OUTER:PVALUE?", "get_cascadeLoopPV"),
         (":SOURCE:CASCADE1:INNER:PVALUE?", "get_cascadeLoopPV"), (":SOURCE:CASCADE1:OUTER:SPOINT?", "get_cascadeLoopSP"),
         (":SOURCE:CASCADE1:INNER:SPOINT?", "get_cascadeLoopSP"))),
-    ("watlow-f4t-scpi", ":PROGRAM:SELECTED:STATE START", _F4T_LIB, "f4tscpi/f4t_interface.py prog_mode",
-     "no profile engine: the simulated F4T stores and runs no profile (a selected profile's name reads empty)"),
-    ("watlow-f4t-scpi", ":SOURCE:CLOOP1:RACTION SETPOINT", _F4T_LIB, "f4tscpi/f4t_interface.py ramp_mode (its "
-     "docstring: OFF, STARTUP, SETPOINT, BOTH)", "ramping is held, not acted on: the simulated air follows a set "
-     "point at the chamber's own rate (the rig config's ramp_rate_c_per_min), as with RACTION OFF"),
+    *(("watlow-f4t-scpi", request, client, where, "no profile engine: the simulated F4T stores and runs no profile "
+       "(a selected profile's name reads empty)") for request, client, where in (
+        (":PROGRAM:SELECTED:STATE START", _F4T_LIB, "f4tscpi/f4t_interface.py prog_mode"),
+        (":PROGRAM:SELECTED:STATE STOP", "PyPI py-lab-hal 2.5.20241201", "testequity_107.py run_profile(n, False)"))),
+    *(("watlow-f4t-scpi", request, client, where, "no ramping: the simulated air follows a set point at the chamber's "
+       "own rate (the rig config's ramp_rate_c_per_min), as with RACTION OFF; rate, time and scale are held")
+      for request, client, where in (
+        (":SOURCE:CLOOP1:RACTION SETPOINT", _F4T_LIB, "f4tscpi/f4t_interface.py ramp_mode (its docstring: OFF, "
+         "STARTUP, SETPOINT, BOTH)"),
+        (":SOURCE:CLOOP1:RACTION BOTH", "PyPI py-lab-hal 2.5.20241201", "testequity_107.py enable_ramp(True)"))),
     ("watlow-f4t-scpi", ":OUTPUT1:NAME?", _F4T_LIB, "f4tscpi/f4t_interface.py get_tsName",
      "not in the F4T's SCPI command list (the library's own): unanswered, as every header the F4T does not have"),
 )
