@@ -21,7 +21,8 @@ from tests.conftest import REPO, SIM_RIG
 QUICK = REPO / "procedures" / "quick-6pos.yaml"
 IDENTITY = {"watlow-f4": "scaled-int16 controller (model 5270", "watlow-f4t": "float32 controller",
             **{name: f"simulated {name} (PV" for name in LINE_PROFILES},
-            "espec-p300": "T,T,accelcal-rig simulated espec-p300,"}  # TYPE?: sensors, controller, max temperature
+            "espec-p300": "T,T,accelcal-rig simulated espec-p300,",  # TYPE?: sensors, controller, max temperature
+            "watlow-f4t-scpi": "Watlow Electric,accelcal-rig simulated watlow-f4t-scpi,1,"}  # *IDN?: maker, part, serial
 
 
 @pytest.mark.parametrize("profile", sorted({*PROFILES, *LINE_PROFILES}))

@@ -21,9 +21,13 @@ from accelcal_rig.protocols.line_templates import NUMBER, TemplateCommand, decim
 #: What a request may name (the set point it writes), with a sample value.
 _SEND_SAMPLE: dict[str, object] = {"value": -12.5}
 #: What an answer may name: the request's set point, the values replies carry, the request as the controller
-#: received it (an echo: ESPEC's `OK:<command>`), and the chamber's sensor types (ESPEC's `TYPE?`).
+#: received it (an echo: ESPEC's `OK:<command>`), the chamber's sensor types and rated maximum (ESPEC's
+#: `TYPE?`: the limits may be set within its range, not beyond), and the humidity control's set point (a
+#: number, or OFF) and limits (ESPEC's `HUMI?`).
 _ANSWER_SAMPLE: dict[str, object] = {**_SEND_SAMPLE, "pv": 0.0, "sp": 0.0, "low": 0.0, "high": 0.0, "identity": "x",
-                                     "alarm": "0", "units": "C", "humidity": 0.0, "request": "x", "sensors": "T"}
+                                     "alarm": "0", "units": "C", "humidity": 0.0, "request": "x", "sensors": "T",
+                                     "rated_high": 0.0, "humidity_sp": "OFF", "humidity_high": 0.0,
+                                     "humidity_low": 0.0}
 
 Operation = Literal["identify", "read_temperature", "read_setpoint", "write_setpoint", "read_low_limit",
                     "read_high_limit", "power_on", "power_off", "alarm", "units", "humidity", "purge_on",
@@ -42,6 +46,9 @@ class ChamberLineProtocol(BaseModel):
 
     write_terminator: str = Field("\n", min_length=1, max_length=4)
     read_terminator: str = Field("\n", min_length=1, max_length=4)
+    any_line_end: bool = Field(False, description="the controller ends a request at CR, LF or CR LF, whichever "
+                               "comes (for the simulator: a client's other terminator answered, not joined to the "
+                               "next request); the driver sends write_terminator")
     dialect: Dialect = Field("plain", description="how the controller reads a request: plain text, ESPEC (a "
                              "blank after a comma optional), SIMSERV (numbered commands), SCPI (headers)")
     encoding: Literal["ascii", "latin-1"] = Field("ascii", description="latin-1 where fields are separated by a "
@@ -52,6 +59,9 @@ class ChamberLineProtocol(BaseModel):
     errors: dict[str, str] = Field({}, description="error code → what it means, for the one-line error")
     unknown_command_answer: str | None = Field(None, max_length=256, description="what the simulator answers to "
                                                "a request it does not know (none: silence)")
+    unsupported_answer: str | None = Field(None, max_length=256, description="what the simulator answers to a "
+                                           "request the controller has but the simulated one does not model: the "
+                                           "controller's own 'not supported' (none: as an unknown request)")
     local_mode_answer: str | None = Field(None, max_length=256, description="what the controller answers to a "
                                           "remote write while its panel locks them (ESPEC: PROTECT ON), for the simulator")
     units_celsius: str = Field("C", max_length=16, description="the `units` reply that means °C")
@@ -193,21 +203,24 @@ ESPEC_P300 = ChamberLineProtocol(
             "PARA ERR": "parameter missing or not recognised",
             "DATA OUT OF RANGE": "value beyond the controller's range",
             "PROTECT ON": "the controller's data protection is on (set on its panel): remote writes are locked",
-            "INVALID REQ": "function not supported", "CHB NOT READY": "the controller could not act on the command"},
-    unknown_command_answer="NA:CMD ERR", local_mode_answer="NA:PROTECT ON",
-    identify=LineCommand(send="TYPE?", reply=r"(?P<identity>.+)", answer="{sensors},{identity},{high:.1f}"),
+            "INVALID REQ": "function not supported (the chamber does not have the option)",
+            "CHB NOT READY": "the controller could not act on the command"},
+    unknown_command_answer="NA:CMD ERR", local_mode_answer="NA:PROTECT ON", unsupported_answer="NA:INVALID REQ",
+    identify=LineCommand(send="TYPE?", reply=r"(?P<identity>.+)", answer="{sensors},{identity},{rated_high:.1f}"),
     read_temperature=_ESPEC_TEMP, read_setpoint=_ESPEC_TEMP, read_low_limit=_ESPEC_TEMP, read_high_limit=_ESPEC_TEMP,
     write_setpoint=LineCommand(send="TEMP, S{value:.1f}", reply=_ESPEC_OK, answer="OK:{request}"),
     power_on=LineCommand(send="MODE,CONSTANT", reply=_ESPEC_OK, answer="OK:{request}"),
     power_off=LineCommand(send="MODE,STANDBY", reply=_ESPEC_OK, answer="OK:{request}"),
     alarm=LineCommand(send="ALARM?", reply=r"(?P<alarm>\d+)(,.*)?", answer="{alarm}"),
-    humidity=LineCommand(send="HUMI?", reply=rf"(?P<humidity>{_N}),.*", answer="{humidity:.0f},0,100,0"),
+    humidity=LineCommand(send="HUMI?", reply=rf"(?P<humidity>{_N}),.*",
+                         answer="{humidity:.0f},{humidity_sp},{humidity_high:.0f},{humidity_low:.0f}"),
 )
 
 #: Thermotron 8800 (8200 class): channel 1 is air temperature, 2 humidity; operations answer `0`. No purge
 #: command: its auxiliaries are set eight at a time (`AUXE1,ddd`), which would clobber the others wired there.
+#: Its clients end requests with CR LF, CR or LF and no source says which it takes: each ends a request.
 THERMOTRON_8800 = ChamberLineProtocol(
-    write_terminator="\r", read_terminator="\r\n", default_port=8888,
+    write_terminator="\r", read_terminator="\r\n", default_port=8888, any_line_end=True,
     identify=LineCommand(send="IDEN?", reply=r"(?P<identity>.+)", answer="{identity}"),
     read_temperature=LineCommand(send="PVAR1?", reply=rf"(?P<pv>{_N})", answer="{pv:.2f}"),
     read_setpoint=LineCommand(send="SETP1?", reply=rf"(?P<sp>{_N})", answer="{sp:.2f}"),
@@ -228,7 +241,7 @@ SIMSERV = ChamberLineProtocol(
     error_pattern=r"^(?P<code>-\d+)",
     errors={"-5": "command number not known", "-6": "too few or incorrect parameters",
             "-8": "data could not be read"},
-    unknown_command_answer="-5",
+    unknown_command_answer="-5", unsupported_answer="-8",
     identify=LineCommand(send=f"99997{_S}1{_S}1", reply=rf"1{_S}(?P<identity>[^{_S}]*){_MORE}",
                          answer=f"1{_S}{{identity}}"),
     read_temperature=LineCommand(send=f"11004{_S}1{_S}1", reply=rf"1{_S}(?P<pv>{_N}){_MORE}", answer=f"1{_S}{{pv:.1f}}"),
@@ -251,10 +264,11 @@ SIMSERV = ChamberLineProtocol(
 
 #: Watlow F4T over SCPI (TCP port 5025 only): loop 1 is temperature, loop 2 humidity. Headers in the
 #: manual's notation (sent as upper-case long forms). Settings are not answered and the F4T has no error
-#: queue: a set point is confirmed by reading it back.
+#: queue: a set point is confirmed by reading it back. `*IDN?` answers `Watlow Electric,<part>,<serial>,
+#: <software>` (ESPEC's F4T command list); the simulator's part is its identity, its serial 1.
 WATLOW_F4T_SCPI = ChamberLineProtocol(
     dialect="scpi", write_terminator="\n", read_terminator="\n", default_port=5025,
-    identify=LineCommand(send="*IDN?", reply=r"(?P<identity>.+)", answer="{identity}"),
+    identify=LineCommand(send="*IDN?", reply=r"(?P<identity>.+)", answer="Watlow Electric,{identity},1,simulated"),
     read_temperature=LineCommand(send=":SOURce:CLOop1:PVALue?", reply=rf"(?P<pv>{_N})", answer="{pv:.2f}"),
     read_setpoint=LineCommand(send=":SOURce:CLOop1:SPOint?", reply=rf"(?P<sp>{_N})", answer="{sp:.2f}"),
     write_setpoint=LineCommand(send=":SOURce:CLOop1:SPOint {value:.2f}"),

@@ -11,9 +11,11 @@ from typing import Literal
 from accelcal_rig.config.rig import ChamberConfig
 from accelcal_rig.protocols.chamber_lines import ChamberLineProtocol, Operation
 from accelcal_rig.protocols.line_templates import finite_number
+from accelcal_rig.sim.controller_extras import Unknown, Unsupported
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
-from accelcal_rig.sim.line_extras import Unknown, extras_for
+from accelcal_rig.sim.line_answers import ANY_LINE_END
+from accelcal_rig.sim.line_extras import extras_for
 from accelcal_rig.sim.pty_line_server import PtyLineServer
 from accelcal_rig.sim.tcp_line_server import TcpLineServer
 
@@ -36,11 +38,13 @@ class SimulatedLineChamberServer:
         #: Active alarms and warnings (tests set them): SIMSERV's status, ESPEC's alarm count.
         self.alarms = 0
         self.warnings = 0
-        self._extras = extras_for(protocol, lab, self)
-        self._stall_after_s = stall_after_s
+        #: The chamber's own range (ESPEC's TYPE? maximum): a client sets the controller's limits within it.
+        self.rated_limits_c: tuple[float, float] = lab.controller_limits_c
         #: The last set point written over the wire, for tests that check the safe state.
         self.last_setpoint_c: float | None = None
-        requests_end = protocol.write_terminator.encode(protocol.encoding)
+        self._extras = extras_for(protocol, lab, self)
+        self._stall_after_s = stall_after_s
+        requests_end = ANY_LINE_END if protocol.any_line_end else protocol.write_terminator.encode(protocol.encoding)
         replies_end = protocol.read_terminator.encode(protocol.encoding)
         server = TcpLineServer if transport == "tcp" else PtyLineServer
         self._server: TcpLineServer | PtyLineServer = server(self._handle, requests_end, "simulated-chamber", faults,
@@ -83,14 +87,25 @@ class SimulatedLineChamberServer:
                 return self._protocol.local_mode_answer
             try:
                 value = finite_number(match["value"]) if "value" in match.groupdict() else None
-            except ValueError:  # `nan`, `inf`, `1e400`, `1_0`: refused as any request it cannot read, set point kept
-                return self._protocol.unknown_command_answer
+            except ValueError:  # `nan`, `inf`, `1e400`, `1_0`: refused as any request it cannot read, set point
+                return self._not_a_number(request)  # kept
             values = self._serve(operation, value)
             return None if command.answer is None else command.answer.format(request=request, **values)
         with self._lab.lock:
             self._lab.moisture.dew_point_c(self._lab.clock.now())
             extra = self._extras.answer(request)
-        return self._protocol.unknown_command_answer if isinstance(extra, Unknown) else extra
+        if isinstance(extra, Unsupported) and self._protocol.unsupported_answer is not None:
+            return self._protocol.unsupported_answer
+        return self._protocol.unknown_command_answer if isinstance(extra, Unknown | Unsupported) else extra
+
+    def _not_a_number(self, request: str) -> str | None:
+        """A write whose set point is no number: answered as an unknown request, unless it is a word the
+        controller has for something not simulated (ESPEC's `TEMP, SOFF`, temperature control off)."""
+        with self._lab.lock:
+            extra = self._extras.answer(request)
+        if isinstance(extra, Unsupported) and self._protocol.unsupported_answer is not None:
+            return self._protocol.unsupported_answer
+        return self._protocol.unknown_command_answer
 
     def overlong_answer(self, head: str) -> str | None:
         """A line too long to be a request (its first characters `head`): answered as an unknown request by a
@@ -104,7 +119,7 @@ class SimulatedLineChamberServer:
             now = lab.clock.now()
             lab.moisture.dew_point_c(now)  # the air's moisture follows the air, request by request
             if operation == "write_setpoint" and value is not None:
-                self._write_setpoint(now, value)
+                self.write_setpoint(now, value)
             elif operation in ("power_on", "power_off"):
                 lab.thermal.set_power(now, operation == "power_on")
             elif operation in ("purge_on", "purge_off"):
@@ -117,14 +132,17 @@ class SimulatedLineChamberServer:
             values: dict[str, object] = {"identity": self.identity, "sp": shown, "low": low, "high": high,
                                          "alarm": quiet, "units": self.units, "sensors": "T",
                                          "value": shown if value is None else value, "pv": 0.0, "humidity": 0.0,
-                                         **self._extras.values()}
+                                         "rated_high": self.rated_limits_c[1], "humidity_sp": "0",
+                                         "humidity_high": 100.0, "humidity_low": 0.0, **self._extras.values()}
             if operation in ("read_temperature", "read_setpoint", "read_low_limit", "read_high_limit"):
                 values["pv"] = lab.chamber_reading_c()  # measured only when a reply may carry it (it draws noise)
             if operation == "humidity":
                 values["humidity"] = lab.chamber_humidity_pct()
         return values
 
-    def _write_setpoint(self, now: float, setpoint_c: float) -> None:
+    def write_setpoint(self, now: float, setpoint_c: float) -> None:
+        """Take a set point: clamped to the controller's limits where the profile reads them, followed by the
+        chamber unless it stalled (the lab's lock held)."""
         if self._protocol.read_low_limit is not None:  # a controller with limits clamps to them, silently
             low, high = self._lab.controller_limits_c
             setpoint_c = min(max(setpoint_c, low), high)

@@ -33,11 +33,12 @@ WRITE_DEADLINE_S = 2.0
 
 
 class PtyLineServer:
-    """Reads requests ending in `terminator` from the pty and writes back `handle(request)` and the reply
-    terminator (the same unless given); a line too long to be a request is answered by `overlong` (none:
-    not at all), without ever being held whole; `strip` and `stale_after_s` as sim/line_answers.py says."""
+    """Reads requests ending in `terminator` (None: at CR, LF or CR LF, line_answers.ANY_LINE_END) from the
+    pty and writes back `handle(request)` and the reply terminator (the same unless given); a line too long
+    to be a request is answered by `overlong` (none: not at all), without ever being held whole; `strip` and
+    `stale_after_s` as sim/line_answers.py says."""
 
-    def __init__(self, handle: Handler, terminator: bytes = b"\n", name: str = "pty",
+    def __init__(self, handle: Handler, terminator: bytes | None = b"\n", name: str = "pty",
                  faults: ReplyFaults | None = None, reply_terminator: bytes | None = None,
                  encoding: str = "utf-8", overlong: Overlong | None = None, strip: bool = True,
                  stale_after_s: float | None = None) -> None:

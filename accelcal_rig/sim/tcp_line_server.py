@@ -45,7 +45,7 @@ class TcpLineServer:
     """Each connection is answered on its own thread (the handler takes the lab's lock); a client that
     reconnects is served anew."""
 
-    def __init__(self, handle: Handler, terminator: bytes = b"\n", name: str = "tcp",
+    def __init__(self, handle: Handler, terminator: bytes | None = b"\n", name: str = "tcp",
                  faults: ReplyFaults | None = None, reply_terminator: bytes | None = None,
                  encoding: str = "utf-8", host: str = "127.0.0.1", port: int = 0,
                  overlong: Overlong | None = None) -> None:

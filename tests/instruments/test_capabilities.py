@@ -77,14 +77,16 @@ def modbus(profile: str, overrides: dict | None = None) -> ModbusChamber:
 def test_a_modbus_chamber_has_the_capabilities_of_its_register_map() -> None:
     assert sorted(PROFILES) == ["watlow-f4", "watlow-f4t"]
     assert capabilities(modbus("watlow-f4")) == {AlarmReporting, ControllerLimits, SetpointResolution}
-    assert capabilities(modbus("watlow-f4t")) == {AlarmReporting}  # float32: the set point in full
-    assert capabilities(modbus("watlow-f4t", {"purge_register": 2010, "alarm_register": None})) == {Purging}
+    assert capabilities(modbus("watlow-f4t")) == {AlarmReporting, ControllerLimits}  # float32: the set point in full
+    assert capabilities(modbus("watlow-f4t", {"purge_register": 2010, "alarm_register": None,
+                                              "setpoint_low_register": None, "setpoint_high_register": None})) == {Purging}
     assert type(modbus("watlow-f4")).__name__ == "ModbusChamber"
     assert setpoint_decimals(modbus("watlow-f4")) == 1
 
 
 def test_the_helpers_answer_for_a_chamber_without_the_capability() -> None:
-    chamber = modbus("watlow-f4t", {"alarm_register": None})
+    chamber = modbus("watlow-f4t", {"alarm_register": None, "setpoint_low_register": None,
+                                    "setpoint_high_register": None})
     assert controller_limits(chamber) is None and humidity_pct(chamber) is None and not has_purge(chamber)
     assert alarm_active(chamber) is False and setpoint_decimals(chamber) is None
     with pytest.raises(InstrumentError, match=r"chamber \(modbus-rtu memory\): no dry-air purge output"):

@@ -128,8 +128,18 @@ def test_limits_that_are_no_range_are_refused_and_a_map_without_them_says_none()
                         profile="watlow-f4")
     with pytest.raises(InstrumentError, match=r"set point limits read 50…40 °C \(registers 602/603\): not a range"):
         driver.controller_limits_c()
-    f4t = chamber([], profile="watlow-f4t")[0]  # F4T Data Map 1: not in our map
-    assert not isinstance(f4t, ControllerLimits) and controller_limits(f4t) is None
+    client = ModbusSerialClient("memory", baudrate=9600, timeout=0.05, retries=0)
+    without = ModbusChamber(client, "modbus-rtu memory",
+                            register_map("watlow-f4t", {"setpoint_low_register": None, "setpoint_high_register": None}))
+    assert not isinstance(without, ControllerLimits) and controller_limits(without) is None
+
+
+def test_f4t_reads_its_own_setpoint_limits_from_2774_and_2776_as_floats() -> None:
+    """ESPEC's ChamberConnectLibrary (watlowf4t.py get_loop_range): loop 1's low limit at 2774, high at 2776."""
+    driver, port = chamber([(read_request(1, 2774, 2), read_reply(1, *float_words_low_first(-70.0))),
+                            (read_request(1, 2776, 2), read_reply(1, *float_words_low_first(180.0)))])
+    assert driver.controller_limits_c() == (-70.0, 180.0)
+    port.assert_finished()
 
 
 @pytest.mark.parametrize("profile", ["watlow-f4", "watlow-f4t"])

@@ -44,12 +44,14 @@ from accelcal_rig.protocols.chamber_registers import register_map
 from accelcal_rig.protocols.turntable_line import ACUTROL3000, turntable_protocol
 from accelcal_rig.sim.chamber_line_server import SimulatedLineChamberServer
 from accelcal_rig.sim.chamber_server import SimulatedChamberServer
+from accelcal_rig.sim.f4t_scpi_extras import serves as f4t_serves
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.register_panels import panel_for
 from accelcal_rig.sim.turntable_server import SimulatedTurntableServer
 from tests.conftest import SIM_RIG
 from tests.protocols.client_requests import DATA_CLIENTS, DataClient, Expect
 from tests.protocols.maker_requests import NOT_SIMULATED as CHAMBER_NOT_SIMULATED
+from tests.protocols.maker_requests import REFUSALS as LINE_REFUSALS
 from tests.protocols.modbus_requests import not_simulated as modbus_not_simulated
 from tests.protocols.turntable_requests import NOT_SIMULATED as TURNTABLE_NOT_SIMULATED
 
@@ -658,6 +660,8 @@ def _unmodelled_setting(profile: str, expect: Expect) -> str:
         return ""
     if any(pattern.fullmatch(expect.request) for _, _, pattern in protocol.request_patterns()):  # type: ignore[attr-defined]
         return ""
+    if f4t_serves(expect.request):  # held by the simulated F4T beyond its profile (sim/f4t_scpi_extras.py)
+        return ""
     return "a documented setting the simulator does not know: unanswered as documented, but not carried out"
 
 
@@ -692,9 +696,9 @@ class Documented:
 
 
 DOCUMENTED: tuple[Documented, ...] = (
-    Documented("espec-p300", r"PRGM,(PAUSE|CONTINUE|ADVANCE|END.*)", "NA:CONT NOT READY-2",
-               "ChamberConnectLibrary especinteract.py ERROR_DESCIPTIONS: 'Chamber is not running a program' (none "
-               "runs in the simulated chamber)"),
+    # the line profiles' refusals, as data (maker_requests.REFUSALS, each checked against the simulator)
+    *(Documented(r.profile, r.request, re.escape(r.reply), f"{r.source} ({r.state}" + ("; the code inferred from "
+      "the error table's meanings)" if r.inferred else ")")) for r in LINE_REFUSALS),
     Documented("watlow-f4", r"read holding (319|1925) x1", "exception 2",
                "ChamberConnectLibrary watlowf4.py process_controller (lines 952-966): loop 2's set point (319) and the "
                "cascade flag (1925) are probed, an exception meaning a single-loop F4 without cascade, as simulated"),
@@ -718,7 +722,8 @@ CLIENT_LIMITS: tuple[ClientLimit, ...] = (
     ClientLimit("PyMeasure Thermotron3800, PyVISA's terminations", r".*", r"VI_ERROR_TMO",
                 "PyVISA's TCPIP SOCKET resource has no read termination unless one is given: the reply came (see "
                 "the wire) and was read only up to the timeout; a Thermotron3800 on a socket needs read_termination"),
-    ClientLimit("espec-pr3j", r"get_temperature_status|get_test_area_state|set_target_temperature",
+    ClientLimit("espec-pr3j", r"get_temperature_status|get_test_area_state|set_target_temperature|"
+                r"set_constant_condition",
                 r"MonitorError|SettingError",
                 "its reply patterns have no minus sign (src/espec_pr3j/espec_pr3j.py: r'(?P<current>\\d+\\.\\d+)'): a "
                 "chamber below 0 °C, or with a lower limit below 0 °C, cannot be read (test_public_clients.py)"),

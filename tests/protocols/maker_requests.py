@@ -34,6 +34,8 @@ class Row:
     setpoint_c: float | None = None  # afterwards the controller's set point is this
     powered: bool | None = None  # afterwards the chamber conditions (runs) or not
     purge: bool | None = None  # afterwards the dry-air purge output is on or off
+    ending: str | None = None  # the line end the client sends, where it is not the profile's write_terminator
+    limits_c: tuple[float, float] | None = None  # afterwards the controller's set point limits are these
 
 
 @dataclass(frozen=True)
@@ -124,7 +126,97 @@ ESPEC = (
         Row("TYPE?", "chamberconnectlibrary/p300.py read_type", "identify", reply=rf"T,[^,]+,{_N}"),
         Row("MON?", "chamberconnectlibrary/p300.py read_mon", reply=rf"{_N},,CONSTANT,0"),
         Row("HUMI?", "chamberconnectlibrary/espec.py process_controller", refused="NA:CONT NOT READY-1"),
+        Row("CONSTANT SET?,HUMI", "chamberconnectlibrary/p300.py read_constant_humi", refused="NA:CONT NOT READY-1"),
+        Row("HUMI, S50.0", "chamberconnectlibrary/p300.py write_humi", refused="NA:CONT NOT READY-1"),
     ), overrides={"humidity": None}),
+    # Beyond the profile (issue 43): ChamberConnectLibrary 2.2.5's P300 and Espec classes' every request that
+    # reads or sets what the simulated controller holds, answered in the format the library's parser reads
+    # (p300.py), each setting echoed `OK:<command as received>` (EHS manual §1.3) and carried out.
+    Conversation("espec-p300", "EspecNorthAmerica/ChamberConnectLibrary", "MIT", (
+        Row("ROM?", "chamberconnectlibrary/p300.py read_rom (espec.py process_controller: startswith('P3') is a "
+            "P300; syndesi sh242.py test: 9-20 characters)", reply=r"P3.{7,18}"),
+        Row("ROM?,DISP", "chamberconnectlibrary/p300.py read_rom(display=True)", reply=r".{9,20}"),
+        Row("CONSTANT SET?,TEMP", "chamberconnectlibrary/p300.py read_constant_temp (espec.py get_loop_sp)",
+            reply=rf"{_N},ON"),
+        Row("TEMP, S-12.5", "chamberconnectlibrary/p300.py write_temp", "write_setpoint", setpoint_c=-12.5),
+        Row("CONSTANT SET?,TEMP", "chamberconnectlibrary/p300.py read_constant_temp", reply=r"-12\.5,ON"),
+        Row("TEMP, L-40.0", "chamberconnectlibrary/p300.py write_temp(min=…) (espec.py set_loop_range)",
+            reply="OK:TEMP, L-40.0", limits_c=(-40.0, 180.0)),
+        Row("TEMP, H100.0", "chamberconnectlibrary/p300.py write_temp(max=…) (espec.py set_loop_range)",
+            reply="OK:TEMP, H100.0", limits_c=(-40.0, 100.0)),
+        Row("TEMP?", "chamberconnectlibrary/p300.py read_temp (espec.py get_loop_range)", "read_high_limit"),
+        Row("TYPE?", "chamberconnectlibrary/p300.py read_type: the chamber's maximum stays", reply=r"T,T,[^,]+,180\.0"),
+        Row("TEMP, S25.0 H120.0 L-50.0", "chamberconnectlibrary/p300.py write_temp(setpoint, max, min)",
+            reply="OK:TEMP, S25.0 H120.0 L-50.0", setpoint_c=25.0, limits_c=(-50.0, 120.0)),
+        Row("TEMP, H200.0", "especinteract.py 'DATA OUT OF RANGE' (beyond TYPE?'s maximum)",
+            refused="NA:DATA OUT OF RANGE", limits_c=(-50.0, 120.0)),
+        Row("TEMP, L-80.0", "especinteract.py 'DATA OUT OF RANGE' (below the chamber's range)",
+            refused="NA:DATA OUT OF RANGE", limits_c=(-50.0, 120.0)),
+        Row("HUMI, S25.0", "chamberconnectlibrary/p300.py write_humi (espec.py set_loop_sp(2))",
+            reply="OK:HUMI, S25.0"),
+        Row("CONSTANT SET?,HUMI", "chamberconnectlibrary/p300.py read_constant_humi (espec.py get_loop_sp(2))",
+            reply="25,ON"),
+        Row("HUMI?", "chamberconnectlibrary/p300.py read_humi", "humidity", reply=r"\d+,25,100,0"),
+        Row("HUMI, S50.0 H90.0 L10.0", "chamberconnectlibrary/p300.py write_humi(setpoint, max, min)",
+            reply="OK:HUMI, S50.0 H90.0 L10.0"),
+        Row("HUMI?", "chamberconnectlibrary/p300.py read_humi", "humidity", reply=r"\d+,50,90,10"),
+        Row("HUMI,SOFF", "chamberconnectlibrary/p300.py write_humi(enable=False) (espec.py set_loop_en(2))",
+            reply="OK:HUMI,SOFF"),
+        Row("CONSTANT SET?,HUMI", "chamberconnectlibrary/p300.py read_constant_humi", reply="50,OFF"),
+        Row("HUMI, H120.0", "especinteract.py 'DATA OUT OF RANGE' (above 100 % RH)", refused="NA:DATA OUT OF RANGE"),
+        Row("SET,REF6", "chamberconnectlibrary/p300.py write_set('manual', 100) (encode_refrig)", reply="OK:SET,REF6"),
+        Row("SET?", "chamberconnectlibrary/p300.py read_set (reflookup)", reply="REF6"),
+        Row("CONSTANT SET?,REF", "chamberconnectlibrary/p300.py read_constant_ref (espec.py get_refrig)",
+            reply="100"),
+        Row("REF?", "chamberconnectlibrary/p300.py read_ref (conditioning, manual refrigeration)", reply="6,ON1"),
+        Row("RELAY,ON,1,3", "chamberconnectlibrary/p300.py write_relay (espec.py set_event)",
+            reply="OK:RELAY,ON,1,3"),
+        Row("RELAY?", "chamberconnectlibrary/p300.py read_relay (espec.py get_event)", reply="2,1,3"),
+        Row("RELAY,OFF,1", "chamberconnectlibrary/p300.py write_relay", reply="OK:RELAY,OFF,1"),
+        Row("CONSTANT SET?,RELAY", "chamberconnectlibrary/p300.py read_constant_relay", reply="1,3"),
+        Row("RELAY,ON,13", "especinteract.py 'DATA OUT OF RANGE' (time signals 1-12)", refused="NA:DATA OUT OF RANGE"),
+        Row("KEYPROTECT,ON", "chamberconnectlibrary/p300.py write_keyprotect", reply="OK:KEYPROTECT,ON"),
+        Row("KEYPROTECT?", "chamberconnectlibrary/p300.py read_keyprotect", reply="ON"),
+        Row("KEYPROTECT,off", "chamberconnectlibrary/p300.py write_keyprotect(False)", reply="OK:KEYPROTECT,off"),
+        Row("KEYPROTECT?", "chamberconnectlibrary/p300.py read_keyprotect", reply="OFF"),
+        Row("MASK,01000000", "chamberconnectlibrary/p300.py write_mask(alarm=True)", reply="OK:MASK,01000000"),
+        Row("MASK?", "chamberconnectlibrary/p300.py read_mask", reply="01000000"),
+        Row("SRQ,RESET", "chamberconnectlibrary/p300.py write_srq", reply="OK:SRQ,RESET"),
+        Row("TIME,12:30:0", "chamberconnectlibrary/p300.py write_time (espec.py set_datetime)",
+            reply="OK:TIME,12:30:0"),
+        Row("DATE,25.1/15. WED", "chamberconnectlibrary/p300.py write_date (espec.py set_datetime)",
+            reply="OK:DATE,25.1/15. WED"),
+        Row("DATE?", "chamberconnectlibrary/p300.py read_date (syndesi sh242.py: '%y.%m/%d')", reply=r"25\.01/15"),
+        Row("TIME?", "chamberconnectlibrary/p300.py read_time (syndesi sh242.py: '%H:%M:%S'; the clock stood still)",
+            reply="12:30:00"),
+        Row("IPSET,192.168.0.10,255.255.255.0,192.168.0.1", "chamberconnectlibrary/p300.py write_ip_set",
+            reply="OK:IPSET,192.168.0.10,255.255.255.0,192.168.0.1"),
+        Row("IPSET?", "chamberconnectlibrary/p300.py read_ip_set (espec.py get_network_settings)",
+            reply=r"192\.168\.0\.10,255\.255\.255\.0,192\.168\.0\.1"),
+        Row("TIMER ON?", "chamberconnectlibrary/p300.py read_timer_on (none on)", reply="0"),
+        Row("TIMER USE?", "chamberconnectlibrary/p300.py read_timer_use (none set)", reply="0"),
+        Row("PRGM USE?,RAM", "chamberconnectlibrary/p300.py read_prgm_use (syndesi: 'N, 1, 2, 5'; none stored)",
+            reply="0"),
+        Row("MODE,STANDBY", "chamberconnectlibrary/p300.py write_mode_standby", "power_off", powered=False),
+        Row("REF?", "chamberconnectlibrary/p300.py read_ref (not conditioning)", reply="6,OFF1"),
+        Row("POWER,off", "chamberconnectlibrary/p300.py write_power(False)", reply="OK:POWER,off", powered=False),
+        Row("KEYPROTECT,ON", "especinteract.py 'CONT NOT READY-4' (the controller is off)",
+            refused="NA:CONT NOT READY-4"),
+    )),
+    Conversation("espec-p300", "leandrolanzieri/espec_pr3j", "MIT (metadata; LGPL-3.0 licence file)", (
+        Row("TEMP, H 100.0", "src/espec_pr3j/espec_pr3j.py set_temperature_limits (f'{upper: 0.1f}')",
+            reply=r"OK:TEMP, H \d+.\d+", limits_c=(-70.0, 100.0)),
+        Row("TEMP, L 0.0", "src/espec_pr3j/espec_pr3j.py set_temperature_limits", reply=r"OK:TEMP, L \d+.\d+",
+            limits_c=(0.0, 100.0)),
+        Row("HUMI, H100.0", "src/espec_pr3j/espec_pr3j.py set_humidity_limits (str(float))", reply=r"OK:HUMI, H\d+.*"),  # re.match
+        Row("HUMI, L0.0", "src/espec_pr3j/espec_pr3j.py set_humidity_limits", reply=r"OK:HUMI, L\d+.*"),
+        Row("HUMI, S45.0", "src/espec_pr3j/espec_pr3j.py set_target_humidity", reply=r"OK:HUMI, S\d+.*\d*"),
+        Row("HUMI, SOFF", "src/espec_pr3j/espec_pr3j.py set_target_humidity(None)", reply="OK:HUMI, SOFF"),
+        Row("HUMI?", "src/espec_pr3j/espec_pr3j.py get_humidity_status", "humidity",
+            reply=r"(\d+),(OFF),(\d+),(\d+)"),
+        Row("MODE, RUN", "src/espec_pr3j/espec_pr3j.py set_mode(RUN) (no program number: MODE,RUN<n>, p300.py "
+            "write_mode_run)", refused="NA:PARA ERR"),
+    )),
 )
 
 THERMOTRON = (
@@ -138,6 +230,12 @@ THERMOTRON = (
         Row("RUNM", "pymeasure/instruments/thermotron/thermotron3800.py run", "power_on", reply="0", powered=True),
         Row("SETP1,-12.5", "pymeasure/instruments/thermotron/thermotron3800.py setpoint (SETP1,%g)",
             "write_setpoint", reply="0", setpoint_c=-12.5),
+        # Thermotron3800 leaves the terminators to its user: PyVISA's default CR LF, or LF, each ends a request
+        Row("IDEN?", "thermotron3800.py id (PyVISA's write_termination, CR LF)", "identify", ending="\r\n"),
+        Row("PVAR1?", "thermotron3800.py temperature (write_termination='\\n')", "read_temperature", ending="\n"),
+        Row("SETP1,-20", "thermotron3800.py setpoint (write_termination='\\n')", "write_setpoint", reply="0",
+            setpoint_c=-20.0, ending="\n"),
+        Row("SETP1?", "thermotron3800.py setpoint (the profile's CR again)", "read_setpoint"),
     )),
 )
 
@@ -192,13 +290,32 @@ SIMSERV = (
 
 WATLOW_F4T = (
     Conversation("watlow-f4t-scpi", "EspecNorthAmerica/WatlowF4T-SCPI-Lib", "MIT", (
-        Row("*IDN?", "f4tscpi/f4t_interface.py get_id", "identify"),
+        Row("*IDN?", "f4tscpi/f4t_interface.py get_id (the F4T list: Watlow Electric | <string> | <integer> | "
+            "<string>)", "identify", reply=r"Watlow Electric,[^,]*,\d+,[^,]*"),
         Row(":UNIT:TEMPERATURE?", "f4tscpi/f4t_interface.py get_units", "units", reply="C|F"),
         Row(":SOURCE:CLOOP1:PVALUE?", "f4tscpi/f4t_interface.py get_pv", "read_temperature"),
         Row("SOURCE:CLOOP1:SPOINT 25.0", "f4tscpi/f4t_interface.py write_sp (no leading colon, str(float))",
             "write_setpoint", silent=True, setpoint_c=25.0),
         Row(":SOURCE:CLOOP1:SPOINT?", "f4tscpi/f4t_interface.py get_sp", "read_setpoint"),
         Row(":SOURCE:CLOOP2:PVALUE?", "f4tscpi/f4t_interface.py get_pv (loop 2)", "humidity"),
+        # Beyond the profile (issue 43): the F4T list's headers (PaulNongL/WatlowF4TscpiLibrary
+        # f4t_scpi_cmds/f4t_scpi_commands.ods) the library sends, held and read back
+        Row(":SOURCE:CLOOP2:SPOINT 45.0", "f4tscpi/f4t_interface.py write_sp(45.0, 2) (Write SP)", silent=True),
+        Row(":SOURCE:CLOOP2:SPOINT?", "f4tscpi/f4t_interface.py get_sp(2) (Read SP)", reply=r"45\.00"),
+        Row(":SOURCE:CLOOP1:RACTION OFF", "f4tscpi/f4t_interface.py ramp_mode (Set ramping off)", silent=True),
+        Row(":SOURCE:CLOOP1:RSCALE MINUTES", "f4tscpi/f4t_interface.py set_rampScale (Write ramp scale to minutes)",
+            silent=True),
+        Row(":SOURCE:CLOOP1:RRATE 2.0", "f4tscpi/f4t_interface.py set_ramp('rate') (Write ramp rate)", silent=True),
+        Row(":SOURCE:CLOOP1:RRATE?", "f4tscpi/f4t_interface.py get_ramp('rate') (Read ramp rate)", reply=r"2\.00"),
+        Row(":SOURCE:CLOOP1:RTIME 30", "f4tscpi/f4t_interface.py set_ramp('time') (Write ramp time)", silent=True),
+        Row(":SOURCE:CLOOP1:RTIME?", "f4tscpi/f4t_interface.py get_ramp('time') (Read ramp time)", reply=r"30\.00"),
+        Row(":SOURCE:CLOOP1:ERROR?", "the F4T list: Query input error → ERROR|NONE", reply="NONE"),
+        Row(":OUTPUT3:STATE?", "f4tscpi/f4t_interface.py get_ts(3) (Query event output state)", reply="OFF"),
+        Row(":OUTPUT3:STATE ON", "f4tscpi/f4t_interface.py set_output(3) (Set event output on)", silent=True),
+        Row(":OUTPUT3:STATE?", "f4tscpi/f4t_interface.py set_output (read back)", reply="ON"),
+        Row(":PROGRAM:NUMBER 1", "f4tscpi/f4t_interface.py select_profile (Select a profile, 1-40)", silent=True),
+        Row(":PROGRAM:NAME?", "f4tscpi/f4t_interface.py get_profiles (Read selected profile name; none stored: "
+            "empty, where the library stops)", reply=""),
     )),
     Conversation("watlow-f4t-scpi", "DAsh0244/te107_control", "MIT", (
         Row("SOURCE:CLOOP1:SPOINT 30.0", "src/f4t_control.py set_temperature", "write_setpoint", silent=True,
@@ -208,7 +325,26 @@ WATLOW_F4T = (
     Conversation("watlow-f4t-scpi", "PyPI py-lab-hal 2.5.20241201", "Apache-2.0", (
         Row(":SOURCE:CLOOP1:SPOINT -12.50", "py_lab_hal/instrument/temp_chamber/testequity_107.py Testequity107",
             "write_setpoint", silent=True, setpoint_c=-12.5),
+        Row("OUTPUT1:STATE ON", "py_lab_hal/instrument/temp_chamber/testequity_107.py enable_power(True) (an event "
+            "output wired to nothing simulated: held)", silent=True),
+        Row(":OUTPUT1:STATE?", "the F4T list: Query event output state", reply="ON"),
+        Row(":SOURCE:CLOOP1:RACTION OFF", "py_lab_hal/instrument/temp_chamber/testequity_107.py enable_ramp(False)",
+            silent=True),
+        Row(":SOURCE:CLOOP1:RRATE 1.50", "py_lab_hal/instrument/temp_chamber/testequity_107.py set_ramp_rate",
+            silent=True),
+        Row(":SOURCE:CLOOP1:RRATE?", "the F4T list: Read ramp rate", reply=r"1\.50"),
+        Row(":PROGRAM:NUMBER 2", "py_lab_hal/instrument/temp_chamber/testequity_107.py run_profile", silent=True),
     )),
+    # A TestEquity chamber: output 1 enables the chamber (TestEquity's F4T manual), the profile's power command
+    # by override (docs/instruments.md); reading the output back is reading the chamber's run.
+    Conversation("watlow-f4t-scpi", "PyPI py-lab-hal 2.5.20241201", "Apache-2.0", (
+        Row("OUTPUT1:STATE OFF", "py_lab_hal/instrument/temp_chamber/testequity_107.py enable_power(False)", "power_off",
+            silent=True, powered=False),
+        Row(":OUTPUT1:STATE?", "the F4T list: Query event output state", reply="OFF"),
+        Row("OUTPUT1:STATE ON", "py_lab_hal/instrument/temp_chamber/testequity_107.py enable_power(True)", "power_on",
+            silent=True, powered=True),
+        Row(":OUTPUT1:STATE?", "the F4T list: Query event output state", reply="ON"),
+    ), overrides={"power_on": {"send": ":OUTPut1:STATe ON"}, "power_off": {"send": ":OUTPut1:STATe OFF"}}),
     # SCPI-99 vol. 1 §6-7: the spellings the manuals' notation (:SOURce:CLOop1:SPOint) allows.
     Conversation("watlow-f4t-scpi", "SCPI-99 program header grammar", "standard", (
         Row(":sour:clo1:spo 30", "short forms, lower case", "write_setpoint", silent=True, setpoint_c=30.0),
@@ -222,23 +358,112 @@ WATLOW_F4T = (
 
 CONVERSATIONS: tuple[Conversation, ...] = (*ESPEC, *THERMOTRON, *SIMSERV, *WATLOW_F4T)
 
+_CCL = "EspecNorthAmerica/ChamberConnectLibrary"
+_F4T_LIB = "EspecNorthAmerica/WatlowF4T-SCPI-Lib"
+_NO_CASCADE = "no cascade: the F4T list gives the CASCADE headers for controllers with cascade control only"
+
 #: (profile, request, client, where, why the simulator does not serve it): requests public clients send that
-#: a real controller understands but the simulated one does not model. It answers them as an unknown
-#: request (ESPEC `NA:CMD ERR`, SIMSERV `-8` for a known number, silence on Thermotron and F4T).
+#: a real controller understands but the simulated one does not model. It answers them with the profile's
+#: `unsupported_answer`, the controller's own 'not supported' (ESPEC `NA:INVALID REQ`, "unsupported function
+#: … this chamber does not have the necessary options"; SIMSERV `-8`, data could not be read), or where the
+#: profile has none, as an unknown request (silence on the Thermotron and the F4T, which document no error
+#: reply).
 NOT_SIMULATED: tuple[tuple[str, str, str, str, str], ...] = (
-    ("espec-p300", "ROM?", "EspecNorthAmerica/ChamberConnectLibrary", "p300.py read_rom", "no ROM version"),
-    ("espec-p300", "SRQ?", "EspecNorthAmerica/ChamberConnectLibrary", "p300.py read_srq", "no service requests"),
-    ("espec-p300", "%?", "leandrolanzieri/espec_pr3j", "espec_pr3j.py get_heater_percentage", "no heater outputs"),
-    ("espec-p300", "TEMP, H 30.0", "leandrolanzieri/espec_pr3j", "espec_pr3j.py set_temperature_limits",
-     "limits are the simulation's, not writable"),
-    ("espec-p300", "HUMI, SOFF", "leandrolanzieri/espec_pr3j", "espec_pr3j.py set_target_humidity",
-     "humidity is measured, not controlled"),
+    ("espec-p300", "SRQ?", _CCL, "p300.py read_srq", "no service requests: the simulated controller raises none"),
+    ("espec-p300", "%?", "leandrolanzieri/espec_pr3j", "espec_pr3j.py get_heater_percentage (p300.py read_htr)",
+     "no heater outputs: the thermal model has no heater"),
+    ("espec-p300", "PRGM DATA WRITE,PGM1,EDIT START", _CCL, "p300.py write_prgm_data_edit (espec.py set_program)",
+     "no program memory: the simulated controller stores no program (so EDIT END / CANCEL answer PRGM WRITE "
+     "ERR-3 and steps ERR-2, not in edit mode)"),
+    ("espec-p300", "PRGM DATA WRITE,PGM1,OVER WRITE START", _CCL, "p300.py write_prgm_data_edit(overwrite=True)",
+     "no program memory: the simulated controller stores no program"),
+    *(("espec-p300", request, _CCL, where, "no timers: none can be set (so TIMER LIST?, TIMER ERASE and TIMER,ON "
+       "answer DATA NOT READY)") for request, where in (
+        ("TIMER WRITE,NO0,12:30,STANDBY", "p300.py write_timer_quick"),
+        ("TIMER WRITE,NO0,12:30,OFF", "p300.py write_timer_quick"),
+        ("TIMER WRITE,NO0,12:30,CONSTANT", "p300.py write_timer_quick"),
+        ("TIMER WRITE,NO1,MODE1,25.1/15,12:30,CONSTANT", "p300.py write_timer_start"),
+        ("TIMER WRITE,NO2,MODE3,12:30,STANDBY", "p300.py write_timer_stop"))),
+    ("espec-p300", "RUN PRGM, TEMP25.0 TIME1:1", _CCL, "p300.py write_run_prgm",
+     "no remote programs: the simulated controller runs none (RUN PRGM? and RUN PRGM MON? answer CONT NOT READY-2)"),
+    ("espec-p300", "TEMP, SOFF", "syndesi-project/drivers", "Python/syndesi_drivers/instruments/ovens/espec/sh242.py "
+     "set_temperature('OFF')", "temperature control switched off: not simulated (the chamber conditions in "
+     "CONSTANT and stops in STANDBY)"),
     ("thermotron-8800", "MODE?", "pymeasure/pymeasure", "thermotron3800.py mode", "no mode register"),
     ("thermotron-8800", "INIT", "pymeasure/pymeasure", "thermotron3800.py initalize_oven", "nothing to initialise"),
     ("simserv", f"11068{S}1{S}1{S}3", "IzaakWN/ClimateChamberMonitor", "chamber_commands.py forceWarmUp",
      "no gradients (answered -8)"),
     ("simserv", f"14010{S}1{S}5", "SiLab-Bonn/basil", "weiss_labevent.py _get_feature_status",
      "outputs have no names (answered -8)"),
-    ("watlow-f4t-scpi", "OUTPUT1:STATE ON", "PyPI py-lab-hal 2.5.20241201", "testequity_107.py enable_power",
-     "no event outputs in the profile (TestEquity wires output 1 to chamber enable)"),
+    *(("watlow-f4t-scpi", request, _F4T_LIB, f"f4tscpi/f4t_interface.py {where}", _NO_CASCADE) for request, where in (
+        (":SOURCE:CASCADE1:SPOINT?", "get_cascadeSP"), (":SOURCE:CASCADE1:OUTER:PVALUE?", "get_cascadeLoopPV"),
+        (":SOURCE:CASCADE1:INNER:PVALUE?", "get_cascadeLoopPV"), (":SOURCE:CASCADE1:OUTER:SPOINT?", "get_cascadeLoopSP"),
+        (":SOURCE:CASCADE1:INNER:SPOINT?", "get_cascadeLoopSP"))),
+    *(("watlow-f4t-scpi", request, client, where, "no profile engine: the simulated F4T stores and runs no profile "
+       "(a selected profile's name reads empty)") for request, client, where in (
+        (":PROGRAM:SELECTED:STATE START", _F4T_LIB, "f4tscpi/f4t_interface.py prog_mode"),
+        (":PROGRAM:SELECTED:STATE STOP", "PyPI py-lab-hal 2.5.20241201", "testequity_107.py run_profile(n, False)"))),
+    *(("watlow-f4t-scpi", request, client, where, "no ramping: the simulated air follows a set point at the chamber's "
+       "own rate (the rig config's ramp_rate_c_per_min), as with RACTION OFF; rate, time and scale are held")
+      for request, client, where in (
+        (":SOURCE:CLOOP1:RACTION SETPOINT", _F4T_LIB, "f4tscpi/f4t_interface.py ramp_mode (its docstring: OFF, "
+         "STARTUP, SETPOINT, BOTH)"),
+        (":SOURCE:CLOOP1:RACTION BOTH", "PyPI py-lab-hal 2.5.20241201", "testequity_107.py enable_ramp(True)"))),
+    ("watlow-f4t-scpi", ":OUTPUT1:NAME?", _F4T_LIB, "f4tscpi/f4t_interface.py get_tsName",
+     "not in the F4T's SCPI command list (the library's own): unanswered, as every header the F4T does not have"),
+)
+
+
+@dataclass(frozen=True)
+class Refusal:
+    """A refusal the maker documents for requests on a controller in the simulated state: each example is
+    answered with it (test_maker_requests.py), and the client sweep (client_sweep.py) takes it as the answer
+    the maker documents."""
+
+    profile: str
+    request: str  # a regular expression over the request as sent (its terminator cut)
+    reply: str  # the refusal, exactly
+    state: str  # the simulated controller's state it is the answer for
+    source: str
+    examples: tuple[str, ...]
+    inferred: bool = False  # the code matched to the state by the error table's meanings, not stated per command
+
+
+_ESPEC_ERRORS = "ChamberConnectLibrary especinteract.py ERROR_DESCIPTIONS"
+REFUSALS: tuple[Refusal, ...] = (
+    Refusal("espec-p300", r"(MON |TEMP |SET )?PTC\?|CONSTANT SET\?, ?PTC|SYSTEM SET\?, ?.*|PRGM DATA PTC\?, ?.*"
+            r"|TEMP PTC, ?.*|PTC, ?.*", "NA:CONT NOT READY-1", "no product temperature control (PTCON)",
+            f"{_ESPEC_ERRORS}: 'CONT NOT READY-1': 'Chamber does not support PTCON/Humidity'; espec.py "
+            "process_controller takes a refused TEMP PTC? as a chamber without PTCON",
+            ("MON PTC?", "TEMP PTC?", "SET PTC?", "PTC?", "CONSTANT SET?,PTC", "SYSTEM SET?,PTCOPT",
+             "PRGM DATA PTC?,RAM:1", "PRGM DATA PTC?,RAM:1,DETAIL", "PRGM DATA PTC?,RAM:1,STEP1",
+             "TEMP PTC, PTCON, DEVP100.0, DEVN0.0", "PTC,100.0,-40.0,1.0,0.0,1.0,0.0,0.0"), inferred=True),
+    Refusal("espec-p300", r"PRGM (MON|SET)\?|RUN PRGM( MON)?\?|PRGM, ?(PAUSE|CONTINUE|ADVANCE|END.*)",
+            "NA:CONT NOT READY-2", "no program running",
+            f"{_ESPEC_ERRORS}: 'CONT NOT READY-2': 'Chamber is not running a program'",
+            ("PRGM MON?", "PRGM SET?", "RUN PRGM MON?", "RUN PRGM?", "PRGM,PAUSE", "PRGM,CONTINUE", "PRGM,ADVANCE",
+             "PRGM,END,STANDBY"), inferred=True),
+    Refusal("espec-p300", r"PRGM DATA\?, ?R[AO]M:\d+.*|PRGM USE\?, ?R[AO]M:\d+|PRGM ERASE, ?R[AO]M:\d+"
+            r"|PRGM, ?RUN, ?R[AO]M:\d+.*|MODE, ?RUN\d+", "NA:DATA NOT READY", "no program stored",
+            f"{_ESPEC_ERRORS}: 'DATA NOT READY': 'Specified program does not exist'",
+            ("PRGM DATA?,RAM:1", "PRGM DATA?,RAM:1,DETAIL", "PRGM DATA?,RAM:1,STEP1", "PRGM USE?,RAM:40",
+             "PRGM ERASE,RAM:1", "PRGM,RUN,RAM:1,STEP1", "MODE,RUN1"), inferred=True),
+    Refusal("espec-p300", r"TIMER LIST\?, ?[0-2]|TIMER ERASE, ?NO[0-2]|TIMER, ?(ON|OFF), ?[0-2]", "NA:DATA NOT READY",
+            "no timer set", "syndesi-project/drivers Python/syndesi_drivers/instruments/ovens/espec/sh242.py "
+            "SH242Exception: 'DATA NOT READY': 'Specified data does not exist'",
+            ("TIMER LIST?,0", "TIMER LIST?,1", "TIMER LIST?,2", "TIMER ERASE,NO1", "TIMER,ON,2", "TIMER,OFF,0"),
+            inferred=True),
+    Refusal("espec-p300", r"MODE, ?RUN|IPSET,,,", "NA:PARA ERR", "a parameter missing",
+            f"{_ESPEC_ERRORS}: 'PARA ERR': 'Parameter missing or unrecognizable'", ("MODE, RUN", "IPSET,,,"),
+            inferred=True),
+    Refusal("espec-p300", r"HUMI, ?.*[SHL] ?-\d.*", "NA:DATA OUT OF RANGE", "a humidity below 0 % RH",
+            f"{_ESPEC_ERRORS}: 'DATA OUT OF RANGE': 'Data not with in valid range' (0-100 % RH)",
+            ("HUMI, L-40.0", "HUMI, S25.0 H100.0 L-40.0", "HUMI, S-5"), inferred=True),
+    Refusal("espec-p300", r"PRGM DATA WRITE, ?PGM\d+, ?EDIT (END|CANCEL)", "NA:PRGM WRITE ERR-3",
+            "no program being edited", f"{_ESPEC_ERRORS}: 'PRGM WRITE ERR-3': 'Edit request not allowed not in "
+            "edit mode'", ("PRGM DATA WRITE,PGM1,EDIT END", "PRGM DATA WRITE,PGM1,EDIT CANCEL"), inferred=True),
+    Refusal("espec-p300", r"PRGM DATA WRITE, ?PGM\d+, ?(STEP|COUNT|NAME|END|[HL](TEMP|HUMI)|PRE ).*",
+            "NA:PRGM WRITE ERR-2", "no program being edited", f"{_ESPEC_ERRORS}: 'PRGM WRITE ERR-2': 'Not in program "
+            "edit/overwrite mode'", ("PRGM DATA WRITE,PGM1,STEP1", "PRGM DATA WRITE,PGM1,STEP1,TEMP25.0,TIME1:0",
+                                     "PRGM DATA WRITE,PGM1,NAME,SAMPLE"), inferred=True),
 )

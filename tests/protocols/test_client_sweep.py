@@ -1,8 +1,9 @@
-"""Issue 43, the prototype: every public client's every public member swept against its simulator
-(tests/protocols/client_sweep.py). It records what each request met and asserts only that the sweep is whole:
-every public member enumerated, and each called or listed as not called with its reason. The deviations it
-finds are reported (the survey, under the test's temporary folder) and expected to fail, not failed on:
-the fixes come next. About 20 s: the Thermotron client pauses 1 s after every write, the sweeps run side by side.
+"""Issue 43: every public client's every public member swept against its simulator
+(tests/protocols/client_sweep.py). The sweep must be whole: every public member enumerated, and each called or
+listed as not called with its reason. Every request of a client must be answered as its maker documents (or be
+listed NOT_SIMULATED with its reason); the clients whose simulators are not fixed yet (STILL_DEVIATING) are
+expected to fail, strictly. The survey is written under the test's temporary folder. About 20 s: the Thermotron
+client pauses 1 s after every write, the sweeps run side by side.
 """
 
 from __future__ import annotations
@@ -101,8 +102,18 @@ def _class_defs(path: Path) -> set[str]:
     return found
 
 
-@pytest.mark.xfail(reason="issue 43: the deviations the sweep finds are fixed next", strict=False)
-@pytest.mark.parametrize("name", NAMES)
+#: The clients whose requests still deviate from what their makers document (issue 43 is fixed simulator by
+#: simulator): their test is a strict expected failure, so a client brought to no deviation must leave this
+#: set; every other client's requests must all be answered as documented (or listed NOT_SIMULATED).
+STILL_DEVIATING = frozenset({
+    "IEAv-EFO acutrol3000", "williamsea Acutrol (C#)",  # the ACUTROL3000's GPIB clients
+})
+assert STILL_DEVIATING <= set(NAMES), sorted(STILL_DEVIATING - set(NAMES))
+
+
+@pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.xfail(
+    reason="issue 43: this client's deviations are not fixed yet", strict=True)) if name in STILL_DEVIATING else name
+    for name in NAMES])
 def test_every_request_is_answered_as_its_maker_documents(records: dict[str, ClientSweep], name: str) -> None:
     record = _record(records, name)
     found = deviation_list(record)

@@ -17,7 +17,7 @@ from accelcal_rig.protocols.chamber_lines import LINE_PROFILES, ChamberLineProto
 from accelcal_rig.sim.chamber_line_server import SimulatedLineChamberServer
 from accelcal_rig.sim.lab import VirtualLab
 from tests.conftest import SIM_RIG
-from tests.protocols.maker_requests import CONVERSATIONS, NOT_SIMULATED, Conversation, Row, S
+from tests.protocols.maker_requests import CONVERSATIONS, NOT_SIMULATED, REFUSALS, Conversation, Refusal, Row, S
 from tests.sim.line_client import LineClient, tcp_client
 
 
@@ -39,8 +39,9 @@ class Wire:
         self.protocol, self._client = protocol, client
         self._end = protocol.read_terminator.encode(protocol.encoding)
 
-    def send(self, request: str) -> None:
-        self._client.send((request + self.protocol.write_terminator).encode(self.protocol.encoding))
+    def send(self, request: str, ending: str | None = None) -> None:
+        end = self.protocol.write_terminator if ending is None else ending
+        self._client.send((request + end).encode(self.protocol.encoding))
 
     def reply(self) -> str:
         return self._client.reply(self._end).removesuffix(self._end).decode(self.protocol.encoding)
@@ -74,7 +75,7 @@ def check_values(values: dict[str, str], protocol: ChamberLineProtocol, server: 
 
 def replay(row: Row, wire: Wire, server: SimulatedLineChamberServer, lab: VirtualLab) -> None:
     protocol = wire.protocol
-    wire.send(row.request)
+    wire.send(row.request, row.ending)
     command = protocol.command(row.operation) if row.operation is not None else None
     if row.silent:
         assert command is None or command.reply is None, "a silent row of an answered operation"
@@ -96,6 +97,8 @@ def replay(row: Row, wire: Wire, server: SimulatedLineChamberServer, lab: Virtua
         assert lab.thermal.powered is row.powered
     if row.purge is not None:
         assert lab.moisture.purge_on is row.purge
+    if row.limits_c is not None:
+        assert lab.controller_limits_c == pytest.approx(row.limits_c)
 
 
 @pytest.mark.parametrize("conversation", CONVERSATIONS,
@@ -117,19 +120,33 @@ def test_every_profile_has_public_clients_on_record() -> None:
 
 
 @pytest.mark.parametrize(("profile", "request_text", "client", "where", "why"), NOT_SIMULATED)
-def test_what_the_simulator_does_not_model_is_answered_as_unknown(profile: str, request_text: str, client: str,
-                                                                    where: str, why: str) -> None:
-    """The gap list is true: each is met as the profile meets a request it does not serve."""
+def test_what_the_simulator_does_not_model_is_answered_as_the_controller_answers_what_it_does_not_support(
+        profile: str, request_text: str, client: str, where: str, why: str) -> None:
+    """The gap list is true: each is met with the profile's own 'not supported' (ESPEC `NA:INVALID REQ`,
+    SIMSERV `-8`), or where it has none as an unknown request (silence on the Thermotron and the F4T)."""
     protocol = LINE_PROFILES[profile]
+    answer = protocol.unsupported_answer or protocol.unknown_command_answer
     with controller(protocol) as (_, _, client_line):
         wire = Wire(protocol, client_line)
         wire.send(request_text)
-        if protocol.dialect == "simserv":
-            assert wire.reply() == "-8"
-        elif protocol.unknown_command_answer is not None:
-            assert wire.reply() == protocol.unknown_command_answer
+        if answer is not None:
+            assert wire.reply() == answer
         else:
             wire.assert_nothing_came()
+
+
+@pytest.mark.parametrize("refusal", REFUSALS, ids=[f"{r.profile}-{r.reply}-{r.state}" for r in REFUSALS])
+def test_each_documented_refusal_is_what_the_simulated_controller_answers_in_its_state(refusal: Refusal) -> None:
+    """The refusals the sweep takes as documented (client_sweep.DOCUMENTED) are true of the simulator, and each
+    example is one of the requests the entry covers."""
+    protocol = LINE_PROFILES[refusal.profile]
+    assert refusal.reply in {f"NA:{code}" for code in protocol.errors} | {"NA:PRGM WRITE ERR-2", "NA:PRGM WRITE ERR-3"}
+    with controller(protocol) as (_, _, client_line):
+        wire = Wire(protocol, client_line)
+        for example in refusal.examples:
+            assert re.fullmatch(refusal.request, example), example
+            wire.send(example)
+            assert wire.reply() == refusal.reply, example
 
 
 @pytest.mark.parametrize(("alarms", "warnings", "status", "active"), [

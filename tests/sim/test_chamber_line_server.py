@@ -105,3 +105,19 @@ def test_a_multi_megabyte_line_is_answered_as_unknown_and_held_only_to_the_bound
         assert client.reply(end).endswith(read)  # every byte before it has been read and answered by now
         assert 0 < server.peak_buffered_bytes <= MAX_LINE_BYTES + len(request_end) - 1
         assert server.buffered_bytes == 0
+
+
+@pytest.mark.parametrize("transport", ["tcp", "pty"])
+def test_the_thermotron_answers_a_request_ended_by_cr_lf_or_cr_lf_alone_and_never_joins_two(transport: str) -> None:
+    """Its clients end requests with CR (the profile), CR LF (PyVISA's default) or LF: each is answered on its
+    own, and an LF-ended request does not swallow the next (issue 43: `IDEN?\\nPVAR1?\\n` was no request)."""
+    with served("thermotron-8800", transport) as (server, client):
+        client.send(b"SETP1,-40.0\n")
+        assert client.reply(b"\r\n") == b"0\r\n"
+        for ending in (b"\n", b"\r", b"\r\n"):
+            client.send(b"SETP1?" + ending)
+            assert client.reply(b"\r\n") == b"-40.00\r\n", ending
+        client.send(b"IDEN?\nSETP1?\r\n")
+        assert client.reply(b"\r\n") == server.identity.encode() + b"\r\n"
+        assert client.reply(b"\r\n") == b"-40.00\r\n"
+        assert server.buffered_bytes == 0

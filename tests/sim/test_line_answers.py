@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from accelcal_rig.sim.line_answers import MAX_LINE_BYTES, OVERLONG_HEAD_BYTES, LineAnswers
+from accelcal_rig.sim.line_answers import ANY_LINE_END, MAX_LINE_BYTES, OVERLONG_HEAD_BYTES, LineAnswers
 
 
 def answers(terminator: bytes = b"\r\n", overlong: bool = True) -> tuple[LineAnswers, list[bytes], list[str]]:
@@ -61,3 +61,15 @@ def test_requests_split_anywhere_and_several_in_one_read_are_each_answered_once(
     reader.feed(b"four\r\nfive\r\nsi", written.append)
     reader.feed(b"x\r\n", written.append)
     assert written == [b"ONE\r\n", b"TWO\r\n", b"\r\n", b"THREE\r\n", b"FOUR\r\n", b"FIVE\r\n", b"SIX\r\n"]
+
+
+@pytest.mark.parametrize("chunk", [1, 2, 3, 65536])
+def test_a_device_reading_any_line_end_answers_cr_lf_and_cr_lf_each_once_whatever_the_reads(chunk: int) -> None:
+    """A client's odd terminator is answered alone: an LF-ended request never joins the next one, and the LF of
+    a CR LF split between two reads ends nothing more."""
+    written: list[bytes] = []
+    reader = LineAnswers(lambda request: request.upper(), ANY_LINE_END, b"\r\n")
+    feed(reader, written, b"one\ntwo\rthree\r\nfour\n\nsix\r", chunk)
+    reader.feed(b"\nseven\r\n", written.append)
+    assert written == [b"ONE\r\n", b"TWO\r\n", b"THREE\r\n", b"FOUR\r\n", b"\r\n", b"SIX\r\n", b"SEVEN\r\n"]
+    assert reader.buffered_bytes == 0
