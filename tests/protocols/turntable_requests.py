@@ -6,8 +6,9 @@ driver's own parser), answered as the manual documents, refused (the profile's e
 (a setting).
 
 tests/protocols/test_turntable_requests.py replays them on a pty. Requests are written without their line
-terminator. What the clients send that the simulator does not model is in NOT_SIMULATED, with the reason,
-and is answered as an unknown request. Facts: docs/instruments.md, "`acutrol3000`".
+terminator. What the clients send that the simulator does not model is in NOT_SIMULATED, with the reason
+and the manual's section, and is answered as an unknown request (on GPIB a real controller answers nothing:
+ON_GPIB says why the simulator does). Facts: docs/instruments.md, "`acutrol3000`".
 """
 
 from __future__ import annotations
