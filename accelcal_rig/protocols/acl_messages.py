@@ -12,6 +12,9 @@ templates are checked, spelled and recognised as the controller does.
   without continues at the level of the command before it (`:R:P? 1;P? 2` is `:R:P? 1;:R:P? 2`); the
   first may leave out its colon. Each of a profile's commands starts at the root, so that it reads the
   same whatever line it is joined into.
+- Blanks around a `;` are not part of either command (`:u:f f ; :R:P 1`, as the williamsea client sends)
+  [inferred: the manual's syntax (§2) shows none; IEEE-488.2, which §2.1 follows, lets white space precede
+  a message unit]. Inside a header a blank still ends it (§2.3: a compound header contains no white space).
 """
 
 from __future__ import annotations
@@ -29,7 +32,7 @@ _QUESTION_OPTIONAL = "READ"
 def commands(message: str) -> list[str]:
     """The message's commands, each from the root (`:` and its whole header), its arguments as sent; a
     trailing `;` ends nothing more (`:A:C? 7;` is one of the manual's examples)."""
-    parts = message.split(SEPARATOR)
+    parts = [part.strip(" \t") for part in message.split(SEPARATOR)]
     if len(parts) > 1 and parts[-1] == "":
         parts.pop()
     rooted: list[str] = []

@@ -181,6 +181,8 @@ class VirtualLab:
         )
         #: The acceleration of a rate command that names none (a profile setting it as a limit of its own).
         self.rate_acceleration_deg_s2 = [a.max_acceleration_dps2 or 100.0 for a in rig.turntable.axes]
+        #: Each axis's highest commanded rate (°/s; None: no rate mode), a simulated controller's rate limit.
+        self.max_rates_deg_s: list[float | None] = [a.max_rate_dps for a in rig.turntable.axes]
         self._gravity_angles_key = b""
         self._gravity_fixture = np.array([0.0, 0.0, 1.0])
         self._truth_coefficients = np.stack([d.truth.coefficients for d in self.duts]) if self.duts \

@@ -117,6 +117,25 @@ class TurntableMotion:
         if self._rating[axis]:
             self.rotate(t_s, axis, 0.0, float(self._r_acc[axis]))
 
+    def halt(self, t_s: float, axis: int) -> None:
+        """One axis brought to rest where it is: in rate mode at its acceleration limit (a hold), a position move
+        stopped where it has got to (the table's travel has no acceleration phase to ramp down)."""
+        if self._rating[axis]:
+            self.hold(t_s, axis)
+            return
+        here = float(self.position_deg(t_s)[axis])
+        self._start[axis] = self._target[axis] = here
+        self._t0[axis] = t_s
+
+    def acceleration_deg_s2(self, t_s: float, axis: int) -> float:
+        """An axis's acceleration now: its ramp's while a rate-mode axis changes rate, else zero (a position
+        move travels at its speed from the start: no acceleration phase is modelled)."""
+        if not self._rating[axis]:
+            return 0.0
+        start, end, acc = self._r_from[axis], self._r_to[axis], self._r_acc[axis]
+        ramping = t_s - self._r_t0[axis] < abs(end - start) / acc
+        return float(np.sign(end - start) * acc) if ramping else 0.0
+
     def stop(self, t_s: float) -> None:
         here = self.position_deg(t_s)
         for axis in np.flatnonzero(self._rating):

@@ -2,9 +2,10 @@
 recognised by its command's template in every spelling the profile's dialect takes and answered with the
 command's answer, from the lab's turntable motion at the shared clock's time. An ACL controller reads a line
 as commands joined by `;` (acl_messages.py): each run of them that is one of the profile's operations is
-carried out, as are the ACL queries and Off mode beyond the profile (sim/turntable_acl.py), and the
-queries' answers come back joined by `;`; a line with any command it does not know, or any it cannot carry
-out, is refused whole and nothing moves."""
+carried out, as are the ACL commands beyond the profile that the simulated table can hold
+(sim/turntable_acl.py; `ALL` axes and the one-command mode form rewritten first, sim/acl_equivalents.py), and
+the queries' answers come back joined by `;`; a line with any command it does not know, or any it cannot
+carry out, is refused whole and nothing moves."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from accelcal_rig.protocols import acl_blocks, acl_messages
 from accelcal_rig.protocols.line_dialects import request_pattern
 from accelcal_rig.protocols.line_templates import finite_number
 from accelcal_rig.protocols.turntable_line import Command, TurntableProtocol
+from accelcal_rig.sim.acl_equivalents import rewritten
 from accelcal_rig.sim.faults import InstrumentFaults, ReplyFaults
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.line_answers import MAX_LINE_BYTES
@@ -23,8 +25,8 @@ from accelcal_rig.sim.turntable_acl import AclExtras
 
 #: Operations that move the table (the last of them is kept for tests).
 _MOTION = ("move", "stop", "home", "rotate", "hold")
-#: The fields of a request that carry a number (degrees, °/s, °/s²).
-_NUMBER_FIELDS = ("angle", "rate", "acceleration", "rate_limit")
+#: The fields of a request that carry a number (degrees, °/s, °/s²; an ACL extra's step and limit).
+_NUMBER_FIELDS = ("angle", "rate", "acceleration", "rate_limit", "delta", "limit")
 
 
 class SimulatedTurntableServer:
@@ -61,8 +63,7 @@ class SimulatedTurntableServer:
         self._setup_seen: list[set[str]] = [set() for _ in range(n_axes)]
         #: Axes a rate command has put in rate mode (a profile with setup then ignores moves until it again).
         self._rate_mode = [False] * n_axes
-        self.acl = AclExtras(lab, n_axes, lambda: any(f in protocol.fault_values for f in self.faults),
-                             self._leave_position_mode)
+        self.acl = AclExtras(lab, self, protocol.fault_values, protocol.fault_ok[0])
 
     @property
     def fault(self) -> str:
@@ -115,7 +116,7 @@ class SimulatedTurntableServer:
 
     def _handle_message(self, request: str) -> str | None:
         """An ACL line: every command recognised and every value read before any is carried out."""
-        commands = acl_messages.commands(request)
+        commands = rewritten(acl_messages.commands(request), len(self._lab.motion.speeds_deg_s))
         steps: list[tuple[str, Command | None, dict[str, str], str]] = []
         taken = 0
         while taken < len(commands):
@@ -160,10 +161,35 @@ class SimulatedTurntableServer:
         fields = self.acl.recognise(commands[0])
         return None if fields is None else ("acl", None, fields, commands[0])
 
-    def _leave_position_mode(self, axis: int) -> None:
+    # ------------------------------------------------------------------ the ACL extras' table (ServoTable)
+    def leave_position_mode(self, axis: int) -> None:
         """Off mode (an ACL extra): a move needs the profile's setup again."""
         if self._protocol.setup:
             self._set_up[axis], self._setup_seen[axis] = False, set()
+
+    def servo_move(self, axis: int, angle_deg: float) -> None:
+        """A position demand as the profile's move carries it out (the lab's lock held)."""
+        now = self._lab.clock.now()
+        if not self._stalled(now) and self._set_up[axis]:
+            self._lab.motion.command_axis(now, axis, angle_deg)
+
+    def servo_turn(self, axis: int, rate_deg_s: float, acceleration_deg_s2: float) -> None:
+        """Rate mode as the profile's rotate carries it out (the lab's lock held)."""
+        now = self._lab.clock.now()
+        if self._stalled(now):
+            return
+        self._lab.motion.rotate(now, axis, rate_deg_s, acceleration_deg_s2)
+        self._rate_mode[axis] = True
+        self.leave_position_mode(axis)
+
+    def servo_shut_down(self, axis: int) -> None:
+        """An opened interlock: the axis at rest where it is, out of both modes (the lab's lock held)."""
+        self._lab.motion.halt(self._lab.clock.now(), axis)
+        self._rate_mode[axis] = False
+        self.leave_position_mode(axis)
+
+    def _stalled(self, now: float) -> bool:
+        return self._stall_after_s is not None and now >= self._stall_after_s
 
     def _match(self, request: str) -> tuple[bool, str | None]:
         """(whether one command's template matches the request, its answer: None if it is unanswered)."""
@@ -189,7 +215,7 @@ class SimulatedTurntableServer:
             if axis is not None and not 0 <= axis < n_axes:
                 raise ValueError(f"no axis {axis + 1}")
             axes = range(n_axes) if axis is None else (axis,)
-            stalled = self._stall_after_s is not None and now >= self._stall_after_s
+            stalled = self._stalled(now)
             if name.startswith("setup"):
                 for a in axes:
                     self._setup_seen[a].add(name)

@@ -16,7 +16,7 @@ from accelcal_rig.protocols.turntable_line import ACUTROL3000
 from accelcal_rig.sim.lab import VirtualLab
 from accelcal_rig.sim.turntable_server import SimulatedTurntableServer
 from tests.conftest import SIM_RIG
-from tests.protocols.turntable_requests import CONVERSATIONS, NOT_SIMULATED, Conversation, Row
+from tests.protocols.turntable_requests import CONVERSATIONS, NOT_SIMULATED, ON_GPIB, Conversation, Row
 from tests.sim.line_client import LineClient, pty_client
 
 _COMMANDS = dict(ACUTROL3000.commands())
@@ -39,6 +39,7 @@ class Table:
 
 
 def replay(row: Row, table: Table) -> None:
+    table.lab.clock.sleep(row.wait_s)
     if row.silent:
         table.client.send(row.request.encode() + b"\n")
     else:
@@ -97,8 +98,15 @@ def test_what_the_simulator_does_not_model_is_answered_as_unknown(request_text: 
         with pty_client(server.endpoint) as line:
             table = Table(line, server, lab)
             assert re.match(ACUTROL3000.error_pattern, table.ask(request_text))  # unknown, or (ALL) no axis
+            assert re.search(r"§\d|Table \d", why), "each reason cites the manual"
     finally:
         server.stop()
+
+
+def test_the_gpib_difference_is_on_record() -> None:
+    """A real controller on GPIB answers a command it does not carry out with silence (TM-8004-C Table 1): the
+    simulator's ERR line is a named difference, not an oversight."""
+    assert "Table 1" in ON_GPIB and "ERR" in ON_GPIB
 
 
 def test_a_tripped_interlock_sets_the_status_byte() -> None:
