@@ -105,9 +105,7 @@ def _class_defs(path: Path) -> set[str]:
 #: The clients whose requests still deviate from what their makers document (issue 43 is fixed simulator by
 #: simulator): their test is a strict expected failure, so a client brought to no deviation must leave this
 #: set; every other client's requests must all be answered as documented (or listed NOT_SIMULATED).
-STILL_DEVIATING = frozenset({
-    "IEAv-EFO acutrol3000", "williamsea Acutrol (C#)",  # the ACUTROL3000's GPIB clients
-})
+STILL_DEVIATING: frozenset[str] = frozenset()
 assert STILL_DEVIATING <= set(NAMES), sorted(STILL_DEVIATING - set(NAMES))
 
 
