@@ -409,6 +409,12 @@ NOT_SIMULATED: tuple[tuple[str, str, str, str, str], ...] = (
         (":SOURCE:CLOOP1:RACTION SETPOINT", _F4T_LIB, "f4tscpi/f4t_interface.py ramp_mode (its docstring: OFF, "
          "STARTUP, SETPOINT, BOTH)"),
         (":SOURCE:CLOOP1:RACTION BOTH", "PyPI py-lab-hal 2.5.20241201", "testequity_107.py enable_ramp(True)"))),
+    *(("watlow-f4t-scpi", request, "PyPI py-lab-hal 2.5.20241201", f"py_lab_hal/instrument/instrument.py {where}",
+       "an IEEE 488.2 common command that py-lab-hal's Instrument base class sends to every instrument: the "
+       "simulated F4T answers *IDN? only and leaves the others unanswered, as every header it does not know (the "
+       "F4T list's rows for them were not checked here)") for request, where in (
+        ("*RST", "reset (and open_instrument at construction)"), ("*CLS", "clear (and open_instrument)"),
+        ("*ESR?", "event_status_register"), ("*TST?", "self_test"), ("*OPC?", "wait_task"))),
     ("watlow-f4t-scpi", ":OUTPUT1:NAME?", _F4T_LIB, "f4tscpi/f4t_interface.py get_tsName",
      "not in the F4T's SCPI command list (the library's own): unanswered, as every header the F4T does not have"),
 )
@@ -459,6 +465,11 @@ REFUSALS: tuple[Refusal, ...] = (
     Refusal("espec-p300", r"HUMI, ?.*[SHL] ?-\d.*", "NA:DATA OUT OF RANGE", "a humidity below 0 % RH",
             f"{_ESPEC_ERRORS}: 'DATA OUT OF RANGE': 'Data not with in valid range' (0-100 % RH)",
             ("HUMI, L-40.0", "HUMI, S25.0 H100.0 L-40.0", "HUMI, S-5"), inferred=True),
+    Refusal("espec-p300", r"\*[A-Z]{3}\??", "NA:CMD ERR", "any state: the P300 command set has no IEEE 488.2 "
+            "common commands (py-lab-hal's Instrument base class sends them to every instrument)",
+            f"{_ESPEC_ERRORS}: 'CMD ERR': 'Unrocognized command'; syndesi-drivers espec_sh242.py SH242Exception: "
+            "'Main command error, the command has probably been mistyped'",
+            ("*IDN?", "*RST", "*CLS", "*ESR?", "*TST?", "*OPC?")),
     Refusal("espec-p300", r"PRGM DATA WRITE, ?PGM\d+, ?EDIT (END|CANCEL)", "NA:PRGM WRITE ERR-3",
             "no program being edited", f"{_ESPEC_ERRORS}: 'PRGM WRITE ERR-3': 'Edit request not allowed not in "
             "edit mode'", ("PRGM DATA WRITE,PGM1,EDIT END", "PRGM DATA WRITE,PGM1,EDIT CANCEL"), inferred=True),
