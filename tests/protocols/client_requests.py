@@ -340,4 +340,193 @@ WILLIAMSEA = DataClient(
                (_w(":u:t 180,177,178,50,32,144,32,176,181,179,50,32,144,32,176,181,181,181", "Table 5 :Utility:Touch (Table 8)"),)),
     ))
 
-DATA_CLIENTS: tuple[DataClient, ...] = (F4T_SCPI, IEAV, ACUTRONIC_ROBOTICS, WILLIAMSEA)
+
+# ---------------------------------------------------------------------- F4T SCPI: DAsh0244/te107_control
+_TE107 = "src/f4t_control.py"
+_TE107_LIST = "te107_control ref/scpi_commands.csv (the F4T SCPI command list the repository ships)"
+
+
+def _te_query(request: str, answer: str, row: str) -> Expect:
+    return Expect(request, answer, f"{_TE107_LIST}: {row}")
+
+
+def _te_setting(request: str, row: str) -> Expect:
+    return Expect(request, None, f"{_TE107_LIST}: {row} (W: a setting, unanswered)")
+
+
+TE107 = DataClient(
+    "DAsh0244 te107_control F4TController", "watlow-f4t-scpi",
+    "DAsh0244/te107_control@4052018c37b7e25e260fdd9f9e50a2d8019d8faf", "MIT",
+    "request lists replayed over TCP through the proxy (the client: socket.create_connection to port 5025, each "
+    "request ending LF, replies read in 10-byte recv()s up to LF)", "\n", "\n", 0.3, (
+        Method("__init__", f"{_TE107} Device.__init__ (get_id when no id is given; _clear_buffer only reads)",
+               "F4TController(host=...)", (_IDN,)),
+        Method("from_other_dev", f"{_TE107} Device.from_other_dev (classmethod)", "F4TController.from_other_dev(dev)",
+               not_sent="builds an object on another's connection and id: get_id is not called, nothing sent"),
+        Method("send_cmd", f"{_TE107} Device.send_cmd", "send_cmd(cmd)",
+               not_sent="the transport primitive: sends what its caller gives it"),
+        Method("get_id", f"{_TE107} Device.get_id", "get_id()", (_IDN,)),
+        Method("get_profiles", f"{_TE107} F4TController.get_profiles (profiles 1…39 until a name reads empty; here "
+               "the first)", "get_profiles()",
+               (_te_setting(":PROGRAM:NUMBER 1", "Select a profile, 1-40"),
+                _te_query(":PROGRAM:NAME?", r".*", "Read selected profile name → <string value>"))),
+        Method("get_units", f"{_TE107} F4TController.get_units (TempUnits(resp))", "get_units()",
+               (_te_query(":UNIT:TEMPERATURE?", "C|F", "Query Comm. Temperature units → C|F"),)),
+        Method("set_units", f"{_TE107} F4TController.set_units (':UNITS:…', where the list has ':UNIT:…')",
+               "set_units()", (Expect(":UNITS:TEMPERATURE C", None, f"{_TE107_LIST}: no such header (Set Comm. "
+                                      "Temperature units to C is ':UNIT:TEMPERATURE C'); the F4T documents no "
+                                      "error reply"),)),
+        Method("set_ramp_scale", f"{_TE107} F4TController.set_ramp_scale (formats the RampScale member itself: "
+               "str() of an Enum member)", "set_ramp_scale('MINUTES')",
+               (Expect(":SOURCE:CLOOP1:RSCALE RampScale.MINUTES", None, f"{_TE107_LIST}: Write ramp scale takes "
+                       "MINUTES or HOURS; no error reply documented"),)),
+        Method("set_ramp_rate", f"{_TE107} F4TController.set_ramp_rate", "set_ramp_rate(2.0)",
+               (_te_setting(":SOURCE:CLOOP1:RRATE 2.0", "Write ramp rate"),)),
+        Method("set_ramp_time", f"{_TE107} F4TController.set_ramp_time", "set_ramp_time(30)",
+               (_te_setting(":SOURCE:CLOOP1:RTIME 30", "Read [sic] ramp time, :SOURCE:CLOOP#:RTIME <value>, W"),)),
+        Method("select_profile", f"{_TE107} F4TController.select_profile", "select_profile(1)",
+               (_te_setting(":PROGRAM:NUMBER 1", "Select a profile, 1-40"),)),
+        Method("run_profile", f"{_TE107} F4TController.run_profile", "run_profile()",
+               (_te_setting(":PROGRAM:SELECTED:STATE START", "start profile"),)),
+        Method("stop_profile", f"{_TE107} F4TController.stop_profile", "stop_profile()",
+               (_te_setting(":PROGRAM:SELECTED:STATE STOP", "stop profile"),)),
+        Method("get_temperature", f"{_TE107} F4TController.get_temperature", "get_temperature()",
+               (_te_query(":SOURCE:CLOOP1:PVALUE?", _FLOAT, "Read Temperature PV (Control loop) → <floating point "
+                          "value>"),)),
+        Method("set_temperature", f"{_TE107} F4TController.set_temperature (no leading colon)", "set_temperature(30.0)",
+               (_te_setting("SOURCE:CLOOP1:SPOINT 30.0", "Write SP"),
+                )),
+        Method("is_done", f"{_TE107} F4TController.is_done", "is_done(1)",
+               (_te_query(":OUTPUT1:STATE?", "OFF|ON", "Query event output state → OFF|ON"),)),
+        Method("set_output", f"{_TE107} F4TController.set_output", "set_output(1, 'ON')",
+               (_te_setting(":OUTPUT1:STATE ON", "Set event output on (outputs 1-7)"),
+                _te_query(":OUTPUT1:STATE?", "ON", "Query event output state (read back)"))),
+    ))
+
+# ---------------------------------------------------------------------- SIMSERV: SengerM, IzaakWN
+S = "\u00b6"  # SIMSERV's field separator (byte 0xB6)
+_SIMSERV_OK = "S!MPAC simserv manual (SengerM's [2], 'Operation manual, Communication protocol S!MPAC simserv', §5 as " \
+              "its COMMANDS_DICT cites it; IzaakWN chamber_commands.py err_dict: 1 'Command is accepted and executed')"
+
+
+def _ss(request: str, answer: str, what: str) -> Expect:
+    return Expect(request, answer, f"{_SIMSERV_OK}: {what}")
+
+
+_SENGER = "VotschTechnikClimateChamber/ClimateChamber.py"
+_VALUE = rf"1{S}[^{S}]+(?:{S}.*)?"  # accepted, then the value (the client takes the first field)
+_BIT = rf"1{S}[01]"
+
+SENGERM = DataClient(
+    "SengerM VotschTechnik ClimateChamber", "simserv",
+    "SengerM/VotschTechnik-climate-chamber-Python@202e17204fd8a884a840fbbcd3a574d5170e03ab", "MIT",
+    "request lists replayed over TCP through the proxy (the client: a socket to port 2049, each request ending CR, "
+    "one recv(512) per reply)", "\r", "\r\n", 0.3, (
+        Method("__init__", f"{_SENGER} ClimateChamber.__init__", "ClimateChamber(ip, -20, 20)",
+               not_sent="connects (port 2049) and sets its own limits: nothing sent"),
+        Method("query_command_low_level", f"{_SENGER} ClimateChamber.query_command_low_level",
+               "query_command_low_level(number, *args)", not_sent="the transport primitive: sends what it is given"),
+        Method("query", f"{_SENGER} ClimateChamber.query", "query(name, *args)",
+               not_sent="sends the numbered command its caller names (every use of it is a member below)"),
+        Method("serial_number", f"{_SENGER} ClimateChamber.serial_number (property)", "serial_number",
+               (_ss(f"99997{S}1{S}3", _VALUE, "GET CHAMBER INFO, item 3: serial number"),)),
+        Method("test_system_type", f"{_SENGER} ClimateChamber.test_system_type (property)", "test_system_type",
+               (_ss(f"99997{S}1{S}1", _VALUE, "GET CHAMBER INFO, item 1: test system type"),)),
+        Method("year_manufactured", f"{_SENGER} ClimateChamber.year_manufactured (property)", "year_manufactured",
+               (_ss(f"99997{S}1{S}2", _VALUE, "GET CHAMBER INFO, item 2: year manufactured"),)),
+        Method("idn", f"{_SENGER} ClimateChamber.idn (property: test_system_type, serial_number, year_manufactured)",
+               "idn", (_ss(f"99997{S}1{S}1", _VALUE, "GET CHAMBER INFO 1"),
+                       _ss(f"99997{S}1{S}3", _VALUE, "GET CHAMBER INFO 3"),
+                       _ss(f"99997{S}1{S}2", _VALUE, "GET CHAMBER INFO 2"))),
+        Method("temperature_measured", f"{_SENGER} ClimateChamber.temperature_measured (property)",
+               "temperature_measured", (_ss(f"11004{S}1{S}1", rf"1{S}{_N}", "GET CONTROL_VARIABLE ACTUAL_VALUE"),)),
+        Method("temperature_set_point", f"{_SENGER} ClimateChamber.temperature_set_point (property, and its setter "
+               "with str(celsius))", "temperature_set_point; temperature_set_point = 15.0",
+               (_ss(f"11002{S}1{S}1", rf"1{S}{_N}", "GET CONTROL_VARIABLE SET_POINT"),
+                _ss(f"11001{S}1{S}1{S}15.0", "1", "SET CONTROL_VARIABLE SET_POINT"))),
+        Method("temperature_min", f"{_SENGER} ClimateChamber.temperature_min (property and setter)",
+               "temperature_min", not_sent="the object's own safety limit: nothing sent"),
+        Method("temperature_max", f"{_SENGER} ClimateChamber.temperature_max (property and setter)",
+               "temperature_max", not_sent="the object's own safety limit: nothing sent"),
+        Method("dryer", f"{_SENGER} ClimateChamber.dryer (property, and its setter)", "dryer; dryer = True",
+               (_ss(f"14003{S}1{S}8", _BIT, "GET DIGITAL_OUT VALUE 8 (the dryer)"),
+                _ss(f"14001{S}1{S}8{S}1", "1", "SET DIGITAL_OUT VALUE 8"))),
+        Method("compressed_air", f"{_SENGER} ClimateChamber.compressed_air (property, and its setter)",
+               "compressed_air; compressed_air = True",
+               (_ss(f"14003{S}1{S}7", _BIT, "GET DIGITAL_OUT VALUE 7 (compressed air)"),
+                _ss(f"14001{S}1{S}7{S}1", "1", "SET DIGITAL_OUT VALUE 7"))),
+        Method("start", f"{_SENGER} ClimateChamber.start", "start()",
+               (_ss(f"14001{S}1{S}1{S}1", "1", "START MANUAL_MODE 1, 1"),)),
+        Method("is_running", f"{_SENGER} ClimateChamber.is_running (property)", "is_running",
+               (_ss(f"14003{S}1{S}1", _BIT, "GET DIGITAL_OUT VALUE 1"),)),
+        Method("stop", f"{_SENGER} ClimateChamber.stop", "stop()",
+               (_ss(f"14001{S}1{S}1{S}0", "1", "START MANUAL_MODE 1, 0"),)),
+    ))
+
+_IZ = "chamber_commands.py"
+_GUI = "a Tk dialog asks first"
+
+IZAAKWN = DataClient(
+    "IzaakWN ClimateChamberMonitor chamber_commands", "simserv",
+    "IzaakWN/ClimateChamberMonitor@858ca67f8fbf2f89cf5b2d85955ca76395e694f4", "none stated",
+    "request lists replayed over TCP through the proxy (the client, Python 2: a socket to port 2049, each request "
+    "ending CR, one recv(512) per reply); the module's functions and its ClimateChamber socket class", "\r", "\r\n",
+    0.3, (
+        Method("getTemp", f"{_IZ} getTemp (and ClimateChamber.getTemp)", "getTemp(c)",
+               (_ss(f"11004{S}1{S}1", rf"1{S}{_N}", "GET CTRL_VAR VAL"),)),
+        Method("getSetp", f"{_IZ} getSetp (and ClimateChamber.getSetp)", "getSetp(c)",
+               (_ss(f"11002{S}1{S}1", rf"1{S}{_N}", "GET CTRL_VAR SETPOINT"),)),
+        Method("getAir", f"{_IZ} getAir (and ClimateChamber.getAir)", "getAir(c)",
+               (_ss(f"14003{S}1{S}7", _BIT, "GET DIGI_OUT VAL 7"),)),
+        Method("getDryer", f"{_IZ} getDryer (and ClimateChamber.getDryer)", "getDryer(c)",
+               (_ss(f"14003{S}1{S}8", _BIT, "GET DIGI_OUT VAL 8"),)),
+        Method("getDewp", f"{_IZ} getDewp", "getDewp(c)", not_sent="returns 18.0: nothing sent"),
+        Method("startRun", f"{_IZ} startRun (and ClimateChamber.startRun)", "startRun(c)",
+               not_sent="its lambda uses a global `client` the module never defines (NameError before sending); "
+               "what it means to send, START MANUAL 1,1, run_manual.py sends (maker_requests.SIMSERV)"),
+        Method("stopRun", f"{_IZ} stopRun (and ClimateChamber.stopRun)", "stopRun(c)",
+               not_sent="as startRun: a global `client` never defined"),
+        Method("disconnect", f"{_IZ} ClimateChamber.disconnect", "c.disconnect()", not_sent="closes the socket"),
+        Method("sendSimServCmd", f"{_IZ} sendSimServCmd (and ClimateChamber.sendSimServCmd)", "sendSimServCmd(c, s)",
+               not_sent="the transport primitive: sends the command its caller names"),
+        Method("createSimServCmdFromString", f"{_IZ} createSimServCmdFromString", "(cmdstr, args)",
+               not_sent="builds a request: nothing sent"),
+        Method("ceateSimServCmd", f"{_IZ} ceateSimServCmd", "(cmdID, args)", not_sent="builds a request: nothing sent"),
+        Method("unpackSimServData", f"{_IZ} unpackSimServData", "(data)", not_sent="parses a reply: nothing sent"),
+        Method("connectClimateChamber", f"{_IZ} connectClimateChamber", "connectClimateChamber(ip)",
+               not_sent="connects (port 2049): nothing sent"),
+        Method("forceWarmUp", f"{_IZ} forceWarmUp (and ClimateChamber.forceWarmUp; no program running: STOP PRGM "
+               "not sent)", "forceWarmUp(c)",
+               (_ss(f"19210{S}1", r"1" + S + r"\d+", "GET PRGM STATUS (0: not running)"),
+                _ss(f"11001{S}1{S}1{S}24", "1", "SET CTRL_VAR SETPOINT"),
+                _ss(f"11068{S}1{S}1{S}3", "1", "SET GRAD_UP VAL"),
+                _ss(f"11072{S}1{S}1{S}3", "1", "SET GRAD_DWN VAL"),
+                _ss(f"14001{S}1{S}7{S}1", "1", "SET DIGI_OUT VAL 7 (air)"),
+                _ss(f"14001{S}1{S}8{S}1", "1", "SET DIGI_OUT VAL 8 (dryer)"),
+                _ss(f"14001{S}1{S}1{S}1", "1", "START MANUAL 1, 1"))),
+        Method("forceWarmUpEvent", f"{_IZ} forceWarmUpEvent", "forceWarmUpEvent(c)",
+               not_sent=f"{_GUI}, then forceWarmUp's requests (above)"),
+        Method("stopClimateChamber", f"{_IZ} stopClimateChamber (and ClimateChamber.stop; no program running)",
+               "stopClimateChamber(c)",
+               (_ss(f"19210{S}1", r"1" + S + r"\d+", "GET PRGM STATUS"),
+                _ss(f"11004{S}1{S}1", rf"1{S}{_N}", "GET CTRL_VAR VAL"),
+                _ss(f"14001{S}1{S}1{S}0", "1", "START MANUAL 1, 0"))),
+        Method("stopClimateChamberEvent", f"{_IZ} stopClimateChamberEvent", "stopClimateChamberEvent(c)",
+               (_ss(f"19210{S}1", r"1" + S + r"\d+", "GET PRGM STATUS (then a Tk dialog asks; stopClimateChamber's "
+                    "requests above)"),)),
+        Method("checkActiveWarnings", f"{_IZ} checkActiveWarnings (no message: the loop sends nothing)",
+               "checkActiveWarnings(c)", (_ss(f"17002{S}1", r"1" + S + r"\d+", "GET MSG NUM"),)),
+        Method("checkInterlock", f"{_IZ} checkInterlock", "checkInterlock(c, temp, dewp)",
+               not_sent="compares its arguments; only below the dew point + 5 °C does it call forceWarmUp (above)"),
+        Method("getActiveWarnings", f"{_IZ} getActiveWarnings (no message)", "getActiveWarnings(c)",
+               (_ss(f"17002{S}1", r"1" + S + r"\d+", "GET MSG NUM"),)),
+        Method("openActiveWarnings", f"{_IZ} openActiveWarnings (then getActiveWarnings; a Tk dialog for any)",
+               "openActiveWarnings(c)",
+               (_ss(f"17002{S}1", r"1" + S + r"\d+", "GET MSG NUM"), _ss(f"17002{S}1", r"1" + S + r"\d+",
+                                                                          "GET MSG NUM"))),
+        Method("getRunStatus", f"{_IZ} getRunStatus (no program: then the chamber's status)", "getRunStatus(c)",
+               (_ss(f"19204{S}1", r"1" + S + r"\d+", "GET PRGM NUM"),
+                _ss(f"10012{S}1", r"1" + S + r"\d+", "GET CHAMBER STATUS (1: not running, 3: running)"))),
+    ))
+
+DATA_CLIENTS: tuple[DataClient, ...] = (F4T_SCPI, IEAV, ACUTRONIC_ROBOTICS, WILLIAMSEA, TE107, SENGERM, IZAAKWN)

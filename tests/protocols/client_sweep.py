@@ -812,7 +812,11 @@ def _reply_text(exchange: Exchange) -> str:
 
 
 def _shape(text: str) -> str:
-    """A request's shape for the NOT_SIMULATED lists: numbers as `#`, blanks after commas dropped, any case."""
+    """A request's shape for the NOT_SIMULATED lists: numbers as `#`, blanks after commas dropped, any case; a
+    SIMSERV request keeps its command number (the first field: the command itself)."""
+    head, separator, rest = text.strip().partition("\u00b6")
+    if separator and head.isdigit():
+        return head + separator + _shape(rest)
     return re.sub(r"[-+]?\d+(\.\d+)?", "#", re.sub(r",\s+", ",", text.strip())).lower()
 
 

@@ -395,6 +395,19 @@ NOT_SIMULATED: tuple[tuple[str, str, str, str, str], ...] = (
      "no gradients (answered -8)"),
     ("simserv", f"14010{S}1{S}5", "SiLab-Bonn/basil", "weiss_labevent.py _get_feature_status",
      "outputs have no names (answered -8)"),
+    ("simserv", f"11072{S}1{S}1{S}3", "IzaakWN/ClimateChamberMonitor", "chamber_commands.py forceWarmUp",
+     "no gradients (answered -8)"),
+    *(("simserv", f"99997{S}1{S}{item}", "SengerM/VotschTechnik-climate-chamber-Python",
+       f"VotschTechnikClimateChamber/ClimateChamber.py {where}", f"the simulated chamber has no {what} (GET "
+       f"CHAMBER INFO item {item} as the client reads it; answered -8, data could not be read)")
+      for item, where, what in (("2", "year_manufactured", "year of manufacture"),
+                                ("3", "serial_number", "serial number"))),
+    *(("simserv", f"{number}{S}1", "IzaakWN/ClimateChamberMonitor", f"chamber_commands.py {where}",
+       f"{why} (answered -8, data could not be read)") for number, where, why in (
+        ("17002", "checkActiveWarnings / getActiveWarnings", "no message list: the simulated chamber keeps no "
+         "messages (its alarms and warnings are the status bits of 10012)"),
+        ("19204", "getRunStatus", "no program engine: the simulated chamber runs no program"),
+        ("19210", "forceWarmUp / stopClimateChamber", "no program engine: the simulated chamber runs no program"))),
     *(("watlow-f4t-scpi", request, _F4T_LIB, f"f4tscpi/f4t_interface.py {where}", _NO_CASCADE) for request, where in (
         (":SOURCE:CASCADE1:SPOINT?", "get_cascadeSP"), (":SOURCE:CASCADE1:OUTER:PVALUE?", "get_cascadeLoopPV"),
         (":SOURCE:CASCADE1:INNER:PVALUE?", "get_cascadeLoopPV"), (":SOURCE:CASCADE1:OUTER:SPOINT?", "get_cascadeLoopSP"),
@@ -415,6 +428,13 @@ NOT_SIMULATED: tuple[tuple[str, str, str, str, str], ...] = (
        "F4T list's rows for them were not checked here)") for request, where in (
         ("*RST", "reset (and open_instrument at construction)"), ("*CLS", "clear (and open_instrument)"),
         ("*ESR?", "event_status_register"), ("*TST?", "self_test"), ("*OPC?", "wait_task"))),
+    ("watlow-f4t-scpi", ":UNITS:TEMPERATURE C", "DAsh0244/te107_control", "src/f4t_control.py set_units",
+     "not an F4T header (its own ref/scpi_commands.csv has :UNIT:TEMPERATURE): unanswered, as every header the F4T "
+     "does not have, and nothing carried out"),
+    ("watlow-f4t-scpi", ":SOURCE:CLOOP1:RSCALE RampScale.MINUTES", "DAsh0244/te107_control",
+     "src/f4t_control.py set_ramp_scale", "the client's own slip: it formats the Enum member (str(), "
+     "'RampScale.MINUTES') where the list takes MINUTES or HOURS; the F4T documents no error reply: unanswered, "
+     "nothing carried out"),
     ("watlow-f4t-scpi", ":OUTPUT1:NAME?", _F4T_LIB, "f4tscpi/f4t_interface.py get_tsName",
      "not in the F4T's SCPI command list (the library's own): unanswered, as every header the F4T does not have"),
 )
