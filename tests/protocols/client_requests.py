@@ -50,6 +50,7 @@ class Expect:
     answer: str | None  # a regular expression the reply (terminators cut) must match in full; None: no reply
     source: str  # where the maker documents that answer
     prefixed: bool = False  # the reply starts with an 8-byte prefix the client cuts off (ACL over TCP)
+    refusal: bool = False  # the documented answer is the controller's refusal (ESPEC NA:…) in the simulated state
 
     def check(self, reply: bytes) -> str:
         """'' when the reply is the documented one; else what is wrong with it."""
@@ -529,4 +530,149 @@ IZAAKWN = DataClient(
                 _ss(f"10012{S}1", r"1" + S + r"\d+", "GET CHAMBER STATUS (1: not running, 3: running)"))),
     ))
 
-DATA_CLIENTS: tuple[DataClient, ...] = (F4T_SCPI, IEAV, ACUTRONIC_ROBOTICS, WILLIAMSEA, TE107, SENGERM, IZAAKWN)
+# ---------------------------------------------------------------------- ESPEC P300 class: ATWG, vincesum
+_ESPEC_OK = "ESPEC: a setting is answered OK:<the command as received> (EHS manual §1.3 as maker_requests.py cites " \
+            "it; ChamberConnectLibrary especinteract.py reads OK:/NA:)"
+_ESPEC_READ = "ChamberConnectLibrary p300.py (the reply formats its parser reads)"
+_TEMP = rf"{_N},{_N},{_N},{_N}"
+_HUMI = r"[^,]*,[^,]*,[^,]*,[^,]*"
+
+
+def _ok_echo(request: str, sent: str | None = None) -> Expect:
+    """A P300 setting: answered OK: and the command as received (without the RS-485 address)."""
+    return Expect(request, re.escape("OK:" + (sent if sent is not None else request)), _ESPEC_OK)
+
+
+def _refused(request: str, reply: str, why: str) -> Expect:
+    return Expect(request, re.escape(reply), f"ChamberConnectLibrary especinteract.py ERROR_DESCIPTIONS: {why}",
+                  refusal=True)
+
+
+_ATWG = "ATWG/driver/espec/sh641.py"
+ATWG = DataClient(
+    "akaeba ATWG especShSu", "espec-p300", "akaeba/ATWG@65783bbdb6243136ef9133445d31b32e769b3023",
+    "GPL-3.0 (facts only: the requests, read from the source; no code copied)",
+    "request lists replayed over TCP through the proxy (the client: RS-232 with pyserial, each request ending CR LF "
+    "(sh641Const.MSC_LINE_END), replies read byte by byte to CR LF)", "\r\n", "\r\n", 0.3, (
+        Method("open", f"{_ATWG} especShSu.open (TYPE?, then its SH-641's own ID, sh641Const.RSP_CH_ID, must be in "
+               "the reply)", "open()",
+               (Expect("TYPE?", r"T,T,[^,]+,[-\d.]+", f"{_ESPEC_READ} read_type: drybulb,wetbulb,controller,max "
+                       "temperature"),)),
+        Method("close", f"{_ATWG} especShSu.close", "close()", not_sent="closes the serial port"),
+        Method("write", f"{_ATWG} especShSu.write", "write(msg)",
+               not_sent="the transport primitive: sends what its caller gives it"),
+        Method("read", f"{_ATWG} especShSu.read", "read()", not_sent="reads a reply; sends nothing"),
+        Method("parse", f"{_ATWG} especShSu.parse", "parse(msg)", not_sent="parses a reply text: sends nothing"),
+        Method("is_numeric", f"{_ATWG} especShSu.is_numeric", "is_numeric(msg)", not_sent="a text check"),
+        Method("get_clima", f"{_ATWG} especShSu.get_clima", "get_clima()",
+               (Expect("TEMP?", _TEMP, f"{_ESPEC_READ} read_temp: measured,set point,upper,lower"),
+                Expect("HUMI?", _HUMI, f"{_ESPEC_READ} read_humi: measured,set point,upper,lower"))),
+        Method("set_clima", f"{_ATWG} especShSu.set_clima (one decimal: MSC_TEMP_RESOLUTION 0.1)",
+               "set_clima({'temperature': 25.0})", (_ok_echo("TEMP,S25.0"),)),
+        Method("set_power", f"{_ATWG} especShSu.set_power (default OFF; ON)", "set_power(); set_power('ON')",
+               (_ok_echo("POWER,OFF"), _ok_echo("POWER,ON"))),
+        Method("set_mode", f"{_ATWG} especShSu.set_mode (default STANDBY; CONSTANT, OFF)",
+               "set_mode(); set_mode('CONSTANT'); set_mode('OFF')",
+               (_ok_echo("MODE,STANDBY"), _ok_echo("MODE,CONSTANT"), _ok_echo("MODE,OFF"))),
+        Method("start", f"{_ATWG} especShSu.start (a temperature given: set_clima, set_power ON, set_mode CONSTANT)",
+               "start(30.0)", (_ok_echo("TEMP,S30.0"), _ok_echo("POWER,ON"), _ok_echo("MODE,CONSTANT"))),
+        Method("stop", f"{_ATWG} especShSu.stop", "stop()", (_ok_echo("MODE,STANDBY"), _ok_echo("POWER,OFF"))),
+        Method("info", f"{_ATWG} especShSu.info", "info()", not_sent="returns its constants: nothing sent"),
+    ))
+
+_VS = "src/ESPEC.py"
+_VS_NOADDR = "sent without the RS-485 address the rest of the class puts in front ('1,'): addressed to no " \
+             "controller on the bus, so none answers (inferred from the address scheme, ChamberConnectLibrary " \
+             "especinteract.py; not stated by ESPEC)"
+_TASKS = "keeps its own task list: nothing sent"
+
+
+def _vs(request: str) -> str:
+    return "1," + request
+
+
+VINCESUM = DataClient(
+    "vincesum ESPEC-Temperature-Control-UI SH241", "espec-p300",
+    "vincesum/ESPEC-Temperature-Control-UI@c8d7f761a865857041af6a64e4079ccee765d491", "none stated",
+    "request lists replayed over TCP through the proxy onto a simulated controller at RS-485 address 1 (the "
+    "client: pyserial through its UARTMaster, each request ending CR LF, replies read with readline())",
+    "\r\n", "\r\n", 0.3, (
+        Method("__init__", f"{_VS} SH241.__init__", "SH241()", not_sent="lists the FTDI devices: nothing sent"),
+        *(Method(name, f"{_VS} SH241.{name} (OpenChannel: the port opened, then SetModeStandby; a thread then "
+                 "sends TEMP? every 3 s, tempCheckerLoop)", f"{name}()", (_ok_echo(_vs("MODE,STANDBY"),
+                                                                          "MODE,STANDBY"),))
+          for name in ("SetRS485", "SetRS232", "OpenChannel")),
+        Method("GetType", f"{_VS} SH241.GetType", "GetType()",
+               (Expect(_vs("TYPE?"), r"T,(T,)?[^,]+,[-\d.]+", f"{_ESPEC_READ} read_type"),)),
+        Method("GetMode", f"{_VS} SH241.GetMode", "GetMode()",
+               (Expect(_vs("MODE?"), "OFF|STANDBY|CONSTANT|RUN", f"{_ESPEC_READ} read_mode"),)),
+        Method("GetCondition", f"{_VS} SH241.GetCondition", "GetCondition()",
+               (Expect(_vs("MON?"), rf"{_N},[^,]*,(OFF|STANDBY|CONSTANT|RUN),\d+", f"{_ESPEC_READ} read_mon"),)),
+        Method("GetTemp", f"{_VS} SH241.GetTemp", "GetTemp()",
+               (Expect(_vs("TEMP?"), _TEMP, f"{_ESPEC_READ} read_temp"),)),
+        Method("GetTempSilent", f"{_VS} SH241.GetTempSilent (also tempCheckerLoop's; it purges the input after "
+               "writing, so it may drop the reply it then reads)", "GetTempSilent()",
+               (Expect(_vs("TEMP?"), _TEMP, f"{_ESPEC_READ} read_temp"),)),
+        Method("SetPowerOn", f"{_VS} SH241.SetPowerOn", "SetPowerOn()", (_ok_echo(_vs("POWER,ON"), "POWER,ON"),)),
+        Method("SetPowerOff", f"{_VS} SH241.SetPowerOff", "SetPowerOff()",
+               (_ok_echo(_vs("POWER,OFF"), "POWER,OFF"),)),
+        Method("SetTemp", f"{_VS} SH241.SetTemp ('%.1f')", "SetTemp(25.0)",
+               (_ok_echo(_vs("TEMP,S25.0"), "TEMP,S25.0"),)),
+        Method("SetHighTemp", f"{_VS} SH241.SetHighTemp", "SetHighTemp(100.0)",
+               (_ok_echo(_vs("TEMP,H100.0"), "TEMP,H100.0"),)),
+        Method("SetLowTemp", f"{_VS} SH241.SetLowTemp", "SetLowTemp(-40.0)",
+               (_ok_echo(_vs("TEMP,L-40.0"), "TEMP,L-40.0"),)),
+        Method("SetHumid", f"{_VS} SH241.SetHumid ('%i')", "SetHumid(50)", (_ok_echo(_vs("HUMI,S50"), "HUMI,S50"),)),
+        Method("SetModeOff", f"{_VS} SH241.SetModeOff", "SetModeOff()", (_ok_echo(_vs("MODE,OFF"), "MODE,OFF"),)),
+        Method("SetModeStandby", f"{_VS} SH241.SetModeStandby", "SetModeStandby()",
+               (_ok_echo(_vs("MODE,STANDBY"), "MODE,STANDBY"),)),
+        Method("SetModeConstant", f"{_VS} SH241.SetModeConstant", "SetModeConstant()",
+               (_ok_echo(_vs("MODE,CONSTANT"), "MODE,CONSTANT"),)),
+        Method("SetModeProgram", f"{_VS} SH241.SetModeProgram ('MODE,RUN 1', a blank before the program number)",
+               "SetModeProgram()", (_refused(_vs("MODE,RUN 1"), "NA:DATA NOT READY", "'DATA NOT READY': 'Specified "
+                                             "program does not exist' (none stored; for MODE,RUN1, the P300's "
+                                             "form)"),)),
+        Method("ProgramWrite", f"{_VS} SH241.ProgramWrite (default program; its first block addressed, then "
+               "ProgramErase, then a second block without the address, then PRGM DATA?)", "ProgramWrite()",
+               (Expect(_vs("PRGM DATA WRITE,PGM:1,EDIT START"), r"OK:.*", _ESPEC_OK),
+                Expect(_vs("PRGM DATA WRITE,PGM:1,STEP1,TEMP30.0,TRAMPON,TIME00:01,"), r"OK:.*", _ESPEC_OK),
+                Expect(_vs("PRGM DATA WRITE,PGM:1,COUNT,(1.1.1)"), r"OK:.*", _ESPEC_OK),
+                Expect(_vs("PRGM DATA WRITE,PGM:1,END,HOLD"), r"OK:.*", _ESPEC_OK),
+                Expect(_vs("PRGM DATA WRITE,PGM:1,EDIT END"), r"OK:.*", _ESPEC_OK),
+                Expect(_vs("PRGM ERASE,PGM:1"), r"OK:.*", _ESPEC_OK),
+                Expect("PRGM DATA WRITE, PGM:1, EDIT START", None, _VS_NOADDR),
+                Expect("PRGM DATA WRITE, PGM:1, STEP1, TEMP12.0, TRAMPOFF, TIME02:40", None, _VS_NOADDR),
+                Expect("PRGM DATA WRITE, PGM:1, EDIT END", None, _VS_NOADDR),
+                Expect("PRGM DATA?", None, _VS_NOADDR))),
+        Method("ProgramErase", f"{_VS} SH241.ProgramErase", "ProgramErase()",
+               (Expect(_vs("PRGM ERASE,PGM:1"), r"OK:.*", _ESPEC_OK),)),
+        Method("ProgramAdvance", f"{_VS} SH241.ProgramAdvance (no program running)", "ProgramAdvance()",
+               (_refused(_vs("PRGM,ADVANCE"), "NA:CONT NOT READY-2", "'CONT NOT READY-2': 'Chamber is not running "
+                         "a program'"),)),
+        Method("ProgramEnd", f"{_VS} SH241.ProgramEnd (no program running)", "ProgramEnd()",
+               (_refused(_vs("PRGM,END,HOLD"), "NA:CONT NOT READY-2", "'CONT NOT READY-2': 'Chamber is not running "
+                         "a program'"),)),
+        *(Method(name, f"{_VS} SH241.{name}", f"{name}(...)", not_sent=_TASKS)
+          for name in ("AddTask", "AddCycle", "AddIdle", "WaitTillDateTime", "deleteTask", "PrintTaskList")),
+        Method("stopTask", f"{_VS} SH241.stopTask (SetModeStandby, and again when the list is empty)", "stopTask()",
+               (_ok_echo(_vs("MODE,STANDBY"), "MODE,STANDBY"), _ok_echo(_vs("MODE,STANDBY"), "MODE,STANDBY"))),
+        *(Method(name, f"{_VS} SH241.{name} (an empty task list: SetModeStandby)", f"{name}()",
+                 (_ok_echo(_vs("MODE,STANDBY"), "MODE,STANDBY"),)) for name in ("startNextTask", "startTask")),
+        Method("startCycle", f"{_VS} SH241.startCycle (state 0: startTemperatureSoak(temp1); then a 3 s timer that "
+               "sends nothing)", "startCycle(1, 1, 25.0, 30.0, 0, 1, 0)",
+               (_ok_echo(_vs("TEMP,S25.0"), "TEMP,S25.0"), _ok_echo(_vs("MODE,CONSTANT"), "MODE,CONSTANT"))),
+        Method("tempCheckerLoop", f"{_VS} SH241.tempCheckerLoop (GetTempSilent every 3 s, for ever; here once)",
+               "tempCheckerLoop()", (Expect(_vs("TEMP?"), _TEMP, f"{_ESPEC_READ} read_temp"),)),
+        Method("temperatureQuerySchedule", f"{_VS} SH241.temperatureQuerySchedule", "(target, seconds)",
+               not_sent="starts a timer for checkTempCallback: nothing sent"),
+        Method("checkTempCallback", f"{_VS} SH241.checkTempCallback", "(target, seconds)",
+               not_sent="compares the temperature tempCheckerLoop last read: nothing sent"),
+        Method("startTemperatureSoak", f"{_VS} SH241.startTemperatureSoak", "startTemperatureSoak(25.0, 60)",
+               (_ok_echo(_vs("TEMP,S25.0"), "TEMP,S25.0"), _ok_echo(_vs("MODE,CONSTANT"), "MODE,CONSTANT"))),
+        Method("returnToAmbient", f"{_VS} SH241.returnToAmbient", "returnToAmbient()",
+               not_sent="calls self.setTemp, which the class does not have (SetTemp): AttributeError before sending"),
+        Method("CloseChannel", f"{_VS} SH241.CloseChannel", "CloseChannel()", not_sent="closes the port"),
+    ), profile_overrides=(("request_prefix", "1,"),))
+
+DATA_CLIENTS: tuple[DataClient, ...] = (F4T_SCPI, IEAV, ACUTRONIC_ROBOTICS, WILLIAMSEA, TE107, SENGERM, IZAAKWN,
+                                        ATWG, VINCESUM)

@@ -39,7 +39,7 @@ from pathlib import Path
 
 from accelcal_rig.config.load import load_rig
 from accelcal_rig.core.clock import VirtualClock
-from accelcal_rig.protocols.chamber_lines import LINE_PROFILES, line_protocol
+from accelcal_rig.protocols.chamber_lines import LINE_PROFILES, ChamberLineProtocol, line_protocol
 from accelcal_rig.protocols.chamber_registers import register_map
 from accelcal_rig.protocols.turntable_line import ACUTROL3000, turntable_protocol
 from accelcal_rig.sim.chamber_line_server import SimulatedLineChamberServer
@@ -52,6 +52,7 @@ from tests.conftest import SIM_RIG
 from tests.protocols.client_requests import DATA_CLIENTS, DataClient, Expect
 from tests.protocols.maker_requests import NOT_SIMULATED as CHAMBER_NOT_SIMULATED
 from tests.protocols.maker_requests import REFUSALS as LINE_REFUSALS
+from tests.protocols.maker_requests import UNDOCUMENTED_SPELLINGS
 from tests.protocols.modbus_requests import not_simulated as modbus_not_simulated
 from tests.protocols.turntable_requests import NOT_SIMULATED as TURNTABLE_NOT_SIMULATED
 
@@ -336,7 +337,10 @@ def simulator(kind: str, profile: str, options: dict[str, object]) -> Iterator[t
     lab = VirtualLab(load_rig(SIM_RIG).model, VirtualClock(), 0)
     server: SimulatedLineChamberServer | SimulatedChamberServer | SimulatedTurntableServer
     if kind == "line":
-        server = SimulatedLineChamberServer(lab, line_protocol(profile), "tcp", **options)  # type: ignore[arg-type]
+        fields = ChamberLineProtocol.model_fields  # a profile's own fields (an RS-485 address) configure the profile
+        overrides = {key: value for key, value in options.items() if key in fields}
+        rest = {key: value for key, value in options.items() if key not in fields}
+        server = SimulatedLineChamberServer(lab, line_protocol(profile, overrides), "tcp", **rest)  # type: ignore[arg-type]
     elif kind == "modbus":
         server = SimulatedChamberServer(lab, register_map(profile), panel=panel_for(profile, register_map(profile)))
     else:
@@ -712,7 +716,8 @@ def _replay(client: DataClient, requests: tuple[Expect, ...], call: CallRecord, 
     call.exchanges = exchanges(proxy.since(mark), error, False)
     if len(call.exchanges) == len(requests):
         for index, (exchange, expect) in enumerate(zip(call.exchanges, requests)):
-            if exchange.simulator == "refused" and not problems[index]:  # an error reply is no documented answer
+            if exchange.simulator == "refused" and not problems[index] and not expect.refusal:  # an error reply is
+                # no documented answer, unless the maker documents that refusal for this request in this state
                 problems[index] = f"refused: {exchange.detail}; documented: {expect.source}"
             exchange.documented = expect.source if expect.answer is None else f"{expect.answer!r}: {expect.source}"
             exchange.problem = problems[index]
@@ -825,6 +830,9 @@ def _shape(text: str) -> str:
 LISTED: dict[str, dict[str, str]] = {}
 for _profile, _request, _client, _where, _why in CHAMBER_NOT_SIMULATED:
     LISTED.setdefault(_profile, {})[_shape(_request)] = f"{_why} (maker_requests.NOT_SIMULATED: {_client} {_where})"
+for _profile, _prefix, _request, _client, _where, _answer, _why in UNDOCUMENTED_SPELLINGS:
+    LISTED.setdefault(_profile, {})[_shape(_prefix + _request)] = f"{_why} (maker_requests.UNDOCUMENTED_SPELLINGS: " \
+                                                                  f"{_client} {_where})"
 for _request, _client, _where, _why in TURNTABLE_NOT_SIMULATED:
     LISTED.setdefault("acutrol3000", {})[_shape(_request)] = f"{_why} (turntable_requests.NOT_SIMULATED: {_client} " \
                                                              f"{_where})"

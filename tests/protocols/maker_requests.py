@@ -440,6 +440,29 @@ NOT_SIMULATED: tuple[tuple[str, str, str, str, str], ...] = (
 )
 
 
+#: (profile, RS-485 address prefix, request, client, where, what the simulator answers, why): requests in a
+#: spelling the maker's documents do not give, so that what a real controller answers is not known; the
+#: simulated one answers as recorded here (test_maker_requests.py checks it), and the client sweep lists them
+#: as not simulated with this reason.
+UNDOCUMENTED_SPELLINGS: tuple[tuple[str, str, str, str, str, str, str], ...] = (
+    *(("espec-p300", "1,", request, "vincesum/ESPEC-Temperature-Control-UI", f"src/ESPEC.py {where}", "NA:CMD ERR",
+       "`PGM:1` (a colon) where the P300's documented form is `PGM1` (ChamberConnectLibrary p300.py "
+       "write_prgm_data_edit; RAM:1 for PRGM ERASE); the client's own comment says the colon form works on its "
+       "chamber. The simulated controller stores no program and does not take the colon: NA:CMD ERR")
+      for request, where in (
+        ("PRGM DATA WRITE,PGM:1,EDIT START", "SH241.ProgramWrite"),
+        ("PRGM DATA WRITE,PGM:1,STEP1,TEMP30.0,TRAMPON,TIME00:01,", "SH241.ProgramWrite"),
+        ("PRGM DATA WRITE,PGM:1,COUNT,(1.1.1)", "SH241.ProgramWrite"),
+        ("PRGM DATA WRITE,PGM:1,END,HOLD", "SH241.ProgramWrite"),
+        ("PRGM DATA WRITE,PGM:1,EDIT END", "SH241.ProgramWrite"),
+        ("PRGM ERASE,PGM:1", "SH241.ProgramErase (and ProgramWrite)"))),
+    ("espec-p300", "1,", "MODE,RUN 1", "vincesum/ESPEC-Temperature-Control-UI", "src/ESPEC.py SH241.SetModeProgram",
+     "NA:PARA ERR", "a blank between RUN and the program number, where the P300's form is MODE,RUN<n> "
+     "(ChamberConnectLibrary p300.py write_mode_run; the simulated controller refuses that DATA NOT READY, no "
+     "program stored); this spelling it answers PARA ERR ('parameter missing or unrecognizable')"),
+)
+
+
 @dataclass(frozen=True)
 class Refusal:
     """A refusal the maker documents for requests on a controller in the simulated state: each example is
