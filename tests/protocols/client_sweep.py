@@ -500,7 +500,7 @@ CLIENTS: tuple[ClientSpec, ...] = (
           ("pu3j", "Pu3j", "TempChamber.PU3J", "espec-p300", {"write": "\r\n", "read": "\r\n"}, "CR LF each way (the "
            "P300's)", 3.0),
           ("testequity_107", "Testequity107", "TempChamber.TESTEQUITY_107", "watlow-f4t-scpi", {"write": "\n", "read": "\n"},
-           "LF each way (the F4T's)", 6.0))),
+           "LF each way (the F4T's)", 3.5))),
 )
 
 
