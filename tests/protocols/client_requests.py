@@ -423,6 +423,10 @@ SENGERM = DataClient(
     "SengerM/VotschTechnik-climate-chamber-Python@202e17204fd8a884a840fbbcd3a574d5170e03ab", "MIT",
     "request lists replayed over TCP through the proxy (the client: a socket to port 2049, each request ending CR, "
     "one recv(512) per reply)", "\r", "\r\n", 0.3, (
+        Method("create_command_string", f"{_SENGER} create_command_string (module function)", "(number, *args)",
+               not_sent="builds a request's bytes: nothing sent"),
+        Method("translate_command_name_to_command_number", f"{_SENGER} translate_command_name_to_command_number "
+               "(module function)", "(name)", not_sent="looks a name up in COMMANDS_DICT: nothing sent"),
         Method("__init__", f"{_SENGER} ClimateChamber.__init__", "ClimateChamber(ip, -20, 20)",
                not_sent="connects (port 2049) and sets its own limits: nothing sent"),
         Method("query_command_low_level", f"{_SENGER} ClimateChamber.query_command_low_level",
