@@ -512,7 +512,7 @@ REFUSALS: tuple[Refusal, ...] = (
             "common commands (py-lab-hal's Instrument base class sends them to every instrument)",
             f"{_ESPEC_ERRORS}: 'CMD ERR': 'Unrocognized command'; syndesi-drivers espec_sh242.py SH242Exception: "
             "'Main command error, the command has probably been mistyped'",
-            ("*IDN?", "*RST", "*CLS", "*ESR?", "*TST?", "*OPC?")),
+            ("*IDN?", "*RST", "*CLS", "*ESR?", "*TST?", "*OPC?"), inferred=True),
     Refusal("espec-p300", r"PRGM DATA WRITE, ?PGM\d+, ?EDIT (END|CANCEL)", "NA:PRGM WRITE ERR-3",
             "no program being edited", f"{_ESPEC_ERRORS}: 'PRGM WRITE ERR-3': 'Edit request not allowed not in "
             "edit mode'", ("PRGM DATA WRITE,PGM1,EDIT END", "PRGM DATA WRITE,PGM1,EDIT CANCEL"), inferred=True),
