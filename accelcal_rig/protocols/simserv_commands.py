@@ -28,6 +28,9 @@ FIELDS: dict[str, frozenset[int]] = {
     "14003": frozenset({2}),          # read digital output n
     "14007": frozenset({1}),          # number of digital outputs
     "14010": frozenset({2}),          # name of digital output n
+    "17002": frozenset({1}),          # number of messages (IzaakWN checkActiveWarnings: the index alone)
+    "19204": frozenset({1}),          # number of the program running (IzaakWN getRunStatus)
+    "19210": frozenset({1}),          # program status: 0 not running, 1 running, +2 paused (IzaakWN forceWarmUp)
 }
 
 

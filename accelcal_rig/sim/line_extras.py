@@ -19,7 +19,7 @@ class SimservExtras(Extras):
     (warnings) + 8 (alarms); 14001 sets digital output n (1 is the manual run, the profile's power command;
     the purge output is the profile's, chamber wiring), 14003 reads one back; a known command number with a
     field count it does not take is `-6`; one the simulated chamber has no data for (another control
-    variable, the year of manufacture, output names) is `-8`, data could not be read."""
+    variable, the year of manufacture, output names, messages, programs) is `-8`, data could not be read."""
 
     def __init__(self, protocol: ChamberLineProtocol, lab: VirtualLab, panel: Panel) -> None:
         super().__init__(protocol, lab, panel)

@@ -50,6 +50,7 @@ class Expect:
     answer: str | None  # a regular expression the reply (terminators cut) must match in full; None: no reply
     source: str  # where the maker documents that answer
     prefixed: bool = False  # the reply starts with an 8-byte prefix the client cuts off (ACL over TCP)
+    refusal: bool = False  # the documented answer is the controller's refusal (ESPEC NA:…) in the simulated state
 
     def check(self, reply: bytes) -> str:
         """'' when the reply is the documented one; else what is wrong with it."""
@@ -340,4 +341,342 @@ WILLIAMSEA = DataClient(
                (_w(":u:t 180,177,178,50,32,144,32,176,181,179,50,32,144,32,176,181,181,181", "Table 5 :Utility:Touch (Table 8)"),)),
     ))
 
-DATA_CLIENTS: tuple[DataClient, ...] = (F4T_SCPI, IEAV, ACUTRONIC_ROBOTICS, WILLIAMSEA)
+
+# ---------------------------------------------------------------------- F4T SCPI: DAsh0244/te107_control
+_TE107 = "src/f4t_control.py"
+_TE107_LIST = "te107_control ref/scpi_commands.csv (the F4T SCPI command list the repository ships)"
+
+
+def _te_query(request: str, answer: str, row: str) -> Expect:
+    return Expect(request, answer, f"{_TE107_LIST}: {row}")
+
+
+def _te_setting(request: str, row: str) -> Expect:
+    return Expect(request, None, f"{_TE107_LIST}: {row} (W: a setting, unanswered)")
+
+
+TE107 = DataClient(
+    "DAsh0244 te107_control F4TController", "watlow-f4t-scpi",
+    "DAsh0244/te107_control@4052018c37b7e25e260fdd9f9e50a2d8019d8faf", "MIT",
+    "request lists replayed over TCP through the proxy (the client: socket.create_connection to port 5025, each "
+    "request ending LF, replies read in 10-byte recv()s up to LF)", "\n", "\n", 0.3, (
+        Method("__init__", f"{_TE107} Device.__init__ (get_id when no id is given; _clear_buffer only reads)",
+               "F4TController(host=...)", (_IDN,)),
+        Method("from_other_dev", f"{_TE107} Device.from_other_dev (classmethod)", "F4TController.from_other_dev(dev)",
+               not_sent="builds an object on another's connection and id: get_id is not called, nothing sent"),
+        Method("send_cmd", f"{_TE107} Device.send_cmd", "send_cmd(cmd)",
+               not_sent="the transport primitive: sends what its caller gives it"),
+        Method("get_id", f"{_TE107} Device.get_id", "get_id()", (_IDN,)),
+        Method("get_profiles", f"{_TE107} F4TController.get_profiles (profiles 1…39 until a name reads empty; here "
+               "the first)", "get_profiles()",
+               (_te_setting(":PROGRAM:NUMBER 1", "Select a profile, 1-40"),
+                _te_query(":PROGRAM:NAME?", r".*", "Read selected profile name → <string value>"))),
+        Method("get_units", f"{_TE107} F4TController.get_units (TempUnits(resp))", "get_units()",
+               (_te_query(":UNIT:TEMPERATURE?", "C|F", "Query Comm. Temperature units → C|F"),)),
+        Method("set_units", f"{_TE107} F4TController.set_units (':UNITS:…', where the list has ':UNIT:…')",
+               "set_units()", (Expect(":UNITS:TEMPERATURE C", None, f"{_TE107_LIST}: no such header (Set Comm. "
+                                      "Temperature units to C is ':UNIT:TEMPERATURE C'); the F4T documents no "
+                                      "error reply"),)),
+        Method("set_ramp_scale", f"{_TE107} F4TController.set_ramp_scale (formats the RampScale member itself: "
+               "str() of an Enum member)", "set_ramp_scale('MINUTES')",
+               (Expect(":SOURCE:CLOOP1:RSCALE RampScale.MINUTES", None, f"{_TE107_LIST}: Write ramp scale takes "
+                       "MINUTES or HOURS; no error reply documented"),)),
+        Method("set_ramp_rate", f"{_TE107} F4TController.set_ramp_rate", "set_ramp_rate(2.0)",
+               (_te_setting(":SOURCE:CLOOP1:RRATE 2.0", "Write ramp rate"),)),
+        Method("set_ramp_time", f"{_TE107} F4TController.set_ramp_time", "set_ramp_time(30)",
+               (_te_setting(":SOURCE:CLOOP1:RTIME 30", "Read [sic] ramp time, :SOURCE:CLOOP#:RTIME <value>, W"),)),
+        Method("select_profile", f"{_TE107} F4TController.select_profile", "select_profile(1)",
+               (_te_setting(":PROGRAM:NUMBER 1", "Select a profile, 1-40"),)),
+        Method("run_profile", f"{_TE107} F4TController.run_profile", "run_profile()",
+               (_te_setting(":PROGRAM:SELECTED:STATE START", "start profile"),)),
+        Method("stop_profile", f"{_TE107} F4TController.stop_profile", "stop_profile()",
+               (_te_setting(":PROGRAM:SELECTED:STATE STOP", "stop profile"),)),
+        Method("get_temperature", f"{_TE107} F4TController.get_temperature", "get_temperature()",
+               (_te_query(":SOURCE:CLOOP1:PVALUE?", _FLOAT, "Read Temperature PV (Control loop) → <floating point "
+                          "value>"),)),
+        Method("set_temperature", f"{_TE107} F4TController.set_temperature (no leading colon)", "set_temperature(30.0)",
+               (_te_setting("SOURCE:CLOOP1:SPOINT 30.0", "Write SP"),
+                )),
+        Method("is_done", f"{_TE107} F4TController.is_done", "is_done(1)",
+               (_te_query(":OUTPUT1:STATE?", "OFF|ON", "Query event output state → OFF|ON"),)),
+        Method("set_output", f"{_TE107} F4TController.set_output", "set_output(1, 'ON')",
+               (_te_setting(":OUTPUT1:STATE ON", "Set event output on (outputs 1-7)"),
+                _te_query(":OUTPUT1:STATE?", "ON", "Query event output state (read back)"))),
+    ))
+
+# ---------------------------------------------------------------------- SIMSERV: SengerM, IzaakWN
+S = "\u00b6"  # SIMSERV's field separator (byte 0xB6)
+_SIMSERV_OK = "S!MPAC simserv manual (SengerM's [2], 'Operation manual, Communication protocol S!MPAC simserv', §5 as " \
+              "its COMMANDS_DICT cites it; IzaakWN chamber_commands.py err_dict: 1 'Command is accepted and executed')"
+
+
+def _ss(request: str, answer: str, what: str) -> Expect:
+    return Expect(request, answer, f"{_SIMSERV_OK}: {what}")
+
+
+_SENGER = "VotschTechnikClimateChamber/ClimateChamber.py"
+_VALUE = rf"1{S}[^{S}]+(?:{S}.*)?"  # accepted, then the value (the client takes the first field)
+_BIT = rf"1{S}[01]"
+
+SENGERM = DataClient(
+    "SengerM VotschTechnik ClimateChamber", "simserv",
+    "SengerM/VotschTechnik-climate-chamber-Python@202e17204fd8a884a840fbbcd3a574d5170e03ab", "MIT",
+    "request lists replayed over TCP through the proxy (the client: a socket to port 2049, each request ending CR, "
+    "one recv(512) per reply)", "\r", "\r\n", 0.3, (
+        Method("create_command_string", f"{_SENGER} create_command_string (module function)", "(number, *args)",
+               not_sent="builds a request's bytes: nothing sent"),
+        Method("translate_command_name_to_command_number", f"{_SENGER} translate_command_name_to_command_number "
+               "(module function)", "(name)", not_sent="looks a name up in COMMANDS_DICT: nothing sent"),
+        Method("__init__", f"{_SENGER} ClimateChamber.__init__", "ClimateChamber(ip, -20, 20)",
+               not_sent="connects (port 2049) and sets its own limits: nothing sent"),
+        Method("query_command_low_level", f"{_SENGER} ClimateChamber.query_command_low_level",
+               "query_command_low_level(number, *args)", not_sent="the transport primitive: sends what it is given"),
+        Method("query", f"{_SENGER} ClimateChamber.query", "query(name, *args)",
+               not_sent="sends the numbered command its caller names (every use of it is a member below)"),
+        Method("serial_number", f"{_SENGER} ClimateChamber.serial_number (property)", "serial_number",
+               (_ss(f"99997{S}1{S}3", _VALUE, "GET CHAMBER INFO, item 3: serial number"),)),
+        Method("test_system_type", f"{_SENGER} ClimateChamber.test_system_type (property)", "test_system_type",
+               (_ss(f"99997{S}1{S}1", _VALUE, "GET CHAMBER INFO, item 1: test system type"),)),
+        Method("year_manufactured", f"{_SENGER} ClimateChamber.year_manufactured (property)", "year_manufactured",
+               (_ss(f"99997{S}1{S}2", _VALUE, "GET CHAMBER INFO, item 2: year manufactured"),)),
+        Method("idn", f"{_SENGER} ClimateChamber.idn (property: test_system_type, serial_number, year_manufactured)",
+               "idn", (_ss(f"99997{S}1{S}1", _VALUE, "GET CHAMBER INFO 1"),
+                       _ss(f"99997{S}1{S}3", _VALUE, "GET CHAMBER INFO 3"),
+                       _ss(f"99997{S}1{S}2", _VALUE, "GET CHAMBER INFO 2"))),
+        Method("temperature_measured", f"{_SENGER} ClimateChamber.temperature_measured (property)",
+               "temperature_measured", (_ss(f"11004{S}1{S}1", rf"1{S}{_N}", "GET CONTROL_VARIABLE ACTUAL_VALUE"),)),
+        Method("temperature_set_point", f"{_SENGER} ClimateChamber.temperature_set_point (property, and its setter "
+               "with str(celsius))", "temperature_set_point; temperature_set_point = 15.0",
+               (_ss(f"11002{S}1{S}1", rf"1{S}{_N}", "GET CONTROL_VARIABLE SET_POINT"),
+                _ss(f"11001{S}1{S}1{S}15.0", "1", "SET CONTROL_VARIABLE SET_POINT"))),
+        Method("temperature_min", f"{_SENGER} ClimateChamber.temperature_min (property and setter)",
+               "temperature_min", not_sent="the object's own safety limit: nothing sent"),
+        Method("temperature_max", f"{_SENGER} ClimateChamber.temperature_max (property and setter)",
+               "temperature_max", not_sent="the object's own safety limit: nothing sent"),
+        Method("dryer", f"{_SENGER} ClimateChamber.dryer (property, and its setter)", "dryer; dryer = True",
+               (_ss(f"14003{S}1{S}8", _BIT, "GET DIGITAL_OUT VALUE 8 (the dryer)"),
+                _ss(f"14001{S}1{S}8{S}1", "1", "SET DIGITAL_OUT VALUE 8"))),
+        Method("compressed_air", f"{_SENGER} ClimateChamber.compressed_air (property, and its setter)",
+               "compressed_air; compressed_air = True",
+               (_ss(f"14003{S}1{S}7", _BIT, "GET DIGITAL_OUT VALUE 7 (compressed air)"),
+                _ss(f"14001{S}1{S}7{S}1", "1", "SET DIGITAL_OUT VALUE 7"))),
+        Method("start", f"{_SENGER} ClimateChamber.start", "start()",
+               (_ss(f"14001{S}1{S}1{S}1", "1", "START MANUAL_MODE 1, 1"),)),
+        Method("is_running", f"{_SENGER} ClimateChamber.is_running (property)", "is_running",
+               (_ss(f"14003{S}1{S}1", _BIT, "GET DIGITAL_OUT VALUE 1"),)),
+        Method("stop", f"{_SENGER} ClimateChamber.stop", "stop()",
+               (_ss(f"14001{S}1{S}1{S}0", "1", "START MANUAL_MODE 1, 0"),)),
+    ))
+
+_IZ = "chamber_commands.py"
+_GUI = "a Tk dialog asks first"
+
+IZAAKWN = DataClient(
+    "IzaakWN ClimateChamberMonitor chamber_commands", "simserv",
+    "IzaakWN/ClimateChamberMonitor@858ca67f8fbf2f89cf5b2d85955ca76395e694f4", "none stated",
+    "request lists replayed over TCP through the proxy (the client, Python 2: a socket to port 2049, each request "
+    "ending CR, one recv(512) per reply); the module's functions and its ClimateChamber socket class", "\r", "\r\n",
+    0.3, (
+        Method("getTemp", f"{_IZ} getTemp (and ClimateChamber.getTemp)", "getTemp(c)",
+               (_ss(f"11004{S}1{S}1", rf"1{S}{_N}", "GET CTRL_VAR VAL"),)),
+        Method("getSetp", f"{_IZ} getSetp (and ClimateChamber.getSetp)", "getSetp(c)",
+               (_ss(f"11002{S}1{S}1", rf"1{S}{_N}", "GET CTRL_VAR SETPOINT"),)),
+        Method("getAir", f"{_IZ} getAir (and ClimateChamber.getAir)", "getAir(c)",
+               (_ss(f"14003{S}1{S}7", _BIT, "GET DIGI_OUT VAL 7"),)),
+        Method("getDryer", f"{_IZ} getDryer (and ClimateChamber.getDryer)", "getDryer(c)",
+               (_ss(f"14003{S}1{S}8", _BIT, "GET DIGI_OUT VAL 8"),)),
+        Method("getDewp", f"{_IZ} getDewp", "getDewp(c)", not_sent="returns 18.0: nothing sent"),
+        Method("startRun", f"{_IZ} startRun (and ClimateChamber.startRun)", "startRun(c)",
+               not_sent="its lambda uses a global `client` the module never defines (NameError before sending); "
+               "what it means to send, START MANUAL 1,1, run_manual.py sends (maker_requests.SIMSERV)"),
+        Method("stopRun", f"{_IZ} stopRun (and ClimateChamber.stopRun)", "stopRun(c)",
+               not_sent="as startRun: a global `client` never defined"),
+        Method("disconnect", f"{_IZ} ClimateChamber.disconnect", "c.disconnect()", not_sent="closes the socket"),
+        Method("sendSimServCmd", f"{_IZ} sendSimServCmd (and ClimateChamber.sendSimServCmd)", "sendSimServCmd(c, s)",
+               not_sent="the transport primitive: sends the command its caller names"),
+        Method("createSimServCmdFromString", f"{_IZ} createSimServCmdFromString", "(cmdstr, args)",
+               not_sent="builds a request: nothing sent"),
+        Method("ceateSimServCmd", f"{_IZ} ceateSimServCmd", "(cmdID, args)", not_sent="builds a request: nothing sent"),
+        Method("unpackSimServData", f"{_IZ} unpackSimServData", "(data)", not_sent="parses a reply: nothing sent"),
+        Method("connectClimateChamber", f"{_IZ} connectClimateChamber", "connectClimateChamber(ip)",
+               not_sent="connects (port 2049): nothing sent"),
+        Method("forceWarmUp", f"{_IZ} forceWarmUp (and ClimateChamber.forceWarmUp; no program running: STOP PRGM "
+               "not sent)", "forceWarmUp(c)",
+               (_ss(f"19210{S}1", r"1" + S + r"\d+", "GET PRGM STATUS (0: not running)"),
+                _ss(f"11001{S}1{S}1{S}24", "1", "SET CTRL_VAR SETPOINT"),
+                _ss(f"11068{S}1{S}1{S}3", "1", "SET GRAD_UP VAL"),
+                _ss(f"11072{S}1{S}1{S}3", "1", "SET GRAD_DWN VAL"),
+                _ss(f"14001{S}1{S}7{S}1", "1", "SET DIGI_OUT VAL 7 (air)"),
+                _ss(f"14001{S}1{S}8{S}1", "1", "SET DIGI_OUT VAL 8 (dryer)"),
+                _ss(f"14001{S}1{S}1{S}1", "1", "START MANUAL 1, 1"))),
+        Method("forceWarmUpEvent", f"{_IZ} forceWarmUpEvent", "forceWarmUpEvent(c)",
+               not_sent=f"{_GUI}, then forceWarmUp's requests (above)"),
+        Method("stopClimateChamber", f"{_IZ} stopClimateChamber (and ClimateChamber.stop; no program running)",
+               "stopClimateChamber(c)",
+               (_ss(f"19210{S}1", r"1" + S + r"\d+", "GET PRGM STATUS"),
+                _ss(f"11004{S}1{S}1", rf"1{S}{_N}", "GET CTRL_VAR VAL"),
+                _ss(f"14001{S}1{S}1{S}0", "1", "START MANUAL 1, 0"))),
+        Method("stopClimateChamberEvent", f"{_IZ} stopClimateChamberEvent", "stopClimateChamberEvent(c)",
+               (_ss(f"19210{S}1", r"1" + S + r"\d+", "GET PRGM STATUS (then a Tk dialog asks; stopClimateChamber's "
+                    "requests above)"),)),
+        Method("checkActiveWarnings", f"{_IZ} checkActiveWarnings (no message: the loop sends nothing)",
+               "checkActiveWarnings(c)", (_ss(f"17002{S}1", r"1" + S + r"\d+", "GET MSG NUM"),)),
+        Method("checkInterlock", f"{_IZ} checkInterlock", "checkInterlock(c, temp, dewp)",
+               not_sent="compares its arguments; only below the dew point + 5 °C does it call forceWarmUp (above)"),
+        Method("getActiveWarnings", f"{_IZ} getActiveWarnings (no message)", "getActiveWarnings(c)",
+               (_ss(f"17002{S}1", r"1" + S + r"\d+", "GET MSG NUM"),)),
+        Method("openActiveWarnings", f"{_IZ} openActiveWarnings (then getActiveWarnings; a Tk dialog for any)",
+               "openActiveWarnings(c)",
+               (_ss(f"17002{S}1", r"1" + S + r"\d+", "GET MSG NUM"), _ss(f"17002{S}1", r"1" + S + r"\d+",
+                                                                          "GET MSG NUM"))),
+        Method("getRunStatus", f"{_IZ} getRunStatus (no program: then the chamber's status)", "getRunStatus(c)",
+               (_ss(f"19204{S}1", r"1" + S + r"\d+", "GET PRGM NUM"),
+                _ss(f"10012{S}1", r"1" + S + r"\d+", "GET CHAMBER STATUS (1: not running, 3: running)"))),
+    ))
+
+# ---------------------------------------------------------------------- ESPEC P300 class: ATWG, vincesum
+_ESPEC_OK = "ESPEC: a setting is answered OK:<the command as received> (EHS manual §1.3 as maker_requests.py cites " \
+            "it; ChamberConnectLibrary especinteract.py reads OK:/NA:)"
+_ESPEC_READ = "ChamberConnectLibrary p300.py (the reply formats its parser reads)"
+_TEMP = rf"{_N},{_N},{_N},{_N}"
+_HUMI = r"[^,]*,[^,]*,[^,]*,[^,]*"
+
+
+def _ok_echo(request: str, sent: str | None = None) -> Expect:
+    """A P300 setting: answered OK: and the command as received (without the RS-485 address)."""
+    return Expect(request, re.escape("OK:" + (sent if sent is not None else request)), _ESPEC_OK)
+
+
+def _refused(request: str, reply: str, why: str) -> Expect:
+    return Expect(request, re.escape(reply), f"ChamberConnectLibrary especinteract.py ERROR_DESCIPTIONS: {why}",
+                  refusal=True)
+
+
+_ATWG = "ATWG/driver/espec/sh641.py"
+ATWG = DataClient(
+    "akaeba ATWG especShSu", "espec-p300", "akaeba/ATWG@65783bbdb6243136ef9133445d31b32e769b3023",
+    "GPL-3.0 (facts only: the requests, read from the source; no code copied)",
+    "request lists replayed over TCP through the proxy (the client: RS-232 with pyserial, each request ending CR LF "
+    "(sh641Const.MSC_LINE_END), replies read byte by byte to CR LF)", "\r\n", "\r\n", 0.3, (
+        Method("open", f"{_ATWG} especShSu.open (TYPE?, then its SH-641's own ID, sh641Const.RSP_CH_ID, must be in "
+               "the reply)", "open()",
+               (Expect("TYPE?", r"T,T,[^,]+,[-\d.]+", f"{_ESPEC_READ} read_type: drybulb,wetbulb,controller,max "
+                       "temperature"),)),
+        Method("close", f"{_ATWG} especShSu.close", "close()", not_sent="closes the serial port"),
+        Method("write", f"{_ATWG} especShSu.write", "write(msg)",
+               not_sent="the transport primitive: sends what its caller gives it"),
+        Method("read", f"{_ATWG} especShSu.read", "read()", not_sent="reads a reply; sends nothing"),
+        Method("parse", f"{_ATWG} especShSu.parse", "parse(msg)", not_sent="parses a reply text: sends nothing"),
+        Method("is_numeric", f"{_ATWG} especShSu.is_numeric", "is_numeric(msg)", not_sent="a text check"),
+        Method("get_clima", f"{_ATWG} especShSu.get_clima", "get_clima()",
+               (Expect("TEMP?", _TEMP, f"{_ESPEC_READ} read_temp: measured,set point,upper,lower"),
+                Expect("HUMI?", _HUMI, f"{_ESPEC_READ} read_humi: measured,set point,upper,lower"))),
+        Method("set_clima", f"{_ATWG} especShSu.set_clima (one decimal: MSC_TEMP_RESOLUTION 0.1)",
+               "set_clima({'temperature': 25.0})", (_ok_echo("TEMP,S25.0"),)),
+        Method("set_power", f"{_ATWG} especShSu.set_power (default OFF; ON)", "set_power(); set_power('ON')",
+               (_ok_echo("POWER,OFF"), _ok_echo("POWER,ON"))),
+        Method("set_mode", f"{_ATWG} especShSu.set_mode (default STANDBY; CONSTANT, OFF)",
+               "set_mode(); set_mode('CONSTANT'); set_mode('OFF')",
+               (_ok_echo("MODE,STANDBY"), _ok_echo("MODE,CONSTANT"), _ok_echo("MODE,OFF"))),
+        Method("start", f"{_ATWG} especShSu.start (a temperature given: set_clima, set_power ON, set_mode CONSTANT)",
+               "start(30.0)", (_ok_echo("TEMP,S30.0"), _ok_echo("POWER,ON"), _ok_echo("MODE,CONSTANT"))),
+        Method("stop", f"{_ATWG} especShSu.stop", "stop()", (_ok_echo("MODE,STANDBY"), _ok_echo("POWER,OFF"))),
+        Method("info", f"{_ATWG} especShSu.info", "info()", not_sent="returns its constants: nothing sent"),
+    ))
+
+_VS = "src/ESPEC.py"
+_VS_NOADDR = "sent without the RS-485 address the rest of the class puts in front ('1,'): addressed to no " \
+             "controller on the bus, so none answers (inferred from the address scheme, ChamberConnectLibrary " \
+             "especinteract.py; not stated by ESPEC)"
+_TASKS = "keeps its own task list: nothing sent"
+
+
+def _vs(request: str) -> str:
+    return "1," + request
+
+
+VINCESUM = DataClient(
+    "vincesum ESPEC-Temperature-Control-UI SH241", "espec-p300",
+    "vincesum/ESPEC-Temperature-Control-UI@c8d7f761a865857041af6a64e4079ccee765d491", "none stated",
+    "request lists replayed over TCP through the proxy onto a simulated controller at RS-485 address 1 (the "
+    "client: pyserial through its UARTMaster, each request ending CR LF, replies read with readline())",
+    "\r\n", "\r\n", 0.3, (
+        Method("__init__", f"{_VS} SH241.__init__", "SH241()", not_sent="lists the FTDI devices: nothing sent"),
+        *(Method(name, f"{_VS} SH241.{name} (OpenChannel: the port opened, then SetModeStandby; a thread then "
+                 "sends TEMP? every 3 s, tempCheckerLoop)", f"{name}()", (_ok_echo(_vs("MODE,STANDBY"),
+                                                                          "MODE,STANDBY"),))
+          for name in ("SetRS485", "SetRS232", "OpenChannel")),
+        Method("GetType", f"{_VS} SH241.GetType", "GetType()",
+               (Expect(_vs("TYPE?"), r"T,(T,)?[^,]+,[-\d.]+", f"{_ESPEC_READ} read_type"),)),
+        Method("GetMode", f"{_VS} SH241.GetMode", "GetMode()",
+               (Expect(_vs("MODE?"), "OFF|STANDBY|CONSTANT|RUN", f"{_ESPEC_READ} read_mode"),)),
+        Method("GetCondition", f"{_VS} SH241.GetCondition", "GetCondition()",
+               (Expect(_vs("MON?"), rf"{_N},[^,]*,(OFF|STANDBY|CONSTANT|RUN),\d+", f"{_ESPEC_READ} read_mon"),)),
+        Method("GetTemp", f"{_VS} SH241.GetTemp", "GetTemp()",
+               (Expect(_vs("TEMP?"), _TEMP, f"{_ESPEC_READ} read_temp"),)),
+        Method("GetTempSilent", f"{_VS} SH241.GetTempSilent (also tempCheckerLoop's; it purges the input after "
+               "writing, so it may drop the reply it then reads)", "GetTempSilent()",
+               (Expect(_vs("TEMP?"), _TEMP, f"{_ESPEC_READ} read_temp"),)),
+        Method("SetPowerOn", f"{_VS} SH241.SetPowerOn", "SetPowerOn()", (_ok_echo(_vs("POWER,ON"), "POWER,ON"),)),
+        Method("SetPowerOff", f"{_VS} SH241.SetPowerOff", "SetPowerOff()",
+               (_ok_echo(_vs("POWER,OFF"), "POWER,OFF"),)),
+        Method("SetTemp", f"{_VS} SH241.SetTemp ('%.1f')", "SetTemp(25.0)",
+               (_ok_echo(_vs("TEMP,S25.0"), "TEMP,S25.0"),)),
+        Method("SetHighTemp", f"{_VS} SH241.SetHighTemp", "SetHighTemp(100.0)",
+               (_ok_echo(_vs("TEMP,H100.0"), "TEMP,H100.0"),)),
+        Method("SetLowTemp", f"{_VS} SH241.SetLowTemp", "SetLowTemp(-40.0)",
+               (_ok_echo(_vs("TEMP,L-40.0"), "TEMP,L-40.0"),)),
+        Method("SetHumid", f"{_VS} SH241.SetHumid ('%i')", "SetHumid(50)", (_ok_echo(_vs("HUMI,S50"), "HUMI,S50"),)),
+        Method("SetModeOff", f"{_VS} SH241.SetModeOff", "SetModeOff()", (_ok_echo(_vs("MODE,OFF"), "MODE,OFF"),)),
+        Method("SetModeStandby", f"{_VS} SH241.SetModeStandby", "SetModeStandby()",
+               (_ok_echo(_vs("MODE,STANDBY"), "MODE,STANDBY"),)),
+        Method("SetModeConstant", f"{_VS} SH241.SetModeConstant", "SetModeConstant()",
+               (_ok_echo(_vs("MODE,CONSTANT"), "MODE,CONSTANT"),)),
+        Method("SetModeProgram", f"{_VS} SH241.SetModeProgram ('MODE,RUN 1', a blank before the program number)",
+               "SetModeProgram()", (_refused(_vs("MODE,RUN 1"), "NA:DATA NOT READY", "'DATA NOT READY': 'Specified "
+                                             "program does not exist' (none stored; for MODE,RUN1, the P300's "
+                                             "form)"),)),
+        Method("ProgramWrite", f"{_VS} SH241.ProgramWrite (default program; its first block addressed, then "
+               "ProgramErase, then a second block without the address, then PRGM DATA?)", "ProgramWrite()",
+               (Expect(_vs("PRGM DATA WRITE,PGM:1,EDIT START"), r"OK:.*", _ESPEC_OK),
+                Expect(_vs("PRGM DATA WRITE,PGM:1,STEP1,TEMP30.0,TRAMPON,TIME00:01,"), r"OK:.*", _ESPEC_OK),
+                Expect(_vs("PRGM DATA WRITE,PGM:1,COUNT,(1.1.1)"), r"OK:.*", _ESPEC_OK),
+                Expect(_vs("PRGM DATA WRITE,PGM:1,END,HOLD"), r"OK:.*", _ESPEC_OK),
+                Expect(_vs("PRGM DATA WRITE,PGM:1,EDIT END"), r"OK:.*", _ESPEC_OK),
+                Expect(_vs("PRGM ERASE,PGM:1"), r"OK:.*", _ESPEC_OK),
+                Expect("PRGM DATA WRITE, PGM:1, EDIT START", None, _VS_NOADDR),
+                Expect("PRGM DATA WRITE, PGM:1, STEP1, TEMP12.0, TRAMPOFF, TIME02:40", None, _VS_NOADDR),
+                Expect("PRGM DATA WRITE, PGM:1, EDIT END", None, _VS_NOADDR),
+                Expect("PRGM DATA?", None, _VS_NOADDR))),
+        Method("ProgramErase", f"{_VS} SH241.ProgramErase", "ProgramErase()",
+               (Expect(_vs("PRGM ERASE,PGM:1"), r"OK:.*", _ESPEC_OK),)),
+        Method("ProgramAdvance", f"{_VS} SH241.ProgramAdvance (no program running)", "ProgramAdvance()",
+               (_refused(_vs("PRGM,ADVANCE"), "NA:CONT NOT READY-2", "'CONT NOT READY-2': 'Chamber is not running "
+                         "a program'"),)),
+        Method("ProgramEnd", f"{_VS} SH241.ProgramEnd (no program running)", "ProgramEnd()",
+               (_refused(_vs("PRGM,END,HOLD"), "NA:CONT NOT READY-2", "'CONT NOT READY-2': 'Chamber is not running "
+                         "a program'"),)),
+        *(Method(name, f"{_VS} SH241.{name}", f"{name}(...)", not_sent=_TASKS)
+          for name in ("AddTask", "AddCycle", "AddIdle", "WaitTillDateTime", "deleteTask", "PrintTaskList")),
+        Method("stopTask", f"{_VS} SH241.stopTask (SetModeStandby, and again when the list is empty)", "stopTask()",
+               (_ok_echo(_vs("MODE,STANDBY"), "MODE,STANDBY"), _ok_echo(_vs("MODE,STANDBY"), "MODE,STANDBY"))),
+        *(Method(name, f"{_VS} SH241.{name} (an empty task list: SetModeStandby)", f"{name}()",
+                 (_ok_echo(_vs("MODE,STANDBY"), "MODE,STANDBY"),)) for name in ("startNextTask", "startTask")),
+        Method("startCycle", f"{_VS} SH241.startCycle (state 0: startTemperatureSoak(temp1); then a 3 s timer that "
+               "sends nothing)", "startCycle(1, 1, 25.0, 30.0, 0, 1, 0)",
+               (_ok_echo(_vs("TEMP,S25.0"), "TEMP,S25.0"), _ok_echo(_vs("MODE,CONSTANT"), "MODE,CONSTANT"))),
+        Method("tempCheckerLoop", f"{_VS} SH241.tempCheckerLoop (GetTempSilent every 3 s, for ever; here once)",
+               "tempCheckerLoop()", (Expect(_vs("TEMP?"), _TEMP, f"{_ESPEC_READ} read_temp"),)),
+        Method("temperatureQuerySchedule", f"{_VS} SH241.temperatureQuerySchedule", "(target, seconds)",
+               not_sent="starts a timer for checkTempCallback: nothing sent"),
+        Method("checkTempCallback", f"{_VS} SH241.checkTempCallback", "(target, seconds)",
+               not_sent="compares the temperature tempCheckerLoop last read: nothing sent"),
+        Method("startTemperatureSoak", f"{_VS} SH241.startTemperatureSoak", "startTemperatureSoak(25.0, 60)",
+               (_ok_echo(_vs("TEMP,S25.0"), "TEMP,S25.0"), _ok_echo(_vs("MODE,CONSTANT"), "MODE,CONSTANT"))),
+        Method("returnToAmbient", f"{_VS} SH241.returnToAmbient", "returnToAmbient()",
+               not_sent="calls self.setTemp, which the class does not have (SetTemp): AttributeError before sending"),
+        Method("CloseChannel", f"{_VS} SH241.CloseChannel", "CloseChannel()", not_sent="closes the port"),
+    ), profile_overrides=(("request_prefix", "1,"),))
+
+DATA_CLIENTS: tuple[DataClient, ...] = (F4T_SCPI, IEAV, ACUTRONIC_ROBOTICS, WILLIAMSEA, TE107, SENGERM, IZAAKWN,
+                                        ATWG, VINCESUM)

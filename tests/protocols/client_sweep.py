@@ -39,7 +39,7 @@ from pathlib import Path
 
 from accelcal_rig.config.load import load_rig
 from accelcal_rig.core.clock import VirtualClock
-from accelcal_rig.protocols.chamber_lines import LINE_PROFILES, line_protocol
+from accelcal_rig.protocols.chamber_lines import LINE_PROFILES, ChamberLineProtocol, line_protocol
 from accelcal_rig.protocols.chamber_registers import register_map
 from accelcal_rig.protocols.turntable_line import ACUTROL3000, turntable_protocol
 from accelcal_rig.sim.chamber_line_server import SimulatedLineChamberServer
@@ -52,6 +52,7 @@ from tests.conftest import SIM_RIG
 from tests.protocols.client_requests import DATA_CLIENTS, DataClient, Expect
 from tests.protocols.maker_requests import NOT_SIMULATED as CHAMBER_NOT_SIMULATED
 from tests.protocols.maker_requests import REFUSALS as LINE_REFUSALS
+from tests.protocols.maker_requests import UNDOCUMENTED_SPELLINGS
 from tests.protocols.modbus_requests import not_simulated as modbus_not_simulated
 from tests.protocols.turntable_requests import NOT_SIMULATED as TURNTABLE_NOT_SIMULATED
 
@@ -169,11 +170,14 @@ class RecordingProxy:
             return list(self.chunks[mark:])
 
     def settle(self, quiet_s: float = QUIET_S, limit_s: float = 2.0) -> None:
-        """Wait until nothing has crossed for `quiet_s` (a reply on its way is recorded before it is read)."""
-        end = time.monotonic() + limit_s
+        """Wait until nothing has crossed for `quiet_s` (a reply on its way is recorded before it is read); a
+        longer `quiet_s` (a client that does not read its replies) counts from now at the earliest, so that a
+        request still on its way through the proxy is recorded too."""
+        start = time.monotonic()
+        end = start + limit_s
         while time.monotonic() < end:
             with self._lock:
-                idle = time.monotonic() - self._last
+                idle = time.monotonic() - (self._last if quiet_s <= QUIET_S else max(self._last, start))
             if idle >= quiet_s:
                 return
             time.sleep(quiet_s - idle)
@@ -233,7 +237,30 @@ class ClientSweep:
     seconds: float = 0.0
 
 
-def exchanges(chunks: list[Chunk], error: re.Pattern[str] | None, modbus: bool) -> list[Exchange]:
+#: Line profiles whose controller answers every request with exactly one line (ESPEC: `OK:<command>` or
+#: `NA:<error>` to every command, EHS manual §1.3 as ChamberConnectLibrary's especinteract.py reads it). A client
+#: that writes several requests before it reads (py-lab-hal's send()) gets their replies together: they are
+#: given back to its requests one line each, in order.
+ONE_REPLY_EACH = frozenset({"espec-p300"})
+
+
+def _one_line_each(pairs: list[list[bytes]]) -> list[list[bytes]]:
+    """Where a reply of k lines follows k-1 requests that got none, each takes one line, in order."""
+    for index, (_, reply) in enumerate(pairs):
+        lines = re.findall(rb"[^\r\n]*\r?\n", reply)
+        if len(lines) < 2 or b"".join(lines) != reply:
+            continue
+        start = index
+        while start > index - len(lines) + 1 and start > 0 and not pairs[start - 1][1]:
+            start -= 1
+        if index - start + 1 == len(lines):
+            for offset, line in enumerate(lines):
+                pairs[start + offset][1] = line
+    return pairs
+
+
+def exchanges(chunks: list[Chunk], error: re.Pattern[str] | None, modbus: bool,
+              one_reply_each: bool = False) -> list[Exchange]:
     """The recorded bytes as request/reply pairs: each request a client sent (a line, with its terminator; a
     Modbus frame: each run of bytes), and what came back before it sent again on that connection."""
     pairs: list[list[bytes]] = []
@@ -253,7 +280,7 @@ def exchanges(chunks: list[Chunk], error: re.Pattern[str] | None, modbus: bool) 
         for request, reply in pairs:
             lines = re.findall(rb"[^\r\n]*(?:\r\n|\r|\n)|[^\r\n]+$", request) or [request]
             split += [[line, b""] for line in lines[:-1]] + [[lines[-1], reply]]
-        pairs = split
+        pairs = _one_line_each(split) if one_reply_each else split
     found = []
     for request, reply in pairs:
         simulator, detail = "answered", ""
@@ -310,7 +337,10 @@ def simulator(kind: str, profile: str, options: dict[str, object]) -> Iterator[t
     lab = VirtualLab(load_rig(SIM_RIG).model, VirtualClock(), 0)
     server: SimulatedLineChamberServer | SimulatedChamberServer | SimulatedTurntableServer
     if kind == "line":
-        server = SimulatedLineChamberServer(lab, line_protocol(profile), "tcp", **options)  # type: ignore[arg-type]
+        fields = ChamberLineProtocol.model_fields  # a profile's own fields (an RS-485 address) configure the profile
+        overrides = {key: value for key, value in options.items() if key in fields}
+        rest = {key: value for key, value in options.items() if key not in fields}
+        server = SimulatedLineChamberServer(lab, line_protocol(profile, overrides), "tcp", **rest)  # type: ignore[arg-type]
     elif kind == "modbus":
         server = SimulatedChamberServer(lab, register_map(profile), panel=panel_for(profile, register_map(profile)))
     else:
@@ -348,6 +378,10 @@ class ClientSpec:
     sim_options: dict[str, object] = field(default_factory=dict)
     table: dict[str, object] = field(default_factory=dict)  # values by parameter name, only where not derivable
     deadline_s: float = 4.0  # a call still running then is ended (its process, and a new one goes on)
+    #: how long the wire must be quiet after a call before its record closes: longer for a client that sends
+    #: settings without reading their replies (the reply then comes after the call has returned)
+    quiet_s: float = QUIET_S
+    not_installed: str = ""  # why it may not be installed here (the sweep skips it then, saying so)
 
 
 #: Parameters of ChamberConnectLibrary's members that neither their signatures nor their docstrings type.
@@ -377,6 +411,21 @@ _BASIL_TABLE: dict[str, object] = {
     "cmd": {"$not_callable": "the transport primitive (query): sends what it is given"},
     "value": True,  # set_compressed_air(value) and the like: int(value) is the output's state, 0 or 1
     "target": 25.0,  # set_temperature(target): a temperature in °C (str(target) is sent)
+}
+
+_SYNDESI_TABLE: dict[str, object] = {
+    "program": 1,  # a program number (its docstring: int; PRGM DATA?,RAM:<program>)
+    "step": 1,
+    "temperature": 25.0,  # set_temperature: 'float or str' ('OFF' the str it documents)
+    "humidity": 50,  # set_humidity: 'int or str'
+}
+_PYLABHAL_TABLE: dict[str, object] = {
+    "mode": True,  # enable_ramp(mode) / enable_power(mode: bool): on or off
+    "temper": 25.0,  # set_set_point: 'temperature of set point in C' (float)
+    "ramp_rate": 1.5,  # set_ramp_rate: 'Ramp rate in C per minute' (float)
+    "num_profile": 1, "num_porfile": 1,  # run_profile / delete_profile: a profile number
+    "run": True,
+    "name": "P1", "number": 1, "step": 1,  # create_profile (sends nothing in either class)
 }
 
 CLIENTS: tuple[ClientSpec, ...] = (
@@ -431,6 +480,27 @@ CLIENTS: tuple[ClientSpec, ...] = (
                "line", "simserv", "basil's Socket transfer layer through the proxy, SIMSERV's CR / CR LF (a basil "
                "user's configuration)", sim_options={"identity": "LabEvent T/210/70/5"}, table=_BASIL_TABLE,
                deadline_s=2.0),
+    ClientSpec("syndesi-drivers SH242", "syndesi-drivers", "syndesi_drivers", "syndesi",
+               {"module": "syndesi_drivers.ovens.espec_sh242", "class": "SH242",
+                "adapter": {"address": "$host", "port": "$port", "timeout": 1.0}},
+               "line", "espec-p300", "syndesi's IP adapter (TCP) through the proxy, built as a syndesi user does with "
+               "the proxy's address and port (the driver sets its 57732 only where no port is given); its own "
+               "Delimited CR LF; a 1 s timeout", table=_SYNDESI_TABLE, deadline_s=3.0),
+    *(ClientSpec(f"py-lab-hal {cls}", "py-lab-hal", "py_lab_hal", "pylabhal",
+                 {"module": f"py_lab_hal.instrument.temp_chamber.{module}", "class": cls, "model": model,
+                  "terminator": terminator, "timeout": {"recv": 1}},
+                 "line", profile, "py-lab-hal's own socket interface (cominterface/socket.py) through the proxy, "
+                 f"built by its PyLabHALBuilder with the proxy's address and port; {how}; a 1 s receive timeout; "
+                 "InstrumentConfig's defaults (reset, clear, idn: *RST, *CLS, *IDN? at construction)",
+                 table=_PYLABHAL_TABLE, deadline_s=deadline, quiet_s=0.3,
+                 not_installed="not in the test extra: py-lab-hal 2.5.20241201 pins PyVISA~=1.14.1, grpcio~=1.62.0 "
+                 "and requests~=2.32.3 and pulls monsoon and libusb; install it by hand (pip install --no-deps "
+                 "py-lab-hal==2.5.20241201 dataclasses-json) to sweep it")
+      for module, cls, model, profile, terminator, how, deadline in (
+          ("pu3j", "Pu3j", "TempChamber.PU3J", "espec-p300", {"write": "\r\n", "read": "\r\n"}, "CR LF each way (the "
+           "P300's)", 3.0),
+          ("testequity_107", "Testequity107", "TempChamber.TESTEQUITY_107", "watlow-f4t-scpi", {"write": "\n", "read": "\n"},
+           "LF each way (the F4T's)", 3.5))),
 )
 
 
@@ -509,7 +579,8 @@ def sweep_client(spec: ClientSpec) -> ClientSweep:
     started = time.monotonic()
     record = ClientSweep(spec.name, spec.profile, _version(spec.distribution), spec.transport)
     if importlib.util.find_spec(spec.own_prefix.split(".")[0]) is None:
-        record.problem = f"{spec.distribution} is not installed"
+        record.problem = f"{spec.distribution} is not installed" + (f": {spec.not_installed}" if spec.not_installed
+                                                                      else "")
         return record
     interpreter = sys.executable
     env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1", "PYTHONUNBUFFERED": "1"}
@@ -542,6 +613,7 @@ def _drive(spec: ClientSpec, record: ClientSweep, proxy: RecordingProxy, command
     """Construct, plan, call by call; a call past its deadline ends the process and a new one goes on from the
     next call (constructing again: recorded as another construction)."""
     modbus = spec.kind == "modbus"
+    each = spec.profile in ONE_REPLY_EACH
     planned: list[CallRecord] = []
     constructions: list[CallRecord] = []
     index, total = 0, None
@@ -551,10 +623,10 @@ def _drive(spec: ClientSpec, record: ClientSweep, proxy: RecordingProxy, command
             child = _Child(command, env, spec_line)
             try:
                 constructed = child.next(spec.deadline_s + 10)
-                proxy.settle()
+                proxy.settle(spec.quiet_s)
                 init = CallRecord("__init__", "construction" + (" (again, after a call's deadline)" if constructions
                                                                 else ""), exchanges=exchanges(proxy.since(mark), error,
-                                                                                              modbus))
+                                                                                              modbus, each))
                 constructions.append(init)
                 if constructed is None or not constructed.get("ok"):
                     init.outcome = "raised"
@@ -580,9 +652,9 @@ def _drive(spec: ClientSpec, record: ClientSweep, proxy: RecordingProxy, command
                     mark = proxy.mark()
                     child.send(f"call {index}")
                     result = child.next(spec.deadline_s)
-                    proxy.settle()
+                    proxy.settle(spec.quiet_s)
                     call = planned[index]
-                    call.exchanges = exchanges(proxy.since(mark), error, modbus)
+                    call.exchanges = exchanges(proxy.since(mark), error, modbus, each)
                     index += 1
                     if result is None:
                         call.outcome = "deadline"
@@ -644,7 +716,8 @@ def _replay(client: DataClient, requests: tuple[Expect, ...], call: CallRecord, 
     call.exchanges = exchanges(proxy.since(mark), error, False)
     if len(call.exchanges) == len(requests):
         for index, (exchange, expect) in enumerate(zip(call.exchanges, requests)):
-            if exchange.simulator == "refused" and not problems[index]:  # an error reply is no documented answer
+            if exchange.simulator == "refused" and not problems[index] and not expect.refusal:  # an error reply is
+                # no documented answer, unless the maker documents that refusal for this request in this state
                 problems[index] = f"refused: {exchange.detail}; documented: {expect.source}"
             exchange.documented = expect.source if expect.answer is None else f"{expect.answer!r}: {expect.source}"
             exchange.problem = problems[index]
@@ -727,6 +800,11 @@ CLIENT_LIMITS: tuple[ClientLimit, ...] = (
                 r"MonitorError|SettingError",
                 "its reply patterns have no minus sign (src/espec_pr3j/espec_pr3j.py: r'(?P<current>\\d+\\.\\d+)'): a "
                 "chamber below 0 °C, or with a lower limit below 0 °C, cannot be read (test_public_clients.py)"),
+    ClientLimit("py-lab-hal Pu3j", r"^read_actual_temp$|^read_set_point$", r"ValueError|IndexError",
+                "py_lab_hal/instrument/temp_chamber/pu3j.py reads TEMP? split on ', ' (comma and blank), where the "
+                "P300's reply as ChamberConnectLibrary's read_temp parses it (split on ',') has no blank; and it "
+                "writes commands with send() without reading the OK:/NA: every command is answered with, so a "
+                "later query may read an earlier reply (every request it sent was answered, see the wire)"),
 )
 
 
@@ -739,7 +817,11 @@ def _reply_text(exchange: Exchange) -> str:
 
 
 def _shape(text: str) -> str:
-    """A request's shape for the NOT_SIMULATED lists: numbers as `#`, blanks after commas dropped, any case."""
+    """A request's shape for the NOT_SIMULATED lists: numbers as `#`, blanks after commas dropped, any case; a
+    SIMSERV request keeps its command number (the first field: the command itself)."""
+    head, separator, rest = text.strip().partition("\u00b6")
+    if separator and head.isdigit():
+        return head + separator + _shape(rest)
     return re.sub(r"[-+]?\d+(\.\d+)?", "#", re.sub(r",\s+", ",", text.strip())).lower()
 
 
@@ -748,6 +830,9 @@ def _shape(text: str) -> str:
 LISTED: dict[str, dict[str, str]] = {}
 for _profile, _request, _client, _where, _why in CHAMBER_NOT_SIMULATED:
     LISTED.setdefault(_profile, {})[_shape(_request)] = f"{_why} (maker_requests.NOT_SIMULATED: {_client} {_where})"
+for _profile, _prefix, _request, _client, _where, _answer, _why in UNDOCUMENTED_SPELLINGS:
+    LISTED.setdefault(_profile, {})[_shape(_prefix + _request)] = f"{_why} (maker_requests.UNDOCUMENTED_SPELLINGS: " \
+                                                                  f"{_client} {_where})"
 for _request, _client, _where, _why in TURNTABLE_NOT_SIMULATED:
     LISTED.setdefault("acutrol3000", {})[_shape(_request)] = f"{_why} (turntable_requests.NOT_SIMULATED: {_client} " \
                                                              f"{_where})"
@@ -762,11 +847,19 @@ def listed(profile: str, exchange: Exchange) -> str | None:
     return LISTED.get(profile, {}).get(_shape(exchange.text))
 
 
+_SCPI_SETTING = Documented("watlow-f4t-scpi", r"[^?]*", "", "F4T list (PaulNongL/WatlowF4TscpiLibrary "
+                           "f4t_scpi_cmds/f4t_scpi_commands.ods): a W row, a setting, is unanswered (only queries "
+                           "answer); this one the simulated F4T carries out")
+
+
 def documented(profile: str, exchange: Exchange) -> Documented | None:
     for entry in DOCUMENTED:
         if entry.profile == profile and re.fullmatch(entry.request, _request_text(exchange)) \
                 and re.fullmatch(entry.reply, _reply_text(exchange)):
             return entry
+    if profile == _SCPI_SETTING.profile and exchange.simulator == "silence" and "?" not in exchange.text \
+            and not _unmodelled_setting(profile, Expect(exchange.text, None, "")):
+        return _SCPI_SETTING  # a setting the simulator knows, unanswered as every SCPI setting is
     return None
 
 

@@ -122,7 +122,35 @@ def factory_chamberconnect(spec):
     return obj, cls, hook
 
 
-FACTORIES = {"plain": factory_plain, "basil": factory_basil, "chamberconnect": factory_chamberconnect}
+def factory_syndesi(spec):
+    """syndesi's drivers: the driver class given the adapter a syndesi user builds (syndesi.adapters.IP), with
+    the endpoint's address and port (SH242 sets its default port, 57732, only where none is given)."""
+    from syndesi.adapters import IP
+
+    adapter = IP(**substitute(spec["adapter"], spec))
+    cls = getattr(importlib.import_module(spec["module"]), spec["class"])
+    return cls(adapter), cls, None
+
+
+def factory_pylabhal(spec):
+    """py-lab-hal: its builder, as its own builder.py's example uses it: a ConnectConfig naming the socket
+    interface, the endpoint and the terminators, the InstrumentConfig's defaults, then build_instrument."""
+    from py_lab_hal import builder
+    from py_lab_hal.cominterface import cominterface
+
+    builder_ = builder.PyLabHALBuilder()
+    builder_.connection_config = cominterface.ConnectConfig(
+        interface_type="socket",
+        network=cominterface.NetworkConfig(host=spec["host"], port=int(spec["port"])),
+        terminator=cominterface.TerminatorConfig(**spec.get("terminator", {})),
+        timeout=cominterface.TimeoutConfig(**spec.get("timeout", {})))
+    enum_name, member = spec["model"].split(".")  # e.g. TempChamber.PU3J: the builder's own enum of models
+    obj = builder_.build_instrument(getattr(getattr(builder, enum_name), member))
+    return obj, type(obj), None
+
+
+FACTORIES = {"plain": factory_plain, "basil": factory_basil, "chamberconnect": factory_chamberconnect,
+             "syndesi": factory_syndesi, "pylabhal": factory_pylabhal}
 
 
 # ---------------------------------------------------------------------- enumeration

@@ -395,6 +395,19 @@ NOT_SIMULATED: tuple[tuple[str, str, str, str, str], ...] = (
      "no gradients (answered -8)"),
     ("simserv", f"14010{S}1{S}5", "SiLab-Bonn/basil", "weiss_labevent.py _get_feature_status",
      "outputs have no names (answered -8)"),
+    ("simserv", f"11072{S}1{S}1{S}3", "IzaakWN/ClimateChamberMonitor", "chamber_commands.py forceWarmUp",
+     "no gradients (answered -8)"),
+    *(("simserv", f"99997{S}1{S}{item}", "SengerM/VotschTechnik-climate-chamber-Python",
+       f"VotschTechnikClimateChamber/ClimateChamber.py {where}", f"the simulated chamber has no {what} (GET "
+       f"CHAMBER INFO item {item} as the client reads it; answered -8, data could not be read)")
+      for item, where, what in (("2", "year_manufactured", "year of manufacture"),
+                                ("3", "serial_number", "serial number"))),
+    *(("simserv", f"{number}{S}1", "IzaakWN/ClimateChamberMonitor", f"chamber_commands.py {where}",
+       f"{why} (answered -8, data could not be read)") for number, where, why in (
+        ("17002", "checkActiveWarnings / getActiveWarnings", "no message list: the simulated chamber keeps no "
+         "messages (its alarms and warnings are the status bits of 10012)"),
+        ("19204", "getRunStatus", "no program engine: the simulated chamber runs no program"),
+        ("19210", "forceWarmUp / stopClimateChamber", "no program engine: the simulated chamber runs no program"))),
     *(("watlow-f4t-scpi", request, _F4T_LIB, f"f4tscpi/f4t_interface.py {where}", _NO_CASCADE) for request, where in (
         (":SOURCE:CASCADE1:SPOINT?", "get_cascadeSP"), (":SOURCE:CASCADE1:OUTER:PVALUE?", "get_cascadeLoopPV"),
         (":SOURCE:CASCADE1:INNER:PVALUE?", "get_cascadeLoopPV"), (":SOURCE:CASCADE1:OUTER:SPOINT?", "get_cascadeLoopSP"),
@@ -409,8 +422,44 @@ NOT_SIMULATED: tuple[tuple[str, str, str, str, str], ...] = (
         (":SOURCE:CLOOP1:RACTION SETPOINT", _F4T_LIB, "f4tscpi/f4t_interface.py ramp_mode (its docstring: OFF, "
          "STARTUP, SETPOINT, BOTH)"),
         (":SOURCE:CLOOP1:RACTION BOTH", "PyPI py-lab-hal 2.5.20241201", "testequity_107.py enable_ramp(True)"))),
+    *(("watlow-f4t-scpi", request, "PyPI py-lab-hal 2.5.20241201", f"py_lab_hal/instrument/instrument.py {where}",
+       "an IEEE 488.2 common command that py-lab-hal's Instrument base class sends to every instrument: the "
+       "simulated F4T answers *IDN? only and leaves the others unanswered, as every header it does not know (the "
+       "F4T list's rows for them were not checked here)") for request, where in (
+        ("*RST", "reset (and open_instrument at construction)"), ("*CLS", "clear (and open_instrument)"),
+        ("*ESR?", "event_status_register"), ("*TST?", "self_test"), ("*OPC?", "wait_task"))),
+    ("watlow-f4t-scpi", ":UNITS:TEMPERATURE C", "DAsh0244/te107_control", "src/f4t_control.py set_units",
+     "not an F4T header (its own ref/scpi_commands.csv has :UNIT:TEMPERATURE): unanswered, as every header the F4T "
+     "does not have, and nothing carried out"),
+    ("watlow-f4t-scpi", ":SOURCE:CLOOP1:RSCALE RampScale.MINUTES", "DAsh0244/te107_control",
+     "src/f4t_control.py set_ramp_scale", "the client's own slip: it formats the Enum member (str(), "
+     "'RampScale.MINUTES') where the list takes MINUTES or HOURS; the F4T documents no error reply: unanswered, "
+     "nothing carried out"),
     ("watlow-f4t-scpi", ":OUTPUT1:NAME?", _F4T_LIB, "f4tscpi/f4t_interface.py get_tsName",
      "not in the F4T's SCPI command list (the library's own): unanswered, as every header the F4T does not have"),
+)
+
+
+#: (profile, RS-485 address prefix, request, client, where, what the simulator answers, why): requests in a
+#: spelling the maker's documents do not give, so that what a real controller answers is not known; the
+#: simulated one answers as recorded here (test_maker_requests.py checks it), and the client sweep lists them
+#: as not simulated with this reason.
+UNDOCUMENTED_SPELLINGS: tuple[tuple[str, str, str, str, str, str, str], ...] = (
+    *(("espec-p300", "1,", request, "vincesum/ESPEC-Temperature-Control-UI", f"src/ESPEC.py {where}", "NA:CMD ERR",
+       "`PGM:1` (a colon) where the P300's documented form is `PGM1` (ChamberConnectLibrary p300.py "
+       "write_prgm_data_edit; RAM:1 for PRGM ERASE); the client's own comment says the colon form works on its "
+       "chamber. The simulated controller stores no program and does not take the colon: NA:CMD ERR")
+      for request, where in (
+        ("PRGM DATA WRITE,PGM:1,EDIT START", "SH241.ProgramWrite"),
+        ("PRGM DATA WRITE,PGM:1,STEP1,TEMP30.0,TRAMPON,TIME00:01,", "SH241.ProgramWrite"),
+        ("PRGM DATA WRITE,PGM:1,COUNT,(1.1.1)", "SH241.ProgramWrite"),
+        ("PRGM DATA WRITE,PGM:1,END,HOLD", "SH241.ProgramWrite"),
+        ("PRGM DATA WRITE,PGM:1,EDIT END", "SH241.ProgramWrite"),
+        ("PRGM ERASE,PGM:1", "SH241.ProgramErase (and ProgramWrite)"))),
+    ("espec-p300", "1,", "MODE,RUN 1", "vincesum/ESPEC-Temperature-Control-UI", "src/ESPEC.py SH241.SetModeProgram",
+     "NA:PARA ERR", "a blank between RUN and the program number, where the P300's form is MODE,RUN<n> "
+     "(ChamberConnectLibrary p300.py write_mode_run; the simulated controller refuses that DATA NOT READY, no "
+     "program stored); this spelling it answers PARA ERR ('parameter missing or unrecognizable')"),
 )
 
 
@@ -459,6 +508,11 @@ REFUSALS: tuple[Refusal, ...] = (
     Refusal("espec-p300", r"HUMI, ?.*[SHL] ?-\d.*", "NA:DATA OUT OF RANGE", "a humidity below 0 % RH",
             f"{_ESPEC_ERRORS}: 'DATA OUT OF RANGE': 'Data not with in valid range' (0-100 % RH)",
             ("HUMI, L-40.0", "HUMI, S25.0 H100.0 L-40.0", "HUMI, S-5"), inferred=True),
+    Refusal("espec-p300", r"\*[A-Z]{3}\??", "NA:CMD ERR", "any state: the P300 command set has no IEEE 488.2 "
+            "common commands (py-lab-hal's Instrument base class sends them to every instrument)",
+            f"{_ESPEC_ERRORS}: 'CMD ERR': 'Unrocognized command'; syndesi-drivers espec_sh242.py SH242Exception: "
+            "'Main command error, the command has probably been mistyped'",
+            ("*IDN?", "*RST", "*CLS", "*ESR?", "*TST?", "*OPC?"), inferred=True),
     Refusal("espec-p300", r"PRGM DATA WRITE, ?PGM\d+, ?EDIT (END|CANCEL)", "NA:PRGM WRITE ERR-3",
             "no program being edited", f"{_ESPEC_ERRORS}: 'PRGM WRITE ERR-3': 'Edit request not allowed not in "
             "edit mode'", ("PRGM DATA WRITE,PGM1,EDIT END", "PRGM DATA WRITE,PGM1,EDIT CANCEL"), inferred=True),

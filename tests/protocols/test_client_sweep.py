@@ -2,8 +2,9 @@
 (tests/protocols/client_sweep.py). The sweep must be whole: every public member enumerated, and each called or
 listed as not called with its reason. Every request of a client must be answered as its maker documents (or be
 listed NOT_SIMULATED with its reason); the clients whose simulators are not fixed yet (STILL_DEVIATING) are
-expected to fail, strictly. The survey is written under the test's temporary folder. About 20 s: the Thermotron
-client pauses 1 s after every write, the sweeps run side by side.
+expected to fail, strictly. The survey is written under the test's temporary folder. About 25 s, or 45 s with py-lab-hal installed by
+hand: the Thermotron client and py-lab-hal's Testequity107 pause 1 s after every write; the sweeps run side by
+side.
 """
 
 from __future__ import annotations

@@ -17,7 +17,16 @@ from accelcal_rig.protocols.chamber_lines import LINE_PROFILES, ChamberLineProto
 from accelcal_rig.sim.chamber_line_server import SimulatedLineChamberServer
 from accelcal_rig.sim.lab import VirtualLab
 from tests.conftest import SIM_RIG
-from tests.protocols.maker_requests import CONVERSATIONS, NOT_SIMULATED, REFUSALS, Conversation, Refusal, Row, S
+from tests.protocols.maker_requests import (
+    CONVERSATIONS,
+    NOT_SIMULATED,
+    REFUSALS,
+    UNDOCUMENTED_SPELLINGS,
+    Conversation,
+    Refusal,
+    Row,
+    S,
+)
 from tests.sim.line_client import LineClient, tcp_client
 
 
@@ -133,6 +142,17 @@ def test_what_the_simulator_does_not_model_is_answered_as_the_controller_answers
             assert wire.reply() == answer
         else:
             wire.assert_nothing_came()
+
+
+@pytest.mark.parametrize(("profile", "prefix", "request_text", "client", "where", "answer", "why"),
+                         UNDOCUMENTED_SPELLINGS)
+def test_a_spelling_the_maker_does_not_document_is_answered_as_recorded(
+        profile: str, prefix: str, request_text: str, client: str, where: str, answer: str, why: str) -> None:
+    protocol = line_protocol(profile, {"request_prefix": prefix})
+    with controller(protocol) as (_, _, client_line):
+        wire = Wire(protocol, client_line)
+        wire.send(prefix + request_text)  # the address in front, as the client writes it
+        assert wire.reply() == answer
 
 
 @pytest.mark.parametrize("refusal", REFUSALS, ids=[f"{r.profile}-{r.reply}-{r.state}" for r in REFUSALS])
