@@ -37,7 +37,12 @@ class SimulatedChamberServer:
                  host: str = "127.0.0.1", port: int = 0, faults: ReplyFaults | None = None,
                  stall_after_s: float | None = None, panel: tuple[PanelRegister, ...] = ()) -> None:
         self._lab = lab
-        self._panel = {register.address: register for register in panel}
+        owned = {registers.process_value, registers.setpoint, registers.identity_register, registers.decimals_register,
+                 registers.units_register, registers.power_register, registers.alarm_register,
+                 registers.setpoint_low_register, registers.setpoint_high_register, registers.purge_register}
+        #: The panel's registers the map does not use: a rig config that wires a map register (a purge output)
+        #: to an address of the panel's (an event) makes it the map's.
+        self._panel = {register.address: register for register in panel if register.address not in owned}
         self._panel_state = PanelState(clock_start=dt.datetime.now(dt.UTC).replace(microsecond=0, tzinfo=None))
         self._faults = faults
         self._stall_after_s = stall_after_s
