@@ -6,6 +6,7 @@ from __future__ import annotations
 from functools import cache
 from importlib.metadata import entry_points
 
+from accelcal_rig.core.logger import LOGGER
 from accelcal_rig.errors import ConfigError
 from accelcal_rig.parts.adxl35x import ADXL355, ADXL357, ADXL359
 from accelcal_rig.parts.icm42688 import ICM42688P
@@ -19,9 +20,12 @@ _BUILT_IN = {part.name: part for part in (ADXL355, ADXL357, ADXL359, ICM42688P, 
 
 @cache
 def known_parts() -> dict[str, Part]:
-    """Every part by name; a built-in name cannot be taken over by a plug-in."""
+    """Every part by name; a built-in name cannot be taken over by a plug-in (a warning names one that tries)."""
     parts = {}
     for entry in entry_points(group=ENTRY_POINT_GROUP):
+        if entry.name in _BUILT_IN:  # said, not silently passed over: the lab meant the plug-in's
+            LOGGER.warning("part plug-in %r (%s) is not used: a built-in part has that name", entry.name, entry.value)
+            continue
         try:
             part = entry.load()
         except Exception as exc:  # noqa: BLE001 - a broken plug-in is one line naming it, not a traceback

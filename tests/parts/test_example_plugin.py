@@ -82,3 +82,18 @@ def test_the_example_files_name_their_schema_and_validate(kind: str, name: str) 
     assert list(validator(kind).iter_errors(as_an_editor_reads(yaml.safe_load(text)))) == []
     if kind == "rig-config":
         assert {s["part"] for s in yaml.safe_load(text)["fixture"]["sensors"]} == set(ENTRY_POINTS)
+
+
+def test_a_plug_in_named_like_a_built_in_part_is_said_and_not_used(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                                  caplog: pytest.LogCaptureFixture) -> None:
+    dist_info = tmp_path / "shadowing-0.1.dist-info"
+    dist_info.mkdir()
+    (dist_info / "METADATA").write_text("Metadata-Version: 2.1\nName: shadowing\nVersion: 0.1\n")
+    (dist_info / "entry_points.txt").write_text(f"[{registry.ENTRY_POINT_GROUP}]\nadxl355 = nowhere:PART\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    registry.known_parts.cache_clear()
+    try:
+        assert registry.part("adxl355").label == "ADXL355"          # the built-in, and no attempt to load nowhere
+        assert "part plug-in 'adxl355' (nowhere:PART) is not used: a built-in part has that name" in caplog.text
+    finally:
+        registry.known_parts.cache_clear()
