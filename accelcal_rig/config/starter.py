@@ -40,22 +40,21 @@ def write_starter(folder: Path) -> list[Path]:
     if not parent.is_dir():
         raise ConfigError(f"{parent} does not exist")
     written = starter_files()
-    staging = Path(tempfile.mkdtemp(prefix=f".{folder.name}.init-", dir=parent))
     try:
+        holder = Path(tempfile.mkdtemp(prefix=f".{folder.name}.init-", dir=parent))
+    except OSError as exc:  # a folder we may not write in: one line, not a traceback
+        raise ConfigError(f"cannot write {folder}: {exc.strerror or exc}") from None
+    staging = holder / folder.name  # made with mkdir, so the umask gives it a normal folder's mode
+    try:
+        staging.mkdir()
         with as_file(files("accelcal_rig") / "starter") as source:
             for relative in written:
                 (staging / relative).parent.mkdir(exist_ok=True)
                 shutil.copyfile(source / relative, staging / relative)
-        staging.chmod(0o777 & ~_umask())
         os.rename(staging, folder)  # onto a missing or empty folder: atomic on POSIX
     except OSError as exc:
-        shutil.rmtree(staging, ignore_errors=True)
         raise ConfigError(f"cannot write {folder}: {exc.strerror or exc}") from None
+    finally:
+        shutil.rmtree(holder, ignore_errors=True)
     return [folder / relative for relative in written]
 
-
-def _umask() -> int:
-    """The process's umask (a folder from mkdtemp is private; the one written is a normal folder)."""
-    current = os.umask(0)
-    os.umask(current)
-    return current

@@ -50,3 +50,13 @@ def test_an_empty_folder_is_written_and_nothing_of_a_users_is_replaced(tmp_path,
     with pytest.raises(ConfigError, match="does not exist"):
         write_starter(tmp_path / "no" / "such" / "lab")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["empty", "mine"]   # no half-written staging left
+
+
+def test_a_folder_that_cannot_be_written_is_one_line(tmp_path, monkeypatch, capsys) -> None:
+    def refused(**_: object) -> str:
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr("accelcal_rig.config.starter.tempfile.mkdtemp", refused)
+    assert main(["init", str(tmp_path / "lab")]) == 2
+    assert capsys.readouterr().err.strip() == f"rig: error: cannot write {tmp_path / 'lab'}: Permission denied"
+    assert not (tmp_path / "lab").exists()
